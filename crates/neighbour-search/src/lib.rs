@@ -1,0 +1,1 @@
+//! Neighbour search (work in progress).

@@ -1,0 +1,32 @@
+//! Shared foundation of the particle-simulation workspace.
+//!
+//! Everything numeric in the workspace is generic over [`Real`] (implemented for `f32` and
+//! `f64`; the precision is chosen by the caller's type, at run time if the caller dispatches,
+//! never by a cargo feature). This crate owns:
+//!
+//! - [`Real`] and the vector aliases [`Vec3`], [`Vec2`] (nalgebra),
+//! - [`ParticleSet`], a structure-of-arrays particle container with an allocation-free
+//!   [`ParticleSet::permute`] used to keep particles sorted by cell,
+//! - [`Aabb`], an axis-aligned box,
+//! - the signed-distance-field trait [`Sdf`] with analytic [`Plane`], [`BoxSdf`], [`Sphere`]
+//!   and the complement [`Inverted`] (a tank is `Inverted<BoxSdf>`),
+//! - [`CoreError`], the crate's error enum.
+
+mod aabb;
+mod error;
+mod particles;
+mod real;
+mod sdf;
+
+pub use aabb::Aabb;
+pub use error::CoreError;
+pub use particles::{
+    apply_permutation, validate_finite_positions, ParticleSet, PermutationScratch,
+};
+pub use real::Real;
+pub use sdf::{BoxSdf, Inverted, Plane, Sdf, Sphere};
+
+/// A 3D column vector of [`Real`] (nalgebra).
+pub type Vec3<R> = nalgebra::Vector3<R>;
+/// A 2D column vector of [`Real`] (nalgebra).
+pub type Vec2<R> = nalgebra::Vector2<R>;

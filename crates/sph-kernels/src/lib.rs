@@ -1,0 +1,1 @@
+//! SPH smoothing kernels (work in progress).
