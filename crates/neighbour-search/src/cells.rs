@@ -1,0 +1,270 @@
+//! Cell coordinates, validation and packed cell keys shared by the grid methods.
+
+use rayon::prelude::*;
+use sph_core::{Real, Vec3};
+
+use crate::SearchError;
+
+/// Relative margin by which the cell edge exceeds the search radius.
+///
+/// Cells are `h · (1 + CELL_MARGIN)` wide instead of exactly `h`. The neighbour test is done
+/// in the caller's precision `R` (`|x_i − x_j|² < h²`), while cell coordinates are computed
+/// in `f64` as `floor(x / cell)`. Rounding in either could otherwise place two particles that
+/// pass the test two cells apart (e.g. at coordinates of 10⁷ cells, where the ulp of `x/cell`
+/// is ~2·10⁻⁹ cells). The test accepts pairs closer than `h(1 + 1.5 ε_R)` at most, and the
+/// `f64` division errs by at most `|x/cell| · 1.1·10⁻¹⁶ ≤ 2.4·10⁻⁷` cells inside the `i32`
+/// range, so `10⁻⁶` covers both for `f32` (ε = 1.2·10⁻⁷) and `f64`. This is the one
+/// deviation from Im & Chan's "cell size equal to h"; it adds 3·10⁻⁶ to the candidate volume.
+pub const CELL_MARGIN: f64 = 1e-6;
+
+/// Largest |cell coordinate| accepted, leaving room for the ±1 neighbour offsets.
+const CELL_LIMIT: f64 = (i32::MAX - 2) as f64;
+
+/// Squared distance `dx² + dy² + dz²`, evaluated in this exact order by every method and by
+/// the oracle, so that ties at the radius are decided identically.
+#[inline(always)]
+pub fn squared_distance<R: Real>(a: &Vec3<R>, b: &Vec3<R>) -> R {
+    let dx = a.x - b.x;
+    let dy = a.y - b.y;
+    let dz = a.z - b.z;
+    dx * dx + dy * dy + dz * dz
+}
+
+/// The neighbour criterion of this crate: `j` is a neighbour of `i` when `j ≠ i` and
+/// `|x_i − x_j|² < h²` (computed by [`squared_distance`] in `R`). The test is **exclusive**:
+/// a particle at distance exactly `h` is not a neighbour (every SPH kernel of `sph-kernels`
+/// is zero there). Coincident particles (distance 0) are neighbours of each other.
+#[inline(always)]
+pub fn is_neighbour<R: Real>(a: &Vec3<R>, b: &Vec3<R>, radius_squared: R) -> bool {
+    squared_distance(a, b) < radius_squared
+}
+
+/// Checks the radius; returns the cell edge length in `f64`.
+pub(crate) fn cell_size<R: Real>(radius: R) -> Result<f64, SearchError> {
+    let h = radius.as_f64();
+    if !(h.is_finite() && h > 0.0) {
+        return Err(SearchError::InvalidRadius { value: h });
+    }
+    // radius² must also be representable (no overflow to inf, no underflow to 0) in R.
+    let r2 = radius * radius;
+    if !(r2.is_finite_value() && r2 > R::zero()) {
+        return Err(SearchError::InvalidRadius { value: h });
+    }
+    Ok(h * (1.0 + CELL_MARGIN))
+}
+
+#[inline(always)]
+fn cell_of_axis(x: f64, cell: f64) -> Option<i32> {
+    // Division, not multiplication by an inverse, keeps the error bound of CELL_MARGIN.
+    let c = (x / cell).floor();
+    if c.abs() <= CELL_LIMIT {
+        Some(c as i32)
+    } else {
+        None
+    }
+}
+
+/// Validates the positions and writes each particle's integer cell `floor(x / cell)`
+/// (Im & Chan 2016, eq. 5), in parallel. Errors name the first offending particle.
+pub(crate) fn compute_cells<R: Real>(
+    positions: &[Vec3<R>],
+    cell: f64,
+    out: &mut Vec<[i32; 3]>,
+) -> Result<(), SearchError> {
+    if positions.len() > u32::MAX as usize / 27 {
+        return Err(SearchError::TooManyParticles {
+            count: positions.len(),
+            limit: u32::MAX as usize / 27,
+        });
+    }
+    out.clear();
+    out.resize(positions.len(), [0; 3]);
+    let ok = out
+        .par_iter_mut()
+        .zip(positions.par_iter())
+        .with_min_len(4096)
+        .map(|(c, p)| {
+            let mut good = true;
+            for a in 0..3 {
+                match cell_of_axis(p[a].as_f64(), cell) {
+                    Some(v) => c[a] = v,
+                    None => good = false,
+                }
+            }
+            good
+        })
+        .reduce(|| true, |a, b| a && b);
+    if ok {
+        return Ok(());
+    }
+    // Slow path, only on error: find the first offending particle deterministically.
+    for (index, p) in positions.iter().enumerate() {
+        for (a, axis) in ['x', 'y', 'z'].into_iter().enumerate() {
+            let x = p[a].as_f64();
+            if !x.is_finite() {
+                return Err(SearchError::NonFinitePosition {
+                    index,
+                    axis,
+                    value: x,
+                });
+            }
+            if cell_of_axis(x, cell).is_none() {
+                return Err(SearchError::CellCoordinateOverflow {
+                    index,
+                    axis,
+                    position: x,
+                    radius: cell / (1.0 + CELL_MARGIN),
+                    cell: (x / cell).floor(),
+                });
+            }
+        }
+    }
+    unreachable!("a cell failed but no particle was found at fault")
+}
+
+/// Componentwise min and max of the cells (`None` when empty).
+pub(crate) fn cell_bounds(cells: &[[i32; 3]]) -> Option<([i32; 3], [i32; 3])> {
+    if cells.is_empty() {
+        return None;
+    }
+    let id = ([i32::MAX; 3], [i32::MIN; 3]);
+    Some(
+        cells
+            .par_iter()
+            .with_min_len(8192)
+            .fold(
+                || id,
+                |(mut lo, mut hi), c| {
+                    for a in 0..3 {
+                        lo[a] = lo[a].min(c[a]);
+                        hi[a] = hi[a].max(c[a]);
+                    }
+                    (lo, hi)
+                },
+            )
+            .reduce(
+                || id,
+                |(mut lo, mut hi), (l, h)| {
+                    for a in 0..3 {
+                        lo[a] = lo[a].min(l[a]);
+                        hi[a] = hi[a].max(h[a]);
+                    }
+                    (lo, hi)
+                },
+            ),
+    )
+}
+
+/// An integer sort key: `u64` when the packed cell fits 64 bits, `u128` otherwise.
+pub(crate) trait Key:
+    Copy + Send + Sync + Eq + Ord + Default + std::hash::Hash + std::fmt::Debug + 'static
+{
+    /// The 8-bit digit at bit `shift`.
+    fn digit(self, shift: u32) -> usize;
+    /// `(x << sx) | (y << sy) | z`.
+    fn compose(x: u64, y: u64, z: u64, sx: u32, sy: u32) -> Self;
+}
+
+impl Key for u64 {
+    #[inline(always)]
+    fn digit(self, shift: u32) -> usize {
+        ((self >> shift) & 0xff) as usize
+    }
+    #[inline(always)]
+    fn compose(x: u64, y: u64, z: u64, sx: u32, sy: u32) -> Self {
+        // sx == 64 only when x's field is empty (x == 0).
+        x.checked_shl(sx).unwrap_or(0) | y.checked_shl(sy).unwrap_or(0) | z
+    }
+}
+
+impl Key for u128 {
+    #[inline(always)]
+    fn digit(self, shift: u32) -> usize {
+        ((self >> shift) & 0xff) as usize
+    }
+    #[inline(always)]
+    fn compose(x: u64, y: u64, z: u64, sx: u32, sy: u32) -> Self {
+        ((x as u128) << sx) | ((y as u128) << sy) | z as u128
+    }
+}
+
+/// Order-preserving packing of cell coordinates into one integer key: lexicographic order
+/// of `(X, Y, Z)` equals numeric order of the key (Im & Chan's Fig. 2 comparison). The width
+/// of each field is set by the occupied range of that axis (plus `pad` cells each side), not
+/// by a grid allocated in memory: nothing here scales with the extent of the scene.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct KeyPacker {
+    origin: [i64; 3],
+    shift_x: u32,
+    shift_y: u32,
+    /// Total number of key bits used (at most 3 × 33).
+    pub bits: u32,
+}
+
+impl KeyPacker {
+    pub fn new(lo: [i32; 3], hi: [i32; 3], pad: i32) -> Self {
+        let mut width = [0u32; 3];
+        let mut origin = [0i64; 3];
+        for a in 0..3 {
+            origin[a] = lo[a] as i64 - pad as i64;
+            let span = (hi[a] as i64 + pad as i64) - origin[a] + 1; // >= 1
+            width[a] = 64 - ((span - 1) as u64).leading_zeros();
+        }
+        Self {
+            origin,
+            shift_x: width[1] + width[2],
+            shift_y: width[2],
+            bits: width[0] + width[1] + width[2],
+        }
+    }
+
+    /// `true` when keys fit a `u64`.
+    pub fn fits_u64(&self) -> bool {
+        self.bits <= 64
+    }
+
+    #[inline(always)]
+    pub fn pack<K: Key>(&self, c: [i32; 3]) -> K {
+        let x = (c[0] as i64 - self.origin[0]) as u64;
+        let y = (c[1] as i64 - self.origin[1]) as u64;
+        let z = (c[2] as i64 - self.origin[2]) as u64;
+        K::compose(x, y, z, self.shift_x, self.shift_y)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn packing_preserves_lexicographic_order() {
+        let lo = [-5, 3, -1_000_000];
+        let hi = [7, 3, 1_000_000];
+        let p = KeyPacker::new(lo, hi, 1);
+        assert!(p.fits_u64());
+        let cells = [
+            [-6, 2, -1_000_001],
+            [-6, 2, 5],
+            [-6, 3, -1_000_001],
+            [0, 4, 1_000_001],
+            [8, 2, -1_000_001],
+            [8, 4, 1_000_001],
+        ];
+        for w in cells.windows(2) {
+            assert!(
+                p.pack::<u64>(w[0]) < p.pack::<u64>(w[1]),
+                "{:?} {:?}",
+                w[0],
+                w[1]
+            );
+            assert!(p.pack::<u128>(w[0]) < p.pack::<u128>(w[1]));
+        }
+        let wide = KeyPacker::new([i32::MIN + 2; 3], [i32::MAX - 2; 3], 1);
+        assert!(!wide.fits_u64());
+        assert!(wide.pack::<u128>([i32::MIN + 1, 0, 0]) < wide.pack::<u128>([i32::MIN + 1, 0, 1]));
+        assert!(
+            wide.pack::<u128>([0, i32::MAX - 1, i32::MAX - 1])
+                < wide.pack::<u128>([1, i32::MIN + 1, i32::MIN + 1])
+        );
+    }
+}

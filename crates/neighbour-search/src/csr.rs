@@ -1,0 +1,65 @@
+//! Assembly of per-task neighbour buffers into [`NeighbourLists`], without allocation once
+//! the buffers have grown.
+
+use rayon::prelude::*;
+
+use crate::NeighbourLists;
+
+/// What one parallel task found: for each of its particles, `(particle, count)`, and the
+/// concatenated neighbour indices. `candidates` is the task's own scratch.
+#[derive(Debug, Default, Clone)]
+pub(crate) struct TaskOutput {
+    pub particles: Vec<(u32, u32)>,
+    pub neighbours: Vec<u32>,
+    pub candidates: Vec<u32>,
+}
+
+impl TaskOutput {
+    pub fn clear(&mut self) {
+        self.particles.clear();
+        self.neighbours.clear();
+    }
+}
+
+#[derive(Clone, Copy)]
+struct SyncPtr<T>(*mut T);
+unsafe impl<T> Send for SyncPtr<T> {}
+unsafe impl<T> Sync for SyncPtr<T> {}
+
+/// Writes the tasks' results into `out` for `n` particles. Every particle must appear in
+/// exactly one task (debug-checked by the offsets being consistent).
+pub(crate) fn assemble(out: &mut NeighbourLists, n: usize, tasks: &[TaskOutput]) {
+    out.reset(n);
+    let offs = SyncPtr(out.offsets.as_mut_ptr());
+    tasks.par_iter().for_each(|t| {
+        let p = offs;
+        for &(i, c) in &t.particles {
+            debug_assert!((i as usize) < n);
+            // SAFETY: each particle index occurs in exactly one task, so each slot of
+            // `offsets[1..=n]` is written by one thread only.
+            unsafe { *p.0.add(i as usize + 1) = c as usize };
+        }
+    });
+    for i in 0..n {
+        out.offsets[i + 1] += out.offsets[i];
+    }
+    let total = out.offsets[n];
+    out.indices.resize(total, 0);
+    let idx = SyncPtr(out.indices.as_mut_ptr());
+    let offsets = &out.offsets;
+    tasks.par_iter().for_each(|t| {
+        let p = idx;
+        let mut src = 0usize;
+        for &(i, c) in &t.particles {
+            let dst = offsets[i as usize];
+            let c = c as usize;
+            debug_assert_eq!(offsets[i as usize + 1] - dst, c);
+            // SAFETY: `[dst, dst + c)` is particle i's own range of `indices`, disjoint from
+            // every other particle's, and within `total` by construction of the offsets.
+            unsafe {
+                std::ptr::copy_nonoverlapping(t.neighbours.as_ptr().add(src), p.0.add(dst), c)
+            };
+            src += c;
+        }
+    });
+}

@@ -1,0 +1,377 @@
+//! Sorted uniform grids: the cell start/end table of Green (2008) and a hashed variant.
+
+use rayon::prelude::*;
+use rustc_hash::FxHashMap;
+use sph_core::{Real, Vec3};
+
+use crate::cells::{cell_bounds, cell_size, compute_cells, is_neighbour, Key, KeyPacker};
+use crate::csr::{assemble, TaskOutput};
+use crate::radix::{sort_pairs, RadixScratch};
+use crate::runs::run_starts;
+use crate::{NeighbourLists, NeighbourSearch, SearchError};
+
+/// Cells (runs) handled by one parallel task.
+const CELLS_PER_TASK: usize = 64;
+const EMPTY: u32 = u32::MAX;
+/// Default limit on the cells of [`CellStartGrid`]: 2²⁶ cells, 512 MiB of start/end table.
+pub const DEFAULT_MAX_CELLS: usize = 1 << 26;
+
+/// Up to nine candidate ranges (one per (dx, dy) column of three z-cells, which are
+/// contiguous in the sorted order) in sorted-particle indices.
+type Ranges = ([(u32, u32); 9], usize);
+
+/// Particles sorted by cell key, with their runs; shared by both grids.
+#[derive(Debug, Clone)]
+struct SortedParticles<R: Real, K> {
+    cells: Vec<[i32; 3]>,
+    keys: Vec<K>,
+    /// `order[k]` = caller's index of the k-th particle in cell order.
+    order: Vec<u32>,
+    positions: Vec<Vec3<R>>,
+    runs: Vec<u32>,
+    block_counts: Vec<usize>,
+    radix: RadixScratch<K>,
+    tasks: Vec<TaskOutput>,
+}
+
+impl<R: Real, K: Key> Default for SortedParticles<R, K> {
+    fn default() -> Self {
+        Self {
+            cells: Vec::new(),
+            keys: Vec::new(),
+            order: Vec::new(),
+            positions: Vec::new(),
+            runs: Vec::new(),
+            block_counts: Vec::new(),
+            radix: RadixScratch::default(),
+            tasks: Vec::new(),
+        }
+    }
+}
+
+impl<R: Real, K: Key> SortedParticles<R, K> {
+    /// Sorts the particles by `key(cell)` (Green's "calcHash + sort"), copies the positions
+    /// into that order and finds the runs of equal cells ("find cell start").
+    fn sort(&mut self, positions: &[Vec3<R>], bits: u32, key: impl Fn([i32; 3]) -> K + Sync) {
+        let n = positions.len();
+        self.keys.clear();
+        self.keys.par_extend(self.cells.par_iter().map(|&c| key(c)));
+        self.order.clear();
+        self.order.par_extend((0..n as u32).into_par_iter());
+        sort_pairs(&mut self.keys, &mut self.order, bits, &mut self.radix);
+        self.positions.clear();
+        self.positions
+            .par_extend(self.order.par_iter().map(|&i| positions[i as usize]));
+        run_starts(&self.keys, &mut self.runs, &mut self.block_counts);
+    }
+}
+
+/// Tests each particle of each run against the candidate ranges given by `locate` (called
+/// with the sorted index of the run's first particle).
+#[allow(clippy::too_many_arguments)]
+fn query_runs<R: Real>(
+    runs: &[u32],
+    pos: &[Vec3<R>],
+    order: &[u32],
+    tasks: &mut Vec<TaskOutput>,
+    r2: R,
+    out: &mut NeighbourLists,
+    locate: impl Fn(usize) -> Ranges + Sync,
+) {
+    let n = pos.len();
+    let run_count = runs.len() - 1;
+    let task_count = run_count.div_ceil(CELLS_PER_TASK);
+    if tasks.len() < task_count {
+        tasks.resize_with(task_count, TaskOutput::default);
+    }
+    tasks[..task_count]
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(task, buf)| {
+            buf.clear();
+            let first = task * CELLS_PER_TASK;
+            for r in first..(first + CELLS_PER_TASK).min(run_count) {
+                let (ranges, count) = locate(runs[r] as usize);
+                for k in runs[r]..runs[r + 1] {
+                    let pk = pos[k as usize];
+                    let before = buf.neighbours.len();
+                    for &(a, b) in &ranges[..count] {
+                        for c in a..b {
+                            if c != k && is_neighbour(&pk, &pos[c as usize], r2) {
+                                buf.neighbours.push(order[c as usize]);
+                            }
+                        }
+                    }
+                    buf.particles
+                        .push((order[k as usize], (buf.neighbours.len() - before) as u32));
+                }
+            }
+        });
+    assemble(out, n, &tasks[..task_count]);
+}
+
+/// Merges the ranges of three z-consecutive cells (contiguous in sorted order) into one.
+#[inline]
+fn push_column(ranges: &mut Ranges, cells: impl Iterator<Item = Option<(u32, u32)>>) {
+    let (mut a, mut b) = (EMPTY, 0);
+    for (s, e) in cells.flatten() {
+        a = a.min(s);
+        b = b.max(e);
+    }
+    if a != EMPTY {
+        ranges.0[ranges.1] = (a, b);
+        ranges.1 += 1;
+    }
+}
+
+/// The classic sorted uniform grid with a cell start/end table, after
+///
+/// > Simon Green, "Particle Simulation using CUDA", NVIDIA whitepaper, 2008 (2010 revision),
+/// > sections "Uniform grid", "Building the grid using sorting".
+///
+/// Per search: the cells' bounding grid `[lo, hi]` is taken from the particles, each particle
+/// gets the linear index of its cell, particles are radix-sorted by it and copied into that
+/// order, and a start/end table over **every cell of the bounding grid** is cleared and
+/// filled. A particle then visits its 27 neighbour cells through the table (the three cells
+/// of each z-column are contiguous, so nine ranges). The table costs memory and clearing
+/// time proportional to the bounding grid's volume, which is what Im & Chan's method avoids;
+/// a grid of more than `max_cells` cells is refused with [`SearchError::DomainTooLarge`].
+#[derive(Debug, Clone)]
+pub struct CellStartGrid<R: Real> {
+    max_cells: usize,
+    sorted: SortedParticles<R, u64>,
+    cell_start: Vec<u32>,
+    cell_end: Vec<u32>,
+}
+
+impl<R: Real> Default for CellStartGrid<R> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<R: Real> CellStartGrid<R> {
+    /// A grid limited to [`DEFAULT_MAX_CELLS`] cells.
+    pub fn new() -> Self {
+        Self::with_max_cells(DEFAULT_MAX_CELLS)
+    }
+
+    /// A grid limited to `max_cells` cells in its start/end table.
+    pub fn with_max_cells(max_cells: usize) -> Self {
+        Self {
+            max_cells,
+            sorted: SortedParticles::default(),
+            cell_start: Vec::new(),
+            cell_end: Vec::new(),
+        }
+    }
+
+    /// Cells in the last start/end table.
+    pub fn table_cells(&self) -> usize {
+        self.cell_start.len()
+    }
+}
+
+impl<R: Real> NeighbourSearch<R> for CellStartGrid<R> {
+    fn name(&self) -> &'static str {
+        "cell-start-grid"
+    }
+
+    fn search(
+        &mut self,
+        positions: &[Vec3<R>],
+        radius: R,
+        out: &mut NeighbourLists,
+    ) -> Result<(), SearchError> {
+        let cell = cell_size(radius)?;
+        compute_cells(positions, cell, &mut self.sorted.cells)?;
+        let Some((lo, hi)) = cell_bounds(&self.sorted.cells) else {
+            out.reset(0);
+            return Ok(());
+        };
+        let dims: [u64; 3] = std::array::from_fn(|a| (hi[a] as i64 - lo[a] as i64 + 1) as u64);
+        let total = dims[0] as f64 * dims[1] as f64 * dims[2] as f64;
+        if total > self.max_cells as f64 {
+            return Err(SearchError::DomainTooLarge {
+                cells: total,
+                limit: self.max_cells,
+            });
+        }
+        let total = (dims[0] * dims[1] * dims[2]) as usize;
+        let linear = move |c: [i32; 3]| -> u64 {
+            let x = (c[0] as i64 - lo[0] as i64) as u64;
+            let y = (c[1] as i64 - lo[1] as i64) as u64;
+            let z = (c[2] as i64 - lo[2] as i64) as u64;
+            (x * dims[1] + y) * dims[2] + z
+        };
+        let bits = 64 - ((total - 1) as u64).leading_zeros();
+        self.sorted.sort(positions, bits, linear);
+        // Clear and fill the start/end table over the whole bounding grid.
+        self.cell_start.clear();
+        self.cell_start.resize(total, EMPTY);
+        self.cell_end.resize(total, 0);
+        let runs = &self.sorted.runs;
+        for r in 0..runs.len() - 1 {
+            let key = self.sorted.keys[runs[r] as usize] as usize;
+            self.cell_start[key] = runs[r];
+            self.cell_end[key] = runs[r + 1];
+        }
+        let (start, end) = (&self.cell_start[..], &self.cell_end[..]);
+        let (cells, order) = (&self.sorted.cells[..], &self.sorted.order[..]);
+        let locate = |k: usize| -> Ranges {
+            let c = cells[order[k] as usize];
+            let mut ranges: Ranges = ([(0, 0); 9], 0);
+            let rel: [i64; 3] = std::array::from_fn(|a| c[a] as i64 - lo[a] as i64);
+            let (z0, z1) = ((rel[2] - 1).max(0), (rel[2] + 1).min(dims[2] as i64 - 1));
+            for dx in -1..=1i64 {
+                let x = rel[0] + dx;
+                if x < 0 || x >= dims[0] as i64 {
+                    continue;
+                }
+                for dy in -1..=1i64 {
+                    let y = rel[1] + dy;
+                    if y < 0 || y >= dims[1] as i64 {
+                        continue;
+                    }
+                    let base = ((x as u64 * dims[1] + y as u64) * dims[2]) as usize;
+                    push_column(
+                        &mut ranges,
+                        (z0..=z1).map(|z| {
+                            let i = base + z as usize;
+                            (start[i] != EMPTY).then(|| (start[i], end[i]))
+                        }),
+                    );
+                }
+            }
+            ranges
+        };
+        query_runs(
+            &self.sorted.runs,
+            &self.sorted.positions,
+            &self.sorted.order,
+            &mut self.sorted.tasks,
+            radius * radius,
+            out,
+            locate,
+        );
+        Ok(())
+    }
+}
+
+/// A sorted grid for **unbounded** domains: like [`CellStartGrid`], but the cell → particle
+/// range table is a hash map over the occupied cells only (as in CompactNSearch, Band et
+/// al., the neighbour search of SPlisHSPlasH), so memory scales with the particles, not
+/// with the extent of the scene. Particles are sorted by an order-preserving packed cell
+/// key (lexicographic, `u64` when the occupied range fits, `u128` otherwise).
+#[derive(Debug, Clone)]
+pub struct HashedGrid<R: Real> {
+    narrow: SortedParticles<R, u64>,
+    wide: SortedParticles<R, u128>,
+    map_narrow: FxHashMap<u64, (u32, u32)>,
+    map_wide: FxHashMap<u128, (u32, u32)>,
+}
+
+impl<R: Real> Default for HashedGrid<R> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<R: Real> HashedGrid<R> {
+    /// A new search with empty buffers.
+    pub fn new() -> Self {
+        Self {
+            narrow: SortedParticles::default(),
+            wide: SortedParticles::default(),
+            map_narrow: FxHashMap::default(),
+            map_wide: FxHashMap::default(),
+        }
+    }
+}
+
+fn hashed_search<R: Real, K: Key>(
+    s: &mut SortedParticles<R, K>,
+    map: &mut FxHashMap<K, (u32, u32)>,
+    packer: &KeyPacker,
+    positions: &[Vec3<R>],
+    r2: R,
+    out: &mut NeighbourLists,
+) {
+    s.sort(positions, packer.bits, |c| packer.pack(c));
+    map.clear();
+    for r in 0..s.runs.len() - 1 {
+        map.insert(s.keys[s.runs[r] as usize], (s.runs[r], s.runs[r + 1]));
+    }
+    let (cells, order) = (&s.cells[..], &s.order[..]);
+    let map = &*map;
+    let locate = |k: usize| -> Ranges {
+        let c = cells[order[k] as usize];
+        let mut ranges: Ranges = ([(0, 0); 9], 0);
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                push_column(
+                    &mut ranges,
+                    (-1..=1).map(|dz| {
+                        map.get(&packer.pack::<K>([c[0] + dx, c[1] + dy, c[2] + dz]))
+                            .copied()
+                    }),
+                );
+            }
+        }
+        ranges
+    };
+    query_runs(
+        &s.runs,
+        &s.positions,
+        &s.order,
+        &mut s.tasks,
+        r2,
+        out,
+        locate,
+    );
+}
+
+impl<R: Real> NeighbourSearch<R> for HashedGrid<R> {
+    fn name(&self) -> &'static str {
+        "hashed-grid"
+    }
+
+    fn search(
+        &mut self,
+        positions: &[Vec3<R>],
+        radius: R,
+        out: &mut NeighbourLists,
+    ) -> Result<(), SearchError> {
+        let cell = cell_size(radius)?;
+        // Both key widths share the cell computation; the narrow one holds the cells.
+        compute_cells(positions, cell, &mut self.narrow.cells)?;
+        let Some((lo, hi)) = cell_bounds(&self.narrow.cells) else {
+            out.reset(0);
+            return Ok(());
+        };
+        let packer = KeyPacker::new(lo, hi, 1);
+        let r2 = radius * radius;
+        if packer.fits_u64() {
+            hashed_search(
+                &mut self.narrow,
+                &mut self.map_narrow,
+                &packer,
+                positions,
+                r2,
+                out,
+            );
+        } else {
+            std::mem::swap(&mut self.narrow.cells, &mut self.wide.cells);
+            hashed_search(
+                &mut self.wide,
+                &mut self.map_wide,
+                &packer,
+                positions,
+                r2,
+                out,
+            );
+            std::mem::swap(&mut self.narrow.cells, &mut self.wide.cells);
+        }
+        Ok(())
+    }
+}
