@@ -1,0 +1,270 @@
+//! Every fast method returns exactly the oracle's neighbour sets (proptest), in f32 and f64.
+
+use neighbour_search::{
+    BruteForce, CellStartGrid, HashedGrid, Method, NeighbourLists, NeighbourSearch, Real,
+    RelationTable, SearchError, Vec3, CELL_MARGIN,
+};
+use proptest::prelude::*;
+
+fn oracle<R: Real>(points: &[Vec3<R>], h: R) -> Result<Vec<Vec<u32>>, SearchError> {
+    let mut out = NeighbourLists::new();
+    BruteForce::new().search(points, h, &mut out)?;
+    Ok(out.to_sorted_sets())
+}
+
+/// Runs every fast method (twice, reusing buffers, to catch stale state) and compares.
+fn check_all<R: Real>(points: &[Vec3<R>], h: R) -> Result<(), TestCaseError> {
+    let expected = oracle(points, h);
+    let mut searches: Vec<Box<dyn NeighbourSearch<R>>> =
+        Method::FAST.iter().map(|m| m.build::<R>()).collect();
+    for s in searches.iter_mut() {
+        for round in 0..2 {
+            let mut out = NeighbourLists::new();
+            match (s.search(points, h, &mut out), &expected) {
+                (Ok(()), Ok(exp)) => {
+                    prop_assert_eq!(out.particle_count(), points.len());
+                    prop_assert_eq!(
+                        out.offsets()[points.len()],
+                        out.indices().len(),
+                        "{} CSR inconsistent",
+                        s.name()
+                    );
+                    let got = out.to_sorted_sets();
+                    for (i, (g, e)) in got.iter().zip(exp).enumerate() {
+                        prop_assert_eq!(
+                            g,
+                            e,
+                            "{} round {}: particle {} differs",
+                            s.name(),
+                            round,
+                            i
+                        );
+                    }
+                }
+                // The bounded grid may refuse a domain whose bounding grid is too large.
+                (Err(SearchError::DomainTooLarge { .. }), Ok(_))
+                    if s.name() == "cell-start-grid" => {}
+                (Err(e), Err(x)) => {
+                    prop_assert_eq!(&e, x, "{} error differs from oracle", s.name())
+                }
+                (got, exp) => prop_assert!(
+                    false,
+                    "{}: got {:?}, oracle {:?}",
+                    s.name(),
+                    got.err(),
+                    exp.as_ref().err()
+                ),
+            }
+        }
+    }
+    Ok(())
+}
+
+fn to_r<R: Real>(p: &[[f64; 3]]) -> Vec<Vec3<R>> {
+    p.iter()
+        .map(|a| Vec3::new(R::of_f64(a[0]), R::of_f64(a[1]), R::of_f64(a[2])))
+        .collect()
+}
+
+fn cloud(max: usize, half: f64) -> impl Strategy<Value = Vec<[f64; 3]>> {
+    proptest::collection::vec([-half..half, -half..half, -half..half], 0..max)
+}
+
+macro_rules! for_both_precisions {
+    ($name:ident, $body:expr) => {
+        mod $name {
+            use super::*;
+            proptest! {
+                #![proptest_config(ProptestConfig::with_cases(64))]
+                #[test]
+                fn f64_(case in $body) { check_all::<f64>(&to_r(&case.0), case.1)?; }
+                #[test]
+                fn f32_(case in $body) { check_all::<f32>(&to_r(&case.0), case.1 as f32)?; }
+            }
+        }
+    };
+}
+
+// Random clouds with random radius: from sparse to ~100 neighbours each.
+for_both_precisions!(random_clouds, (cloud(400, 3.0), 0.05..2.0f64));
+
+// Negative and offset coordinates.
+for_both_precisions!(
+    negative_coordinates,
+    (cloud(300, 1.0), 0.1..1.0f64, -1e3..-1.0f64).prop_map(|(c, h, off)| (
+        c.into_iter()
+            .map(|p| p.map(|x| x + off))
+            .collect::<Vec<_>>(),
+        h
+    ))
+);
+
+// Two clusters 1e6 apart (the cell-start grid may refuse: its bounding grid is huge).
+for_both_precisions!(
+    far_clusters,
+    (
+        cloud(150, 0.5),
+        cloud(150, 0.5),
+        0.05..0.5f64,
+        any::<bool>()
+    )
+        .prop_map(|(a, b, h, neg)| {
+            let d = if neg { -1e6 } else { 1e6 };
+            let mut v = a;
+            v.extend(b.into_iter().map(|p| [p[0] + d, p[1] - d, p[2] + 0.5 * d]));
+            (v, h)
+        })
+);
+
+// Points on a lattice of spacing h (distance exactly h between lattice neighbours, and on the
+// faces of cells of edge h) and on a lattice of the actual cell edge h(1 + CELL_MARGIN),
+// with duplicates.
+for_both_precisions!(
+    lattice_faces_and_duplicates,
+    (1usize..6, 0.01..3.0f64, any::<bool>(), 0usize..20, -5i32..5).prop_map(
+        |(n, h, on_cells, dups, shift)| {
+            let step = if on_cells { h * (1.0 + CELL_MARGIN) } else { h };
+            let mut v = Vec::new();
+            for i in 0..n {
+                for j in 0..n {
+                    for k in 0..n {
+                        v.push([
+                            (i as i32 + shift) as f64 * step,
+                            j as f64 * step,
+                            -(k as f64) * step,
+                        ]);
+                    }
+                }
+            }
+            let m = v.len();
+            for d in 0..dups.min(m) {
+                v.push(v[(d * 7) % m]);
+            }
+            (v, h)
+        }
+    )
+);
+
+// Dense near-duplicates: many particles within a fraction of h.
+for_both_precisions!(dense_blob, (cloud(300, 0.05), 0.01..0.2f64));
+
+#[test]
+fn empty_and_single() {
+    for s in Method::FAST.iter().chain([Method::BruteForce].iter()) {
+        let mut search = s.build::<f64>();
+        let mut out = NeighbourLists::new();
+        search.search(&[], 1.0, &mut out).unwrap();
+        assert_eq!(out.particle_count(), 0);
+        search
+            .search(&[Vec3::new(1.0, -2.0, 3.0)], 1.0, &mut out)
+            .unwrap();
+        assert_eq!(out.particle_count(), 1);
+        assert!(out.neighbours(0).is_empty());
+    }
+}
+
+#[test]
+fn distance_exactly_h_is_excluded_and_just_below_is_included() {
+    let h = 0.1f64;
+    let pts = vec![
+        Vec3::new(0.0, 0.0, 0.0),
+        Vec3::new(h, 0.0, 0.0),
+        Vec3::new(0.0, h * (1.0 - 1e-15), 0.0),
+    ];
+    for m in Method::FAST.iter().chain([Method::BruteForce].iter()) {
+        let mut out = NeighbourLists::new();
+        m.build::<f64>().search(&pts, h, &mut out).unwrap();
+        let sets = out.to_sorted_sets();
+        assert_eq!(sets[0], vec![2], "{}", m.name());
+        assert!(
+            sets[1].is_empty(),
+            "{}: distance h*sqrt(2) and exactly h",
+            m.name()
+        );
+    }
+}
+
+#[test]
+fn bad_input_is_named() {
+    let mut pts = vec![Vec3::new(0.0f32, 0.0, 0.0); 5];
+    pts[3].y = f32::NAN;
+    for m in Method::FAST.iter().chain([Method::BruteForce].iter()) {
+        let mut out = NeighbourLists::new();
+        let mut s = m.build::<f32>();
+        match s.search(&pts, 1.0, &mut out) {
+            Err(SearchError::NonFinitePosition {
+                index: 3,
+                axis: 'y',
+                ..
+            }) => {}
+            other => panic!("{}: {other:?}", m.name()),
+        }
+        let ok = vec![Vec3::new(0.0f32, 0.0, 0.0); 2];
+        for h in [0.0f32, -1.0, f32::NAN, f32::INFINITY, 1e-30] {
+            let e = s.search(&ok, h, &mut out).unwrap_err();
+            assert!(
+                matches!(e, SearchError::InvalidRadius { .. }),
+                "{}: h = {h}: {e}",
+                m.name()
+            );
+            assert!(e.to_string().contains("radius"));
+        }
+        let far = vec![Vec3::new(0.0f32, 0.0, 0.0), Vec3::new(0.0, 0.0, 3e9)];
+        let e = s.search(&far, 1.0, &mut out).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                SearchError::CellCoordinateOverflow {
+                    index: 1,
+                    axis: 'z',
+                    ..
+                }
+            ),
+            "{}: {e}",
+            m.name()
+        );
+    }
+}
+
+#[test]
+fn cell_start_grid_refuses_huge_domains_with_a_clear_error() {
+    let pts = vec![Vec3::new(0.0f64, 0.0, 0.0), Vec3::new(1e6, 1e6, 1e6)];
+    let mut out = NeighbourLists::new();
+    let e = CellStartGrid::<f64>::new()
+        .search(&pts, 0.1, &mut out)
+        .unwrap_err();
+    assert!(matches!(e, SearchError::DomainTooLarge { .. }), "{e}");
+    assert!(e.to_string().contains("unbounded method"), "{e}");
+    RelationTable::new().search(&pts, 0.1, &mut out).unwrap();
+    HashedGrid::<f64>::new()
+        .search(&pts, 0.1, &mut out)
+        .unwrap();
+}
+
+#[test]
+fn output_is_identical_for_any_thread_count() {
+    let pts: Vec<Vec3<f64>> = (0..20_000)
+        .map(|i| {
+            let t = i as f64;
+            Vec3::new(
+                (t * 0.61803).fract() * 3.0,
+                (t * 0.41421).fract() * 3.0,
+                (t * 0.7320).fract() * 3.0,
+            )
+        })
+        .collect();
+    for m in Method::FAST {
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let mut out = NeighbourLists::new();
+                m.build::<f64>().search(&pts, 0.12, &mut out).unwrap();
+                out
+            })
+        };
+        assert_eq!(run(1), run(3), "{}", m.name());
+    }
+}
