@@ -6,12 +6,11 @@ use rayon::prelude::*;
 use crate::NeighbourLists;
 
 /// What one parallel task found: for each of its particles, `(particle, count)`, and the
-/// concatenated neighbour indices. `candidates` is the task's own scratch.
+/// concatenated neighbour indices.
 #[derive(Debug, Default, Clone)]
 pub(crate) struct TaskOutput {
     pub particles: Vec<(u32, u32)>,
     pub neighbours: Vec<u32>,
-    pub candidates: Vec<u32>,
 }
 
 impl TaskOutput {
@@ -26,12 +25,18 @@ struct SyncPtr<T>(*mut T);
 unsafe impl<T> Send for SyncPtr<T> {}
 unsafe impl<T> Sync for SyncPtr<T> {}
 
-/// Writes the tasks' results into `out` for `n` particles. Every particle must appear in
-/// exactly one task (debug-checked by the offsets being consistent).
-pub(crate) fn assemble(out: &mut NeighbourLists, n: usize, tasks: &[TaskOutput]) {
+/// Writes the tasks' results into `out` for `n` particles.
+/// Every particle must appear in exactly one task. The tasks may be any type holding a
+/// [`TaskOutput`].
+pub(crate) fn assemble_by<T: Sync>(
+    out: &mut NeighbourLists,
+    n: usize,
+    tasks: &[T],
+    output: impl Fn(&T) -> &TaskOutput + Sync,
+) {
     out.reset(n);
     let offs = SyncPtr(out.offsets.as_mut_ptr());
-    tasks.par_iter().for_each(|t| {
+    tasks.par_iter().map(&output).for_each(|t| {
         let p = offs;
         for &(i, c) in &t.particles {
             debug_assert!((i as usize) < n);
@@ -47,7 +52,7 @@ pub(crate) fn assemble(out: &mut NeighbourLists, n: usize, tasks: &[TaskOutput])
     out.indices.resize(total, 0);
     let idx = SyncPtr(out.indices.as_mut_ptr());
     let offsets = &out.offsets;
-    tasks.par_iter().for_each(|t| {
+    tasks.par_iter().map(&output).for_each(|t| {
         let p = idx;
         let mut src = 0usize;
         for &(i, c) in &t.particles {

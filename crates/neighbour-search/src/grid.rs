@@ -4,11 +4,12 @@ use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 use sph_core::{Real, Vec3};
 
-use crate::cells::{cell_bounds, cell_size, compute_cells, is_neighbour, Key, KeyPacker};
-use crate::csr::{assemble, TaskOutput};
+use crate::cells::{cell_bounds, cell_size, compute_cells, Key, KeyPacker};
+use crate::csr::{assemble_by, TaskOutput};
 use crate::radix::{sort_pairs, RadixScratch};
 use crate::runs::run_starts;
-use crate::{NeighbourLists, NeighbourSearch, SearchError};
+use crate::scan::Gathered;
+use crate::{NeighbourLists, NeighbourSearch, SearchError, SearchTimings, Stopwatch};
 
 /// Cells (runs) handled by one parallel task.
 const CELLS_PER_TASK: usize = 64;
@@ -27,11 +28,15 @@ struct SortedParticles<R: Real, K> {
     keys: Vec<K>,
     /// `order[k]` = caller's index of the k-th particle in cell order.
     order: Vec<u32>,
-    positions: Vec<Vec3<R>>,
+    /// Positions in cell order, structure of arrays.
+    xs: Vec<R>,
+    ys: Vec<R>,
+    zs: Vec<R>,
     runs: Vec<u32>,
     block_counts: Vec<usize>,
     radix: RadixScratch<K>,
-    tasks: Vec<TaskOutput>,
+    tasks: Vec<(TaskOutput, Gathered<R>)>,
+    timings: SearchTimings,
 }
 
 impl<R: Real, K: Key> Default for SortedParticles<R, K> {
@@ -40,11 +45,14 @@ impl<R: Real, K: Key> Default for SortedParticles<R, K> {
             cells: Vec::new(),
             keys: Vec::new(),
             order: Vec::new(),
-            positions: Vec::new(),
+            xs: Vec::new(),
+            ys: Vec::new(),
+            zs: Vec::new(),
             runs: Vec::new(),
             block_counts: Vec::new(),
             radix: RadixScratch::default(),
             tasks: Vec::new(),
+            timings: SearchTimings::default(),
         }
     }
 }
@@ -54,60 +62,76 @@ impl<R: Real, K: Key> SortedParticles<R, K> {
     /// into that order and finds the runs of equal cells ("find cell start").
     fn sort(&mut self, positions: &[Vec3<R>], bits: u32, key: impl Fn([i32; 3]) -> K + Sync) {
         let n = positions.len();
+        let mut watch = Stopwatch::start();
         self.keys.clear();
         self.keys.par_extend(self.cells.par_iter().map(|&c| key(c)));
         self.order.clear();
         self.order.par_extend((0..n as u32).into_par_iter());
+        self.timings.cells_s += watch.lap();
         sort_pairs(&mut self.keys, &mut self.order, bits, &mut self.radix);
-        self.positions.clear();
-        self.positions
-            .par_extend(self.order.par_iter().map(|&i| positions[i as usize]));
+        for (a, dst) in [&mut self.xs, &mut self.ys, &mut self.zs]
+            .into_iter()
+            .enumerate()
+        {
+            dst.clear();
+            dst.par_extend(self.order.par_iter().map(|&i| positions[i as usize][a]));
+        }
+        self.timings.sort_s = watch.lap();
         run_starts(&self.keys, &mut self.runs, &mut self.block_counts);
+        self.timings.table_s = watch.lap();
     }
 }
 
 /// Tests each particle of each run against the candidate ranges given by `locate` (called
 /// with the sorted index of the run's first particle).
+///
+/// The candidates of a run's 27 cells are gathered once into a contiguous block
+/// ([`Gathered`]) and every particle of the run is tested against it.
 #[allow(clippy::too_many_arguments)]
 fn query_runs<R: Real>(
     runs: &[u32],
-    pos: &[Vec3<R>],
+    (xs, ys, zs): (&[R], &[R], &[R]),
     order: &[u32],
-    tasks: &mut Vec<TaskOutput>,
+    tasks: &mut Vec<(TaskOutput, Gathered<R>)>,
     r2: R,
     out: &mut NeighbourLists,
+    timings: &mut SearchTimings,
     locate: impl Fn(usize) -> Ranges + Sync,
 ) {
-    let n = pos.len();
+    let mut watch = Stopwatch::start();
+    let n = xs.len();
     let run_count = runs.len() - 1;
     let task_count = run_count.div_ceil(CELLS_PER_TASK);
     if tasks.len() < task_count {
-        tasks.resize_with(task_count, TaskOutput::default);
+        tasks.resize_with(task_count, Default::default);
     }
     tasks[..task_count]
         .par_iter_mut()
         .enumerate()
-        .for_each(|(task, buf)| {
+        .for_each(|(task, (buf, g))| {
             buf.clear();
             let first = task * CELLS_PER_TASK;
             for r in first..(first + CELLS_PER_TASK).min(run_count) {
                 let (ranges, count) = locate(runs[r] as usize);
-                for k in runs[r]..runs[r + 1] {
-                    let pk = pos[k as usize];
-                    let before = buf.neighbours.len();
-                    for &(a, b) in &ranges[..count] {
-                        for c in a..b {
-                            if c != k && is_neighbour(&pk, &pos[c as usize], r2) {
-                                buf.neighbours.push(order[c as usize]);
-                            }
-                        }
+                g.clear();
+                let mut own = 0;
+                for &(a, b) in &ranges[..count] {
+                    let (a, b) = (a as usize, b as usize);
+                    if a <= runs[r] as usize && (runs[r] as usize) < b {
+                        own = g.len() + runs[r] as usize - a;
                     }
-                    buf.particles
-                        .push((order[k as usize], (buf.neighbours.len() - before) as u32));
+                    g.extend(&xs[a..b], &ys[a..b], &zs[a..b], &order[a..b]);
+                }
+                g.finish();
+                for (e, k) in (runs[r]..runs[r + 1]).enumerate() {
+                    let found = g.neighbours_of(own + e, r2, &mut buf.neighbours);
+                    buf.particles.push((order[k as usize], found));
                 }
             }
         });
-    assemble(out, n, &tasks[..task_count]);
+    timings.query_s = watch.lap();
+    assemble_by(out, n, &tasks[..task_count], |t| &t.0);
+    timings.assemble_s = watch.lap();
 }
 
 /// Merges the ranges of three z-consecutive cells (contiguous in sorted order) into one.
@@ -177,12 +201,17 @@ impl<R: Real> NeighbourSearch<R> for CellStartGrid<R> {
         "cell-start-grid"
     }
 
+    fn timings(&self) -> SearchTimings {
+        self.sorted.timings
+    }
+
     fn search(
         &mut self,
         positions: &[Vec3<R>],
         radius: R,
         out: &mut NeighbourLists,
     ) -> Result<(), SearchError> {
+        let mut watch = Stopwatch::start();
         let cell = cell_size(radius)?;
         compute_cells(positions, cell, &mut self.sorted.cells)?;
         let Some((lo, hi)) = cell_bounds(&self.sorted.cells) else {
@@ -205,7 +234,12 @@ impl<R: Real> NeighbourSearch<R> for CellStartGrid<R> {
             (x * dims[1] + y) * dims[2] + z
         };
         let bits = 64 - ((total - 1) as u64).leading_zeros();
+        self.sorted.timings = SearchTimings {
+            cells_s: watch.lap(),
+            ..Default::default()
+        };
         self.sorted.sort(positions, bits, linear);
+        watch.lap();
         // Clear and fill the start/end table over the whole bounding grid.
         self.cell_start.clear();
         self.cell_start.resize(total, EMPTY);
@@ -216,6 +250,7 @@ impl<R: Real> NeighbourSearch<R> for CellStartGrid<R> {
             self.cell_start[key] = runs[r];
             self.cell_end[key] = runs[r + 1];
         }
+        self.sorted.timings.table_s += watch.lap();
         let (start, end) = (&self.cell_start[..], &self.cell_end[..]);
         let (cells, order) = (&self.sorted.cells[..], &self.sorted.order[..]);
         let locate = |k: usize| -> Ranges {
@@ -247,11 +282,12 @@ impl<R: Real> NeighbourSearch<R> for CellStartGrid<R> {
         };
         query_runs(
             &self.sorted.runs,
-            &self.sorted.positions,
+            (&self.sorted.xs, &self.sorted.ys, &self.sorted.zs),
             &self.sorted.order,
             &mut self.sorted.tasks,
             radius * radius,
             out,
+            &mut self.sorted.timings,
             locate,
         );
         Ok(())
@@ -269,6 +305,7 @@ pub struct HashedGrid<R: Real> {
     wide: SortedParticles<R, u128>,
     map_narrow: FxHashMap<u64, (u32, u32)>,
     map_wide: FxHashMap<u128, (u32, u32)>,
+    timings: SearchTimings,
 }
 
 impl<R: Real> Default for HashedGrid<R> {
@@ -285,10 +322,12 @@ impl<R: Real> HashedGrid<R> {
             wide: SortedParticles::default(),
             map_narrow: FxHashMap::default(),
             map_wide: FxHashMap::default(),
+            timings: SearchTimings::default(),
         }
     }
 }
 
+#[allow(clippy::too_many_arguments)]
 fn hashed_search<R: Real, K: Key>(
     s: &mut SortedParticles<R, K>,
     map: &mut FxHashMap<K, (u32, u32)>,
@@ -296,12 +335,19 @@ fn hashed_search<R: Real, K: Key>(
     positions: &[Vec3<R>],
     r2: R,
     out: &mut NeighbourLists,
+    cells_s: f64,
 ) {
+    s.timings = SearchTimings {
+        cells_s,
+        ..Default::default()
+    };
     s.sort(positions, packer.bits, |c| packer.pack(c));
+    let mut watch = Stopwatch::start();
     map.clear();
     for r in 0..s.runs.len() - 1 {
         map.insert(s.keys[s.runs[r] as usize], (s.runs[r], s.runs[r + 1]));
     }
+    s.timings.table_s += watch.lap();
     let (cells, order) = (&s.cells[..], &s.order[..]);
     let map = &*map;
     let locate = |k: usize| -> Ranges {
@@ -322,11 +368,12 @@ fn hashed_search<R: Real, K: Key>(
     };
     query_runs(
         &s.runs,
-        &s.positions,
+        (&s.xs, &s.ys, &s.zs),
         &s.order,
         &mut s.tasks,
         r2,
         out,
+        &mut s.timings,
         locate,
     );
 }
@@ -336,12 +383,17 @@ impl<R: Real> NeighbourSearch<R> for HashedGrid<R> {
         "hashed-grid"
     }
 
+    fn timings(&self) -> SearchTimings {
+        self.timings
+    }
+
     fn search(
         &mut self,
         positions: &[Vec3<R>],
         radius: R,
         out: &mut NeighbourLists,
     ) -> Result<(), SearchError> {
+        let mut watch = Stopwatch::start();
         let cell = cell_size(radius)?;
         // Both key widths share the cell computation; the narrow one holds the cells.
         compute_cells(positions, cell, &mut self.narrow.cells)?;
@@ -351,6 +403,7 @@ impl<R: Real> NeighbourSearch<R> for HashedGrid<R> {
         };
         let packer = KeyPacker::new(lo, hi, 1);
         let r2 = radius * radius;
+        let t = watch.lap();
         if packer.fits_u64() {
             hashed_search(
                 &mut self.narrow,
@@ -359,7 +412,9 @@ impl<R: Real> NeighbourSearch<R> for HashedGrid<R> {
                 positions,
                 r2,
                 out,
+                t,
             );
+            self.timings = self.narrow.timings;
         } else {
             std::mem::swap(&mut self.narrow.cells, &mut self.wide.cells);
             hashed_search(
@@ -369,8 +424,10 @@ impl<R: Real> NeighbourSearch<R> for HashedGrid<R> {
                 positions,
                 r2,
                 out,
+                t,
             );
             std::mem::swap(&mut self.narrow.cells, &mut self.wide.cells);
+            self.timings = self.wide.timings;
         }
         Ok(())
     }

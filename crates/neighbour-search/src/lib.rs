@@ -36,6 +36,7 @@ mod radix;
 mod relation_table;
 mod reorder;
 mod runs;
+mod scan;
 
 pub use brute::BruteForce;
 pub use cells::{is_neighbour, squared_distance, CELL_MARGIN};
@@ -60,6 +61,59 @@ pub trait NeighbourSearch<R: Real>: Send {
         radius: R,
         out: &mut NeighbourLists,
     ) -> Result<(), SearchError>;
+
+    /// Phase timings of the last successful search (zero if the method does not time them).
+    fn timings(&self) -> SearchTimings {
+        SearchTimings::default()
+    }
+}
+
+/// Wall-clock time of the phases of the last search, in seconds.
+///
+/// `build_s()` is what the PBF paper's Table 2 calls "Create Hash Grid" (cells, sort, cell
+/// table) and `detect_s()` its "Detect Neighbors" (distance tests and list assembly).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct SearchTimings {
+    /// Validation and cell coordinates (and, for the relation table, its 27 entries per particle).
+    pub cells_s: f64,
+    /// Sorting by cell.
+    pub sort_s: f64,
+    /// Runs of equal cells and the cell lookup (start/end table or hash map).
+    pub table_s: f64,
+    /// Distance tests.
+    pub query_s: f64,
+    /// Assembly of the CSR lists.
+    pub assemble_s: f64,
+}
+
+impl SearchTimings {
+    /// Build time: cells + sort + table.
+    pub fn build_s(&self) -> f64 {
+        self.cells_s + self.sort_s + self.table_s
+    }
+    /// Neighbour detection time: distance tests + assembly.
+    pub fn detect_s(&self) -> f64 {
+        self.query_s + self.assemble_s
+    }
+    /// Total.
+    pub fn total_s(&self) -> f64 {
+        self.build_s() + self.detect_s()
+    }
+}
+
+/// Accumulates phase times.
+pub(crate) struct Stopwatch(std::time::Instant);
+impl Stopwatch {
+    pub(crate) fn start() -> Self {
+        Self(std::time::Instant::now())
+    }
+    /// Seconds since the last lap (or the start), and restarts.
+    pub(crate) fn lap(&mut self) -> f64 {
+        let now = std::time::Instant::now();
+        let dt = (now - self.0).as_secs_f64();
+        self.0 = now;
+        dt
+    }
 }
 
 /// The available methods, for run-time selection (scene files, benchmarks, reports).
@@ -97,7 +151,7 @@ impl Method {
     /// A boxed searcher of this method for precision `R`.
     pub fn build<R: Real>(self) -> Box<dyn NeighbourSearch<R>> {
         match self {
-            Method::RelationTable => Box::new(RelationTable::new()),
+            Method::RelationTable => Box::new(RelationTable::<R>::new()),
             Method::CellStartGrid => Box::new(CellStartGrid::<R>::new()),
             Method::HashedGrid => Box::new(HashedGrid::<R>::new()),
             Method::BruteForce => Box::new(BruteForce::new()),

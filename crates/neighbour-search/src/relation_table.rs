@@ -3,11 +3,12 @@
 use rayon::prelude::*;
 use sph_core::{Real, Vec3};
 
-use crate::cells::{cell_bounds, cell_size, compute_cells, is_neighbour, Key, KeyPacker};
-use crate::csr::{assemble, TaskOutput};
+use crate::cells::{cell_bounds, cell_size, compute_cells, Key, KeyPacker};
+use crate::csr::TaskOutput;
 use crate::radix::{sort_pairs, RadixScratch};
 use crate::runs::run_starts;
-use crate::{NeighbourLists, NeighbourSearch, SearchError};
+use crate::scan::Gathered;
+use crate::{NeighbourLists, NeighbourSearch, SearchError, SearchTimings, Stopwatch};
 
 /// Offset index of a particle's own cell among its 27 (dx, dy, dz ∈ {−1, 0, 1}, x major).
 const SELF_OFFSET: u32 = 13;
@@ -39,14 +40,12 @@ const RUNS_PER_TASK: usize = 128;
 /// Cost: 27 entries (12 or 20 bytes) written and radix-sorted per particle, against one
 /// for the cell-start grid; the query reads one contiguous run per particle. Neighbours
 /// come out in increasing index order (the sort is stable).
-#[derive(Debug, Default, Clone)]
-pub struct RelationTable {
+#[derive(Debug, Clone)]
+pub struct RelationTable<R: Real> {
     cells: Vec<[i32; 3]>,
     narrow: Table<u64>,
     wide: Table<u128>,
-    runs: Vec<u32>,
-    block_counts: Vec<usize>,
-    tasks: Vec<TaskOutput>,
+    work: Workspace<R>,
 }
 
 #[derive(Debug, Default, Clone)]
@@ -56,10 +55,34 @@ struct Table<K> {
     radix: RadixScratch<K>,
 }
 
-impl RelationTable {
+#[derive(Debug, Clone)]
+struct Workspace<R: Real> {
+    runs: Vec<u32>,
+    block_counts: Vec<usize>,
+    tasks: Vec<(TaskOutput, Gathered<R>)>,
+    timings: SearchTimings,
+}
+
+impl<R: Real> Default for RelationTable<R> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<R: Real> RelationTable<R> {
     /// A new search with empty buffers (they grow on first use and are reused).
     pub fn new() -> Self {
-        Self::default()
+        Self {
+            cells: Vec::new(),
+            narrow: Table::default(),
+            wide: Table::default(),
+            work: Workspace {
+                runs: Vec::new(),
+                block_counts: Vec::new(),
+                tasks: Vec::new(),
+                timings: SearchTimings::default(),
+            },
+        }
     }
 
     /// Entries in the last relation table (27 per particle).
@@ -68,9 +91,13 @@ impl RelationTable {
     }
 }
 
-impl<R: Real> NeighbourSearch<R> for RelationTable {
+impl<R: Real> NeighbourSearch<R> for RelationTable<R> {
     fn name(&self) -> &'static str {
         "relation-table"
+    }
+
+    fn timings(&self) -> SearchTimings {
+        self.work.timings
     }
 
     fn search(
@@ -79,6 +106,7 @@ impl<R: Real> NeighbourSearch<R> for RelationTable {
         radius: R,
         out: &mut NeighbourLists,
     ) -> Result<(), SearchError> {
+        let watch = Stopwatch::start();
         let cell = cell_size(radius)?;
         compute_cells(positions, cell, &mut self.cells)?;
         let Some((lo, hi)) = cell_bounds(&self.cells) else {
@@ -86,32 +114,30 @@ impl<R: Real> NeighbourSearch<R> for RelationTable {
             return Ok(());
         };
         let packer = KeyPacker::new(lo, hi, 1);
-        let r2 = radius * radius;
+        let (cells, r2, work) = (&self.cells[..], radius * radius, &mut self.work);
         if packer.fits_u64() {
             self.wide.keys.clear();
             build_and_query(
                 &mut self.narrow,
-                &self.cells,
+                cells,
                 &packer,
                 positions,
                 r2,
-                &mut self.runs,
-                &mut self.block_counts,
-                &mut self.tasks,
+                work,
                 out,
+                watch,
             );
         } else {
             self.narrow.keys.clear();
             build_and_query(
                 &mut self.wide,
-                &self.cells,
+                cells,
                 &packer,
                 positions,
                 r2,
-                &mut self.runs,
-                &mut self.block_counts,
-                &mut self.tasks,
+                work,
                 out,
+                watch,
             );
         }
         Ok(())
@@ -125,10 +151,9 @@ fn build_and_query<K: Key, R: Real>(
     packer: &KeyPacker,
     positions: &[Vec3<R>],
     r2: R,
-    runs: &mut Vec<u32>,
-    block_counts: &mut Vec<usize>,
-    tasks: &mut Vec<TaskOutput>,
+    work: &mut Workspace<R>,
     out: &mut NeighbourLists,
+    mut watch: Stopwatch,
 ) {
     let n = cells.len();
     // 1. Each particle writes its 27 entries (Fig. 3a).
@@ -152,22 +177,25 @@ fn build_and_query<K: Key, R: Real>(
                 }
             }
         });
+    work.timings.cells_s = watch.lap();
     // 2. Lexicographic sort by cell (Fig. 3b).
     sort_pairs(&mut t.keys, &mut t.vals, packer.bits, &mut t.radix);
+    work.timings.sort_s = watch.lap();
     // 3. Runs of equal cells (Fig. 3c: each run's start and number).
-    run_starts(&t.keys, runs, block_counts);
-    let run_count = runs.len() - 1;
+    run_starts(&t.keys, &mut work.runs, &mut work.block_counts);
+    let run_count = work.runs.len() - 1;
+    work.timings.table_s = watch.lap();
     // 4. Each particle scans the run of its own cell.
     let task_count = run_count.div_ceil(RUNS_PER_TASK);
-    if tasks.len() < task_count {
-        tasks.resize_with(task_count, TaskOutput::default);
+    if work.tasks.len() < task_count {
+        work.tasks.resize_with(task_count, Default::default);
     }
     let vals = &t.vals;
-    let runs = &runs[..];
-    tasks[..task_count]
+    let runs = &work.runs[..];
+    work.tasks[..task_count]
         .par_iter_mut()
         .enumerate()
-        .for_each(|(task, buf)| {
+        .for_each(|(task, (buf, g))| {
             buf.clear();
             let first = task * RUNS_PER_TASK;
             let last = (first + RUNS_PER_TASK).min(run_count);
@@ -176,24 +204,30 @@ fn build_and_query<K: Key, R: Real>(
                 if !run.iter().any(|&v| v % 27 == SELF_OFFSET) {
                     continue; // a cell that holds no particle: nobody scans this run
                 }
-                buf.candidates.clear();
-                buf.candidates.extend(run.iter().map(|&v| v / 27));
+                g.clear();
                 for &v in run {
-                    if v % 27 != SELF_OFFSET {
-                        continue;
+                    let p = &positions[(v / 27) as usize];
+                    g.push(p.x, p.y, p.z, v / 27);
+                }
+                g.finish();
+                for (e, &v) in run.iter().enumerate() {
+                    if v % 27 == SELF_OFFSET {
+                        let found = g.neighbours_of(e, r2, &mut buf.neighbours);
+                        buf.particles.push((v / 27, found));
                     }
-                    let i = v / 27;
-                    let pi = positions[i as usize];
-                    let before = buf.neighbours.len();
-                    for &j in &buf.candidates {
-                        if j != i && is_neighbour(&pi, &positions[j as usize], r2) {
-                            buf.neighbours.push(j);
-                        }
-                    }
-                    buf.particles
-                        .push((i, (buf.neighbours.len() - before) as u32));
                 }
             }
         });
-    assemble(out, n, &tasks[..task_count]);
+    work.timings.query_s = watch.lap();
+    let tasks = &work.tasks[..task_count];
+    assemble_pairs(out, n, tasks);
+    work.timings.assemble_s = watch.lap();
+}
+
+fn assemble_pairs<R: Real>(
+    out: &mut NeighbourLists,
+    n: usize,
+    tasks: &[(TaskOutput, Gathered<R>)],
+) {
+    crate::csr::assemble_by(out, n, tasks, |t| &t.0);
 }

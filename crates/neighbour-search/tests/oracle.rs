@@ -235,7 +235,9 @@ fn cell_start_grid_refuses_huge_domains_with_a_clear_error() {
         .unwrap_err();
     assert!(matches!(e, SearchError::DomainTooLarge { .. }), "{e}");
     assert!(e.to_string().contains("unbounded method"), "{e}");
-    RelationTable::new().search(&pts, 0.1, &mut out).unwrap();
+    RelationTable::<f64>::new()
+        .search(&pts, 0.1, &mut out)
+        .unwrap();
     HashedGrid::<f64>::new()
         .search(&pts, 0.1, &mut out)
         .unwrap();

@@ -17,6 +17,7 @@ mod error;
 mod particles;
 mod real;
 mod sdf;
+pub mod sampling;
 
 pub use aabb::Aabb;
 pub use error::CoreError;

@@ -1,0 +1,51 @@
+//! Quick single-run timing of the neighbour searches on the dam-break anchor scene:
+//! `cargo run --release -p benches --example ns_profile [threads] [method]`. For figures to quote,
+//! use the criterion benchmark (`cargo bench -p benches --bench neighbour_search`).
+use benches::dam_break_anchor;
+use neighbour_search::{Method, NeighbourLists};
+use std::time::Instant;
+
+fn main() {
+    let threads: usize = std::env::args()
+        .nth(1)
+        .and_then(|a| a.parse().ok())
+        .unwrap_or(1);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    let (pts, fluid) = dam_break_anchor::<f32>();
+    println!(
+        "{} particles ({} fluid), {} thread(s)",
+        pts.len(),
+        fluid,
+        threads
+    );
+    let only: Option<String> = std::env::args().nth(2);
+    for m in Method::FAST {
+        if only.as_deref().is_some_and(|o| o != m.name()) {
+            continue;
+        }
+        let mut s = m.build::<f32>();
+        let mut out = NeighbourLists::new();
+        let mut times = Vec::new();
+        pool.install(|| {
+            for _ in 0..15 {
+                let t = Instant::now();
+                s.search(&pts, 0.05, &mut out).unwrap();
+                times.push(t.elapsed().as_secs_f64());
+            }
+        });
+        times.sort_by(f64::total_cmp);
+        let med = times[times.len() / 2];
+        let t = s.timings();
+        println!(
+            "{:16} median {:7.2} ms  {:.3} us/particle  pairs/particle {:.1}  last: cells {:.1} sort {:.1} table {:.1} query {:.1} assemble {:.1} ms",
+            m.name(),
+            med * 1e3,
+            med * 1e6 / pts.len() as f64,
+            out.pair_count() as f64 / pts.len() as f64,
+            t.cells_s * 1e3, t.sort_s * 1e3, t.table_s * 1e3, t.query_s * 1e3, t.assemble_s * 1e3
+        );
+    }
+}
