@@ -49,7 +49,8 @@ pub(crate) fn assemble_by<T: Sync>(
         out.offsets[i + 1] += out.offsets[i];
     }
     let total = out.offsets[n];
-    out.indices.resize(total, 0);
+    out.indices.clear();
+    out.indices.reserve(total);
     let idx = SyncPtr(out.indices.as_mut_ptr());
     let offsets = &out.offsets;
     tasks.par_iter().map(&output).for_each(|t| {
@@ -61,10 +62,14 @@ pub(crate) fn assemble_by<T: Sync>(
             debug_assert_eq!(offsets[i as usize + 1] - dst, c);
             // SAFETY: `[dst, dst + c)` is particle i's own range of `indices`, disjoint from
             // every other particle's, and within `total` by construction of the offsets.
-            unsafe {
-                std::ptr::copy_nonoverlapping(t.neighbours.as_ptr().add(src), p.0.add(dst), c)
-            };
+            // An element loop: lists are short and a `memcpy` call each costs more.
+            for (k, &j) in t.neighbours[src..src + c].iter().enumerate() {
+                unsafe { *p.0.add(dst + k) = j };
+            }
             src += c;
         }
     });
+    // SAFETY: the tasks wrote every slot of [0, total): each particle's range is covered
+    // by its own list, and the ranges tile [0, total) by construction of the offsets.
+    unsafe { out.indices.set_len(total) };
 }
