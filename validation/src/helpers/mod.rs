@@ -1,0 +1,10 @@
+//! Shared helpers of the experiments: CSV output, reference-data loading, plotting and a
+//! small deterministic random-number generator.
+
+mod data;
+mod plot;
+mod rng;
+
+pub use data::{load_reference_csv, write_csv_columns, write_csv_rows, ReferenceTable};
+pub use plot::{ensure_fonts, plot_xy, Legend, Marker, PlotSpec, Series, SeriesStyle};
+pub use rng::SplitMix64;

@@ -1,0 +1,484 @@
+//! Runs the selected experiments and writes the results.
+//!
+//! Output layout (`<out>` defaults to `target/validation` under the workspace root):
+//!
+//! - `<out>/<id>/` — each experiment's CSV data and PNG plots, and `verdict.json`
+//!   (id, source, status, wall_s, metrics, checks, notes, error);
+//! - `<out>/summary.json` — `{"mode", "experiments": [{"id", "source", "status", "wall_s",
+//!   "metrics", "checks": [{"name", "value", "bound", "pass", "origin"}], ...}]}`;
+//! - `<out>/report.md` — every check in one table, then each experiment's notes and plots.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::time::Instant;
+
+use anyhow::{bail, Context as _, Result};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use serde::Serialize;
+
+use crate::{fmt_num, reference_data_dir, Artifact, Check, Context, Experiment, Mode, Outcome};
+
+/// What to run and where to write.
+#[derive(Debug, Clone)]
+pub struct RunOptions {
+    /// Quick or full.
+    pub mode: Mode,
+    /// Experiment ids to run (empty: all).
+    pub only: Vec<String>,
+    /// Output directory.
+    pub out: PathBuf,
+}
+
+/// Final state of an experiment.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Status {
+    /// Ran, every check passed.
+    Pass,
+    /// Ran, some check failed.
+    Fail,
+    /// Returned an error or panicked.
+    Error,
+}
+
+impl Status {
+    /// `"pass"`, `"fail"` or `"error"`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Status::Pass => "pass",
+            Status::Fail => "fail",
+            Status::Error => "error",
+        }
+    }
+}
+
+/// Everything recorded about one experiment run (the content of `verdict.json`).
+#[derive(Debug, Clone, Serialize)]
+pub struct Verdict {
+    /// Experiment id.
+    pub id: String,
+    /// What it reproduces.
+    pub source: String,
+    /// pass / fail / error.
+    pub status: Status,
+    /// Wall-clock time of `run`, seconds.
+    pub wall_s: f64,
+    /// Metrics.
+    pub metrics: BTreeMap<String, f64>,
+    /// Checks.
+    pub checks: Vec<Check>,
+    /// Notes.
+    pub notes: Vec<String>,
+    /// Error or panic message when `status` is error.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+    /// Plots (relative to the experiment's directory).
+    pub plots: Vec<Artifact>,
+    /// Data files (relative to the experiment's directory).
+    pub files: Vec<Artifact>,
+}
+
+#[derive(Serialize)]
+struct Summary<'a> {
+    mode: Mode,
+    experiments: &'a [Verdict],
+}
+
+/// Selects experiments by id, in registry order; unknown ids are an error naming the
+/// known ones.
+pub fn select<'a>(
+    all: &'a [Box<dyn Experiment>],
+    only: &[String],
+) -> Result<Vec<&'a dyn Experiment>> {
+    let known: Vec<&str> = all.iter().map(|e| e.id()).collect();
+    let unknown: Vec<&String> = only
+        .iter()
+        .filter(|o| !known.contains(&o.as_str()))
+        .collect();
+    if !unknown.is_empty() {
+        bail!(
+            "unknown experiment id(s) {} (known: {})",
+            unknown
+                .iter()
+                .map(|s| format!("{s:?}"))
+                .collect::<Vec<_>>()
+                .join(", "),
+            known.join(", ")
+        );
+    }
+    Ok(all
+        .iter()
+        .filter(|e| only.is_empty() || only.iter().any(|o| o == e.id()))
+        .map(|e| e.as_ref())
+        .collect())
+}
+
+static PANIC_MESSAGE: Mutex<Option<String>> = Mutex::new(None);
+
+fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
+    if let Some(s) = payload.downcast_ref::<&str>() {
+        (*s).to_string()
+    } else if let Some(s) = payload.downcast_ref::<String>() {
+        s.clone()
+    } else {
+        "panic with a non-string payload".to_string()
+    }
+}
+
+/// Runs one experiment with its progress bar, catching errors and panics.
+pub fn run_one(
+    exp: &dyn Experiment,
+    mode: Mode,
+    out: &Path,
+    reference_dir: &Path,
+) -> Result<Verdict> {
+    let dir = out.join(exp.id());
+    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    let bar = ProgressBar::with_draw_target(Some(0), ProgressDrawTarget::stderr());
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{prefix:>18.bold} [{elapsed_precise}] {wide_bar} {pos}/{len} {msg}",
+        )
+        .expect("valid template")
+        .progress_chars("=> "),
+    );
+    bar.set_prefix(exp.id());
+    let mut ctx = Context::new(mode, dir.clone(), reference_dir.to_path_buf(), bar.clone());
+
+    *PANIC_MESSAGE.lock().unwrap_or_else(|e| e.into_inner()) = None;
+    let previous_hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|info| {
+        let mut slot = PANIC_MESSAGE.lock().unwrap_or_else(|e| e.into_inner());
+        if slot.is_none() {
+            *slot = Some(info.to_string());
+        }
+    }));
+    let start = Instant::now();
+    let result = catch_unwind(AssertUnwindSafe(|| exp.run(&mut ctx)));
+    let wall_s = start.elapsed().as_secs_f64();
+    std::panic::set_hook(previous_hook);
+    bar.finish_and_clear();
+
+    let (outcome, error) = match result {
+        Ok(Ok(outcome)) => (outcome, None),
+        Ok(Err(e)) => (Outcome::new(), Some(format!("{e:#}"))),
+        Err(payload) => {
+            let hooked = PANIC_MESSAGE
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .take();
+            let text = hooked.unwrap_or_else(|| panic_text(payload.as_ref()));
+            (Outcome::new(), Some(format!("panic: {text}")))
+        }
+    };
+    let status = if error.is_some() {
+        Status::Error
+    } else if outcome.all_pass() {
+        Status::Pass
+    } else {
+        Status::Fail
+    };
+    let verdict = Verdict {
+        id: exp.id().to_string(),
+        source: exp.source().to_string(),
+        status,
+        wall_s,
+        metrics: outcome.metrics,
+        checks: outcome.checks,
+        notes: outcome.notes,
+        error,
+        plots: ctx.plots().to_vec(),
+        files: ctx.files().to_vec(),
+    };
+    write_json(&dir.join("verdict.json"), &verdict)?;
+    Ok(verdict)
+}
+
+fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<()> {
+    let text = serde_json::to_string_pretty(value)?;
+    std::fs::write(path, text + "\n").with_context(|| format!("writing {}", path.display()))
+}
+
+/// Runs the selected experiments, writes `summary.json` and `report.md`, prints the final
+/// table. Returns the verdicts.
+pub fn run(all: &[Box<dyn Experiment>], opts: &RunOptions) -> Result<Vec<Verdict>> {
+    let selected = select(all, &opts.only)?;
+    std::fs::create_dir_all(&opts.out)
+        .with_context(|| format!("creating {}", opts.out.display()))?;
+    let reference_dir = reference_data_dir();
+    eprintln!(
+        "validation ({} mode): {} experiment(s) -> {}  [reference data: {}, rayon threads: {}]",
+        opts.mode,
+        selected.len(),
+        opts.out.display(),
+        reference_dir.display(),
+        rayon::current_num_threads()
+    );
+    let mut verdicts = Vec::new();
+    for exp in selected {
+        let v = run_one(exp, opts.mode, &opts.out, &reference_dir)?;
+        let failed = v.checks.iter().filter(|c| !c.pass).count();
+        eprintln!(
+            "{:>18}: {} in {:.2} s ({} checks, {} failed)",
+            v.id,
+            v.status.as_str(),
+            v.wall_s,
+            v.checks.len(),
+            failed
+        );
+        verdicts.push(v);
+    }
+    write_json(
+        &opts.out.join("summary.json"),
+        &Summary {
+            mode: opts.mode,
+            experiments: &verdicts,
+        },
+    )?;
+    let report = report_markdown(opts.mode, &verdicts);
+    let report_path = opts.out.join("report.md");
+    std::fs::write(&report_path, report)
+        .with_context(|| format!("writing {}", report_path.display()))?;
+    print!("{}", terminal_table(&verdicts));
+    println!("summary: {}", opts.out.join("summary.json").display());
+    println!("report:  {}", report_path.display());
+    Ok(verdicts)
+}
+
+/// `true` when every verdict passed.
+pub fn all_pass(verdicts: &[Verdict]) -> bool {
+    verdicts.iter().all(|v| v.status == Status::Pass)
+}
+
+/// The final terminal table: one row per experiment, then each failed check.
+pub fn terminal_table(verdicts: &[Verdict]) -> String {
+    let mut s = String::new();
+    let w = verdicts
+        .iter()
+        .map(|v| v.id.len())
+        .max()
+        .unwrap_or(2)
+        .max(10);
+    let _ = writeln!(
+        s,
+        "\n{:<w$}  {:<6}  {:>9}  checks",
+        "experiment", "status", "wall [s]"
+    );
+    let _ = writeln!(s, "{}", "-".repeat(w + 30));
+    for v in verdicts {
+        let passed = v.checks.iter().filter(|c| c.pass).count();
+        let status = match v.status {
+            Status::Pass => "pass",
+            Status::Fail => "FAIL",
+            Status::Error => "ERROR",
+        };
+        let _ = writeln!(
+            s,
+            "{:<w$}  {:<6}  {:>9.2}  {}/{} pass",
+            v.id,
+            status,
+            v.wall_s,
+            passed,
+            v.checks.len()
+        );
+        if let Some(e) = &v.error {
+            let _ = writeln!(s, "    error: {}", e.replace('\n', "\n           "));
+        }
+        for c in v.checks.iter().filter(|c| !c.pass) {
+            let _ = writeln!(
+                s,
+                "    FAIL {}: value {} (bound {})",
+                c.name,
+                fmt_num(c.value),
+                c.bound
+            );
+        }
+    }
+    let bad = verdicts.iter().filter(|v| v.status != Status::Pass).count();
+    let _ = writeln!(
+        s,
+        "{}",
+        if bad == 0 {
+            "all experiments pass".to_string()
+        } else {
+            format!("{bad} experiment(s) FAIL or ERROR")
+        }
+    );
+    s
+}
+
+fn cell(text: &str) -> String {
+    text.replace('|', "\\|").replace('\n', " ")
+}
+
+/// The Markdown report (paths relative to the output directory).
+pub fn report_markdown(mode: Mode, verdicts: &[Verdict]) -> String {
+    let mut s = String::new();
+    let count = |st: Status| verdicts.iter().filter(|v| v.status == st).count();
+    let _ = writeln!(s, "# Validation report\n");
+    let _ = writeln!(
+        s,
+        "Mode: **{mode}**. Experiments: {} — {} pass, {} fail, {} error. \
+         Generated by `cargo xtask validate{}`.\n",
+        verdicts.len(),
+        count(Status::Pass),
+        count(Status::Fail),
+        count(Status::Error),
+        if mode == Mode::Full { " --full" } else { "" }
+    );
+    let _ = writeln!(
+        s,
+        "| experiment | status | wall [s] | source |\n| --- | --- | ---: | --- |"
+    );
+    for v in verdicts {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.2} | {} |",
+            v.id,
+            v.status.as_str(),
+            v.wall_s,
+            cell(&v.source)
+        );
+    }
+    let _ = writeln!(s, "\n## Checks\n");
+    let _ = writeln!(
+        s,
+        "| experiment | check | value | bound | origin of the bound | result |\n| --- | --- | ---: | --- | --- | --- |"
+    );
+    for v in verdicts {
+        for c in &v.checks {
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {} | {} | {} |",
+                v.id,
+                cell(&c.name),
+                fmt_num(c.value),
+                cell(&c.bound),
+                cell(&c.origin),
+                if c.pass { "pass" } else { "**FAIL**" }
+            );
+        }
+    }
+    for v in verdicts {
+        let _ = writeln!(s, "\n## {} — {}\n", v.id, v.status.as_str());
+        let _ = writeln!(s, "Source: {}. Wall time {:.2} s.\n", v.source, v.wall_s);
+        if let Some(e) = &v.error {
+            let _ = writeln!(s, "**Error:**\n\n```text\n{e}\n```\n");
+        }
+        if !v.notes.is_empty() {
+            let _ = writeln!(s, "### Notes\n");
+            for n in &v.notes {
+                let _ = writeln!(s, "- {n}");
+            }
+            let _ = writeln!(s);
+        }
+        for p in &v.plots {
+            let _ = writeln!(
+                s,
+                "![{}]({}/{})\n\n*{}*\n",
+                cell(&p.caption),
+                v.id,
+                p.file,
+                p.caption
+            );
+        }
+        if !v.files.is_empty() {
+            let _ = writeln!(s, "### Data\n");
+            for f in &v.files {
+                let _ = writeln!(s, "- [`{}`]({}/{}): {}", f.file, v.id, f.file, f.caption);
+            }
+            let _ = writeln!(s);
+        }
+        if !v.metrics.is_empty() {
+            let _ = writeln!(
+                s,
+                "<details><summary>{} metrics</summary>\n\n| metric | value |\n| --- | ---: |",
+                v.metrics.len()
+            );
+            for (k, x) in &v.metrics {
+                let _ = writeln!(s, "| {} | {} |", cell(k), fmt_num(*x));
+            }
+            let _ = writeln!(s, "\n</details>");
+        }
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    struct Fails;
+    impl Experiment for Fails {
+        fn id(&self) -> &'static str {
+            "fails"
+        }
+        fn source(&self) -> &'static str {
+            "test"
+        }
+        fn run(&self, _ctx: &mut Context) -> Result<Outcome> {
+            let mut o = Outcome::new();
+            o.metric("m", 1.0);
+            o.check(Check::less_than("c", 2.0, 1.0, "test"));
+            Ok(o)
+        }
+    }
+    struct Panics;
+    impl Experiment for Panics {
+        fn id(&self) -> &'static str {
+            "panics"
+        }
+        fn source(&self) -> &'static str {
+            "test"
+        }
+        fn run(&self, _ctx: &mut Context) -> Result<Outcome> {
+            panic!("boom")
+        }
+    }
+    struct Errs;
+    impl Experiment for Errs {
+        fn id(&self) -> &'static str {
+            "errs"
+        }
+        fn source(&self) -> &'static str {
+            "test"
+        }
+        fn run(&self, _ctx: &mut Context) -> Result<Outcome> {
+            bail!("no data")
+        }
+    }
+
+    #[test]
+    fn statuses_and_files() {
+        let all: Vec<Box<dyn Experiment>> = vec![Box::new(Fails), Box::new(Panics), Box::new(Errs)];
+        let out = std::env::temp_dir().join(format!("validation-runner-{}", std::process::id()));
+        let opts = RunOptions {
+            mode: Mode::Quick,
+            only: vec![],
+            out: out.clone(),
+        };
+        let v = run(&all, &opts).unwrap();
+        assert_eq!(v[0].status, Status::Fail);
+        assert_eq!(v[1].status, Status::Error);
+        assert!(v[1].error.as_deref().unwrap().contains("boom"));
+        assert_eq!(v[2].status, Status::Error);
+        assert!(!all_pass(&v));
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        assert_eq!(summary["mode"], "quick");
+        assert_eq!(summary["experiments"][0]["checks"][0]["pass"], false);
+        assert_eq!(summary["experiments"][0]["metrics"]["m"], 1.0);
+        assert!(out.join("fails/verdict.json").is_file());
+        assert!(out.join("report.md").is_file());
+        let err = select(&all, &["nope".to_string()])
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(err.contains("known: fails, panics, errs"), "{err}");
+        std::fs::remove_dir_all(&out).ok();
+    }
+}
