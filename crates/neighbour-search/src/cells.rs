@@ -56,12 +56,15 @@ pub(crate) fn cell_size<R: Real>(radius: R) -> Result<f64, SearchError> {
 #[inline(always)]
 fn cell_of_axis(x: f64, cell: f64) -> Option<i32> {
     // Division, not multiplication by an inverse, keeps the error bound of CELL_MARGIN.
-    let c = (x / cell).floor();
-    if c.abs() <= CELL_LIMIT {
-        Some(c as i32)
-    } else {
-        None
+    let q = x / cell;
+    // `!(a <= b)` is also true for NaN.
+    if !(q.abs() <= CELL_LIMIT) {
+        return None;
     }
+    // floor without a libm call (baseline x86-64 has no rounding instruction): truncation
+    // towards zero is exact here (|q| < 2³¹), and corrects by one below zero.
+    let t = q as i64;
+    Some((t - ((t as f64) > q) as i64) as i32)
 }
 
 /// Validates the positions and writes each particle's integer cell `floor(x / cell)`
@@ -159,16 +162,16 @@ pub(crate) fn cell_bounds(cells: &[[i32; 3]]) -> Option<([i32; 3], [i32; 3])> {
 pub(crate) trait Key:
     Copy + Send + Sync + Eq + Ord + Default + std::hash::Hash + std::fmt::Debug + 'static
 {
-    /// The 8-bit digit at bit `shift`.
-    fn digit(self, shift: u32) -> usize;
+    /// The key shifted right by `shift`, truncated to `usize` (the radix sort masks it).
+    fn shifted(self, shift: u32) -> usize;
     /// `(x << sx) | (y << sy) | z`.
     fn compose(x: u64, y: u64, z: u64, sx: u32, sy: u32) -> Self;
 }
 
 impl Key for u64 {
     #[inline(always)]
-    fn digit(self, shift: u32) -> usize {
-        ((self >> shift) & 0xff) as usize
+    fn shifted(self, shift: u32) -> usize {
+        (self >> shift) as usize
     }
     #[inline(always)]
     fn compose(x: u64, y: u64, z: u64, sx: u32, sy: u32) -> Self {
@@ -179,8 +182,8 @@ impl Key for u64 {
 
 impl Key for u128 {
     #[inline(always)]
-    fn digit(self, shift: u32) -> usize {
-        ((self >> shift) & 0xff) as usize
+    fn shifted(self, shift: u32) -> usize {
+        (self >> shift) as usize
     }
     #[inline(always)]
     fn compose(x: u64, y: u64, z: u64, sx: u32, sy: u32) -> Self {

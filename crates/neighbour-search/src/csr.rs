@@ -35,6 +35,23 @@ pub(crate) fn assemble_by<T: Sync>(
     output: impl Fn(&T) -> &TaskOutput + Sync,
 ) {
     out.reset(n);
+    if in_caller_order(n, tasks, &output) {
+        // Fast path (particles already sorted by cell, as a solver keeps them): the tasks'
+        // lists, concatenated, are the CSR indices.
+        let mut k = 0;
+        for t in tasks.iter().map(&output) {
+            for &(_, c) in &t.particles {
+                out.offsets[k + 1] = out.offsets[k] + c as usize;
+                k += 1;
+            }
+        }
+        out.indices.clear();
+        out.indices.reserve(out.offsets[n]);
+        for t in tasks.iter().map(&output) {
+            out.indices.extend_from_slice(&t.neighbours);
+        }
+        return;
+    }
     let offs = SyncPtr(out.offsets.as_mut_ptr());
     tasks.par_iter().map(&output).for_each(|t| {
         let p = offs;
@@ -72,4 +89,31 @@ pub(crate) fn assemble_by<T: Sync>(
     // SAFETY: the tasks wrote every slot of [0, total): each particle's range is covered
     // by its own list, and the ranges tile [0, total) by construction of the offsets.
     unsafe { out.indices.set_len(total) };
+}
+
+/// `true` when the tasks, in order, list the particles 0, 1, …, n − 1.
+fn in_caller_order<T: Sync>(
+    n: usize,
+    tasks: &[T],
+    output: &(impl Fn(&T) -> &TaskOutput + Sync),
+) -> bool {
+    let mut next = 0u32;
+    for t in tasks.iter().map(output) {
+        let Some(&(first, _)) = t.particles.first() else {
+            continue;
+        };
+        if first != next {
+            return false;
+        }
+        let consecutive = t
+            .particles
+            .iter()
+            .enumerate()
+            .all(|(k, &(i, _))| i == first + k as u32);
+        if !consecutive {
+            return false;
+        }
+        next += t.particles.len() as u32;
+    }
+    next as usize == n
 }

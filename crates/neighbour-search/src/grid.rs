@@ -68,7 +68,16 @@ impl<R: Real, K: Key> SortedParticles<R, K> {
         self.order.clear();
         self.order.par_extend((0..n as u32).into_par_iter());
         self.timings.cells_s += watch.lap();
-        sort_pairs(&mut self.keys, &mut self.order, bits, &mut self.radix);
+        // Particles kept in cell order by the caller (the usual case in a solver, see
+        // `CellSorter`) need no sort: check first, it costs one pass over the keys.
+        let sorted = self
+            .keys
+            .par_windows(2)
+            .with_min_len(4096)
+            .all(|w| w[0] <= w[1]);
+        if !sorted {
+            sort_pairs(&mut self.keys, &mut self.order, bits, &mut self.radix);
+        }
         for (a, dst) in [&mut self.xs, &mut self.ys, &mut self.zs]
             .into_iter()
             .enumerate()
@@ -83,10 +92,10 @@ impl<R: Real, K: Key> SortedParticles<R, K> {
 }
 
 /// Tests each particle of each run against the candidate ranges given by `locate` (called
-/// with the sorted index of the run's first particle).
-///
-/// The candidates of a run's 27 cells are gathered once into a contiguous block
-/// ([`Gathered`]) and every particle of the run is tested against it.
+/// with the sorted index of the run's first particle). The candidates of a cell's 27
+/// neighbour cells are first gathered into one contiguous block: measured on the dam-break
+/// anchor scene, this beats scanning the nine ranges in place (their ragged ends cost
+/// more than the copy, which is shared by the ~8 particles of a cell).
 #[allow(clippy::too_many_arguments)]
 fn query_runs<R: Real>(
     runs: &[u32],
@@ -112,20 +121,21 @@ fn query_runs<R: Real>(
             buf.clear();
             let first = task * CELLS_PER_TASK;
             for r in first..(first + CELLS_PER_TASK).min(run_count) {
-                let (ranges, count) = locate(runs[r] as usize);
+                let (start, end) = (runs[r] as usize, runs[r + 1] as usize);
+                let (ranges, count) = locate(start);
                 g.clear();
                 let mut own = 0;
                 for &(a, b) in &ranges[..count] {
                     let (a, b) = (a as usize, b as usize);
-                    if a <= runs[r] as usize && (runs[r] as usize) < b {
-                        own = g.len() + runs[r] as usize - a;
+                    if a <= start && start < b {
+                        own = g.len() + start - a;
                     }
                     g.extend(&xs[a..b], &ys[a..b], &zs[a..b], &order[a..b]);
                 }
-                g.finish();
-                for (e, k) in (runs[r]..runs[r + 1]).enumerate() {
-                    let found = g.neighbours_of(own + e, r2, &mut buf.neighbours);
-                    buf.particles.push((order[k as usize], found));
+                let len = g.finish();
+                for (e, k) in (start..end).enumerate() {
+                    let found = g.neighbours_of(len, own + e, r2, &mut buf.neighbours);
+                    buf.particles.push((order[k], found));
                 }
             }
         });

@@ -209,10 +209,10 @@ fn build_and_query<K: Key, R: Real>(
                     let p = &positions[(v / 27) as usize];
                     g.push(p.x, p.y, p.z, v / 27);
                 }
-                g.finish();
+                let len = g.finish();
                 for (e, &v) in run.iter().enumerate() {
                     if v % 27 == SELF_OFFSET {
-                        let found = g.neighbours_of(e, r2, &mut buf.neighbours);
+                        let found = g.neighbours_of(len, e, r2, &mut buf.neighbours);
                         buf.particles.push((v / 27, found));
                     }
                 }

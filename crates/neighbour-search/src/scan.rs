@@ -1,30 +1,40 @@
-//! The innermost loop shared by every fast method: one particle against a contiguous,
-//! structure-of-arrays block of gathered candidates.
+//! The innermost loop shared by every fast method: one particle against ranges of a
+//! structure-of-arrays block of candidates (the cell-sorted particles of the grids, or the
+//! candidates the relation table gathers for one run).
 //!
 //! On x86-64 CPUs with AVX2 (detected at run time; nothing is compiled with
 //! `target-cpu=native`), eight candidates are tested per instruction sequence and the
 //! indices that pass are left-packed with one permutation from a 256-entry table, without
-//! a branch. Elsewhere a portable branch-free loop does the same one candidate at a time.
-//! Both evaluate `(dx·dx + dy·dy) + dz·dz < h²` with the same IEEE operations in the same
-//! order as [`crate::squared_distance`] (no fused multiply-add), so results are identical.
+//! a branch; range ends and the particle itself are masked out. Elsewhere a portable
+//! branch-free loop does the same one candidate at a time. Both evaluate
+//! `(dx·dx + dy·dy) + dz·dz < h²` with the same IEEE operations in the same order as
+//! [`crate::squared_distance`] (no fused multiply-add), so their results are identical.
 
 use std::any::TypeId;
 
 use sph_core::Real;
 
-/// Lanes processed per step; gathered blocks are padded to a multiple of this.
-const LANES: usize = 8;
+/// Lanes processed per step. Blocks carry this many padding entries after their last
+/// candidate, so that a step may read past the end of a range.
+pub(crate) const LANES: usize = 8;
 
-/// Candidates gathered for one cell.
+/// Candidates in structure-of-arrays form (`ids` are the caller's indices), each slice
+/// followed by at least [`LANES`] padding entries.
+#[derive(Clone, Copy)]
+pub(crate) struct Block<'a, R> {
+    pub xs: &'a [R],
+    pub ys: &'a [R],
+    pub zs: &'a [R],
+    pub ids: &'a [u32],
+}
+
+/// Candidates gathered into one contiguous structure-of-arrays block (per cell or run).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Gathered<R> {
     xs: Vec<R>,
     ys: Vec<R>,
     zs: Vec<R>,
-    /// Caller's index of each candidate.
     ids: Vec<u32>,
-    /// Number of real (unpadded) candidates.
-    len: usize,
 }
 
 impl<R: Real> Gathered<R> {
@@ -33,17 +43,11 @@ impl<R: Real> Gathered<R> {
         self.ys.clear();
         self.zs.clear();
         self.ids.clear();
-        self.len = 0;
     }
 
-    /// Appends candidates.
-    #[inline]
-    pub fn extend(&mut self, xs: &[R], ys: &[R], zs: &[R], ids: &[u32]) {
-        append(&mut self.xs, xs);
-        append(&mut self.ys, ys);
-        append(&mut self.zs, zs);
-        append(&mut self.ids, ids);
-        self.len = self.xs.len();
+    /// Number of candidates gathered.
+    pub fn len(&self) -> usize {
+        self.ids.len()
     }
 
     /// Appends one candidate.
@@ -53,48 +57,36 @@ impl<R: Real> Gathered<R> {
         self.ys.push(y);
         self.zs.push(z);
         self.ids.push(id);
-        self.len = self.xs.len();
     }
 
-    /// Number of candidates gathered so far.
-    pub fn len(&self) -> usize {
-        self.len
-    }
-
-    /// Pads to a multiple of the lane count with candidates at infinity, which fail every
-    /// test (`(p − ∞)² = ∞`, never NaN for a finite `p`). Call once after gathering.
-    pub fn finish(&mut self) {
-        let inf = R::of_f64(f64::INFINITY);
-        while self.xs.len() % LANES != 0 {
-            self.xs.push(inf);
-            self.ys.push(inf);
-            self.zs.push(inf);
-            self.ids.push(u32::MAX);
-        }
-    }
-
-    /// Appends to `out` the neighbours of candidate `e` (the query particle, skipped)
-    /// among all gathered candidates, in gathered order; returns how many.
+    /// Appends a run of candidates.
     #[inline]
-    pub fn neighbours_of(&mut self, e: usize, r2: R, out: &mut Vec<u32>) -> u32 {
-        debug_assert!(e < self.len && self.xs.len() % LANES == 0);
-        let (px, py, pz) = (self.xs[e], self.ys[e], self.zs[e]);
-        // Exclude the particle itself by moving its copy to infinity for this scan.
-        self.xs[e] = R::of_f64(f64::INFINITY);
-        let m = self.xs.len();
-        out.reserve(m);
-        let before = out.len();
-        // SAFETY: `out` has room for `m` more entries; every kernel writes at most
-        // `found + LANES <= m` entries past `before` (m is a multiple of LANES) and
-        // returns `found`, all of which it has initialised.
-        let found = unsafe {
-            let dst = out.as_mut_ptr().add(before);
-            let f = scan(px, py, pz, &self.xs, &self.ys, &self.zs, &self.ids, r2, dst);
-            out.set_len(before + f);
-            f
+    pub fn extend(&mut self, xs: &[R], ys: &[R], zs: &[R], ids: &[u32]) {
+        append(&mut self.xs, xs);
+        append(&mut self.ys, ys);
+        append(&mut self.zs, zs);
+        append(&mut self.ids, ids);
+    }
+
+    /// Pads the block and scans particle `e` of it against all others: appends its
+    /// neighbours' ids to `out`, returns how many. Call [`Gathered::finish`] first.
+    #[inline]
+    pub fn neighbours_of(&self, len: usize, e: usize, r2: R, out: &mut Vec<u32>) -> u32 {
+        let block = Block {
+            xs: &self.xs,
+            ys: &self.ys,
+            zs: &self.zs,
+            ids: &self.ids,
         };
-        self.xs[e] = px;
-        found as u32
+        let p = [self.xs[e], self.ys[e], self.zs[e]];
+        scan_ranges(p, block, &[(0, len as u32)], e, r2, out)
+    }
+
+    /// Appends the padding the scan needs; returns the number of real candidates.
+    pub fn finish(&mut self) -> usize {
+        let len = self.len();
+        pad(&mut self.xs, &mut self.ys, &mut self.zs, &mut self.ids);
+        len
     }
 }
 
@@ -116,6 +108,52 @@ fn append<T: Copy>(dst: &mut Vec<T>, src: &[T]) {
     }
 }
 
+/// Appends [`LANES`] padding entries (at infinity: they would fail every test anyway).
+pub(crate) fn pad<R: Real>(xs: &mut Vec<R>, ys: &mut Vec<R>, zs: &mut Vec<R>, ids: &mut Vec<u32>) {
+    let inf = R::of_f64(f64::INFINITY);
+    for _ in 0..LANES {
+        xs.push(inf);
+        ys.push(inf);
+        zs.push(inf);
+        ids.push(u32::MAX);
+    }
+}
+
+/// Appends to `out` the ids of the candidates in `ranges` (indices into `block`) that are
+/// neighbours of the point `p` (strictly closer than `r`, `r2 = r·r`), skipping index
+/// `skip` (the particle itself); returns how many.
+#[inline]
+pub(crate) fn scan_ranges<R: Real>(
+    p: [R; 3],
+    block: Block<'_, R>,
+    ranges: &[(u32, u32)],
+    skip: usize,
+    r2: R,
+    out: &mut Vec<u32>,
+) -> u32 {
+    let n = block.xs.len();
+    assert!(block.ys.len() == n && block.zs.len() == n && block.ids.len() == n);
+    let room: usize = ranges.iter().map(|&(a, b)| (b - a) as usize + LANES).sum();
+    for &(_, b) in ranges {
+        assert!(
+            b as usize + LANES <= n,
+            "range end {b} not followed by padding ({n})"
+        );
+    }
+    out.reserve(room);
+    let before = out.len();
+    // SAFETY: `out` has room for `room` more entries; a kernel writes at most LANES
+    // entries past its count per step and at most (b − a) counted entries per range, so
+    // never beyond `room`; it initialises every entry it counts. Reads stay below
+    // `b + LANES <= n` (asserted above).
+    unsafe {
+        let dst = out.as_mut_ptr().add(before);
+        let found = scan(p, block, ranges, skip, r2, dst);
+        out.set_len(before + found);
+        found as u32
+    }
+}
+
 /// Reinterprets a slice of `R` as a slice of `T` when they are the same type.
 #[inline(always)]
 fn same<R: 'static, T: 'static>(s: &[R]) -> Option<&[T]> {
@@ -124,16 +162,12 @@ fn same<R: 'static, T: 'static>(s: &[R]) -> Option<&[T]> {
         .then(|| unsafe { std::slice::from_raw_parts(s.as_ptr() as *const T, s.len()) })
 }
 
-#[allow(clippy::too_many_arguments)]
 #[inline]
 unsafe fn scan<R: Real>(
-    px: R,
-    py: R,
-    pz: R,
-    xs: &[R],
-    ys: &[R],
-    zs: &[R],
-    ids: &[u32],
+    p: [R; 3],
+    b: Block<'_, R>,
+    ranges: &[(u32, u32)],
+    skip: usize,
     r2: R,
     out: *mut u32,
 ) -> usize {
@@ -142,47 +176,58 @@ unsafe fn scan<R: Real>(
         if std::arch::is_x86_feature_detected!("avx2")
             && std::arch::is_x86_feature_detected!("popcnt")
         {
-            let p = [px.as_f64(), py.as_f64(), pz.as_f64(), r2.as_f64()];
-            if let (Some(x), Some(y), Some(z)) = (same::<R, f32>(xs), same(ys), same(zs)) {
-                let p = p.map(|v| v as f32); // exact: the values are f32
-                return unsafe { avx2::scan_f32(p, x, y, z, ids, out) };
+            let q = [p[0].as_f64(), p[1].as_f64(), p[2].as_f64(), r2.as_f64()];
+            if let (Some(xs), Some(ys), Some(zs)) = (same::<R, f32>(b.xs), same(b.ys), same(b.zs)) {
+                let q = q.map(|v| v as f32); // exact: the values are f32
+                let blk = Block {
+                    xs,
+                    ys,
+                    zs,
+                    ids: b.ids,
+                };
+                return unsafe { avx2::scan_f32(q, blk, ranges, skip, out) };
             }
-            if let (Some(x), Some(y), Some(z)) = (same::<R, f64>(xs), same(ys), same(zs)) {
-                return unsafe { avx2::scan_f64(p, x, y, z, ids, out) };
+            if let (Some(xs), Some(ys), Some(zs)) = (same::<R, f64>(b.xs), same(b.ys), same(b.zs)) {
+                let blk = Block {
+                    xs,
+                    ys,
+                    zs,
+                    ids: b.ids,
+                };
+                return unsafe { avx2::scan_f64(q, blk, ranges, skip, out) };
             }
         }
     }
-    unsafe { scan_portable(px, py, pz, xs, ys, zs, ids, r2, out) }
+    unsafe { scan_portable(p, b, ranges, skip, r2, out) }
 }
 
 /// The portable kernel: branch-free compaction, one candidate at a time.
-#[allow(clippy::too_many_arguments)]
 #[inline]
 unsafe fn scan_portable<R: Real>(
-    px: R,
-    py: R,
-    pz: R,
-    xs: &[R],
-    ys: &[R],
-    zs: &[R],
-    ids: &[u32],
+    p: [R; 3],
+    b: Block<'_, R>,
+    ranges: &[(u32, u32)],
+    skip: usize,
     r2: R,
     out: *mut u32,
 ) -> usize {
     let mut found = 0;
-    for t in 0..xs.len() {
-        let dx = px - xs[t];
-        let dy = py - ys[t];
-        let dz = pz - zs[t];
-        // SAFETY: found <= t < xs.len() <= capacity guaranteed by the caller.
-        unsafe { *out.add(found) = ids[t] };
-        found += (dx * dx + dy * dy + dz * dz < r2) as usize;
+    for &(lo, hi) in ranges {
+        for t in lo as usize..hi as usize {
+            let dx = p[0] - b.xs[t];
+            let dy = p[1] - b.ys[t];
+            let dz = p[2] - b.zs[t];
+            // SAFETY: found is below the room reserved by the caller.
+            unsafe { *out.add(found) = b.ids[t] };
+            found += ((dx * dx + dy * dy + dz * dz < r2) & (t != skip)) as usize;
+        }
     }
     found
 }
 
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
+    use super::Block;
     use std::arch::x86_64::*;
 
     /// `LEFT_PACK[mask]` lists the set lanes of `mask` first (then zeros).
@@ -203,6 +248,22 @@ mod avx2 {
         t
     };
 
+    /// Lanes `[t, t + 8)` that lie inside `[t, end)` and are not `skip`.
+    #[inline(always)]
+    fn valid_lanes(t: usize, end: usize, skip: usize) -> usize {
+        let left = end - t;
+        let mut m = if left >= 8 {
+            0xff
+        } else {
+            (1usize << left) - 1
+        };
+        let s = skip.wrapping_sub(t);
+        if s < 8 {
+            m &= !(1 << s);
+        }
+        m
+    }
+
     #[inline(always)]
     unsafe fn pack(mask: usize, ids: *const u32, out: *mut u32) -> usize {
         unsafe {
@@ -215,64 +276,61 @@ mod avx2 {
 
     #[target_feature(enable = "avx2,popcnt")]
     pub(super) unsafe fn scan_f32(
-        p: [f32; 4],
-        xs: &[f32],
-        ys: &[f32],
-        zs: &[f32],
-        ids: &[u32],
+        q: [f32; 4],
+        b: Block<'_, f32>,
+        ranges: &[(u32, u32)],
+        skip: usize,
         out: *mut u32,
     ) -> usize {
-        let n = xs.len();
-        assert!(n % 8 == 0 && ys.len() == n && zs.len() == n && ids.len() == n);
         let (vx, vy, vz) = (
-            _mm256_set1_ps(p[0]),
-            _mm256_set1_ps(p[1]),
-            _mm256_set1_ps(p[2]),
+            _mm256_set1_ps(q[0]),
+            _mm256_set1_ps(q[1]),
+            _mm256_set1_ps(q[2]),
         );
-        let vr2 = _mm256_set1_ps(p[3]);
+        let vr2 = _mm256_set1_ps(q[3]);
         let mut found = 0;
-        let mut t = 0;
-        while t < n {
-            // SAFETY: t + 8 <= n for all four arrays; `out` has room (see caller).
-            unsafe {
-                let dx = _mm256_sub_ps(vx, _mm256_loadu_ps(xs.as_ptr().add(t)));
-                let dy = _mm256_sub_ps(vy, _mm256_loadu_ps(ys.as_ptr().add(t)));
-                let dz = _mm256_sub_ps(vz, _mm256_loadu_ps(zs.as_ptr().add(t)));
-                let d2 = _mm256_add_ps(
-                    _mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
-                    _mm256_mul_ps(dz, dz),
-                );
-                let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(d2, vr2)) as usize;
-                found += pack(mask, ids.as_ptr().add(t), out.add(found));
+        for &(lo, hi) in ranges {
+            let (mut t, end) = (lo as usize, hi as usize);
+            while t < end {
+                // SAFETY: t + 8 <= end + 7 < len (padding); `out` has room (see caller).
+                unsafe {
+                    let dx = _mm256_sub_ps(vx, _mm256_loadu_ps(b.xs.as_ptr().add(t)));
+                    let dy = _mm256_sub_ps(vy, _mm256_loadu_ps(b.ys.as_ptr().add(t)));
+                    let dz = _mm256_sub_ps(vz, _mm256_loadu_ps(b.zs.as_ptr().add(t)));
+                    let d2 = _mm256_add_ps(
+                        _mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
+                        _mm256_mul_ps(dz, dz),
+                    );
+                    let near = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(d2, vr2)) as usize;
+                    let mask = near & valid_lanes(t, end, skip);
+                    found += pack(mask, b.ids.as_ptr().add(t), out.add(found));
+                }
+                t += 8;
             }
-            t += 8;
         }
         found
     }
 
     #[target_feature(enable = "avx2,popcnt")]
     pub(super) unsafe fn scan_f64(
-        p: [f64; 4],
-        xs: &[f64],
-        ys: &[f64],
-        zs: &[f64],
-        ids: &[u32],
+        q: [f64; 4],
+        b: Block<'_, f64>,
+        ranges: &[(u32, u32)],
+        skip: usize,
         out: *mut u32,
     ) -> usize {
-        let n = xs.len();
-        assert!(n % 8 == 0 && ys.len() == n && zs.len() == n && ids.len() == n);
         let (vx, vy, vz) = (
-            _mm256_set1_pd(p[0]),
-            _mm256_set1_pd(p[1]),
-            _mm256_set1_pd(p[2]),
+            _mm256_set1_pd(q[0]),
+            _mm256_set1_pd(q[1]),
+            _mm256_set1_pd(q[2]),
         );
-        let vr2 = _mm256_set1_pd(p[3]);
+        let vr2 = _mm256_set1_pd(q[3]);
         let half = |t: usize| -> usize {
-            // SAFETY: t + 4 <= n (t is 0 or 4 past a multiple of 8 below n).
+            // SAFETY: t + 4 <= len (padding).
             unsafe {
-                let dx = _mm256_sub_pd(vx, _mm256_loadu_pd(xs.as_ptr().add(t)));
-                let dy = _mm256_sub_pd(vy, _mm256_loadu_pd(ys.as_ptr().add(t)));
-                let dz = _mm256_sub_pd(vz, _mm256_loadu_pd(zs.as_ptr().add(t)));
+                let dx = _mm256_sub_pd(vx, _mm256_loadu_pd(b.xs.as_ptr().add(t)));
+                let dy = _mm256_sub_pd(vy, _mm256_loadu_pd(b.ys.as_ptr().add(t)));
+                let dz = _mm256_sub_pd(vz, _mm256_loadu_pd(b.zs.as_ptr().add(t)));
                 let d2 = _mm256_add_pd(
                     _mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy)),
                     _mm256_mul_pd(dz, dz),
@@ -281,12 +339,14 @@ mod avx2 {
             }
         };
         let mut found = 0;
-        let mut t = 0;
-        while t < n {
-            let mask = half(t) | half(t + 4) << 4;
-            // SAFETY: t + 8 <= n; `out` has room (see caller).
-            found += unsafe { pack(mask, ids.as_ptr().add(t), out.add(found)) };
-            t += 8;
+        for &(lo, hi) in ranges {
+            let (mut t, end) = (lo as usize, hi as usize);
+            while t < end {
+                let mask = (half(t) | half(t + 4) << 4) & valid_lanes(t, end, skip);
+                // SAFETY: t + 8 <= end + 7 < len (padding); `out` has room (see caller).
+                found += unsafe { pack(mask, b.ids.as_ptr().add(t), out.add(found)) };
+                t += 8;
+            }
         }
         found
     }
@@ -297,58 +357,71 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
-    fn both<R: Real>(pts: &[[f64; 3]], q: [f64; 3], r: f64) -> (Vec<u32>, Vec<u32>) {
-        let mut g = Gathered::<R>::default();
+    fn both<R: Real>(
+        pts: &[[f64; 3]],
+        ranges: &[(u32, u32)],
+        skip: usize,
+        q: [f64; 3],
+        r: f64,
+    ) -> (Vec<u32>, Vec<u32>) {
+        let (mut xs, mut ys, mut zs, mut ids) = (vec![], vec![], vec![], vec![]);
         for (i, p) in pts.iter().enumerate() {
-            g.push(R::of_f64(p[0]), R::of_f64(p[1]), R::of_f64(p[2]), i as u32);
+            xs.push(R::of_f64(p[0]));
+            ys.push(R::of_f64(p[1]));
+            zs.push(R::of_f64(p[2]));
+            ids.push(i as u32);
         }
-        g.push(R::of_f64(q[0]), R::of_f64(q[1]), R::of_f64(q[2]), 9999);
-        let e = g.len() - 1;
-        g.finish();
-        let r2 = R::of_f64(r) * R::of_f64(r);
-        let mut fast = Vec::new();
-        g.neighbours_of(e, r2, &mut fast);
-        // The portable kernel on the same data, with the query moved away as above.
-        let (px, py, pz) = (g.xs[e], g.ys[e], g.zs[e]);
-        g.xs[e] = R::of_f64(f64::INFINITY);
-        let mut slow = vec![0u32; g.xs.len()];
-        let n = unsafe {
-            scan_portable(
-                px,
-                py,
-                pz,
-                &g.xs,
-                &g.ys,
-                &g.zs,
-                &g.ids,
-                r2,
-                slow.as_mut_ptr(),
-            )
+        pad(&mut xs, &mut ys, &mut zs, &mut ids);
+        let b = Block {
+            xs: &xs,
+            ys: &ys,
+            zs: &zs,
+            ids: &ids,
         };
+        let p = q.map(R::of_f64);
+        let r2 = R::of_f64(r) * R::of_f64(r);
+        let mut fast = vec![7];
+        scan_ranges(p, b, ranges, skip, r2, &mut fast);
+        let room: usize = ranges.iter().map(|&(a, b)| (b - a) as usize).sum();
+        let mut slow = vec![0u32; room];
+        let n = unsafe { scan_portable(p, b, ranges, skip, r2, slow.as_mut_ptr()) };
         slow.truncate(n);
+        slow.insert(0, 7);
         (fast, slow)
     }
 
     proptest! {
         /// The run-time selected kernel (AVX2 where available) equals the portable one
-        /// and the direct definition, in both precisions, for any block length.
+        /// and the direct definition, in both precisions, for any ranges and skip.
         #[test]
         fn simd_and_portable_agree(
-            pts in proptest::collection::vec([-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64], 0..70),
+            pts in proptest::collection::vec([-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64], 1..70),
+            cuts in proptest::collection::vec(0.0..1.0f64, 0..6),
+            skip_at in 0.0..1.2f64,
             q in [-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64],
             r in 0.01..1.5f64,
         ) {
-            let direct: Vec<u32> = pts.iter().enumerate()
-                .filter(|(_, p)| {
+            let n = pts.len();
+            let mut c: Vec<u32> = cuts.iter().map(|f| (f * n as f64) as u32).collect();
+            c.push(0);
+            c.push(n as u32);
+            c.sort_unstable();
+            let ranges: Vec<(u32, u32)> = c.windows(2).step_by(2).map(|w| (w[0], w[1])).collect();
+            let skip = (skip_at * n as f64) as usize; // sometimes beyond every range
+            let mut direct = vec![7u32];
+            for &(a, b) in &ranges {
+                for t in a as usize..b as usize {
+                    let p = pts[t];
                     let d = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
-                    d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < r * r
-                })
-                .map(|(i, _)| i as u32)
-                .collect();
-            let (fast, slow) = both::<f64>(&pts, q, r);
+                    if t != skip && d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < r * r {
+                        direct.push(t as u32);
+                    }
+                }
+            }
+            let (fast, slow) = both::<f64>(&pts, &ranges, skip, q, r);
             prop_assert_eq!(&fast, &slow);
             prop_assert_eq!(&fast, &direct);
-            let (fast, slow) = both::<f32>(&pts, q, r);
+            let (fast, slow) = both::<f32>(&pts, &ranges, skip, q, r);
             prop_assert_eq!(fast, slow);
         }
     }
