@@ -47,14 +47,15 @@ fn main() {
         times.sort_by(f64::total_cmp);
         let med = times[times.len() / 2];
         let min = times[0];
-        let t = s.timings();
+        let t = s.stats();
         println!(
-            "{:16} median {:7.2} ms min {:7.2} ms {:.3} us/particle  pairs/particle {:.1}  last: cells {:.1} sort {:.1} table {:.1} query {:.1} assemble {:.1} ms",
+            "{:16} median {:7.2} ms min {:7.2} ms {:.3} us/particle  pairs/particle {:.1} tests/particle {:.1}  last: cells {:.1} sort {:.1} table {:.1} query {:.1} assemble {:.1} ms",
             m.name(),
             med * 1e3,
             min * 1e3,
             med * 1e6 / pts.len() as f64,
             out.pair_count() as f64 / pts.len() as f64,
+            t.candidate_tests as f64 / pts.len() as f64,
             t.cells_s * 1e3, t.sort_s * 1e3, t.table_s * 1e3, t.query_s * 1e3, t.assemble_s * 1e3
         );
     }

@@ -11,12 +11,17 @@ use crate::NeighbourLists;
 pub(crate) struct TaskOutput {
     pub particles: Vec<(u32, u32)>,
     pub neighbours: Vec<u32>,
+    /// Where this task's block starts in the CSR indices (fast path of `assemble_by`).
+    start: usize,
+    /// Candidate pairs tested.
+    pub tests: u64,
 }
 
 impl TaskOutput {
     pub fn clear(&mut self) {
         self.particles.clear();
         self.neighbours.clear();
+        self.tests = 0;
     }
 }
 
@@ -31,27 +36,56 @@ unsafe impl<T> Sync for SyncPtr<T> {}
 pub(crate) fn assemble_by<T: Sync>(
     out: &mut NeighbourLists,
     n: usize,
-    tasks: &[T],
+    tasks: &mut [T],
     output: impl Fn(&T) -> &TaskOutput + Sync,
+    output_mut: impl Fn(&mut T) -> &mut TaskOutput,
 ) {
     out.reset(n);
-    if in_caller_order(n, tasks, &output) {
-        // Fast path (particles already sorted by cell, as a solver keeps them): the tasks'
-        // lists, concatenated, are the CSR indices.
-        let mut k = 0;
-        for t in tasks.iter().map(&output) {
-            for &(_, c) in &t.particles {
-                out.offsets[k + 1] = out.offsets[k] + c as usize;
-                k += 1;
-            }
+    if tasks.len() == 1 && in_caller_order(n, tasks, &output) {
+        // One task holding every list in caller order: its buffer becomes the indices
+        // (swapped, not copied; the old index buffer becomes the task's next buffer).
+        let t = output_mut(&mut tasks[0]);
+        for (k, &(_, c)) in t.particles.iter().enumerate() {
+            out.offsets[k + 1] = out.offsets[k] + c as usize;
         }
-        out.indices.clear();
-        out.indices.reserve(out.offsets[n]);
-        for t in tasks.iter().map(&output) {
-            out.indices.extend_from_slice(&t.neighbours);
-        }
+        std::mem::swap(&mut out.indices, &mut t.neighbours);
         return;
     }
+    if in_caller_order(n, tasks, &output) {
+        // Fast path (particles already sorted by cell, as a solver keeps them): the tasks'
+        // lists, concatenated, are the CSR indices; each task copies its block in parallel.
+        let mut total = 0;
+        for t in tasks.iter_mut().map(&output_mut) {
+            t.start = total;
+            total += t.neighbours.len();
+        }
+        out.indices.clear();
+        out.indices.reserve(total);
+        let offs = SyncPtr(out.offsets.as_mut_ptr());
+        let idx = SyncPtr(out.indices.as_mut_ptr());
+        tasks.par_iter().map(&output).for_each(|t| {
+            let (offs, idx) = (offs, idx);
+            // SAFETY: the tasks cover consecutive, disjoint particle ranges and index
+            // ranges (checked by `in_caller_order`); each writes only its own offsets
+            // `offsets[i + 1]` for its particles and its own block of indices.
+            unsafe {
+                let mut at = t.start;
+                std::ptr::copy_nonoverlapping(
+                    t.neighbours.as_ptr(),
+                    idx.0.add(at),
+                    t.neighbours.len(),
+                );
+                for &(i, c) in &t.particles {
+                    at += c as usize;
+                    *offs.0.add(i as usize + 1) = at;
+                }
+            }
+        });
+        // SAFETY: the tasks' blocks tile [0, total).
+        unsafe { out.indices.set_len(total) };
+        return;
+    }
+    let tasks = &*tasks;
     let offs = SyncPtr(out.offsets.as_mut_ptr());
     tasks.par_iter().map(&output).for_each(|t| {
         let p = offs;
@@ -116,4 +150,15 @@ fn in_caller_order<T: Sync>(
         next += t.particles.len() as u32;
     }
     next as usize == n
+}
+
+/// Work items (cells or runs) per parallel task: `default`, or all of them in one task when
+/// the pool has a single thread (which lets [`assemble_by`] hand the task's buffer over
+/// without a copy). The lists do not depend on this choice.
+pub(crate) fn items_per_task(items: usize, default: usize) -> usize {
+    if rayon::current_num_threads() == 1 {
+        items.max(1)
+    } else {
+        default
+    }
 }

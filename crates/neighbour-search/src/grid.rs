@@ -5,11 +5,11 @@ use rustc_hash::FxHashMap;
 use sph_core::{Real, Vec3};
 
 use crate::cells::{cell_bounds, cell_size, compute_cells, Key, KeyPacker};
-use crate::csr::{assemble_by, TaskOutput};
+use crate::csr::{assemble_by, items_per_task, TaskOutput};
 use crate::radix::{sort_pairs, RadixScratch};
 use crate::runs::run_starts;
 use crate::scan::Gathered;
-use crate::{NeighbourLists, NeighbourSearch, SearchError, SearchTimings, Stopwatch};
+use crate::{NeighbourLists, NeighbourSearch, SearchError, SearchStats, Stopwatch};
 
 /// Cells (runs) handled by one parallel task.
 const CELLS_PER_TASK: usize = 64;
@@ -36,7 +36,7 @@ struct SortedParticles<R: Real, K> {
     block_counts: Vec<usize>,
     radix: RadixScratch<K>,
     tasks: Vec<(TaskOutput, Gathered<R>)>,
-    timings: SearchTimings,
+    stats: SearchStats,
 }
 
 impl<R: Real, K: Key> Default for SortedParticles<R, K> {
@@ -52,7 +52,7 @@ impl<R: Real, K: Key> Default for SortedParticles<R, K> {
             block_counts: Vec::new(),
             radix: RadixScratch::default(),
             tasks: Vec::new(),
-            timings: SearchTimings::default(),
+            stats: SearchStats::default(),
         }
     }
 }
@@ -67,7 +67,7 @@ impl<R: Real, K: Key> SortedParticles<R, K> {
         self.keys.par_extend(self.cells.par_iter().map(|&c| key(c)));
         self.order.clear();
         self.order.par_extend((0..n as u32).into_par_iter());
-        self.timings.cells_s += watch.lap();
+        self.stats.cells_s += watch.lap();
         // Particles kept in cell order by the caller (the usual case in a solver, see
         // `CellSorter`) need no sort: check first, it costs one pass over the keys.
         let sorted = self
@@ -85,9 +85,9 @@ impl<R: Real, K: Key> SortedParticles<R, K> {
             dst.clear();
             dst.par_extend(self.order.par_iter().map(|&i| positions[i as usize][a]));
         }
-        self.timings.sort_s = watch.lap();
+        self.stats.sort_s = watch.lap();
         run_starts(&self.keys, &mut self.runs, &mut self.block_counts);
-        self.timings.table_s = watch.lap();
+        self.stats.table_s = watch.lap();
     }
 }
 
@@ -104,13 +104,14 @@ fn query_runs<R: Real>(
     tasks: &mut Vec<(TaskOutput, Gathered<R>)>,
     r2: R,
     out: &mut NeighbourLists,
-    timings: &mut SearchTimings,
+    stats: &mut SearchStats,
     locate: impl Fn(usize) -> Ranges + Sync,
 ) {
     let mut watch = Stopwatch::start();
     let n = xs.len();
     let run_count = runs.len() - 1;
-    let task_count = run_count.div_ceil(CELLS_PER_TASK);
+    let per_task = items_per_task(run_count, CELLS_PER_TASK);
+    let task_count = run_count.div_ceil(per_task);
     if tasks.len() < task_count {
         tasks.resize_with(task_count, Default::default);
     }
@@ -119,8 +120,8 @@ fn query_runs<R: Real>(
         .enumerate()
         .for_each(|(task, (buf, g))| {
             buf.clear();
-            let first = task * CELLS_PER_TASK;
-            for r in first..(first + CELLS_PER_TASK).min(run_count) {
+            let first = task * per_task;
+            for r in first..(first + per_task).min(run_count) {
                 let (start, end) = (runs[r] as usize, runs[r + 1] as usize);
                 let (ranges, count) = locate(start);
                 g.clear();
@@ -133,15 +134,17 @@ fn query_runs<R: Real>(
                     g.extend(&xs[a..b], &ys[a..b], &zs[a..b], &order[a..b]);
                 }
                 let len = g.finish();
+                buf.tests += (len * (end - start)) as u64;
                 for (e, k) in (start..end).enumerate() {
                     let found = g.neighbours_of(len, own + e, r2, &mut buf.neighbours);
                     buf.particles.push((order[k], found));
                 }
             }
         });
-    timings.query_s = watch.lap();
-    assemble_by(out, n, &tasks[..task_count], |t| &t.0);
-    timings.assemble_s = watch.lap();
+    stats.query_s = watch.lap();
+    stats.candidate_tests = tasks[..task_count].iter().map(|t| t.0.tests).sum();
+    assemble_by(out, n, &mut tasks[..task_count], |t| &t.0, |t| &mut t.0);
+    stats.assemble_s = watch.lap();
 }
 
 /// Merges the ranges of three z-consecutive cells (contiguous in sorted order) into one.
@@ -211,8 +214,8 @@ impl<R: Real> NeighbourSearch<R> for CellStartGrid<R> {
         "cell-start-grid"
     }
 
-    fn timings(&self) -> SearchTimings {
-        self.sorted.timings
+    fn stats(&self) -> SearchStats {
+        self.sorted.stats
     }
 
     fn search(
@@ -244,7 +247,7 @@ impl<R: Real> NeighbourSearch<R> for CellStartGrid<R> {
             (x * dims[1] + y) * dims[2] + z
         };
         let bits = 64 - ((total - 1) as u64).leading_zeros();
-        self.sorted.timings = SearchTimings {
+        self.sorted.stats = SearchStats {
             cells_s: watch.lap(),
             ..Default::default()
         };
@@ -260,7 +263,7 @@ impl<R: Real> NeighbourSearch<R> for CellStartGrid<R> {
             self.cell_start[key] = runs[r];
             self.cell_end[key] = runs[r + 1];
         }
-        self.sorted.timings.table_s += watch.lap();
+        self.sorted.stats.table_s += watch.lap();
         let (start, end) = (&self.cell_start[..], &self.cell_end[..]);
         let (cells, order) = (&self.sorted.cells[..], &self.sorted.order[..]);
         let locate = |k: usize| -> Ranges {
@@ -297,7 +300,7 @@ impl<R: Real> NeighbourSearch<R> for CellStartGrid<R> {
             &mut self.sorted.tasks,
             radius * radius,
             out,
-            &mut self.sorted.timings,
+            &mut self.sorted.stats,
             locate,
         );
         Ok(())
@@ -315,7 +318,7 @@ pub struct HashedGrid<R: Real> {
     wide: SortedParticles<R, u128>,
     map_narrow: FxHashMap<u64, (u32, u32)>,
     map_wide: FxHashMap<u128, (u32, u32)>,
-    timings: SearchTimings,
+    stats: SearchStats,
 }
 
 impl<R: Real> Default for HashedGrid<R> {
@@ -332,7 +335,7 @@ impl<R: Real> HashedGrid<R> {
             wide: SortedParticles::default(),
             map_narrow: FxHashMap::default(),
             map_wide: FxHashMap::default(),
-            timings: SearchTimings::default(),
+            stats: SearchStats::default(),
         }
     }
 }
@@ -347,7 +350,7 @@ fn hashed_search<R: Real, K: Key>(
     out: &mut NeighbourLists,
     cells_s: f64,
 ) {
-    s.timings = SearchTimings {
+    s.stats = SearchStats {
         cells_s,
         ..Default::default()
     };
@@ -357,7 +360,7 @@ fn hashed_search<R: Real, K: Key>(
     for r in 0..s.runs.len() - 1 {
         map.insert(s.keys[s.runs[r] as usize], (s.runs[r], s.runs[r + 1]));
     }
-    s.timings.table_s += watch.lap();
+    s.stats.table_s += watch.lap();
     let (cells, order) = (&s.cells[..], &s.order[..]);
     let map = &*map;
     let locate = |k: usize| -> Ranges {
@@ -383,7 +386,7 @@ fn hashed_search<R: Real, K: Key>(
         &mut s.tasks,
         r2,
         out,
-        &mut s.timings,
+        &mut s.stats,
         locate,
     );
 }
@@ -393,8 +396,8 @@ impl<R: Real> NeighbourSearch<R> for HashedGrid<R> {
         "hashed-grid"
     }
 
-    fn timings(&self) -> SearchTimings {
-        self.timings
+    fn stats(&self) -> SearchStats {
+        self.stats
     }
 
     fn search(
@@ -424,7 +427,7 @@ impl<R: Real> NeighbourSearch<R> for HashedGrid<R> {
                 out,
                 t,
             );
-            self.timings = self.narrow.timings;
+            self.stats = self.narrow.stats;
         } else {
             std::mem::swap(&mut self.narrow.cells, &mut self.wide.cells);
             hashed_search(
@@ -437,7 +440,7 @@ impl<R: Real> NeighbourSearch<R> for HashedGrid<R> {
                 t,
             );
             std::mem::swap(&mut self.narrow.cells, &mut self.wide.cells);
-            self.timings = self.wide.timings;
+            self.stats = self.wide.stats;
         }
         Ok(())
     }

@@ -62,18 +62,20 @@ pub trait NeighbourSearch<R: Real>: Send {
         out: &mut NeighbourLists,
     ) -> Result<(), SearchError>;
 
-    /// Phase timings of the last successful search (zero if the method does not time them).
-    fn timings(&self) -> SearchTimings {
-        SearchTimings::default()
+    /// Statistics of the last successful search (zero if the method does not keep them).
+    fn stats(&self) -> SearchStats {
+        SearchStats::default()
     }
 }
 
-/// Wall-clock time of the phases of the last search, in seconds.
+/// Statistics of the last search: wall-clock time of its phases, in seconds, and work done.
 ///
 /// `build_s()` is what the PBF paper's Table 2 calls "Create Hash Grid" (cells, sort, cell
 /// table) and `detect_s()` its "Detect Neighbors" (distance tests and list assembly).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct SearchTimings {
+pub struct SearchStats {
+    /// Candidate pairs whose distance was tested (the self pair included).
+    pub candidate_tests: u64,
     /// Validation and cell coordinates (and, for the relation table, its 27 entries per particle).
     pub cells_s: f64,
     /// Sorting by cell.
@@ -86,7 +88,7 @@ pub struct SearchTimings {
     pub assemble_s: f64,
 }
 
-impl SearchTimings {
+impl SearchStats {
     /// Build time: cells + sort + table.
     pub fn build_s(&self) -> f64 {
         self.cells_s + self.sort_s + self.table_s

@@ -8,7 +8,7 @@ use crate::csr::TaskOutput;
 use crate::radix::{sort_pairs, RadixScratch};
 use crate::runs::run_starts;
 use crate::scan::Gathered;
-use crate::{NeighbourLists, NeighbourSearch, SearchError, SearchTimings, Stopwatch};
+use crate::{NeighbourLists, NeighbourSearch, SearchError, SearchStats, Stopwatch};
 
 /// Offset index of a particle's own cell among its 27 (dx, dy, dz ∈ {−1, 0, 1}, x major).
 const SELF_OFFSET: u32 = 13;
@@ -60,7 +60,7 @@ struct Workspace<R: Real> {
     runs: Vec<u32>,
     block_counts: Vec<usize>,
     tasks: Vec<(TaskOutput, Gathered<R>)>,
-    timings: SearchTimings,
+    stats: SearchStats,
 }
 
 impl<R: Real> Default for RelationTable<R> {
@@ -80,7 +80,7 @@ impl<R: Real> RelationTable<R> {
                 runs: Vec::new(),
                 block_counts: Vec::new(),
                 tasks: Vec::new(),
-                timings: SearchTimings::default(),
+                stats: SearchStats::default(),
             },
         }
     }
@@ -96,8 +96,8 @@ impl<R: Real> NeighbourSearch<R> for RelationTable<R> {
         "relation-table"
     }
 
-    fn timings(&self) -> SearchTimings {
-        self.work.timings
+    fn stats(&self) -> SearchStats {
+        self.work.stats
     }
 
     fn search(
@@ -177,16 +177,17 @@ fn build_and_query<K: Key, R: Real>(
                 }
             }
         });
-    work.timings.cells_s = watch.lap();
+    work.stats.cells_s = watch.lap();
     // 2. Lexicographic sort by cell (Fig. 3b).
     sort_pairs(&mut t.keys, &mut t.vals, packer.bits, &mut t.radix);
-    work.timings.sort_s = watch.lap();
+    work.stats.sort_s = watch.lap();
     // 3. Runs of equal cells (Fig. 3c: each run's start and number).
     run_starts(&t.keys, &mut work.runs, &mut work.block_counts);
     let run_count = work.runs.len() - 1;
-    work.timings.table_s = watch.lap();
+    work.stats.table_s = watch.lap();
     // 4. Each particle scans the run of its own cell.
-    let task_count = run_count.div_ceil(RUNS_PER_TASK);
+    let per_task = crate::csr::items_per_task(run_count, RUNS_PER_TASK);
+    let task_count = run_count.div_ceil(per_task);
     if work.tasks.len() < task_count {
         work.tasks.resize_with(task_count, Default::default);
     }
@@ -197,8 +198,8 @@ fn build_and_query<K: Key, R: Real>(
         .enumerate()
         .for_each(|(task, (buf, g))| {
             buf.clear();
-            let first = task * RUNS_PER_TASK;
-            let last = (first + RUNS_PER_TASK).min(run_count);
+            let first = task * per_task;
+            let last = (first + per_task).min(run_count);
             for r in first..last {
                 let run = &vals[runs[r] as usize..runs[r + 1] as usize];
                 if !run.iter().any(|&v| v % 27 == SELF_OFFSET) {
@@ -212,22 +213,16 @@ fn build_and_query<K: Key, R: Real>(
                 let len = g.finish();
                 for (e, &v) in run.iter().enumerate() {
                     if v % 27 == SELF_OFFSET {
+                        buf.tests += len as u64;
                         let found = g.neighbours_of(len, e, r2, &mut buf.neighbours);
                         buf.particles.push((v / 27, found));
                     }
                 }
             }
         });
-    work.timings.query_s = watch.lap();
-    let tasks = &work.tasks[..task_count];
-    assemble_pairs(out, n, tasks);
-    work.timings.assemble_s = watch.lap();
-}
-
-fn assemble_pairs<R: Real>(
-    out: &mut NeighbourLists,
-    n: usize,
-    tasks: &[(TaskOutput, Gathered<R>)],
-) {
-    crate::csr::assemble_by(out, n, tasks, |t| &t.0);
+    work.stats.query_s = watch.lap();
+    work.stats.candidate_tests = work.tasks[..task_count].iter().map(|t| t.0.tests).sum();
+    let tasks = &mut work.tasks[..task_count];
+    crate::csr::assemble_by(out, n, tasks, |t| &t.0, |t| &mut t.0);
+    work.stats.assemble_s = watch.lap();
 }

@@ -2,10 +2,11 @@
 //! structure-of-arrays block of candidates (the cell-sorted particles of the grids, or the
 //! candidates the relation table gathers for one run).
 //!
-//! On x86-64 CPUs with AVX2 (detected at run time; nothing is compiled with
-//! `target-cpu=native`), eight candidates are tested per instruction sequence and the
-//! indices that pass are left-packed with one permutation from a 256-entry table, without
-//! a branch; range ends and the particle itself are masked out. Elsewhere a portable
+//! On x86-64 CPUs with AVX-512F or AVX2 (detected at run time; nothing is compiled with
+//! `target-cpu=native`), 16 or 8 candidates are tested per instruction sequence and the
+//! indices that pass are left-packed without a branch (AVX-512's in-register compress, or
+//! for AVX2 one permutation from a 256-entry table); range ends and the particle itself
+//! are masked out. Elsewhere a portable
 //! branch-free loop does the same one candidate at a time. Both evaluate
 //! `(dx·dx + dy·dy) + dz·dz < h²` with the same IEEE operations in the same order as
 //! [`crate::squared_distance`] (no fused multiply-add), so their results are identical.
@@ -14,9 +15,9 @@ use std::any::TypeId;
 
 use sph_core::Real;
 
-/// Lanes processed per step. Blocks carry this many padding entries after their last
-/// candidate, so that a step may read past the end of a range.
-pub(crate) const LANES: usize = 8;
+/// Most lanes processed per step (AVX-512: 16). Blocks carry this many padding entries after
+/// their last candidate, so that a step may read past the end of a range.
+pub(crate) const LANES: usize = 16;
 
 /// Candidates in structure-of-arrays form (`ids` are the caller's indices), each slice
 /// followed by at least [`LANES`] padding entries.
@@ -173,6 +174,28 @@ unsafe fn scan<R: Real>(
 ) -> usize {
     #[cfg(target_arch = "x86_64")]
     {
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            let q = [p[0].as_f64(), p[1].as_f64(), p[2].as_f64(), r2.as_f64()];
+            if let (Some(xs), Some(ys), Some(zs)) = (same::<R, f32>(b.xs), same(b.ys), same(b.zs)) {
+                let q = q.map(|v| v as f32); // exact: the values are f32
+                let blk = Block {
+                    xs,
+                    ys,
+                    zs,
+                    ids: b.ids,
+                };
+                return unsafe { avx512::scan_f32(q, blk, ranges, skip, out) };
+            }
+            if let (Some(xs), Some(ys), Some(zs)) = (same::<R, f64>(b.xs), same(b.ys), same(b.zs)) {
+                let blk = Block {
+                    xs,
+                    ys,
+                    zs,
+                    ids: b.ids,
+                };
+                return unsafe { avx512::scan_f64(q, blk, ranges, skip, out) };
+            }
+        }
         if std::arch::is_x86_feature_detected!("avx2")
             && std::arch::is_x86_feature_detected!("popcnt")
         {
@@ -346,6 +369,116 @@ mod avx2 {
                 // SAFETY: t + 8 <= end + 7 < len (padding); `out` has room (see caller).
                 found += unsafe { pack(mask, b.ids.as_ptr().add(t), out.add(found)) };
                 t += 8;
+            }
+        }
+        found
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+mod avx512 {
+    use super::Block;
+    use std::arch::x86_64::*;
+
+    /// Lanes `[t, t + 16)` that lie inside `[t, end)` and are not `skip`.
+    #[inline(always)]
+    fn valid_lanes(t: usize, end: usize, skip: usize) -> u16 {
+        let left = end - t;
+        let mut m = if left >= 16 {
+            0xffff
+        } else {
+            ((1u32 << left) - 1) as u16
+        };
+        let s = skip.wrapping_sub(t);
+        if s < 16 {
+            m &= !(1 << s);
+        }
+        m
+    }
+
+    /// Left-packs the ids of the set lanes (in-register compress, then a full store into
+    /// the reserved room).
+    #[inline(always)]
+    unsafe fn pack(mask: u16, ids: *const u32, out: *mut u32) -> usize {
+        unsafe {
+            let idv = _mm512_loadu_si512(ids as *const __m512i);
+            _mm512_storeu_si512(out as *mut __m512i, _mm512_maskz_compress_epi32(mask, idv));
+        }
+        mask.count_ones() as usize
+    }
+
+    #[target_feature(enable = "avx512f,popcnt")]
+    pub(super) unsafe fn scan_f32(
+        q: [f32; 4],
+        b: Block<'_, f32>,
+        ranges: &[(u32, u32)],
+        skip: usize,
+        out: *mut u32,
+    ) -> usize {
+        let (vx, vy, vz) = (
+            _mm512_set1_ps(q[0]),
+            _mm512_set1_ps(q[1]),
+            _mm512_set1_ps(q[2]),
+        );
+        let vr2 = _mm512_set1_ps(q[3]);
+        let mut found = 0;
+        for &(lo, hi) in ranges {
+            let (mut t, end) = (lo as usize, hi as usize);
+            while t < end {
+                // SAFETY: t + 16 <= end + 15 < len (padding); `out` has room (see caller).
+                unsafe {
+                    let dx = _mm512_sub_ps(vx, _mm512_loadu_ps(b.xs.as_ptr().add(t)));
+                    let dy = _mm512_sub_ps(vy, _mm512_loadu_ps(b.ys.as_ptr().add(t)));
+                    let dz = _mm512_sub_ps(vz, _mm512_loadu_ps(b.zs.as_ptr().add(t)));
+                    let d2 = _mm512_add_ps(
+                        _mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)),
+                        _mm512_mul_ps(dz, dz),
+                    );
+                    let near = _mm512_cmp_ps_mask::<_CMP_LT_OQ>(d2, vr2);
+                    let mask = near & valid_lanes(t, end, skip);
+                    found += pack(mask, b.ids.as_ptr().add(t), out.add(found));
+                }
+                t += 16;
+            }
+        }
+        found
+    }
+
+    #[target_feature(enable = "avx512f,popcnt")]
+    pub(super) unsafe fn scan_f64(
+        q: [f64; 4],
+        b: Block<'_, f64>,
+        ranges: &[(u32, u32)],
+        skip: usize,
+        out: *mut u32,
+    ) -> usize {
+        let (vx, vy, vz) = (
+            _mm512_set1_pd(q[0]),
+            _mm512_set1_pd(q[1]),
+            _mm512_set1_pd(q[2]),
+        );
+        let vr2 = _mm512_set1_pd(q[3]);
+        let half = |t: usize| -> u16 {
+            // SAFETY: t + 8 <= len (padding).
+            unsafe {
+                let dx = _mm512_sub_pd(vx, _mm512_loadu_pd(b.xs.as_ptr().add(t)));
+                let dy = _mm512_sub_pd(vy, _mm512_loadu_pd(b.ys.as_ptr().add(t)));
+                let dz = _mm512_sub_pd(vz, _mm512_loadu_pd(b.zs.as_ptr().add(t)));
+                let d2 = _mm512_add_pd(
+                    _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)),
+                    _mm512_mul_pd(dz, dz),
+                );
+                _mm512_cmp_pd_mask::<_CMP_LT_OQ>(d2, vr2) as u16
+            }
+        };
+        let mut found = 0;
+        for &(lo, hi) in ranges {
+            let (mut t, end) = (lo as usize, hi as usize);
+            while t < end {
+                let mask = (half(t) | half(t + 8) << 8) & valid_lanes(t, end, skip);
+                // SAFETY: t + 16 <= end + 15 < len (padding); `out` has room (see caller).
+                found += unsafe { pack(mask, b.ids.as_ptr().add(t), out.add(found)) };
+                t += 16;
             }
         }
         found

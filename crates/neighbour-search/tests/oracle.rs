@@ -270,3 +270,37 @@ fn output_is_identical_for_any_thread_count() {
         assert_eq!(run(1), run(3), "{}", m.name());
     }
 }
+
+/// Clouds already sorted by cell (as a solver keeps them): the searches skip their sort and
+/// take the contiguous assembly path, on one thread and on several.
+mod cell_sorted {
+    use super::*;
+    use neighbour_search::{CellOrder, CellSorter};
+
+    fn sorted(case: &(Vec<[f64; 3]>, f64), sort_radius: f64) -> Vec<Vec3<f64>> {
+        let pts: Vec<Vec3<f64>> = to_r(&case.0);
+        let perm = CellSorter::new()
+            .permutation(&pts, sort_radius, CellOrder::Lexicographic)
+            .unwrap()
+            .to_vec();
+        perm.iter().map(|&i| pts[i as usize]).collect()
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(48))]
+        #[test]
+        fn sorted_clouds_match_the_oracle(case in (cloud(3000, 2.0), 0.05..0.6f64), sparse in any::<bool>(), threads in 1usize..4) {
+            // Sparse: stretch the cloud so that many relation-table runs hold no particle
+            // and whole tasks come out empty.
+            let mut case = case;
+            if sparse {
+                for p in case.0.iter_mut() {
+                    *p = p.map(|x| x * 20.0);
+                }
+            }
+            let pts = sorted(&case, case.1);
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| check_all::<f64>(&pts, case.1))?;
+        }
+    }
+}

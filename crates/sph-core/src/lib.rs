@@ -16,8 +16,8 @@ mod aabb;
 mod error;
 mod particles;
 mod real;
-mod sdf;
 pub mod sampling;
+mod sdf;
 
 pub use aabb::Aabb;
 pub use error::CoreError;
