@@ -2,13 +2,14 @@
 //!
 //! `cargo bench -p benches --bench neighbour_search` (or `cargo xtask bench`). Scenes:
 //! a jittered uniform block at rest spacing 0.025 with h = 0.05 (~30 neighbours each) and a
-//! splash-like sparse cloud, at 10k, 100k and 1M particles (f32), on the default rayon
-//! pool; and SPlisHSPlasH's dam-break anchor scene (59k fluid + 129k boundary particles) on
-//! one thread and on two.
+//! splash-like sparse cloud, at 10k, 100k and 1M particles (f32, in generation order), on
+//! the default rayon pool; and SPlisHSPlasH's dam-break anchor scene (59k fluid + 129k
+//! boundary particles) sorted by cell (as a solver keeps them) on one thread and on two,
+//! and unsorted on one thread. kiddo builds its tree from the same points each iteration.
 
 use benches::{dam_break_anchor, kiddo_search, splash_cloud, uniform_block};
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use neighbour_search::{Method, NeighbourLists, Vec3};
+use neighbour_search::{CellOrder, CellSorter, Method, NeighbourLists, Vec3};
 use std::hint::black_box;
 use std::time::Duration;
 
@@ -65,8 +66,15 @@ fn splash(c: &mut Criterion) {
 
 fn anchor(c: &mut Criterion) {
     let (points, _) = dam_break_anchor::<f32>();
-    run_methods(c, "dam-break-anchor-1-thread", &points, Some(1));
-    run_methods(c, "dam-break-anchor-2-threads", &points, Some(2));
+    // As generated (lattice order), and sorted by cell as a solver keeps its particles.
+    let perm = CellSorter::new()
+        .permutation(&points, H, CellOrder::Lexicographic)
+        .unwrap()
+        .to_vec();
+    let sorted: Vec<Vec3<f32>> = perm.iter().map(|&i| points[i as usize]).collect();
+    run_methods(c, "dam-break-anchor-sorted-1-thread", &sorted, Some(1));
+    run_methods(c, "dam-break-anchor-sorted-2-threads", &sorted, Some(2));
+    run_methods(c, "dam-break-anchor-unsorted-1-thread", &points, Some(1));
 }
 
 criterion_group!(benches, anchor, uniform, splash);

@@ -12,7 +12,7 @@
 //!     mismatch. Any other error counts every particle of the cloud as mismatching. Also
 //!     checked: identical raw output with 1 thread and with the whole pool.
 //! (b) **Timing.** Jittered uniform block (one particle uniformly random in each cube of edge
-//!     `s = 0.025`, `h = 0.05`, ≈ 33 neighbours inside), sorted once by `CellSorter` (Morton),
+//!     `s = 0.025`, `h = 0.05`, ≈ 33 neighbours inside), sorted once by `CellSorter` (lexicographic cell order, the order the searches use),
 //!     f64. Median wall time of `search` over several repetitions after one warm-up, per
 //!     method and N, with the current rayon pool and with a 1-thread pool. Reported: µs per
 //!     particle, the ratio cell-start grid / relation table at the largest N against Im &
@@ -296,6 +296,26 @@ impl Experiment for NeighbourSearchExperiment {
             );
             out.note(claim_note(ratio, claim_lo, claim_hi, threads, n_max));
         }
+        // The fastest method on one thread against the same anchor.
+        let fastest = Method::FAST
+            .iter()
+            .filter_map(|&m| find(m, anchor_threads as usize))
+            .min_by(|a, b| a.median_s.total_cmp(&b.median_s));
+        if let Some(f) = fastest {
+            out.metric(
+                "fastest_over_compactnsearch_anchor/1t",
+                f.us_per_particle() / anchor_us,
+            );
+            out.note(format!(
+                "Fastest method on {} thread(s), N = {n_max}: {} at {} µs/particle, {}× the CompactNSearch anchor of {} µs/particle (this block has about {} neighbours per particle; the anchor scene of the benchmarks has about 23).",
+                anchor_threads,
+                f.method.name(),
+                fmt_num(f.us_per_particle()),
+                fmt_num(f.us_per_particle() / anchor_us),
+                fmt_num(anchor_us),
+                fmt_num(f.pairs as f64 / f.n as f64),
+            ));
+        }
         if let Some(rt1) = find(Method::RelationTable, anchor_threads as usize) {
             out.metric(
                 "relation_table_over_compactnsearch_anchor/1t",
@@ -311,7 +331,7 @@ impl Experiment for NeighbourSearchExperiment {
         }
         out.note(format!(
             "Timing setup: jittered block (one particle uniformly random in each cube of edge {SPACING}), h = {RADIUS}, \
-             f64, particles pre-sorted by CellSorter (Morton order, as a simulation re-sorts them), median of \
+             f64, particles pre-sorted by CellSorter (lexicographic cell order of h, as a simulation keeps them), median of \
              {} searches after one warm-up search; rayon pool of {pool_threads} thread(s) and a 1-thread pool. \
              The machine is shared with other builds: timings are indicative.",
             mode.pick("5", "5–9")
@@ -555,7 +575,7 @@ fn correctness<R: Real>(cloud: &Cloud) -> Result<Vec<CorrectnessRow>> {
 }
 
 /// Jittered block of `side³` particles (one uniformly random in each cube of edge SPACING),
-/// sorted by cell in Morton order.
+/// sorted by cell in lexicographic order (the searches then skip their own sort).
 fn timing_block(side: usize) -> Result<Vec<Vec3<f64>>> {
     let mut rng = SplitMix64::new(0xb10c_0000 + side as u64);
     let mut pos = Vec::with_capacity(side * side * side);
@@ -572,7 +592,7 @@ fn timing_block(side: usize) -> Result<Vec<Vec3<f64>>> {
     }
     let mut sorter = CellSorter::new();
     let perm = sorter
-        .permutation(&pos, RADIUS, CellOrder::Morton)?
+        .permutation(&pos, RADIUS, CellOrder::Lexicographic)?
         .to_vec();
     Ok(perm.iter().map(|&i| pos[i as usize]).collect())
 }
