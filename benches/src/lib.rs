@@ -54,8 +54,8 @@ pub fn splash_cloud<R: Real>(n: usize, spacing: f64) -> Vec<Vec3<R>> {
 /// The neighbour-search anchor scene of SPlisHSPlasH's `DamBreakModel.json` at particle
 /// radius 0.0125 m (support 0.05 m): a fluid block of 39³ = 59,319 particles at spacing
 /// 0.025 m starting at (−1.95, 0.05, −0.5) + half a spacing, and the walls of the 4 × 3 × 1.5 m
-/// tank centred at (0, 1.5, 0), sampled here on square lattices of spacing 0.0186 m (about
-/// 129k particles, close to SPlisHSPlasH's 129,454 boundary particles from its own surface
+/// tank centred at (0, 1.5, 0), sampled here on square lattices of spacing 0.0186 m (131,976
+/// particles, close to SPlisHSPlasH's 129,454 boundary particles from its own surface
 /// sampling, which differs in detail). Returns (positions, fluid count).
 pub fn dam_break_anchor<R: Real>() -> (Vec<Vec3<R>>, usize) {
     let s = 0.025;

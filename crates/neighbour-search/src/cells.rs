@@ -57,8 +57,8 @@ pub(crate) fn cell_size<R: Real>(radius: R) -> Result<f64, SearchError> {
 fn cell_of_axis(x: f64, cell: f64) -> Option<i32> {
     // Division, not multiplication by an inverse, keeps the error bound of CELL_MARGIN.
     let q = x / cell;
-    // `!(a <= b)` is also true for NaN.
-    if !(q.abs() <= CELL_LIMIT) {
+    // NaN and ±∞ fail this test too.
+    if q.is_nan() || q.abs() > CELL_LIMIT {
         return None;
     }
     // floor without a libm call (baseline x86-64 has no rounding instruction): truncation

@@ -307,11 +307,19 @@ impl<R: Real> NeighbourSearch<R> for CellStartGrid<R> {
     }
 }
 
-/// A sorted grid for **unbounded** domains: like [`CellStartGrid`], but the cell → particle
-/// range table is a hash map over the occupied cells only (as in CompactNSearch, Band et
-/// al., the neighbour search of SPlisHSPlasH), so memory scales with the particles, not
-/// with the extent of the scene. Particles are sorted by an order-preserving packed cell
-/// key (lexicographic, `u64` when the occupied range fits, `u128` otherwise).
+/// A sorted grid for **unbounded** domains, in the spirit of compact hashing:
+///
+/// > Markus Ihmsen, Nadir Akinci, Markus Becker and Matthias Teschner, "A Parallel SPH
+/// > Implementation on Multi-Core CPUs", *Computer Graphics Forum* 30(1), 2011, 99–112
+/// > (compact hashing), the scheme behind CompactNSearch, SPlisHSPlasH's search.
+///
+/// Like [`CellStartGrid`], particles are sorted by cell, but the cell → particle-range table
+/// is a hash map over the **occupied** cells only, so memory scales with the particles, not
+/// with the extent of the scene. Deviation: Ihmsen et al. hash cells into a fixed-size table
+/// of buckets with a handle array of used cells; here a general hash map (FxHash) of the
+/// occupied cells' packed keys is rebuilt each search, and the particles are sorted by an
+/// order-preserving packed cell key (lexicographic, `u64` when the occupied range fits,
+/// `u128` otherwise), so the three cells of a z-column are one contiguous range.
 #[derive(Debug, Clone)]
 pub struct HashedGrid<R: Real> {
     narrow: SortedParticles<R, u64>,

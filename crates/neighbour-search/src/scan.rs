@@ -543,8 +543,7 @@ mod tests {
             let skip = (skip_at * n as f64) as usize; // sometimes beyond every range
             let mut direct = vec![7u32];
             for &(a, b) in &ranges {
-                for t in a as usize..b as usize {
-                    let p = pts[t];
+                for (t, p) in pts.iter().enumerate().take(b as usize).skip(a as usize) {
                     let d = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
                     if t != skip && d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < r * r {
                         direct.push(t as u32);

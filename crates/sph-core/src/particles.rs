@@ -216,8 +216,8 @@ mod tests {
             perm.sort_by_key(|&i| (keys[i as usize], i));
             let mut s = PermutationScratch::default();
             set.permute(&perm, &mut s).unwrap();
-            for k in 0..n {
-                let i = perm[k] as f64;
+            for (k, &pk) in perm.iter().enumerate() {
+                let i = pk as f64;
                 prop_assert_eq!(set.positions[k].x, i);
                 prop_assert_eq!(set.velocities[k].x, -i);
                 prop_assert_eq!(set.masses[k], i + 1.0);
