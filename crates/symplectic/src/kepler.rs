@@ -1,0 +1,178 @@
+//! The exact two-body drift in universal variables.
+//!
+//! Solves Kepler's problem `r̈ = −μ r/|r|³` for a time step `dt` from any initial state:
+//! elliptic, parabolic or hyperbolic, forwards or backwards. Formulation of
+//!
+//! > J. M. A. Danby, *Fundamentals of Celestial Mechanics*, 2nd ed., Willmann-Bell 1988,
+//! > §6.9–6.10 (universal variables, Stumpff functions `c_k`, Gauss `f` and `g` functions),
+//!
+//! with `β = 2μ/r₀ − v₀²`, `η₀ = r₀·v₀` and the universal anomaly `s`, which solves
+//! Kepler's equation `dt = r₀ G₁(s) + η₀ G₂(s) + μ G₃(s)` where `G_k(s) = s^k c_k(β s²)`.
+//! Then `f = 1 − μ G₂/r₀`, `g = r₀ G₁ + η₀ G₂`, `ḟ = −μ G₁/(r r₀)`, `ġ = 1 − μ G₂/r` with
+//! `r = r₀ G₀ + η₀ G₁ + μ G₂`.
+//!
+//! The Stumpff functions are evaluated by their series after reducing the argument by
+//! powers of four, then rebuilt with the quadruple-argument formulas (Danby §6.9), which
+//! keeps them accurate to round-off for any `βs²`. The equation is solved by Newton's
+//! method from Danby's starting value; Kepler's equation is strictly increasing in `s`
+//! (its derivative is `r > 0`), so when Newton does not converge the solver falls back to
+//! a bracketed bisection–Newton hybrid that always does. For bound orbits the step is
+//! first reduced modulo the period, which changes nothing mathematically and keeps `s`
+//! small for drifts of many orbits.
+
+use crate::{SymplecticError, Vec3};
+
+/// The four Stumpff functions `c₀..c₃` at `z`.
+pub fn stumpff(z: f64) -> [f64; 4] {
+    // Reduce |z| below 0.1 by quarter steps: c_k(z) from c_k(z/4^n).
+    let mut n = 0;
+    let mut x = z;
+    while x.abs() > 0.1 {
+        x *= 0.25;
+        n += 1;
+    }
+    // Series (Horner form) for c2 and c3 at small x, then c1 = 1 − x c3, c0 = 1 − x c2.
+    let c3 = (1.0
+        - x / 20.0 * (1.0 - x / 42.0 * (1.0 - x / 72.0 * (1.0 - x / 110.0 * (1.0 - x / 156.0 * (1.0 - x / 210.0))))))
+        / 6.0;
+    let c2 = (1.0
+        - x / 12.0 * (1.0 - x / 30.0 * (1.0 - x / 56.0 * (1.0 - x / 90.0 * (1.0 - x / 132.0 * (1.0 - x / 182.0))))))
+        / 2.0;
+    let mut c = [1.0 - x * c2, 1.0 - x * c3, c2, c3];
+    for _ in 0..n {
+        let [c0, c1, c2, c3] = c;
+        c = [2.0 * c0 * c0 - 1.0, c1 * c0, 0.5 * c1 * c1, 0.25 * (c2 + c0 * c3)];
+    }
+    c
+}
+
+/// Outcome of one drift, for diagnostics.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DriftInfo {
+    /// Newton iterations used.
+    pub iterations: u32,
+    /// `true` when the bracketed fallback was needed.
+    pub used_fallback: bool,
+}
+
+/// Advances `(r, v)` by `dt` on the Kepler orbit of gravitational parameter `mu` (length³/time²).
+///
+/// Errors when `mu <= 0`, the state is not finite, `r = 0`, or the solver fails (it cannot
+/// for finite input, but a non-finite intermediate is reported rather than returned).
+pub fn drift(r: &mut Vec3, v: &mut Vec3, mu: f64, dt: f64) -> Result<DriftInfo, SymplecticError> {
+    if !(mu.is_finite() && mu > 0.0) {
+        return Err(SymplecticError::InvalidParameter { name: "mu", value: mu, reason: "must be finite and > 0" });
+    }
+    let r0 = r.norm();
+    if !(r0.is_finite() && r0 > 0.0 && v.iter().all(|x| x.is_finite()) && dt.is_finite()) {
+        return Err(SymplecticError::InvalidState {
+            what: "Kepler drift",
+            reason: format!("r = {r:?}, v = {v:?}, dt = {dt}: need finite values and r != 0"),
+        });
+    }
+    if dt == 0.0 {
+        return Ok(DriftInfo { iterations: 0, used_fallback: false });
+    }
+    let eta = r.dot(v);
+    let beta = 2.0 * mu / r0 - v.norm_squared();
+    // Bound orbit: reduce the step modulo the period.
+    let mut dt_eff = dt;
+    if beta > 0.0 {
+        let period = 2.0 * std::f64::consts::PI * mu / (beta * beta.sqrt());
+        if dt.abs() > period {
+            dt_eff = dt % period;
+        }
+    }
+    let kepler = |s: f64| -> (f64, f64, [f64; 4]) {
+        let c = stumpff(beta * s * s);
+        let g1 = s * c[1];
+        let g2 = s * s * c[2];
+        let g3 = s * s * s * c[3];
+        let t = r0 * g1 + eta * g2 + mu * g3;
+        let rr = r0 * c[0] + eta * g1 + mu * g2;
+        (t - dt_eff, rr, c)
+    };
+    // Newton from dt/r0 (a first-order guess valid for any conic).
+    let mut s = dt_eff / r0;
+    let mut info = DriftInfo { iterations: 0, used_fallback: false };
+    let mut converged = false;
+    for _ in 0..40 {
+        info.iterations += 1;
+        let (f, fp, _) = kepler(s);
+        let ds = f / fp;
+        let s_new = s - ds;
+        if !s_new.is_finite() {
+            break;
+        }
+        let done = ds.abs() <= 4.0 * f64::EPSILON * s_new.abs().max(f64::MIN_POSITIVE);
+        s = s_new;
+        if done {
+            converged = true;
+            break;
+        }
+    }
+    if !converged {
+        s = solve_bracketed(&kepler, dt_eff, r0)?;
+        info.used_fallback = true;
+    }
+    let (_, rr, c) = kepler(s);
+    let g1 = s * c[1];
+    let g2 = s * s * c[2];
+    let f = 1.0 - mu * g2 / r0;
+    let g = r0 * g1 + eta * g2;
+    let fdot = -mu * g1 / (rr * r0);
+    let gdot = 1.0 - mu * g2 / rr;
+    let (r_old, v_old) = (*r, *v);
+    *r = r_old * f + v_old * g;
+    *v = r_old * fdot + v_old * gdot;
+    if !(r.iter().chain(v.iter()).all(|x| x.is_finite())) {
+        return Err(SymplecticError::InvalidState {
+            what: "Kepler drift",
+            reason: format!("non-finite result from r = {r_old:?}, v = {v_old:?}, mu = {mu}, dt = {dt}"),
+        });
+    }
+    Ok(info)
+}
+
+/// Bisection–Newton hybrid on the strictly increasing Kepler function (root of `f`).
+fn solve_bracketed(
+    kepler: &impl Fn(f64) -> (f64, f64, [f64; 4]),
+    dt: f64,
+    r0: f64,
+) -> Result<f64, SymplecticError> {
+    // Bracket: expand from 0 in the direction of dt until the sign changes.
+    let (mut lo, mut hi) = (0.0f64, dt / r0);
+    let mut grow = 0;
+    while kepler(hi).0.signum() == kepler(lo).0.signum() {
+        lo = hi;
+        hi *= 2.0;
+        grow += 1;
+        if grow > 2000 || !hi.is_finite() {
+            return Err(SymplecticError::InvalidState {
+                what: "Kepler drift",
+                reason: format!("could not bracket the universal anomaly for dt = {dt}"),
+            });
+        }
+    }
+    if lo > hi {
+        std::mem::swap(&mut lo, &mut hi);
+    }
+    let mut s = 0.5 * (lo + hi);
+    for _ in 0..300 {
+        let (f, fp, _) = kepler(s);
+        if f == 0.0 {
+            return Ok(s);
+        }
+        if f < 0.0 {
+            lo = s;
+        } else {
+            hi = s;
+        }
+        let newton = s - f / fp;
+        s = if newton > lo && newton < hi { newton } else { 0.5 * (lo + hi) };
+        if hi - lo <= 2.0 * f64::EPSILON * s.abs() {
+            break;
+        }
+    }
+    Ok(s)
+}

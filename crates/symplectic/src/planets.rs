@@ -1,0 +1,249 @@
+use crate::{kepler, SymplecticError, Vec3};
+
+/// The Sun and `n` planets in mixed (democratic heliocentric) variables, Chegodaeva (2004)
+/// eq. 9 after Duncan, Levison & Lee (1998): heliocentric positions `Q_i = q_i − q_0` and
+/// barycentric momenta `P_i = p_i − m_i/M Σ p_j` of the planets `i = 1..n`. The barycentre
+/// moves uniformly and is not integrated.
+///
+/// The Hamiltonian (eqs. 10–12) is split into
+/// - `H_Kepl = Σ_i |P_i|²/2 (1/m_i + 1/m_0) − G m_i m_0/|Q_i|` — each planet on its own Kepler
+///   orbit with `μ_i = G (m_0 + m_i)` and velocity `P_i (1/m_i + 1/m_0)`;
+/// - `H_Sun = (1/m_0) Σ_{i<j} P_i·P_j` — the cross terms of `|Σ P_i|²/2m_0` (eq. 11);
+/// - `H_Inter = −Σ_{i<j} G m_i m_j / |Q_i − Q_j|`.
+///
+/// Each part has an exact flow, exposed as a named piece.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Planets {
+    g: f64,
+    sun_mass: f64,
+    masses: Vec<f64>,
+    /// Heliocentric positions `Q_i`.
+    positions: Vec<Vec3>,
+    /// Barycentric momenta `P_i`.
+    momenta: Vec<Vec3>,
+    /// Time.
+    time: f64,
+}
+
+impl Planets {
+    /// Builds the system from heliocentric positions and velocities (`q_i − q_0`,
+    /// `v_i − v_0`) of the planets, the Sun's mass and the constant of gravitation `g`.
+    pub fn from_heliocentric(
+        g: f64,
+        sun_mass: f64,
+        masses: &[f64],
+        positions: &[Vec3],
+        velocities: &[Vec3],
+    ) -> Result<Self, SymplecticError> {
+        let positive = |name, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(SymplecticError::InvalidParameter { name, value: v, reason: "must be finite and > 0" })
+            }
+        };
+        positive("G", g)?;
+        positive("sun mass", sun_mass)?;
+        if masses.len() != positions.len() || masses.len() != velocities.len() {
+            return Err(SymplecticError::InvalidState {
+                what: "planets",
+                reason: format!(
+                    "{} masses, {} positions, {} velocities: lengths differ",
+                    masses.len(),
+                    positions.len(),
+                    velocities.len()
+                ),
+            });
+        }
+        for (i, ((&m, q), v)) in masses.iter().zip(positions).zip(velocities).enumerate() {
+            positive("planet mass", m)?;
+            if !(q.iter().chain(v.iter()).all(|x| x.is_finite())) || q.norm() == 0.0 {
+                return Err(SymplecticError::InvalidState {
+                    what: "planets",
+                    reason: format!("planet {}: position {q:?}, velocity {v:?} must be finite, position non-zero", i + 1),
+                });
+            }
+        }
+        let total: f64 = sun_mass + masses.iter().sum::<f64>();
+        // Velocity of the barycentre in the heliocentric frame (the Sun is at rest there).
+        let v_cm: Vec3 = masses.iter().zip(velocities).map(|(&m, v)| v * m).sum::<Vec3>() / total;
+        let momenta = masses.iter().zip(velocities).map(|(&m, v)| (v - v_cm) * m).collect();
+        Ok(Self {
+            g,
+            sun_mass,
+            masses: masses.to_vec(),
+            positions: positions.to_vec(),
+            momenta,
+            time: 0.0,
+        })
+    }
+
+    /// Number of planets.
+    pub fn len(&self) -> usize {
+        self.masses.len()
+    }
+
+    /// `true` without planets.
+    pub fn is_empty(&self) -> bool {
+        self.masses.is_empty()
+    }
+
+    /// Constant of gravitation.
+    pub fn g(&self) -> f64 {
+        self.g
+    }
+
+    /// Mass of the Sun.
+    pub fn sun_mass(&self) -> f64 {
+        self.sun_mass
+    }
+
+    /// Planet masses.
+    pub fn masses(&self) -> &[f64] {
+        &self.masses
+    }
+
+    /// Heliocentric positions `Q_i`.
+    pub fn positions(&self) -> &[Vec3] {
+        &self.positions
+    }
+
+    /// Barycentric momenta `P_i`.
+    pub fn momenta(&self) -> &[Vec3] {
+        &self.momenta
+    }
+
+    /// Time elapsed since the initial state.
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// Barycentric velocities `P_i/m_i` of the planets.
+    pub fn barycentric_velocities(&self) -> Vec<Vec3> {
+        self.momenta.iter().zip(&self.masses).map(|(p, &m)| p / m).collect()
+    }
+
+    /// Heliocentric velocities `v_i − v_0` of the planets.
+    pub fn heliocentric_velocities(&self) -> Vec<Vec3> {
+        let sun_velocity = -self.momenta.iter().sum::<Vec3>() / self.sun_mass;
+        self.barycentric_velocities().into_iter().map(|v| v - sun_velocity).collect()
+    }
+
+    /// The state as a flat vector `(Q_1, P_1, Q_2, P_2, ...)` (for Jacobians and checkpoints).
+    pub fn state_vector(&self) -> Vec<f64> {
+        let mut s = Vec::with_capacity(6 * self.len());
+        for (q, p) in self.positions.iter().zip(&self.momenta) {
+            s.extend_from_slice(q.as_slice());
+            s.extend_from_slice(p.as_slice());
+        }
+        s
+    }
+
+    /// Sets the state from a vector laid out as [`Planets::state_vector`].
+    pub fn set_state_vector(&mut self, s: &[f64]) -> Result<(), SymplecticError> {
+        if s.len() != 6 * self.len() {
+            return Err(SymplecticError::InvalidState {
+                what: "planets",
+                reason: format!("state vector of {} values for {} planets", s.len(), self.len()),
+            });
+        }
+        for (i, c) in s.chunks_exact(6).enumerate() {
+            self.positions[i] = Vec3::new(c[0], c[1], c[2]);
+            self.momenta[i] = Vec3::new(c[3], c[4], c[5]);
+        }
+        Ok(())
+    }
+
+    /// Sets the time (for resuming from a checkpoint).
+    pub fn set_time(&mut self, t: f64) {
+        self.time = t;
+    }
+
+    /// `H_Kepl`, eq. 10.
+    pub fn kepler_energy(&self) -> f64 {
+        let m0 = self.sun_mass;
+        self.masses
+            .iter()
+            .zip(&self.positions)
+            .zip(&self.momenta)
+            .map(|((&m, q), p)| 0.5 * p.norm_squared() * (1.0 / m + 1.0 / m0) - self.g * m * m0 / q.norm())
+            .sum()
+    }
+
+    /// `H_Sun`, eq. 11.
+    pub fn sun_energy(&self) -> f64 {
+        let total: Vec3 = self.momenta.iter().sum();
+        let squares: f64 = self.momenta.iter().map(|p| p.norm_squared()).sum();
+        0.5 * (total.norm_squared() - squares) / self.sun_mass
+    }
+
+    /// `H_Inter`, eq. 12.
+    pub fn interaction_energy(&self) -> f64 {
+        let mut e = 0.0;
+        for i in 0..self.len() {
+            for j in i + 1..self.len() {
+                e -= self.g * self.masses[i] * self.masses[j] / (self.positions[i] - self.positions[j]).norm();
+            }
+        }
+        e
+    }
+
+    /// Total energy `H = H_Kepl + H_Sun + H_Inter` (the barycentric N-body energy).
+    pub fn energy(&self) -> f64 {
+        self.kepler_energy() + self.sun_energy() + self.interaction_energy()
+    }
+
+    /// Piece **A**: the exact flow of `H_Kepl` for `dt` — each planet drifts on its Kepler
+    /// orbit with `μ_i = G (m_0 + m_i)`.
+    pub fn kepler_drift(&mut self, dt: f64) -> Result<(), SymplecticError> {
+        let m0 = self.sun_mass;
+        for i in 0..self.len() {
+            let m = self.masses[i];
+            let factor = 1.0 / m + 1.0 / m0;
+            let mut v = self.momenta[i] * factor;
+            kepler::drift(&mut self.positions[i], &mut v, self.g * (m0 + m), dt).map_err(|e| match e {
+                SymplecticError::InvalidState { reason, .. } => SymplecticError::InvalidState {
+                    what: "planet Kepler drift",
+                    reason: format!("planet {}: {reason}", i + 1),
+                },
+                other => other,
+            })?;
+            self.momenta[i] = v / factor;
+        }
+        self.time += dt;
+        Ok(())
+    }
+
+    /// Piece **B**: the exact flow of `H_Inter` for `dt` (positions fixed, momenta kicked).
+    pub fn interaction_kick(&mut self, dt: f64) {
+        let n = self.len();
+        for i in 0..n {
+            for j in i + 1..n {
+                let d = self.positions[j] - self.positions[i];
+                let r2 = d.norm_squared();
+                let f = d * (self.g * self.masses[i] * self.masses[j] / (r2 * r2.sqrt()) * dt);
+                self.momenta[i] += f;
+                self.momenta[j] -= f;
+            }
+        }
+    }
+
+    /// Piece **C**: the exact flow of `H_Sun` for `dt` (momenta fixed, each position drifts
+    /// by `dt/m_0 Σ_{j≠i} P_j`).
+    pub fn sun_drift(&mut self, dt: f64) {
+        let total: Vec3 = self.momenta.iter().sum();
+        let k = dt / self.sun_mass;
+        for (q, p) in self.positions.iter_mut().zip(&self.momenta) {
+            *q += (total - p) * k;
+        }
+    }
+
+    /// The first planet whose state is not finite (1-based), if any.
+    pub fn first_non_finite(&self) -> Option<usize> {
+        self.positions
+            .iter()
+            .zip(&self.momenta)
+            .position(|(q, p)| !q.iter().chain(p.iter()).all(|x| x.is_finite()))
+            .map(|i| i + 1)
+    }
+}
