@@ -33,15 +33,27 @@ pub fn stumpff(z: f64) -> [f64; 4] {
     }
     // Series (Horner form) for c2 and c3 at small x, then c1 = 1 − x c3, c0 = 1 − x c2.
     let c3 = (1.0
-        - x / 20.0 * (1.0 - x / 42.0 * (1.0 - x / 72.0 * (1.0 - x / 110.0 * (1.0 - x / 156.0 * (1.0 - x / 210.0))))))
+        - x / 20.0
+            * (1.0
+                - x / 42.0
+                    * (1.0
+                        - x / 72.0 * (1.0 - x / 110.0 * (1.0 - x / 156.0 * (1.0 - x / 210.0))))))
         / 6.0;
     let c2 = (1.0
-        - x / 12.0 * (1.0 - x / 30.0 * (1.0 - x / 56.0 * (1.0 - x / 90.0 * (1.0 - x / 132.0 * (1.0 - x / 182.0))))))
+        - x / 12.0
+            * (1.0
+                - x / 30.0
+                    * (1.0 - x / 56.0 * (1.0 - x / 90.0 * (1.0 - x / 132.0 * (1.0 - x / 182.0))))))
         / 2.0;
     let mut c = [1.0 - x * c2, 1.0 - x * c3, c2, c3];
     for _ in 0..n {
         let [c0, c1, c2, c3] = c;
-        c = [2.0 * c0 * c0 - 1.0, c1 * c0, 0.5 * c1 * c1, 0.25 * (c2 + c0 * c3)];
+        c = [
+            2.0 * c0 * c0 - 1.0,
+            c1 * c0,
+            0.5 * c1 * c1,
+            0.25 * (c2 + c0 * c3),
+        ];
     }
     c
 }
@@ -61,7 +73,11 @@ pub struct DriftInfo {
 /// for finite input, but a non-finite intermediate is reported rather than returned).
 pub fn drift(r: &mut Vec3, v: &mut Vec3, mu: f64, dt: f64) -> Result<DriftInfo, SymplecticError> {
     if !(mu.is_finite() && mu > 0.0) {
-        return Err(SymplecticError::InvalidParameter { name: "mu", value: mu, reason: "must be finite and > 0" });
+        return Err(SymplecticError::InvalidParameter {
+            name: "mu",
+            value: mu,
+            reason: "must be finite and > 0",
+        });
     }
     let r0 = r.norm();
     if !(r0.is_finite() && r0 > 0.0 && v.iter().all(|x| x.is_finite()) && dt.is_finite()) {
@@ -71,7 +87,10 @@ pub fn drift(r: &mut Vec3, v: &mut Vec3, mu: f64, dt: f64) -> Result<DriftInfo, 
         });
     }
     if dt == 0.0 {
-        return Ok(DriftInfo { iterations: 0, used_fallback: false });
+        return Ok(DriftInfo {
+            iterations: 0,
+            used_fallback: false,
+        });
     }
     let eta = r.dot(v);
     let beta = 2.0 * mu / r0 - v.norm_squared();
@@ -94,7 +113,10 @@ pub fn drift(r: &mut Vec3, v: &mut Vec3, mu: f64, dt: f64) -> Result<DriftInfo, 
     };
     // Newton from dt/r0 (a first-order guess valid for any conic).
     let mut s = dt_eff / r0;
-    let mut info = DriftInfo { iterations: 0, used_fallback: false };
+    let mut info = DriftInfo {
+        iterations: 0,
+        used_fallback: false,
+    };
     let mut converged = false;
     for _ in 0..40 {
         info.iterations += 1;
@@ -128,7 +150,9 @@ pub fn drift(r: &mut Vec3, v: &mut Vec3, mu: f64, dt: f64) -> Result<DriftInfo, 
     if !(r.iter().chain(v.iter()).all(|x| x.is_finite())) {
         return Err(SymplecticError::InvalidState {
             what: "Kepler drift",
-            reason: format!("non-finite result from r = {r_old:?}, v = {v_old:?}, mu = {mu}, dt = {dt}"),
+            reason: format!(
+                "non-finite result from r = {r_old:?}, v = {v_old:?}, mu = {mu}, dt = {dt}"
+            ),
         });
     }
     Ok(info)
@@ -169,7 +193,11 @@ fn solve_bracketed(
             hi = s;
         }
         let newton = s - f / fp;
-        s = if newton > lo && newton < hi { newton } else { 0.5 * (lo + hi) };
+        s = if newton > lo && newton < hi {
+            newton
+        } else {
+            0.5 * (lo + hi)
+        };
         if hi - lo <= 2.0 * f64::EPSILON * s.abs() {
             break;
         }

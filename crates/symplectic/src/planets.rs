@@ -39,7 +39,11 @@ impl Planets {
             if v.is_finite() && v > 0.0 {
                 Ok(())
             } else {
-                Err(SymplecticError::InvalidParameter { name, value: v, reason: "must be finite and > 0" })
+                Err(SymplecticError::InvalidParameter {
+                    name,
+                    value: v,
+                    reason: "must be finite and > 0",
+                })
             }
         };
         positive("G", g)?;
@@ -66,8 +70,17 @@ impl Planets {
         }
         let total: f64 = sun_mass + masses.iter().sum::<f64>();
         // Velocity of the barycentre in the heliocentric frame (the Sun is at rest there).
-        let v_cm: Vec3 = masses.iter().zip(velocities).map(|(&m, v)| v * m).sum::<Vec3>() / total;
-        let momenta = masses.iter().zip(velocities).map(|(&m, v)| (v - v_cm) * m).collect();
+        let v_cm: Vec3 = masses
+            .iter()
+            .zip(velocities)
+            .map(|(&m, v)| v * m)
+            .sum::<Vec3>()
+            / total;
+        let momenta = masses
+            .iter()
+            .zip(velocities)
+            .map(|(&m, v)| (v - v_cm) * m)
+            .collect();
         Ok(Self {
             g,
             sun_mass,
@@ -120,13 +133,20 @@ impl Planets {
 
     /// Barycentric velocities `P_i/m_i` of the planets.
     pub fn barycentric_velocities(&self) -> Vec<Vec3> {
-        self.momenta.iter().zip(&self.masses).map(|(p, &m)| p / m).collect()
+        self.momenta
+            .iter()
+            .zip(&self.masses)
+            .map(|(p, &m)| p / m)
+            .collect()
     }
 
     /// Heliocentric velocities `v_i − v_0` of the planets.
     pub fn heliocentric_velocities(&self) -> Vec<Vec3> {
         let sun_velocity = -self.momenta.iter().sum::<Vec3>() / self.sun_mass;
-        self.barycentric_velocities().into_iter().map(|v| v - sun_velocity).collect()
+        self.barycentric_velocities()
+            .into_iter()
+            .map(|v| v - sun_velocity)
+            .collect()
     }
 
     /// The state as a flat vector `(Q_1, P_1, Q_2, P_2, ...)` (for Jacobians and checkpoints).
@@ -144,7 +164,11 @@ impl Planets {
         if s.len() != 6 * self.len() {
             return Err(SymplecticError::InvalidState {
                 what: "planets",
-                reason: format!("state vector of {} values for {} planets", s.len(), self.len()),
+                reason: format!(
+                    "state vector of {} values for {} planets",
+                    s.len(),
+                    self.len()
+                ),
             });
         }
         for (i, c) in s.chunks_exact(6).enumerate() {
@@ -166,7 +190,9 @@ impl Planets {
             .iter()
             .zip(&self.positions)
             .zip(&self.momenta)
-            .map(|((&m, q), p)| 0.5 * p.norm_squared() * (1.0 / m + 1.0 / m0) - self.g * m * m0 / q.norm())
+            .map(|((&m, q), p)| {
+                0.5 * p.norm_squared() * (1.0 / m + 1.0 / m0) - self.g * m * m0 / q.norm()
+            })
             .sum()
     }
 
@@ -182,7 +208,8 @@ impl Planets {
         let mut e = 0.0;
         for i in 0..self.len() {
             for j in i + 1..self.len() {
-                e -= self.g * self.masses[i] * self.masses[j] / (self.positions[i] - self.positions[j]).norm();
+                e -= self.g * self.masses[i] * self.masses[j]
+                    / (self.positions[i] - self.positions[j]).norm();
             }
         }
         e
@@ -201,12 +228,14 @@ impl Planets {
             let m = self.masses[i];
             let factor = 1.0 / m + 1.0 / m0;
             let mut v = self.momenta[i] * factor;
-            kepler::drift(&mut self.positions[i], &mut v, self.g * (m0 + m), dt).map_err(|e| match e {
-                SymplecticError::InvalidState { reason, .. } => SymplecticError::InvalidState {
-                    what: "planet Kepler drift",
-                    reason: format!("planet {}: {reason}", i + 1),
-                },
-                other => other,
+            kepler::drift(&mut self.positions[i], &mut v, self.g * (m0 + m), dt).map_err(|e| {
+                match e {
+                    SymplecticError::InvalidState { reason, .. } => SymplecticError::InvalidState {
+                        what: "planet Kepler drift",
+                        reason: format!("planet {}: {reason}", i + 1),
+                    },
+                    other => other,
+                }
             })?;
             self.momenta[i] = v / factor;
         }

@@ -16,15 +16,28 @@ fn stumpff_matches_trigonometric_forms() {
         let c = stumpff(z);
         let (c0, c1, c2, c3) = if z > 0.0 {
             let s = z.sqrt();
-            (s.cos(), s.sin() / s, (1.0 - s.cos()) / z, (s - s.sin()) / (z * s))
+            (
+                s.cos(),
+                s.sin() / s,
+                (1.0 - s.cos()) / z,
+                (s - s.sin()) / (z * s),
+            )
         } else {
             let s = (-z).sqrt();
-            (s.cosh(), s.sinh() / s, (s.cosh() - 1.0) / -z, (s.sinh() - s) / (-z * s))
+            (
+                s.cosh(),
+                s.sinh() / s,
+                (s.cosh() - 1.0) / -z,
+                (s.sinh() - s) / (-z * s),
+            )
         };
         // The closed forms lose a few digits to cancellation; 1e-13 relative (or absolute
         // near zeros of c0, c1) is what they can be trusted to.
         for (k, (got, exp)) in c.iter().zip([c0, c1, c2, c3]).enumerate() {
-            assert!((got - exp).abs() <= 1e-13 * exp.abs().max(1.0), "c{k}({z}) = {got} vs {exp}");
+            assert!(
+                (got - exp).abs() <= 1e-13 * exp.abs().max(1.0),
+                "c{k}({z}) = {got} vs {exp}"
+            );
         }
     }
     // Series limit.
@@ -68,8 +81,14 @@ fn elliptic_orbits_match_keplers_equation() {
             // the energy in one and the semi-major axis in the other) amplified near a
             // pericentre of eccentricity e by ~1/(1−e)^1.5: bound 1e-13 (1 + orbits)/(1−e)².
             let tol = 1e-13 * (1.0 + orbits) / (1.0 - e).powi(2);
-            assert!(rel(&r, &r_ref) < tol, "e = {e}, {orbits} orbits: r {r:?} vs {r_ref:?}");
-            assert!(rel(&v, &v_ref) < tol, "e = {e}, {orbits} orbits: v {v:?} vs {v_ref:?}");
+            assert!(
+                rel(&r, &r_ref) < tol,
+                "e = {e}, {orbits} orbits: r {r:?} vs {r_ref:?}"
+            );
+            assert!(
+                rel(&v, &v_ref) < tol,
+                "e = {e}, {orbits} orbits: v {v:?} vs {v_ref:?}"
+            );
         }
     }
 }
@@ -97,7 +116,10 @@ fn hyperbolic_orbit_matches_hyperbolic_keplers_equation() {
         let (mut r, mut v) = (p0, v0);
         drift(&mut r, &mut v, MU, t).unwrap();
         // Round-off of the two solutions: a few ε times the growth of F (≤ 1e-12 here).
-        assert!(rel(&r, &r_ref) < 1e-12 && rel(&v, &v_ref) < 1e-12, "t = {t}: {r:?} vs {r_ref:?}");
+        assert!(
+            rel(&r, &r_ref) < 1e-12 && rel(&v, &v_ref) < 1e-12,
+            "t = {t}: {r:?} vs {r_ref:?}"
+        );
     }
 }
 
@@ -117,7 +139,10 @@ fn parabolic_orbit_matches_barkers_equation() {
         let v_ref = Vec3::new(-2.0 * w * d / den, 2.0 * w / den, 0.0);
         let (mut r, mut v) = (r0, v0);
         drift(&mut r, &mut v, MU, t).unwrap();
-        assert!(rel(&r, &r_ref) < 1e-12 && rel(&v, &v_ref) < 1e-12, "t = {t}: {r:?} vs {r_ref:?}");
+        assert!(
+            rel(&r, &r_ref) < 1e-12 && rel(&v, &v_ref) < 1e-12,
+            "t = {t}: {r:?} vs {r_ref:?}"
+        );
     }
 }
 
@@ -152,15 +177,24 @@ fn reversible_over_a_million_orbits() {
     for n in [1_000, 1_000_000] {
         let err = forward_and_back(n);
         let bound = 2.0 * round_off_bound(n);
-        assert!(err < bound, "{n} orbits: returned with relative error {err:e} (bound {bound:e})");
+        assert!(
+            err < bound,
+            "{n} orbits: returned with relative error {err:e} (bound {bound:e})"
+        );
     }
 }
 
 #[test]
 fn bad_input_is_an_error() {
     let (mut r, mut v) = (Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0));
-    assert!(matches!(drift(&mut r, &mut v, 0.0, 1.0), Err(SymplecticError::InvalidParameter { name: "mu", .. })));
-    assert!(matches!(drift(&mut r, &mut v, -1.0, 1.0), Err(SymplecticError::InvalidParameter { .. })));
+    assert!(matches!(
+        drift(&mut r, &mut v, 0.0, 1.0),
+        Err(SymplecticError::InvalidParameter { name: "mu", .. })
+    ));
+    assert!(matches!(
+        drift(&mut r, &mut v, -1.0, 1.0),
+        Err(SymplecticError::InvalidParameter { .. })
+    ));
     let mut z = Vec3::zeros();
     assert!(drift(&mut z, &mut v, 1.0, 1.0).is_err());
     let mut nan = Vec3::new(f64::NAN, 0.0, 0.0);
