@@ -39,9 +39,9 @@ pub const S2_STAGES: [Stage; 5] = [
 ];
 
 /// `c₁ = 1/√5` of eq. 7 (Laskar & Robutel 2001, SBAB₃).
-pub const S6_C1: f64 = 0.447_213_595_499_957_94;
+pub const S6_C1: f64 = 0.447_213_595_499_957_9;
 /// `c₂ = (1 − 1/√5)/2` of eq. 7.
-pub const S6_C2: f64 = 0.276_393_202_250_021_03;
+pub const S6_C2: f64 = 0.276_393_202_250_021;
 /// `d₁ = 1/12` of eq. 7.
 pub const S6_D1: f64 = 1.0 / 12.0;
 /// `d₂ = 5/12` of eq. 7.
@@ -140,5 +140,42 @@ impl Integrator {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn coefficients_are_those_of_eq_7() {
+        let c1 = 1.0 / 5f64.sqrt();
+        assert!((S6_C1 - c1).abs() <= f64::EPSILON * c1);
+        assert!((S6_C2 - 0.5 * (1.0 - c1)).abs() <= 2.0 * f64::EPSILON);
+        // Consistency: the drifts and the kicks each sum to one step.
+        let sum = |p: Piece| {
+            S6_STAGES
+                .iter()
+                .filter(|s| s.piece == p)
+                .map(|s| s.coefficient)
+                .sum::<f64>()
+        };
+        assert!((sum(Piece::Kepler) - 1.0).abs() < 1e-15);
+        assert!((sum(Piece::Perturbation) - 1.0).abs() < 1e-15);
+        let sum2 = |p: Piece| {
+            S2_STAGES
+                .iter()
+                .filter(|s| s.piece == p)
+                .map(|s| s.coefficient)
+                .sum::<f64>()
+        };
+        assert_eq!(
+            [
+                sum2(Piece::Kepler),
+                sum2(Piece::Interaction),
+                sum2(Piece::Sun)
+            ],
+            [1.0; 3]
+        );
     }
 }
