@@ -520,6 +520,49 @@ mod tests {
         let n = unsafe { scan_portable(p, b, ranges, skip, r2, slow.as_mut_ptr()) };
         slow.truncate(n);
         slow.insert(0, 7);
+        // The AVX2 kernel directly, where the CPU has it (the dispatcher prefers AVX-512).
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2")
+            && std::arch::is_x86_feature_detected!("popcnt")
+        {
+            let room = room + LANES * ranges.len();
+            let mut avx2_out = vec![0u32; room];
+            let q4 = [p[0].as_f64(), p[1].as_f64(), p[2].as_f64(), r2.as_f64()];
+            let n = if let (Some(x), Some(y), Some(z)) = (same::<R, f32>(&xs), same(&ys), same(&zs))
+            {
+                let blk = Block {
+                    xs: x,
+                    ys: y,
+                    zs: z,
+                    ids: &ids,
+                };
+                unsafe {
+                    avx2::scan_f32(
+                        q4.map(|v| v as f32),
+                        blk,
+                        ranges,
+                        skip,
+                        avx2_out.as_mut_ptr(),
+                    )
+                }
+            } else {
+                let (x, y, z) = (
+                    same::<R, f64>(&xs).unwrap(),
+                    same(&ys).unwrap(),
+                    same(&zs).unwrap(),
+                );
+                let blk = Block {
+                    xs: x,
+                    ys: y,
+                    zs: z,
+                    ids: &ids,
+                };
+                unsafe { avx2::scan_f64(q4, blk, ranges, skip, avx2_out.as_mut_ptr()) }
+            };
+            avx2_out.truncate(n);
+            avx2_out.insert(0, 7);
+            assert_eq!(avx2_out, slow, "AVX2 kernel differs from the portable one");
+        }
         (fast, slow)
     }
 
