@@ -32,10 +32,11 @@ fn run<R: neighbour_search::Real>() {
         pts = perm.iter().map(|&i| pts[i as usize]).collect();
     }
     println!(
-        "{} particles ({} fluid), {} thread(s)",
+        "{} particles ({} fluid), {} thread(s), {}",
         pts.len(),
         fluid,
-        threads
+        threads,
+        R::NAME
     );
     let only: Option<String> = std::env::args().nth(2);
     for m in Method::FAST {

@@ -166,9 +166,14 @@ fn solve_bracketed(
 ) -> Result<f64, SymplecticError> {
     // Bracket: expand from 0 in the direction of dt until the sign changes.
     let (mut lo, mut hi) = (0.0f64, dt / r0);
+    let mut f_lo = kepler(lo).0;
     let mut grow = 0;
-    while kepler(hi).0.signum() == kepler(lo).0.signum() {
-        lo = hi;
+    loop {
+        let f_hi = kepler(hi).0;
+        if f_hi.signum() != f_lo.signum() {
+            break;
+        }
+        (lo, f_lo) = (hi, f_hi);
         hi *= 2.0;
         grow += 1;
         if grow > 2000 || !hi.is_finite() {
