@@ -111,8 +111,19 @@ pub fn drift(r: &mut Vec3, v: &mut Vec3, mu: f64, dt: f64) -> Result<DriftInfo, 
         let rr = r0 * c[0] + eta * g1 + mu * g2;
         (t - dt_eff, rr, c)
     };
-    // Newton from dt/r0 (a first-order guess valid for any conic).
-    let mut s = dt_eff / r0;
+    // Newton from the third-order series inversion of Kepler's equation,
+    // dt = r0 s + η0 s²/2 + (μ − β r0) s³/6 + O(s⁴), when it is a small correction to dt/r0
+    // (the usual case of a step much shorter than the orbit); otherwise from dt/r0, a
+    // first-order guess valid for any conic.
+    let x = dt_eff / r0;
+    let a2 = eta / (2.0 * r0);
+    let a3 = (mu - beta * r0) / (6.0 * r0);
+    let correction = -a2 * x * x + (2.0 * a2 * a2 - a3) * x * x * x;
+    let mut s = if correction.abs() < 0.1 * x.abs() {
+        x + correction
+    } else {
+        x
+    };
     let mut info = DriftInfo {
         iterations: 0,
         used_fallback: false,
@@ -208,4 +219,44 @@ fn solve_bracketed(
         }
     }
     Ok(s)
+}
+
+/// Osculating elements of a two-body state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Elements {
+    /// Semi-major axis (negative for hyperbolae, infinite for a parabola).
+    pub semi_major_axis: f64,
+    /// Eccentricity.
+    pub eccentricity: f64,
+    /// Inclination to the reference plane (rad).
+    pub inclination: f64,
+    /// Perihelion distance `q = p/(1 + e)` (accurate for every conic).
+    pub perihelion: f64,
+}
+
+/// Osculating elements of `(r, v)` about a centre of gravitational parameter `mu`.
+pub fn elements(r: &Vec3, v: &Vec3, mu: f64) -> Result<Elements, SymplecticError> {
+    let rn = r.norm();
+    if !(mu.is_finite() && mu > 0.0 && rn > 0.0 && r.iter().chain(v.iter()).all(|x| x.is_finite()))
+    {
+        return Err(SymplecticError::InvalidState {
+            what: "osculating elements",
+            reason: format!("r = {r:?}, v = {v:?}, mu = {mu}: need finite values, r != 0, mu > 0"),
+        });
+    }
+    let h = r.cross(v);
+    let e_vec = v.cross(&h) / mu - r / rn;
+    let e = e_vec.norm();
+    let inv_a = 2.0 / rn - v.norm_squared() / mu;
+    let hn = h.norm();
+    Ok(Elements {
+        semi_major_axis: 1.0 / inv_a,
+        eccentricity: e,
+        inclination: if hn > 0.0 {
+            (h.z / hn).clamp(-1.0, 1.0).acos()
+        } else {
+            0.0
+        },
+        perihelion: h.norm_squared() / mu / (1.0 + e),
+    })
 }

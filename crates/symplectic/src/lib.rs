@@ -1,6 +1,6 @@
 //! Symplectic integrators for the planets and small bodies of the Solar System.
 //!
-//! Implements the planetary part of
+//! Implements
 //!
 //! > Е. А. Чегодаева (E. A. Chegodaeva), «Метод симплектического интегрирования уравнений
 //! > движения малых тел Солнечной системы» ("A method of symplectic integration of the
@@ -24,18 +24,49 @@
 //! Units are the caller's; the experiments use AU, days and solar masses with
 //! `G = 2.95912208286e-4 AU³ M☉⁻¹ day⁻²`.
 //!
-//! Not yet implemented (issue #4 continues): the test particles with Emel'yanenko's variable
-//! time step (eqs. 14–38).
+//! Test particles (massless comets) are integrated separately from the planets, each on its
+//! own clock, with Emel'yanenko's variable time step in the extended phase space:
+//!
+//! - [`Ephemeris`]: the planets on their fixed-step grid, interpolated (quintic Hermite) to
+//!   any particle time, with velocities that are the exact derivative of positions;
+//! - [`ParticleIntegrator`]: the logarithmic-Hamiltonian maps of eqs. 21–32 (mixed
+//!   coordinates, [`Variant::Mixed`]) and eqs. 36–38 (barycentric, [`Variant::Barycentric`],
+//!   the paper's recommendation), with the second-order ([`Scheme::S2`], eq. 27) or
+//!   pseudo-sixth-order ([`Scheme::S6`], eq. 7) composition of the pieces
+//!   [`ParticleIntegrator::kepler_drift`] (`E₀`) and [`ParticleIntegrator::perturbation`] (`E₁`);
+//! - [`CometRun`]: planets and particles advanced together, stop criteria ([`Limits`]), and
+//!   atomic checkpoints ([`save_checkpoint`], [`load_checkpoint`]) that resume bit for bit.
 
+pub mod ephemeris;
 pub mod kepler;
 mod maps;
+mod particles;
 mod planets;
+mod run;
 
+pub use ephemeris::{BodyStates, Ephemeris};
 pub use maps::{Integrator, Piece, Stage, S2_STAGES, S6_C1, S6_C2, S6_D1, S6_D2, S6_STAGES};
+pub use particles::{
+    ParticleIntegrator, ParticlePiece, ParticleScratch, ParticleStage, ParticleStepInfo, Scheme,
+    TestParticle, Variant, PARTICLE_S2_STAGES, PARTICLE_S6_STAGES,
+};
 pub use planets::Planets;
+pub use run::{
+    load_checkpoint, save_checkpoint, CometRun, Limits, ParticleStatus, TrackedParticle,
+};
 
 /// 3-vector of `f64` (nalgebra).
 pub type Vec3 = nalgebra::Vector3<f64>;
+
+/// Obliquity of the ecliptic at J2000, ε = 84381.448″ (IAU 1976 value), in radians.
+pub const OBLIQUITY_J2000_RAD: f64 = 84_381.448 / 3600.0 * std::f64::consts::PI / 180.0;
+
+/// Rotates a vector from the equatorial to the ecliptic frame of J2000 (about `x` by
+/// [`OBLIQUITY_J2000_RAD`]).
+pub fn equatorial_to_ecliptic(v: &Vec3) -> Vec3 {
+    let (s, c) = OBLIQUITY_J2000_RAD.sin_cos();
+    Vec3::new(v.x, c * v.y + s * v.z, -s * v.y + c * v.z)
+}
 
 /// Errors of `symplectic`.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -57,6 +88,27 @@ pub enum SymplecticError {
         /// Where it was detected.
         what: &'static str,
         /// Details, naming the body and values.
+        reason: String,
+    },
+    /// A test particle's `K₀/r` or `K₁/r` (Chegodaeva 2004, eq. 22) is not positive: `B₀, B₁`
+    /// no longer dominate the perturbation (condition 35) and the logarithm is undefined.
+    #[error(
+        "{quantity} = {value} <= 0 at t = {time}: B0, B1 too small for this orbit (condition 35)"
+    )]
+    RegularisationLost {
+        /// `"K0/r"` or `"K1/r"`.
+        quantity: &'static str,
+        /// Its value.
+        value: f64,
+        /// The particle's time.
+        time: f64,
+    },
+    /// A checkpoint could not be written or read.
+    #[error("checkpoint {path}: {reason}")]
+    Checkpoint {
+        /// File.
+        path: String,
+        /// Why.
         reason: String,
     },
     /// The integration blew up: a non-finite value appeared at this step.

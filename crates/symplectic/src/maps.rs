@@ -67,7 +67,7 @@ pub const S6_STAGES: [Stage; 7] = [
 ///   `A + εB`; in mixed variables the perturbation has two parts (`H_Sun`, `H_Inter`) that do
 ///   not commute, so each `e^{dτB}` is applied as `e^{dτC/2} e^{dτB} e^{dτC/2}`
 ///   ([`Piece::Perturbation`]). Its own error is `O(ε² τ³)`, below the scheme's `ε² τ²` term.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Integrator {
     /// Eq. 13 with step `τ`.
     S2 {

@@ -12,7 +12,7 @@ use crate::{kepler, SymplecticError, Vec3};
 /// - `H_Inter = −Σ_{i<j} G m_i m_j / |Q_i − Q_j|`.
 ///
 /// Each part has an exact flow, exposed as a named piece.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Planets {
     g: f64,
     sun_mass: f64,

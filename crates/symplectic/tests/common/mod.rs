@@ -102,3 +102,56 @@ pub fn rk4(m: &[f64], q: &mut [Vec3], v: &mut [Vec3], dt: f64, steps: usize) {
         }
     }
 }
+
+/// The outer Solar System rotated to the ecliptic frame of J2000.
+pub fn outer_solar_system_ecliptic() -> Planets {
+    let (m, q, v) = outer_solar_system_table();
+    let q: Vec<Vec3> = q.iter().map(symplectic::equatorial_to_ecliptic).collect();
+    let v: Vec<Vec3> = v.iter().map(symplectic::equatorial_to_ecliptic).collect();
+    Planets::from_heliocentric(G, m[0], &m[1..], &q[1..], &v[1..]).unwrap()
+}
+
+/// One row of `reference-data/symplectic/particles.csv`.
+#[derive(Debug, Clone)]
+pub struct ParticleRow {
+    pub a: f64,
+    pub q: f64,
+    pub i_deg: f64,
+    pub r0: f64,
+    /// Heliocentric ecliptic position and velocity.
+    pub position: Vec3,
+    pub velocity: Vec3,
+    pub dt0_s2: f64,
+    pub dt0_s6: f64,
+}
+
+pub fn particle_rows() -> Vec<ParticleRow> {
+    let text = include_str!("../../../../reference-data/symplectic/particles.csv");
+    text.lines()
+        .filter(|l| !l.starts_with('#'))
+        .skip(1)
+        .map(|line| {
+            let f: Vec<f64> = line
+                .split(',')
+                .skip(1)
+                .map(|x| x.trim().parse().unwrap())
+                .collect();
+            ParticleRow {
+                a: f[0],
+                q: f[1],
+                i_deg: f[3],
+                r0: f[4],
+                position: Vec3::new(f[6], f[7], f[8]),
+                velocity: Vec3::new(f[9], f[10], f[11]),
+                dt0_s2: f[12],
+                dt0_s6: f[13],
+            }
+        })
+        .collect()
+}
+
+/// Barycentric position and velocity of a heliocentric particle state, at the planets' time.
+pub fn barycentric_particle(planets: &Planets, position: Vec3, velocity: Vec3) -> (Vec3, Vec3) {
+    let (_, q, v) = to_inertial(planets);
+    (position + q[0], velocity + v[0])
+}

@@ -1,0 +1,237 @@
+//! Several test particles and the planets advanced together, with atomic checkpoints.
+
+use std::io::Write;
+use std::path::Path;
+
+use serde::{de::DeserializeOwned, Deserialize, Serialize};
+
+use crate::ephemeris::Ephemeris;
+use crate::kepler::Elements;
+use crate::particles::{ParticleIntegrator, ParticleScratch, ParticleStepInfo, TestParticle};
+use crate::SymplecticError;
+
+/// Why a particle stopped being integrated.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum ParticleStatus {
+    /// Still integrated.
+    Active,
+    /// Its barycentric osculating perihelion fell below [`Limits::min_perihelion`] (outside
+    /// the validity domain of `B₀, B₁`).
+    PerihelionBelowLimit {
+        /// Time when detected.
+        time: f64,
+        /// The perihelion distance then.
+        perihelion: f64,
+    },
+    /// Unbound (`e ≥ 1`) beyond [`Limits::ejection_distance`].
+    Ejected {
+        /// Time when detected.
+        time: f64,
+        /// Distance from the barycentre then.
+        distance: f64,
+    },
+    /// `K₀/r` or `K₁/r` stopped being positive.
+    RegularisationLost {
+        /// Time.
+        time: f64,
+        /// `"K0/r"` or `"K1/r"`.
+        quantity: String,
+        /// Its value.
+        value: f64,
+    },
+}
+
+/// A particle with its status.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TrackedParticle {
+    /// State.
+    pub particle: TestParticle,
+    /// Status.
+    pub status: ParticleStatus,
+}
+
+/// When to stop integrating a particle.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Limits {
+    /// Smallest barycentric osculating perihelion distance allowed.
+    pub min_perihelion: f64,
+    /// Distance from the barycentre beyond which an unbound particle counts as ejected.
+    pub ejection_distance: f64,
+}
+
+/// Planets plus test particles, each particle on its own clock (Chegodaeva 2004: the
+/// particles are integrated separately from the planets, which saves time).
+///
+/// [`CometRun::advance_to`] always steps the active particle that is furthest behind, so the
+/// ephemeris window stays short; the run is a deterministic function of its state, which is
+/// what [`save_checkpoint`] stores: a run resumed from a checkpoint continues bit for bit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CometRun {
+    /// The planets.
+    pub ephemeris: Ephemeris,
+    /// The particle map.
+    pub integrator: ParticleIntegrator,
+    /// The particles.
+    pub particles: Vec<TrackedParticle>,
+    /// Stop criteria.
+    pub limits: Limits,
+    #[serde(skip)]
+    scratch: ParticleScratch,
+}
+
+impl CometRun {
+    /// A run of `particles` (built with [`ParticleIntegrator::particle`]).
+    pub fn new(
+        ephemeris: Ephemeris,
+        integrator: ParticleIntegrator,
+        particles: Vec<TestParticle>,
+        limits: Limits,
+    ) -> Self {
+        Self {
+            ephemeris,
+            integrator,
+            particles: particles
+                .into_iter()
+                .map(|particle| TrackedParticle {
+                    particle,
+                    status: ParticleStatus::Active,
+                })
+                .collect(),
+            limits,
+            scratch: ParticleScratch::default(),
+        }
+    }
+
+    /// Barycentric osculating elements of particle `i` (`μ = G M`, positions relative to the
+    /// barycentre; for the mixed variant the heliocentric position is shifted).
+    /// Errors if the particle's time precedes the ephemeris' retained window (a stopped
+    /// particle left behind).
+    pub fn elements(&mut self, i: usize) -> Result<Elements, SymplecticError> {
+        let mut bodies = crate::ephemeris::BodyStates::default();
+        self.ephemeris
+            .bodies_at(self.particles[i].particle.time, &mut bodies)?;
+        particle_elements(&self.integrator, &self.particles[i].particle, &bodies)
+    }
+
+    /// Advances every active particle until its time reaches `t_end` (the last step
+    /// overshoots: the steps are variable) and the planets to `t_end`; `on_step(i, particle,
+    /// info)` sees every particle step. Particles leaving the limits are marked and stopped.
+    pub fn advance_to(
+        &mut self,
+        t_end: f64,
+        mut on_step: impl FnMut(usize, &TestParticle, &ParticleStepInfo),
+    ) -> Result<(), SymplecticError> {
+        loop {
+            let next = self
+                .particles
+                .iter()
+                .enumerate()
+                .filter(|(_, p)| p.status == ParticleStatus::Active && p.particle.time < t_end)
+                .min_by(|a, b| a.1.particle.time.total_cmp(&b.1.particle.time))
+                .map(|(i, _)| i);
+            let Some(i) = next else { break };
+            let mut particle = self.particles[i].particle.clone();
+            match self
+                .integrator
+                .step(&mut particle, &mut self.ephemeris, &mut self.scratch)
+            {
+                Ok(info) => {
+                    self.particles[i].particle = particle;
+                    on_step(i, &self.particles[i].particle, &info);
+                    let p = &self.particles[i].particle;
+                    // The scratch holds the bodies at the particle's new time.
+                    let el = particle_elements(&self.integrator, p, self.scratch.bodies())?;
+                    if el.eccentricity >= 1.0 && p.position.norm() > self.limits.ejection_distance {
+                        self.particles[i].status = ParticleStatus::Ejected {
+                            time: p.time,
+                            distance: p.position.norm(),
+                        };
+                    } else if el.perihelion < self.limits.min_perihelion {
+                        self.particles[i].status = ParticleStatus::PerihelionBelowLimit {
+                            time: p.time,
+                            perihelion: el.perihelion,
+                        };
+                    }
+                }
+                Err(SymplecticError::RegularisationLost {
+                    quantity,
+                    value,
+                    time,
+                }) => {
+                    self.particles[i].status = ParticleStatus::RegularisationLost {
+                        time,
+                        quantity: quantity.to_string(),
+                        value,
+                    };
+                }
+                Err(e) => return Err(e),
+            }
+            let oldest = self
+                .particles
+                .iter()
+                .filter(|p| p.status == ParticleStatus::Active)
+                .map(|p| p.particle.time)
+                .fold(f64::INFINITY, f64::min);
+            if oldest.is_finite() {
+                self.ephemeris.discard_before(oldest);
+            }
+        }
+        self.ephemeris.extend_to(t_end)?;
+        let newest = self.ephemeris.grid_time(self.ephemeris.planet_steps());
+        let oldest = self
+            .particles
+            .iter()
+            .filter(|p| p.status == ParticleStatus::Active)
+            .map(|p| p.particle.time)
+            .fold(newest, f64::min);
+        self.ephemeris.discard_before(oldest);
+        Ok(())
+    }
+}
+
+fn particle_elements(
+    integrator: &ParticleIntegrator,
+    p: &TestParticle,
+    bodies: &crate::ephemeris::BodyStates,
+) -> Result<Elements, SymplecticError> {
+    let position = match integrator.variant {
+        crate::Variant::Barycentric => p.position,
+        crate::Variant::Mixed => p.position + bodies.positions[0],
+    };
+    crate::kepler::elements(&position, &p.velocity, bodies.total_gm())
+}
+
+/// Writes `value` as JSON to `path` atomically: a temporary file in the same directory is
+/// written, flushed to disk and renamed over `path`, so a crash leaves either the old or the
+/// new checkpoint, never a torn one. `f64` values round-trip exactly.
+pub fn save_checkpoint<T: Serialize>(path: &Path, value: &T) -> Result<(), SymplecticError> {
+    let io = |e: std::io::Error| SymplecticError::Checkpoint {
+        path: path.display().to_string(),
+        reason: e.to_string(),
+    };
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(".tmp");
+    let tmp = std::path::PathBuf::from(tmp);
+    {
+        let mut f = std::fs::File::create(&tmp).map_err(io)?;
+        serde_json::to_writer(&mut f, value).map_err(|e| SymplecticError::Checkpoint {
+            path: tmp.display().to_string(),
+            reason: e.to_string(),
+        })?;
+        f.flush().map_err(io)?;
+        f.sync_all().map_err(io)?;
+    }
+    std::fs::rename(&tmp, path).map_err(io)
+}
+
+/// Reads a checkpoint written by [`save_checkpoint`].
+pub fn load_checkpoint<T: DeserializeOwned>(path: &Path) -> Result<T, SymplecticError> {
+    let text = std::fs::read_to_string(path).map_err(|e| SymplecticError::Checkpoint {
+        path: path.display().to_string(),
+        reason: e.to_string(),
+    })?;
+    serde_json::from_str(&text).map_err(|e| SymplecticError::Checkpoint {
+        path: path.display().to_string(),
+        reason: format!("malformed checkpoint: {e}"),
+    })
+}
