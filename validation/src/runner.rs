@@ -140,7 +140,7 @@ pub fn run_one(
     let bar = ProgressBar::with_draw_target(Some(0), ProgressDrawTarget::stderr());
     bar.set_style(
         ProgressStyle::with_template(
-            "{prefix:>18.bold} [{elapsed_precise}] {wide_bar} {pos}/{len} {msg}",
+            "{prefix:>18.bold} [{elapsed_precise}] {wide_bar} {pos}/{len} eta {eta} {msg}",
         )
         .expect("valid template")
         .progress_chars("=> "),

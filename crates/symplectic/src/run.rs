@@ -12,6 +12,7 @@ use crate::SymplecticError;
 
 /// Why a particle stopped being integrated.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub enum ParticleStatus {
     /// Still integrated.
     Active,

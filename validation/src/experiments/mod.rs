@@ -4,11 +4,13 @@ use crate::Experiment;
 
 pub mod kernels;
 pub mod neighbour_search;
+pub mod symplectic_100myr;
 
 /// Every registered experiment, in run order.
 pub fn registry() -> Vec<Box<dyn Experiment>> {
     vec![
         Box::new(kernels::Kernels),
         Box::new(neighbour_search::NeighbourSearchExperiment),
+        Box::new(symplectic_100myr::Symplectic100Myr),
     ]
 }

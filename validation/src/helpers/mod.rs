@@ -4,6 +4,7 @@
 mod data;
 mod plot;
 mod rng;
+pub mod solar_system;
 
 pub use data::{load_reference_csv, write_csv_columns, write_csv_rows, ReferenceTable};
 pub use plot::{ensure_fonts, plot_xy, Legend, Marker, PlotSpec, Series, SeriesStyle};

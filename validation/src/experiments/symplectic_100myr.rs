@@ -1,0 +1,483 @@
+//! `symplectic-100myr`: the numerical experiment of Chegodaeva (2004) — two comet-like test
+//! particles among the four giant planets for 100 Myr, with the second-order (S2) and the
+//! pseudo-sixth-order (S6) integrator.
+//!
+//! Set-up (paper, "Численные эксперименты"; English in `../shared/papers/README.md`): Jupiter,
+//! Saturn, Uranus, Neptune (Hairer, Lubich & Wanner Table 2.1, rotated to the ecliptic), planet
+//! step 365 d, barycentric particle variant (eqs. 36–38), `B₀ = 0`, `B₁ = 0.21·10⁻⁶`, particle
+//! initial steps 298/310 d (S2) and 910/953 d (S6); particle initial states in
+//! `reference-data/symplectic/particles.csv` (Ω = ω = 0, outbound). Quick mode integrates
+//! 1 Myr, `--full` 100 Myr. S2 and S6 run in parallel, one thread each; each checkpoints
+//! atomically to `<out>/checkpoint-S2.json` / `-S6.json` every 1 % of the span and an
+//! interrupted run resumes from there (bit-identically: see the `symplectic` crate's test
+//! `checkpoint_resumes_bit_identically`). Checkpoints are removed when the run completes.
+//!
+//! Plotted as in the paper: the extended-Hamiltonian error `|ΔH| = |H + p₄|/|H|` (largest over
+//! each sampling window) and the barycentric osculating semi-major axis against time, per
+//! particle and integrator, and the planets' relative energy error. The paper's figure is not
+//! in the extracted text (no curve to digitise), so the checks are its stated findings, each
+//! with the bound's origin given next to it.
+
+use std::path::Path;
+
+use anyhow::{Context as _, Result};
+use serde::{Deserialize, Serialize};
+use symplectic::{
+    load_checkpoint, save_checkpoint, CometRun, Ephemeris, Integrator, Limits, ParticleIntegrator,
+    ParticleScratch, ParticleStatus, Scheme, Variant,
+};
+
+use crate::helpers::solar_system::{
+    outer_planets, particles, thread_cpu_seconds, to_barycentric, DAYS_PER_YEAR,
+};
+use crate::helpers::{plot_xy, write_csv_rows, Legend, PlotSpec, Series};
+use crate::{fmt_num, Check, Context, Experiment, Mode, Outcome};
+
+/// The experiment.
+pub struct Symplectic100Myr;
+
+/// Paper: `B₀ = 0`, `B₁ = 0.21·10⁻⁶` (AU³/day²).
+const B0: f64 = 0.0;
+const B1: f64 = 0.21e-6;
+/// Paper: planet step 365 days.
+const PLANET_STEP_DAY: f64 = 365.0;
+/// Samples per run (plot resolution).
+const SAMPLES: usize = 1000;
+/// Checkpoint every this many samples (1 % of the span).
+const CHECKPOINT_EVERY: usize = 10;
+/// Paper: the particles' perihelia must stay above 26 AU for these `B₀, B₁`.
+const MIN_PERIHELION_AU: f64 = 26.0;
+/// An unbound particle further than this from the barycentre counts as ejected.
+const EJECTION_DISTANCE_AU: f64 = 1000.0;
+/// Checkpoint format tag (changes invalidate old checkpoints).
+const CHECKPOINT_VERSION: u32 = 1;
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct Sample {
+    t_yr: f64,
+    /// Per particle: `(H + p₄)/|H|` at the last step, the largest |…| since the previous
+    /// sample, `a` and `q` (AU); NaN once the particle stopped.
+    last_error: Vec<f64>,
+    max_abs_error: Vec<f64>,
+    a_au: Vec<f64>,
+    q_au: Vec<f64>,
+    /// Planets' relative energy error at the newest grid state.
+    planets_error: f64,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct RunState {
+    version: u32,
+    scheme: Scheme,
+    span_day: f64,
+    run: CometRun,
+    initial_planet_energy: f64,
+    samples: Vec<Sample>,
+    cpu_s: f64,
+    particle_steps: Vec<u64>,
+}
+
+impl RunState {
+    fn new(ctx: &Context, scheme: Scheme, span_day: f64) -> Result<Self> {
+        let planets = outer_planets(ctx, true)?;
+        let initial_planet_energy = planets.energy();
+        let integrator = match scheme {
+            Scheme::S2 => Integrator::S2 {
+                step: PLANET_STEP_DAY,
+            },
+            Scheme::S6 => Integrator::S6 {
+                step: PLANET_STEP_DAY,
+            },
+        };
+        let mut eph = Ephemeris::new(planets.clone(), integrator)?;
+        let pi = ParticleIntegrator::new(Variant::Barycentric, scheme, B0, B1)?;
+        let mut scratch = ParticleScratch::default();
+        let mut ps = Vec::new();
+        for p in particles(ctx)? {
+            let (q, v) = to_barycentric(&planets, p.position, p.velocity);
+            let dt0 = match scheme {
+                Scheme::S2 => p.dt0_s2_day,
+                Scheme::S6 => p.dt0_s6_day,
+            };
+            ps.push(
+                pi.particle(q, v, 0.0, dt0, &mut eph, &mut scratch)
+                    .with_context(|| format!("initial state of {}", p.name))?,
+            );
+        }
+        let n = ps.len();
+        let limits = Limits {
+            min_perihelion: MIN_PERIHELION_AU,
+            ejection_distance: EJECTION_DISTANCE_AU,
+        };
+        Ok(Self {
+            version: CHECKPOINT_VERSION,
+            scheme,
+            span_day,
+            run: CometRun::new(eph, pi, ps, limits),
+            initial_planet_energy,
+            samples: Vec::new(),
+            cpu_s: 0.0,
+            particle_steps: vec![0; n],
+        })
+    }
+
+    /// Runs to the end of the span, sampling, checkpointing to `checkpoint`.
+    fn finish(&mut self, checkpoint: &Path, progress: &indicatif::ProgressBar) -> Result<()> {
+        let n = self.run.particles.len();
+        while self.samples.len() < SAMPLES {
+            let k = self.samples.len() + 1;
+            let t = self.span_day * k as f64 / SAMPLES as f64;
+            let cpu0 = thread_cpu_seconds();
+            let mut last = vec![f64::NAN; n];
+            let mut max_abs = vec![0.0f64; n];
+            let steps = &mut self.particle_steps;
+            self.run.advance_to(t, |i, _, info| {
+                last[i] = info.relative_error;
+                max_abs[i] = max_abs[i].max(info.relative_error.abs());
+                steps[i] += 1;
+            })?;
+            let mut a_au = vec![f64::NAN; n];
+            let mut q_au = vec![f64::NAN; n];
+            for i in 0..n {
+                if self.run.particles[i].status == ParticleStatus::Active {
+                    let el = self.run.elements(i)?;
+                    a_au[i] = el.semi_major_axis;
+                    q_au[i] = el.perihelion;
+                } else {
+                    max_abs[i] = f64::NAN;
+                }
+            }
+            let e = self.run.ephemeris.planets().energy();
+            self.cpu_s += thread_cpu_seconds() - cpu0;
+            self.samples.push(Sample {
+                t_yr: t / DAYS_PER_YEAR,
+                last_error: last,
+                max_abs_error: max_abs,
+                a_au,
+                q_au,
+                planets_error: (e - self.initial_planet_energy) / self.initial_planet_energy.abs(),
+            });
+            progress.inc(1);
+            if self.samples.len() % CHECKPOINT_EVERY == 0 && self.samples.len() < SAMPLES {
+                save_checkpoint(checkpoint, self)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+fn checkpoint_path(ctx: &Context, scheme: Scheme) -> std::path::PathBuf {
+    ctx.path(&format!("checkpoint-{scheme:?}.json"))
+}
+
+/// Loads a matching checkpoint, or starts afresh.
+fn start_or_resume(ctx: &Context, scheme: Scheme, span_day: f64) -> Result<(RunState, bool)> {
+    let path = checkpoint_path(ctx, scheme);
+    if path.is_file() {
+        match load_checkpoint::<RunState>(&path) {
+            Ok(s)
+                if s.version == CHECKPOINT_VERSION
+                    && s.span_day == span_day
+                    && s.scheme == scheme =>
+            {
+                return Ok((s, true));
+            }
+            Ok(_) => ctx.println(format!(
+                "{}: checkpoint of another configuration, starting afresh",
+                path.display()
+            )),
+            Err(e) => ctx.println(format!("{e}; starting afresh")),
+        }
+    }
+    Ok((RunState::new(ctx, scheme, span_day)?, false))
+}
+
+/// Median of the finite values.
+fn median(mut v: Vec<f64>) -> f64 {
+    v.retain(|x| x.is_finite());
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Values of `f(sample)` over the first and the last tenth of the run.
+fn tenths(samples: &[Sample], f: impl Fn(&Sample) -> f64) -> (Vec<f64>, Vec<f64>) {
+    let n = samples.len();
+    let tenth = (n / 10).max(1);
+    (
+        samples[..tenth].iter().map(&f).collect(),
+        samples[n - tenth..].iter().map(&f).collect(),
+    )
+}
+
+fn status_text(s: &ParticleStatus) -> String {
+    match s {
+        ParticleStatus::Active => "integrated to the end".into(),
+        ParticleStatus::PerihelionBelowLimit { time, perihelion } => format!(
+            "stopped at t = {} yr: perihelion {} AU < {MIN_PERIHELION_AU} AU (outside the paper's B0, B1 validity)",
+            fmt_num(time / DAYS_PER_YEAR),
+            fmt_num(*perihelion)
+        ),
+        ParticleStatus::Ejected { time, distance } => format!(
+            "ejected at t = {} yr (unbound at {} AU)",
+            fmt_num(time / DAYS_PER_YEAR),
+            fmt_num(*distance)
+        ),
+        ParticleStatus::RegularisationLost { time, quantity, value } => format!(
+            "stopped at t = {} yr: {quantity} = {value:e} <= 0 (condition 35 violated)",
+            fmt_num(time / DAYS_PER_YEAR)
+        ),
+        other => format!("{other:?}"),
+    }
+}
+
+impl Experiment for Symplectic100Myr {
+    fn id(&self) -> &'static str {
+        "symplectic-100myr"
+    }
+
+    fn source(&self) -> &'static str {
+        "Chegodaeva 2004, numerical experiments and figure (ΔH and a of two comets over 100 Myr, S2 vs S6)"
+    }
+
+    fn run(&self, ctx: &mut Context) -> Result<Outcome> {
+        let span_yr = ctx.mode.pick(1.0e6, 1.0e8);
+        let span_day = span_yr * DAYS_PER_YEAR;
+        let mut states = Vec::new();
+        for scheme in [Scheme::S2, Scheme::S6] {
+            let (s, resumed) = start_or_resume(ctx, scheme, span_day)?;
+            if resumed {
+                ctx.println(format!(
+                    "{scheme:?}: resuming from checkpoint at t = {} yr",
+                    fmt_num(s.samples.last().map_or(0.0, |x| x.t_yr))
+                ));
+            }
+            states.push(s);
+        }
+        ctx.progress.set_length(2 * SAMPLES as u64);
+        ctx.progress
+            .set_position(states.iter().map(|s| s.samples.len() as u64).sum());
+        ctx.progress
+            .set_message(format!("{} Myr, S2 ∥ S6", fmt_num(span_yr / 1e6)));
+        let paths: Vec<_> = states
+            .iter()
+            .map(|s| checkpoint_path(ctx, s.scheme))
+            .collect();
+        let bar = ctx.progress.clone();
+        let (mut s6_state, mut s2_state) = (states.pop().unwrap(), states.pop().unwrap());
+        let (r2, r6) = rayon::join(
+            || s2_state.finish(&paths[0], &bar),
+            || s6_state.finish(&paths[1], &bar),
+        );
+        r2.context("S2 run")?;
+        r6.context("S6 run")?;
+        for p in &paths {
+            std::fs::remove_file(p).ok();
+        }
+        let runs = [s2_state, s6_state];
+        let names: Vec<String> = particles(ctx)?.into_iter().map(|p| p.name).collect();
+        let np = names.len();
+
+        // CSV: one file per integrator.
+        for s in &runs {
+            let file = format!("series_{:?}.csv", s.scheme);
+            let mut headers = vec!["t_yr".to_string(), "planets_rel_energy_error".to_string()];
+            for n in &names {
+                for c in ["rel_error_last", "max_abs_rel_error", "a_au", "q_au"] {
+                    headers.push(format!("{n}_{c}"));
+                }
+            }
+            let header_refs: Vec<&str> = headers.iter().map(String::as_str).collect();
+            write_csv_rows(
+                &ctx.path(&file),
+                &header_refs,
+                s.samples.iter().map(|x| {
+                    let mut row = vec![x.t_yr, x.planets_error];
+                    for i in 0..np {
+                        row.extend([x.last_error[i], x.max_abs_error[i], x.a_au[i], x.q_au[i]]);
+                    }
+                    row.iter().map(|v| format!("{v:e}")).collect::<Vec<_>>()
+                }),
+            )?;
+            ctx.add_file(
+                &file,
+                format!(
+                    "{:?}: per-sample errors, a and q of each particle",
+                    s.scheme
+                ),
+            );
+        }
+
+        // Plots.
+        let t_label = "time (yr)";
+        for (i, name) in names.iter().enumerate() {
+            let mut spec = PlotSpec::new(
+                format!("{name}: extended-Hamiltonian error, S2 vs S6"),
+                t_label,
+                "max |H + p4| / |H| per sample window",
+            );
+            spec.log_y = true;
+            spec.legend = Legend::LowerRight;
+            for (c, s) in runs.iter().enumerate() {
+                spec.series.push(Series::line(
+                    format!("{:?}", s.scheme),
+                    s.samples
+                        .iter()
+                        .map(|x| (x.t_yr, x.max_abs_error[i]))
+                        .collect(),
+                    c,
+                ));
+            }
+            let file = format!("dH_{name}.png");
+            plot_xy(&ctx.path(&file), &spec)?;
+            ctx.add_plot(
+                &file,
+                format!("{name}: |ΔH| against time (paper's figure, left/right column)"),
+            );
+            let mut spec = PlotSpec::new(
+                format!("{name}: semi-major axis"),
+                t_label,
+                "a (AU, barycentric osculating)",
+            );
+            for (c, s) in runs.iter().enumerate() {
+                spec.series.push(Series::line(
+                    format!("{:?}", s.scheme),
+                    s.samples.iter().map(|x| (x.t_yr, x.a_au[i])).collect(),
+                    c,
+                ));
+            }
+            let file = format!("a_{name}.png");
+            plot_xy(&ctx.path(&file), &spec)?;
+            ctx.add_plot(&file, format!("{name}: semi-major axis against time"));
+        }
+        let mut spec = PlotSpec::new("Planets: relative energy error", t_label, "|ΔE/E|");
+        spec.log_y = true;
+        spec.legend = Legend::LowerRight;
+        for (c, s) in runs.iter().enumerate() {
+            spec.series.push(Series::line(
+                format!("{:?}, τ = 365 d", s.scheme),
+                s.samples
+                    .iter()
+                    .map(|x| (x.t_yr, x.planets_error.abs()))
+                    .collect(),
+                c,
+            ));
+        }
+        plot_xy(&ctx.path("planets_energy.png"), &spec)?;
+        ctx.add_plot(
+            "planets_energy.png",
+            "Planets' relative energy error against time",
+        );
+
+        // Metrics and checks.
+        let mut out = Outcome::new();
+        out.metric("span_yr", span_yr);
+        for s in &runs {
+            let tag = format!("{:?}", s.scheme);
+            out.metric(format!("{tag}_cpu_s"), s.cpu_s);
+            let (first, last) = tenths(&s.samples, |x| x.planets_error.abs());
+            let (f, l) = (
+                first.iter().cloned().fold(0.0, f64::max),
+                last.iter().cloned().fold(0.0, f64::max),
+            );
+            out.metric(
+                format!("{tag}_planets_max_rel_energy_error"),
+                s.samples
+                    .iter()
+                    .map(|x| x.planets_error.abs())
+                    .fold(0.0, f64::max),
+            );
+            // Origin: a symplectic map's energy error is bounded (backward error analysis); a
+            // drift linear in t that dominated the last tenth would make this ratio ≥ 9 (the
+            // last tenth is 19× later on average), so 3 separates bounded from secular.
+            out.check(Check::less_than(
+                format!("{tag} planets: max |ΔE/E| last tenth / first tenth"),
+                l / f,
+                3.0,
+                "bounded error of a symplectic map; a secular drift would give >= 9",
+            ));
+            for (i, name) in names.iter().enumerate() {
+                out.metric(format!("{tag}_{name}_steps"), s.particle_steps[i] as f64);
+                out.metric(
+                    format!("{tag}_{name}_max_abs_dH"),
+                    s.samples
+                        .iter()
+                        .map(|x| x.max_abs_error[i])
+                        .filter(|x| x.is_finite())
+                        .fold(0.0, f64::max),
+                );
+                let last_a = s
+                    .samples
+                    .iter()
+                    .rev()
+                    .map(|x| x.a_au[i])
+                    .find(|x| x.is_finite())
+                    .unwrap_or(f64::NAN);
+                out.metric(format!("{tag}_{name}_final_a_au"), last_a);
+                let status = &s.run.particles[i].status;
+                out.metric(
+                    format!("{tag}_{name}_integrated_to_end"),
+                    if *status == ParticleStatus::Active {
+                        1.0
+                    } else {
+                        0.0
+                    },
+                );
+                out.note(format!("{tag} {name}: {}", status_text(status)));
+            }
+        }
+        let [s2, s6] = &runs;
+        for (i, name) in names.iter().enumerate() {
+            let both_active = runs
+                .iter()
+                .all(|s| s.run.particles[i].status == ParticleStatus::Active);
+            let (f2, l2) = tenths(&s2.samples, |x| x.max_abs_error[i]);
+            let (_, l6) = tenths(&s6.samples, |x| x.max_abs_error[i]);
+            let (m_f2, m_l2, m_l6) = (median(f2), median(l2), median(l6));
+            out.metric(format!("S2_{name}_median_dH_first_tenth"), m_f2);
+            out.metric(format!("S2_{name}_median_dH_last_tenth"), m_l2);
+            out.metric(format!("S6_{name}_median_dH_last_tenth"), m_l6);
+            if !both_active {
+                out.note(format!(
+                    "{name}: left the validity domain in at least one run; its checks below use the samples before that"
+                ));
+            }
+            // Origin: the paper ("the accuracy of the second-order integrator is preserved over
+            // the whole interval"); same factor-3 criterion as for the planets, on medians so
+            // that single close encounters with Neptune do not decide it.
+            out.check(Check::less_than(
+                format!("S2 {name}: median |ΔH| last tenth / first tenth"),
+                m_l2 / m_f2,
+                3.0,
+                "paper: S2 keeps its accuracy; a secular drift would give >= 9",
+            ));
+            // Origin: the paper ("for the pseudo-sixth order, especially the second particle,
+            // the error in the Hamiltonian accumulates", steps of 910/953 d > ~400 d).
+            out.check(Check::greater_than(
+                format!("{name}: median |ΔH| last tenth, S6 / S2"),
+                m_l6 / m_l2,
+                1.0,
+                "paper: S6 at its large steps accumulates more error than S2",
+            ));
+        }
+        out.metric("cpu_ratio_S2_over_S6", s2.cpu_s / s6.cpu_s);
+        out.check(Check::less_than(
+            "CPU time S2 / S6",
+            s2.cpu_s / s6.cpu_s,
+            1.0,
+            "paper: the second-order run costs about 5 % less CPU time than the sixth-order one",
+        ));
+        out.note(format!(
+            "Span {} yr; planet step {PLANET_STEP_DAY} d; B0 = {B0}, B1 = {B1}; CPU: S2 {} s, S6 {} s (one thread each, run in parallel).",
+            fmt_num(span_yr),
+            fmt_num(s2.cpu_s),
+            fmt_num(s6.cpu_s)
+        ));
+        if ctx.mode == Mode::Quick {
+            out.note("Quick mode: 1 Myr instead of the paper's 100 Myr (`--full`).");
+        }
+        Ok(out)
+    }
+}

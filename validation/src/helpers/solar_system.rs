@@ -1,0 +1,136 @@
+//! The outer Solar System and the comet-like test particles of Chegodaeva (2004), read from
+//! `reference-data/symplectic/`.
+
+use anyhow::{Context as _, Result};
+use symplectic::{Planets, Vec3};
+
+use super::load_reference_csv;
+use crate::Context;
+
+/// `G` of Hairer, Lubich & Wanner (Table 2.1), AU³ M☉⁻¹ day⁻².
+pub const G_AU_DAY: f64 = 2.959_122_082_86e-4;
+/// Days per Julian year.
+pub const DAYS_PER_YEAR: f64 = 365.25;
+
+/// The Sun and the four giant planets of `outer_solar_system.csv` (heliocentric, equatorial
+/// as stored, or rotated to the ecliptic of J2000).
+pub fn outer_planets(ctx: &Context, ecliptic: bool) -> Result<Planets> {
+    let t = load_reference_csv(
+        ctx,
+        "symplectic/outer_solar_system.csv",
+        &["body", "m", "x", "y", "z", "vx", "vy", "vz"],
+    )?;
+    let sun = t.find(&[("body", "Sun")])?;
+    let (mut m, mut q, mut v) = (vec![], vec![], vec![]);
+    for row in 0..t.len() {
+        if row == sun {
+            continue;
+        }
+        let vec = |a: &str, b: &str, c: &str| -> Result<Vec3> {
+            Ok(Vec3::new(
+                t.number(row, a)?,
+                t.number(row, b)?,
+                t.number(row, c)?,
+            ))
+        };
+        let (pos, vel) = (vec("x", "y", "z")?, vec("vx", "vy", "vz")?);
+        let (pos, vel) = if ecliptic {
+            (
+                symplectic::equatorial_to_ecliptic(&pos),
+                symplectic::equatorial_to_ecliptic(&vel),
+            )
+        } else {
+            (pos, vel)
+        };
+        m.push(t.number(row, "m")?);
+        q.push(pos);
+        v.push(vel);
+    }
+    Planets::from_heliocentric(G_AU_DAY, t.number(sun, "m")?, &m, &q, &v)
+        .with_context(|| format!("building the planets from {}", t.path.display()))
+}
+
+/// One test particle of `particles.csv`.
+#[derive(Debug, Clone)]
+pub struct ParticleInitial {
+    /// Name.
+    pub name: String,
+    /// Semi-major axis (AU) and perihelion (AU) given by the paper.
+    pub a_au: f64,
+    /// Perihelion distance (AU).
+    pub q_au: f64,
+    /// Heliocentric ecliptic position (AU) and velocity (AU/day).
+    pub position: Vec3,
+    /// Velocity (AU/day).
+    pub velocity: Vec3,
+    /// Initial steps of the paper (days) for S2 and S6.
+    pub dt0_s2_day: f64,
+    /// For S6.
+    pub dt0_s6_day: f64,
+}
+
+/// The particles of `particles.csv`.
+pub fn particles(ctx: &Context) -> Result<Vec<ParticleInitial>> {
+    let cols = [
+        "name",
+        "a_au",
+        "q_au",
+        "x",
+        "y",
+        "z",
+        "vx",
+        "vy",
+        "vz",
+        "dt0_s2_day",
+        "dt0_s6_day",
+    ];
+    let t = load_reference_csv(ctx, "symplectic/particles.csv", &cols)?;
+    (0..t.len())
+        .map(|r| {
+            Ok(ParticleInitial {
+                name: t.text(r, "name")?.to_string(),
+                a_au: t.number(r, "a_au")?,
+                q_au: t.number(r, "q_au")?,
+                position: Vec3::new(t.number(r, "x")?, t.number(r, "y")?, t.number(r, "z")?),
+                velocity: Vec3::new(t.number(r, "vx")?, t.number(r, "vy")?, t.number(r, "vz")?),
+                dt0_s2_day: t.number(r, "dt0_s2_day")?,
+                dt0_s6_day: t.number(r, "dt0_s6_day")?,
+            })
+        })
+        .collect()
+}
+
+/// Barycentric position and velocity of a heliocentric state, at the planets' time.
+pub fn to_barycentric(planets: &Planets, position: Vec3, velocity: Vec3) -> (Vec3, Vec3) {
+    let total = planets.sun_mass() + planets.masses().iter().sum::<f64>();
+    let sun_q = -planets
+        .masses()
+        .iter()
+        .zip(planets.positions())
+        .map(|(&m, q)| q * m)
+        .sum::<Vec3>()
+        / total;
+    let sun_v = -planets.momenta().iter().sum::<Vec3>() / planets.sun_mass();
+    (position + sun_q, velocity + sun_v)
+}
+
+/// CPU time of the calling thread, seconds (falls back to wall time where unsupported).
+pub fn thread_cpu_seconds() -> f64 {
+    #[cfg(unix)]
+    {
+        let mut ts = libc::timespec {
+            tv_sec: 0,
+            tv_nsec: 0,
+        };
+        // SAFETY: clock_gettime writes into the timespec we own.
+        let rc = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+        if rc == 0 {
+            return ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9;
+        }
+    }
+    use std::time::{SystemTime, UNIX_EPOCH};
+    SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map(|d| d.as_secs_f64())
+        .unwrap_or(0.0)
+}
