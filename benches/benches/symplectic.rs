@@ -1,9 +1,14 @@
-//! One planetary step of S2 and S6 (outer Solar System, four planets, τ = 365 d):
-//! `cargo bench -p benches --bench symplectic`. Peer anchor (issue #4): REBOUND 5.2 WHFast,
-//! democratic heliocentric, ≈ 0.55 µs per step on one core of this machine (not run here).
+//! One planetary step of S2 and S6 (outer Solar System, four planets, τ = 365 d) and one
+//! test-particle step (Chegodaeva's particle 1, barycentric variant, B₁ = 0.21e-6, planets
+//! interpolated from a pre-computed ephemeris): `cargo bench -p benches --bench symplectic`.
+//! Peer anchor (issue #4): REBOUND 5.2 WHFast, democratic heliocentric, ≈ 0.55 µs per step on
+//! one core of this machine; measured here with REBOUND 5.2.2 (safe_mode 0, 1e6 steps):
+//! 0.71–0.85 µs per step (script outside the repository, see the closing note of issue #4).
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
-use symplectic::{Integrator, Planets, Vec3};
+use symplectic::{
+    Ephemeris, Integrator, ParticleIntegrator, ParticleScratch, Planets, Scheme, Variant, Vec3,
+};
 
 fn outer_solar_system() -> Planets {
     // Hairer, Lubich & Wanner, Table 2.1 (reference-data/symplectic/outer_solar_system.csv).
@@ -39,5 +44,63 @@ fn planet_step(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, planet_step);
+fn ecliptic(v: Vec3) -> Vec3 {
+    symplectic::equatorial_to_ecliptic(&v)
+}
+
+fn particle_step(c: &mut Criterion) {
+    let equatorial = outer_solar_system();
+    let rot = |vs: &[Vec3]| vs.iter().map(|v| ecliptic(*v)).collect::<Vec<_>>();
+    let planets = Planets::from_heliocentric(
+        equatorial.g(),
+        equatorial.sun_mass(),
+        equatorial.masses(),
+        &rot(equatorial.positions()),
+        &rot(&equatorial.heliocentric_velocities()),
+    )
+    .unwrap();
+    // Particle 1 of reference-data/symplectic/particles.csv (heliocentric ecliptic).
+    let text = include_str!("../../reference-data/symplectic/particles.csv");
+    let row: Vec<f64> = text
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .skip(1)
+        .map(|x| x.trim().parse().unwrap())
+        .collect();
+    let total = planets.sun_mass() + planets.masses().iter().sum::<f64>();
+    let sun_q = -planets
+        .masses()
+        .iter()
+        .zip(planets.positions())
+        .map(|(&m, q)| q * m)
+        .sum::<Vec3>()
+        / total;
+    let sun_v = -planets.momenta().iter().sum::<Vec3>() / planets.sun_mass();
+    let q = Vec3::new(row[6], row[7], row[8]) + sun_q;
+    let v = Vec3::new(row[9], row[10], row[11]) + sun_v;
+    let mut group = c.benchmark_group("particle-step");
+    for (scheme, dt0) in [(Scheme::S2, 298.0), (Scheme::S6, 910.0)] {
+        let mut eph = Ephemeris::new(planets.clone(), Integrator::S2 { step: 365.0 }).unwrap();
+        let integ = ParticleIntegrator::new(Variant::Barycentric, scheme, 0.0, 0.21e-6).unwrap();
+        let mut scratch = ParticleScratch::default();
+        let start = integ
+            .particle(q, v, 0.0, dt0, &mut eph, &mut scratch)
+            .unwrap();
+        // Cover the first step so that the timed steps interpolate only.
+        eph.extend_to(20.0 * 365.25).unwrap();
+        group.bench_function(format!("{scheme:?}"), |b| {
+            b.iter_batched_ref(
+                || start.clone(),
+                |p| integ.step(p, &mut eph, &mut scratch).unwrap(),
+                criterion::BatchSize::SmallInput,
+            )
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, planet_step, particle_step);
 criterion_main!(benches);

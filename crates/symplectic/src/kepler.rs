@@ -23,6 +23,7 @@
 use crate::{SymplecticError, Vec3};
 
 /// The four Stumpff functions `c₀..c₃` at `z`.
+#[inline]
 pub fn stumpff(z: f64) -> [f64; 4] {
     // Reduce |z| below 0.1 by quarter steps: c_k(z) from c_k(z/4^n).
     let mut n = 0;
@@ -96,11 +97,11 @@ pub fn drift(r: &mut Vec3, v: &mut Vec3, mu: f64, dt: f64) -> Result<DriftInfo, 
     let beta = 2.0 * mu / r0 - v.norm_squared();
     // Bound orbit: reduce the step modulo the period.
     let mut dt_eff = dt;
-    if beta > 0.0 {
-        let period = 2.0 * std::f64::consts::PI * mu / (beta * beta.sqrt());
-        if dt.abs() > period {
-            dt_eff = dt % period;
-        }
+    // |dt| > period ⟺ dt² β³ > (2πμ)², tested without the square root.
+    let two_pi_mu = 2.0 * std::f64::consts::PI * mu;
+    if beta > 0.0 && dt * dt * beta * beta * beta > two_pi_mu * two_pi_mu {
+        let period = two_pi_mu / (beta * beta.sqrt());
+        dt_eff = dt % period;
     }
     let kepler = |s: f64| -> (f64, f64, [f64; 4]) {
         let c = stumpff(beta * s * s);
@@ -128,29 +129,55 @@ pub fn drift(r: &mut Vec3, v: &mut Vec3, mu: f64, dt: f64) -> Result<DriftInfo, 
         iterations: 0,
         used_fallback: false,
     };
-    let mut converged = false;
+    // Halley's iteration (cubic convergence; f'' = dr/ds = η0 G0 + (μ − β r0) G1). Once a
+    // correction is below HALLEY_ACCEPT relative to s, the error left after applying it is
+    // ~(1e-6)³: the iteration stops and the G_k are carried to the new s by their Taylor
+    // series (dG0/ds = −β G1, dG_k/ds = G_(k−1)), to second order in the correction (the
+    // third-order term is ~1e-18 relative), instead of a further Stumpff evaluation.
+    const HALLEY_ACCEPT: f64 = 1e-6;
+    let mut solution: Option<(f64, f64, f64, f64)> = None; // (s, G0, G1, G2)
     for _ in 0..40 {
         info.iterations += 1;
-        let (f, fp, _) = kepler(s);
-        let ds = f / fp;
+        let c = stumpff(beta * s * s);
+        let (g0, g1, g2, g3) = (c[0], s * c[1], s * s * c[2], s * s * s * c[3]);
+        let f = r0 * g1 + eta * g2 + mu * g3 - dt_eff;
+        let fp = r0 * g0 + eta * g1 + mu * g2;
+        let fpp = eta * g0 + (mu - beta * r0) * g1;
+        // Halley, ds = f/(f' − f f''/2f'), written with one division; Newton where the
+        // Halley denominator is not safely positive (f' = r > 0).
+        let denominator = 2.0 * fp * fp - f * fpp;
+        let ds = if denominator > fp * fp {
+            2.0 * f * fp / denominator
+        } else {
+            f / fp
+        };
         let s_new = s - ds;
         if !s_new.is_finite() {
             break;
         }
-        let done = ds.abs() <= 4.0 * f64::EPSILON * s_new.abs().max(f64::MIN_POSITIVE);
-        s = s_new;
-        if done {
-            converged = true;
+        if ds.abs() <= HALLEY_ACCEPT * s_new.abs() || ds == 0.0 {
+            let d = -ds;
+            let half_d2 = 0.5 * d * d;
+            solution = Some((
+                s_new,
+                g0 - beta * (g1 * d + g0 * half_d2),
+                g1 + g0 * d - beta * g1 * half_d2,
+                g2 + g1 * d + g0 * half_d2,
+            ));
             break;
         }
+        s = s_new;
     }
-    if !converged {
-        s = solve_bracketed(&kepler, dt_eff, r0)?;
-        info.used_fallback = true;
-    }
-    let (_, rr, c) = kepler(s);
-    let g1 = s * c[1];
-    let g2 = s * s * c[2];
+    let (g0, g1, g2) = match solution {
+        Some((_, g0, g1, g2)) => (g0, g1, g2),
+        None => {
+            let s = solve_bracketed(&kepler, dt_eff, r0)?;
+            info.used_fallback = true;
+            let c = stumpff(beta * s * s);
+            (c[0], s * c[1], s * s * c[2])
+        }
+    };
+    let rr = r0 * g0 + eta * g1 + mu * g2;
     let f = 1.0 - mu * g2 / r0;
     let g = r0 * g1 + eta * g2;
     let fdot = -mu * g1 / (rr * r0);
