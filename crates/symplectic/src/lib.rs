@@ -21,6 +21,16 @@
 //!   [`Integrator::S6`] of Laskar & Robutel (eq. 7, coefficients [`S6_C1`], [`S6_C2`],
 //!   [`S6_D1`], [`S6_D2`]).
 //!
+//! # Performance
+//!
+//! `cargo bench -p benches --bench symplectic` (one thread, this project's 2-core Xeon):
+//! S2 planet step (four giant planets, τ = 365 d, state synchronised after every step)
+//! 0.60 µs, S6 1.65 µs; particle step (barycentric, planets interpolated) S2 0.45–0.49 µs,
+//! S6 1.0–1.1 µs. REBOUND 5.2.2's WHFast in democratic heliocentric coordinates on the same
+//! system, measured in the same session: 0.71 µs per step with `safe_mode = 0` (unsynchronised
+//! between steps), 1.23 µs with `safe_mode = 1`. The Kepler drift uses Halley's iteration from
+//! a third-order series start, which converges in two Stumpff evaluations for these steps.
+//!
 //! Units are the caller's; the experiments use AU, days and solar masses with
 //! `G = 2.95912208286e-4 AU³ M☉⁻¹ day⁻²`.
 //!

@@ -90,9 +90,10 @@ pub struct TestParticle {
 /// particle, as Chegodaeva (2004) builds it (eqs. 21–32 mixed, 36–38 barycentric), after
 ///
 /// > V. V. Emel'yanenko, "An explicit symplectic integrator for cometary orbits",
-/// > *Celestial Mechanics and Dynamical Astronomy* 84, 331–341 (2002; cited as 2001 in the
-/// > paper), and S. Mikkola & K. Tanikawa, "Explicit symplectic algorithms for
-/// > time-transformed Hamiltonians", *Celest. Mech. Dyn. Astron.* 74, 287–295 (1999).
+/// > *Celestial Mechanics and Dynamical Astronomy* (the paper's reference 4 gives 2001,
+/// > vol. 74, pp. 287–295, the volume and pages of the Mikkola–Tanikawa entry; we could not
+/// > verify the correct ones), and S. Mikkola & K. Tanikawa, "Explicit symplectic algorithms
+/// > for time-transformed Hamiltonians", *Celest. Mech. Dyn. Astron.* 74, 287–295 (1999).
 ///
 /// Phase space is extended by `q₄ = t`, `p₄ = −H`; with `dτ = dt/r` the Hamiltonian
 /// `K = r(H + p₄)` is split by adding `rB₀ + B₁` to both parts (eq. 22):
