@@ -70,15 +70,7 @@ fn particle_step(c: &mut Criterion) {
         .skip(1)
         .map(|x| x.trim().parse().unwrap())
         .collect();
-    let total = planets.sun_mass() + planets.masses().iter().sum::<f64>();
-    let sun_q = -planets
-        .masses()
-        .iter()
-        .zip(planets.positions())
-        .map(|(&m, q)| q * m)
-        .sum::<Vec3>()
-        / total;
-    let sun_v = -planets.momenta().iter().sum::<Vec3>() / planets.sun_mass();
+    let (sun_q, sun_v) = planets.sun_barycentric_state();
     let q = Vec3::new(row[6], row[7], row[8]) + sun_q;
     let v = Vec3::new(row[9], row[10], row[11]) + sun_v;
     let mut group = c.benchmark_group("particle-step");

@@ -122,43 +122,46 @@ impl Ephemeris {
         self.first_index + ((self.grid.len() - self.offset) / self.stride()) as u64 - 1
     }
 
+    /// Appends the barycentric positions, velocities and accelerations of every body at the
+    /// planets' current state (written straight into the grid: no allocation per step once
+    /// the grid has its capacity).
     fn push_state(&mut self) {
         let n = self.planets.len();
         let g = self.planets.g();
         let m0 = self.planets.sun_mass();
-        let total = m0 + self.planets.masses().iter().sum::<f64>();
-        let mut pos = vec![Vec3::zeros(); n + 1];
-        let mut vel = vec![Vec3::zeros(); n + 1];
-        let mut acc = vec![Vec3::zeros(); n + 1];
-        let mut mass = vec![m0; n + 1];
-        let sun_pos = -self
-            .planets
-            .masses()
-            .iter()
-            .zip(self.planets.positions())
-            .map(|(&m, q)| q * m)
-            .sum::<Vec3>()
-            / total;
-        pos[0] = sun_pos;
-        vel[0] = -self.planets.momenta().iter().sum::<Vec3>() / m0;
+        let (sun_pos, sun_vel) = self.planets.sun_barycentric_state();
+        let base = self.grid.len();
+        self.grid.resize(base + 9 * (n + 1), 0.0);
+        let body = |j: usize| base + 9 * j;
+        self.grid[body(0)..body(0) + 3].copy_from_slice(sun_pos.as_slice());
+        self.grid[body(0) + 3..body(0) + 6].copy_from_slice(sun_vel.as_slice());
         for i in 0..n {
-            mass[i + 1] = self.planets.masses()[i];
-            pos[i + 1] = self.planets.positions()[i] + sun_pos;
-            vel[i + 1] = self.planets.momenta()[i] / mass[i + 1];
+            let m = self.planets.masses()[i];
+            let o = body(i + 1);
+            let q = self.planets.positions()[i] + sun_pos;
+            let v = self.planets.momenta()[i] / m;
+            self.grid[o..o + 3].copy_from_slice(q.as_slice());
+            self.grid[o + 3..o + 6].copy_from_slice(v.as_slice());
         }
+        let mass = |j: usize| {
+            if j == 0 {
+                m0
+            } else {
+                self.planets.masses()[j - 1]
+            }
+        };
         for j in 0..=n {
             for k in j + 1..=n {
-                let d = pos[k] - pos[j];
+                let d = self.vec_at(body(k)) - self.vec_at(body(j));
                 let r2 = d.norm_squared();
                 let f = d * (g / (r2 * r2.sqrt()));
-                acc[j] += f * mass[k];
-                acc[k] -= f * mass[j];
+                let (aj, ak) = (
+                    self.vec_at(body(j) + 6) + f * mass(k),
+                    self.vec_at(body(k) + 6) - f * mass(j),
+                );
+                self.grid[body(j) + 6..body(j) + 9].copy_from_slice(aj.as_slice());
+                self.grid[body(k) + 6..body(k) + 9].copy_from_slice(ak.as_slice());
             }
-        }
-        for j in 0..=n {
-            self.grid.extend(pos[j].iter());
-            self.grid.extend(vel[j].iter());
-            self.grid.extend(acc[j].iter());
         }
     }
 

@@ -140,9 +140,23 @@ impl Planets {
             .collect()
     }
 
+    /// Barycentric position and velocity of the Sun, `q_0 = −Σ m_i Q_i / M` and
+    /// `v_0 = −Σ P_i / m_0` (the barycentre at rest at the origin).
+    pub fn sun_barycentric_state(&self) -> (Vec3, Vec3) {
+        let total = self.sun_mass + self.masses.iter().sum::<f64>();
+        let position = -self
+            .masses
+            .iter()
+            .zip(&self.positions)
+            .map(|(&m, q)| q * m)
+            .sum::<Vec3>()
+            / total;
+        (position, -self.momenta.iter().sum::<Vec3>() / self.sun_mass)
+    }
+
     /// Heliocentric velocities `v_i − v_0` of the planets.
     pub fn heliocentric_velocities(&self) -> Vec<Vec3> {
-        let sun_velocity = -self.momenta.iter().sum::<Vec3>() / self.sun_mass;
+        let sun_velocity = self.sun_barycentric_state().1;
         self.barycentric_velocities()
             .into_iter()
             .map(|v| v - sun_velocity)

@@ -167,26 +167,24 @@ impl CometRun {
                 }
                 Err(e) => return Err(e),
             }
-            let oldest = self
-                .particles
-                .iter()
-                .filter(|p| p.status == ParticleStatus::Active)
-                .map(|p| p.particle.time)
-                .fold(f64::INFINITY, f64::min);
-            if oldest.is_finite() {
+            if let Some(oldest) = self.oldest_active_time() {
                 self.ephemeris.discard_before(oldest);
             }
         }
         self.ephemeris.extend_to(t_end)?;
         let newest = self.ephemeris.grid_time(self.ephemeris.planet_steps());
-        let oldest = self
-            .particles
+        let oldest = self.oldest_active_time().map_or(newest, |t| t.min(newest));
+        self.ephemeris.discard_before(oldest);
+        Ok(())
+    }
+
+    /// Time of the active particle furthest behind, if any particle is active.
+    fn oldest_active_time(&self) -> Option<f64> {
+        self.particles
             .iter()
             .filter(|p| p.status == ParticleStatus::Active)
             .map(|p| p.particle.time)
-            .fold(newest, f64::min);
-        self.ephemeris.discard_before(oldest);
-        Ok(())
+            .reduce(f64::min)
     }
 }
 

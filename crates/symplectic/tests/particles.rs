@@ -37,6 +37,20 @@ fn particle(
     integ.particle(q, v_bary, 0.0, dt0, eph, scratch).unwrap()
 }
 
+/// A run of `particles` stopped below `min_perihelion` AU or when ejected beyond 1e4 AU.
+fn comet_run(
+    eph: Ephemeris,
+    integ: ParticleIntegrator,
+    particles: Vec<TestParticle>,
+    min_perihelion: f64,
+) -> CometRun {
+    let limits = Limits {
+        min_perihelion,
+        ejection_distance: 1e4,
+    };
+    CometRun::new(eph, integ, particles, limits)
+}
+
 #[test]
 fn stored_initial_states_have_the_papers_elements() {
     // reference-data/symplectic/particles.csv was derived by gen_particles.py (Python); here
@@ -316,15 +330,7 @@ fn extended_hamiltonian_error_stays_bounded() {
     let mut eph = ephemeris();
     let mut scratch = ParticleScratch::default();
     let p = particle(&integ, 0, 298.0, &mut eph, &mut scratch);
-    let mut run = CometRun::new(
-        eph,
-        integ,
-        vec![p],
-        Limits {
-            min_perihelion: 26.0,
-            ejection_distance: 1e4,
-        },
-    );
+    let mut run = comet_run(eph, integ, vec![p], 26.0);
     let mut first = 0.0f64;
     let mut last = 0.0f64;
     let span = 5000.0 * 365.25;
@@ -356,15 +362,7 @@ fn checkpoint_resumes_bit_identically() {
             particle(&integ, 0, 910.0, &mut eph, &mut scratch),
             particle(&integ, 1, 953.0, &mut eph, &mut scratch),
         ];
-        CometRun::new(
-            eph,
-            integ,
-            ps,
-            Limits {
-                min_perihelion: 26.0,
-                ejection_distance: 1e4,
-            },
-        )
+        comet_run(eph, integ, ps, 26.0)
     };
     let year = 365.25;
     let mut straight = build();
@@ -398,15 +396,7 @@ fn leaving_the_validity_domain_is_reported() {
     let mut eph = ephemeris();
     let mut scratch = ParticleScratch::default();
     let p = particle(&integ, 1, 310.0, &mut eph, &mut scratch);
-    let mut run = CometRun::new(
-        eph,
-        integ,
-        vec![p],
-        Limits {
-            min_perihelion: 26.0,
-            ejection_distance: 1e4,
-        },
-    );
+    let mut run = comet_run(eph, integ, vec![p], 26.0);
     run.advance_to(1000.0 * 365.25, |_, _, _| {}).unwrap();
     assert!(
         matches!(
@@ -420,15 +410,7 @@ fn leaving_the_validity_domain_is_reported() {
     let integ = ParticleIntegrator::new(Variant::Barycentric, Scheme::S2, 0.0, B1_PAPER).unwrap();
     let mut eph = ephemeris();
     let p = particle(&integ, 0, 298.0, &mut eph, &mut scratch);
-    let mut run = CometRun::new(
-        eph,
-        integ,
-        vec![p],
-        Limits {
-            min_perihelion: 30.5,
-            ejection_distance: 1e4,
-        },
-    );
+    let mut run = comet_run(eph, integ, vec![p], 30.5);
     run.advance_to(100.0 * 365.25, |_, _, _| {}).unwrap();
     match run.particles[0].status {
         ParticleStatus::PerihelionBelowLimit { perihelion, time } => {

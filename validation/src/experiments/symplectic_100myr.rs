@@ -166,7 +166,7 @@ impl RunState {
                 cpu_s: self.cpu_s,
             });
             progress.inc(1);
-            if self.samples.len() % CHECKPOINT_EVERY == 0 && self.samples.len() < SAMPLES {
+            if self.samples.len().is_multiple_of(CHECKPOINT_EVERY) && self.samples.len() < SAMPLES {
                 save_checkpoint(checkpoint, self)?;
             }
         }

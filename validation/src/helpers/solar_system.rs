@@ -102,15 +102,7 @@ pub fn particles(ctx: &Context) -> Result<Vec<ParticleInitial>> {
 
 /// Barycentric position and velocity of a heliocentric state, at the planets' time.
 pub fn to_barycentric(planets: &Planets, position: Vec3, velocity: Vec3) -> (Vec3, Vec3) {
-    let total = planets.sun_mass() + planets.masses().iter().sum::<f64>();
-    let sun_q = -planets
-        .masses()
-        .iter()
-        .zip(planets.positions())
-        .map(|(&m, q)| q * m)
-        .sum::<Vec3>()
-        / total;
-    let sun_v = -planets.momenta().iter().sum::<Vec3>() / planets.sun_mass();
+    let (sun_q, sun_v) = planets.sun_barycentric_state();
     (position + sun_q, velocity + sun_v)
 }
 
