@@ -10,10 +10,12 @@
 //! - [`Aabb`], an axis-aligned box,
 //! - the signed-distance-field trait [`Sdf`] with analytic [`Plane`], [`BoxSdf`], [`Sphere`]
 //!   and the complement [`Inverted`] (a tank is `Inverted<BoxSdf>`),
+//! - [`TriangleMesh`] and its sampled signed distance [`GridSdf`] (module [`mesh`]),
 //! - [`CoreError`], the crate's error enum.
 
 mod aabb;
 mod error;
+pub mod mesh;
 mod particles;
 mod real;
 pub mod sampling;
@@ -21,6 +23,7 @@ mod sdf;
 
 pub use aabb::Aabb;
 pub use error::CoreError;
+pub use mesh::{GridSdf, MeshError, TriangleMesh};
 pub use particles::{
     apply_permutation, validate_finite_positions, ParticleSet, PermutationScratch,
 };
