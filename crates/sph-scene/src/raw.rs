@@ -1,0 +1,120 @@
+//! The scene file as written (serde), before validation.
+
+use serde::Deserialize;
+
+use crate::{Precision, SolverKind};
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawScene {
+    pub name: String,
+    pub simulation: RawSimulation,
+    pub solver: RawSolver,
+    pub tank: Option<RawBox>,
+    #[serde(default)]
+    pub fluid: Vec<RawFluid>,
+    #[serde(default)]
+    pub solid: Vec<RawSolid>,
+    pub output: Option<RawOutput>,
+    pub quick: Option<RawQuick>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawSimulation {
+    pub precision: Option<Precision>,
+    pub particle_spacing: f64,
+    pub duration: f64,
+    pub frame_dt: f64,
+    pub gravity: Option<[f64; 3]>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawSolver {
+    pub kind: SolverKind,
+    pub substeps: usize,
+    pub iterations: usize,
+    pub rest_density: Option<f64>,
+    pub support_over_spacing: Option<f64>,
+    pub relative_cfm: Option<f64>,
+    pub scorr_k: Option<f64>,
+    pub scorr_n: Option<u32>,
+    pub scorr_delta_q: Option<f64>,
+    pub vorticity_epsilon: Option<f64>,
+    pub xsph_c: Option<f64>,
+    pub reorder_every: Option<usize>,
+    pub clamp_negative_pressure: Option<bool>,
+    pub density_error_tolerance: Option<f64>,
+}
+
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawBox {
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+}
+
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub(crate) enum RawFluidKind {
+    Block,
+    Mesh,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawFluid {
+    pub kind: RawFluidKind,
+    pub min: Option<[f64; 3]>,
+    pub max: Option<[f64; 3]>,
+    pub velocity: Option<[f64; 3]>,
+    pub path: Option<String>,
+    pub scale: Option<f64>,
+    pub translate: Option<[f64; 3]>,
+    pub fit: Option<RawBox>,
+}
+
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub(crate) enum RawSolidKind {
+    Sphere,
+    Box,
+    Plane,
+    Mesh,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawSolid {
+    pub kind: RawSolidKind,
+    pub center: Option<[f64; 3]>,
+    pub radius: Option<f64>,
+    pub min: Option<[f64; 3]>,
+    pub max: Option<[f64; 3]>,
+    pub point: Option<[f64; 3]>,
+    pub normal: Option<[f64; 3]>,
+    pub path: Option<String>,
+    pub scale: Option<f64>,
+    pub translate: Option<[f64; 3]>,
+    pub fit: Option<RawBox>,
+    pub sdf_cell: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawOutput {
+    pub every_frames: Option<usize>,
+    pub vtk: Option<bool>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawQuick {
+    pub particle_spacing: Option<f64>,
+    pub duration: Option<f64>,
+    pub frame_dt: Option<f64>,
+    pub substeps: Option<usize>,
+    pub iterations: Option<usize>,
+    pub every_frames: Option<usize>,
+}

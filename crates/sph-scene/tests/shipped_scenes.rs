@@ -1,0 +1,191 @@
+//! The scenes shipped in `scenes/` parse, produce the particle counts stated in their
+//! comments (within ±15 % of the paper's targets), and build their solids.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use sph_core::{Sdf, Vec3};
+use sph_scene::{FluidSpec, Precision, Scene, SolverKind};
+
+fn scene_path(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes")
+        .join(name)
+}
+
+fn counts(scene: &Scene) -> (usize, usize) {
+    let full = scene.fluid_positions::<f32>().unwrap().len();
+    let quick = scene.quick().fluid_positions::<f32>().unwrap().len();
+    (full, quick)
+}
+
+fn check_inside(scene: &Scene) {
+    let pts = scene.fluid_positions::<f64>().unwrap();
+    let solids = scene.build_solids::<f64>().unwrap();
+    assert!(!solids.is_empty());
+    for p in &pts {
+        for s in &solids {
+            assert!(s.signed_distance(p) > 0.0, "{p:?}");
+        }
+    }
+}
+
+#[test]
+fn dam_break_matches_table_1() {
+    let t = Instant::now();
+    let s = Scene::load(&scene_path("dam_break.toml")).unwrap();
+    assert_eq!(s.name, "dam_break");
+    assert_eq!(s.precision, Precision::F32);
+    assert_eq!(s.solver.kind, SolverKind::Pbf);
+    assert_eq!((s.solver.substeps, s.solver.iterations), (4, 3));
+    assert_eq!(s.solver.vorticity_epsilon, Some(0.0));
+    assert_eq!((s.frame_dt_s, s.duration_s), (0.016, 6.0));
+    assert_eq!(s.frame_count(), 375);
+    let (full, quick) = counts(&s);
+    println!(
+        "dam_break: {full} particles, quick {quick} (load {:?})",
+        t.elapsed()
+    );
+    assert_eq!(full, 98_304);
+    assert_eq!(quick, 12_288);
+    assert!((full as f64 - 100_000.0).abs() <= 15_000.0);
+    assert!((8_000..=15_000).contains(&quick));
+    let q = s.quick();
+    assert_eq!((q.particle_spacing, q.duration_s), (0.025, 1.5));
+    assert!(q.quick_overrides.is_none());
+    check_inside(&s);
+    check_inside(&q);
+}
+
+#[test]
+fn bunny_drop_matches_fig_3() {
+    let t = Instant::now();
+    let s = Scene::load(&scene_path("bunny_drop.toml")).unwrap();
+    assert_eq!((s.solver.substeps, s.solver.iterations), (4, 10));
+    assert!(matches!(s.fluids[1], FluidSpec::Mesh { .. }));
+    let (full, quick) = counts(&s);
+    println!(
+        "bunny_drop: {full} particles, quick {quick} (load {:?})",
+        t.elapsed()
+    );
+    assert!((full as f64 - 80_000.0).abs() <= 0.15 * 80_000.0, "{full}");
+    assert!(quick <= 10_000, "{quick}");
+    check_inside(&s);
+}
+
+#[test]
+fn armadillo_splash_matches_table_1() {
+    let t = Instant::now();
+    let s = Scene::load(&scene_path("armadillo_splash.toml")).unwrap();
+    assert_eq!((s.solver.substeps, s.solver.iterations), (2, 3));
+    let (full, quick) = counts(&s);
+    println!(
+        "armadillo_splash: {full} particles, quick {quick} (load {:?})",
+        t.elapsed()
+    );
+    assert!(
+        (full as f64 - 128_000.0).abs() <= 0.15 * 128_000.0,
+        "{full}"
+    );
+    assert!(quick <= 10_000, "{quick}");
+    check_inside(&s);
+}
+
+/// Every `.toml` in `scenes/` (including scenes written by others) parses.
+#[test]
+fn every_shipped_scene_parses() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    let mut n = 0;
+    for e in std::fs::read_dir(&dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_some_and(|x| x == "toml") {
+            let s = Scene::load(&p).unwrap_or_else(|e| panic!("{e}"));
+            let q = s.quick();
+            println!(
+                "{}: {} particles (quick {})",
+                p.display(),
+                s.fluid_positions::<f32>().unwrap().len(),
+                q.fluid_positions::<f32>().unwrap().len()
+            );
+            n += 1;
+        }
+    }
+    assert!(n >= 3);
+}
+
+/// Mesh fluids: the particle volume `N s³` approximates the mesh volume (the lattice is
+/// unbiased: a point counts when its centre is inside), and the velocities line up.
+#[test]
+fn mesh_fluid_volume_and_velocities() {
+    let s = Scene::load(&scene_path("bunny_drop.toml")).unwrap();
+    let FluidSpec::Mesh { mesh, .. } = &s.fluids[1] else {
+        unreachable!()
+    };
+    // Divergence theorem volume of the placed closed mesh.
+    let v = mesh.mesh.vertices();
+    let vol: f64 = mesh
+        .mesh
+        .triangles()
+        .iter()
+        .map(|t| {
+            let (a, b, c) = (v[t[0] as usize], v[t[1] as usize], v[t[2] as usize]);
+            a.dot(&b.cross(&c)) / 6.0
+        })
+        .sum();
+    let pts = s.fluid_positions::<f64>().unwrap();
+    let pool = 64 * 16 * 64;
+    let n = pts.len() - pool;
+    let sp = s.particle_spacing;
+    let rel = (n as f64 * sp * sp * sp - vol) / vol;
+    println!(
+        "bunny: mesh volume {vol:.5} m³, {n} particles, N s³ off by {:.2} %",
+        rel * 100.0
+    );
+    assert!(rel.abs() < 0.03, "{rel}");
+    let vel = s.fluid_velocities::<f32>().unwrap();
+    assert_eq!(vel.len(), pts.len());
+    assert!(vel.iter().all(|v| *v == Vec3::zeros()));
+}
+
+/// Building twice does not reload the meshes (they are shared through an `Arc`) and the
+/// grid SDF of a scene mesh builds quickly.
+#[test]
+fn meshes_are_cached_and_grids_build_fast() {
+    let s = Scene::load(&scene_path("armadillo_splash.toml")).unwrap();
+    let FluidSpec::Mesh { mesh, .. } = &s.fluids[1] else {
+        unreachable!()
+    };
+    let q = s.quick();
+    let FluidSpec::Mesh { mesh: qm, .. } = &q.fluids[1] else {
+        unreachable!()
+    };
+    assert!(std::sync::Arc::ptr_eq(&mesh.mesh, &qm.mesh));
+    let tris = mesh.mesh.triangles().len();
+    // The dragon as a solid GridSdf at ~100 cells along its length.
+    let cell = mesh.mesh.bounds().extent().x / 100.0;
+    let t = Instant::now();
+    let g = sph_core::GridSdf::new(&mesh.mesh, cell, 2.0 * cell).unwrap();
+    let dt = t.elapsed().as_secs_f64();
+    println!(
+        "dragon: {tris} triangles, grid {:?}, build {dt:.3} s",
+        g.dims()
+    );
+    assert!(dt < 10.0);
+    // Spot check against the exact distance.
+    let b = g.grid_box();
+    let mut worst: f64 = 0.0;
+    for i in 0..50 {
+        let f = (i as f64 + 0.5) / 50.0;
+        let p = b.min
+            + b.extent()
+                .component_mul(&Vec3::new(f, (f * 7.0).fract(), (f * 13.0).fract()));
+        let exact = mesh.mesh.signed_distance_exact(&p);
+        let v = g.signed_distance(&p);
+        worst = worst.max((v - exact).abs() / cell);
+        if exact.abs() > cell {
+            assert_eq!(v < 0.0, exact < 0.0, "{p:?}");
+        }
+    }
+    println!("dragon grid: max |grid - exact| at 50 points = {worst:.3} cells");
+    assert!(worst < 0.97);
+}
