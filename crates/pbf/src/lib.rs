@@ -7,7 +7,13 @@
 //! [`Pbf::step`] runs the paper's Algorithm 1 on a structure-of-arrays
 //! [`sph_core::ParticleSet`] (positions, velocities, masses, densities), generic over
 //! [`sph_core::Real`] (`f32` or `f64`), with rayon-parallel loops over the particles.
-//! Scenes, experiments and PCISPH are not part of this crate.
+//!
+//! The crate also holds the baseline the paper compares against (§8): [`Pcisph`], the
+//! predictive-corrective incompressible SPH of Solenthaler & Pajarola (2009), with the same
+//! kernels, neighbour search, SDF collision response and XSPH viscosity (see its
+//! documentation for the equations, the deviations and the measured behaviour). Both
+//! implement [`FluidSolver`], so a scene runner can hold a `Box<dyn FluidSolver<R>>`. Scenes
+//! and experiments are not part of this crate.
 //!
 //! ```
 //! use pbf::{ParticleSet, Pbf, PbfParams, Solids, Vec3};
@@ -116,11 +122,13 @@
 
 mod error;
 mod params;
+mod pcisph;
 mod scorr;
 mod solver;
 
 pub use error::PbfError;
 pub use params::{PbfParams, DEFAULT_RELATIVE_CFM, DEFAULT_SUPPORT_OVER_SPACING};
+pub use pcisph::{Pcisph, PcisphParams};
 pub use scorr::ArtificialPressure;
 pub use solver::{ConstraintEval, Pbf, PbfScratch, StepStats};
 
@@ -130,3 +138,56 @@ pub use sph_core::{ParticleSet, Real, Sdf, Vec3};
 /// The solids of a scene: signed distance fields, negative inside the solid (a tank is
 /// `sph_core::Inverted<sph_core::BoxSdf>`), resolved in order.
 pub type Solids<R> = Vec<Box<dyn Sdf<R>>>;
+
+/// A fluid solver advancing a [`ParticleSet`] by one frame per call: the object-safe common
+/// interface of [`Pbf`] and [`Pcisph`], for scene runners holding a `Box<dyn FluidSolver<R>>`.
+pub trait FluidSolver<R: Real>: Send {
+    /// Advances `state` by one frame ([`FluidSolver::frame_dt`]); see [`Pbf::step`] and
+    /// [`Pcisph::step`] for the errors and the meaning of the [`StepStats`] fields.
+    fn step(&mut self, state: &mut ParticleSet<R>) -> Result<StepStats, PbfError>;
+    /// Time advanced by one [`FluidSolver::step`] call (s): the parameters' `dt`.
+    fn frame_dt(&self) -> R;
+    /// Support radius `h` of the kernels (m).
+    fn support_radius(&self) -> R;
+    /// The permutation applied to the particles by the last step (`new[k] = old[perm[k]]`),
+    /// or `None` if it did not reorder.
+    fn last_permutation(&self) -> Option<&[u32]>;
+    /// Short name for reports: `"PBF"` or `"PCISPH"`.
+    fn name(&self) -> &'static str;
+}
+
+impl<R: Real> FluidSolver<R> for Pbf<R> {
+    fn step(&mut self, state: &mut ParticleSet<R>) -> Result<StepStats, PbfError> {
+        Pbf::step(self, state)
+    }
+    fn frame_dt(&self) -> R {
+        self.params().dt
+    }
+    fn support_radius(&self) -> R {
+        self.params().support_radius
+    }
+    fn last_permutation(&self) -> Option<&[u32]> {
+        Pbf::last_permutation(self)
+    }
+    fn name(&self) -> &'static str {
+        "PBF"
+    }
+}
+
+impl<R: Real> FluidSolver<R> for Pcisph<R> {
+    fn step(&mut self, state: &mut ParticleSet<R>) -> Result<StepStats, PbfError> {
+        Pcisph::step(self, state)
+    }
+    fn frame_dt(&self) -> R {
+        self.params().dt
+    }
+    fn support_radius(&self) -> R {
+        self.params().support_radius
+    }
+    fn last_permutation(&self) -> Option<&[u32]> {
+        Pcisph::last_permutation(self)
+    }
+    fn name(&self) -> &'static str {
+        "PCISPH"
+    }
+}

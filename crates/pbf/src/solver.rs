@@ -15,10 +15,10 @@ use sph_kernels::{Kernel, Poly6, Spiky};
 use crate::{ArtificialPressure, PbfError, PbfParams, Solids};
 
 /// Smallest number of particles handed to one rayon task.
-const MIN_LEN: usize = 256;
+pub(crate) const MIN_LEN: usize = 256;
 /// Particles per partial sum of the end-of-step statistics (fixed, so that the statistics do
 /// not depend on the number of threads).
-const REDUCE_CHUNK: usize = 4096;
+pub(crate) const REDUCE_CHUNK: usize = 4096;
 
 /// Wall-clock time of the phases of one [`Pbf::step`] call (all substeps), in seconds, named
 /// after the rows of the paper's Table 2, and the state at the end of the call.
@@ -225,11 +225,11 @@ impl<R: Real> fmt::Debug for Pbf<R> {
     }
 }
 
-fn non_finite<R: Real>(v: &Vec3<R>) -> Option<usize> {
+pub(crate) fn non_finite<R: Real>(v: &Vec3<R>) -> Option<usize> {
     (0..3).find(|&a| !v[a].is_finite_value())
 }
 
-fn check_masses<R: Real>(masses: &[R]) -> Result<(), PbfError> {
+pub(crate) fn check_masses<R: Real>(masses: &[R]) -> Result<(), PbfError> {
     match masses
         .par_iter()
         .with_min_len(MIN_LEN)
@@ -245,7 +245,7 @@ fn check_masses<R: Real>(masses: &[R]) -> Result<(), PbfError> {
 
 /// Runs the configured search, falling back to a hashed grid when the cell-start grid
 /// refuses the domain (an exceptional case: the fallback allocates on first use).
-fn find_neighbours<R: Real>(
+pub(crate) fn find_neighbours<R: Real>(
     search: &mut dyn NeighbourSearch<R>,
     fallback: &mut Option<HashedGrid<R>>,
     positions: &[Vec3<R>],
@@ -267,7 +267,7 @@ fn find_neighbours<R: Real>(
 /// each solid in order, a position closer than `radius` to it (signed distance `d < radius`)
 /// is moved along the normalised SDF gradient by `radius − d`.
 #[inline]
-fn collide<R: Real>(solids: &[Box<dyn Sdf<R>>], mut x: Vec3<R>, radius: R) -> Vec3<R> {
+pub(crate) fn collide<R: Real>(solids: &[Box<dyn Sdf<R>>], mut x: Vec3<R>, radius: R) -> Vec3<R> {
     for s in solids {
         let d = s.signed_distance(&x);
         if d < radius {
@@ -279,6 +279,124 @@ fn collide<R: Real>(solids: &[Box<dyn Sdf<R>>], mut x: Vec3<R>, radius: R) -> Ve
         }
     }
     x
+}
+
+/// The divergence checks of a substep, before anything is written to the state: a non-finite
+/// final position `x` or velocity `v`, or a position more than `h` inside a solid, is a
+/// [`PbfError::BlowUp`] of call `step`, substep `sub`, naming the first such particle.
+pub(crate) fn check_divergence<R: Real>(
+    step: u64,
+    sub: usize,
+    x: &[Vec3<R>],
+    v: &[Vec3<R>],
+    solids: &[Box<dyn Sdf<R>>],
+    h: R,
+) -> Result<(), PbfError> {
+    if let Some(i) = (0..x.len())
+        .into_par_iter()
+        .with_min_len(MIN_LEN)
+        .position_first(|i| non_finite(&x[i]).is_some() || non_finite(&v[i]).is_some())
+    {
+        return Err(blow_up(
+            step,
+            i,
+            format!(
+                "substep {sub}: position {:?} or velocity {:?} is not finite",
+                x[i], v[i]
+            ),
+        ));
+    }
+    if !solids.is_empty() {
+        let margin = -h;
+        if let Some(i) = x
+            .par_iter()
+            .with_min_len(MIN_LEN)
+            .position_first(|xi| solids.iter().any(|sd| sd.signed_distance(xi) < margin))
+        {
+            let (k, d) = solids
+                .iter()
+                .enumerate()
+                .map(|(k, sd)| (k, sd.signed_distance(&x[i])))
+                .find(|&(_, d)| d < margin)
+                .unwrap_or((0, R::zero()));
+            return Err(blow_up(
+                step,
+                i,
+                format!(
+                    "substep {sub}: position {:?} is {} m inside solid {k} (more than h = {})",
+                    x[i],
+                    -d.as_f64(),
+                    h.as_f64()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+pub(crate) fn blow_up(step: u64, particle: usize, reason: String) -> PbfError {
+    PbfError::BlowUp {
+        step,
+        particle,
+        reason,
+    }
+}
+
+/// Density ratios and kinetic energy of `state` into `stats`, summed over fixed chunks of
+/// [`REDUCE_CHUNK`] particles (`partials` holds one entry per chunk), so that the result does
+/// not depend on the number of threads.
+pub(crate) fn density_energy_stats<R: Real>(
+    state: &ParticleSet<R>,
+    rest_density: R,
+    partials: &mut [[f64; 3]],
+    stats: &mut StepStats,
+) {
+    let n = state.len();
+    if n == 0 {
+        return;
+    }
+    let inv_rho0 = 1.0 / rest_density.as_f64();
+    let (rho, v, m) = (&state.densities, &state.velocities, &state.masses);
+    partials.par_iter_mut().enumerate().for_each(|(c, part)| {
+        let (a, b) = (c * REDUCE_CHUNK, ((c + 1) * REDUCE_CHUNK).min(n));
+        let mut sum = 0.0;
+        let mut max = f64::NEG_INFINITY;
+        let mut ke = 0.0;
+        for i in a..b {
+            let r = rho[i].as_f64() * inv_rho0;
+            sum += r;
+            max = max.max(r);
+            ke += 0.5 * m[i].as_f64() * v[i].norm_squared().as_f64();
+        }
+        *part = [sum, max, ke];
+    });
+    let mut sum = 0.0;
+    let mut max = f64::NEG_INFINITY;
+    let mut ke = 0.0;
+    for part in partials.iter() {
+        sum += part[0];
+        max = max.max(part[1]);
+        ke += part[2];
+    }
+    stats.mean_density_ratio = sum / n as f64;
+    stats.max_density_ratio = max;
+    stats.kinetic_energy = ke;
+}
+
+/// Reorders `state` by cell of size `h` (lexicographic cell order, for locality), keeping the
+/// permutation (`new[k] = old[perm[k]]`) in `permutation`.
+pub(crate) fn reorder_by_cell<R: Real>(
+    sorter: &mut CellSorter,
+    state: &mut ParticleSet<R>,
+    h: R,
+    permutation: &mut Vec<u32>,
+    perm_scratch: &mut PermutationScratch<R>,
+) -> Result<(), PbfError> {
+    let perm = sorter.permutation(&state.positions, h, CellOrder::Lexicographic)?;
+    permutation.clear();
+    permutation.extend_from_slice(perm);
+    state.permute(permutation, perm_scratch)?;
+    Ok(())
 }
 
 /// Eqs. 1, 2, 8 and 11: densities and `λ_i` at positions `x`.
@@ -509,14 +627,13 @@ impl<R: Real> Pbf<R> {
         let every = self.params.reorder_every as u64;
         if every > 0 && step.is_multiple_of(every) && n > 1 {
             let t = Instant::now();
-            let perm = self.sorter.permutation(
-                &state.positions,
+            reorder_by_cell(
+                &mut self.sorter,
+                state,
                 self.params.support_radius,
-                CellOrder::Lexicographic,
+                &mut self.permutation,
+                &mut self.perm_scratch,
             )?;
-            self.permutation.clear();
-            self.permutation.extend_from_slice(perm);
-            state.permute(&self.permutation, &mut self.perm_scratch)?;
             self.reordered = true;
             stats.reordered = true;
             stats.reorder_s = t.elapsed().as_secs_f64();
@@ -530,14 +647,6 @@ impl<R: Real> Pbf<R> {
         self.end_of_step_stats(state, &mut stats);
         stats.velocity_update_s += t.elapsed().as_secs_f64();
         Ok(stats)
-    }
-
-    fn blow_up(step: u64, particle: usize, reason: String) -> PbfError {
-        PbfError::BlowUp {
-            step,
-            particle,
-            reason,
-        }
     }
 
     fn substep(
@@ -576,7 +685,7 @@ impl<R: Real> Pbf<R> {
             .with_min_len(MIN_LEN)
             .position_first(|x| non_finite(x).is_some())
         {
-            return Err(Self::blow_up(
+            return Err(blow_up(
                 step,
                 i,
                 format!(
@@ -598,7 +707,7 @@ impl<R: Real> Pbf<R> {
             Ok(st) => st,
             Err(SearchError::NonFinitePosition { index, .. })
             | Err(SearchError::CellCoordinateOverflow { index, .. }) => {
-                return Err(Self::blow_up(
+                return Err(blow_up(
                     step,
                     index,
                     format!(
@@ -708,47 +817,7 @@ impl<R: Real> Pbf<R> {
             });
 
         // Divergence checks before anything is written to the state.
-        if let Some(i) = (0..x.len())
-            .into_par_iter()
-            .with_min_len(MIN_LEN)
-            .position_first(|i| {
-                non_finite(&x[i]).is_some() || non_finite(&s.velocity_new[i]).is_some()
-            })
-        {
-            return Err(Self::blow_up(
-                step,
-                i,
-                format!(
-                    "substep {sub}: position {:?} or velocity {:?} is not finite",
-                    x[i], s.velocity_new[i]
-                ),
-            ));
-        }
-        if !solids.is_empty() {
-            let margin = -h;
-            if let Some(i) = x
-                .par_iter()
-                .with_min_len(MIN_LEN)
-                .position_first(|xi| solids.iter().any(|sd| sd.signed_distance(xi) < margin))
-            {
-                let (k, d) = solids
-                    .iter()
-                    .enumerate()
-                    .map(|(k, sd)| (k, sd.signed_distance(&x[i])))
-                    .find(|&(_, d)| d < margin)
-                    .unwrap_or((0, R::zero()));
-                return Err(Self::blow_up(
-                    step,
-                    i,
-                    format!(
-                        "substep {sub}: position {:?} is {} m inside solid {k} (more than h = {})",
-                        x[i],
-                        -d.as_f64(),
-                        h.as_f64()
-                    ),
-                ));
-            }
-        }
+        check_divergence(step, sub, x, &s.velocity_new, solids, h)?;
         state.positions.copy_from_slice(x);
         state.velocities.copy_from_slice(&s.velocity_new);
         state.densities.copy_from_slice(&s.density);
@@ -761,39 +830,11 @@ impl<R: Real> Pbf<R> {
     /// Density ratios and kinetic energy, summed over fixed chunks (independent of the
     /// thread count).
     fn end_of_step_stats(&mut self, state: &ParticleSet<R>, stats: &mut StepStats) {
-        let n = state.len();
-        if n == 0 {
-            return;
-        }
-        let inv_rho0 = 1.0 / self.params.rest_density.as_f64();
-        let (rho, v, m) = (&state.densities, &state.velocities, &state.masses);
-        self.scratch
-            .partials
-            .par_iter_mut()
-            .enumerate()
-            .for_each(|(c, part)| {
-                let (a, b) = (c * REDUCE_CHUNK, ((c + 1) * REDUCE_CHUNK).min(n));
-                let mut sum = 0.0;
-                let mut max = f64::NEG_INFINITY;
-                let mut ke = 0.0;
-                for i in a..b {
-                    let r = rho[i].as_f64() * inv_rho0;
-                    sum += r;
-                    max = max.max(r);
-                    ke += 0.5 * m[i].as_f64() * v[i].norm_squared().as_f64();
-                }
-                *part = [sum, max, ke];
-            });
-        let mut sum = 0.0;
-        let mut max = f64::NEG_INFINITY;
-        let mut ke = 0.0;
-        for part in &self.scratch.partials {
-            sum += part[0];
-            max = max.max(part[1]);
-            ke += part[2];
-        }
-        stats.mean_density_ratio = sum / n as f64;
-        stats.max_density_ratio = max;
-        stats.kinetic_energy = ke;
+        density_energy_stats(
+            state,
+            self.params.rest_density,
+            &mut self.scratch.partials,
+            stats,
+        );
     }
 }
