@@ -112,3 +112,18 @@ pub fn kiddo_search(points: &[Vec3<f32>], radius: f32) -> usize {
         })
         .sum()
 }
+
+/// The fluid of SPlisHSPlasH's `DamBreakModel.json` at particle radius 0.0125 m (the issue's
+/// side-by-side scene): the 39³ = 59,319 particles of [`dam_break_anchor`] without the
+/// boundary samples, and the tank 4 × 3 × 1.5 m centred at (0, 1.5, 0) as an inverted box
+/// (the solvers here use signed distance fields instead of boundary particles).
+pub fn dam_break_fluid<R: Real>() -> (Vec<Vec3<R>>, Aabb<R>) {
+    let (mut p, fluid) = dam_break_anchor::<R>();
+    p.truncate(fluid);
+    let tank = Aabb::new(
+        Vec3::new(R::of_f64(-2.0), R::zero(), R::of_f64(-0.75)),
+        Vec3::new(R::of_f64(2.0), R::of_f64(3.0), R::of_f64(0.75)),
+    )
+    .expect("valid tank");
+    (p, tank)
+}

@@ -19,6 +19,7 @@ use serde::Serialize;
 pub mod experiments;
 pub mod helpers;
 pub mod runner;
+pub mod sim;
 
 pub use experiments::registry;
 

@@ -1,10 +1,12 @@
-//! `validation run [--full] [--only ID...] [--out DIR]` and `validation list`.
+//! `validation run [--full] [--only ID...] [--out DIR]`, `validation list` and
+//! `validation scene PATH [--quick] [--frames N] [--out DIR]`.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use validation::runner::{self, RunOptions};
+use validation::sim::{run_scene, SceneRunOptions};
 use validation::{registry, workspace_root, Mode};
 
 #[derive(Parser)]
@@ -33,6 +35,20 @@ enum Command {
     },
     /// List the experiments and what each reproduces.
     List,
+    /// Run a scene file: VTK frames and per-frame statistics.
+    Scene {
+        /// The scene file (TOML).
+        path: PathBuf,
+        /// Apply the scene's `[quick]` overrides.
+        #[arg(long)]
+        quick: bool,
+        /// Stop after this many frames.
+        #[arg(long, value_name = "N")]
+        frames: Option<usize>,
+        /// Output directory [default: target/scenes/<file stem> under the workspace root].
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+    },
 }
 
 fn main() -> ExitCode {
@@ -45,6 +61,30 @@ fn main() -> ExitCode {
                 println!("{:<w$}  {}", e.id(), e.source());
             }
             ExitCode::SUCCESS
+        }
+        Command::Scene {
+            path,
+            quick,
+            frames,
+            out,
+        } => {
+            let stem = path
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "scene".into());
+            let opts = SceneRunOptions {
+                quick,
+                max_frames: frames,
+                out_dir: out
+                    .unwrap_or_else(|| workspace_root().join("target").join("scenes").join(stem)),
+            };
+            match run_scene(&path, &opts) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => {
+                    eprintln!("error: {e:#}");
+                    ExitCode::from(1)
+                }
+            }
         }
         Command::Run { full, only, out } => {
             let opts = RunOptions {

@@ -4,6 +4,8 @@
 //!   crate in release and runs the experiments (`validation run ...`); exit code 1 when any
 //!   check fails or an experiment errors.
 //! - `cargo xtask list` — the experiments and the paper figure each reproduces.
+//! - `cargo xtask run SCENE [--quick] [--frames N] [--out DIR]` — builds `validation` in release
+//!   and runs a scene file (`validation scene ...`): ParaView frames and per-frame statistics.
 //! - `cargo xtask bench [ARGS...]` — `cargo bench -p benches -- ARGS...` (criterion).
 //!
 //! Deliberately light: clap + anyhow + std. Cargo is the one running this (`$CARGO`), and
@@ -42,6 +44,21 @@ enum Task {
     },
     /// List the experiments and the figure or claim each reproduces.
     List,
+    /// Run a scene file (e.g. `scenes/dam_break.toml`): VTK frames for ParaView and a CSV of
+    /// per-frame statistics in `--out` [default: target/scenes/<scene name>].
+    Run {
+        /// The scene file (TOML).
+        scene: PathBuf,
+        /// Apply the scene's `[quick]` overrides (fewer particles, shorter).
+        #[arg(long)]
+        quick: bool,
+        /// Stop after this many frames.
+        #[arg(long, value_name = "N")]
+        frames: Option<usize>,
+        /// Output directory.
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+    },
     /// Run the criterion benchmarks: `cargo bench -p benches -- ARGS...`.
     Bench {
         /// Arguments passed to criterion (e.g. a filter, `--save-baseline main`).
@@ -105,6 +122,32 @@ fn main() -> ExitCode {
                 let out = std::path::absolute(&out).unwrap_or(out);
                 a.push("--out".into());
                 a.push(out.into_os_string());
+            }
+            a
+        }
+        Task::Run {
+            scene,
+            quick,
+            frames,
+            out,
+        } => {
+            let mut a = os(&["run", "--release", "-p", "validation", "--", "scene"]);
+            // Paths relative to where the user typed the command, not the workspace root.
+            a.push(
+                std::path::absolute(&scene)
+                    .unwrap_or(scene)
+                    .into_os_string(),
+            );
+            if quick {
+                a.push("--quick".into());
+            }
+            if let Some(n) = frames {
+                a.push("--frames".into());
+                a.push(n.to_string().into());
+            }
+            if let Some(out) = out {
+                a.push("--out".into());
+                a.push(std::path::absolute(&out).unwrap_or(out).into_os_string());
             }
             a
         }

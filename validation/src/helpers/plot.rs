@@ -404,7 +404,7 @@ where
         macro_rules! label {
             ($anno:expr) => {{
                 let anno = $anno;
-                if std::mem::take(&mut first) {
+                if std::mem::take(&mut first) && !s.name.is_empty() {
                     let anno = anno.label(s.name.as_str());
                     let dash = move |x: i32, y: i32| {
                         EmptyElement::at((x, y))

@@ -1,0 +1,200 @@
+//! `pbf-performance` (Macklin & Müller 2013, Tables 1 and 2): time per step of the three
+//! scenes with the paper's steps per frame and iterations, and the per-phase breakdown of a
+//! frame, beside the paper's GTX 680 figures (`reference-data/pbf/macklin_muller_2013_performance.csv`).
+//!
+//! Each scene (quick overrides in quick mode, paper scale in full mode) runs
+//! [`WARM_UP_FRAMES`] frames, then [`MEASURED_FRAMES`] timed frames from which the time per
+//! step (frame time / steps per frame) and the phase percentages are taken. This is a CPU
+//! (rayon, this machine's cores) against the paper's GPU: the table is a record, not a race.
+
+use anyhow::Result;
+use sph_core::Real;
+use sph_scene::{Precision, Scene};
+
+use crate::helpers::{load_reference_csv, write_csv_rows};
+use crate::sim::SceneSim;
+use crate::{fmt_num, workspace_root, Check, Context, Experiment, Outcome};
+
+/// The experiment.
+pub struct PbfPerformance;
+
+/// Frames run before timing (the particles are reordered by cell and the buffers grown).
+pub const WARM_UP_FRAMES: usize = 3;
+/// Frames timed.
+pub const MEASURED_FRAMES: usize = 10;
+/// The scenes of Table 1, by file stem.
+const SCENES: [&str; 3] = ["armadillo_splash", "dam_break", "bunny_drop"];
+/// Phase names of Table 2, in its order.
+const PHASES: [&str; 5] = [
+    "integrate",
+    "create_hash_grid",
+    "detect_neighbours",
+    "constraint_solve",
+    "velocity_update",
+];
+
+/// Timings of one scene: particles, steps/frame, iterations/step, ms per step, phase %.
+struct Timing {
+    particles: usize,
+    steps: usize,
+    iterations: usize,
+    ms_per_step: f64,
+    percent: [f64; 5],
+    threads: usize,
+}
+
+fn time_scene<R: Real>(ctx: &Context, scene: &Scene) -> Result<Timing> {
+    let mut sim = SceneSim::<R>::new(scene)?;
+    for _ in 0..WARM_UP_FRAMES {
+        sim.advance()?;
+        ctx.progress.inc(1);
+    }
+    let mut phases = [0.0f64; 5];
+    let mut total = 0.0;
+    for _ in 0..MEASURED_FRAMES {
+        let s = sim.advance()?;
+        let p = [
+            s.integrate_s,
+            s.create_hash_grid_s,
+            s.detect_neighbours_s,
+            s.constraint_solve_s,
+            s.velocity_update_s + s.reorder_s,
+        ];
+        for (a, b) in phases.iter_mut().zip(p) {
+            *a += b;
+        }
+        total += s.total_s();
+        ctx.progress.inc(1);
+    }
+    let steps = scene.solver.substeps;
+    Ok(Timing {
+        particles: sim.state.len(),
+        steps,
+        iterations: scene.solver.iterations,
+        ms_per_step: 1e3 * total / (MEASURED_FRAMES * steps) as f64,
+        percent: phases.map(|p| 100.0 * p / total),
+        threads: rayon::current_num_threads(),
+    })
+}
+
+impl Experiment for PbfPerformance {
+    fn id(&self) -> &'static str {
+        "pbf-performance"
+    }
+
+    fn source(&self) -> &'static str {
+        "Macklin & Müller (2013) Position Based Fluids, Tables 1 and 2: time per step and frame breakdown"
+    }
+
+    fn run(&self, ctx: &mut Context) -> Result<Outcome> {
+        let paper = load_reference_csv(
+            ctx,
+            "pbf/macklin_muller_2013_performance.csv",
+            &[
+                "scene",
+                "particles",
+                "steps_per_frame",
+                "iterations_per_step",
+                "time_per_step_ms",
+            ],
+        )?;
+        ctx.progress
+            .set_length((SCENES.len() * (WARM_UP_FRAMES + MEASURED_FRAMES)) as u64);
+        let mut out = Outcome::new();
+        let mut rows = Vec::new();
+        let mut md = String::from(
+            "| scene | particles (paper) | steps/frame | iters/step | time/step ms (paper, GTX 680) | µs per particle-step | Integrate % | Create Hash Grid % | Detect Neighbors % | Constraint Solve % | Velocity Update % |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+        );
+        for name in SCENES {
+            let scene = Scene::load(&workspace_root().join(format!("scenes/{name}.toml")))?;
+            let scene = ctx.mode.pick(scene.quick(), scene);
+            let t = match scene.precision {
+                Precision::F32 => time_scene::<f32>(ctx, &scene)?,
+                Precision::F64 => time_scene::<f64>(ctx, &scene)?,
+            };
+            let row = paper.find(&[("scene", name)])?;
+            let paper_ms = paper.number(row, "time_per_step_ms")?;
+            let paper_n = paper.number(row, "particles")?;
+            let paper_pct: Vec<String> = PHASES
+                .iter()
+                .map(|p| {
+                    paper
+                        .number(row, &format!("{p}_percent"))
+                        .map_or("–".to_string(), fmt_num)
+                })
+                .collect();
+            let us_per_particle_step = 1e3 * t.ms_per_step / t.particles as f64;
+            out.metric(format!("{name}/particles"), t.particles as f64);
+            out.metric(format!("{name}/ms_per_step"), t.ms_per_step);
+            out.metric(format!("{name}/us_per_particle_step"), us_per_particle_step);
+            for (p, v) in PHASES.iter().zip(t.percent) {
+                out.metric(format!("{name}/{p}_percent"), v);
+            }
+            // Table 2: the constraint solve is the largest phase in both scenes.
+            let largest = t.percent.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+            out.check(Check::equals(
+                format!("{name}/constraint solve is the largest phase (1 = yes)"),
+                (t.percent[3] == largest) as u8 as f64,
+                1.0,
+                "Table 2 of the paper: Constraint Solve is the largest share (38 %, 51 %)",
+            ));
+            md.push_str(&format!(
+                "| {name} | {} ({}) | {} | {} | {} ({}) | {} | {} |\n",
+                t.particles,
+                fmt_num(paper_n),
+                t.steps,
+                t.iterations,
+                fmt_num(t.ms_per_step),
+                fmt_num(paper_ms),
+                fmt_num(us_per_particle_step),
+                t.percent
+                    .iter()
+                    .zip(&paper_pct)
+                    .map(|(v, p)| format!("{:.1} ({p})", v))
+                    .collect::<Vec<_>>()
+                    .join(" | "),
+            ));
+            let mut r = vec![
+                name.to_string(),
+                t.particles.to_string(),
+                t.steps.to_string(),
+                t.iterations.to_string(),
+                format!("{:.4}", t.ms_per_step),
+                t.threads.to_string(),
+            ];
+            r.extend(t.percent.iter().map(|v| format!("{v:.2}")));
+            rows.push(r);
+        }
+        let mut header = vec![
+            "scene",
+            "particles",
+            "steps_per_frame",
+            "iterations_per_step",
+            "ms_per_step",
+            "threads",
+        ];
+        header.extend(PHASES.iter().map(|p| match *p {
+            "integrate" => "integrate_percent",
+            "create_hash_grid" => "create_hash_grid_percent",
+            "detect_neighbours" => "detect_neighbours_percent",
+            "constraint_solve" => "constraint_solve_percent",
+            _ => "velocity_update_percent",
+        }));
+        write_csv_rows(&ctx.path("performance.csv"), &header, rows)?;
+        ctx.add_file(
+            "performance.csv",
+            "time per step and phase percentages of each scene (this machine)",
+        );
+        md.push_str(&format!(
+            "\nThis machine, {} rayon threads, CPU; in parentheses the paper's GTX 680 figures (Tables 1 and 2). Reorder time is counted in Velocity Update.\n",
+            rayon::current_num_threads()
+        ));
+        std::fs::write(ctx.path("performance.md"), &md)?;
+        ctx.add_file(
+            "performance.md",
+            "Tables 1 and 2 side by side with the paper's figures",
+        );
+        out.note(md);
+        Ok(out)
+    }
+}
