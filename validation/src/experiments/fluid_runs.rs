@@ -1,5 +1,10 @@
 //! Shared by the PBF/PCISPH experiments: a scene run recording the density and energy of
 //! every frame, which keeps a blow-up as a result instead of an error.
+//!
+//! A run also stops as diverged when a frame ends with `max ρ/ρ0 >` [`DIVERGED_DENSITY_RATIO`]:
+//! the solver reports no error then (its state is finite and inside the tank), but a liquid
+//! compressed to twice its rest density is no longer a simulation of water, and such clumped
+//! states have hundreds of neighbours per particle, which makes every further step slow.
 
 use anyhow::Result;
 use pbf::PbfError;
@@ -8,6 +13,10 @@ use sph_scene::{Precision, Scene, SolverKind};
 
 use crate::sim::SceneSim;
 use crate::Context;
+
+/// `max ρ/ρ0` above which a run counts as diverged (twice the rest density: 100 %
+/// compression of a liquid whose solvers aim at 0.1–1 %).
+pub const DIVERGED_DENSITY_RATIO: f64 = 2.0;
 
 /// One frame's statistics.
 #[derive(Debug, Clone, Copy)]
@@ -33,7 +42,11 @@ pub struct FluidRun {
     pub particles: usize,
     /// Statistics of each completed frame.
     pub frames: Vec<FrameStats>,
-    /// The solver's divergence report (`PbfError::BlowUp`), when the run stopped early.
+    /// Potential energy of the initial state above the tank floor, `Σ m_i |g| (y_i − y_floor)`
+    /// (J): the most kinetic energy a scene starting at rest can ever have.
+    pub initial_potential_energy_j: f64,
+    /// Why the run stopped early: the solver's divergence report (`PbfError::BlowUp`), or a
+    /// density above [`DIVERGED_DENSITY_RATIO`].
     pub blow_up: Option<String>,
 }
 
@@ -48,6 +61,19 @@ impl FluidRun {
             .collect();
         v.iter().sum::<f64>() / v.len() as f64
     }
+    /// Largest kinetic energy over the completed frames (J).
+    pub fn peak_kinetic_energy(&self) -> f64 {
+        self.frames
+            .iter()
+            .map(|s| s.kinetic_energy_j)
+            .fold(f64::NAN, f64::max)
+    }
+    /// Bounded: no blow-up or divergence, and the kinetic energy never above the initial
+    /// potential energy (energy conservation: a stable solver can only lose energy from a
+    /// state at rest).
+    pub fn bounded(&self) -> bool {
+        self.blow_up.is_none() && self.peak_kinetic_energy() <= self.initial_potential_energy_j
+    }
     /// Largest `max ρ/ρ0` over the completed frames.
     pub fn peak_density_ratio(&self) -> f64 {
         self.frames
@@ -60,21 +86,49 @@ impl FluidRun {
 fn run_in<R: Real>(ctx: &Context, scene: &Scene, label: String) -> Result<FluidRun> {
     let mut sim = SceneSim::<R>::new(scene)?;
     let frames = sim.frames_total();
+    let g = scene.gravity.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let floor = scene.tank.map_or_else(
+        || {
+            sim.state
+                .positions
+                .iter()
+                .map(|p| p.y.as_f64())
+                .fold(f64::INFINITY, f64::min)
+        },
+        |t| t.min.y,
+    );
+    let initial_potential_energy_j = sim
+        .state
+        .positions
+        .iter()
+        .zip(&sim.state.masses)
+        .map(|(p, m)| m.as_f64() * g * (p.y.as_f64() - floor))
+        .sum();
     let mut run = FluidRun {
         label,
+        initial_potential_energy_j,
         particles: sim.state.len(),
         frames: Vec::with_capacity(frames),
         blow_up: None,
     };
     for _ in 0..frames {
         match sim.advance() {
-            Ok(s) => run.frames.push(FrameStats {
-                t_s: sim.time_s,
-                max_density_ratio: s.max_density_ratio,
-                mean_density_ratio: s.mean_density_ratio,
-                kinetic_energy_j: s.kinetic_energy,
-                wall_s: s.total_s(),
-            }),
+            Ok(s) => {
+                run.frames.push(FrameStats {
+                    t_s: sim.time_s,
+                    max_density_ratio: s.max_density_ratio,
+                    mean_density_ratio: s.mean_density_ratio,
+                    kinetic_energy_j: s.kinetic_energy,
+                    wall_s: s.total_s(),
+                });
+                if !(s.max_density_ratio <= DIVERGED_DENSITY_RATIO) {
+                    run.blow_up = Some(format!(
+                        "diverged: max rho/rho0 = {:.3} > {DIVERGED_DENSITY_RATIO} at t = {:.3} s (frame {})",
+                        s.max_density_ratio, sim.time_s, sim.frame
+                    ));
+                    break;
+                }
+            }
             Err(e) => match e.downcast_ref::<PbfError>() {
                 Some(PbfError::BlowUp { .. }) => {
                     run.blow_up = Some(format!("{e:#}"));
