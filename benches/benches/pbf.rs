@@ -2,9 +2,11 @@
 //! radius 0.0125 m (59,319 fluid particles, support 0.05 m, Δt = 0.002 s, one step per call),
 //! from the rest state: `cargo bench -p benches --bench pbf`.
 //!
-//! Iterations: 5 per step, SPlisHSPlasH 2.19's average for this scene with its PBF solver
-//! iterating to 0.1 % mean density error (4.8 over the first 10 steps, measured side by side
-//! by `examples/pbf_dambreak.rs`; see its docs for the comparison figures).
+//! Iterations: 5 per step, close to SPlisHSPlasH 2.19's mean for this scene with its PBF
+//! solver iterating to 0.1 % mean density error (5.33 over the first 250 steps; 2.55 over
+//! the first 51). The side-by-side figures (`examples/pbf_dambreak.rs` against
+//! SPlisHSPlasH) are in the `pbf` crate documentation, section "Performance and
+//! determinism".
 use criterion::{criterion_group, criterion_main, Criterion};
 use pbf::{FluidSolver, ParticleSet, Pbf, PbfParams, Pcisph, PcisphParams, Solids};
 use sph_core::{BoxSdf, Inverted};

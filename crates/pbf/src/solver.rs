@@ -85,6 +85,7 @@ pub struct PbfScratch<R: Real> {
     vorticity: Vec<Vec3<R>>,
     vorticity_norm: Vec<R>,
     partials: Vec<[f64; 3]>,
+    pairs: PairCache<R>,
 }
 
 impl<R: Real> PbfScratch<R> {
@@ -159,6 +160,8 @@ struct Consts<R: Real> {
     scorr_unit: R,
     inv_rho0: R,
     eps: R,
+    /// Support radius `h` (m).
+    h: R,
 }
 
 impl<R: Real> Consts<R> {
@@ -174,6 +177,7 @@ impl<R: Real> Consts<R> {
             scorr_unit: p.scorr_unit()?,
             inv_rho0: R::one() / p.rest_density,
             eps: p.cfm_epsilon,
+            h,
         })
     }
 }
@@ -399,55 +403,149 @@ pub(crate) fn reorder_by_cell<R: Real>(
     Ok(())
 }
 
-/// Eqs. 1, 2, 8 and 11: densities and `λ_i` at positions `x`.
+/// Per-pair values of one Jacobi iteration, in the CSR order of the neighbour lists:
+/// computed by `lambda_pass` and reused by `delta_pass`, which sees the same positions, so
+/// that the second pass needs no square root, division or kernel evaluation (measured: this
+/// is faster than recomputing `s_corr` from `r²` in the second pass, although it streams a
+/// second per-pair array).
+#[derive(Debug, Clone, Default)]
+struct PairCache<R: Real> {
+    /// Spiky gradient factor `f_ij` with `∇W(p_i − p_j) = (p_i − p_j) f_ij` (`dW/dr / r`;
+    /// 0 at `r = 0` and at or beyond `h`).
+    grad_factor: Vec<R>,
+    /// `s_corr` of the pair (eq. 13; 0 when the artificial pressure is off).
+    scorr: Vec<R>,
+}
+
+impl<R: Real> PairCache<R> {
+    /// Makes room for `pairs` pairs (reallocates only when the capacity is exceeded).
+    fn resize(&mut self, pairs: usize) {
+        self.grad_factor.resize(pairs, R::zero());
+        self.scorr.resize(pairs, R::zero());
+    }
+}
+
+/// The Spiky gradient factor `dW/dr / r` (see [`PairCache::grad_factor`]); the same
+/// arithmetic as `Kernel::gradient`, so that `r * factor` equals `spiky.gradient(&r)`.
+#[inline]
+fn spiky_factor<R: Real>(c: &Consts<R>, r2: R) -> R {
+    let len = r2.sqrt();
+    if len > R::zero() && len < c.h {
+        c.spiky.derivative(len) / len
+    } else {
+        R::zero()
+    }
+}
+
+/// What the particle loops of one pass read.
+#[derive(Clone, Copy)]
+struct PassInput<'a, R: Real> {
+    c: &'a Consts<R>,
+    x: &'a [Vec3<R>],
+    m: &'a [R],
+    nb: &'a NeighbourLists,
+}
+
+/// Eqs. 1, 2, 8 and 11: densities and `λ_i` at positions `x`, and the pair cache for
+/// [`delta_pass`].
 fn lambda_pass<R: Real>(
-    c: &Consts<R>,
-    x: &[Vec3<R>],
-    m: &[R],
-    nb: &NeighbourLists,
+    input: PassInput<'_, R>,
     density: &mut [R],
     lambda: &mut [R],
+    cache: &mut PairCache<R>,
 ) {
-    density
-        .par_iter_mut()
-        .zip(lambda.par_iter_mut())
-        .enumerate()
-        .with_min_len(MIN_LEN)
-        .for_each(|(i, (rho, lam))| {
-            let xi = x[i];
-            let mut sum_w = m[i] * c.w0;
-            let mut grad_i = Vec3::zeros();
-            let mut sum_g2 = R::zero();
-            for &j in nb.neighbours(i) {
-                let j = j as usize;
-                let r = xi - x[j];
-                sum_w += m[j] * c.poly6.value_r2(r.norm_squared());
-                // ∇_{p_j} C_i = −(m_j/ρ0) ∇W(p_i − p_j); ∇_{p_i} C_i = Σ_j (m_j/ρ0) ∇W.
-                let g = c.spiky.gradient(&r) * (m[j] * c.inv_rho0);
-                grad_i += g;
-                sum_g2 += g.norm_squared();
-            }
-            *rho = sum_w;
-            let constraint = sum_w * c.inv_rho0 - R::one();
-            *lam = -constraint / (sum_g2 + grad_i.norm_squared() + c.eps);
-        });
+    let pairs = input.nb.pair_count();
+    cache.resize(pairs);
+    lambda_block(
+        input,
+        0,
+        density,
+        lambda,
+        &mut cache.grad_factor[..pairs],
+        &mut cache.scorr[..pairs],
+    );
+}
+
+/// [`lambda_pass`] over the particles `first..first + density.len()`, whose pairs are
+/// `grad_factor` and `scorr`: split in halves (rayon `join`) down to `MIN_LEN` particles, so
+/// that each task owns its particles' contiguous CSR range of the cache.
+fn lambda_block<R: Real>(
+    input: PassInput<'_, R>,
+    first: usize,
+    density: &mut [R],
+    lambda: &mut [R],
+    grad_factor: &mut [R],
+    scorr: &mut [R],
+) {
+    let n = density.len();
+    let offsets = input.nb.offsets();
+    if n > MIN_LEN {
+        let mid = n / 2;
+        let split = offsets[first + mid] - offsets[first];
+        let (d0, d1) = density.split_at_mut(mid);
+        let (l0, l1) = lambda.split_at_mut(mid);
+        let (g0, g1) = grad_factor.split_at_mut(split);
+        let (s0, s1) = scorr.split_at_mut(split);
+        rayon::join(
+            || lambda_block(input, first, d0, l0, g0, s0),
+            || lambda_block(input, first + mid, d1, l1, g1, s1),
+        );
+        return;
+    }
+    let PassInput { c, x, m, nb } = input;
+    let base = offsets[first];
+    for (k, (rho, lam)) in density.iter_mut().zip(lambda.iter_mut()).enumerate() {
+        let i = first + k;
+        let (a, b) = (offsets[i] - base, offsets[i + 1] - base);
+        let xi = x[i];
+        let mut sum_w = m[i] * c.w0;
+        let mut grad_i = Vec3::zeros();
+        let mut sum_g2 = R::zero();
+        for ((&j, gf), sc) in nb
+            .neighbours(i)
+            .iter()
+            .zip(&mut grad_factor[a..b])
+            .zip(&mut scorr[a..b])
+        {
+            let j = j as usize;
+            let r = xi - x[j];
+            let r2 = r.norm_squared();
+            let w = c.poly6.value_r2(r2);
+            sum_w += m[j] * w;
+            *sc = if c.scorr_on {
+                c.scorr.from_kernel_value(w)
+            } else {
+                R::zero()
+            };
+            let f = spiky_factor(c, r2);
+            *gf = f;
+            // ∇_{p_j} C_i = −(m_j/ρ0) ∇W(p_i − p_j); ∇_{p_i} C_i = Σ_j (m_j/ρ0) ∇W.
+            let g = (r * f) * (m[j] * c.inv_rho0);
+            grad_i += g;
+            sum_g2 += g.norm_squared();
+        }
+        *rho = sum_w;
+        let constraint = sum_w * c.inv_rho0 - R::one();
+        *lam = -constraint / (sum_g2 + grad_i.norm_squared() + c.eps);
+    }
 }
 
 /// Eqs. 13 and 14, then collision response: `delta_p` receives `Δp_i`, `next` the corrected
-/// position `x_i + Δp_i` moved out of the solids.
+/// position `x_i + Δp_i` moved out of the solids. Reads the pair cache written by
+/// [`lambda_pass`] at the same positions.
 #[allow(clippy::too_many_arguments)]
 fn delta_pass<R: Real>(
-    c: &Consts<R>,
-    x: &[Vec3<R>],
-    m: &[R],
+    input: PassInput<'_, R>,
     lambda: &[R],
-    nb: &NeighbourLists,
+    cache: &PairCache<R>,
     solids: &[Box<dyn Sdf<R>>],
     radius: R,
     delta_p: &mut [Vec3<R>],
     next: &mut [Vec3<R>],
 ) {
+    let PassInput { c, x, m, nb } = input;
     let half_unit = R::of_f64(0.5) * c.scorr_unit;
+    let offsets = nb.offsets();
     delta_p
         .par_iter_mut()
         .zip(next.par_iter_mut())
@@ -455,17 +553,23 @@ fn delta_pass<R: Real>(
         .with_min_len(MIN_LEN)
         .for_each(|(i, (dp, xn))| {
             let (xi, li, mi) = (x[i], lambda[i], m[i]);
+            let (a, b) = (offsets[i], offsets[i + 1]);
             let mut acc = Vec3::zeros();
-            for &j in nb.neighbours(i) {
+            for ((&j, &f), &sc) in nb
+                .neighbours(i)
+                .iter()
+                .zip(&cache.grad_factor[a..b])
+                .zip(&cache.scorr[a..b])
+            {
                 let j = j as usize;
                 let r = xi - x[j];
                 let mj = m[j];
                 // λ_i ∇_{p_i} C_i + λ_j ∇_{p_i} C_j, with ∇_{p_i} C_j = (m_i/ρ0) ∇W(p_i − p_j).
                 let mut coeff = li * mj + lambda[j] * mi;
                 if c.scorr_on {
-                    coeff += c.scorr.value_r2(r.norm_squared()) * (mi + mj) * half_unit;
+                    coeff += sc * (mi + mj) * half_unit;
                 }
-                acc += c.spiky.gradient(&r) * coeff;
+                acc += (r * f) * coeff;
             }
             let d = acc * c.inv_rho0;
             *dp = d;
@@ -574,20 +678,17 @@ impl<R: Real> Pbf<R> {
             self.params.support_radius,
             &mut self.neighbours,
         )?;
-        lambda_pass(
-            &self.c,
-            &s.predicted,
-            masses,
-            &self.neighbours,
-            &mut s.density,
-            &mut s.lambda,
-        );
+        let input = PassInput {
+            c: &self.c,
+            x: &s.predicted,
+            m: masses,
+            nb: &self.neighbours,
+        };
+        lambda_pass(input, &mut s.density, &mut s.lambda, &mut s.pairs);
         delta_pass(
-            &self.c,
-            &s.predicted,
-            masses,
+            input,
             &s.lambda,
-            &self.neighbours,
+            &s.pairs,
             &self.solids,
             self.params.particle_radius(),
             &mut s.delta_p,
@@ -727,13 +828,17 @@ impl<R: Real> Pbf<R> {
         // Lines 8–19: Jacobi iterations with collision handling.
         let t = Instant::now();
         for _ in 0..p.solver_iterations {
-            lambda_pass(&c, &s.predicted, m, nb, &mut s.density, &mut s.lambda);
-            delta_pass(
-                &c,
-                &s.predicted,
+            let input = PassInput {
+                c: &c,
+                x: &s.predicted,
                 m,
-                &s.lambda,
                 nb,
+            };
+            lambda_pass(input, &mut s.density, &mut s.lambda, &mut s.pairs);
+            delta_pass(
+                input,
+                &s.lambda,
+                &s.pairs,
                 solids,
                 radius,
                 &mut s.delta_p,
@@ -756,65 +861,69 @@ impl<R: Real> Pbf<R> {
         let vort_on = p.vorticity_epsilon > R::zero();
         let xsph_on = p.xsph_c > R::zero();
         let v = &s.velocity[..];
-        // Densities at the final positions (for the statistics and the state) and eq. 15.
+        // Densities at the final positions (for the statistics and the state) and eq. 15;
+        // without vorticity confinement, XSPH (eq. 17) in the same pass (it needs the same
+        // Poly6 values and nothing else of this pass).
+        let (eps_v, xsph_c) = (p.vorticity_epsilon, p.xsph_c);
         s.density
             .par_iter_mut()
             .zip(s.vorticity.par_iter_mut())
             .zip(s.vorticity_norm.par_iter_mut())
+            .zip(s.velocity_new.par_iter_mut())
             .enumerate()
             .with_min_len(MIN_LEN)
-            .for_each(|(i, ((rho, w), wn))| {
+            .for_each(|(i, (((rho, w), wn), vn))| {
                 let (xi, vi) = (x[i], v[i]);
                 let mut sum_w = m[i] * c.w0;
                 let mut omega = Vec3::zeros();
+                let mut xsph = Vec3::zeros();
                 for &j in nb.neighbours(i) {
                     let j = j as usize;
                     let r = xi - x[j];
-                    sum_w += m[j] * c.poly6.value_r2(r.norm_squared());
+                    let wij = c.poly6.value_r2(r.norm_squared());
+                    sum_w += m[j] * wij;
                     if vort_on {
                         // v_ij × ∇_{p_j} W(p_i − p_j) = ∇W(p_i − p_j) × v_ij, volume m_j/ρ0.
                         omega += c.spiky.gradient(&r).cross(&(v[j] - vi)) * (m[j] * c.inv_rho0);
+                    } else if xsph_on {
+                        xsph += (v[j] - vi) * (m[j] * c.inv_rho0 * wij);
                     }
                 }
                 *rho = sum_w;
                 *w = omega;
                 *wn = omega.norm();
-            });
-        let (omega, omega_norm) = (&s.vorticity[..], &s.vorticity_norm[..]);
-        let (eps_v, xsph_c) = (p.vorticity_epsilon, p.xsph_c);
-        s.velocity_new
-            .par_iter_mut()
-            .enumerate()
-            .with_min_len(MIN_LEN)
-            .for_each(|(i, vn)| {
-                let (xi, vi) = (x[i], v[i]);
-                if !(vort_on || xsph_on) {
-                    *vn = vi;
-                    return;
+                if !vort_on {
+                    *vn = vi + xsph * xsph_c;
                 }
-                let mut eta = Vec3::zeros();
-                let mut xsph = Vec3::zeros();
-                for &j in nb.neighbours(i) {
-                    let j = j as usize;
-                    let r = xi - x[j];
-                    let vol = m[j] * c.inv_rho0;
-                    if vort_on {
+            });
+        if vort_on {
+            let (omega, omega_norm) = (&s.vorticity[..], &s.vorticity_norm[..]);
+            s.velocity_new
+                .par_iter_mut()
+                .enumerate()
+                .with_min_len(MIN_LEN)
+                .for_each(|(i, vn)| {
+                    let (xi, vi) = (x[i], v[i]);
+                    let mut eta = Vec3::zeros();
+                    let mut xsph = Vec3::zeros();
+                    for &j in nb.neighbours(i) {
+                        let j = j as usize;
+                        let r = xi - x[j];
+                        let vol = m[j] * c.inv_rho0;
                         // η = ∇|ω| (SPH gradient, difference form).
                         eta += c.spiky.gradient(&r) * (vol * (omega_norm[j] - omega_norm[i]));
+                        if xsph_on {
+                            xsph += (v[j] - vi) * (vol * c.poly6.value_r2(r.norm_squared()));
+                        }
                     }
-                    if xsph_on {
-                        xsph += (v[j] - vi) * (vol * c.poly6.value_r2(r.norm_squared()));
-                    }
-                }
-                let mut out = vi + xsph * xsph_c;
-                if vort_on {
+                    let mut out = vi + xsph * xsph_c;
                     let len = eta.norm();
                     if len > R::zero() {
                         out += (eta / len).cross(&omega[i]) * (eps_v * dt);
                     }
-                }
-                *vn = out;
-            });
+                    *vn = out;
+                });
+        }
 
         // Divergence checks before anything is written to the state.
         check_divergence(step, sub, x, &s.velocity_new, solids, h)?;
