@@ -5,13 +5,14 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{ensure, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use pbf::{FluidSolver, Pbf, PbfParams, Pcisph, PcisphParams, StepStats};
 use sph_core::{apply_permutation, ParticleSet, Real, Vec3};
 use sph_scene::{Precision, Scene, SolverKind};
 
 use crate::helpers::vtk::{write_particle_frame, ParticleFrame};
+use crate::{workspace_root, Mode};
 
 /// Absolute-value conversion of a scene number to the solver's precision.
 fn r<R: Real>(x: f64) -> R {
@@ -20,6 +21,12 @@ fn r<R: Real>(x: f64) -> R {
 
 fn vec3<R: Real>(v: [f64; 3]) -> Vec3<R> {
     Vec3::new(r(v[0]), r(v[1]), r(v[2]))
+}
+
+/// The shipped scene `scenes/<name>.toml`, with its `[quick]` overrides in quick mode.
+pub fn shipped_scene(name: &str, mode: Mode) -> Result<Scene> {
+    let scene = Scene::load(&workspace_root().join("scenes").join(format!("{name}.toml")))?;
+    Ok(mode.pick(scene.quick(), scene))
 }
 
 /// The PBF parameters a scene asks for: [`PbfParams::for_spacing`] at the scene's spacing,
@@ -153,8 +160,6 @@ impl<R: Real> SceneSim<R> {
                     rho0,
                 )
             }
-            #[allow(unreachable_patterns)]
-            other => bail!("{file}: solver kind {other:?} is not a fluid solver of this runner"),
         };
         let mut state = ParticleSet::from_positions(positions, mass, rho0);
         Self::set_initial_velocities(scene, &mut state)?;
@@ -163,9 +168,14 @@ impl<R: Real> SceneSim<R> {
 
     fn set_initial_velocities(scene: &Scene, state: &mut ParticleSet<R>) -> Result<()> {
         let velocities = scene.fluid_velocities::<R>()?;
-        if velocities.len() == state.len() {
-            state.velocities = velocities;
-        }
+        ensure!(
+            velocities.len() == state.len(),
+            "{}: {} initial velocities for {} particles",
+            scene.source.display(),
+            velocities.len(),
+            state.len()
+        );
+        state.velocities = velocities;
         Ok(())
     }
 
@@ -180,13 +190,6 @@ impl<R: Real> SceneSim<R> {
             solver,
             id_scratch: Vec::new(),
         }
-    }
-
-    /// Number of frames that cover the scene's duration.
-    pub fn frames_total(&self) -> usize {
-        (self.scene.duration_s / self.scene.frame_dt_s - 1e-9)
-            .ceil()
-            .max(0.0) as usize
     }
 
     /// The solver.
@@ -299,7 +302,7 @@ fn run_scene_in<R: Real>(scene: &Scene, opts: &SceneRunOptions) -> Result<()> {
     let mut sim = SceneSim::<R>::new(scene)?;
     let frames = opts
         .max_frames
-        .map_or(sim.frames_total(), |m| m.min(sim.frames_total()));
+        .map_or(scene.frame_count(), |m| m.min(scene.frame_count()));
     eprintln!(
         "{}: {} particles, solver {}, {} frames of {} s, set-up {:.2} s -> {}",
         scene.name,

@@ -3,16 +3,14 @@
 use std::fmt;
 use std::time::Instant;
 
-use neighbour_search::{
-    CellSorter, HashedGrid, Method, NeighbourLists, NeighbourSearch, SearchError,
-};
+use neighbour_search::{HashedGrid, Method, NeighbourLists, NeighbourSearch, SearchError};
 use rayon::prelude::*;
-use sph_core::{ParticleSet, PermutationScratch, Real, Sdf, Vec3};
+use sph_core::{ParticleSet, Real, Sdf, Vec3};
 use sph_kernels::{Kernel, Poly6, Spiky};
 
 use crate::solver::{
     blow_up, check_divergence, check_masses, collide, density_energy_stats, find_neighbours,
-    non_finite, reorder_by_cell, MIN_LEN, REDUCE_CHUNK,
+    non_finite, CellReorder, MIN_LEN, REDUCE_CHUNK,
 };
 use crate::{PbfError, PbfParams, Solids, StepStats};
 
@@ -388,10 +386,7 @@ pub struct Pcisph<R: Real> {
     fallback: Option<HashedGrid<R>>,
     neighbours: NeighbourLists,
     scratch: Scratch<R>,
-    sorter: CellSorter,
-    perm_scratch: PermutationScratch<R>,
-    permutation: Vec<u32>,
-    reordered: bool,
+    reorder: CellReorder<R>,
     steps: u64,
 }
 
@@ -442,10 +437,7 @@ impl<R: Real> Pcisph<R> {
             fallback: None,
             neighbours: NeighbourLists::new(),
             scratch: Scratch::default(),
-            sorter: CellSorter::new(),
-            perm_scratch: PermutationScratch::default(),
-            permutation: Vec::new(),
-            reordered: false,
+            reorder: CellReorder::default(),
             steps: 0,
         })
     }
@@ -484,7 +476,7 @@ impl<R: Real> Pcisph<R> {
     /// The permutation applied to the particles at the start of the last [`Pcisph::step`]
     /// call (`new[k] = old[perm[k]]`), or `None` if that call did not reorder.
     pub fn last_permutation(&self) -> Option<&[u32]> {
-        self.reordered.then_some(&self.permutation[..])
+        self.reorder.last_permutation()
     }
 
     /// Advances `state` by `dt`: `substeps` PCISPH time steps (see [`Pcisph`]).
@@ -498,7 +490,6 @@ impl<R: Real> Pcisph<R> {
     pub fn step(&mut self, state: &mut ParticleSet<R>) -> Result<StepStats, PbfError> {
         let step = self.steps;
         self.steps += 1;
-        self.reordered = false;
         let mut stats = StepStats::default();
         let t = Instant::now();
         state.validate()?;
@@ -506,20 +497,13 @@ impl<R: Real> Pcisph<R> {
         self.scratch.resize(state.len());
         stats.integrate_s += t.elapsed().as_secs_f64();
 
-        let every = self.params.reorder_every as u64;
-        if every > 0 && step.is_multiple_of(every) && state.len() > 1 {
-            let t = Instant::now();
-            reorder_by_cell(
-                &mut self.sorter,
-                state,
-                self.params.support_radius,
-                &mut self.permutation,
-                &mut self.perm_scratch,
-            )?;
-            self.reordered = true;
-            stats.reordered = true;
-            stats.reorder_s = t.elapsed().as_secs_f64();
-        }
+        self.reorder.at_step(
+            state,
+            self.params.support_radius,
+            step,
+            self.params.reorder_every,
+            &mut stats,
+        )?;
 
         for sub in 0..self.params.substeps {
             self.substep(state, step, sub, &mut stats)?;

@@ -210,10 +210,7 @@ pub struct Pbf<R: Real> {
     fallback: Option<HashedGrid<R>>,
     neighbours: NeighbourLists,
     scratch: PbfScratch<R>,
-    sorter: CellSorter,
-    perm_scratch: PermutationScratch<R>,
-    permutation: Vec<u32>,
-    reordered: bool,
+    reorder: CellReorder<R>,
     steps: u64,
 }
 
@@ -387,20 +384,51 @@ pub(crate) fn density_energy_stats<R: Real>(
     stats.kinetic_energy = ke;
 }
 
-/// Reorders `state` by cell of size `h` (lexicographic cell order, for locality), keeping the
-/// permutation (`new[k] = old[perm[k]]`) in `permutation`.
-pub(crate) fn reorder_by_cell<R: Real>(
-    sorter: &mut CellSorter,
-    state: &mut ParticleSet<R>,
-    h: R,
-    permutation: &mut Vec<u32>,
-    perm_scratch: &mut PermutationScratch<R>,
-) -> Result<(), PbfError> {
-    let perm = sorter.permutation(&state.positions, h, CellOrder::Lexicographic)?;
-    permutation.clear();
-    permutation.extend_from_slice(perm);
-    state.permute(permutation, perm_scratch)?;
-    Ok(())
+/// The periodic reordering of the particles by cell shared by [`Pbf`] and
+/// [`crate::Pcisph`]: the sorter, the last permutation and its scratch buffers.
+#[derive(Debug, Default)]
+pub(crate) struct CellReorder<R: Real> {
+    sorter: CellSorter,
+    scratch: PermutationScratch<R>,
+    permutation: Vec<u32>,
+    reordered: bool,
+}
+
+impl<R: Real> CellReorder<R> {
+    /// At the start of step `step`: every `every` steps (never when 0, nor for fewer than two
+    /// particles) reorders `state` by cell of size `h` (lexicographic cell order, for
+    /// locality), keeping the permutation, and records the time in `stats`.
+    pub(crate) fn at_step(
+        &mut self,
+        state: &mut ParticleSet<R>,
+        h: R,
+        step: u64,
+        every: usize,
+        stats: &mut StepStats,
+    ) -> Result<(), PbfError> {
+        self.reordered = false;
+        let every = every as u64;
+        if every == 0 || !step.is_multiple_of(every) || state.len() < 2 {
+            return Ok(());
+        }
+        let t = Instant::now();
+        let perm = self
+            .sorter
+            .permutation(&state.positions, h, CellOrder::Lexicographic)?;
+        self.permutation.clear();
+        self.permutation.extend_from_slice(perm);
+        state.permute(&self.permutation, &mut self.scratch)?;
+        self.reordered = true;
+        stats.reordered = true;
+        stats.reorder_s = t.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// The permutation of the last [`CellReorder::at_step`] (`new[k] = old[perm[k]]`), or
+    /// `None` if it did not reorder.
+    pub(crate) fn last_permutation(&self) -> Option<&[u32]> {
+        self.reordered.then_some(&self.permutation[..])
+    }
 }
 
 /// Per-pair values of one Jacobi iteration, in the CSR order of the neighbour lists:
@@ -591,10 +619,7 @@ impl<R: Real> Pbf<R> {
             fallback: None,
             neighbours: NeighbourLists::new(),
             scratch: PbfScratch::default(),
-            sorter: CellSorter::new(),
-            perm_scratch: PermutationScratch::default(),
-            permutation: Vec::new(),
-            reordered: false,
+            reorder: CellReorder::default(),
             steps: 0,
         })
     }
@@ -645,7 +670,7 @@ impl<R: Real> Pbf<R> {
     /// call (`new[k] = old[perm[k]]`), or `None` if that call did not reorder. Apply it to any
     /// per-particle data kept beside the [`ParticleSet`] (`sph_core::apply_permutation`).
     pub fn last_permutation(&self) -> Option<&[u32]> {
-        self.reordered.then_some(&self.permutation[..])
+        self.reorder.last_permutation()
     }
 
     /// Computes, at the given positions and without moving anything, the neighbours, the
@@ -716,7 +741,6 @@ impl<R: Real> Pbf<R> {
     pub fn step(&mut self, state: &mut ParticleSet<R>) -> Result<StepStats, PbfError> {
         let step = self.steps;
         self.steps += 1;
-        self.reordered = false;
         let mut stats = StepStats::default();
         let t = Instant::now();
         state.validate()?;
@@ -725,20 +749,13 @@ impl<R: Real> Pbf<R> {
         self.scratch.resize(n);
         stats.integrate_s += t.elapsed().as_secs_f64();
 
-        let every = self.params.reorder_every as u64;
-        if every > 0 && step.is_multiple_of(every) && n > 1 {
-            let t = Instant::now();
-            reorder_by_cell(
-                &mut self.sorter,
-                state,
-                self.params.support_radius,
-                &mut self.permutation,
-                &mut self.perm_scratch,
-            )?;
-            self.reordered = true;
-            stats.reordered = true;
-            stats.reorder_s = t.elapsed().as_secs_f64();
-        }
+        self.reorder.at_step(
+            state,
+            self.params.support_radius,
+            step,
+            self.params.reorder_every,
+            &mut stats,
+        )?;
 
         for sub in 0..self.params.substeps {
             self.substep(state, step, sub, &mut stats)?;

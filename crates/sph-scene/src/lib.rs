@@ -639,8 +639,16 @@ fn placement_field(field: &str, m: &MeshSpec) -> String {
 }
 
 /// Rejects fields that do not belong to a kind.
-fn forbid(ctx: &Ctx, field: &str, kind: &str, present: &[(&str, bool)]) -> Result<(), SceneError> {
-    if let Some((name, _)) = present.iter().find(|(_, p)| *p) {
+/// Rejects the first field of `present` (name, given?) that is given but not one of the
+/// kind's `own` fields.
+fn forbid(
+    ctx: &Ctx,
+    field: &str,
+    kind: &str,
+    present: &[(&str, bool)],
+    own: &[&str],
+) -> Result<(), SceneError> {
+    if let Some((name, _)) = present.iter().find(|(n, p)| *p && !own.contains(n)) {
         return Err(ctx.invalid(
             format!("{field}.{name}"),
             format!("not a field of kind = \"{kind}\""),
@@ -845,19 +853,18 @@ impl Scene {
             let field = format!("fluid[{i}]");
             let velocity = f.velocity.unwrap_or([0.0; 3]);
             ctx.finite3(&format!("{field}.velocity"), &velocity)?;
+            // The kind-specific fields given, in the order errors report them.
+            let present = [
+                ("min", f.min.is_some()),
+                ("max", f.max.is_some()),
+                ("path", f.path.is_some()),
+                ("scale", f.scale.is_some()),
+                ("translate", f.translate.is_some()),
+                ("fit", f.fit.is_some()),
+            ];
             let spec = match f.kind {
                 RawFluidKind::Block => {
-                    forbid(
-                        ctx,
-                        &field,
-                        "block",
-                        &[
-                            ("path", f.path.is_some()),
-                            ("scale", f.scale.is_some()),
-                            ("translate", f.translate.is_some()),
-                            ("fit", f.fit.is_some()),
-                        ],
-                    )?;
+                    forbid(ctx, &field, "block", &present, &["min", "max"])?;
                     let b = RawBox {
                         min: require(ctx, &format!("{field}.min"), "block", f.min)?,
                         max: require(ctx, &format!("{field}.max"), "block", f.max)?,
@@ -874,7 +881,8 @@ impl Scene {
                         ctx,
                         &field,
                         "mesh",
-                        &[("min", f.min.is_some()), ("max", f.max.is_some())],
+                        &present,
+                        &["path", "scale", "translate", "fit"],
                     )?;
                     let mesh = mesh_spec(
                         ctx,
@@ -926,25 +934,23 @@ impl Scene {
         let mut solids = Vec::with_capacity(raw.solid.len());
         for (i, s) in raw.solid.iter().enumerate() {
             let field = format!("solid[{i}]");
-            let has = |name: &'static str, p: bool| (name, p);
+            // The kind-specific fields given, in the order errors report them.
+            let present = [
+                ("center", s.center.is_some()),
+                ("radius", s.radius.is_some()),
+                ("min", s.min.is_some()),
+                ("max", s.max.is_some()),
+                ("point", s.point.is_some()),
+                ("normal", s.normal.is_some()),
+                ("path", s.path.is_some()),
+                ("scale", s.scale.is_some()),
+                ("translate", s.translate.is_some()),
+                ("fit", s.fit.is_some()),
+                ("sdf_cell", s.sdf_cell.is_some()),
+            ];
             let spec = match s.kind {
                 RawSolidKind::Sphere => {
-                    forbid(
-                        ctx,
-                        &field,
-                        "sphere",
-                        &[
-                            has("min", s.min.is_some()),
-                            has("max", s.max.is_some()),
-                            has("point", s.point.is_some()),
-                            has("normal", s.normal.is_some()),
-                            has("path", s.path.is_some()),
-                            has("scale", s.scale.is_some()),
-                            has("translate", s.translate.is_some()),
-                            has("fit", s.fit.is_some()),
-                            has("sdf_cell", s.sdf_cell.is_some()),
-                        ],
-                    )?;
+                    forbid(ctx, &field, "sphere", &present, &["center", "radius"])?;
                     let center = require(ctx, &format!("{field}.center"), "sphere", s.center)?;
                     ctx.finite3(&format!("{field}.center"), &center)?;
                     let radius = require(ctx, &format!("{field}.radius"), "sphere", s.radius)?;
@@ -952,22 +958,7 @@ impl Scene {
                     SolidSpec::Sphere { center, radius }
                 }
                 RawSolidKind::Box => {
-                    forbid(
-                        ctx,
-                        &field,
-                        "box",
-                        &[
-                            has("center", s.center.is_some()),
-                            has("radius", s.radius.is_some()),
-                            has("point", s.point.is_some()),
-                            has("normal", s.normal.is_some()),
-                            has("path", s.path.is_some()),
-                            has("scale", s.scale.is_some()),
-                            has("translate", s.translate.is_some()),
-                            has("fit", s.fit.is_some()),
-                            has("sdf_cell", s.sdf_cell.is_some()),
-                        ],
-                    )?;
+                    forbid(ctx, &field, "box", &present, &["min", "max"])?;
                     let b = RawBox {
                         min: require(ctx, &format!("{field}.min"), "box", s.min)?,
                         max: require(ctx, &format!("{field}.max"), "box", s.max)?,
@@ -979,22 +970,7 @@ impl Scene {
                     }
                 }
                 RawSolidKind::Plane => {
-                    forbid(
-                        ctx,
-                        &field,
-                        "plane",
-                        &[
-                            has("center", s.center.is_some()),
-                            has("radius", s.radius.is_some()),
-                            has("min", s.min.is_some()),
-                            has("max", s.max.is_some()),
-                            has("path", s.path.is_some()),
-                            has("scale", s.scale.is_some()),
-                            has("translate", s.translate.is_some()),
-                            has("fit", s.fit.is_some()),
-                            has("sdf_cell", s.sdf_cell.is_some()),
-                        ],
-                    )?;
+                    forbid(ctx, &field, "plane", &present, &["point", "normal"])?;
                     let point = require(ctx, &format!("{field}.point"), "plane", s.point)?;
                     ctx.finite3(&format!("{field}.point"), &point)?;
                     let normal = require(ctx, &format!("{field}.normal"), "plane", s.normal)?;
@@ -1013,14 +989,8 @@ impl Scene {
                         ctx,
                         &field,
                         "mesh",
-                        &[
-                            has("center", s.center.is_some()),
-                            has("radius", s.radius.is_some()),
-                            has("min", s.min.is_some()),
-                            has("max", s.max.is_some()),
-                            has("point", s.point.is_some()),
-                            has("normal", s.normal.is_some()),
-                        ],
+                        &present,
+                        &["path", "scale", "translate", "fit", "sdf_cell"],
                     )?;
                     if let Some(c) = s.sdf_cell {
                         ctx.positive(&format!("{field}.sdf_cell"), c)?;

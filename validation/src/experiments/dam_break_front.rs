@@ -19,8 +19,8 @@ use sph_scene::{Precision, Scene};
 use crate::helpers::{
     load_reference_csv, plot_xy, write_csv_rows, Legend, Marker, PlotSpec, Series, SeriesStyle,
 };
-use crate::sim::SceneSim;
-use crate::{workspace_root, Check, Context, Experiment, Outcome};
+use crate::sim::{shipped_scene, SceneSim};
+use crate::{Check, Context, Experiment, Outcome};
 
 /// The experiment.
 pub struct DamBreakFront;
@@ -55,7 +55,7 @@ fn interpolate(points: &[(f64, f64)], x: f64) -> Option<f64> {
 
 fn simulate<R: Real>(ctx: &Context, scene: &Scene) -> Result<(Vec<(f64, f64)>, usize)> {
     let mut sim = SceneSim::<R>::new(scene)?;
-    let frames = sim.frames_total();
+    let frames = scene.frame_count();
     let radius = 0.5 * scene.particle_spacing;
     let g = (scene.gravity[0].powi(2) + scene.gravity[1].powi(2) + scene.gravity[2].powi(2)).sqrt();
     let t_scale = (2.0 * g / COLUMN_WIDTH_M).sqrt();
@@ -90,8 +90,7 @@ impl Experiment for DamBreakFront {
         for row in 0..reference.len() {
             measured.push((reference.number(row, "T")?, reference.number(row, "Z")?));
         }
-        let scene = Scene::load(&workspace_root().join("scenes/martin_moyce.toml"))?;
-        let scene = ctx.mode.pick(scene.quick(), scene);
+        let scene = shipped_scene("martin_moyce", ctx.mode)?;
         let (series, particles) = match scene.precision {
             Precision::F32 => simulate::<f32>(ctx, &scene)?,
             Precision::F64 => simulate::<f64>(ctx, &scene)?,

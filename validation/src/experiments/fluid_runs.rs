@@ -85,7 +85,7 @@ impl FluidRun {
 
 fn run_in<R: Real>(ctx: &Context, scene: &Scene, label: String) -> Result<FluidRun> {
     let mut sim = SceneSim::<R>::new(scene)?;
-    let frames = sim.frames_total();
+    let frames = scene.frame_count();
     let g = scene.gravity.iter().map(|x| x * x).sum::<f64>().sqrt();
     let floor = scene.tank.map_or_else(
         || {
@@ -121,7 +121,7 @@ fn run_in<R: Real>(ctx: &Context, scene: &Scene, label: String) -> Result<FluidR
                     kinetic_energy_j: s.kinetic_energy,
                     wall_s: s.total_s(),
                 });
-                if !(s.max_density_ratio <= DIVERGED_DENSITY_RATIO) {
+                if s.max_density_ratio.is_nan() || s.max_density_ratio > DIVERGED_DENSITY_RATIO {
                     run.blow_up = Some(format!(
                         "diverged: max rho/rho0 = {:.3} > {DIVERGED_DENSITY_RATIO} at t = {:.3} s (frame {})",
                         s.max_density_ratio, sim.time_s, sim.frame
@@ -158,17 +158,10 @@ pub fn run_fluid(
     let name = match kind {
         SolverKind::Pbf => "PBF",
         SolverKind::Pcisph => "PCISPH",
-        #[allow(unreachable_patterns)]
-        _ => "solver",
     };
     let label = format!("{name} {substeps}×{iterations}");
     match scene.precision {
         Precision::F32 => run_in::<f32>(ctx, &scene, label),
         Precision::F64 => run_in::<f64>(ctx, &scene, label),
     }
-}
-
-/// Frames of a scene's duration.
-pub fn frame_count(scene: &Scene) -> usize {
-    (scene.duration_s / scene.frame_dt_s - 1e-9).ceil().max(0.0) as usize
 }

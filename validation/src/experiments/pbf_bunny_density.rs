@@ -3,11 +3,12 @@
 //! iterations per 16 ms frame (each 40 pressure iterations per frame, §8).
 
 use anyhow::Result;
-use sph_scene::{Scene, SolverKind};
+use sph_scene::SolverKind;
 
-use super::fluid_runs::{frame_count, run_fluid, FluidRun};
+use super::fluid_runs::{run_fluid, FluidRun};
 use crate::helpers::{plot_xy, write_csv_rows, Legend, PlotSpec, Series, SeriesStyle};
-use crate::{workspace_root, Check, Context, Experiment, Outcome};
+use crate::sim::shipped_scene;
+use crate::{Check, Context, Experiment, Outcome};
 
 /// The experiment.
 pub struct PbfBunnyDensity;
@@ -34,9 +35,8 @@ impl Experiment for PbfBunnyDensity {
     }
 
     fn run(&self, ctx: &mut Context) -> Result<Outcome> {
-        let scene = Scene::load(&workspace_root().join("scenes/bunny_drop.toml"))?;
-        let scene = ctx.mode.pick(scene.quick(), scene);
-        ctx.progress.set_length(2 * frame_count(&scene) as u64);
+        let scene = shipped_scene("bunny_drop", ctx.mode)?;
+        ctx.progress.set_length(2 * scene.frame_count() as u64);
         let pbf = run_fluid(ctx, &scene, SolverKind::Pbf, 4, 10)?;
         let pci = run_fluid(ctx, &scene, SolverKind::Pcisph, 10, 4)?;
 

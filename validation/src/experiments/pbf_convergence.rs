@@ -16,8 +16,8 @@ use sph_core::Real;
 use sph_scene::{Precision, Scene};
 
 use crate::helpers::{plot_xy, write_csv_rows, Legend, PlotSpec, Series, SeriesStyle};
-use crate::sim::{pbf_params, SceneSim};
-use crate::{workspace_root, Check, Context, Experiment, Outcome};
+use crate::sim::{pbf_params, shipped_scene, SceneSim};
+use crate::{Check, Context, Experiment, Outcome};
 
 /// The experiment.
 pub struct PbfConvergence;
@@ -76,8 +76,7 @@ impl Experiment for PbfConvergence {
     }
 
     fn run(&self, ctx: &mut Context) -> Result<Outcome> {
-        let scene = Scene::load(&workspace_root().join("scenes/dam_break.toml"))?;
-        let scene = ctx.mode.pick(scene.quick(), scene);
+        let scene = shipped_scene("dam_break", ctx.mode)?;
         let (rows, particles) = match scene.precision {
             Precision::F32 => sweep::<f32>(ctx, &scene)?,
             Precision::F64 => sweep::<f64>(ctx, &scene)?,

@@ -12,8 +12,8 @@ use sph_core::Real;
 use sph_scene::{Precision, Scene};
 
 use crate::helpers::{load_reference_csv, write_csv_rows};
-use crate::sim::SceneSim;
-use crate::{fmt_num, workspace_root, Check, Context, Experiment, Outcome};
+use crate::sim::{shipped_scene, SceneSim};
+use crate::{fmt_num, Check, Context, Experiment, Outcome};
 
 /// The experiment.
 pub struct PbfPerformance;
@@ -106,8 +106,7 @@ impl Experiment for PbfPerformance {
             "| scene | particles (paper) | steps/frame | iters/step | time/step ms (paper, GTX 680) | µs per particle-step | Integrate % | Create Hash Grid % | Detect Neighbors % | Constraint Solve % | Velocity Update % |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
         );
         for name in SCENES {
-            let scene = Scene::load(&workspace_root().join(format!("scenes/{name}.toml")))?;
-            let scene = ctx.mode.pick(scene.quick(), scene);
+            let scene = shipped_scene(name, ctx.mode)?;
             let t = match scene.precision {
                 Precision::F32 => time_scene::<f32>(ctx, &scene)?,
                 Precision::F64 => time_scene::<f64>(ctx, &scene)?,

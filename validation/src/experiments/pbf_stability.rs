@@ -13,11 +13,12 @@
 //! paper claims only that it stays stable.
 
 use anyhow::Result;
-use sph_scene::{Scene, SolverKind};
+use sph_scene::SolverKind;
 
-use super::fluid_runs::{frame_count, run_fluid, FluidRun};
+use super::fluid_runs::{run_fluid, FluidRun};
 use crate::helpers::{plot_xy, write_csv_rows, Legend, PlotSpec, Series};
-use crate::{fmt_num, workspace_root, Check, Context, Experiment, Outcome};
+use crate::sim::shipped_scene;
+use crate::{fmt_num, Check, Context, Experiment, Outcome};
 
 /// The experiment.
 pub struct PbfStability;
@@ -53,10 +54,9 @@ impl Experiment for PbfStability {
     }
 
     fn run(&self, ctx: &mut Context) -> Result<Outcome> {
-        let scene = Scene::load(&workspace_root().join("scenes/bunny_drop.toml"))?;
-        let scene = ctx.mode.pick(scene.quick(), scene);
+        let scene = shipped_scene("bunny_drop", ctx.mode)?;
         ctx.progress
-            .set_length(((1 + PCISPH_SUBSTEPS.len()) * frame_count(&scene)) as u64);
+            .set_length(((1 + PCISPH_SUBSTEPS.len()) * scene.frame_count()) as u64);
         let mut runs = vec![run_fluid(ctx, &scene, SolverKind::Pbf, 1, 10)?];
         for k in PCISPH_SUBSTEPS {
             runs.push(run_fluid(ctx, &scene, SolverKind::Pcisph, k, 4)?);

@@ -13,8 +13,8 @@ use sph_core::Real;
 use sph_scene::{Precision, Scene};
 
 use crate::helpers::{plot_xy, side_view_png, write_csv_rows, Legend, PlotSpec, Series};
-use crate::sim::SceneSim;
-use crate::{workspace_root, Check, Context, Experiment, Outcome};
+use crate::sim::{shipped_scene, SceneSim};
+use crate::{Check, Context, Experiment, Outcome};
 
 /// The experiment.
 pub struct PbfVorticity;
@@ -47,7 +47,7 @@ struct Run {
 
 fn simulate<R: Real>(ctx: &Context, scene: &Scene) -> Result<Run> {
     let mut sim = SceneSim::<R>::new(scene)?;
-    let frames = sim.frames_total();
+    let frames = scene.frame_count();
     let mut series = Vec::with_capacity(frames);
     for _ in 0..frames {
         let stats = sim.advance()?;
@@ -96,9 +96,8 @@ impl Experiment for PbfVorticity {
     }
 
     fn run(&self, ctx: &mut Context) -> Result<Outcome> {
-        let scene = Scene::load(&workspace_root().join("scenes/dam_break.toml"))?;
-        let scene = ctx.mode.pick(scene.quick(), scene);
-        let frames = (scene.duration_s / scene.frame_dt_s - 1e-9).ceil() as u64;
+        let scene = shipped_scene("dam_break", ctx.mode)?;
+        let frames = scene.frame_count() as u64;
         ctx.progress.set_length(2 * frames);
         let off = run_with(ctx, &scene, 0.0)?;
         let on = run_with(ctx, &scene, VORTICITY_EPSILON)?;
