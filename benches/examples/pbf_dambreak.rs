@@ -1,17 +1,26 @@
 //! Side by side with SPlisHSPlasH 2.19: our PBF (or PCISPH) on its `DamBreakModel` scene at
 //! particle radius 0.0125 m (59,319 fluid particles, tank 4 × 3 × 1.5 m, Δt = 0.002 s, one
-//! step per frame), from rest, for a number of steps at a fixed iteration count:
+//! step per frame), from rest, for a number of steps at a fixed iteration count, or (PBF
+//! only) iterating to a mean compression as SPlisHSPlasH does (`tol=0.001`: 0.1 %, 2–100
+//! iterations):
 //!
 //! ```text
-//! RAYON_NUM_THREADS=1 cargo run --release -p benches --example pbf_dambreak -- [STEPS] [ITERATIONS] [pbf|pcisph]
+//! RAYON_NUM_THREADS=1 cargo run --release -p benches --example pbf_dambreak -- [STEPS] [ITERATIONS|tol=ETA] [pbf|pcisph] [unilateral]
 //! ```
 //!
+//! `unilateral` (PBF) switches to SPlisHSPlasH's form of the constraint: `max(C_i, 0)`,
+//! `ε = 10⁻⁶ m⁻²`, no artificial pressure and its particle mass `0.8 ρ0 (2r)³`, instead of
+//! the paper's defaults.
+//!
 //! Prints the mean wall time per step over all steps (as SPlisHSPlasH's "Average time:
-//! SimStep"), the phase breakdown and the density error at the end. SPlisHSPlasH is run on
+//! SimStep"), the mean iteration count, the phase breakdown and the density error at the
+//! end. SPlisHSPlasH is run on
 //! the same scene with its PBF solver (`simulationMethod` 2, iterating to 0.1 % mean density
 //! error, 2–100 iterations, boundary particles of Akinci et al. 2012) by a script kept
 //! outside the repository (`pip install pysplishsplash==2.19.0` in a throwaway venv); its
-//! mean iteration count is what to pass as ITERATIONS for an iteration-matched comparison.
+//! mean iteration count is what to pass as ITERATIONS for an iteration-matched comparison,
+//! and `tol=0.001` gives the accuracy-matched one (same stopping rule and tolerance; the
+//! density it measures differs in that SPlisHSPlasH's includes its boundary particles).
 use std::time::Instant;
 
 use pbf::{FluidSolver, ParticleSet, Pbf, PbfParams, Pcisph, PcisphParams, Solids, StepStats};
@@ -20,10 +29,19 @@ use sph_core::{BoxSdf, Inverted};
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let steps: usize = args.first().and_then(|s| s.parse().ok()).unwrap_or(10);
-    let iterations: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(5);
+    let iter_arg = args.get(1).map_or("5", String::as_str);
+    let tolerance: Option<f32> = iter_arg.strip_prefix("tol=").and_then(|t| t.parse().ok());
+    let iterations: usize = match tolerance {
+        Some(_) => 100,
+        None => iter_arg.parse().unwrap_or(5),
+    };
     let which = args.get(2).map_or("pbf", String::as_str);
     let (p, tank) = benches::dam_break_fluid::<f32>();
-    let mut state = ParticleSet::from_positions(p, 1000.0 * 0.025f32.powi(3), 1000.0);
+    let unilateral = args.iter().any(|a| a == "unilateral");
+    // SPlisHSPlasH's particle volume is 0.8 (2r)³ (`FluidModel`), so its lattice starts
+    // under-dense and settles; the paper's form uses the full lattice volume s³.
+    let volume = if unilateral { 0.8 } else { 1.0 } * 0.025f32.powi(3);
+    let mut state = ParticleSet::from_positions(p, 1000.0 * volume, 1000.0);
     let solids: Solids<f32> = vec![Box::new(Inverted(BoxSdf::new(tank).expect("tank")))];
     let mut solver: Box<dyn FluidSolver<f32>> = match which {
         "pcisph" => {
@@ -38,6 +56,16 @@ fn main() {
             q.dt = 0.002;
             q.substeps = 1;
             q.solver_iterations = iterations;
+            if unilateral {
+                // SPlisHSPlasH's PBF constraint: max(C, 0), ε = 1e-6 m⁻², no s_corr.
+                q.clamp_negative_constraint = true;
+                q.cfm_epsilon = 1e-6;
+                q.scorr_k = 0.0;
+            }
+            if tolerance.is_some() {
+                q.mean_compression_tolerance = tolerance;
+                q.min_solver_iterations = 2;
+            }
             Box::new(Pbf::new(q, solids).expect("params"))
         }
     };
@@ -52,28 +80,39 @@ fn main() {
         sum.constraint_solve_s += last.constraint_solve_s;
         sum.velocity_update_s += last.velocity_update_s;
         sum.reorder_s += last.reorder_s;
+        sum.iterations += last.iterations;
+        sum.unconverged_substeps += last.unconverged_substeps;
     }
     let wall = t.elapsed().as_secs_f64();
     let n = steps as f64;
+    let rule = match tolerance {
+        Some(t) => format!("2-{iterations} iterations to {t} mean compression"),
+        None => format!("{iterations} iterations"),
+    };
     println!(
-        "{} on {} particles, {} rayon threads, {steps} steps x {iterations} iterations",
+        "{} on {} particles, {} rayon threads, {steps} steps x {rule}",
         solver.name(),
         state.len(),
         rayon::current_num_threads()
     );
     println!("mean wall time per step: {:.2} ms", 1e3 * wall / n);
     println!(
+        "mean iterations per step: {:.2} ({} steps at the maximum without meeting the tolerance)",
+        sum.iterations as f64 / n,
+        sum.unconverged_substeps
+    );
+    println!(
         "phases per step (ms): integrate {:.2}, hash grid {:.2}, neighbours {:.2}, solve {:.2} ({:.3} us per particle-iteration), velocity update {:.2}, reorder {:.2}",
         1e3 * sum.integrate_s / n,
         1e3 * sum.create_hash_grid_s / n,
         1e3 * sum.detect_neighbours_s / n,
         1e3 * sum.constraint_solve_s / n,
-        1e6 * sum.constraint_solve_s / (n * iterations as f64 * state.len() as f64),
+        1e6 * sum.constraint_solve_s / (sum.iterations as f64 * state.len() as f64),
         1e3 * sum.velocity_update_s / n,
         1e3 * sum.reorder_s / n,
     );
     println!(
-        "end: max rho/rho0 {:.5}, mean rho/rho0 {:.5}, neighbour pairs {}",
-        last.max_density_ratio, last.mean_density_ratio, last.neighbour_pairs
+        "end: max rho/rho0 {:.5}, mean rho/rho0 {:.5}, last iteration's mean compression {:.5}, neighbour pairs {}",
+        last.max_density_ratio, last.mean_density_ratio, last.last_solve_error, last.neighbour_pairs
     );
 }

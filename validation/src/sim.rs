@@ -70,6 +70,15 @@ pub fn pbf_params<R: Real>(scene: &Scene) -> Result<PbfParams<R>> {
     if let Some(k) = s.reorder_every {
         p.reorder_every = k;
     }
+    if let Some(c) = s.clamp_negative_constraint {
+        p.clamp_negative_constraint = c;
+    }
+    if let Some(t) = s.mean_compression_tolerance {
+        p.mean_compression_tolerance = Some(r(t));
+        p.min_solver_iterations = s
+            .min_iterations
+            .unwrap_or(p.min_solver_iterations.min(s.iterations));
+    }
     p.validate()
         .with_context(|| format!("{}: solver parameters", scene.source.display()))?;
     Ok(p)
@@ -243,13 +252,14 @@ pub struct SceneRunOptions {
 }
 
 /// Header of the per-frame statistics CSV written by [`run_scene`].
-pub const STATS_HEADER: [&str; 15] = [
+pub const STATS_HEADER: [&str; 16] = [
     "frame",
     "time_s",
     "particles",
     "max_density_ratio",
     "mean_density_ratio",
     "iterations",
+    "unconverged_substeps",
     "neighbour_pairs",
     "kinetic_energy_j",
     "integrate_s",
@@ -270,6 +280,7 @@ pub fn stats_row(frame: usize, time_s: f64, particles: usize, s: &StepStats) -> 
         format!("{:.6}", s.max_density_ratio),
         format!("{:.6}", s.mean_density_ratio),
         s.iterations.to_string(),
+        s.unconverged_substeps.to_string(),
         s.neighbour_pairs.to_string(),
         format!("{:.6e}", s.kinetic_energy),
         format!("{:.6e}", s.integrate_s),

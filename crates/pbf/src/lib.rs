@@ -126,22 +126,32 @@
 //! same positions, so it needs no square root, division or kernel evaluation.
 //!
 //! Measured side by side with SPlisHSPlasH 2.19 (`pip install pysplishsplash==2.19.0`, its
-//! PBF, `simulationMethod` 2, iterating to 0.1 % mean density error, boundary particles) on
-//! its `DamBreakModel` scene at particle radius 0.0125 m (59,319 fluid particles, Δt =
-//! 0.002 s), 250 steps from rest, on this 2-core machine (`benches/examples/pbf_dambreak.rs`):
+//! PBF, `simulationMethod` 2, iterating to 0.1 % mean density error, 2–100 iterations,
+//! boundary particles) on its `DamBreakModel` scene at particle radius 0.0125 m (59,319
+//! fluid particles, Δt = 0.002 s), 250 steps from rest, on this 2-core machine
+//! (`benches/examples/pbf_dambreak.rs`; one script ran all columns of a row one after the
+//! other, 2026-11-21):
 //!
-//! | threads | SPlisHSPlasH ms/step (mean 5.33 iterations) | here, 5 iterations | here, 6 iterations |
-//! | --- | --- | --- | --- |
-//! | 1 | 423 | 186 | 217 |
-//! | 2 | 305 | 103 | 111 |
+//! | threads | SPlisHSPlasH | here, SPlisHSPlasH's constraint, to 0.1 % | here, paper's form, to 0.1 % | here, paper's form, 5 iterations |
+//! | --- | --- | --- | --- | --- |
+//! | 1 | 462 ms (5.33 it.) | 168 ms (4.68 it.) | 1182 ms (42.7 it.) | 172 ms |
+//! | 2 | 287 ms (5.36 it.) | 76 ms (4.68 it.) | 601 ms (42.7 it.) | 93 ms |
 //!
-//! i.e. 2.0–2.3× faster on one thread and 2.7–3.0× on two at matched iteration counts. The
-//! comparison is iteration-matched, not accuracy-matched: with `ε = D_ref` our iterations
-//! converge more slowly (max `ρ/ρ0` 1.05–1.08 at the end against SPlisHSPlasH's 0.1 % mean
-//! target), and SPlisHSPlasH also searches 129,454 boundary particles (83 ms of its 423 ms;
-//! our boundaries are SDFs). The constraint solve costs 0.51 µs per particle-iteration on
-//! one thread (SPlisHSPlasH: 1.02). Its memory-bandwidth bound: per iteration both passes
-//! stream the neighbour indices (2 × 4 B per pair), the pair cache is written and read
+//! The accuracy-matched comparison is the second column: the same stopping rule and
+//! tolerance ([`PbfParams::mean_compression_tolerance`] = 0.001, 2–100 iterations) and
+//! SPlisHSPlasH's form of the constraint ([`PbfParams::clamp_negative_constraint`], `ε` =
+//! 10⁻⁶ m⁻², no `s_corr`, particle mass `0.8 ρ0 (2r)³`): 2.7× faster on one thread and 3.8×
+//! on two. The density both measure differs in that SPlisHSPlasH's includes its 129,454
+//! boundary particles (and it spends 93 ms of its 462 ms searching them; our walls are
+//! SDFs), which is also why it needs slightly more iterations. With the paper's form
+//! (bilateral `C_i`, `ε = D_ref`, `s_corr`) the Jacobi iterations converge far more slowly:
+//! reaching 0.1 % takes 43 iterations on average and 37 of the 250 steps stop at 100 without
+//! it, so this form is 2.1–2.6× *slower* than SPlisHSPlasH at equal accuracy; at a fixed
+//! 5 iterations (the last column, iteration-matched, the paper's way of running) it is
+//! 2.7–3.1× faster but ends with max `ρ/ρ0` 1.08. Results are bit-identical on one and two
+//! threads. The constraint solve costs 0.46–0.51 µs per particle-iteration on one thread (SPlisHSPlasH:
+//! 350.5 ms / (5.33 × 59,319) = 1.11 µs, boundary pairs included). Its memory-bandwidth
+//! bound: per iteration both passes stream the neighbour indices (2 × 4 B per pair), the pair cache is written and read
 //! (2 × 8 B per pair), about 64 B per particle of particle arrays: 47 MB per iteration for
 //! 1.81 M pairs, 4.7 ms at this machine's 10 GB/s single-thread copy bandwidth
 //! (`benches/examples/bandwidth.rs`), i.e. 0.08 µs per particle-iteration. The loops run

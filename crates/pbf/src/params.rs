@@ -33,7 +33,10 @@ pub const DEFAULT_RELATIVE_CFM: f64 = 1.0;
 /// | `dt` | 0.016 s | §8, Table 1: "a frame time of 16 ms is used in all cases" |
 /// | `substeps` | 4 | Table 1: Dam Break and Bunny Drop, 4 steps/frame |
 /// | `solver_iterations` | 4 | §8: "typically 2–4" (Table 1: 3 for the dam break, 10 for the bunny drop) |
+/// | `mean_compression_tolerance` | `None` (fixed iteration count, as the paper) | not in the paper; SPlisHSPlasH's stopping rule (`maxError`, e.g. 0.001 = 0.1 %) |
+/// | `min_solver_iterations` | 2 | SPlisHSPlasH's minimum (`minIterations`); only used with a tolerance |
 /// | `cfm_epsilon` | `1.0 ·` [`PbfParams::reference_denominator`] (597 m⁻² at the default spacing) | eq. 11; value not given in the paper, [`DEFAULT_RELATIVE_CFM`] |
+/// | `clamp_negative_constraint` | `false` | the paper (bilateral `C_i`, eq. 1); `true` is SPlisHSPlasH's unilateral `max(C_i, 0)` |
 /// | `scorr_k` | 0.1 | §4, eq. 13: "k = 0.1" |
 /// | `scorr_n` | 4 | §4, eq. 13: "n = 4" |
 /// | `scorr_delta_q` | 0.2 (× h) | §4, eq. 13: "\|Δq\| = 0.1h … 0.3h" (middle of the range) |
@@ -58,12 +61,30 @@ pub struct PbfParams<R: Real> {
     pub dt: R,
     /// Steps of Algorithm 1 per [`crate::Pbf::step`] call (≥ 1).
     pub substeps: usize,
-    /// Jacobi iterations of the constraint solve per step (Algorithm 1 `solverIterations`, ≥ 1).
+    /// Jacobi iterations of the constraint solve per step (Algorithm 1 `solverIterations`,
+    /// ≥ 1); the maximum when `mean_compression_tolerance` is set.
     pub solver_iterations: usize,
+    /// Optional stopping rule (not in the paper, which iterates a fixed count; the rule of
+    /// SPlisHSPlasH's PBF solver): `Some(η)` ends a step's Jacobi iterations after the first
+    /// iteration, from the `min_solver_iterations`-th on, whose mean compression
+    /// `(1/N) Σ_i max(ρ_i/ρ0 − 1, 0)`, measured at the positions that iteration starts from
+    /// (eq. 2), is at most `η` (dimensionless: 0.001 = 0.1 %; finite and > 0). A step that
+    /// reaches `solver_iterations` without it is counted in
+    /// [`crate::StepStats::unconverged_substeps`], not an error. `None`: always
+    /// `solver_iterations`.
+    pub mean_compression_tolerance: Option<R>,
+    /// Fewest Jacobi iterations per step when `mean_compression_tolerance` is set (≥ 1 and
+    /// ≤ `solver_iterations`); ignored otherwise.
+    pub min_solver_iterations: usize,
     /// Constraint force mixing relaxation `ε` of eq. 11, in the units of `Σ_k |∇_{p_k} C_i|²`,
     /// i.e. m⁻² (the masses are kept in the constraint gradients, see the crate docs). Must be
     /// finite and > 0 (it keeps `λ` finite for a particle without neighbours).
     pub cfm_epsilon: R,
+    /// Unilateral density constraint: `C_i = max(ρ_i/ρ0 − 1, 0)` instead of eq. 1's
+    /// `ρ_i/ρ0 − 1`, so that under-dense particles (free surface, walls) exert no pull (not in
+    /// the paper, whose artificial pressure of eq. 13 counters the clustering instead; the
+    /// choice of SPlisHSPlasH's PBF, which with it runs at a negligible `ε` = 10⁻⁶ m⁻²).
+    pub clamp_negative_constraint: bool,
     /// Artificial pressure strength `k` of eq. 13 (dimensionless, ≥ 0; 0 disables `s_corr`).
     /// `s_corr` enters eq. 14 in units of [`PbfParams::scorr_unit`] (see the crate docs).
     pub scorr_k: R,
@@ -130,7 +151,10 @@ impl<R: Real> PbfParams<R> {
             dt: R::of_f64(0.016),
             substeps: 4,
             solver_iterations: 4,
+            mean_compression_tolerance: None,
+            min_solver_iterations: 2,
             cfm_epsilon: R::one(),
+            clamp_negative_constraint: false,
             scorr_k: R::of_f64(0.1),
             scorr_n: 4,
             scorr_delta_q: R::of_f64(0.2),
@@ -236,6 +260,24 @@ impl<R: Real> PbfParams<R> {
         }
         if self.solver_iterations == 0 {
             return Err(invalid("solver_iterations", 0.0, "must be >= 1"));
+        }
+        if let Some(tol) = self.mean_compression_tolerance {
+            if !(tol.is_finite_value() && tol > R::zero()) {
+                return Err(invalid(
+                    "mean_compression_tolerance",
+                    tol.as_f64(),
+                    "must be finite and > 0 (or None for a fixed iteration count)",
+                ));
+            }
+            if self.min_solver_iterations == 0
+                || self.min_solver_iterations > self.solver_iterations
+            {
+                return Err(invalid(
+                    "min_solver_iterations",
+                    self.min_solver_iterations as f64,
+                    "must be >= 1 and <= solver_iterations",
+                ));
+            }
         }
         positive("cfm_epsilon", self.cfm_epsilon)?;
         non_negative("scorr_k", self.scorr_k)?;

@@ -105,7 +105,10 @@ impl<R: Real> PcisphParams<R> {
             dt: self.dt,
             substeps: self.substeps,
             solver_iterations: 1,
+            mean_compression_tolerance: None,
+            min_solver_iterations: 1,
             cfm_epsilon: R::one(),
+            clamp_negative_constraint: false,
             scorr_k: R::zero(),
             scorr_n: 1,
             scorr_delta_q: R::of_f64(0.5),
@@ -614,7 +617,7 @@ impl<R: Real> Pcisph<R> {
         // Step 3: prediction-correction iterations.
         let t = Instant::now();
         let clamp = p.clamp_negative_pressure;
-        for _ in 0..p.pressure_iterations {
+        for it in 0..p.pressure_iterations {
             // Predicted density, density error, pressure update (eq. 8's δ).
             let xp = &s.predicted[..];
             s.density
@@ -640,7 +643,13 @@ impl<R: Real> Pcisph<R> {
                     .with_min_len(MIN_LEN)
                     .map(|r| r.as_f64())
                     .reduce(|| f64::NEG_INFINITY, f64::max);
-                max / rho0.as_f64() - 1.0 <= tol.as_f64()
+                let error = (max / rho0.as_f64() - 1.0).max(0.0);
+                stats.last_solve_error = error;
+                let met = error <= tol.as_f64();
+                if !met && it + 1 == p.pressure_iterations {
+                    stats.unconverged_substeps += 1;
+                }
+                met
             });
             // Pressure force at x(t) and the next prediction.
             let pr = &s.pressure[..];

@@ -42,8 +42,17 @@ pub struct StepStats {
     pub reorder_s: f64,
     /// Steps of Algorithm 1 done (the `substeps` parameter).
     pub substeps: usize,
-    /// Jacobi iterations done in total (`substeps × solver_iterations`).
+    /// Jacobi (PBF) or pressure (PCISPH) iterations done in total (`substeps ×
+    /// solver_iterations` without a stopping tolerance).
     pub iterations: usize,
+    /// Substeps whose iterations reached the maximum without meeting the stopping tolerance
+    /// (PBF `mean_compression_tolerance`, PCISPH `density_error_tolerance`); 0 without one.
+    /// Non-convergence is reported here, not as an error.
+    pub unconverged_substeps: usize,
+    /// The density error the stopping rule saw in the last iteration of the last substep
+    /// (PBF: mean compression `(1/N) Σ max(ρ_i/ρ0 − 1, 0)` at the positions the iteration
+    /// started from; PCISPH: maximum predicted compression); 0 without a tolerance.
+    pub last_solve_error: f64,
     /// Ordered neighbour pairs found in the last substep.
     pub neighbour_pairs: usize,
     /// `max_i ρ_i / ρ0` at the end of the solve (eq. 2 at the final positions, with the
@@ -160,6 +169,8 @@ struct Consts<R: Real> {
     scorr_unit: R,
     inv_rho0: R,
     eps: R,
+    /// [`PbfParams::clamp_negative_constraint`].
+    unilateral: bool,
     /// Support radius `h` (m).
     h: R,
 }
@@ -177,6 +188,7 @@ impl<R: Real> Consts<R> {
             scorr_unit: p.scorr_unit()?,
             inv_rho0: R::one() / p.rest_density,
             eps: p.cfm_epsilon,
+            unilateral: p.clamp_negative_constraint,
             h,
         })
     }
@@ -195,7 +207,11 @@ impl<R: Real> Consts<R> {
 /// 3. `solver_iterations` Jacobi iterations (lines 8–19), each:
 ///    `ρ_i` (eq. 2, Poly6), `λ_i` (eqs. 1, 8, 11, Spiky gradients, CFM `ε`) for all `i`;
 ///    then `Δp_i` (eq. 14 with `s_corr` of eq. 13) and collision response against the solids
-///    for all `i`; then `x* ← x* + Δp` (+ collision) for all `i`;
+///    for all `i`; then `x* ← x* + Δp` (+ collision) for all `i`. With
+///    [`PbfParams::mean_compression_tolerance`] (not in the paper; SPlisHSPlasH's rule) the
+///    count is adaptive: between `min_solver_iterations` and `solver_iterations`, stopping
+///    after the first iteration whose mean compression at its start is within the tolerance;
+///    [`PbfParams::clamp_negative_constraint`] makes `C_i` unilateral;
 /// 4. `v = (x* − x)/Δt` (line 21); vorticity `ω_i` (eq. 15) and the confinement
 ///    acceleration `ε N × ω` (eq. 16), XSPH (eq. 17), both from the line-21 velocities;
 ///    `x ← x*` (line 23).
@@ -475,13 +491,15 @@ struct PassInput<'a, R: Real> {
 }
 
 /// Eqs. 1, 2, 8 and 11: densities and `λ_i` at positions `x`, and the pair cache for
-/// [`delta_pass`].
+/// [`delta_pass`]. Returns the sum of the compressions `max(ρ_i/ρ0 − 1, 0)` (in f64, summed
+/// over a split tree that depends only on the particle count, so the result does not depend
+/// on the number of threads).
 fn lambda_pass<R: Real>(
     input: PassInput<'_, R>,
     density: &mut [R],
     lambda: &mut [R],
     cache: &mut PairCache<R>,
-) {
+) -> f64 {
     let pairs = input.nb.pair_count();
     cache.resize(pairs);
     lambda_block(
@@ -491,12 +509,13 @@ fn lambda_pass<R: Real>(
         lambda,
         &mut cache.grad_factor[..pairs],
         &mut cache.scorr[..pairs],
-    );
+    )
 }
 
 /// [`lambda_pass`] over the particles `first..first + density.len()`, whose pairs are
 /// `grad_factor` and `scorr`: split in halves (rayon `join`) down to `MIN_LEN` particles, so
-/// that each task owns its particles' contiguous CSR range of the cache.
+/// that each task owns its particles' contiguous CSR range of the cache. Returns the block's
+/// compression sum.
 fn lambda_block<R: Real>(
     input: PassInput<'_, R>,
     first: usize,
@@ -504,7 +523,7 @@ fn lambda_block<R: Real>(
     lambda: &mut [R],
     grad_factor: &mut [R],
     scorr: &mut [R],
-) {
+) -> f64 {
     let n = density.len();
     let offsets = input.nb.offsets();
     if n > MIN_LEN {
@@ -514,14 +533,15 @@ fn lambda_block<R: Real>(
         let (l0, l1) = lambda.split_at_mut(mid);
         let (g0, g1) = grad_factor.split_at_mut(split);
         let (s0, s1) = scorr.split_at_mut(split);
-        rayon::join(
+        let (a, b) = rayon::join(
             || lambda_block(input, first, d0, l0, g0, s0),
             || lambda_block(input, first + mid, d1, l1, g1, s1),
         );
-        return;
+        return a + b;
     }
     let PassInput { c, x, m, nb } = input;
     let base = offsets[first];
+    let mut compression = R::zero();
     for (k, (rho, lam)) in density.iter_mut().zip(lambda.iter_mut()).enumerate() {
         let i = first + k;
         let (a, b) = (offsets[i] - base, offsets[i + 1] - base);
@@ -553,9 +573,15 @@ fn lambda_block<R: Real>(
             sum_g2 += g.norm_squared();
         }
         *rho = sum_w;
-        let constraint = sum_w * c.inv_rho0 - R::one();
+        let mut constraint = sum_w * c.inv_rho0 - R::one();
+        if constraint > R::zero() {
+            compression += constraint;
+        } else if c.unilateral {
+            constraint = R::zero();
+        }
         *lam = -constraint / (sum_g2 + grad_i.norm_squared() + c.eps);
     }
+    compression.as_f64()
 }
 
 /// Eqs. 13 and 14, then collision response: `delta_p` receives `Δp_i`, `next` the corrected
@@ -709,7 +735,7 @@ impl<R: Real> Pbf<R> {
             m: masses,
             nb: &self.neighbours,
         };
-        lambda_pass(input, &mut s.density, &mut s.lambda, &mut s.pairs);
+        let _ = lambda_pass(input, &mut s.density, &mut s.lambda, &mut s.pairs);
         delta_pass(
             input,
             &s.lambda,
@@ -844,14 +870,17 @@ impl<R: Real> Pbf<R> {
 
         // Lines 8–19: Jacobi iterations with collision handling.
         let t = Instant::now();
-        for _ in 0..p.solver_iterations {
+        let inv_n = 1.0 / (state.len().max(1) as f64);
+        let mut done = 0;
+        loop {
             let input = PassInput {
                 c: &c,
                 x: &s.predicted,
                 m,
                 nb,
             };
-            lambda_pass(input, &mut s.density, &mut s.lambda, &mut s.pairs);
+            let compression =
+                lambda_pass(input, &mut s.density, &mut s.lambda, &mut s.pairs) * inv_n;
             delta_pass(
                 input,
                 &s.lambda,
@@ -862,9 +891,25 @@ impl<R: Real> Pbf<R> {
                 &mut s.next,
             );
             std::mem::swap(&mut s.predicted, &mut s.next);
+            done += 1;
+            // The stopping rule of `mean_compression_tolerance` (fixed count without it).
+            let Some(tol) = p.mean_compression_tolerance else {
+                if done == p.solver_iterations {
+                    break;
+                }
+                continue;
+            };
+            stats.last_solve_error = compression;
+            let met = compression <= tol.as_f64();
+            if done >= p.solver_iterations || (met && done >= p.min_solver_iterations) {
+                if !met {
+                    stats.unconverged_substeps += 1;
+                }
+                break;
+            }
         }
         stats.constraint_solve_s += t.elapsed().as_secs_f64();
-        stats.iterations += p.solver_iterations;
+        stats.iterations += done;
 
         // Lines 20–24: velocity update, vorticity confinement, XSPH, position update.
         let t = Instant::now();

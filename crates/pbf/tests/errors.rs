@@ -52,6 +52,28 @@ fn invalid_parameters_are_named() {
         ),
         ("xsph_c", Box::new(|p| p.xsph_c = 1.5)),
         ("gravity", Box::new(|p| p.gravity.y = f64::NEG_INFINITY)),
+        (
+            "mean_compression_tolerance",
+            Box::new(|p| p.mean_compression_tolerance = Some(0.0)),
+        ),
+        (
+            "mean_compression_tolerance",
+            Box::new(|p| p.mean_compression_tolerance = Some(f64::NAN)),
+        ),
+        (
+            "min_solver_iterations",
+            Box::new(|p| {
+                p.mean_compression_tolerance = Some(1e-3);
+                p.min_solver_iterations = p.solver_iterations + 1;
+            }),
+        ),
+        (
+            "min_solver_iterations",
+            Box::new(|p| {
+                p.mean_compression_tolerance = Some(1e-3);
+                p.min_solver_iterations = 0;
+            }),
+        ),
     ];
     for (name, set) in cases {
         let mut p = ok.clone();

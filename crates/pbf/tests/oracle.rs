@@ -284,6 +284,31 @@ proptest! {
         }
     }
 
+    /// `clamp_negative_constraint` (SPlisHSPlasH's unilateral `max(C_i, 0)`): the oracle's
+    /// λ where the particle is compressed, exactly 0 where it is not.
+    #[test]
+    fn unilateral_lambda(c in case()) {
+        let mut p = params(&c);
+        p.clamp_negative_constraint = true;
+        let oracle = Oracle::new(&p);
+        let x: Vec<V> = c.points.clone();
+        let masses: Vec<f64> = c.mass_factors.iter().map(|f| f * p.particle_mass()).collect();
+        let nb = oracle.neighbours(&x);
+        let (rho, lambda, _) = oracle.lambda_delta(&x, &masses, &nb);
+        let pts: Vec<Vec3<f64>> = x.iter().map(|a| Vec3::new(a[0], a[1], a[2])).collect();
+        let mut solver = Pbf::new(p.clone(), vec![]).unwrap();
+        let ev = solver.evaluate_constraints(&pts, &masses).unwrap();
+        let lam_scale = lambda.iter().fold(0.0f64, |a, &l| a.max(l.abs()));
+        for i in 0..x.len() {
+            if (rho[i] / p.rest_density - 1.0).abs() < 1e-12 {
+                continue; // the sign is not decided at round-off
+            }
+            let expected = if rho[i] > p.rest_density { lambda[i] } else { 0.0 };
+            prop_assert!(close(ev.lambda[i], expected, 1e-10 * lam_scale + 1e-300),
+                "lambda {i}: {} vs {expected} (rho {})", ev.lambda[i], rho[i]);
+        }
+    }
+
     /// One full step of Algorithm 1 (gravity, prediction, neighbours once, Jacobi iterations
     /// with collisions against a floor, velocity update, vorticity confinement, XSPH)
     /// against the oracle.

@@ -39,6 +39,10 @@
 //! # vorticity_epsilon = 0.0        # vorticity confinement ε, m/s (>= 0)
 //! # xsph_c = 0.01                  # XSPH viscosity c, in [0, 1]
 //! # reorder_every = 10             # frames between particle reorderings (0 = never)
+//! # clamp_negative_constraint = false # PBF only: unilateral C = max(ρ/ρ0 − 1, 0)
+//! # mean_compression_tolerance = 0.001 # PBF only: stop iterating at this mean compression
+//! #                                # (> 0); `iterations` is then the maximum
+//! # min_iterations = 2             # PBF only, with mean_compression_tolerance (>= 1)
 //! # clamp_negative_pressure = true # PCISPH only
 //! # density_error_tolerance = 0.01 # PCISPH only: relative density error to stop at (> 0)
 //!
@@ -237,6 +241,14 @@ pub struct SolverSpec {
     pub clamp_negative_pressure: Option<bool>,
     /// PCISPH: relative density error at which the pressure iteration stops (> 0).
     pub density_error_tolerance: Option<f64>,
+    /// PBF: unilateral density constraint `max(ρ/ρ0 − 1, 0)`.
+    pub clamp_negative_constraint: Option<bool>,
+    /// PBF: mean compression at which the Jacobi iterations stop (> 0; `iterations` is then
+    /// the maximum).
+    pub mean_compression_tolerance: Option<f64>,
+    /// PBF: fewest iterations per step with `mean_compression_tolerance` (≥ 1, ≤
+    /// `iterations`).
+    pub min_iterations: Option<usize>,
 }
 
 /// Output settings.
@@ -769,6 +781,24 @@ impl Scene {
         opt_pos("rest_density", rs.rest_density)?;
         opt_pos("relative_cfm", rs.relative_cfm)?;
         opt_pos("density_error_tolerance", rs.density_error_tolerance)?;
+        opt_pos("mean_compression_tolerance", rs.mean_compression_tolerance)?;
+        if let Some(k) = rs.min_iterations {
+            if rs.mean_compression_tolerance.is_none() {
+                return Err(ctx.invalid(
+                    "solver.min_iterations",
+                    "only applies with solver.mean_compression_tolerance",
+                ));
+            }
+            if k == 0 || k > rs.iterations {
+                return Err(ctx.invalid(
+                    "solver.min_iterations",
+                    format!(
+                        "must be >= 1 and <= solver.iterations = {}, got {k}",
+                        rs.iterations
+                    ),
+                ));
+            }
+        }
         if let Some(v) = rs.support_over_spacing {
             if !(v.is_finite() && v > 1.0) {
                 return Err(ctx.invalid(
@@ -806,24 +836,46 @@ impl Scene {
                 return Err(ctx.invalid("solver.xsph_c", format!("must be in [0, 1], got {v}")));
             }
         }
-        if rs.kind != SolverKind::Pcisph {
-            for (name, given) in [
-                (
-                    "clamp_negative_pressure",
-                    rs.clamp_negative_pressure.is_some(),
-                ),
-                (
-                    "density_error_tolerance",
-                    rs.density_error_tolerance.is_some(),
-                ),
-            ] {
-                if given {
-                    return Err(ctx.invalid(
-                        format!("solver.{name}"),
-                        "only applies to kind = \"pcisph\"",
-                    ));
-                }
-            }
+        // Fields of one solver kind, rejected for the other (in file-documentation order).
+        let (other_kind, only_other): (&str, &[(&str, bool)]) = match rs.kind {
+            SolverKind::Pbf => (
+                "pcisph",
+                &[
+                    (
+                        "clamp_negative_pressure",
+                        rs.clamp_negative_pressure.is_some(),
+                    ),
+                    (
+                        "density_error_tolerance",
+                        rs.density_error_tolerance.is_some(),
+                    ),
+                ],
+            ),
+            SolverKind::Pcisph => (
+                "pbf",
+                &[
+                    ("relative_cfm", rs.relative_cfm.is_some()),
+                    ("scorr_k", rs.scorr_k.is_some()),
+                    ("scorr_n", rs.scorr_n.is_some()),
+                    ("scorr_delta_q", rs.scorr_delta_q.is_some()),
+                    ("vorticity_epsilon", rs.vorticity_epsilon.is_some()),
+                    (
+                        "clamp_negative_constraint",
+                        rs.clamp_negative_constraint.is_some(),
+                    ),
+                    (
+                        "mean_compression_tolerance",
+                        rs.mean_compression_tolerance.is_some(),
+                    ),
+                    ("min_iterations", rs.min_iterations.is_some()),
+                ],
+            ),
+        };
+        if let Some((name, _)) = only_other.iter().find(|(_, given)| *given) {
+            return Err(ctx.invalid(
+                format!("solver.{name}"),
+                format!("only applies to kind = \"{other_kind}\""),
+            ));
         }
         let solver = SolverSpec {
             kind: rs.kind,
@@ -840,6 +892,9 @@ impl Scene {
             reorder_every: rs.reorder_every,
             clamp_negative_pressure: rs.clamp_negative_pressure,
             density_error_tolerance: rs.density_error_tolerance,
+            clamp_negative_constraint: rs.clamp_negative_constraint,
+            mean_compression_tolerance: rs.mean_compression_tolerance,
+            min_iterations: rs.min_iterations,
         };
 
         let tank = match &raw.tank {
@@ -1045,6 +1100,14 @@ impl Scene {
                 ] {
                     if v == Some(0) {
                         return Err(ctx.invalid(format!("quick.{name}"), "must be >= 1, got 0"));
+                    }
+                }
+                if let (Some(k), Some(min)) = (q.iterations, solver.min_iterations) {
+                    if k < min {
+                        return Err(ctx.invalid(
+                            "quick.iterations",
+                            format!("must be >= solver.min_iterations = {min}, got {k}"),
+                        ));
                     }
                 }
                 Some(QuickSpec {

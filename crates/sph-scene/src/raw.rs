@@ -46,6 +46,9 @@ pub(crate) struct RawSolver {
     pub reorder_every: Option<usize>,
     pub clamp_negative_pressure: Option<bool>,
     pub density_error_tolerance: Option<f64>,
+    pub clamp_negative_constraint: Option<bool>,
+    pub mean_compression_tolerance: Option<f64>,
+    pub min_iterations: Option<usize>,
 }
 
 #[derive(Debug, Clone, Copy, Deserialize)]

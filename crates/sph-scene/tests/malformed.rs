@@ -341,6 +341,76 @@ fn pcisph_option_on_pbf() {
 }
 
 #[test]
+fn pbf_option_on_pcisph() {
+    let e = err_with(
+        "pbf_only",
+        "kind = \"pbf\"\nsubsteps = 2",
+        "kind = \"pcisph\"\nvorticity_epsilon = 0.1\nsubsteps = 2",
+    );
+    assert_names(
+        &e,
+        "pbf_only",
+        "solver.vorticity_epsilon",
+        "only applies to kind = \"pbf\"",
+    );
+}
+
+#[test]
+fn min_iterations_without_tolerance() {
+    let e = err_with("min_no_tol", "xsph_c = 0.01", "min_iterations = 2");
+    assert_names(
+        &e,
+        "min_no_tol",
+        "solver.min_iterations",
+        "only applies with solver.mean_compression_tolerance",
+    );
+}
+
+#[test]
+fn min_iterations_above_iterations() {
+    let e = err_with(
+        "min_above_max",
+        "xsph_c = 0.01",
+        "mean_compression_tolerance = 0.001\nmin_iterations = 4",
+    );
+    assert_names(
+        &e,
+        "min_above_max",
+        "solver.min_iterations",
+        "must be >= 1 and <= solver.iterations = 3, got 4",
+    );
+}
+
+#[test]
+fn non_positive_compression_tolerance() {
+    let e = err_with(
+        "zero_tol",
+        "xsph_c = 0.01",
+        "mean_compression_tolerance = 0.0",
+    );
+    assert_names(&e, "zero_tol", "solver.mean_compression_tolerance", "> 0");
+}
+
+#[test]
+fn quick_iterations_below_min_iterations() {
+    let text = VALID
+        .replacen(
+            "xsph_c = 0.01",
+            "mean_compression_tolerance = 0.001\nmin_iterations = 2",
+            1,
+        )
+        .replacen("duration = 0.5", "duration = 0.5\niterations = 1", 1);
+    let file = fixture_dir("quick_min").join("quick_min.toml");
+    let e = Scene::parse_str(&text, &file).unwrap_err();
+    assert_names(
+        &e,
+        "quick_min",
+        "quick.iterations",
+        "must be >= solver.min_iterations = 2, got 1",
+    );
+}
+
+#[test]
 fn bad_quick_override() {
     let e = err_with(
         "bad_quick",
