@@ -61,19 +61,20 @@ fn cell_of_axis(x: f64, cell: f64) -> Option<i32> {
     if q.is_nan() || q.abs() > CELL_LIMIT {
         return None;
     }
-    // floor without a libm call (baseline x86-64 has no rounding instruction): truncation
-    // towards zero is exact here (|q| < 2³¹), and corrects by one below zero.
-    let t = q as i64;
-    Some((t - ((t as f64) > q) as i64) as i32)
+    Some(floor_i32(q))
 }
 
 /// Validates the positions and writes each particle's integer cell `floor(x / cell)`
-/// (Im & Chan 2016, eq. 5), in parallel. Errors name the first offending particle.
+/// (Im & Chan 2016, eq. 5), in parallel, and returns the componentwise min and max of the
+/// cells (`None` without particles). Errors name the first offending particle.
+///
+/// The loop is branch-free (an invalid coordinate is replaced by 0 and flagged), so that it
+/// vectorises; the bounds are reduced in the same pass.
 pub(crate) fn compute_cells<R: Real>(
     positions: &[Vec3<R>],
     cell: f64,
     out: &mut Vec<[i32; 3]>,
-) -> Result<(), SearchError> {
+) -> Result<CellBounds, SearchError> {
     if positions.len() > u32::MAX as usize / 27 {
         return Err(SearchError::TooManyParticles {
             count: positions.len(),
@@ -82,23 +83,40 @@ pub(crate) fn compute_cells<R: Real>(
     }
     out.clear();
     out.resize(positions.len(), [0; 3]);
-    let ok = out
-        .par_iter_mut()
-        .zip(positions.par_iter())
-        .with_min_len(4096)
-        .map(|(c, p)| {
-            let mut good = true;
-            for a in 0..3 {
-                match cell_of_axis(p[a].as_f64(), cell) {
-                    Some(v) => c[a] = v,
-                    None => good = false,
+    if positions.is_empty() {
+        return Ok(None);
+    }
+    type Acc = (bool, [i32; 3], [i32; 3]);
+    let id = || -> Acc { (true, [i32::MAX; 3], [i32::MIN; 3]) };
+    let merge = |(g0, mut lo, mut hi): Acc, (g1, l, h): Acc| -> Acc {
+        for a in 0..3 {
+            lo[a] = lo[a].min(l[a]);
+            hi[a] = hi[a].max(h[a]);
+        }
+        (g0 && g1, lo, hi)
+    };
+    let (ok, lo, hi) = out
+        .par_chunks_mut(CELLS_CHUNK)
+        .zip(positions.par_chunks(CELLS_CHUNK))
+        .map(|(cells, pts)| {
+            let (mut good, mut lo, mut hi) = id();
+            for (c, p) in cells.iter_mut().zip(pts) {
+                for a in 0..3 {
+                    let q = p[a].as_f64() / cell;
+                    // False for NaN and ±∞ too.
+                    let valid = q.abs() <= CELL_LIMIT;
+                    let v = floor_i32(if valid { q } else { 0.0 });
+                    good &= valid;
+                    c[a] = v;
+                    lo[a] = lo[a].min(v);
+                    hi[a] = hi[a].max(v);
                 }
             }
-            good
+            (good, lo, hi)
         })
-        .reduce(|| true, |a, b| a && b);
+        .reduce(id, merge);
     if ok {
-        return Ok(());
+        return Ok(Some((lo, hi)));
     }
     // Slow path, only on error: find the first offending particle deterministically.
     for (index, p) in positions.iter().enumerate() {
@@ -125,37 +143,19 @@ pub(crate) fn compute_cells<R: Real>(
     unreachable!("a cell failed but no particle was found at fault")
 }
 
-/// Componentwise min and max of the cells (`None` when empty).
-pub(crate) fn cell_bounds(cells: &[[i32; 3]]) -> Option<([i32; 3], [i32; 3])> {
-    if cells.is_empty() {
-        return None;
-    }
-    let id = ([i32::MAX; 3], [i32::MIN; 3]);
-    Some(
-        cells
-            .par_iter()
-            .with_min_len(8192)
-            .fold(
-                || id,
-                |(mut lo, mut hi), c| {
-                    for a in 0..3 {
-                        lo[a] = lo[a].min(c[a]);
-                        hi[a] = hi[a].max(c[a]);
-                    }
-                    (lo, hi)
-                },
-            )
-            .reduce(
-                || id,
-                |(mut lo, mut hi), (l, h)| {
-                    for a in 0..3 {
-                        lo[a] = lo[a].min(l[a]);
-                        hi[a] = hi[a].max(h[a]);
-                    }
-                    (lo, hi)
-                },
-            ),
-    )
+/// Particles per task of [`compute_cells`].
+const CELLS_CHUNK: usize = 8192;
+
+/// Componentwise min and max of the cells of a set of particles (`None` when empty).
+pub(crate) type CellBounds = Option<([i32; 3], [i32; 3])>;
+
+/// `floor(q)` for `|q| <= CELL_LIMIT`, without a libm call (baseline x86-64 has no rounding
+/// instruction): truncation towards zero is exact here (|q| < 2³¹), corrected by one below
+/// zero.
+#[inline(always)]
+fn floor_i32(q: f64) -> i32 {
+    let t = q as i64;
+    (t - ((t as f64) > q) as i64) as i32
 }
 
 /// An integer sort key: `u64` when the packed cell fits 64 bits, `u128` otherwise.

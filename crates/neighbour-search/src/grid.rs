@@ -4,7 +4,7 @@ use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 use sph_core::{Real, Vec3};
 
-use crate::cells::{cell_bounds, cell_size, compute_cells, Key, KeyPacker};
+use crate::cells::{cell_size, compute_cells, Key, KeyPacker};
 use crate::csr::{assemble_by, items_per_task, TaskOutput};
 use crate::radix::{sort_pairs, RadixScratch};
 use crate::runs::run_starts;
@@ -226,8 +226,8 @@ impl<R: Real> NeighbourSearch<R> for CellStartGrid<R> {
     ) -> Result<(), SearchError> {
         let mut watch = Stopwatch::start();
         let cell = cell_size(radius)?;
-        compute_cells(positions, cell, &mut self.sorted.cells)?;
-        let Some((lo, hi)) = cell_bounds(&self.sorted.cells) else {
+        let bounds = compute_cells(positions, cell, &mut self.sorted.cells)?;
+        let Some((lo, hi)) = bounds else {
             out.reset(0);
             return Ok(());
         };
@@ -417,8 +417,8 @@ impl<R: Real> NeighbourSearch<R> for HashedGrid<R> {
         let mut watch = Stopwatch::start();
         let cell = cell_size(radius)?;
         // Both key widths share the cell computation; the narrow one holds the cells.
-        compute_cells(positions, cell, &mut self.narrow.cells)?;
-        let Some((lo, hi)) = cell_bounds(&self.narrow.cells) else {
+        let bounds = compute_cells(positions, cell, &mut self.narrow.cells)?;
+        let Some((lo, hi)) = bounds else {
             out.reset(0);
             return Ok(());
         };

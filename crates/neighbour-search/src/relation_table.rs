@@ -3,7 +3,7 @@
 use rayon::prelude::*;
 use sph_core::{Real, Vec3};
 
-use crate::cells::{cell_bounds, cell_size, compute_cells, Key, KeyPacker};
+use crate::cells::{cell_size, compute_cells, Key, KeyPacker};
 use crate::csr::TaskOutput;
 use crate::radix::{sort_pairs, RadixScratch};
 use crate::runs::run_starts;
@@ -108,8 +108,8 @@ impl<R: Real> NeighbourSearch<R> for RelationTable<R> {
     ) -> Result<(), SearchError> {
         let watch = Stopwatch::start();
         let cell = cell_size(radius)?;
-        compute_cells(positions, cell, &mut self.cells)?;
-        let Some((lo, hi)) = cell_bounds(&self.cells) else {
+        let bounds = compute_cells(positions, cell, &mut self.cells)?;
+        let Some((lo, hi)) = bounds else {
             out.reset(0);
             return Ok(());
         };

@@ -2,7 +2,7 @@
 
 use sph_core::{Real, Vec3};
 
-use crate::cells::{cell_bounds, cell_size, compute_cells, Key, KeyPacker};
+use crate::cells::{cell_size, compute_cells, Key, KeyPacker};
 use crate::radix::{sort_pairs, RadixScratch};
 use crate::SearchError;
 
@@ -62,10 +62,10 @@ impl CellSorter {
         order: CellOrder,
     ) -> Result<&[u32], SearchError> {
         let cell = cell_size(cell_size_abs)?;
-        compute_cells(positions, cell, &mut self.cells)?;
+        let bounds = compute_cells(positions, cell, &mut self.cells)?;
         self.perm.clear();
         self.perm.extend(0..positions.len() as u32);
-        let Some((lo, hi)) = cell_bounds(&self.cells) else {
+        let Some((lo, hi)) = bounds else {
             return Ok(&self.perm);
         };
         let packer = KeyPacker::new(lo, hi, 0);
