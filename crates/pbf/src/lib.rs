@@ -96,8 +96,14 @@
 //!   `r − d`, i.e. onto the surface offset by `r`. No friction or restitution: the velocity
 //!   follows from line 21. The paper gives no details beyond "collision detection against
 //!   solids as part of the constraint solving loop" with SDFs.
-//! - **No clamping** of `C_i` (the paper does not clamp; particles with deficient
+//! - **No clamping** of `C_i` by default (the paper does not clamp; particles with deficient
 //!   neighbourhoods get `C_i < 0` and attract, limited by `s_corr` and `ε`).
+//!   [`PbfParams::clamp_negative_constraint`] gives SPlisHSPlasH's unilateral
+//!   `max(C_i, 0)` instead.
+//! - **Fixed iteration count** by default, as in the paper;
+//!   [`PbfParams::mean_compression_tolerance`] stops earlier (SPlisHSPlasH's rule), and a step
+//!   that reaches the maximum without meeting it is counted in
+//!   [`StepStats::unconverged_substeps`].
 //! - **Neighbour lists** are found once per step at the predicted positions and reused by
 //!   every iteration and the velocity update (as in the paper, §6).
 //!
