@@ -3,14 +3,14 @@
 use std::fmt;
 use std::time::Instant;
 
-use neighbour_search::{HashedGrid, Method, NeighbourLists, NeighbourSearch, SearchError};
+use neighbour_search::{HashedGrid, Method, NeighbourLists, NeighbourSearch};
 use rayon::prelude::*;
 use sph_core::{ParticleSet, Real, Sdf, Vec3};
 use sph_kernels::{Kernel, Poly6, Spiky};
 
 use crate::solver::{
-    blow_up, check_divergence, check_masses, collide, density_energy_stats, find_neighbours,
-    non_finite, CellReorder, MIN_LEN, REDUCE_CHUNK,
+    check_divergence, check_masses, check_predicted, collide, density_energy_stats,
+    find_step_neighbours, CellReorder, MIN_LEN, REDUCE_CHUNK,
 };
 use crate::{PbfError, PbfParams, Solids, StepStats};
 
@@ -547,25 +547,16 @@ impl<R: Real> Pcisph<R> {
         );
 
         // Step 1: neighbours once, at the current positions.
-        let search_stats = find_neighbours(
+        let search_stats = find_step_neighbours(
             &mut *self.search,
             &mut self.fallback,
             x,
             h,
             &mut self.neighbours,
-        )
-        .map_err(|e| match e {
-            SearchError::NonFinitePosition { index, .. }
-            | SearchError::CellCoordinateOverflow { index, .. } => blow_up(
-                step,
-                index,
-                format!(
-                    "substep {sub}: position {:?} is out of the range of the neighbour grid",
-                    x[index]
-                ),
-            ),
-            e => e.into(),
-        })?;
+            step,
+            sub,
+            "position",
+        )?;
         stats.create_hash_grid_s += search_stats.build_s();
         stats.detect_neighbours_s += search_stats.detect_s();
         let nb = &self.neighbours;
@@ -597,21 +588,7 @@ impl<R: Real> Pcisph<R> {
                 *acc = Vec3::zeros();
                 *xp = collide(solids, advance(xi, vn, g, dt).1, radius);
             });
-        if let Some(i) = s
-            .predicted
-            .par_iter()
-            .with_min_len(MIN_LEN)
-            .position_first(|x| non_finite(x).is_some())
-        {
-            return Err(blow_up(
-                step,
-                i,
-                format!(
-                    "substep {sub}: predicted position {:?} is not finite",
-                    s.predicted[i]
-                ),
-            ));
-        }
+        check_predicted(step, sub, &s.predicted)?;
         stats.integrate_s += t.elapsed().as_secs_f64();
 
         // Step 3: prediction-correction iterations.

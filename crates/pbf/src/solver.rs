@@ -280,6 +280,59 @@ pub(crate) fn find_neighbours<R: Real>(
     }
 }
 
+/// [`find_neighbours`] inside call `step`, substep `sub` of a solver: a position the
+/// neighbour grid cannot hold (non-finite, or a cell coordinate overflowing `i32`) is a
+/// [`PbfError::BlowUp`] naming the particle and `what` the positions are (e.g. "predicted
+/// position"); other search errors pass through.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn find_step_neighbours<R: Real>(
+    search: &mut dyn NeighbourSearch<R>,
+    fallback: &mut Option<HashedGrid<R>>,
+    positions: &[Vec3<R>],
+    h: R,
+    out: &mut NeighbourLists,
+    step: u64,
+    sub: usize,
+    what: &str,
+) -> Result<SearchStats, PbfError> {
+    find_neighbours(search, fallback, positions, h, out).map_err(|e| match e {
+        SearchError::NonFinitePosition { index, .. }
+        | SearchError::CellCoordinateOverflow { index, .. } => blow_up(
+            step,
+            index,
+            format!(
+                "substep {sub}: {what} {:?} is out of the range of the neighbour grid",
+                positions[index]
+            ),
+        ),
+        e => e.into(),
+    })
+}
+
+/// A non-finite predicted position (after applying the external forces) is a
+/// [`PbfError::BlowUp`] of call `step`, substep `sub`, naming the first such particle.
+pub(crate) fn check_predicted<R: Real>(
+    step: u64,
+    sub: usize,
+    predicted: &[Vec3<R>],
+) -> Result<(), PbfError> {
+    match predicted
+        .par_iter()
+        .with_min_len(MIN_LEN)
+        .position_first(|x| non_finite(x).is_some())
+    {
+        Some(i) => Err(blow_up(
+            step,
+            i,
+            format!(
+                "substep {sub}: predicted position {:?} is not finite",
+                predicted[i]
+            ),
+        )),
+        None => Ok(()),
+    }
+}
+
 /// Collision detection and response (inside the constraint loop, Algorithm 1 line 14): for
 /// each solid in order, a position closer than `radius` to it (signed distance `d < radius`)
 /// is moved along the normalised SDF gradient by `radius − d`.
@@ -823,46 +876,20 @@ impl<R: Real> Pbf<R> {
                     *xp = x[i] + vi * dt;
                 });
         }
-        if let Some(i) = s
-            .predicted
-            .par_iter()
-            .with_min_len(MIN_LEN)
-            .position_first(|x| non_finite(x).is_some())
-        {
-            return Err(blow_up(
-                step,
-                i,
-                format!(
-                    "substep {sub}: predicted position {:?} is not finite",
-                    s.predicted[i]
-                ),
-            ));
-        }
+        check_predicted(step, sub, &s.predicted)?;
         stats.integrate_s += t.elapsed().as_secs_f64();
 
         // Lines 5–7: neighbours at the predicted positions, once per step.
-        let search_stats = match find_neighbours(
+        let search_stats = find_step_neighbours(
             &mut *self.search,
             &mut self.fallback,
             &s.predicted,
             h,
             &mut self.neighbours,
-        ) {
-            Ok(st) => st,
-            Err(SearchError::NonFinitePosition { index, .. })
-            | Err(SearchError::CellCoordinateOverflow { index, .. }) => {
-                return Err(blow_up(
-                    step,
-                    index,
-                    format!(
-                        "substep {sub}: predicted position {:?} is out of the range of the \
-                         neighbour grid",
-                        s.predicted[index]
-                    ),
-                ))
-            }
-            Err(e) => return Err(e.into()),
-        };
+            step,
+            sub,
+            "predicted position",
+        )?;
         stats.create_hash_grid_s += search_stats.build_s();
         stats.detect_neighbours_s += search_stats.detect_s();
         let nb = &self.neighbours;

@@ -30,11 +30,7 @@ static GLOBAL: Counting = Counting;
 
 #[test]
 fn step_does_not_allocate_when_warm() {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(2)
-        .build()
-        .unwrap();
-    pool.install(|| {
+    common::in_pool(2, || {
         let (mut p, mut state, solids) = common::dam_break::<f32>();
         p.reorder_every = 3;
         let mut solver = Pbf::new(p, solids).unwrap();

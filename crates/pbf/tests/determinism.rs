@@ -15,23 +15,15 @@ fn run<R: Real>(frames: usize) -> (Vec<u64>, StepStats) {
     (common::bits(&state), last)
 }
 
-fn in_pool<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .unwrap()
-        .install(f)
-}
-
 #[test]
 fn two_sequential_runs_are_bit_identical() {
-    let a = in_pool(1, || run::<f64>(12));
-    let b = in_pool(1, || run::<f64>(12));
+    let a = common::in_pool(1, || run::<f64>(12));
+    let b = common::in_pool(1, || run::<f64>(12));
     assert_eq!(a.0, b.0);
     assert_eq!(a.1.max_density_ratio, b.1.max_density_ratio);
     assert_eq!(a.1.kinetic_energy, b.1.kinetic_energy);
-    let c = in_pool(1, || run::<f32>(12));
-    let d = in_pool(1, || run::<f32>(12));
+    let c = common::in_pool(1, || run::<f32>(12));
+    let d = common::in_pool(1, || run::<f32>(12));
     assert_eq!(c.0, d.0);
 }
 
@@ -39,8 +31,8 @@ fn two_sequential_runs_are_bit_identical() {
 /// so the thread count does not change a bit.
 #[test]
 fn thread_count_does_not_change_results() {
-    let a = in_pool(1, || run::<f64>(8));
-    let b = in_pool(2, || run::<f64>(8));
+    let a = common::in_pool(1, || run::<f64>(8));
+    let b = common::in_pool(2, || run::<f64>(8));
     assert_eq!(a.0, b.0);
     assert_eq!(a.1.mean_density_ratio, b.1.mean_density_ratio);
     assert_eq!(a.1.kinetic_energy, b.1.kinetic_energy);

@@ -2,56 +2,14 @@
 //! equations: brute-force neighbour loops, the Poly6 / Spiky formulas of Müller et al. (2003)
 //! written out, and Algorithm 1 of Macklin & Müller (2013) step by step.
 
+mod common;
+
 use std::f64::consts::PI;
 
+use common::formulas::{add, cross, dot, norm, poly6, scale, spiky_grad, sub, to_v, V};
 use pbf::{Pbf, PbfParams, Sdf, Vec3};
 use proptest::prelude::*;
 use sph_core::Plane;
-
-type V = [f64; 3];
-
-fn sub(a: V, b: V) -> V {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn add(a: V, b: V) -> V {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-fn scale(a: V, k: f64) -> V {
-    [a[0] * k, a[1] * k, a[2] * k]
-}
-fn dot(a: V, b: V) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: V, b: V) -> V {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn norm(a: V) -> f64 {
-    dot(a, a).sqrt()
-}
-
-/// Poly6, `315/(64π h⁹)(h² − r²)³`.
-fn poly6(r: V, h: f64) -> f64 {
-    let r2 = dot(r, r);
-    if r2 >= h * h {
-        0.0
-    } else {
-        315.0 / (64.0 * PI * h.powi(9)) * (h * h - r2).powi(3)
-    }
-}
-
-/// Spiky gradient, `−45/(π h⁶)(h − r)² r̂` (zero at r = 0 and r >= h).
-fn spiky_grad(r: V, h: f64) -> V {
-    let l = norm(r);
-    if l == 0.0 || l >= h {
-        [0.0; 3]
-    } else {
-        scale(r, -45.0 / (PI * h.powi(6)) * (h - l).powi(2) / l)
-    }
-}
 
 /// `Σ_k |∇_{p_k} C_i|²` for a particle inside a simple cubic lattice of spacing `s` with
 /// volumes `s³` (the unit of `s_corr`, see the crate docs).
@@ -168,10 +126,6 @@ impl Oracle {
             })
             .collect()
     }
-}
-
-fn to_v(p: &Vec3<f64>) -> V {
-    [p.x, p.y, p.z]
 }
 
 #[derive(Debug, Clone)]

@@ -1,8 +1,10 @@
-//! Scenes shared by the integration tests.
+//! Scenes, oracle formulas and helpers shared by the integration tests.
 #![allow(dead_code)]
 
-use pbf::{ParticleSet, PbfParams, Real, Solids, Vec3};
-use sph_core::{sampling::cubic_lattice, Aabb, BoxSdf, Inverted};
+pub mod formulas;
+
+use pbf::{FluidSolver, ParticleSet, PbfError, PbfParams, Real, Solids, Vec3};
+use sph_core::{sampling::cubic_lattice, Aabb, BoxSdf, CoreError, Inverted};
 
 /// A fluid block of `n = [nx, ny, nz]` particles at spacing `s`, at rest in the corner
 /// `(0, 0, 0)` of a tank of `tank = [tx, ty, tz]` spacings (an `Inverted<BoxSdf>`), with
@@ -43,4 +45,37 @@ pub fn bits<R: Real>(state: &ParticleSet<R>) -> Vec<u64> {
         .chain(&state.velocities)
         .flat_map(|v| v.iter().map(|c| c.as_f64().to_bits()).collect::<Vec<_>>())
         .collect()
+}
+
+/// Runs `f` in a rayon pool of `threads` threads.
+pub fn in_pool<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(f)
+}
+
+/// Steps `solver` on `state` with particle 7's `y` set to NaN: the error must name particle 7
+/// and axis `y`, and the state must be left untouched.
+pub fn assert_nan_position_rejected(
+    solver: &mut dyn FluidSolver<f64>,
+    mut state: ParticleSet<f64>,
+) {
+    state.positions[7].y = f64::NAN;
+    let before = bits(&state);
+    let e = solver.step(&mut state).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            PbfError::InvalidState(CoreError::NonFinitePosition {
+                index: 7,
+                axis: 'y',
+                ..
+            })
+        ),
+        "{e:?}"
+    );
+    assert!(e.to_string().contains("particle 7"), "{e}");
+    assert_eq!(bits(&state), before, "state untouched");
 }
