@@ -210,8 +210,10 @@ pub enum SolverKind {
 }
 
 /// Solver settings: step counts and optional overrides of the solver's defaults (`None` =
-/// the solver's default). Units as in the crate documentation.
-#[derive(Debug, Clone, PartialEq)]
+/// the solver's default). Units as in the crate documentation. Read from the `[solver]`
+/// table as written (serde) and range-checked by the scene parser.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SolverSpec {
     /// Which solver.
     pub kind: SolverKind,
@@ -877,25 +879,7 @@ impl Scene {
                 format!("only applies to kind = \"{other_kind}\""),
             ));
         }
-        let solver = SolverSpec {
-            kind: rs.kind,
-            substeps: rs.substeps,
-            iterations: rs.iterations,
-            rest_density: rs.rest_density,
-            support_over_spacing: rs.support_over_spacing,
-            relative_cfm: rs.relative_cfm,
-            scorr_k: rs.scorr_k,
-            scorr_n: rs.scorr_n,
-            scorr_delta_q: rs.scorr_delta_q,
-            vorticity_epsilon: rs.vorticity_epsilon,
-            xsph_c: rs.xsph_c,
-            reorder_every: rs.reorder_every,
-            clamp_negative_pressure: rs.clamp_negative_pressure,
-            density_error_tolerance: rs.density_error_tolerance,
-            clamp_negative_constraint: rs.clamp_negative_constraint,
-            mean_compression_tolerance: rs.mean_compression_tolerance,
-            min_iterations: rs.min_iterations,
-        };
+        let solver = rs.clone();
 
         let tank = match &raw.tank {
             Some(t) => Some(ctx.check_box("tank", t)?),

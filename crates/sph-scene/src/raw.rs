@@ -2,14 +2,14 @@
 
 use serde::Deserialize;
 
-use crate::{Precision, SolverKind};
+use crate::{Precision, SolverSpec};
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct RawScene {
     pub name: String,
     pub simulation: RawSimulation,
-    pub solver: RawSolver,
+    pub solver: SolverSpec,
     pub tank: Option<RawBox>,
     #[serde(default)]
     pub fluid: Vec<RawFluid>,
@@ -27,28 +27,6 @@ pub(crate) struct RawSimulation {
     pub duration: f64,
     pub frame_dt: f64,
     pub gravity: Option<[f64; 3]>,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(crate) struct RawSolver {
-    pub kind: SolverKind,
-    pub substeps: usize,
-    pub iterations: usize,
-    pub rest_density: Option<f64>,
-    pub support_over_spacing: Option<f64>,
-    pub relative_cfm: Option<f64>,
-    pub scorr_k: Option<f64>,
-    pub scorr_n: Option<u32>,
-    pub scorr_delta_q: Option<f64>,
-    pub vorticity_epsilon: Option<f64>,
-    pub xsph_c: Option<f64>,
-    pub reorder_every: Option<usize>,
-    pub clamp_negative_pressure: Option<bool>,
-    pub density_error_tolerance: Option<f64>,
-    pub clamp_negative_constraint: Option<bool>,
-    pub mean_compression_tolerance: Option<f64>,
-    pub min_iterations: Option<usize>,
 }
 
 #[derive(Debug, Clone, Copy, Deserialize)]
