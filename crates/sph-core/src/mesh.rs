@@ -10,6 +10,11 @@
 //!    by [`GridSdf::EXACT_BAND`] cells (the narrow band), remembering the closest triangle,
 //! 2. propagation of the closest triangle to the remaining nodes by sweeping (each node
 //!    tries the closest triangle of its already-visited neighbour and keeps it when nearer),
+//!    then two rounds in which every node tries the closest triangles of its 26 neighbours
+//!    (not in SDFGen, whose sweeps run along the 8 diagonal octants; here the sweeps run
+//!    along the axes, which alone left nodes deep inside curved surfaces with a distant
+//!    triangle: on an 81,920-triangle icosphere the largest node error falls from 0.77 to
+//!    0.45 cells, at 4× the build time, 0.23 → 0.94 s for 10⁶ nodes on 2 threads),
 //! 3. the sign from the parity of ray crossings along +x through each row of nodes, with
 //!    the robust 2D point-in-triangle test of SDFGen (exact orientation signs with a
 //!    simulation-of-simplicity tie break, so a ray through a shared edge or vertex is counted
@@ -612,6 +617,8 @@ pub struct GridSdf<R: Real> {
 }
 
 const NO_TRI: u32 = u32::MAX;
+/// Rounds of the 26-neighbour relaxation after the sweeps of [`build_grid`].
+const RELAX_ROUNDS: usize = 2;
 
 impl<R: Real> GridSdf<R> {
     /// Largest number of grid nodes [`GridSdf::new`] accepts (64 Mi nodes).
@@ -991,6 +998,35 @@ fn build_grid<R: Real>(
         }
     }
 
+    // 2b. Relaxation: the axis-wise sweeps carry triangles along the axes only, which leaves
+    //    nodes deep inside curved surfaces with a triangle that is not the closest (measured
+    //    on an icosphere: gradient directions 20–35° off the radius 3–14 cells inside). Each
+    //    node also tries the closest triangles of its 26 neighbours, from the previous
+    //    round's assignment (Jacobi, so the result does not depend on the thread count).
+    for _round in 0..RELAX_ROUNDS {
+        let prev = closest.clone();
+        phi.par_chunks_mut(nx)
+            .zip(closest.par_chunks_mut(nx))
+            .enumerate()
+            .for_each(|(row, (ph, cl))| {
+                let (j, k) = (row % ny, row / ny);
+                let (j0, j1) = (j.saturating_sub(1), (j + 1).min(ny - 1));
+                let (k0, k1) = (k.saturating_sub(1), (k + 1).min(nz - 1));
+                for i in 0..nx {
+                    let p = node(i, j, k);
+                    let (i0, i1) = (i.saturating_sub(1), (i + 1).min(nx - 1));
+                    for kk in k0..=k1 {
+                        for jj in j0..=j1 {
+                            let base = plane * kk + nx * jj;
+                            for &cand in &prev[base + i0..=base + i1] {
+                                try_tri(&mut ph[i], &mut cl[i], cand, p);
+                            }
+                        }
+                    }
+                }
+            });
+    }
+
     // 3. (continued) Parity along each row: odd = inside = negative.
     phi.par_chunks_mut(nx)
         .zip(crossings.par_chunks(nx))
@@ -1109,10 +1145,12 @@ mod tests {
     /// Icosphere of radius r with 4 subdivisions: the facets lie between the inscribed
     /// radius r·cos θ and r; the largest edge angle is below 0.08 rad, so the distance to the
     /// mesh differs from the sphere's by at most r(1 − cos 0.08) < 0.0032 r.
+    const SPHERE_CENTER: Vec3<f64> = Vec3::new(0.2, -0.1, 0.3);
+
     fn sphere_mesh() -> &'static (TriangleMesh<f64>, Sphere<f64>) {
         static S: OnceLock<(TriangleMesh<f64>, Sphere<f64>)> = OnceLock::new();
         S.get_or_init(|| {
-            let c = Vec3::new(0.2, -0.1, 0.3);
+            let c = SPHERE_CENTER;
             (
                 TriangleMesh::icosphere(c, 0.6, 4).unwrap(),
                 Sphere::new(c, 0.6).unwrap(),
@@ -1279,7 +1317,11 @@ mod tests {
         /// Icosphere: exact mesh distance within the facet sagitta (0.0032 r) of the sphere;
         /// grid within (√3/2)·cell + 0.1·cell of the exact value (the extra tenth of a cell
         /// covers swept node values, which are distances to a nearby but not always the
-        /// nearest facet), sign right beyond one cell; the gradient points along the radius.
+        /// nearest facet), sign right beyond one cell; the gradient points along the radius
+        /// (within 18°) except within 6 cells of the centre: the distance is not
+        /// differentiable at the centre (the sphere's medial axis), and where the level sets'
+        /// radius of curvature ρ is a few cells the trilinear gradient's direction error,
+        /// of order cell/ρ, exceeds that angle (measured: 41° at 0–1 cell, 33° at 1–2).
         #[test]
         fn sphere_grid_vs_exact(x in -0.55..0.95f64, y in -0.85..0.65f64, z in -0.45..1.05f64) {
             let (m, s) = sphere_mesh();
@@ -1292,8 +1334,10 @@ mod tests {
             prop_assert!((v - exact).abs() <= (0.75f64.sqrt() + 0.1) * cell, "grid {v} exact {exact}");
             if exact.abs() > cell {
                 prop_assert_eq!(v < 0.0, exact < 0.0);
-                let n = g.gradient(&p);
-                prop_assert!(n.dot(&s.gradient(&p)) > 0.95, "{n:?}");
+                if (p - SPHERE_CENTER).norm() >= 6.0 * cell {
+                    let n = g.gradient(&p);
+                    prop_assert!(n.dot(&s.gradient(&p)) > 0.95, "{n:?}");
+                }
             }
         }
     }
