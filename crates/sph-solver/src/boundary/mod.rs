@@ -1,0 +1,121 @@
+//! Solid boundaries as values: the [`Boundary`] trait and its two models.
+//!
+//! - [`CollisionBoundary`]: particles are projected out of the solids' signed distance fields
+//!   to a contact distance (the PBF paper's "collision detection against solids as part of
+//!   the constraint solving loop"). The walls contribute no density.
+//! - `VolumeMapBoundary`: Bender, Kugelstadt, Weiler & Koschier (2019), "Volume Maps: An
+//!   Implicit Boundary Representation for SPH" (MIG '19). Each solid contributes its share
+//!   of every particle's density, `ρ_B = ρ0 Ψ(x)` with `Ψ(x) = ∫_solid W(x − y) dy`, and its
+//!   gradient `∇Ψ` to the pressure forces; see the module `volume_map` for the equations.
+
+mod collision;
+
+pub use collision::CollisionBoundary;
+
+use sph_core::{Real, Sdf, Vec3};
+
+/// What the boundary contributes to a particle at one position.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BoundarySample<R: Real> {
+    /// `Ψ(x) = Σ_k ∫_{solid k} W(x − y) dy` (dimensionless): the boundary's share of the
+    /// density is `ρ0 Ψ`. In the notation of Bender et al. (2019) and of the SPH boundary
+    /// literature (Akinci et al. 2012), `Ψ(x_i) = Σ_b V_b W_ib`. 0 for [`CollisionBoundary`].
+    pub volume: R,
+    /// `∇Ψ(x) = Σ_b V_b ∇W_ib` (1/m); points into the solids. Zero for
+    /// [`CollisionBoundary`].
+    pub volume_gradient: Vec3<R>,
+}
+
+impl<R: Real> Default for BoundarySample<R> {
+    fn default() -> Self {
+        Self {
+            volume: R::zero(),
+            volume_gradient: Vec3::zeros(),
+        }
+    }
+}
+
+/// The nearest solid surface to a position.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClosestPoint<R: Real> {
+    /// Index of the solid (in [`Boundary::solids`] order).
+    pub solid: usize,
+    /// Signed distance to its surface (m; negative inside the solid).
+    pub distance: R,
+    /// Unit outward normal of the solid at the closest point (the SDF gradient).
+    pub normal: Vec3<R>,
+    /// The closest surface point, `x − distance · normal`.
+    pub point: Vec3<R>,
+}
+
+/// A solid boundary model shared by the particle solvers.
+///
+/// Solvers call [`Boundary::sample`] wherever they sum densities or pressure forces (when
+/// [`Boundary::has_volume`]) and [`Boundary::project`] on every position they predict.
+pub trait Boundary<R: Real>: Send + Sync {
+    /// Short name for reports: `"collision"` or `"volume-map"`.
+    fn name(&self) -> &'static str;
+    /// The solids (signed distance fields, negative inside).
+    fn solids(&self) -> &[Box<dyn Sdf<R>>];
+    /// Whether [`Boundary::sample`] can be non-zero (the boundary takes part in the density).
+    fn has_volume(&self) -> bool;
+    /// The kernel the boundary volumes were integrated with, as `(name, support radius)`
+    /// (`None` when [`Boundary::has_volume`] is false). Solvers refuse a boundary whose
+    /// kernel differs from their density kernel.
+    fn volume_kernel(&self) -> Option<(&'static str, R)>;
+    /// `Ψ` and `∇Ψ` at `x` (zero when the boundary has no volume).
+    fn sample(&self, x: &Vec3<R>) -> BoundarySample<R>;
+    /// The contact response: `x` moved out of each solid in turn, along the solid's SDF
+    /// gradient, to at least [`Boundary::contact_distance`] from its surface.
+    fn project(&self, x: Vec3<R>) -> Vec3<R>;
+    /// The distance (m) [`Boundary::project`] keeps particles from the surfaces.
+    fn contact_distance(&self) -> R;
+    /// The nearest solid surface (`None` without solids).
+    fn closest(&self, x: &Vec3<R>) -> Option<ClosestPoint<R>> {
+        closest_of(self.solids(), x)
+    }
+}
+
+/// [`Boundary::closest`] over a list of solids.
+pub fn closest_of<R: Real>(solids: &[Box<dyn Sdf<R>>], x: &Vec3<R>) -> Option<ClosestPoint<R>> {
+    let mut best: Option<ClosestPoint<R>> = None;
+    for (k, s) in solids.iter().enumerate() {
+        let d = s.signed_distance(x);
+        if best.is_none_or(|b| d < b.distance) {
+            let normal = unit_or_zero(s.gradient(x));
+            best = Some(ClosestPoint {
+                solid: k,
+                distance: d,
+                normal,
+                point: x - normal * d,
+            });
+        }
+    }
+    best
+}
+
+/// Moves `x` out of each solid in turn to at least `radius` from its surface, along the
+/// normalised SDF gradient (no move where the gradient vanishes or is not finite).
+#[inline]
+pub fn project_out<R: Real>(solids: &[Box<dyn Sdf<R>>], mut x: Vec3<R>, radius: R) -> Vec3<R> {
+    for s in solids {
+        let d = s.signed_distance(&x);
+        if d < radius {
+            let g = s.gradient(&x);
+            let len = g.norm();
+            if len > R::zero() && len.is_finite_value() {
+                x += g * ((radius - d) / len);
+            }
+        }
+    }
+    x
+}
+
+fn unit_or_zero<R: Real>(g: Vec3<R>) -> Vec3<R> {
+    let len = g.norm();
+    if len > R::zero() && len.is_finite_value() {
+        g / len
+    } else {
+        Vec3::zeros()
+    }
+}
