@@ -1,34 +1,35 @@
 //! Position Based Fluids: the solver core of
 //!
 //! > Miles Macklin and Matthias Müller, "Position Based Fluids", *ACM Transactions on
-//! > Graphics* 32(4), Article 104, 2013 (SIGGRAPH 2013)
-//! > (`../shared/papers/000_c4812046a0b6e3de.txt`).
+//! > Graphics* 32(4), Article 104, 2013 (SIGGRAPH 2013), doi:10.1145/2461912.2461984.
 //!
 //! [`Pbf::step`] runs the paper's Algorithm 1 on a structure-of-arrays
 //! [`sph_core::ParticleSet`] (positions, velocities, masses, densities), generic over
 //! [`sph_core::Real`] (`f32` or `f64`), with rayon-parallel loops over the particles.
 //!
-//! The crate also holds the baseline the paper compares against (§8): [`Pcisph`], the
-//! predictive-corrective incompressible SPH of Solenthaler & Pajarola (2009), with the same
-//! kernels, neighbour search, SDF collision response and XSPH viscosity (see its
-//! documentation for the equations, the deviations and the measured behaviour). Both
-//! implement [`FluidSolver`], so a scene runner can hold a `Box<dyn FluidSolver<R>>`. Scenes
-//! and experiments are not part of this crate.
+//! [`Pbf`] implements `sph_solver::FluidSolver`, so a scene runner can hold a
+//! `Box<dyn FluidSolver<R>>` beside the other solvers of the workspace (the PCISPH baseline
+//! the paper compares against is the `pcisph` crate). Its walls are a
+//! [`sph_solver::Boundary`]: [`Pbf::new`] takes solids and projects particles out of them
+//! (the paper's collision handling); [`Pbf::with_boundary`] takes any model, e.g. volume
+//! maps, whose walls take part in the density. Scenes and experiments are not part of this
+//! crate.
 //!
 //! ```
 //! use pbf::{ParticleSet, Pbf, PbfParams, Solids, Vec3};
 //! use sph_core::{sampling::cubic_lattice, Aabb, BoxSdf, Inverted};
 //!
 //! let params = PbfParams::<f32>::default(); // s = 0.025 m, h = 0.05 m, 16 ms frames
-//! let s = params.particle_spacing;
+//! let s = params.common.particle_spacing;
 //! let block = Aabb::new(Vec3::zeros(), Vec3::new(4.0, 4.0, 4.0) * s).unwrap();
 //! let tank = Aabb::new(Vec3::zeros(), Vec3::new(12.0, 8.0, 4.0) * s).unwrap();
 //! let positions = cubic_lattice(&block, s, 1 << 20).unwrap();
-//! let (m, rho0) = (params.particle_mass(), params.rest_density);
+//! let (m, rho0) = (params.particle_mass(), params.common.rest_density);
 //! let mut state = ParticleSet::from_positions(positions, m, rho0);
 //! let solids: Solids<f32> = vec![Box::new(Inverted(BoxSdf::new(tank).unwrap()))];
 //! let mut solver = Pbf::new(params, solids).unwrap();
 //! for _ in 0..10 {
+//!     // One call advances a whole 16 ms frame of `substeps` steps.
 //!     let stats = solver.step(&mut state).unwrap();
 //!     assert!(stats.max_density_ratio < 1.5);
 //! }
@@ -36,13 +37,13 @@
 //!
 //! | paper | here |
 //! | --- | --- |
-//! | Algorithm 1 lines 1–4 (gravity, prediction) | [`Pbf::step`], phase `integrate_s` of [`StepStats`] |
-//! | lines 5–7 (neighbours once per step, at `x*`; Green 2008) | `neighbour_search::CellStartGrid`, phases `create_hash_grid_s`, `detect_neighbours_s` |
+//! | Algorithm 1 lines 1–4 (gravity, prediction) | [`Pbf::step`], phase `integrate` of [`StepStats`] ([`PBF_PHASES`]) |
+//! | lines 5–7 (neighbours once per step, at `x*`; Green 2008) | `neighbour_search::CellStartGrid`, phases `create_hash_grid`, `detect_neighbours` |
 //! | eqs. 1–2 (constraint, density, Poly6) | `lambda_pass` (private), [`PbfScratch::density`] |
 //! | eqs. 7–8 (constraint gradients, Spiky) and 9–11 (`λ_i` with CFM `ε`) | `lambda_pass`, [`PbfScratch::lambda`] |
 //! | eqs. 12–14 (`Δp_i` with `s_corr`) | `delta_pass` (private), [`ArtificialPressure`] (eq. 13), [`PbfScratch::delta_p`] |
-//! | line 14 (collision detection and response, inside the loop) | `collide` (private), against [`sph_core::Sdf`] solids |
-//! | lines 20–24, eq. 15 (vorticity), eq. 16 (confinement), eq. 17 (XSPH) | [`Pbf::step`], phase `velocity_update_s` |
+//! | line 14 (collision detection and response, inside the loop) | [`sph_solver::Boundary::project`] (collision or volume-map model) |
+//! | lines 20–24, eq. 15 (vorticity), eq. 16 (confinement), eq. 17 (XSPH) | [`Pbf::step`], phase `velocity_update` |
 //! | Table 2 (time per phase) | [`StepStats`] |
 //! | §8, Table 1 (frame of 16 ms, 4 substeps, 2–4 iterations) | [`PbfParams`] defaults |
 //!
@@ -89,7 +90,8 @@
 //!   "force" is applied as an acceleration: `v_i ← v_i + Δt ε (N × ω_i)`, `ε` in m/s. Both
 //!   confinement and XSPH are computed from the velocities of line 21 (neither sees the
 //!   other's change). Default `ε = 0` (the paper uses it "optionally" and gives no value).
-//! - **Collision response** (line 14, Algorithm 1): each iteration, the corrected position
+//! - **Collision response** (line 14, Algorithm 1; the [`sph_solver::CollisionBoundary`]
+//!   that [`Pbf::new`] builds): each iteration, the corrected position
 //!   `x*_i + Δp_i` is tested against every solid in turn; where the signed distance `d` is
 //!   below the particle radius `r = s/2`, it is moved along the solid's SDF gradient
 //!   (normalised; analytic for the `sph_core` shapes, central differences otherwise) by
@@ -111,7 +113,7 @@
 //!
 //! [`PbfParams::validate`] rejects nonsense parameters by name. [`Pbf::step`] rejects
 //! non-finite positions or velocities and non-positive masses on entry (naming the particle),
-//! and reports divergence as [`PbfError::BlowUp`] instead of writing it: a non-finite
+//! and reports divergence as [`SolverError::BlowUp`] instead of writing it: a non-finite
 //! predicted position, final position or velocity, or a particle more than `h` inside any
 //! solid after the solve (e.g. outside the tank). The state then holds the last completed
 //! substep.
@@ -164,51 +166,30 @@
 //! 6.5× above that bound: they are compute-bound (about 28 cycles per pair evaluation), the
 //! positions of the neighbours being L2 hits after the cell reorder.
 
-mod error;
 mod params;
-mod pcisph;
+mod passes;
 mod scorr;
 mod solver;
 
-pub use error::PbfError;
 pub use params::{PbfParams, DEFAULT_RELATIVE_CFM, DEFAULT_SUPPORT_OVER_SPACING};
-pub use pcisph::{Pcisph, PcisphParams};
 pub use scorr::ArtificialPressure;
-pub use solver::{ConstraintEval, Pbf, PbfScratch, StepStats};
+pub use solver::{ConstraintEval, Pbf, PbfScratch, PBF_PHASES};
 
 pub use neighbour_search::Method;
 pub use sph_core::{ParticleSet, Real, Sdf, Vec3};
-
-/// The solids of a scene: signed distance fields, negative inside the solid (a tank is
-/// `sph_core::Inverted<sph_core::BoxSdf>`), resolved in order.
-pub type Solids<R> = Vec<Box<dyn Sdf<R>>>;
-
-/// A fluid solver advancing a [`ParticleSet`] by one frame per call: the object-safe common
-/// interface of [`Pbf`] and [`Pcisph`], for scene runners holding a `Box<dyn FluidSolver<R>>`.
-pub trait FluidSolver<R: Real>: Send {
-    /// Advances `state` by one frame ([`FluidSolver::frame_dt`]); see [`Pbf::step`] and
-    /// [`Pcisph::step`] for the errors and the meaning of the [`StepStats`] fields.
-    fn step(&mut self, state: &mut ParticleSet<R>) -> Result<StepStats, PbfError>;
-    /// Time advanced by one [`FluidSolver::step`] call (s): the parameters' `dt`.
-    fn frame_dt(&self) -> R;
-    /// Support radius `h` of the kernels (m).
-    fn support_radius(&self) -> R;
-    /// The permutation applied to the particles by the last step (`new[k] = old[perm[k]]`),
-    /// or `None` if it did not reorder.
-    fn last_permutation(&self) -> Option<&[u32]>;
-    /// Short name for reports: `"PBF"` or `"PCISPH"`.
-    fn name(&self) -> &'static str;
-}
+pub use sph_solver::{
+    Boundary, CollisionBoundary, CommonParams, FluidSolver, SolverError, Solids, StepStats,
+};
 
 impl<R: Real> FluidSolver<R> for Pbf<R> {
-    fn step(&mut self, state: &mut ParticleSet<R>) -> Result<StepStats, PbfError> {
+    fn step(&mut self, state: &mut ParticleSet<R>) -> Result<StepStats, SolverError> {
         Pbf::step(self, state)
     }
-    fn frame_dt(&self) -> R {
-        self.params().dt
+    fn common(&self) -> &CommonParams<R> {
+        &self.params().common
     }
-    fn support_radius(&self) -> R {
-        self.params().support_radius
+    fn boundary(&self) -> &dyn Boundary<R> {
+        Pbf::boundary(self)
     }
     fn last_permutation(&self) -> Option<&[u32]> {
         Pbf::last_permutation(self)
@@ -216,22 +197,7 @@ impl<R: Real> FluidSolver<R> for Pbf<R> {
     fn name(&self) -> &'static str {
         "PBF"
     }
-}
-
-impl<R: Real> FluidSolver<R> for Pcisph<R> {
-    fn step(&mut self, state: &mut ParticleSet<R>) -> Result<StepStats, PbfError> {
-        Pcisph::step(self, state)
-    }
-    fn frame_dt(&self) -> R {
-        self.params().dt
-    }
-    fn support_radius(&self) -> R {
-        self.params().support_radius
-    }
-    fn last_permutation(&self) -> Option<&[u32]> {
-        Pcisph::last_permutation(self)
-    }
-    fn name(&self) -> &'static str {
-        "PCISPH"
+    fn phase_names(&self) -> &'static [&'static str] {
+        PBF_PHASES
     }
 }

@@ -1,17 +1,9 @@
 //! Solver parameters, with the paper's values where it gives them.
 
-use neighbour_search::Method;
-use sph_core::{Real, Vec3};
-use sph_kernels::{Kernel, Spiky};
+use sph_core::Real;
+use sph_solver::{CommonParams, SolverError};
 
-use crate::PbfError;
-
-/// Ratio `h / s` of the support radius to the particle spacing used by
-/// [`PbfParams::for_spacing`]: `h = 2 s` (26 neighbours on a simple cubic lattice; the value of
-/// the workspace's SPlisHSPlasH anchor scene, `s = 0.025 m`, `h = 0.05 m`). The paper gives no
-/// ratio; it notes that with the artificial pressure term a particle does not need the
-/// "30–40 neighbours" of the SPH rule of thumb (§4).
-pub const DEFAULT_SUPPORT_OVER_SPACING: f64 = 2.0;
+pub use sph_solver::DEFAULT_SUPPORT_OVER_SPACING;
 
 /// CFM relaxation used by [`PbfParams::for_spacing`], relative to the constraint-gradient
 /// denominator of a particle at rest in a full lattice ([`PbfParams::reference_denominator`]):
@@ -27,11 +19,11 @@ pub const DEFAULT_RELATIVE_CFM: f64 = 1.0;
 ///
 /// | field | default | source |
 /// | --- | --- | --- |
-/// | `rest_density` | 1000 kg/m³ | water; the paper works with unit masses and gives no value |
-/// | `particle_spacing` | given (0.025 m for `Default`) | scene |
-/// | `support_radius` | `2 s` | [`DEFAULT_SUPPORT_OVER_SPACING`]; not given in the paper |
-/// | `dt` | 0.016 s | §8, Table 1: "a frame time of 16 ms is used in all cases" |
-/// | `substeps` | 4 | Table 1: Dam Break and Bunny Drop, 4 steps/frame |
+/// | `common.rest_density` | 1000 kg/m³ | water; the paper works with unit masses and gives no value |
+/// | `common.particle_spacing` | given (0.025 m for `Default`) | scene |
+/// | `common.support_radius` | `2 s` | [`DEFAULT_SUPPORT_OVER_SPACING`]; not given in the paper |
+/// | `common.dt` | 0.016 s | §8, Table 1: "a frame time of 16 ms is used in all cases" |
+/// | `common.substeps` | 4 | Table 1: Dam Break and Bunny Drop, 4 steps/frame |
 /// | `solver_iterations` | 4 | §8: "typically 2–4" (Table 1: 3 for the dam break, 10 for the bunny drop) |
 /// | `mean_compression_tolerance` | `None` (fixed iteration count, as the paper) | not in the paper; SPlisHSPlasH's stopping rule (`maxError`, e.g. 0.001 = 0.1 %) |
 /// | `min_solver_iterations` | 2 | SPlisHSPlasH's minimum (`minIterations`); only used with a tolerance |
@@ -42,25 +34,17 @@ pub const DEFAULT_RELATIVE_CFM: f64 = 1.0;
 /// | `scorr_delta_q` | 0.2 (× h) | §4, eq. 13: "\|Δq\| = 0.1h … 0.3h" (middle of the range) |
 /// | `vorticity_epsilon` | 0 m/s (off) | eq. 16; optional in the paper, no value given |
 /// | `xsph_c` | 0.01 | §5, eq. 17: "typically chosen to be 0.01" |
-/// | `gravity` | (0, −9.81, 0) m/s² | standard gravity along −y |
-/// | `reorder_every` | 10 | not in the paper (locality of the CPU loops) |
-/// | `neighbour_method` | [`Method::CellStartGrid`] | §8: "for neighbor finding we use the method of [Green 2008]"; also the workspace's fastest |
+/// | `common.gravity` | (0, −9.81, 0) m/s² | standard gravity along −y |
+/// | `common.reorder_every` | 10 | not in the paper (locality of the CPU loops) |
+/// | `common.neighbour_method` | `Method::CellStartGrid` | §8: "for neighbor finding we use the method of [Green 2008]"; also the workspace's fastest |
 #[derive(Debug, Clone, PartialEq)]
 pub struct PbfParams<R: Real> {
-    /// Rest density `ρ0` (kg/m³), eq. 1.
-    pub rest_density: R,
-    /// Particle spacing `s` (m) of the fluid's initial lattice: the particle mass is
-    /// `ρ0 s³` ([`PbfParams::particle_mass`], used by scenes to fill [`sph_core::ParticleSet`])
-    /// and the collision radius is `s / 2` ([`PbfParams::particle_radius`]).
-    pub particle_spacing: R,
-    /// Support radius `h` (m, absolute) of the Poly6 and Spiky kernels: `W = 0` for `r >= h`.
-    /// Must exceed `particle_spacing`.
-    pub support_radius: R,
-    /// Time advanced by one [`crate::Pbf::step`] call (s): a frame of `substeps` steps of
-    /// Algorithm 1, each of `Δt = dt / substeps`.
-    pub dt: R,
-    /// Steps of Algorithm 1 per [`crate::Pbf::step`] call (≥ 1).
-    pub substeps: usize,
+    /// The parameters every solver has: rest density `ρ0` (eq. 1), particle spacing `s`
+    /// (mass `ρ0 s³`, particle radius `s / 2`), support radius `h` of the Poly6 and Spiky
+    /// kernels, frame length `dt` (one [`crate::Pbf::step`] call: `substeps` steps of
+    /// Algorithm 1, each of `Δt = dt / substeps`), gravity (`f_ext` of line 2), reordering
+    /// and the neighbour method (found once per step at the predicted positions).
+    pub common: CommonParams<R>,
     /// Jacobi iterations of the constraint solve per step (Algorithm 1 `solverIterations`,
     /// ≥ 1); the maximum when `mean_compression_tolerance` is set.
     pub solver_iterations: usize,
@@ -104,14 +88,6 @@ pub struct PbfParams<R: Real> {
     pub vorticity_epsilon: R,
     /// XSPH viscosity `c` of eq. 17 (dimensionless, in [0, 1]; 0 disables it).
     pub xsph_c: R,
-    /// External acceleration `f_ext` of Algorithm 1 line 2 (m/s²).
-    pub gravity: Vec3<R>,
-    /// Reorder the particles by cell (neighbour-search [`neighbour_search::CellSorter`],
-    /// lexicographic order) at the start of every `reorder_every`-th [`crate::Pbf::step`]
-    /// call, starting with the first; 0 never reorders.
-    pub reorder_every: usize,
-    /// Neighbour search method (found once per step at the predicted positions).
-    pub neighbour_method: Method,
 }
 
 impl<R: Real> Default for PbfParams<R> {
@@ -121,23 +97,16 @@ impl<R: Real> Default for PbfParams<R> {
     }
 }
 
-fn invalid(name: &'static str, value: f64, reason: &'static str) -> PbfError {
-    PbfError::InvalidParameter {
+fn invalid(name: &'static str, value: f64, reason: &'static str) -> SolverError {
+    SolverError::InvalidParameter {
+        solver: "PBF",
         name,
         value,
         reason,
     }
 }
 
-fn positive<R: Real>(name: &'static str, v: R) -> Result<(), PbfError> {
-    if v.is_finite_value() && v > R::zero() {
-        Ok(())
-    } else {
-        Err(invalid(name, v.as_f64(), "must be finite and > 0"))
-    }
-}
-
-fn non_negative<R: Real>(name: &'static str, v: R) -> Result<(), PbfError> {
+fn non_negative<R: Real>(name: &'static str, v: R) -> Result<(), SolverError> {
     if v.is_finite_value() && v >= R::zero() {
         Ok(())
     } else {
@@ -150,13 +119,10 @@ impl<R: Real> PbfParams<R> {
     /// full-lattice denominator. Not validated here (a bad `s` is reported by
     /// [`PbfParams::validate`]).
     pub fn for_spacing(s: R) -> Self {
-        let h = s * R::of_f64(DEFAULT_SUPPORT_OVER_SPACING);
+        let mut common = CommonParams::for_spacing(s);
+        common.substeps = 4;
         let mut p = Self {
-            rest_density: R::of_f64(1000.0),
-            particle_spacing: s,
-            support_radius: h,
-            dt: R::of_f64(0.016),
-            substeps: 4,
+            common,
             solver_iterations: 4,
             mean_compression_tolerance: None,
             min_solver_iterations: 2,
@@ -167,9 +133,6 @@ impl<R: Real> PbfParams<R> {
             scorr_delta_q: R::of_f64(0.2),
             vorticity_epsilon: R::zero(),
             xsph_c: R::of_f64(0.01),
-            gravity: Vec3::new(R::zero(), R::of_f64(-9.81), R::zero()),
-            reorder_every: 10,
-            neighbour_method: Method::CellStartGrid,
         };
         if let Some(d) = p.reference_denominator() {
             p.cfm_epsilon = d * R::of_f64(DEFAULT_RELATIVE_CFM);
@@ -179,92 +142,49 @@ impl<R: Real> PbfParams<R> {
 
     /// Particle mass `ρ0 s³` (kg) of a fluid sampled on a simple cubic lattice of spacing `s`.
     pub fn particle_mass(&self) -> R {
-        let s = self.particle_spacing;
-        self.rest_density * s * s * s
+        self.common.particle_mass()
     }
 
-    /// Collision radius `s / 2` (m): particles are kept at least this far from every solid.
+    /// Collision radius `s / 2` (m): particles are kept at least this far from every solid
+    /// by the collision boundary.
     pub fn particle_radius(&self) -> R {
-        self.particle_spacing * R::of_f64(0.5)
+        self.common.particle_radius()
     }
 
     /// Length of one step of Algorithm 1, `Δt = dt / substeps` (s).
     pub fn substep_dt(&self) -> R {
-        self.dt / R::of_f64(self.substeps.max(1) as f64)
+        self.common.substep_dt()
     }
 
     /// The denominator `Σ_k |∇_{p_k} C_i|²` of eq. 9 (m⁻²) for a particle at rest inside a
     /// simple cubic lattice of spacing `s` with masses `ρ0 s³` (eq. 8 with Spiky gradients),
-    /// the scale against which `cfm_epsilon` is chosen. `None` if `s` or `h` are invalid.
-    /// For `h = 2 s` it is `0.37339 / s²`.
+    /// the scale against which `cfm_epsilon` is chosen
+    /// ([`CommonParams::reference_denominator`]). `None` if `s` or `h` are invalid. For
+    /// `h = 2 s` it is `0.37339 / s²`.
     pub fn reference_denominator(&self) -> Option<R> {
-        let (s, h) = (self.particle_spacing, self.support_radius);
-        if !(s.is_finite_value() && s > R::zero() && h.is_finite_value() && h > R::zero()) {
-            return None;
-        }
-        let spiky = Spiky::new(h).ok()?;
-        let reach = (h / s).as_f64().ceil();
-        if reach > 64.0 {
-            return None;
-        }
-        let reach = reach as i64;
-        // m / ρ0 = s³.
-        let vol = s * s * s;
-        let mut sum = R::zero();
-        let mut grad_i = Vec3::<R>::zeros();
-        for a in -reach..=reach {
-            for b in -reach..=reach {
-                for c in -reach..=reach {
-                    if (a, b, c) == (0, 0, 0) {
-                        continue;
-                    }
-                    let r = Vec3::new(
-                        R::of_f64(a as f64),
-                        R::of_f64(b as f64),
-                        R::of_f64(c as f64),
-                    ) * s;
-                    let g = spiky.gradient(&r) * vol;
-                    sum += g.norm_squared();
-                    grad_i += g;
-                }
-            }
-        }
-        Some(sum + grad_i.norm_squared())
+        self.common.reference_denominator()
     }
 
     /// The unit (m²) in which the dimensionless `s_corr` of eq. 13 is added to `λ_i + λ_j`
     /// in eq. 14: `1 / D_ref` with `D_ref` = [`PbfParams::reference_denominator`], i.e. the
     /// `λ` that corrects a unit density error of a particle in a full neighbourhood (see the
     /// crate documentation). Errors when `s` or `h` are invalid.
-    pub fn scorr_unit(&self) -> Result<R, PbfError> {
+    pub fn scorr_unit(&self) -> Result<R, SolverError> {
         match self.reference_denominator() {
             Some(d) if d.is_finite_value() && d > R::zero() && (R::one() / d).is_finite_value() => {
                 Ok(R::one() / d)
             }
             _ => Err(invalid(
                 "support_radius",
-                self.support_radius.as_f64(),
+                self.common.support_radius.as_f64(),
                 "no finite reference denominator for this spacing and support radius",
             )),
         }
     }
 
     /// Checks every field; the error names the first invalid one.
-    pub fn validate(&self) -> Result<(), PbfError> {
-        positive("rest_density", self.rest_density)?;
-        positive("particle_spacing", self.particle_spacing)?;
-        positive("support_radius", self.support_radius)?;
-        if self.support_radius <= self.particle_spacing {
-            return Err(invalid(
-                "support_radius",
-                self.support_radius.as_f64(),
-                "must exceed particle_spacing (no neighbours otherwise)",
-            ));
-        }
-        positive("dt", self.dt)?;
-        if self.substeps == 0 {
-            return Err(invalid("substeps", 0.0, "must be >= 1"));
-        }
+    pub fn validate(&self) -> Result<(), SolverError> {
+        self.common.validate("PBF")?;
         if self.solver_iterations == 0 {
             return Err(invalid("solver_iterations", 0.0, "must be >= 1"));
         }
@@ -286,7 +206,13 @@ impl<R: Real> PbfParams<R> {
                 ));
             }
         }
-        positive("cfm_epsilon", self.cfm_epsilon)?;
+        if !(self.cfm_epsilon.is_finite_value() && self.cfm_epsilon > R::zero()) {
+            return Err(invalid(
+                "cfm_epsilon",
+                self.cfm_epsilon.as_f64(),
+                "must be finite and > 0",
+            ));
+        }
         non_negative("scorr_k", self.scorr_k)?;
         if self.scorr_n == 0 {
             return Err(invalid("scorr_n", 0.0, "must be >= 1"));
@@ -304,36 +230,6 @@ impl<R: Real> PbfParams<R> {
         non_negative("vorticity_epsilon", self.vorticity_epsilon)?;
         if !(self.xsph_c.is_finite_value() && self.xsph_c >= R::zero() && self.xsph_c <= R::one()) {
             return Err(invalid("xsph_c", self.xsph_c.as_f64(), "must be in [0, 1]"));
-        }
-        if let Some(a) = (0..3).find(|&a| !self.gravity[a].is_finite_value()) {
-            return Err(invalid(
-                "gravity",
-                self.gravity[a].as_f64(),
-                "components must be finite",
-            ));
-        }
-        let dt_sub = self.substep_dt();
-        if !(dt_sub.is_finite_value() && dt_sub > R::zero()) {
-            return Err(invalid(
-                "substeps",
-                self.substeps as f64,
-                "dt / substeps underflows to zero",
-            ));
-        }
-        let m = self.particle_mass();
-        if !(m.is_finite_value() && m > R::zero()) {
-            return Err(invalid(
-                "particle_spacing",
-                self.particle_spacing.as_f64(),
-                "particle mass rest_density * spacing^3 is not representable",
-            ));
-        }
-        if (self.support_radius / self.particle_spacing).as_f64() > 64.0 {
-            return Err(invalid(
-                "support_radius",
-                self.support_radius.as_f64(),
-                "must be at most 64 particle spacings",
-            ));
         }
         self.scorr_unit()?;
         Ok(())

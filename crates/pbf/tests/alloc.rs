@@ -32,7 +32,7 @@ static GLOBAL: Counting = Counting;
 fn step_does_not_allocate_when_warm() {
     common::in_pool(2, || {
         let (mut p, mut state, solids) = common::dam_break::<f32>();
-        p.reorder_every = 3;
+        p.common.reorder_every = 3;
         let mut solver = Pbf::new(p, solids).unwrap();
         let start = ALLOCATIONS.load(Ordering::SeqCst);
         solver.step(&mut state).unwrap();

@@ -84,10 +84,10 @@ fn f32_and_f64_both_run() {
 #[test]
 fn reordering_is_a_permutation() {
     let (mut p, state0, solids) = common::dam_break::<f64>();
-    p.reorder_every = 0;
+    p.common.reorder_every = 0;
     let mut plain = Pbf::new(p.clone(), solids).unwrap();
     let (_, _, solids) = common::dam_break::<f64>();
-    p.reorder_every = 1;
+    p.common.reorder_every = 1;
     let mut sorted = Pbf::new(p, solids).unwrap();
     let (mut a, mut b) = (state0.clone(), state0.clone());
     plain.step(&mut a).unwrap();

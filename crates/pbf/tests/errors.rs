@@ -3,14 +3,14 @@
 
 mod common;
 
-use pbf::{Pbf, PbfError, PbfParams, Vec3};
+use pbf::{Pbf, SolverError, PbfParams, Vec3};
 use sph_core::CoreError;
 
 fn param_error(p: PbfParams<f64>) -> &'static str {
     let e = p.validate().unwrap_err();
     assert!(Pbf::new(p, vec![]).is_err());
     match e {
-        PbfError::InvalidParameter { name, .. } => name,
+        SolverError::InvalidParameter { name, .. } => name,
         other => panic!("unexpected {other:?}"),
     }
 }
@@ -21,27 +21,27 @@ fn invalid_parameters_are_named() {
     ok.validate().unwrap();
     type Setter = Box<dyn Fn(&mut PbfParams<f64>)>;
     let cases: Vec<(&str, Setter)> = vec![
-        ("support_radius", Box::new(|p| p.support_radius = 0.0)),
-        ("support_radius", Box::new(|p| p.support_radius = -0.05)),
-        ("support_radius", Box::new(|p| p.support_radius = f64::NAN)),
+        ("support_radius", Box::new(|p| p.common.support_radius = 0.0)),
+        ("support_radius", Box::new(|p| p.common.support_radius = -0.05)),
+        ("support_radius", Box::new(|p| p.common.support_radius = f64::NAN)),
         (
             "support_radius",
-            Box::new(|p| p.support_radius = p.particle_spacing),
+            Box::new(|p| p.common.support_radius = p.common.particle_spacing),
         ),
         (
             "support_radius",
-            Box::new(|p| p.support_radius = 100.0 * p.particle_spacing),
+            Box::new(|p| p.common.support_radius = 100.0 * p.common.particle_spacing),
         ),
-        ("dt", Box::new(|p| p.dt = 0.0)),
-        ("dt", Box::new(|p| p.dt = f64::NAN)),
-        ("dt", Box::new(|p| p.dt = f64::INFINITY)),
-        ("rest_density", Box::new(|p| p.rest_density = -1.0)),
+        ("dt", Box::new(|p| p.common.dt = 0.0)),
+        ("dt", Box::new(|p| p.common.dt = f64::NAN)),
+        ("dt", Box::new(|p| p.common.dt = f64::INFINITY)),
+        ("rest_density", Box::new(|p| p.common.rest_density = -1.0)),
         (
             "particle_spacing",
-            Box::new(|p| p.particle_spacing = f64::NAN),
+            Box::new(|p| p.common.particle_spacing = f64::NAN),
         ),
         ("solver_iterations", Box::new(|p| p.solver_iterations = 0)),
-        ("substeps", Box::new(|p| p.substeps = 0)),
+        ("substeps", Box::new(|p| p.common.substeps = 0)),
         ("cfm_epsilon", Box::new(|p| p.cfm_epsilon = 0.0)),
         ("scorr_k", Box::new(|p| p.scorr_k = -0.1)),
         ("scorr_n", Box::new(|p| p.scorr_n = 0)),
@@ -51,7 +51,7 @@ fn invalid_parameters_are_named() {
             Box::new(|p| p.vorticity_epsilon = f64::NAN),
         ),
         ("xsph_c", Box::new(|p| p.xsph_c = 1.5)),
-        ("gravity", Box::new(|p| p.gravity.y = f64::NEG_INFINITY)),
+        ("gravity", Box::new(|p| p.common.gravity.y = f64::NEG_INFINITY)),
         (
             "mean_compression_tolerance",
             Box::new(|p| p.mean_compression_tolerance = Some(0.0)),
@@ -81,7 +81,7 @@ fn invalid_parameters_are_named() {
         assert_eq!(param_error(p), name);
     }
     let mut p = ok.clone();
-    p.support_radius = -1.0;
+    p.common.support_radius = -1.0;
     let msg = p.validate().unwrap_err().to_string();
     assert!(
         msg.contains("support_radius") && msg.contains("-1"),
@@ -104,7 +104,7 @@ fn bad_velocity_mass_and_lengths_are_named() {
     s.velocities[11].x = f32::INFINITY;
     assert!(matches!(
         solver.step(&mut s),
-        Err(PbfError::InvalidState(CoreError::NonFiniteVelocity {
+        Err(SolverError::InvalidState(CoreError::NonFiniteVelocity {
             index: 11,
             ..
         }))
@@ -113,20 +113,20 @@ fn bad_velocity_mass_and_lengths_are_named() {
     s.masses[3] = 0.0;
     assert!(matches!(
         solver.step(&mut s),
-        Err(PbfError::InvalidMass { index: 3, .. })
+        Err(SolverError::InvalidMass { index: 3, .. })
     ));
     let mut s = state.clone();
     s.masses.pop();
     assert!(matches!(
         solver.step(&mut s),
-        Err(PbfError::InvalidState(CoreError::LengthMismatch { .. }))
+        Err(SolverError::InvalidState(CoreError::LengthMismatch { .. }))
     ));
     let e = solver
         .evaluate_constraints(&[Vec3::zeros(), Vec3::new(f32::NAN, 0.0, 0.0)], &[1.0, 1.0])
         .unwrap_err();
     assert!(matches!(
         e,
-        PbfError::InvalidState(CoreError::NonFinitePosition { index: 1, .. })
+        SolverError::InvalidState(CoreError::NonFinitePosition { index: 1, .. })
     ));
 }
 
@@ -138,11 +138,11 @@ fn huge_dt_is_a_blow_up_not_nan() {
     let (mut p, mut state, solids) = common::dam_break::<f32>();
     let mut solver = Pbf::new(p.clone(), solids).unwrap();
     solver.step(&mut state).unwrap();
-    p.dt = 1e20;
+    p.common.dt = 1e20;
     solver.set_params(p).unwrap();
     let before = common::bits(&state);
     match solver.step(&mut state) {
-        Err(PbfError::BlowUp {
+        Err(SolverError::BlowUp {
             step: 1, reason, ..
         }) => assert!(reason.contains("not finite"), "{reason}"),
         other => panic!("expected BlowUp, got {other:?}"),
@@ -156,10 +156,10 @@ fn huge_dt_is_a_blow_up_not_nan() {
 
     // f64, from the start: dt = 1e160 s.
     let (mut p, mut state, solids) = common::dam_break::<f64>();
-    p.dt = 1e160;
+    p.common.dt = 1e160;
     let mut solver = Pbf::new(p, solids).unwrap();
     let e = solver.step(&mut state).unwrap_err();
-    assert!(matches!(e, PbfError::BlowUp { step: 0, .. }), "{e:?}");
+    assert!(matches!(e, SolverError::BlowUp { step: 0, .. }), "{e:?}");
     assert!(e.to_string().contains("blow-up in step 0"), "{e}");
     assert!(state
         .positions
@@ -173,7 +173,7 @@ fn huge_dt_is_a_blow_up_not_nan() {
 fn particle_deep_inside_a_solid_is_a_blow_up() {
     use sph_core::{Aabb, BoxSdf, Inverted, Plane};
     let (p, mut state, mut solids) = common::dam_break::<f64>();
-    let h = p.support_radius;
+    let h = p.common.support_radius;
     // A floor at y = 0.3 m (free above), resolved first, and, resolved last, a second tank
     // whose top is at y = 2 h = 0.1 m (free below): no position satisfies both, and the
     // last projection leaves every particle about 0.2 m (> h) inside the floor.
@@ -186,7 +186,7 @@ fn particle_deep_inside_a_solid_is_a_blow_up() {
     let mut solver = Pbf::new(p, solids).unwrap();
     let e = solver.step(&mut state).unwrap_err();
     match &e {
-        PbfError::BlowUp { reason, .. } => assert!(reason.contains("inside solid"), "{reason}"),
+        SolverError::BlowUp { reason, .. } => assert!(reason.contains("inside solid"), "{reason}"),
         other => panic!("{other:?}"),
     }
 }

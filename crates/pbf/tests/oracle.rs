@@ -48,13 +48,13 @@ struct Oracle {
 impl Oracle {
     fn new(p: &PbfParams<f64>) -> Self {
         Self {
-            h: p.support_radius,
-            rho0: p.rest_density,
+            h: p.common.support_radius,
+            rho0: p.common.rest_density,
             eps: p.cfm_epsilon,
             k: p.scorr_k,
             n: p.scorr_n as i32,
-            dq: p.scorr_delta_q * p.support_radius,
-            scorr_unit: 1.0 / lattice_denominator(p.particle_spacing, p.support_radius),
+            dq: p.scorr_delta_q * p.common.support_radius,
+            scorr_unit: 1.0 / lattice_denominator(p.common.particle_spacing, p.common.support_radius),
         }
     }
 
@@ -172,7 +172,7 @@ fn case() -> impl Strategy<Value = Case> {
 
 fn params(c: &Case) -> PbfParams<f64> {
     let mut p = PbfParams::<f64>::for_spacing(c.h / c.ratio);
-    p.support_radius = c.h;
+    p.common.support_radius = c.h;
     p.cfm_epsilon = c.eps_rel * p.reference_denominator().unwrap();
     p.scorr_k = c.k;
     p.scorr_n = c.n;
@@ -205,7 +205,7 @@ proptest! {
         let lam_scale = lambda.iter().fold(0.0f64, |a, &l| a.max(l.abs()));
         let dp_scale = dp.iter().fold(0.0f64, |a, d| a.max(norm(*d)));
         for i in 0..x.len() {
-            prop_assert!(close(ev.density[i], rho[i], 1e-12 * p.rest_density),
+            prop_assert!(close(ev.density[i], rho[i], 1e-12 * p.common.rest_density),
                 "rho {i}: {} vs {}", ev.density[i], rho[i]);
             prop_assert!(close(ev.lambda[i], lambda[i], 1e-10 * lam_scale + 1e-300),
                 "lambda {i}: {} vs {}", ev.lambda[i], lambda[i]);
@@ -232,7 +232,7 @@ proptest! {
         let lam_scale = lambda.iter().fold(0.0f64, |a, &l| a.max(l.abs()));
         let dp_scale = dp.iter().fold(0.0f64, |a, d| a.max(norm(*d)));
         for i in 0..x.len() {
-            prop_assert!(close(ev.density[i], rho[i], 1e-12 * p.rest_density));
+            prop_assert!(close(ev.density[i], rho[i], 1e-12 * p.common.rest_density));
             prop_assert!(close(ev.lambda[i], lambda[i], 1e-10 * lam_scale + 1e-300));
             prop_assert!(norm(sub(to_v(&ev.delta_p[i]), dp[i])) <= 1e-10 * dp_scale + 1e-300);
         }
@@ -254,10 +254,10 @@ proptest! {
         let ev = solver.evaluate_constraints(&pts, &masses).unwrap();
         let lam_scale = lambda.iter().fold(0.0f64, |a, &l| a.max(l.abs()));
         for i in 0..x.len() {
-            if (rho[i] / p.rest_density - 1.0).abs() < 1e-12 {
+            if (rho[i] / p.common.rest_density - 1.0).abs() < 1e-12 {
                 continue; // the sign is not decided at round-off
             }
-            let expected = if rho[i] > p.rest_density { lambda[i] } else { 0.0 };
+            let expected = if rho[i] > p.common.rest_density { lambda[i] } else { 0.0 };
             prop_assert!(close(ev.lambda[i], expected, 1e-10 * lam_scale + 1e-300),
                 "lambda {i}: {} vs {expected} (rho {})", ev.lambda[i], rho[i]);
         }
@@ -270,12 +270,12 @@ proptest! {
     fn full_step(c in case(), iters in 1usize..4, vort in 0.0..0.5f64, xsph in 0.0..0.2f64,
                  vel in proptest::collection::vec([-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64], 48)) {
         let mut p = params(&c);
-        p.substeps = 1;
-        p.dt = 0.004;
+        p.common.substeps = 1;
+        p.common.dt = 0.004;
         p.solver_iterations = iters;
         p.vorticity_epsilon = vorticity_scale(vort);
         p.xsph_c = xsph;
-        p.reorder_every = 0;
+        p.common.reorder_every = 0;
         let n = c.points.len();
         let masses: Vec<f64> = c.mass_factors.iter().map(|f| f * p.particle_mass()).collect();
         let v0: Vec<V> = vel[..n].to_vec();
@@ -294,8 +294,8 @@ proptest! {
 
         // Oracle: Algorithm 1.
         let o = Oracle::new(&p);
-        let dt = p.dt;
-        let g = to_v(&p.gravity);
+        let dt = p.common.dt;
+        let g = to_v(&p.common.gravity);
         let x0 = c.points.clone();
         let mut xs: Vec<V> = (0..n).map(|i| add(x0[i], scale(add(v0[i], scale(g, dt)), dt))).collect();
         let nb = o.neighbours(&xs);
@@ -312,7 +312,7 @@ proptest! {
                 .collect();
         }
         let v: Vec<V> = (0..n).map(|i| scale(sub(xs[i], x0[i]), 1.0 / dt)).collect();
-        let vol: Vec<f64> = masses.iter().map(|m| m / p.rest_density).collect();
+        let vol: Vec<f64> = masses.iter().map(|m| m / p.common.rest_density).collect();
         let mut omega = vec![[0.0; 3]; n];
         let mut rho = vec![0.0; n];
         for i in 0..n {
@@ -353,7 +353,7 @@ proptest! {
                 "x {i}: {:?} vs {:?}", state.positions[i], xs[i]);
             prop_assert!(norm(sub(to_v(&state.velocities[i]), v_new[i])) <= 1e-8 * v_scale,
                 "v {i}: {:?} vs {:?}", state.velocities[i], v_new[i]);
-            prop_assert!(close(state.densities[i], rho[i], 1e-10 * p.rest_density));
+            prop_assert!(close(state.densities[i], rho[i], 1e-10 * p.common.rest_density));
         }
     }
 }
@@ -369,7 +369,7 @@ fn vorticity_scale(x: f64) -> f64 {
 fn two_particles_by_hand() {
     let mut p = PbfParams::<f64>::for_spacing(0.025);
     p.scorr_k = 0.0;
-    let h = p.support_radius;
+    let h = p.common.support_radius;
     let m = p.particle_mass();
     let pts = vec![Vec3::zeros(), Vec3::new(0.5 * h, 0.0, 0.0)];
     let mut solver = Pbf::new(p.clone(), vec![]).unwrap();
@@ -379,8 +379,8 @@ fn two_particles_by_hand() {
     let rho = m * (w(0.0) + w(0.5));
     assert!((ev.density[0] - rho).abs() < 1e-12 * rho);
     // |∇W(h/2)| = 45/(π h⁶)(h/2)², both gradient terms have that length times m/ρ0.
-    let g = m / p.rest_density * 45.0 / (PI * h.powi(6)) * (0.5 * h).powi(2);
-    let lambda = -(rho / p.rest_density - 1.0) / (2.0 * g * g + p.cfm_epsilon);
+    let g = m / p.common.rest_density * 45.0 / (PI * h.powi(6)) * (0.5 * h).powi(2);
+    let lambda = -(rho / p.common.rest_density - 1.0) / (2.0 * g * g + p.cfm_epsilon);
     assert!((ev.lambda[0] - lambda).abs() < 1e-12 * lambda.abs());
     // Δp_0 = (m/ρ0)(λ0 + λ1) ∇W(x0 − x1); ∇W(x0 − x1) points from x0 to x1 (+x), so an
     // under-dense pair (λ > 0) attracts.

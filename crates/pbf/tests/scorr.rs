@@ -40,7 +40,7 @@ fn scorr_value_at_half_h() {
 fn scorr_in_position_update() {
     let s = 0.025;
     let mut p = PbfParams::<f64>::for_spacing(s);
-    let h = p.support_radius;
+    let h = p.common.support_radius;
     assert!((p.reference_denominator().unwrap() * s * s - 0.3733944911767979).abs() < 1e-12);
     let m = p.particle_mass();
     let pts = vec![Vec3::zeros(), Vec3::new(0.5 * h, 0.0, 0.0)];
@@ -52,7 +52,7 @@ fn scorr_in_position_update() {
     }
     let grad = 45.0 / (PI * h.powi(6)) * (0.5 * h).powi(2); // |∇W(h/2)|, pointing to +x
     let scorr = -0.0051698788284564225;
-    let expected = m / p.rest_density * scorr * (s * s / 0.3733944911767979) * grad;
+    let expected = m / p.common.rest_density * scorr * (s * s / 0.3733944911767979) * grad;
     assert!(expected < 0.0);
     assert!(
         ((dp[1] - dp[0]) - expected).abs() < 1e-9 * expected.abs(),

@@ -17,7 +17,7 @@ fn settle<R: Real>() {
     let (mut state, solids, tank) = common::block_in_tank(&p, [10, 10, 10], [10.0, 20.0, 10.0]);
     let n = state.len();
     let mass0: f64 = state.masses.iter().map(|m| m.as_f64()).sum();
-    let s = p.particle_spacing.as_f64();
+    let s = p.common.particle_spacing.as_f64();
     let r = p.particle_radius();
     let tank_sdf = Inverted(BoxSdf::new(tank).unwrap());
     let mut solver = Pbf::new(p.clone(), solids).unwrap();

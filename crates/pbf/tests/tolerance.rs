@@ -13,7 +13,7 @@ use sph_kernels::{Kernel, Poly6};
 /// Mean compression `(1/N) Σ max(ρ_i/ρ0 − 1, 0)` at positions `x`, with the neighbour lists
 /// `nb` (CSR of the step), in f64 and in particle order.
 fn mean_compression(p: &PbfParams<f64>, x: &[Vec3<f64>], m: &[f64], solver: &Pbf<f64>) -> f64 {
-    let poly6 = Poly6::new(p.support_radius).unwrap();
+    let poly6 = Poly6::new(p.common.support_radius).unwrap();
     let nb = solver.neighbours();
     let mut sum = 0.0;
     for i in 0..x.len() {
@@ -21,7 +21,7 @@ fn mean_compression(p: &PbfParams<f64>, x: &[Vec3<f64>], m: &[f64], solver: &Pbf
         for &j in nb.neighbours(i) {
             rho += m[j as usize] * poly6.value((x[i] - x[j as usize]).norm());
         }
-        sum += (rho / p.rest_density - 1.0).max(0.0);
+        sum += (rho / p.common.rest_density - 1.0).max(0.0);
     }
     sum / x.len() as f64
 }
@@ -49,8 +49,8 @@ fn fixed_step(
 fn check_run(tol: f64, min: usize, max: usize, frames: usize) -> Vec<usize> {
     let (mut p, mut state, _) = common::dam_break::<f64>();
     let solids_of = || common::dam_break::<f64>().2;
-    p.substeps = 1;
-    p.reorder_every = 0;
+    p.common.substeps = 1;
+    p.common.reorder_every = 0;
     p.mean_compression_tolerance = Some(tol);
     p.min_solver_iterations = min;
     p.solver_iterations = max;
@@ -69,7 +69,7 @@ fn check_run(tol: f64, min: usize, max: usize, frames: usize) -> Vec<usize> {
 
         // Compression at the start of iteration j: at the predicted positions for j = 1,
         // after j − 1 fixed iterations otherwise (a step's final positions are x*).
-        let g = p.gravity;
+        let g = p.common.gravity;
         let dt = p.substep_dt();
         let predicted: Vec<Vec3<f64>> = before
             .positions
@@ -137,8 +137,8 @@ fn unreachable_tolerance_runs_the_maximum_and_counts_it() {
     let mut solver = Pbf::new(p.clone(), solids).unwrap();
     for _ in 0..3 {
         let s = solver.step(&mut state).unwrap();
-        assert_eq!(s.iterations, p.substeps * 3);
-        assert_eq!(s.unconverged_substeps, p.substeps);
+        assert_eq!(s.iterations, p.common.substeps * 3);
+        assert_eq!(s.unconverged_substeps, p.common.substeps);
         assert!(s.last_solve_error > 0.0);
     }
 }
@@ -151,7 +151,7 @@ fn loose_tolerance_runs_the_minimum() {
     p.solver_iterations = 50;
     let mut solver = Pbf::new(p.clone(), solids).unwrap();
     let s = solver.step(&mut state).unwrap();
-    assert_eq!(s.iterations, p.substeps * 2);
+    assert_eq!(s.iterations, p.common.substeps * 2);
     assert_eq!(s.unconverged_substeps, 0);
 }
 

@@ -1,81 +1,32 @@
 //! Scenes, oracle formulas and helpers shared by the integration tests.
 #![allow(dead_code)]
 
-pub mod formulas;
+#[allow(unused_imports)]
+pub use sph_solver::testing::{assert_nan_position_rejected, bits, formulas, in_pool};
 
-use pbf::{FluidSolver, ParticleSet, PbfError, PbfParams, Real, Solids, Vec3};
-use sph_core::{sampling::cubic_lattice, Aabb, BoxSdf, CoreError, Inverted};
+use pbf::{CommonParams, ParticleSet, PbfParams, Real, Solids};
+use sph_core::Aabb;
 
-/// A fluid block of `n = [nx, ny, nz]` particles at spacing `s`, at rest in the corner
-/// `(0, 0, 0)` of a tank of `tank = [tx, ty, tz]` spacings (an `Inverted<BoxSdf>`), with
-/// masses `ρ0 s³`. The particles start `s/2` from the walls, i.e. touching them.
+/// [`sph_solver::testing::block_in_tank`] with PBF's parameters.
 pub fn block_in_tank<R: Real>(
     params: &PbfParams<R>,
     n: [usize; 3],
     tank: [f64; 3],
 ) -> (ParticleSet<R>, Solids<R>, Aabb<R>) {
-    let s = params.particle_spacing;
-    let v = |a: [f64; 3]| Vec3::new(R::of_f64(a[0]), R::of_f64(a[1]), R::of_f64(a[2])) * s;
-    let block = Aabb::new(Vec3::zeros(), v([n[0] as f64, n[1] as f64, n[2] as f64])).unwrap();
-    let tank = Aabb::new(Vec3::zeros(), v(tank)).unwrap();
-    let pts = cubic_lattice(&block, s, 1 << 20).unwrap();
-    assert_eq!(pts.len(), n[0] * n[1] * n[2]);
-    let state = ParticleSet::from_positions(pts, params.particle_mass(), params.rest_density);
-    let solids: Solids<R> = vec![Box::new(Inverted(BoxSdf::new(tank).unwrap()))];
-    (state, solids, tank)
+    sph_solver::testing::block_in_tank(&params.common, n, tank)
 }
 
 /// A small dam break: a block of 8 × 12 × 6 particles in the corner of a tank of
 /// 24 × 16 × 6 spacings, with vorticity confinement on (so every code path runs).
 pub fn dam_break<R: Real>() -> (PbfParams<R>, ParticleSet<R>, Solids<R>) {
-    let p = PbfParams::<R> {
+    let mut p = PbfParams::<R> {
         vorticity_epsilon: R::of_f64(0.05),
-        reorder_every: 5,
         ..Default::default()
+    };
+    p.common = CommonParams {
+        reorder_every: 5,
+        ..p.common
     };
     let (state, solids, _) = block_in_tank(&p, [8, 12, 6], [24.0, 16.0, 6.0]);
     (p, state, solids)
-}
-
-/// Bit patterns of positions and velocities, for exact comparisons.
-pub fn bits<R: Real>(state: &ParticleSet<R>) -> Vec<u64> {
-    state
-        .positions
-        .iter()
-        .chain(&state.velocities)
-        .flat_map(|v| v.iter().map(|c| c.as_f64().to_bits()).collect::<Vec<_>>())
-        .collect()
-}
-
-/// Runs `f` in a rayon pool of `threads` threads.
-pub fn in_pool<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .unwrap()
-        .install(f)
-}
-
-/// Steps `solver` on `state` with particle 7's `y` set to NaN: the error must name particle 7
-/// and axis `y`, and the state must be left untouched.
-pub fn assert_nan_position_rejected(
-    solver: &mut dyn FluidSolver<f64>,
-    mut state: ParticleSet<f64>,
-) {
-    state.positions[7].y = f64::NAN;
-    let before = bits(&state);
-    let e = solver.step(&mut state).unwrap_err();
-    assert!(
-        matches!(
-            e,
-            PbfError::InvalidState(CoreError::NonFinitePosition {
-                index: 7,
-                axis: 'y',
-                ..
-            })
-        ),
-        "{e:?}"
-    );
-    assert!(e.to_string().contains("particle 7"), "{e}");
-    assert_eq!(bits(&state), before, "state untouched");
 }

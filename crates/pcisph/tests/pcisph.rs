@@ -4,19 +4,19 @@
 //! determinism across thread counts, no allocation in a warm step, errors, and an unstable
 //! setup failing cleanly.
 
-mod common;
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
-use common::formulas::{add, dot, norm, poly6, scale, spiky_grad, sub, to_v, V};
+use sph_solver::testing::formulas::{add, dot, norm, poly6, scale, spiky_grad, sub, to_v, V};
+use sph_solver::testing as common;
 
-use pbf::{
-    FluidSolver, ParticleSet, Pbf, PbfError, PbfParams, Pcisph, PcisphParams, Real, Sdf, Solids,
-    StepStats, Vec3,
+use pcisph::{
+    CommonParams, FluidSolver, ParticleSet, Pcisph, PcisphParams, Real, SolverError, Solids, StepStats, Vec3,
 };
+use sph_core::Sdf;
 use proptest::prelude::*;
 use sph_core::{sampling::cubic_lattice, Aabb, BoxSdf, Inverted, Plane};
 
@@ -92,9 +92,7 @@ fn block<R: Real>(
     n: [usize; 3],
     tank: [f64; 3],
 ) -> (ParticleSet<R>, Solids<R>, Aabb<R>) {
-    let mut shape = PbfParams::<R>::for_spacing(p.particle_spacing);
-    shape.rest_density = p.rest_density;
-    common::block_in_tank(&shape, n, tank)
+    common::block_in_tank(&p.common, n, tank)
 }
 
 // ---------------------------------------------------------------------------------------
@@ -113,12 +111,13 @@ fn delta_equals_direct_eq8() {
         (0.003, 3.2, 1200.0, 0.001, 2),
         (0.05, 4.0, 998.0, 0.016, 7),
     ] {
-        let p = PcisphParams::<f64> {
+        let mut p = PcisphParams::<f64>::for_spacing(s);
+        p.common = CommonParams {
             support_radius: ratio * s,
             rest_density: rho0,
             dt,
             substeps,
-            ..PcisphParams::for_spacing(s)
+            ..p.common
         };
         let oracle = delta_eq8(s, ratio * s, rho0, dt / substeps as f64);
         let got = p.scaling_factor().unwrap();
@@ -183,12 +182,12 @@ fn oracle_step(
 ) -> (Vec<V>, Vec<V>, Vec<f64>) {
     let n = x0.len();
     let (h, rho0, dt, r) = (
-        p.support_radius,
-        p.rest_density,
-        p.dt / p.substeps as f64,
+        p.common.support_radius,
+        p.common.rest_density,
+        p.common.dt / p.common.substeps as f64,
         p.particle_radius(),
     );
-    let g = to_v(&p.gravity);
+    let g = to_v(&p.common.gravity);
     let nb: Vec<Vec<usize>> = (0..n)
         .map(|i| {
             (0..n)
@@ -257,15 +256,18 @@ proptest! {
     fn one_step_matches_naive_oracle(c in case(), iters in 1usize..6, xsph in 0.0..0.2f64,
                                      clamp in any::<bool>(), dt in 0.001..0.01f64) {
         let s = c.h / c.ratio;
-        let p = PcisphParams::<f64> {
-            support_radius: c.h,
-            dt,
-            substeps: 1,
+        let mut p = PcisphParams::<f64> {
             pressure_iterations: iters,
             xsph_c: xsph,
             clamp_negative_pressure: clamp,
-            reorder_every: 0,
             ..PcisphParams::for_spacing(s)
+        };
+        p.common = CommonParams {
+            support_radius: c.h,
+            dt,
+            substeps: 1,
+            reorder_every: 0,
+            ..p.common
         };
         let n = c.points.len();
         let m: Vec<f64> = c.mass_factors.iter().map(|f| f * p.particle_mass()).collect();
@@ -277,7 +279,7 @@ proptest! {
             Box::new(Plane::new(Vec3::zeros(), Vec3::new(0.0, 1.0, 0.0)).unwrap());
         let mut solver = Pcisph::new(p.clone(), vec![floor]).unwrap();
         let result = solver.step(&mut state);
-        let delta = delta_eq8(s, c.h, p.rest_density, dt);
+        let delta = delta_eq8(s, c.h, p.common.rest_density, dt);
         let (xs, v, rho) = oracle_step(&c.points, &c.velocities, &m, &p, delta, iters);
 
         let st = result.unwrap();
@@ -285,7 +287,7 @@ proptest! {
         prop_assert_eq!(st.substeps, 1);
         let x_scale = xs.iter().fold(10.0 * c.h, |a, w| a.max(norm(*w)));
         let v_scale = v.iter().fold(1.0f64, |a, w| a.max(norm(*w)));
-        let rho_scale = rho.iter().fold(p.rest_density, |a, &r| a.max(r));
+        let rho_scale = rho.iter().fold(p.common.rest_density, |a, &r| a.max(r));
         for i in 0..n {
             prop_assert!(norm(sub(to_v(&state.positions[i]), xs[i])) <= 1e-9 * x_scale,
                 "x {}: {:?} vs {:?}", i, state.positions[i], xs[i]);
@@ -338,7 +340,7 @@ fn settle<R: Real>(xsph_c: f64) -> (StepStats, f64, f64) {
             );
         }
     }
-    let s = p.particle_spacing.as_f64();
+    let s = p.common.particle_spacing.as_f64();
     let top = state
         .positions
         .iter()
@@ -461,13 +463,13 @@ fn unclamped_block_clumps() {
 /// A small dam break (8 × 12 × 6 particles in a tank of 24 × 16 × 6 spacings), clamped
 /// pressures when an early-stop tolerance is given.
 fn dam_break(tol: Option<f64>) -> (PcisphParams<f64>, ParticleSet<f64>, Solids<f64>) {
-    let p = PcisphParams::<f64> {
-        reorder_every: 3,
+    let mut p = PcisphParams::<f64> {
         clamp_negative_pressure: tol.is_some(),
         density_error_tolerance: tol,
         pressure_iterations: if tol.is_some() { 8 } else { 4 },
         ..Default::default()
     };
+    p.common.reorder_every = 3;
     let (state, solids, _) = block(&p, [8, 12, 6], [24.0, 16.0, 6.0]);
     (p, state, solids)
 }
@@ -509,10 +511,10 @@ fn thread_count_does_not_change_results() {
 #[test]
 fn reordering_is_a_permutation() {
     let (mut p, state0, solids) = dam_break(Some(0.01));
-    p.reorder_every = 0;
+    p.common.reorder_every = 0;
     let mut plain = Pcisph::new(p.clone(), solids).unwrap();
     let (_, _, solids) = dam_break(Some(0.01));
-    p.reorder_every = 1;
+    p.common.reorder_every = 1;
     let mut sorted = Pcisph::new(p, solids).unwrap();
     let (mut a, mut b) = (state0.clone(), state0);
     plain.step(&mut a).unwrap();
@@ -583,26 +585,26 @@ fn invalid_parameters_are_named() {
             "density_error_tolerance",
             Box::new(|p| p.density_error_tolerance = Some(f64::NAN)),
         ),
-        ("substeps", Box::new(|p| p.substeps = 0)),
-        ("dt", Box::new(|p| p.dt = f64::NAN)),
-        ("dt", Box::new(|p| p.dt = -0.01)),
-        ("rest_density", Box::new(|p| p.rest_density = 0.0)),
+        ("substeps", Box::new(|p| p.common.substeps = 0)),
+        ("dt", Box::new(|p| p.common.dt = f64::NAN)),
+        ("dt", Box::new(|p| p.common.dt = -0.01)),
+        ("rest_density", Box::new(|p| p.common.rest_density = 0.0)),
         (
             "particle_spacing",
-            Box::new(|p| p.particle_spacing = f64::INFINITY),
+            Box::new(|p| p.common.particle_spacing = f64::INFINITY),
         ),
-        ("support_radius", Box::new(|p| p.support_radius = 0.02)),
-        ("support_radius", Box::new(|p| p.support_radius = f64::NAN)),
+        ("support_radius", Box::new(|p| p.common.support_radius = 0.02)),
+        ("support_radius", Box::new(|p| p.common.support_radius = f64::NAN)),
         ("xsph_c", Box::new(|p| p.xsph_c = 1.5)),
         ("xsph_c", Box::new(|p| p.xsph_c = -0.1)),
-        ("gravity", Box::new(|p| p.gravity.x = f64::NAN)),
+        ("gravity", Box::new(|p| p.common.gravity.x = f64::NAN)),
     ];
     for (name, set) in cases {
         let mut p = ok.clone();
         set(&mut p);
         let e = p.validate().unwrap_err();
         assert!(
-            matches!(e, PbfError::InvalidParameter { name: n, .. } if n == name),
+            matches!(e, SolverError::InvalidParameter { name: n, .. } if n == name),
             "expected {name}, got {e:?}"
         );
         assert!(Pcisph::new(p, vec![]).is_err());
@@ -618,7 +620,7 @@ fn nan_position_names_the_particle() {
     s.masses[3] = -1.0;
     assert!(matches!(
         solver.step(&mut s),
-        Err(PbfError::InvalidMass { index: 3, .. })
+        Err(SolverError::InvalidMass { index: 3, .. })
     ));
 }
 
@@ -632,11 +634,9 @@ fn nan_position_names_the_particle() {
 /// density error.
 #[test]
 fn one_substep_per_frame_fails_cleanly() {
-    let p = PcisphParams::<f64> {
-        substeps: 1,
-        ..Default::default()
-    };
-    let s = p.particle_spacing;
+    let mut p = PcisphParams::<f64>::default();
+    p.common.substeps = 1;
+    let s = p.common.particle_spacing;
     let block_box = Aabb::new(
         Vec3::new(2.0, 10.0, 2.0) * s,
         Vec3::new(12.0, 20.0, 12.0) * s,
@@ -644,7 +644,7 @@ fn one_substep_per_frame_fails_cleanly() {
     .unwrap();
     let tank = Aabb::new(Vec3::zeros(), Vec3::new(16.0, 32.0, 16.0) * s).unwrap();
     let pts = cubic_lattice(&block_box, s, 1 << 20).unwrap();
-    let mut state = ParticleSet::from_positions(pts, p.particle_mass(), p.rest_density);
+    let mut state = ParticleSet::from_positions(pts, p.particle_mass(), p.common.rest_density);
     let solids: Solids<f64> = vec![Box::new(Inverted(BoxSdf::new(tank).unwrap()))];
     let mut solver = Pcisph::new(p, solids).unwrap();
     let mut worst: f64 = 0.0;
@@ -654,7 +654,7 @@ fn one_substep_per_frame_fails_cleanly() {
         match solver.step(&mut state) {
             Ok(st) => worst = worst.max(st.max_density_ratio),
             Err(e) => {
-                assert!(matches!(e, PbfError::BlowUp { .. }), "{e:?}");
+                assert!(matches!(e, SolverError::BlowUp { .. }), "{e:?}");
                 assert_eq!(common::bits(&state), before, "state of the last substep");
                 outcome = Some((frame, e));
                 break;
@@ -682,23 +682,20 @@ fn one_substep_per_frame_fails_cleanly() {
 // ---------------------------------------------------------------------------------------
 // The common interface.
 
-/// `Box<dyn FluidSolver>` drives both solvers; PCISPH and PBF run the same resting block to
-/// similar densities.
+/// `Box<dyn FluidSolver>` drives PCISPH: the trait's accessors and a resting block held to
+/// a bounded density.
 #[test]
-fn both_solvers_behind_the_trait() {
+fn behind_the_trait() {
     let pp = PcisphParams::<f64> {
         clamp_negative_pressure: true,
         ..Default::default()
     };
     let (state0, solids_a, _) = block(&pp, [6, 6, 6], [6.0, 12.0, 6.0]);
-    let (_, solids_b, _) = block(&pp, [6, 6, 6], [6.0, 12.0, 6.0]);
-    let solvers: Vec<Box<dyn FluidSolver<f64>>> = vec![
-        Box::new(Pcisph::new(pp.clone(), solids_a).unwrap()),
-        Box::new(Pbf::new(PbfParams::default(), solids_b).unwrap()),
-    ];
+    let solvers: Vec<Box<dyn FluidSolver<f64>>> =
+        vec![Box::new(Pcisph::new(pp.clone(), solids_a).unwrap())];
     for mut solver in solvers {
         assert_eq!(solver.frame_dt(), 0.016);
-        assert_eq!(solver.support_radius(), 0.05);
+        assert_eq!(solver.common().support_radius, 0.05);
         let mut state = state0.clone();
         let mut st = StepStats::default();
         for _ in 0..10 {

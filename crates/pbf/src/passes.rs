@@ -1,0 +1,282 @@
+//! The two passes of one Jacobi iteration (Algorithm 1 lines 9–13) and their per-pair cache.
+
+use neighbour_search::NeighbourLists;
+use rayon::prelude::*;
+use sph_core::{Real, Vec3};
+use sph_kernels::{Kernel, Poly6, Spiky};
+use sph_solver::step::MIN_LEN;
+use sph_solver::{Boundary, SolverError};
+
+use crate::{ArtificialPressure, PbfParams};
+
+/// Kernels and constants shared by the per-particle loops.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Consts<R: Real> {
+    pub poly6: Poly6<R>,
+    pub spiky: Spiky<R>,
+    /// `W(0)` of Poly6: the self term of the density sum.
+    pub w0: R,
+    pub scorr: ArtificialPressure<R>,
+    pub scorr_on: bool,
+    /// `1 / D_ref` (m²): the unit in which `s_corr` is added to `λ_i + λ_j`.
+    pub scorr_unit: R,
+    pub rho0: R,
+    pub inv_rho0: R,
+    pub eps: R,
+    /// [`PbfParams::clamp_negative_constraint`].
+    pub unilateral: bool,
+    /// Support radius `h` (m).
+    pub h: R,
+}
+
+impl<R: Real> Consts<R> {
+    pub(crate) fn new(p: &PbfParams<R>) -> Result<Self, SolverError> {
+        let h = p.common.support_radius;
+        let poly6 = Poly6::new(h)?;
+        Ok(Self {
+            poly6,
+            spiky: Spiky::new(h)?,
+            w0: poly6.value_r2(R::zero()),
+            scorr: ArtificialPressure::new(h, p.scorr_k, p.scorr_n, p.scorr_delta_q)?,
+            scorr_on: p.scorr_k > R::zero(),
+            scorr_unit: p.scorr_unit()?,
+            rho0: p.common.rest_density,
+            inv_rho0: R::one() / p.common.rest_density,
+            eps: p.cfm_epsilon,
+            unilateral: p.clamp_negative_constraint,
+            h,
+        })
+    }
+}
+
+/// Per-pair values of one Jacobi iteration, in the CSR order of the neighbour lists:
+/// computed by [`lambda_pass`] and reused by [`delta_pass`], which sees the same positions,
+/// so that the second pass needs no square root, division or kernel evaluation (measured:
+/// this is faster than recomputing `s_corr` from `r²` in the second pass, although it
+/// streams a second per-pair array).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct PairCache<R: Real> {
+    /// Spiky gradient factor `f_ij` with `∇W(p_i − p_j) = (p_i − p_j) f_ij` (`dW/dr / r`;
+    /// 0 at `r = 0` and at or beyond `h`).
+    grad_factor: Vec<R>,
+    /// `s_corr` of the pair (eq. 13; 0 when the artificial pressure is off).
+    scorr: Vec<R>,
+}
+
+impl<R: Real> PairCache<R> {
+    /// Makes room for `pairs` pairs (reallocates only when the capacity is exceeded).
+    fn resize(&mut self, pairs: usize) {
+        self.grad_factor.resize(pairs, R::zero());
+        self.scorr.resize(pairs, R::zero());
+    }
+}
+
+/// The Spiky gradient factor `dW/dr / r` (see [`PairCache::grad_factor`]); the same
+/// arithmetic as `Kernel::gradient`, so that `r * factor` equals `spiky.gradient(&r)`.
+#[inline]
+fn spiky_factor<R: Real>(c: &Consts<R>, r2: R) -> R {
+    let len = r2.sqrt();
+    if len > R::zero() && len < c.h {
+        c.spiky.derivative(len) / len
+    } else {
+        R::zero()
+    }
+}
+
+/// What the particle loops of one pass read.
+#[derive(Clone, Copy)]
+pub(crate) struct PassInput<'a, R: Real> {
+    pub c: &'a Consts<R>,
+    pub x: &'a [Vec3<R>],
+    pub m: &'a [R],
+    pub nb: &'a NeighbourLists,
+    /// The boundary when it takes part in the density (volume maps), `None` otherwise.
+    pub volume: Option<&'a dyn Boundary<R>>,
+}
+
+/// Per-particle outputs of [`lambda_pass`].
+pub(crate) struct LambdaOut<'a, R: Real> {
+    pub density: &'a mut [R],
+    pub lambda: &'a mut [R],
+    /// `∇Ψ_i` of the boundary at `x_i` (zero without a volume boundary).
+    pub boundary_grad: &'a mut [Vec3<R>],
+}
+
+/// Eqs. 1, 2, 8 and 11: densities and `λ_i` at positions `x`, and the pair cache for
+/// [`delta_pass`]. With a volume boundary, `ρ_i += ρ0 Ψ(x_i)` and `∇_{p_i} C_i += ∇Ψ(x_i)`
+/// (the boundary is a fixed neighbour without a constraint of its own). Returns the sum of
+/// the compressions `max(ρ_i/ρ0 − 1, 0)` (in f64, summed over a split tree that depends only
+/// on the particle count, so the result does not depend on the number of threads).
+pub(crate) fn lambda_pass<R: Real>(
+    input: PassInput<'_, R>,
+    out: LambdaOut<'_, R>,
+    cache: &mut PairCache<R>,
+) -> f64 {
+    let pairs = input.nb.pair_count();
+    cache.resize(pairs);
+    lambda_block(
+        input,
+        0,
+        out,
+        &mut cache.grad_factor[..pairs],
+        &mut cache.scorr[..pairs],
+    )
+}
+
+/// [`lambda_pass`] over the particles `first..first + out.density.len()`, whose pairs are
+/// `grad_factor` and `scorr`: split in halves (rayon `join`) down to `MIN_LEN` particles, so
+/// that each task owns its particles' contiguous CSR range of the cache. Returns the block's
+/// compression sum.
+fn lambda_block<R: Real>(
+    input: PassInput<'_, R>,
+    first: usize,
+    out: LambdaOut<'_, R>,
+    grad_factor: &mut [R],
+    scorr: &mut [R],
+) -> f64 {
+    let n = out.density.len();
+    let offsets = input.nb.offsets();
+    if n > MIN_LEN {
+        let mid = n / 2;
+        let split = offsets[first + mid] - offsets[first];
+        let (d0, d1) = out.density.split_at_mut(mid);
+        let (l0, l1) = out.lambda.split_at_mut(mid);
+        let (b0, b1) = out.boundary_grad.split_at_mut(mid);
+        let (g0, g1) = grad_factor.split_at_mut(split);
+        let (s0, s1) = scorr.split_at_mut(split);
+        let (a, b) = rayon::join(
+            || {
+                let out = LambdaOut {
+                    density: d0,
+                    lambda: l0,
+                    boundary_grad: b0,
+                };
+                lambda_block(input, first, out, g0, s0)
+            },
+            || {
+                let out = LambdaOut {
+                    density: d1,
+                    lambda: l1,
+                    boundary_grad: b1,
+                };
+                lambda_block(input, first + mid, out, g1, s1)
+            },
+        );
+        return a + b;
+    }
+    let PassInput {
+        c,
+        x,
+        m,
+        nb,
+        volume,
+    } = input;
+    let base = offsets[first];
+    let mut compression = R::zero();
+    for (k, ((rho, lam), bg)) in out
+        .density
+        .iter_mut()
+        .zip(out.lambda.iter_mut())
+        .zip(out.boundary_grad.iter_mut())
+        .enumerate()
+    {
+        let i = first + k;
+        let (a, b) = (offsets[i] - base, offsets[i + 1] - base);
+        let xi = x[i];
+        let mut sum_w = m[i] * c.w0;
+        let mut grad_i = Vec3::zeros();
+        let mut sum_g2 = R::zero();
+        for ((&j, gf), sc) in nb
+            .neighbours(i)
+            .iter()
+            .zip(&mut grad_factor[a..b])
+            .zip(&mut scorr[a..b])
+        {
+            let j = j as usize;
+            let r = xi - x[j];
+            let r2 = r.norm_squared();
+            let w = c.poly6.value_r2(r2);
+            sum_w += m[j] * w;
+            *sc = if c.scorr_on {
+                c.scorr.from_kernel_value(w)
+            } else {
+                R::zero()
+            };
+            let f = spiky_factor(c, r2);
+            *gf = f;
+            // ∇_{p_j} C_i = −(m_j/ρ0) ∇W(p_i − p_j); ∇_{p_i} C_i = Σ_j (m_j/ρ0) ∇W.
+            let g = (r * f) * (m[j] * c.inv_rho0);
+            grad_i += g;
+            sum_g2 += g.norm_squared();
+        }
+        if let Some(bd) = volume {
+            // ρ_B = ρ0 Ψ; ∇_{p_i} (ρ0 Ψ / ρ0) = ∇Ψ.
+            let s = bd.sample(&xi);
+            sum_w += c.rho0 * s.volume;
+            grad_i += s.volume_gradient;
+            *bg = s.volume_gradient;
+        }
+        *rho = sum_w;
+        let mut constraint = sum_w * c.inv_rho0 - R::one();
+        if constraint > R::zero() {
+            compression += constraint;
+        } else if c.unilateral {
+            constraint = R::zero();
+        }
+        *lam = -constraint / (sum_g2 + grad_i.norm_squared() + c.eps);
+    }
+    compression.as_f64()
+}
+
+/// Eqs. 13 and 14, then the boundary's contact response: `delta_p` receives `Δp_i` (with
+/// the boundary term `λ_i ∇Ψ_i` of a volume boundary), `next` the corrected position
+/// `x_i + Δp_i` after [`Boundary::project`]. Reads the pair cache written by
+/// [`lambda_pass`] at the same positions.
+pub(crate) fn delta_pass<R: Real>(
+    input: PassInput<'_, R>,
+    lambda: &[R],
+    boundary_grad: &[Vec3<R>],
+    cache: &PairCache<R>,
+    boundary: &dyn Boundary<R>,
+    delta_p: &mut [Vec3<R>],
+    next: &mut [Vec3<R>],
+) {
+    let PassInput {
+        c, x, m, nb, volume,
+    } = input;
+    let half_unit = R::of_f64(0.5) * c.scorr_unit;
+    let offsets = nb.offsets();
+    let with_volume = volume.is_some();
+    delta_p
+        .par_iter_mut()
+        .zip(next.par_iter_mut())
+        .enumerate()
+        .with_min_len(MIN_LEN)
+        .for_each(|(i, (dp, xn))| {
+            let (xi, li, mi) = (x[i], lambda[i], m[i]);
+            let (a, b) = (offsets[i], offsets[i + 1]);
+            let mut acc = Vec3::zeros();
+            for ((&j, &f), &sc) in nb
+                .neighbours(i)
+                .iter()
+                .zip(&cache.grad_factor[a..b])
+                .zip(&cache.scorr[a..b])
+            {
+                let j = j as usize;
+                let r = xi - x[j];
+                let mj = m[j];
+                // λ_i ∇_{p_i} C_i + λ_j ∇_{p_i} C_j, with ∇_{p_i} C_j = (m_i/ρ0) ∇W(p_i − p_j).
+                let mut coeff = li * mj + lambda[j] * mi;
+                if c.scorr_on {
+                    coeff += sc * (mi + mj) * half_unit;
+                }
+                acc += (r * f) * coeff;
+            }
+            let mut d = acc * c.inv_rho0;
+            if with_volume {
+                d += boundary_grad[i] * li;
+            }
+            *dp = d;
+            *xn = boundary.project(xi + d);
+        });
+}

@@ -1,0 +1,324 @@
+//! The in-step plumbing every particle solver needs: state checks, the neighbour search
+//! inside a step, periodic reordering by cell, the blow-up checks made before a substep's
+//! result is written, and the end-of-step statistics.
+//!
+//! Every parallel loop here writes one particle's values or reduces over fixed chunks, so
+//! results do not depend on the number of threads.
+
+use std::time::Instant;
+
+use neighbour_search::{
+    CellOrder, CellSorter, HashedGrid, Method, NeighbourLists, NeighbourSearch, SearchError,
+    SearchStats,
+};
+use rayon::prelude::*;
+use sph_core::{ParticleSet, PermutationScratch, Real, Vec3};
+
+use crate::{Boundary, SolverError, StepStats};
+
+/// Smallest number of particles handed to one rayon task.
+pub const MIN_LEN: usize = 256;
+/// Particles per partial sum of the end-of-step statistics (fixed, so that the statistics do
+/// not depend on the number of threads).
+pub const REDUCE_CHUNK: usize = 4096;
+
+/// The first non-finite axis of `v`.
+#[inline]
+pub fn non_finite<R: Real>(v: &Vec3<R>) -> Option<usize> {
+    (0..3).find(|&a| !v[a].is_finite_value())
+}
+
+/// Checks a state on entry to a step: array lengths, finite positions and velocities
+/// ([`SolverError::InvalidState`]) and finite positive masses ([`SolverError::InvalidMass`]),
+/// naming the first offending particle.
+pub fn check_state<R: Real>(state: &ParticleSet<R>) -> Result<(), SolverError> {
+    state.validate()?;
+    check_masses(&state.masses)
+}
+
+/// Finite, positive masses ([`SolverError::InvalidMass`] naming the first other one).
+pub fn check_masses<R: Real>(masses: &[R]) -> Result<(), SolverError> {
+    match masses
+        .par_iter()
+        .with_min_len(MIN_LEN)
+        .position_first(|&m| !(m.is_finite_value() && m > R::zero()))
+    {
+        Some(index) => Err(SolverError::InvalidMass {
+            index,
+            value: masses[index].as_f64(),
+        }),
+        None => Ok(()),
+    }
+}
+
+/// A [`SolverError::BlowUp`] of `solver` in call `step` at `particle`.
+pub fn blow_up(solver: &'static str, step: u64, particle: usize, reason: String) -> SolverError {
+    SolverError::BlowUp {
+        solver,
+        step,
+        particle,
+        reason,
+    }
+}
+
+/// The neighbour search of a solver: the configured method, a hashed-grid fallback for
+/// domains the cell-start grid refuses (it allocates on first use), and the lists.
+pub struct StepNeighbours<R: Real> {
+    method: Method,
+    search: Box<dyn NeighbourSearch<R>>,
+    fallback: Option<HashedGrid<R>>,
+    lists: NeighbourLists,
+}
+
+impl<R: Real> std::fmt::Debug for StepNeighbours<R> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("StepNeighbours")
+            .field("method", &self.method)
+            .field("pairs", &self.lists.pair_count())
+            .finish()
+    }
+}
+
+impl<R: Real> StepNeighbours<R> {
+    /// A search with `method` and empty lists.
+    pub fn new(method: Method) -> Self {
+        Self {
+            method,
+            search: method.build::<R>(),
+            fallback: None,
+            lists: NeighbourLists::new(),
+        }
+    }
+
+    /// The method in use.
+    pub fn method(&self) -> Method {
+        self.method
+    }
+
+    /// Switches to `method` (no-op when unchanged).
+    pub fn set_method(&mut self, method: Method) {
+        if method != self.method {
+            self.method = method;
+            self.search = method.build::<R>();
+        }
+    }
+
+    /// The lists of the last search (within `h`, excluding the particle itself).
+    pub fn lists(&self) -> &NeighbourLists {
+        &self.lists
+    }
+
+    /// Finds the neighbours of `positions` within `h`, falling back to a hashed grid when the
+    /// cell-start grid refuses the domain.
+    pub fn find(&mut self, positions: &[Vec3<R>], h: R) -> Result<SearchStats, SearchError> {
+        match self.search.search(positions, h, &mut self.lists) {
+            Ok(()) => Ok(self.search.stats()),
+            Err(SearchError::DomainTooLarge { .. }) => {
+                let fb = self.fallback.get_or_insert_with(HashedGrid::new);
+                fb.search(positions, h, &mut self.lists)?;
+                Ok(fb.stats())
+            }
+            Err(e) => Err(e),
+        }
+    }
+
+    /// [`StepNeighbours::find`] inside call `step`, substep `sub` of `solver`: a position the
+    /// grid cannot hold (non-finite, or a cell coordinate overflowing `i32`) is a
+    /// [`SolverError::BlowUp`] naming the particle and `what` the positions are.
+    pub fn find_in_step(
+        &mut self,
+        positions: &[Vec3<R>],
+        h: R,
+        at: StepAt,
+        what: &str,
+    ) -> Result<SearchStats, SolverError> {
+        self.find(positions, h).map_err(|e| match e {
+            SearchError::NonFinitePosition { index, .. }
+            | SearchError::CellCoordinateOverflow { index, .. } => blow_up(
+                at.solver,
+                at.step,
+                index,
+                format!(
+                    "substep {}: {what} {:?} is out of the range of the neighbour grid",
+                    at.substep, positions[index]
+                ),
+            ),
+            e => e.into(),
+        })
+    }
+}
+
+/// Where in a run a check happens: the solver, its `step` call (0-based) and the substep.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StepAt {
+    /// The solver's name.
+    pub solver: &'static str,
+    /// 0-based count of `step` calls.
+    pub step: u64,
+    /// 0-based substep within the call.
+    pub substep: usize,
+}
+
+/// A non-finite predicted position is a [`SolverError::BlowUp`] naming the first such
+/// particle.
+pub fn check_predicted<R: Real>(at: StepAt, predicted: &[Vec3<R>]) -> Result<(), SolverError> {
+    match predicted
+        .par_iter()
+        .with_min_len(MIN_LEN)
+        .position_first(|x| non_finite(x).is_some())
+    {
+        Some(i) => Err(blow_up(
+            at.solver,
+            at.step,
+            i,
+            format!(
+                "substep {}: predicted position {:?} is not finite",
+                at.substep, predicted[i]
+            ),
+        )),
+        None => Ok(()),
+    }
+}
+
+/// The divergence checks of a substep, before anything is written to the state: a non-finite
+/// final position `x` or velocity `v`, or a position more than `h` inside a solid of the
+/// boundary, is a [`SolverError::BlowUp`] naming the first such particle.
+pub fn check_divergence<R: Real>(
+    at: StepAt,
+    x: &[Vec3<R>],
+    v: &[Vec3<R>],
+    boundary: &dyn Boundary<R>,
+    h: R,
+) -> Result<(), SolverError> {
+    if let Some(i) = (0..x.len())
+        .into_par_iter()
+        .with_min_len(MIN_LEN)
+        .position_first(|i| non_finite(&x[i]).is_some() || non_finite(&v[i]).is_some())
+    {
+        return Err(blow_up(
+            at.solver,
+            at.step,
+            i,
+            format!(
+                "substep {}: position {:?} or velocity {:?} is not finite",
+                at.substep, x[i], v[i]
+            ),
+        ));
+    }
+    let solids = boundary.solids();
+    if solids.is_empty() {
+        return Ok(());
+    }
+    let margin = -h;
+    if let Some(i) = x
+        .par_iter()
+        .with_min_len(MIN_LEN)
+        .position_first(|xi| solids.iter().any(|sd| sd.signed_distance(xi) < margin))
+    {
+        let (k, d) = solids
+            .iter()
+            .enumerate()
+            .map(|(k, sd)| (k, sd.signed_distance(&x[i])))
+            .find(|&(_, d)| d < margin)
+            .unwrap_or((0, R::zero()));
+        return Err(blow_up(
+            at.solver,
+            at.step,
+            i,
+            format!(
+                "substep {}: position {:?} is {} m inside solid {k} (more than h = {})",
+                at.substep,
+                x[i],
+                -d.as_f64(),
+                h.as_f64()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Density ratios and kinetic energy of `state` into `stats`, summed over fixed chunks of
+/// [`REDUCE_CHUNK`] particles (`partials` is resized to one entry per chunk), so that the
+/// result does not depend on the number of threads.
+pub fn density_energy_stats<R: Real>(
+    state: &ParticleSet<R>,
+    rest_density: R,
+    partials: &mut Vec<[f64; 3]>,
+    stats: &mut StepStats,
+) {
+    let n = state.len();
+    if n == 0 {
+        return;
+    }
+    partials.resize(n.div_ceil(REDUCE_CHUNK), [0.0; 3]);
+    let inv_rho0 = 1.0 / rest_density.as_f64();
+    let (rho, v, m) = (&state.densities, &state.velocities, &state.masses);
+    partials.par_iter_mut().enumerate().for_each(|(c, part)| {
+        let (a, b) = (c * REDUCE_CHUNK, ((c + 1) * REDUCE_CHUNK).min(n));
+        let mut sum = 0.0;
+        let mut max = f64::NEG_INFINITY;
+        let mut ke = 0.0;
+        for i in a..b {
+            let r = rho[i].as_f64() * inv_rho0;
+            sum += r;
+            max = max.max(r);
+            ke += 0.5 * m[i].as_f64() * v[i].norm_squared().as_f64();
+        }
+        *part = [sum, max, ke];
+    });
+    let mut sum = 0.0;
+    let mut max = f64::NEG_INFINITY;
+    let mut ke = 0.0;
+    for part in partials.iter() {
+        sum += part[0];
+        max = max.max(part[1]);
+        ke += part[2];
+    }
+    stats.mean_density_ratio = sum / n as f64;
+    stats.max_density_ratio = max;
+    stats.kinetic_energy = ke;
+}
+
+/// Periodic reordering of the particles by cell (for locality): the sorter, the last
+/// permutation and its scratch buffers.
+#[derive(Debug, Default)]
+pub struct CellReorder<R: Real> {
+    sorter: CellSorter,
+    scratch: PermutationScratch<R>,
+    permutation: Vec<u32>,
+    reordered: bool,
+}
+
+impl<R: Real> CellReorder<R> {
+    /// At the start of call `step`: every `every` calls (never when 0, nor for fewer than two
+    /// particles) reorders `state` by cell of size `h` (lexicographic cell order), keeping the
+    /// permutation. Returns the seconds spent (0 when it did not reorder).
+    pub fn at_step(
+        &mut self,
+        state: &mut ParticleSet<R>,
+        h: R,
+        step: u64,
+        every: usize,
+    ) -> Result<f64, SolverError> {
+        self.reordered = false;
+        let every = every as u64;
+        if every == 0 || !step.is_multiple_of(every) || state.len() < 2 {
+            return Ok(0.0);
+        }
+        let t = Instant::now();
+        let perm = self
+            .sorter
+            .permutation(&state.positions, h, CellOrder::Lexicographic)?;
+        self.permutation.clear();
+        self.permutation.extend_from_slice(perm);
+        state.permute(&self.permutation, &mut self.scratch)?;
+        self.reordered = true;
+        Ok(t.elapsed().as_secs_f64())
+    }
+
+    /// The permutation of the last [`CellReorder::at_step`] (`new[k] = old[perm[k]]`), or
+    /// `None` if it did not reorder.
+    pub fn last_permutation(&self) -> Option<&[u32]> {
+        self.reordered.then_some(&self.permutation[..])
+    }
+}

@@ -1,0 +1,70 @@
+//! Scenes, independent oracle formulas and helpers shared by the solver crates' tests
+//! (feature `testing`; not part of the solvers' API).
+
+pub mod formulas;
+
+use sph_core::{sampling::cubic_lattice, Aabb, BoxSdf, CoreError, Inverted, ParticleSet, Real, Vec3};
+
+use crate::{CommonParams, FluidSolver, SolverError, Solids};
+
+/// A fluid block of `n = [nx, ny, nz]` particles at spacing `s`, at rest in the corner
+/// `(0, 0, 0)` of a tank of `tank = [tx, ty, tz]` spacings (an `Inverted<BoxSdf>`), with
+/// masses `ρ0 s³`. The particles start `s/2` from the walls, i.e. touching them.
+pub fn block_in_tank<R: Real>(
+    params: &CommonParams<R>,
+    n: [usize; 3],
+    tank: [f64; 3],
+) -> (ParticleSet<R>, Solids<R>, Aabb<R>) {
+    let s = params.particle_spacing;
+    let v = |a: [f64; 3]| Vec3::new(R::of_f64(a[0]), R::of_f64(a[1]), R::of_f64(a[2])) * s;
+    let block = Aabb::new(Vec3::zeros(), v([n[0] as f64, n[1] as f64, n[2] as f64])).unwrap();
+    let tank = Aabb::new(Vec3::zeros(), v(tank)).unwrap();
+    let pts = cubic_lattice(&block, s, 1 << 20).unwrap();
+    assert_eq!(pts.len(), n[0] * n[1] * n[2]);
+    let state = ParticleSet::from_positions(pts, params.particle_mass(), params.rest_density);
+    let solids: Solids<R> = vec![Box::new(Inverted(BoxSdf::new(tank).unwrap()))];
+    (state, solids, tank)
+}
+
+/// Bit patterns of positions and velocities, for exact comparisons.
+pub fn bits<R: Real>(state: &ParticleSet<R>) -> Vec<u64> {
+    state
+        .positions
+        .iter()
+        .chain(&state.velocities)
+        .flat_map(|v| v.iter().map(|c| c.as_f64().to_bits()).collect::<Vec<_>>())
+        .collect()
+}
+
+/// Runs `f` in a rayon pool of `threads` threads.
+pub fn in_pool<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(f)
+}
+
+/// Steps `solver` on `state` with particle 7's `y` set to NaN: the error must name particle 7
+/// and axis `y`, and the state must be left untouched.
+pub fn assert_nan_position_rejected(
+    solver: &mut dyn FluidSolver<f64>,
+    mut state: ParticleSet<f64>,
+) {
+    state.positions[7].y = f64::NAN;
+    let before = bits(&state);
+    let e = solver.step(&mut state).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            SolverError::InvalidState(CoreError::NonFinitePosition {
+                index: 7,
+                axis: 'y',
+                ..
+            })
+        ),
+        "{e:?}"
+    );
+    assert!(e.to_string().contains("particle 7"), "{e}");
+    assert_eq!(bits(&state), before, "state untouched");
+}
