@@ -26,7 +26,7 @@ use std::collections::HashMap;
 
 use rayon::prelude::*;
 
-use crate::{Aabb, Real, Sdf, Vec3};
+use crate::{Aabb, Real, SampledGrid, Sdf, Vec3};
 
 /// Errors of mesh construction, topology checks and [`GridSdf`] building.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -609,10 +609,7 @@ fn point_in_triangle_2d(
 /// get wrong signs. [`Inverted`](crate::Inverted)`<GridSdf>` turns the solid into a container.
 #[derive(Debug, Clone)]
 pub struct GridSdf<R: Real> {
-    origin: Vec3<f64>,
-    cell: f64,
-    dims: [usize; 3],
-    values: Vec<R>,
+    grid: SampledGrid<R>,
     surface_bounds: Aabb<R>,
 }
 
@@ -621,8 +618,9 @@ const NO_TRI: u32 = u32::MAX;
 const RELAX_ROUNDS: usize = 2;
 
 impl<R: Real> GridSdf<R> {
-    /// Largest number of grid nodes [`GridSdf::new`] accepts (64 Mi nodes).
-    pub const MAX_NODES: usize = 1 << 26;
+    /// Largest number of grid nodes [`GridSdf::new`] accepts (64 Mi nodes,
+    /// [`SampledGrid::MAX_NODES`]).
+    pub const MAX_NODES: usize = SampledGrid::<R>::MAX_NODES;
     /// Half-width, in cells, of the band around each triangle's bounding box where node
     /// distances are computed exactly (SDFGen's `exact_band`, 1 there).
     pub const EXACT_BAND: usize = 1;
@@ -668,131 +666,53 @@ impl<R: Real> GridSdf<R> {
             });
         }
         let (phi, _) = build_grid(mesh, origin, dx, dims);
+        let values = phi.into_iter().map(R::of_f64).collect();
         Ok(Self {
-            origin,
-            cell: dx,
-            dims,
-            values: phi.into_iter().map(R::of_f64).collect(),
+            grid: SampledGrid::from_checked_parts(origin, dx, dims, values),
             surface_bounds: b,
         })
     }
 
+    /// The sampled grid of node values (signed distances) behind this field.
+    pub fn grid(&self) -> &SampledGrid<R> {
+        &self.grid
+    }
+
     /// Node spacing (length).
     pub fn cell_size(&self) -> R {
-        R::of_f64(self.cell)
+        R::of_f64(self.grid.cell_size())
     }
 
     /// Number of nodes along x, y, z.
     pub fn dims(&self) -> [usize; 3] {
-        self.dims
+        self.grid.dims()
     }
 
     /// The box spanned by the grid nodes.
     pub fn grid_box(&self) -> Aabb<R> {
-        let hi = self.origin
-            + Vec3::new(
-                (self.dims[0] - 1) as f64,
-                (self.dims[1] - 1) as f64,
-                (self.dims[2] - 1) as f64,
-            ) * self.cell;
-        Aabb {
-            min: Vec3::new(
-                R::of_f64(self.origin.x),
-                R::of_f64(self.origin.y),
-                R::of_f64(self.origin.z),
-            ),
-            max: Vec3::new(R::of_f64(hi.x), R::of_f64(hi.y), R::of_f64(hi.z)),
-        }
+        self.grid.grid_box()
     }
 
     /// Stored signed distance at node `(i, j, k)` (`None` out of range).
     pub fn node_value(&self, i: usize, j: usize, k: usize) -> Option<R> {
-        let [nx, ny, nz] = self.dims;
-        (i < nx && j < ny && k < nz).then(|| self.values[i + nx * (j + ny * k)])
+        self.grid.node_value(i, j, k)
     }
 
     /// Position of node `(i, j, k)`.
     pub fn node_position(&self, i: usize, j: usize, k: usize) -> Vec3<R> {
-        let p = self.origin + Vec3::new(i as f64, j as f64, k as f64) * self.cell;
+        let p = self.grid.node_position(i, j, k);
         Vec3::new(R::of_f64(p.x), R::of_f64(p.y), R::of_f64(p.z))
-    }
-
-    /// Clamps `p` into the grid box: returns grid coordinates (in cells) of the clamped
-    /// point and the offset `p − q` in length units.
-    #[inline]
-    fn locate(&self, p: &Vec3<R>) -> ([f64; 3], Vec3<f64>) {
-        let mut u = [0.0; 3];
-        let mut off = Vec3::zeros();
-        for a in 0..3 {
-            let x = p[a].as_f64();
-            let g = (x - self.origin[a]) / self.cell;
-            let max = (self.dims[a] - 1) as f64;
-            // Offsets only on clamped axes (exactly 0 inside the box, whatever the rounding).
-            if g < 0.0 {
-                off[a] = x - self.origin[a];
-                u[a] = 0.0;
-            } else if g > max {
-                off[a] = x - (self.origin[a] + max * self.cell);
-                u[a] = max;
-            } else if g.is_nan() {
-                u[a] = 0.0;
-            } else {
-                u[a] = g;
-            }
-        }
-        (u, off)
-    }
-
-    /// Trilinear value and gradient (per length) at grid coordinates `u` (inside the box).
-    #[inline]
-    fn trilinear(&self, u: [f64; 3]) -> (f64, Vec3<f64>) {
-        let [nx, ny, _] = self.dims;
-        let mut base = [0usize; 3];
-        let mut f = [0.0; 3];
-        for a in 0..3 {
-            let i = (u[a].floor() as usize).min(self.dims[a] - 2);
-            base[a] = i;
-            f[a] = u[a] - i as f64;
-        }
-        let idx = |i: usize, j: usize, k: usize| {
-            self.values[(base[0] + i) + nx * ((base[1] + j) + ny * (base[2] + k))].as_f64()
-        };
-        let c000 = idx(0, 0, 0);
-        let c100 = idx(1, 0, 0);
-        let c010 = idx(0, 1, 0);
-        let c110 = idx(1, 1, 0);
-        let c001 = idx(0, 0, 1);
-        let c101 = idx(1, 0, 1);
-        let c011 = idx(0, 1, 1);
-        let c111 = idx(1, 1, 1);
-        let [fx, fy, fz] = f;
-        let c00 = c000 + (c100 - c000) * fx;
-        let c10 = c010 + (c110 - c010) * fx;
-        let c01 = c001 + (c101 - c001) * fx;
-        let c11 = c011 + (c111 - c011) * fx;
-        let c0 = c00 + (c10 - c00) * fy;
-        let c1 = c01 + (c11 - c01) * fy;
-        let value = c0 + (c1 - c0) * fz;
-        // d/dfx
-        let dx0 = (c100 - c000) + ((c110 - c010) - (c100 - c000)) * fy;
-        let dx1 = (c101 - c001) + ((c111 - c011) - (c101 - c001)) * fy;
-        let gx = dx0 + (dx1 - dx0) * fz;
-        let gy = (c10 - c00) + ((c11 - c01) - (c10 - c00)) * fz;
-        let gz = c1 - c0;
-        (value, Vec3::new(gx, gy, gz) / self.cell)
     }
 }
 
 impl<R: Real> Sdf<R> for GridSdf<R> {
     fn signed_distance(&self, p: &Vec3<R>) -> R {
-        let (u, off) = self.locate(p);
-        let (v, _) = self.trilinear(u);
+        let (v, _, off) = self.grid.sample_clamped(p);
         R::of_f64(v + off.norm())
     }
 
     fn gradient(&self, p: &Vec3<R>) -> Vec3<R> {
-        let (u, off) = self.locate(p);
-        let (_, mut g) = self.trilinear(u);
+        let (_, mut g, off) = self.grid.sample_clamped(p);
         let n = off.norm();
         if n > 0.0 {
             for a in 0..3 {
