@@ -3,6 +3,7 @@
 
 use rayon::prelude::*;
 
+use crate::sync_ptr::SyncPtr;
 use crate::NeighbourLists;
 
 /// What one parallel task found: for each of its particles, `(particle, count)`, and the
@@ -24,11 +25,6 @@ impl TaskOutput {
         self.tests = 0;
     }
 }
-
-#[derive(Clone, Copy)]
-struct SyncPtr<T>(*mut T);
-unsafe impl<T> Send for SyncPtr<T> {}
-unsafe impl<T> Sync for SyncPtr<T> {}
 
 /// Writes the tasks' results into `out` for `n` particles.
 /// Every particle must appear in exactly one task. The tasks may be any type holding a

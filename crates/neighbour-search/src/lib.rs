@@ -69,6 +69,7 @@ mod relation_table;
 mod reorder;
 mod runs;
 mod scan;
+mod sync_ptr;
 
 pub use brute::BruteForce;
 pub use cells::{is_neighbour, squared_distance, CELL_MARGIN};

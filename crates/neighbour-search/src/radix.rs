@@ -9,6 +9,7 @@
 use rayon::prelude::*;
 
 use crate::cells::Key;
+use crate::sync_ptr::SyncPtr;
 
 const DIGIT_BITS: u32 = 11;
 const BUCKETS: usize = 1 << DIGIT_BITS;
@@ -22,11 +23,6 @@ pub(crate) struct RadixScratch<K> {
     vals: Vec<u32>,
     histograms: Vec<[usize; BUCKETS]>,
 }
-
-#[derive(Clone, Copy)]
-struct SyncPtr<T>(*mut T);
-unsafe impl<T> Send for SyncPtr<T> {}
-unsafe impl<T> Sync for SyncPtr<T> {}
 
 /// Sorts `keys` (ascending, only the low `bits` bits are significant: higher bits must be
 /// zero) and permutes `vals` alongside, stably.

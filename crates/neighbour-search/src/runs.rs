@@ -2,12 +2,9 @@
 
 use rayon::prelude::*;
 
-const BLOCK: usize = 1 << 15;
+use crate::sync_ptr::SyncPtr;
 
-#[derive(Clone, Copy)]
-struct SyncPtr<T>(*mut T);
-unsafe impl<T> Send for SyncPtr<T> {}
-unsafe impl<T> Sync for SyncPtr<T> {}
+const BLOCK: usize = 1 << 15;
 
 /// Writes the start index of every run of equal keys in `keys` to `starts`, followed by a
 /// final sentinel `keys.len()`; run `r` is `starts[r]..starts[r + 1]`.

@@ -50,4 +50,17 @@ pub enum CoreError {
         /// The offending entry.
         value: u32,
     },
+    /// A [`SampledGrid`](crate::SampledGrid) would have more nodes than allowed (counts
+    /// that do not fit a `usize` are reported as `usize::MAX`).
+    #[error("sampled grid of {nx} x {ny} x {nz} nodes exceeds the maximum of {max} nodes (cell size too small for the box)")]
+    GridTooLarge {
+        /// Nodes along x.
+        nx: usize,
+        /// Nodes along y.
+        ny: usize,
+        /// Nodes along z.
+        nz: usize,
+        /// [`SampledGrid::MAX_NODES`](crate::SampledGrid::MAX_NODES).
+        max: usize,
+    },
 }

@@ -10,11 +10,14 @@
 //! - [`Aabb`], an axis-aligned box,
 //! - the signed-distance-field trait [`Sdf`] with analytic [`Plane`], [`BoxSdf`], [`Sphere`]
 //!   and the complement [`Inverted`] (a tank is `Inverted<BoxSdf>`),
+//! - [`SampledGrid`], a scalar field sampled on a regular grid with trilinear interpolation
+//!   (module [`grid`]),
 //! - [`TriangleMesh`] and its sampled signed distance [`GridSdf`] (module [`mesh`]),
 //! - [`CoreError`], the crate's error enum.
 
 mod aabb;
 mod error;
+pub mod grid;
 pub mod mesh;
 mod particles;
 mod real;
@@ -23,6 +26,7 @@ mod sdf;
 
 pub use aabb::Aabb;
 pub use error::CoreError;
+pub use grid::SampledGrid;
 pub use mesh::{GridSdf, MeshError, TriangleMesh};
 pub use particles::{
     apply_permutation, validate_finite_positions, ParticleSet, PermutationScratch,
