@@ -7,7 +7,7 @@
 //! states have hundreds of neighbours per particle, which makes every further step slow.
 
 use anyhow::Result;
-use pbf::PbfError;
+use sph_solver::SolverError;
 use sph_core::Real;
 use sph_scene::{Precision, Scene, SolverKind};
 
@@ -45,7 +45,7 @@ pub struct FluidRun {
     /// Potential energy of the initial state above the tank floor, `Σ m_i |g| (y_i − y_floor)`
     /// (J): the most kinetic energy a scene starting at rest can ever have.
     pub initial_potential_energy_j: f64,
-    /// Why the run stopped early: the solver's divergence report (`PbfError::BlowUp`), or a
+    /// Why the run stopped early: the solver's divergence report (`SolverError::BlowUp`), or a
     /// density above [`DIVERGED_DENSITY_RATIO`].
     pub blow_up: Option<String>,
 }
@@ -129,8 +129,8 @@ fn run_in<R: Real>(ctx: &Context, scene: &Scene, label: String) -> Result<FluidR
                     break;
                 }
             }
-            Err(e) => match e.downcast_ref::<PbfError>() {
-                Some(PbfError::BlowUp { .. }) => {
+            Err(e) => match e.downcast_ref::<SolverError>() {
+                Some(SolverError::BlowUp { .. }) => {
                     run.blow_up = Some(format!("{e:#}"));
                     break;
                 }

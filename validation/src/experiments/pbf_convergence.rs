@@ -51,7 +51,7 @@ fn one_step<R: Real>(
     let mut solver = Pbf::new(p, scene.build_solids::<R>()?)?;
     let mut state = state.clone();
     let stats = solver.step(&mut state)?;
-    let rho0 = solver.params().rest_density.as_f64();
+    let rho0 = solver.params().common.rest_density.as_f64();
     let avg = state
         .densities
         .iter()
@@ -74,10 +74,10 @@ fn sweep<R: Real>(ctx: &Context, scene: &Scene) -> Result<(Vec<Row>, usize)> {
     let mut rows = Vec::new();
     for k in ITERATIONS {
         let mut p = base.clone();
-        p.dt = base.substep_dt();
-        p.substeps = 1;
+        p.common.dt = base.substep_dt();
+        p.common.substeps = 1;
         p.solver_iterations = k;
-        p.reorder_every = 0;
+        p.common.reorder_every = 0;
         let (max, avg) = one_step(scene, p.clone(), &sim.state)?;
         ctx.progress.inc(1);
         p.clamp_negative_constraint = true;

@@ -54,11 +54,11 @@ fn time_scene<R: Real>(ctx: &Context, scene: &Scene) -> Result<Timing> {
     for _ in 0..MEASURED_FRAMES {
         let s = sim.advance()?;
         let p = [
-            s.integrate_s,
-            s.create_hash_grid_s,
-            s.detect_neighbours_s,
-            s.constraint_solve_s,
-            s.velocity_update_s + s.reorder_s,
+            s.phase_s("integrate"),
+            s.phase_s("create_hash_grid"),
+            s.phase_s("detect_neighbours"),
+            s.phase_s("constraint_solve"),
+            s.phase_s("velocity_update") + s.phase_s("reorder"),
         ];
         for (a, b) in phases.iter_mut().zip(p) {
             *a += b;
