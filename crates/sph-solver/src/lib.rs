@@ -4,5 +4,9 @@
 pub mod boundary;
 mod error;
 
-pub use boundary::{Boundary, BoundarySample, ClosestPoint, CollisionBoundary};
+pub use boundary::{
+    half_space_volume, half_space_volume_derivative, Boundary, BoundarySample, ClosestPoint,
+    CollisionBoundary, Interpolation, VolumeMap, VolumeMapBoundary, VolumeMapOptions,
+    VolumeMapStats,
+};
 pub use error::SolverError;
