@@ -72,6 +72,13 @@ impl<R: Real> VolumeMapBoundary<R> {
                 return Err(invalid("domain", domain.max[a].as_f64(), "max must be >= min"));
             }
         }
+        if kernel == KernelKind::Viscosity {
+            return Err(invalid(
+                "kernel",
+                f64::NAN,
+                "the viscosity kernel is singular at r = 0 (its W'' r² is not integrable)",
+            ));
+        }
         let k = kernel.build(support_radius.as_f64())?;
         // The kernel must also be representable in the solver's precision.
         kernel.build(support_radius)?;

@@ -75,7 +75,8 @@ use sph_core::{Aabb, Real, Sdf, Vec3};
 // Switch to `sph_core::grid::SampledGrid` when it lands.
 use super::grid_standin::SampledGrid;
 use crate::SolverError;
-use quadrature::{looks_planar, node_correction, Directions, KernelTables};
+use nalgebra::Matrix3;
+use quadrature::{looks_planar, node_correction, Directions, KernelTables, NodeCorrection};
 
 /// How `Ψ` is interpolated between grid nodes (see the module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -171,6 +172,8 @@ struct NodeModel {
     n: [f32; 3],
     c: f32,
     g: [f32; 3],
+    /// `∇∇D` as `[xx, yy, zz, xy, xz, yz]`.
+    hess: [f32; 6],
 }
 
 const FAR: u32 = u32::MAX;
@@ -285,28 +288,32 @@ impl<R: Real> VolumeMap<R> {
         let band = AtomicUsize::new(0);
         let quad = AtomicUsize::new(0);
         let eps = R::MACHINE_EPSILON.as_f64();
-        // One node: (φ, n, C, ∇D); C = ∇D = 0 outside the band and where planar.
+        // One node: (φ, n, correction); the correction is 0 outside the band and where planar.
+        let zero = NodeCorrection {
+            c: 0.0,
+            grad: Vec3::zeros(),
+            hess: Matrix3::zeros(),
+        };
         let node = |p: Vec3<f64>| {
             let pr = vr::<R>(&p);
             let phi = solid.signed_distance(&pr).as_f64();
             let n = unit_normal(solid, &pr);
             if !(phi.abs() < h) {
-                return (phi, n, 0.0, Vec3::zeros());
+                return (phi, n, zero);
             }
             band.fetch_add(1, Ordering::Relaxed);
             // 1e-9 h (the brief), or the rounding of the solid's own precision.
             let tol = 1e-9 * h + 16.0 * eps * (p.amax() + h);
             if looks_planar(solid, p, phi, n, h, tol) {
-                return (phi, n, 0.0, Vec3::zeros());
+                return (phi, n, zero);
             }
             quad.fetch_add(1, Ordering::Relaxed);
-            let (c, g) = node_correction(solid, p, phi, n, &tables, &dirs);
-            (phi, n, c, g)
+            (phi, n, node_correction(solid, p, phi, n, &tables, &dirs))
         };
         let reach = h + 3f64.sqrt() * cell;
         let storage = match options.interpolation {
             Interpolation::TrilinearCorrection => Storage::Trilinear(
-                SampledGrid::from_fn(origin, cell, dims, |_, p| node(p).2)
+                SampledGrid::from_fn(origin, cell, dims, |_, p| node(p).2.c)
                     .map_err(|e| SolverError::Boundary(format!("volume map grid: {e}")))?,
             ),
             Interpolation::NodePlanes => {
@@ -319,7 +326,7 @@ impl<R: Real> VolumeMap<R> {
                         for j in 0..ny {
                             for i in 0..nx {
                                 let p = origin + Vec3::new(i as f64, j as f64, k as f64) * cell;
-                                let (phi, n, c, g) = node(p);
+                                let (phi, n, NodeCorrection { c, grad: g, hess: hs }) = node(p);
                                 if phi >= reach {
                                     index.push(FAR);
                                 } else if phi <= -reach {
@@ -331,6 +338,14 @@ impl<R: Real> VolumeMap<R> {
                                         n: [n.x as f32, n.y as f32, n.z as f32],
                                         c: c as f32,
                                         g: [g.x as f32, g.y as f32, g.z as f32],
+                                        hess: [
+                                            hs[(0, 0)] as f32,
+                                            hs[(1, 1)] as f32,
+                                            hs[(2, 2)] as f32,
+                                            hs[(0, 1)] as f32,
+                                            hs[(0, 2)] as f32,
+                                            hs[(1, 2)] as f32,
+                                        ],
                                     });
                                 }
                             }
@@ -476,10 +491,16 @@ impl<R: Real> VolumeMap<R> {
                     let dx = p - xc;
                     let n = Vec3::new(m.n[0] as f64, m.n[1] as f64, m.n[2] as f64);
                     let g = Vec3::new(m.g[0] as f64, m.g[1] as f64, m.g[2] as f64);
+                    let hs = m.hess.map(|v| v as f64);
+                    let hdx = Vec3::new(
+                        hs[0] * dx.x + hs[3] * dx.y + hs[4] * dx.z,
+                        hs[3] * dx.x + hs[1] * dx.y + hs[5] * dx.z,
+                        hs[4] * dx.x + hs[5] * dx.y + hs[2] * dx.z,
+                    );
                     let arg = m.phi as f64 + n.dot(&dx);
                     (
-                        t.psi_plane(arg) + m.c as f64 + g.dot(&dx),
-                        n * t.psi_plane_derivative(arg) + g,
+                        t.psi_plane(arg) + m.c as f64 + g.dot(&dx) + 0.5 * dx.dot(&hdx),
+                        n * t.psi_plane_derivative(arg) + g + hdx,
                     )
                 }
             };

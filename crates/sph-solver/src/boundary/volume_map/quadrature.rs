@@ -4,6 +4,7 @@
 
 use std::f64::consts::PI;
 
+use nalgebra::Matrix3;
 use sph_core::{Real, Sdf, Vec3};
 use sph_kernels::Kernel;
 
@@ -142,16 +143,26 @@ pub fn half_space_volume_derivative<K: Kernel<f64>>(kernel: &K, d: f64) -> f64 {
 #[derive(Debug, Clone)]
 pub(crate) struct HermiteTable {
     dx: f64,
-    /// `(value, slope)` per node.
-    nodes: Vec<(f64, f64)>,
+    /// `(value, slope from the left, slope to the right)` per node (one-sided slopes keep
+    /// the table exact to the bound where the derivative jumps at a node, e.g. `W''` of the
+    /// cubic spline at `h/2`).
+    nodes: Vec<(f64, f64, f64)>,
 }
 
 impl HermiteTable {
-    fn new(h: f64, n: usize, f: impl Fn(usize, f64) -> (f64, f64)) -> Self {
+    /// `f(k, t) = value`, `slope(t)` the derivative, evaluated `1e-9 Δ` left and right of
+    /// each node.
+    fn new(h: f64, n: usize, f: impl Fn(usize, f64) -> f64, slope: impl Fn(f64) -> f64) -> Self {
         let dx = h / n as f64;
+        let e = 1e-9 * dx;
         Self {
             dx,
-            nodes: (0..=n).map(|k| f(k, k as f64 * dx)).collect(),
+            nodes: (0..=n)
+                .map(|k| {
+                    let t = k as f64 * dx;
+                    (f(k, t), slope((t - e).max(0.0)), slope(t + e))
+                })
+                .collect(),
         }
     }
 
@@ -167,7 +178,7 @@ impl HermiteTable {
         }
         let i = (u as usize).min(n - 1);
         let s = u - i as f64;
-        let ((y0, m0), (y1, m1)) = (self.nodes[i], self.nodes[i + 1]);
+        let ((y0, _, m0), (y1, m1, _)) = (self.nodes[i], self.nodes[i + 1]);
         let s2 = s * s;
         let h00 = (1.0 + 2.0 * s) * (1.0 - s) * (1.0 - s);
         let h10 = s * (1.0 - s) * (1.0 - s);
@@ -188,6 +199,8 @@ pub(crate) struct KernelTables {
     pub(crate) h: f64,
     g: HermiteTable,
     g1: HermiteTable,
+    g2: HermiteTable,
+    g3: HermiteTable,
     plane: HermiteTable,
     plane_d: HermiteTable,
 }
@@ -197,10 +210,16 @@ impl KernelTables {
         let h = kernel.support_radius();
         let n = TABLE_INTERVALS;
         let rule = gauss_legendre(PANEL_POINTS);
-        // The viscosity kernel is singular at r = 0: slopes there are taken at 1e-12 h.
+        // Slopes at r = 0 are taken at 1e-12 h (limits; the viscosity kernel is rejected by
+        // the volume maps, its W'' r² diverges).
         let at = |r: f64| r.max(1e-12 * h);
         let w = |r: f64| kernel.value(at(r));
         let dw = |r: f64| kernel.derivative(at(r));
+        // W'' = ∇²W − 2W'/r (the 3D radial Laplacian).
+        let ddw = |r: f64| {
+            let r = at(r);
+            kernel.laplacian(r).unwrap_or(f64::NAN) - 2.0 * kernel.derivative(r) / r
+        };
         let dx = h / n as f64;
         let accumulate = |f: &dyn Fn(f64) -> f64| {
             let mut acc = vec![0.0; n + 1];
@@ -212,22 +231,27 @@ impl KernelTables {
         };
         let gv = accumulate(&|r| kernel.value(r) * r * r);
         let g1v = accumulate(&|r| kernel.derivative(r) * r * r);
+        let g2v = accumulate(&|r| ddw(r) * r * r);
+        let g3v = accumulate(&|r| kernel.derivative(r) * r);
+        let sq = |r: f64| at(r) * at(r);
         Self {
             h,
-            g: HermiteTable::new(h, n, |k, r| (gv[k], w(r) * at(r) * at(r))),
-            g1: HermiteTable::new(h, n, |k, r| (g1v[k], dw(r) * at(r) * at(r))),
-            plane: HermiteTable::new(h, n, |_, d| {
-                (
-                    half_space_volume(kernel, d),
-                    half_space_volume_derivative(kernel, d),
-                )
-            }),
-            plane_d: HermiteTable::new(h, n, |_, d| {
-                (
-                    half_space_volume_derivative(kernel, d),
-                    2.0 * PI * w(d) * at(d),
-                )
-            }),
+            g: HermiteTable::new(h, n, |k, _| gv[k], |r| w(r) * sq(r)),
+            g1: HermiteTable::new(h, n, |k, _| g1v[k], |r| dw(r) * sq(r)),
+            g2: HermiteTable::new(h, n, |k, _| g2v[k], |r| ddw(r) * sq(r)),
+            g3: HermiteTable::new(h, n, |k, _| g3v[k], |r| dw(r) * at(r)),
+            plane: HermiteTable::new(
+                h,
+                n,
+                |_, d| half_space_volume(kernel, d),
+                |d| half_space_volume_derivative(kernel, d),
+            ),
+            plane_d: HermiteTable::new(
+                h,
+                n,
+                |_, d| half_space_volume_derivative(kernel, d),
+                |d| 2.0 * PI * w(d) * at(d),
+            ),
         }
     }
 
@@ -241,6 +265,18 @@ impl KernelTables {
     #[inline]
     pub(crate) fn g1(&self, t: f64) -> f64 {
         self.g1.eval(t)
+    }
+
+    /// `G₂(t) = ∫_0^t W''(r) r² dr`.
+    #[inline]
+    pub(crate) fn g2(&self, t: f64) -> f64 {
+        self.g2.eval(t)
+    }
+
+    /// `G₃(t) = ∫_0^t W'(r) r dr`.
+    #[inline]
+    pub(crate) fn g3(&self, t: f64) -> f64 {
+        self.g3.eval(t)
     }
 
     /// `Ψ_plane(d)` from the table.
@@ -377,23 +413,36 @@ impl<R: Real> Ray<'_, R> {
 /// `(∫ W t² dt, ∫ W' t² dt)` over the parts of `[0, h]` where the list of crossings (sign
 /// changes, in order) says the ray is inside, starting inside when `inside0`.
 #[inline]
-fn radial_sums(tables: &KernelTables, inside0: bool, crossings: &[f64]) -> (f64, f64) {
-    let (mut inside, mut prev, mut s, mut s1) = (inside0, 0.0, 0.0, 0.0);
+fn radial_sums(tables: &KernelTables, inside0: bool, crossings: &[f64]) -> [f64; 4] {
+    let (mut inside, mut prev, mut s) = (inside0, 0.0, [0.0; 4]);
     for &t in crossings.iter().chain(std::iter::once(&tables.h)) {
         if inside {
-            s += tables.g(t) - tables.g(prev);
-            s1 += tables.g1(t) - tables.g1(prev);
+            let d = interval_sums(tables, prev, t);
+            for (a, b) in s.iter_mut().zip(d) {
+                *a += b;
+            }
         }
         inside = !inside;
         prev = t;
     }
-    (s, s1)
+    s
+}
+
+/// `[∫ W t², ∫ W' t², ∫ W'' t², ∫ W' t]` over `[a, b]`.
+#[inline]
+fn interval_sums(tables: &KernelTables, a: f64, b: f64) -> [f64; 4] {
+    [
+        tables.g(b) - tables.g(a),
+        tables.g1(b) - tables.g1(a),
+        tables.g2(b) - tables.g2(a),
+        tables.g3(b) - tables.g3(a),
+    ]
 }
 
 /// The same sums for the tangent half-space `{y : φ₀ + n·(y − x) < 0}` along a direction
 /// with `μ = n·ω`.
 #[inline]
-fn plane_sums(tables: &KernelTables, phi0: f64, mu: f64) -> (f64, f64) {
+fn plane_sums(tables: &KernelTables, phi0: f64, mu: f64) -> [f64; 4] {
     let h = tables.h;
     let (a, b) = if mu == 0.0 {
         if phi0 < 0.0 {
@@ -409,17 +458,17 @@ fn plane_sums(tables: &KernelTables, phi0: f64, mu: f64) -> (f64, f64) {
             (t, h)
         }
     };
-    (
-        tables.g(b) - tables.g(a),
-        tables.g1(b) - tables.g1(a),
-    )
+    interval_sums(tables, a, b)
 }
 
-/// `(C, ∇D)` at a node `x` with signed distance `phi0` and unit normal `n`:
-/// `C = Ψ_exact(x) − Ψ_plane(phi0)` and `∇D = ∇Ψ_exact(x) − Ψ_plane'(phi0) n`, by the
+/// `(C, ∇D, ∇∇D)` at a node `x` with signed distance `phi0` and unit normal `n`:
+/// `C = Ψ_exact(x) − Ψ_plane(phi0)`, `∇D = ∇Ψ_exact(x) − Ψ_plane'(phi0) n` and
+/// `∇∇D = ∇∇Ψ_exact(x) − Ψ_plane''(phi0) n nᵀ`, by the
 /// spherical quadrature `∫_{S²} [f_solid(ω) − f_plane(ω)] dω` with
 /// `f(ω) = ∫_{inside, t<h} W(t) t² dt` (and `−∫ ω ∫ W'(t) t² dt dω` for the gradient, since
-/// `∇_x W(|x − y|) = −W'(t) ω` for `y = x + t ω`). Directions: Gauss–Legendre in `μ = cos θ`
+/// `∇_x W(|x − y|) = −W'(t) ω` for `y = x + t ω`; and
+/// `∫ [ω ωᵀ ∫ W'' t² dt + (I − ω ωᵀ) ∫ W' t dt] dω` for the Hessian, from
+/// `∇∇W = W'' ω ωᵀ + (W'/t)(I − ω ωᵀ)`). Directions: Gauss–Legendre in `μ = cos θ`
 /// about `n`, split at `μ* = −phi0/h` where the tangent plane's `f_plane` has its kink,
 /// times uniform azimuths.
 pub(crate) fn node_correction<R: Real>(
@@ -429,7 +478,7 @@ pub(crate) fn node_correction<R: Real>(
     n: Vec3<f64>,
     tables: &KernelTables,
     dirs: &Directions,
-) -> (f64, Vec3<f64>) {
+) -> NodeCorrection {
     let h = tables.h;
     let helper = if n.x.abs() < 0.9 {
         Vec3::x()
@@ -448,7 +497,7 @@ pub(crate) fn node_correction<R: Real>(
     };
     let w_az = 2.0 * PI / dirs.azimuth.len() as f64;
     let mut crossings = Vec::with_capacity(8);
-    let (mut c, mut grad) = (0.0, Vec3::zeros());
+    let (mut c, mut grad, mut hess) = (0.0, Vec3::zeros(), Matrix3::zeros());
     let s_step = h / dirs.ray_samples as f64;
     for &(lo, hi, count) in &pieces {
         if count == 0 || hi <= lo {
@@ -458,7 +507,7 @@ pub(crate) fn node_correction<R: Real>(
         for &(xi, wi) in &dirs.polar_rules[count - 1] {
             let mu = m + hl * xi;
             let s = (1.0 - mu * mu).max(0.0).sqrt();
-            let (fp, fp1) = plane_sums(tables, phi0, mu);
+            let fp = plane_sums(tables, phi0, mu);
             for &(ca, sa) in &dirs.azimuth {
                 let dir = n * mu + (t1 * ca + t2 * sa) * s;
                 let ray = Ray { sdf, x, dir, h };
@@ -474,14 +523,26 @@ pub(crate) fn node_correction<R: Real>(
                     ray.scan(a, fa, b, fb, &mut crossings);
                     (a, fa) = (b, fb);
                 }
-                let (fs, fs1) = radial_sums(tables, phi0 < 0.0, &crossings);
+                let fs = radial_sums(tables, phi0 < 0.0, &crossings);
                 let w = wi * hl * w_az;
-                c += w * (fs - fp);
-                grad -= dir * (w * (fs1 - fp1));
+                c += w * (fs[0] - fp[0]);
+                grad -= dir * (w * (fs[1] - fp[1]));
+                let (s2, s3) = (w * (fs[2] - fp[2]), w * (fs[3] - fp[3]));
+                let oo = dir * dir.transpose();
+                hess += oo * (s2 - s3) + Matrix3::identity() * s3;
             }
         }
     }
-    (c, grad)
+    NodeCorrection { c, grad, hess }
+}
+
+/// The correction at one node relative to its tangent half-space `P`:
+/// `C = Ψ_exact − Ψ_P`, `∇(Ψ_exact − Ψ_P)` (1/m) and `∇∇(Ψ_exact − Ψ_P)` (1/m²).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct NodeCorrection {
+    pub(crate) c: f64,
+    pub(crate) grad: Vec3<f64>,
+    pub(crate) hess: Matrix3<f64>,
 }
 
 /// Probe directions of the planarity test: the 26 neighbour directions of a cube, unit.
