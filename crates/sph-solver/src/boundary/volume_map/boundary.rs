@@ -31,7 +31,10 @@ impl<R: Real> fmt::Debug for VolumeMapBoundary<R> {
             .field("kernel", &self.kernel)
             .field("support_radius", &self.support_radius)
             .field("contact_distance", &self.contact_distance)
-            .field("maps", &self.maps.iter().map(|m| m.stats()).collect::<Vec<_>>())
+            .field(
+                "maps",
+                &self.maps.iter().map(|m| m.stats()).collect::<Vec<_>>(),
+            )
             .finish()
     }
 }
@@ -69,7 +72,11 @@ impl<R: Real> VolumeMapBoundary<R> {
                 }
             }
             if domain.min[a] > domain.max[a] {
-                return Err(invalid("domain", domain.max[a].as_f64(), "max must be >= min"));
+                return Err(invalid(
+                    "domain",
+                    domain.max[a].as_f64(),
+                    "max must be >= min",
+                ));
             }
         }
         if kernel == KernelKind::Viscosity {
@@ -87,11 +94,10 @@ impl<R: Real> VolumeMapBoundary<R> {
             .iter()
             .enumerate()
             .map(|(i, s)| {
-                VolumeMap::build(s.as_ref(), tables.clone(), &domain, &options).map_err(|e| {
-                    match e {
-                        SolverError::Boundary(m) => SolverError::Boundary(format!("solid {i}: {m}")),
-                        e => e,
-                    }
+                VolumeMap::build(s.as_ref(), tables.clone(), &domain, &options).map_err(|e| match e
+                {
+                    SolverError::Boundary(m) => SolverError::Boundary(format!("solid {i}: {m}")),
+                    e => e,
                 })
             })
             .collect::<Result<Vec<_>, _>>()?;

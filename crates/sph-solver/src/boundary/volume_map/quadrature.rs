@@ -489,8 +489,8 @@ pub(crate) fn node_correction<R: Real>(
     let t2 = n.cross(&t1);
     let mu_star = (-phi0 / h).clamp(-1.0, 1.0);
     let pieces: [(f64, f64, usize); 2] = if dirs.polar >= 2 {
-        let n1 = ((dirs.polar as f64 * (mu_star + 1.0) / 2.0).round() as usize)
-            .clamp(1, dirs.polar - 1);
+        let n1 =
+            ((dirs.polar as f64 * (mu_star + 1.0) / 2.0).round() as usize).clamp(1, dirs.polar - 1);
         [(-1.0, mu_star, n1), (mu_star, 1.0, dirs.polar - n1)]
     } else {
         [(-1.0, 1.0, 1), (1.0, 1.0, 0)]
@@ -548,7 +548,11 @@ pub(crate) struct NodeCorrection {
 /// Probe directions of the planarity test: the 26 neighbour directions of a cube, unit.
 fn probe_directions() -> impl Iterator<Item = Vec3<f64>> {
     (0..27).filter(|&k| k != 13).map(|k| {
-        let v = Vec3::new((k % 3) as f64 - 1.0, ((k / 3) % 3) as f64 - 1.0, (k / 9) as f64 - 1.0);
+        let v = Vec3::new(
+            (k % 3) as f64 - 1.0,
+            ((k / 3) % 3) as f64 - 1.0,
+            (k / 9) as f64 - 1.0,
+        );
         v.normalize()
     })
 }
@@ -586,7 +590,11 @@ mod tests {
             let rule = gauss_legendre(n);
             for deg in 0..2 * n {
                 let q: f64 = rule.iter().map(|&(x, w)| w * x.powi(deg as i32)).sum();
-                let exact = if deg % 2 == 1 { 0.0 } else { 2.0 / (deg as f64 + 1.0) };
+                let exact = if deg % 2 == 1 {
+                    0.0
+                } else {
+                    2.0 / (deg as f64 + 1.0)
+                };
                 // Rounding only: the rule is exact for degree < 2n; 1e-13 covers the
                 // accumulated f64 error of up to 20 terms of size ≤ 2.
                 assert!((q - exact).abs() < 1e-13, "n {n} deg {deg}: {q} vs {exact}");
@@ -603,7 +611,10 @@ mod tests {
             let (a, b) = (t.psi_plane(d), half_space_volume(&k, d));
             // Hermite bound Δ⁴/384·max|f⁗| < 1e-13 (module docs) plus GL rounding.
             assert!((a - b).abs() < 1e-12, "{} d {d}: {a} vs {b}", k.name());
-            let (a, b) = (t.psi_plane_derivative(d), half_space_volume_derivative(&k, d));
+            let (a, b) = (
+                t.psi_plane_derivative(d),
+                half_space_volume_derivative(&k, d),
+            );
             assert!((a - b).abs() * h < 1e-11, "{} d' {d}: {a} vs {b}", k.name());
         }
         // G(h) = ∫ W r² dr = 1/(4π) for a normalised 3D kernel: independent of the table.
