@@ -350,7 +350,7 @@ impl<R: Real> VolumeMap<R> {
             let pr = vr::<R>(&p);
             let phi = solid.signed_distance(&pr).as_f64();
             let n = unit_normal(solid, &pr);
-            if !(phi.abs() < h) {
+            if phi.is_nan() || phi.abs() >= h {
                 return (phi, n, zero);
             }
             band.fetch_add(1, Ordering::Relaxed);
@@ -486,7 +486,7 @@ impl<R: Real> VolumeMap<R> {
 
     fn plane_only(&self, solid: &dyn Sdf<R>, x: &Vec3<R>) -> (f64, Vec3<f64>) {
         let phi = solid.signed_distance(x).as_f64();
-        if !(phi < self.tables.h) {
+        if phi.is_nan() || phi >= self.tables.h {
             return (0.0, Vec3::zeros());
         }
         let n = unit_normal(solid, x);
