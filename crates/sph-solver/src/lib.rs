@@ -25,7 +25,11 @@ pub mod step;
 #[cfg(feature = "testing")]
 pub mod testing;
 
-pub use boundary::{Boundary, BoundarySample, ClosestPoint, CollisionBoundary};
+pub use boundary::{
+    half_space_volume, half_space_volume_derivative, Boundary, BoundarySample, ClosestPoint,
+    CollisionBoundary, Interpolation, VolumeMap, VolumeMapBoundary, VolumeMapOptions,
+    VolumeMapStats,
+};
 pub use error::SolverError;
 pub use params::{CommonParams, DEFAULT_SUPPORT_OVER_SPACING, MAX_SUBSTEPS};
 pub use stats::{PhaseTimes, StepStats, MAX_PHASES};

@@ -9,8 +9,14 @@
 //!   gradient `∇Ψ` to the pressure forces; see the module `volume_map` for the equations.
 
 mod collision;
+mod grid_standin;
+pub mod volume_map;
 
 pub use collision::CollisionBoundary;
+pub use volume_map::{
+    half_space_volume, half_space_volume_derivative, Interpolation, VolumeMap, VolumeMapBoundary,
+    VolumeMapOptions, VolumeMapStats,
+};
 
 use sph_core::{Real, Sdf, Vec3};
 

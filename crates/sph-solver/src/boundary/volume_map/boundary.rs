@@ -1,0 +1,149 @@
+//! [`VolumeMapBoundary`]: one [`VolumeMap`] per solid behind the [`Boundary`] trait.
+
+use std::fmt;
+use std::sync::Arc;
+
+use sph_core::{Aabb, Real, Sdf, Vec3};
+use sph_kernels::{Kernel, KernelKind};
+
+use super::quadrature::KernelTables;
+use super::{invalid, VolumeMap, VolumeMapOptions};
+use crate::boundary::{project_out, Boundary, BoundarySample};
+use crate::SolverError;
+
+/// Solids with volume maps (Bender et al. 2019; equations in the module docs of
+/// `volume_map`): [`Boundary::sample`] returns `Ψ(x) = Σ_k Ψ_k(x)` and
+/// `∇Ψ(x) = Σ_k ∇Ψ_k(x)` summed over the solids (overlapping solids double-count their
+/// overlap), [`Boundary::project`] moves particles out of the solids to `contact_distance`
+/// (m) as a safety net against tunnelling.
+pub struct VolumeMapBoundary<R: Real> {
+    solids: Vec<Box<dyn Sdf<R>>>,
+    maps: Vec<VolumeMap<R>>,
+    kernel: KernelKind,
+    support_radius: R,
+    contact_distance: R,
+}
+
+impl<R: Real> fmt::Debug for VolumeMapBoundary<R> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("VolumeMapBoundary")
+            .field("solids", &self.solids.len())
+            .field("kernel", &self.kernel)
+            .field("support_radius", &self.support_radius)
+            .field("contact_distance", &self.contact_distance)
+            .field(
+                "maps",
+                &self.maps.iter().map(|m| m.stats()).collect::<Vec<_>>(),
+            )
+            .finish()
+    }
+}
+
+impl<R: Real> VolumeMapBoundary<R> {
+    /// Builds one volume map per solid for `kernel` with support radius `support_radius`
+    /// (m, finite and > 0), over `domain` (m; finite, `min ≤ max`; the grids of unbounded
+    /// solids cover it grown by `h`, those of bounded solids their bounds grown by `h`
+    /// intersected with it). `contact_distance` (m, finite, ≥ 0) is the distance
+    /// [`Boundary::project`] keeps particles from the surfaces.
+    ///
+    /// Errors: [`SolverError::InvalidParameter`] (`solver: "volume map"`) for bad options,
+    /// distances or domain; [`SolverError::Kernel`] for an unusable `h`;
+    /// [`SolverError::Boundary`] naming the solid when its grid is too large.
+    pub fn new(
+        solids: Vec<Box<dyn Sdf<R>>>,
+        kernel: KernelKind,
+        support_radius: R,
+        domain: Aabb<R>,
+        contact_distance: R,
+        options: VolumeMapOptions,
+    ) -> Result<Self, SolverError> {
+        options.validate()?;
+        if !(contact_distance.is_finite_value() && contact_distance >= R::zero()) {
+            return Err(invalid(
+                "contact_distance",
+                contact_distance.as_f64(),
+                "must be finite and >= 0",
+            ));
+        }
+        for a in 0..3 {
+            for v in [domain.min[a], domain.max[a]] {
+                if !v.is_finite_value() {
+                    return Err(invalid("domain", v.as_f64(), "corners must be finite"));
+                }
+            }
+            if domain.min[a] > domain.max[a] {
+                return Err(invalid(
+                    "domain",
+                    domain.max[a].as_f64(),
+                    "max must be >= min",
+                ));
+            }
+        }
+        if kernel == KernelKind::Viscosity {
+            return Err(invalid(
+                "kernel",
+                f64::NAN,
+                "the viscosity kernel is singular at r = 0 (its W'' r² is not integrable)",
+            ));
+        }
+        let k = kernel.build(support_radius.as_f64())?;
+        // The kernel must also be representable in the solver's precision.
+        kernel.build(support_radius)?;
+        let tables = Arc::new(KernelTables::new(&k));
+        let maps = solids
+            .iter()
+            .enumerate()
+            .map(|(i, s)| {
+                VolumeMap::build(s.as_ref(), tables.clone(), &domain, &options).map_err(|e| match e
+                {
+                    SolverError::Boundary(m) => SolverError::Boundary(format!("solid {i}: {m}")),
+                    e => e,
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        debug_assert_eq!(k.name(), kernel.name());
+        Ok(Self {
+            solids,
+            maps,
+            kernel,
+            support_radius,
+            contact_distance,
+        })
+    }
+
+    /// The maps, one per solid (in [`Boundary::solids`] order), with their build statistics.
+    pub fn maps(&self) -> &[VolumeMap<R>] {
+        &self.maps
+    }
+}
+
+impl<R: Real> Boundary<R> for VolumeMapBoundary<R> {
+    fn name(&self) -> &'static str {
+        "volume-map"
+    }
+    fn solids(&self) -> &[Box<dyn Sdf<R>>] {
+        &self.solids
+    }
+    fn has_volume(&self) -> bool {
+        true
+    }
+    fn volume_kernel(&self) -> Option<(&'static str, R)> {
+        Some((self.kernel.name(), self.support_radius))
+    }
+    fn sample(&self, x: &Vec3<R>) -> BoundarySample<R> {
+        let mut out = BoundarySample::default();
+        for (s, m) in self.solids.iter().zip(&self.maps) {
+            let (v, g) = m.sample(s.as_ref(), x);
+            out.volume += v;
+            out.volume_gradient += g;
+        }
+        out
+    }
+    #[inline]
+    fn project(&self, x: Vec3<R>) -> Vec3<R> {
+        project_out(&self.solids, x, self.contact_distance)
+    }
+    fn contact_distance(&self) -> R {
+        self.contact_distance
+    }
+}

@@ -1,0 +1,634 @@
+//! The integrals behind the volume maps: Gauss–Legendre rules, the exact half-space volume
+//! `Ψ_plane(d)`, tabulated radial antiderivatives, and the spherical quadrature of the
+//! difference between a solid and its tangent half-space at one grid node.
+
+use std::f64::consts::PI;
+
+use nalgebra::Matrix3;
+use sph_core::{Real, Sdf, Vec3};
+use sph_kernels::Kernel;
+
+/// Gauss–Legendre nodes and weights on `[−1, 1]` (`n ≥ 1` points, exact for polynomials of
+/// degree `2n − 1`), by Newton iteration on the three-term recurrence of `P_n`.
+pub(crate) fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
+    let n = n.max(1);
+    let legendre = |x: f64| {
+        let (mut p0, mut p1) = (1.0, x);
+        for k in 2..=n {
+            let kf = k as f64;
+            let p2 = ((2.0 * kf - 1.0) * x * p1 - (kf - 1.0) * p0) / kf;
+            p0 = p1;
+            p1 = p2;
+        }
+        if n == 1 {
+            (x, 1.0)
+        } else {
+            // P_n' = n (x P_n − P_{n−1}) / (x² − 1)
+            (p1, n as f64 * (x * p1 - p0) / (x * x - 1.0))
+        }
+    };
+    let mut out = vec![(0.0, 0.0); n];
+    for i in 0..n.div_ceil(2) {
+        let mut x = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+        for _ in 0..100 {
+            let (p, dp) = legendre(x);
+            let dx = p / dp;
+            x -= dx;
+            if dx.abs() < 1e-16 {
+                break;
+            }
+        }
+        let (_, dp) = legendre(x);
+        let w = 2.0 / ((1.0 - x * x) * dp * dp);
+        out[i] = (-x, w);
+        out[n - 1 - i] = (x, w);
+    }
+    out
+}
+
+/// Points of the per-panel rule of the radial integrals (8 points: exact to degree 15,
+/// enough for every polynomial kernel of `sph-kernels` times `r²` or `r (r − d)`).
+const PANEL_POINTS: usize = 8;
+/// Panels per smooth piece for a kernel whose name is not in [`breakpoints`] (composite rule:
+/// for a piecewise polynomial of unknown breakpoints the error of a panel containing a kink in
+/// the `k`-th derivative is `O(panel^{k+1})`; 256 panels reach 1e-12 for `C¹` kernels).
+const UNKNOWN_KERNEL_PANELS: usize = 256;
+
+/// Interior breakpoints (in units of `h`) where the kernel changes polynomial piece, and the
+/// number of panels per piece: `cubic-spline` changes at `h/2`; the Müller and Wendland kernels
+/// are one polynomial (the viscosity kernel a polynomial plus `h/(2r)`, which becomes a
+/// polynomial in every integrand used here); unknown kernels get a composite rule.
+fn breakpoints(name: &str) -> (&'static [f64], usize) {
+    match name {
+        "cubic-spline" | "cubic-spline-2d" => (&[0.5], 1),
+        "poly6" | "spiky" | "viscosity" | "wendland-c2" | "wendland-c2-2d" => (&[], 1),
+        _ => (&[], UNKNOWN_KERNEL_PANELS),
+    }
+}
+
+/// `∫_a^b f(r) dr` for `0 ≤ a ≤ b ≤ h`, split at the kernel's breakpoints, Gauss–Legendre per
+/// panel.
+fn integrate_radial<K: Kernel<f64>>(
+    kernel: &K,
+    rule: &[(f64, f64)],
+    a: f64,
+    b: f64,
+    f: impl Fn(f64) -> f64,
+) -> f64 {
+    let h = kernel.support_radius();
+    let (bps, panels) = breakpoints(kernel.name());
+    let mut cuts = vec![a];
+    cuts.extend(bps.iter().map(|q| q * h).filter(|&r| r > a && r < b));
+    cuts.push(b);
+    let mut sum = 0.0;
+    for w in cuts.windows(2) {
+        let step = (w[1] - w[0]) / panels as f64;
+        for p in 0..panels {
+            let lo = w[0] + step * p as f64;
+            let (m, hl) = (lo + 0.5 * step, 0.5 * step);
+            sum += hl * rule.iter().map(|&(x, wt)| wt * f(m + hl * x)).sum::<f64>();
+        }
+    }
+    sum
+}
+
+/// The kernel-weighted volume of a half-space at signed distance `d` (m) from the evaluation
+/// point (`d > 0`: the solid is on the far side of a plane `d` away; `d < 0`: the point is
+/// inside the solid), for a 3D kernel of support radius `h` (dimensionless, in `[0, 1]`):
+///
+/// `Ψ_plane(d) = 2π ∫_d^h W(r) r (r − d) dr` for `0 ≤ d < h` (`2π r (r − d)` is the area of
+/// the spherical cap of radius `r` beyond the plane), `0` for `d ≥ h`, and
+/// `Ψ_plane(−d) = 1 − Ψ_plane(d)` (so `Ψ_plane(0) = 1/2`, `Ψ_plane(−h) = 1` for a normalised
+/// kernel).
+///
+/// Computed with 8-point Gauss–Legendre on `[d, h]` split at the kernel's interior
+/// breakpoints (`h/2` for `cubic-spline`): exact up to rounding for the polynomial kernels of
+/// `sph-kernels`; a kernel with an unknown name gets a 256-panel composite rule. NaN for a NaN
+/// `d` or an invalid support radius; the value is meaningless for 2D kernels.
+pub fn half_space_volume<K: Kernel<f64>>(kernel: &K, d: f64) -> f64 {
+    let h = kernel.support_radius();
+    if d.is_nan() || !(h.is_finite() && h > 0.0) {
+        return f64::NAN;
+    }
+    if d >= h {
+        0.0
+    } else if d <= -h {
+        1.0
+    } else if d < 0.0 {
+        1.0 - half_space_volume(kernel, -d)
+    } else {
+        let rule = gauss_legendre(PANEL_POINTS);
+        2.0 * PI * integrate_radial(kernel, &rule, d, h, |r| kernel.value(r) * r * (r - d))
+    }
+}
+
+/// `dΨ_plane/dd` (1/m) of [`half_space_volume`]: `−2π ∫_{|d|}^h W(r) r dr` for `|d| < h`
+/// (even in `d`), 0 for `|d| ≥ h`; same quadrature. NaN for a NaN `d`.
+pub fn half_space_volume_derivative<K: Kernel<f64>>(kernel: &K, d: f64) -> f64 {
+    let h = kernel.support_radius();
+    if d.is_nan() || !(h.is_finite() && h > 0.0) {
+        return f64::NAN;
+    }
+    let a = d.abs();
+    if a >= h {
+        return 0.0;
+    }
+    let rule = gauss_legendre(PANEL_POINTS);
+    -2.0 * PI * integrate_radial(kernel, &rule, a, h, |r| kernel.value(r) * r)
+}
+
+/// A function on `[0, h]` tabulated with its derivative at `n + 1` equidistant nodes and
+/// evaluated by cubic Hermite interpolation (error `≤ Δ⁴/384 · max|f⁗|`, `Δ = h/n`), clamped
+/// to the end values outside `[0, h]`.
+#[derive(Debug, Clone)]
+pub(crate) struct HermiteTable {
+    dx: f64,
+    /// `(value, slope from the left, slope to the right)` per node (one-sided slopes keep
+    /// the table exact to the bound where the derivative jumps at a node, e.g. `W''` of the
+    /// cubic spline at `h/2`).
+    nodes: Vec<(f64, f64, f64)>,
+}
+
+impl HermiteTable {
+    /// `f(k, t) = value`, `slope(t)` the derivative, evaluated `1e-9 Δ` left and right of
+    /// each node.
+    fn new(h: f64, n: usize, f: impl Fn(usize, f64) -> f64, slope: impl Fn(f64) -> f64) -> Self {
+        let dx = h / n as f64;
+        let e = 1e-9 * dx;
+        Self {
+            dx,
+            nodes: (0..=n)
+                .map(|k| {
+                    let t = k as f64 * dx;
+                    (f(k, t), slope((t - e).max(0.0)), slope(t + e))
+                })
+                .collect(),
+        }
+    }
+
+    #[inline]
+    pub(crate) fn eval(&self, t: f64) -> f64 {
+        let n = self.nodes.len() - 1;
+        let u = t / self.dx;
+        if u.is_nan() || u <= 0.0 {
+            return self.nodes[0].0;
+        }
+        if u >= n as f64 {
+            return self.nodes[n].0;
+        }
+        let i = (u as usize).min(n - 1);
+        let s = u - i as f64;
+        let ((y0, _, m0), (y1, m1, _)) = (self.nodes[i], self.nodes[i + 1]);
+        let s2 = s * s;
+        let h00 = (1.0 + 2.0 * s) * (1.0 - s) * (1.0 - s);
+        let h10 = s * (1.0 - s) * (1.0 - s);
+        let h01 = s2 * (3.0 - 2.0 * s);
+        let h11 = s2 * (s - 1.0);
+        h00 * y0 + h10 * self.dx * m0 + h01 * y1 + h11 * self.dx * m1
+    }
+}
+
+/// Intervals of each table (the Hermite error bound gives < 1e-13 for every kernel of
+/// `sph-kernels`; the tests check the tables against [`half_space_volume`] to 1e-12).
+pub(crate) const TABLE_INTERVALS: usize = 4096;
+
+/// The per-kernel tables of a volume map: `G(t) = ∫_0^t W r² dr`, `G₁(t) = ∫_0^t W'(r) r² dr`,
+/// `Ψ_plane` and `dΨ_plane/dd` on `[0, h]`.
+#[derive(Debug, Clone)]
+pub(crate) struct KernelTables {
+    pub(crate) h: f64,
+    g: HermiteTable,
+    g1: HermiteTable,
+    g2: HermiteTable,
+    g3: HermiteTable,
+    plane: HermiteTable,
+    plane_d: HermiteTable,
+}
+
+impl KernelTables {
+    pub(crate) fn new<K: Kernel<f64>>(kernel: &K) -> Self {
+        let h = kernel.support_radius();
+        let n = TABLE_INTERVALS;
+        let rule = gauss_legendre(PANEL_POINTS);
+        // Slopes at r = 0 are taken at 1e-12 h (limits; the viscosity kernel is rejected by
+        // the volume maps, its W'' r² diverges).
+        let at = |r: f64| r.max(1e-12 * h);
+        let w = |r: f64| kernel.value(at(r));
+        let dw = |r: f64| kernel.derivative(at(r));
+        // W'' = ∇²W − 2W'/r (the 3D radial Laplacian).
+        let ddw = |r: f64| {
+            let r = at(r);
+            kernel.laplacian(r).unwrap_or(f64::NAN) - 2.0 * kernel.derivative(r) / r
+        };
+        let dx = h / n as f64;
+        let accumulate = |f: &dyn Fn(f64) -> f64| {
+            let mut acc = vec![0.0; n + 1];
+            for k in 0..n {
+                let (a, b) = (k as f64 * dx, (k + 1) as f64 * dx);
+                acc[k + 1] = acc[k] + integrate_radial(kernel, &rule, a, b, f);
+            }
+            acc
+        };
+        let gv = accumulate(&|r| kernel.value(r) * r * r);
+        let g1v = accumulate(&|r| kernel.derivative(r) * r * r);
+        let g2v = accumulate(&|r| ddw(r) * r * r);
+        let g3v = accumulate(&|r| kernel.derivative(r) * r);
+        let sq = |r: f64| at(r) * at(r);
+        Self {
+            h,
+            g: HermiteTable::new(h, n, |k, _| gv[k], |r| w(r) * sq(r)),
+            g1: HermiteTable::new(h, n, |k, _| g1v[k], |r| dw(r) * sq(r)),
+            g2: HermiteTable::new(h, n, |k, _| g2v[k], |r| ddw(r) * sq(r)),
+            g3: HermiteTable::new(h, n, |k, _| g3v[k], |r| dw(r) * at(r)),
+            plane: HermiteTable::new(
+                h,
+                n,
+                |_, d| half_space_volume(kernel, d),
+                |d| half_space_volume_derivative(kernel, d),
+            ),
+            plane_d: HermiteTable::new(
+                h,
+                n,
+                |_, d| half_space_volume_derivative(kernel, d),
+                |d| 2.0 * PI * w(d) * at(d),
+            ),
+        }
+    }
+
+    /// `G(t) = ∫_0^t W(r) r² dr`.
+    #[inline]
+    pub(crate) fn g(&self, t: f64) -> f64 {
+        self.g.eval(t)
+    }
+
+    /// `G₁(t) = ∫_0^t W'(r) r² dr`.
+    #[inline]
+    pub(crate) fn g1(&self, t: f64) -> f64 {
+        self.g1.eval(t)
+    }
+
+    /// `G₂(t) = ∫_0^t W''(r) r² dr`.
+    #[inline]
+    pub(crate) fn g2(&self, t: f64) -> f64 {
+        self.g2.eval(t)
+    }
+
+    /// `G₃(t) = ∫_0^t W'(r) r dr`.
+    #[inline]
+    pub(crate) fn g3(&self, t: f64) -> f64 {
+        self.g3.eval(t)
+    }
+
+    /// `Ψ_plane(d)` from the table.
+    #[inline]
+    pub(crate) fn psi_plane(&self, d: f64) -> f64 {
+        if d >= self.h {
+            0.0
+        } else if d <= -self.h {
+            1.0
+        } else if d < 0.0 {
+            1.0 - self.plane.eval(-d)
+        } else {
+            self.plane.eval(d)
+        }
+    }
+
+    /// `dΨ_plane/dd` from the table (1/m).
+    #[inline]
+    pub(crate) fn psi_plane_derivative(&self, d: f64) -> f64 {
+        if d.abs() >= self.h {
+            0.0
+        } else {
+            self.plane_d.eval(d.abs())
+        }
+    }
+}
+
+/// The direction set of the node quadrature.
+#[derive(Debug, Clone)]
+pub(crate) struct Directions {
+    /// Gauss–Legendre rules on `[−1, 1]` with `1..=polar` points (index = count − 1).
+    polar_rules: Vec<Vec<(f64, f64)>>,
+    polar: usize,
+    /// `(cos α, sin α)` of the azimuths, uniform with a half-step offset.
+    azimuth: Vec<(f64, f64)>,
+    ray_samples: usize,
+}
+
+impl Directions {
+    pub(crate) fn new(polar: usize, azimuth: usize, ray_samples: usize) -> Self {
+        Self {
+            polar_rules: (1..=polar).map(gauss_legendre).collect(),
+            polar,
+            azimuth: (0..azimuth)
+                .map(|k| {
+                    let a = 2.0 * PI * (k as f64 + 0.5) / azimuth as f64;
+                    (a.cos(), a.sin())
+                })
+                .collect(),
+            ray_samples,
+        }
+    }
+}
+
+/// Lipschitz bound assumed for the signed distance along a ray when looking for thin
+/// slivers between samples of equal sign (1 for exact distances; 2 leaves room for the
+/// trilinear `GridSdf`, whose gradient norm is at most `√3`).
+const LIPSCHITZ: f64 = 2.0;
+/// Slivers thinner than this (relative to `h`) are not looked for.
+const MIN_SLIVER: f64 = 1e-6;
+/// Root tolerance along a ray (relative to `h`).
+const ROOT_TOL: f64 = 1e-10;
+
+/// The solid's signed distance along the ray `x + t ω`, evaluated in the solid's precision.
+struct Ray<'a, R: Real> {
+    sdf: &'a dyn Sdf<R>,
+    x: Vec3<f64>,
+    dir: Vec3<f64>,
+    h: f64,
+}
+
+impl<R: Real> Ray<'_, R> {
+    fn phi(&self, t: f64) -> f64 {
+        let p = self.x + self.dir * t;
+        self.sdf
+            .signed_distance(&Vec3::new(R::of_f64(p.x), R::of_f64(p.y), R::of_f64(p.z)))
+            .as_f64()
+    }
+
+    /// Appends the sign changes of `φ` in `(a, b)`, in order.
+    fn scan(&self, a: f64, fa: f64, b: f64, fb: f64, out: &mut Vec<f64>) {
+        if (fa < 0.0) != (fb < 0.0) {
+            out.push(self.root(a, fa, b, fb));
+            return;
+        }
+        if fa.is_nan() || fb.is_nan() || fa.abs() + fb.abs() >= LIPSCHITZ * (b - a) {
+            return;
+        }
+        if b - a < MIN_SLIVER * self.h {
+            return;
+        }
+        let m = 0.5 * (a + b);
+        let fm = self.phi(m);
+        self.scan(a, fa, m, fm, out);
+        self.scan(m, fm, b, fb, out);
+    }
+
+    /// A sign change of `φ` in `[a, b]` (Illinois regula falsi, bisection fallback).
+    fn root(&self, mut a: f64, mut fa: f64, mut b: f64, mut fb: f64) -> f64 {
+        let tol = ROOT_TOL * self.h;
+        let mut side = 0i8;
+        for _ in 0..100 {
+            if b - a <= tol {
+                break;
+            }
+            let mut c = (a * fb - b * fa) / (fb - fa);
+            if !(c > a && c < b) {
+                c = 0.5 * (a + b);
+            }
+            let fc = self.phi(c);
+            if fc.abs() <= tol {
+                return c;
+            }
+            if (fc < 0.0) == (fa < 0.0) {
+                a = c;
+                fa = fc;
+                if side == -1 {
+                    fb *= 0.5;
+                }
+                side = -1;
+            } else {
+                b = c;
+                fb = fc;
+                if side == 1 {
+                    fa *= 0.5;
+                }
+                side = 1;
+            }
+        }
+        0.5 * (a + b)
+    }
+}
+
+/// `(∫ W t² dt, ∫ W' t² dt)` over the parts of `[0, h]` where the list of crossings (sign
+/// changes, in order) says the ray is inside, starting inside when `inside0`.
+#[inline]
+fn radial_sums(tables: &KernelTables, inside0: bool, crossings: &[f64]) -> [f64; 4] {
+    let (mut inside, mut prev, mut s) = (inside0, 0.0, [0.0; 4]);
+    for &t in crossings.iter().chain(std::iter::once(&tables.h)) {
+        if inside {
+            let d = interval_sums(tables, prev, t);
+            for (a, b) in s.iter_mut().zip(d) {
+                *a += b;
+            }
+        }
+        inside = !inside;
+        prev = t;
+    }
+    s
+}
+
+/// `[∫ W t², ∫ W' t², ∫ W'' t², ∫ W' t]` over `[a, b]`.
+#[inline]
+fn interval_sums(tables: &KernelTables, a: f64, b: f64) -> [f64; 4] {
+    [
+        tables.g(b) - tables.g(a),
+        tables.g1(b) - tables.g1(a),
+        tables.g2(b) - tables.g2(a),
+        tables.g3(b) - tables.g3(a),
+    ]
+}
+
+/// The same sums for the tangent half-space `{y : φ₀ + n·(y − x) < 0}` along a direction
+/// with `μ = n·ω`.
+#[inline]
+fn plane_sums(tables: &KernelTables, phi0: f64, mu: f64) -> [f64; 4] {
+    let h = tables.h;
+    let (a, b) = if mu == 0.0 {
+        if phi0 < 0.0 {
+            (0.0, h)
+        } else {
+            (0.0, 0.0)
+        }
+    } else {
+        let t = (-phi0 / mu).clamp(0.0, h);
+        if mu > 0.0 {
+            (0.0, t)
+        } else {
+            (t, h)
+        }
+    };
+    interval_sums(tables, a, b)
+}
+
+/// `(C, ∇D, ∇∇D)` at a node `x` with signed distance `phi0` and unit normal `n`:
+/// `C = Ψ_exact(x) − Ψ_plane(phi0)`, `∇D = ∇Ψ_exact(x) − Ψ_plane'(phi0) n` and
+/// `∇∇D = ∇∇Ψ_exact(x) − Ψ_plane''(phi0) n nᵀ`, by the
+/// spherical quadrature `∫_{S²} [f_solid(ω) − f_plane(ω)] dω` with
+/// `f(ω) = ∫_{inside, t<h} W(t) t² dt` (and `−∫ ω ∫ W'(t) t² dt dω` for the gradient, since
+/// `∇_x W(|x − y|) = −W'(t) ω` for `y = x + t ω`; and
+/// `∫ [ω ωᵀ ∫ W'' t² dt + (I − ω ωᵀ) ∫ W' t dt] dω` for the Hessian, from
+/// `∇∇W = W'' ω ωᵀ + (W'/t)(I − ω ωᵀ)`). Directions: Gauss–Legendre in `μ = cos θ`
+/// about `n`, split at `μ* = −phi0/h` where the tangent plane's `f_plane` has its kink,
+/// times uniform azimuths.
+pub(crate) fn node_correction<R: Real>(
+    sdf: &dyn Sdf<R>,
+    x: Vec3<f64>,
+    phi0: f64,
+    n: Vec3<f64>,
+    tables: &KernelTables,
+    dirs: &Directions,
+) -> NodeCorrection {
+    let h = tables.h;
+    let helper = if n.x.abs() < 0.9 {
+        Vec3::x()
+    } else {
+        Vec3::y()
+    };
+    let t1 = (helper - n * helper.dot(&n)).normalize();
+    let t2 = n.cross(&t1);
+    let mu_star = (-phi0 / h).clamp(-1.0, 1.0);
+    let pieces: [(f64, f64, usize); 2] = if dirs.polar >= 2 {
+        let n1 =
+            ((dirs.polar as f64 * (mu_star + 1.0) / 2.0).round() as usize).clamp(1, dirs.polar - 1);
+        [(-1.0, mu_star, n1), (mu_star, 1.0, dirs.polar - n1)]
+    } else {
+        [(-1.0, 1.0, 1), (1.0, 1.0, 0)]
+    };
+    let w_az = 2.0 * PI / dirs.azimuth.len() as f64;
+    let mut crossings = Vec::with_capacity(8);
+    let (mut c, mut grad, mut hess) = (0.0, Vec3::zeros(), Matrix3::zeros());
+    let s_step = h / dirs.ray_samples as f64;
+    for &(lo, hi, count) in &pieces {
+        if count == 0 || hi <= lo {
+            continue;
+        }
+        let (m, hl) = (0.5 * (lo + hi), 0.5 * (hi - lo));
+        for &(xi, wi) in &dirs.polar_rules[count - 1] {
+            let mu = m + hl * xi;
+            let s = (1.0 - mu * mu).max(0.0).sqrt();
+            let fp = plane_sums(tables, phi0, mu);
+            for &(ca, sa) in &dirs.azimuth {
+                let dir = n * mu + (t1 * ca + t2 * sa) * s;
+                let ray = Ray { sdf, x, dir, h };
+                crossings.clear();
+                let (mut a, mut fa) = (0.0, phi0);
+                for k in 1..=dirs.ray_samples {
+                    let b = if k == dirs.ray_samples {
+                        h
+                    } else {
+                        k as f64 * s_step
+                    };
+                    let fb = ray.phi(b);
+                    ray.scan(a, fa, b, fb, &mut crossings);
+                    (a, fa) = (b, fb);
+                }
+                let fs = radial_sums(tables, phi0 < 0.0, &crossings);
+                let w = wi * hl * w_az;
+                c += w * (fs[0] - fp[0]);
+                grad -= dir * (w * (fs[1] - fp[1]));
+                let (s2, s3) = (w * (fs[2] - fp[2]), w * (fs[3] - fp[3]));
+                let oo = dir * dir.transpose();
+                hess += oo * (s2 - s3) + Matrix3::identity() * s3;
+            }
+        }
+    }
+    NodeCorrection { c, grad, hess }
+}
+
+/// The correction at one node relative to its tangent half-space `P`:
+/// `C = Ψ_exact − Ψ_P`, `∇(Ψ_exact − Ψ_P)` (1/m) and `∇∇(Ψ_exact − Ψ_P)` (1/m²).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct NodeCorrection {
+    pub(crate) c: f64,
+    pub(crate) grad: Vec3<f64>,
+    pub(crate) hess: Matrix3<f64>,
+}
+
+/// Probe directions of the planarity test: the 26 neighbour directions of a cube, unit.
+fn probe_directions() -> impl Iterator<Item = Vec3<f64>> {
+    (0..27).filter(|&k| k != 13).map(|k| {
+        let v = Vec3::new(
+            (k % 3) as f64 - 1.0,
+            ((k / 3) % 3) as f64 - 1.0,
+            (k / 9) as f64 - 1.0,
+        );
+        v.normalize()
+    })
+}
+
+/// Whether the solid agrees with its tangent half-space at `x` on the probe points
+/// `x + r e` (26 directions `e`, `r ∈ {h/3, 2h/3, h}`), to `tol` (m).
+pub(crate) fn looks_planar<R: Real>(
+    sdf: &dyn Sdf<R>,
+    x: Vec3<f64>,
+    phi0: f64,
+    n: Vec3<f64>,
+    h: f64,
+    tol: f64,
+) -> bool {
+    probe_directions().all(|e| {
+        (1..=3).all(|k| {
+            let r = h * k as f64 / 3.0;
+            let p = x + e * r;
+            let phi = sdf
+                .signed_distance(&Vec3::new(R::of_f64(p.x), R::of_f64(p.y), R::of_f64(p.z)))
+                .as_f64();
+            (phi - (phi0 + r * n.dot(&e))).abs() <= tol
+        })
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sph_kernels::{CubicSpline, Poly6, Spiky, WendlandC2};
+
+    #[test]
+    fn gauss_legendre_integrates_monomials() {
+        for n in 1..=20 {
+            let rule = gauss_legendre(n);
+            for deg in 0..2 * n {
+                let q: f64 = rule.iter().map(|&(x, w)| w * x.powi(deg as i32)).sum();
+                let exact = if deg % 2 == 1 {
+                    0.0
+                } else {
+                    2.0 / (deg as f64 + 1.0)
+                };
+                // Rounding only: the rule is exact for degree < 2n; 1e-13 covers the
+                // accumulated f64 error of up to 20 terms of size ≤ 2.
+                assert!((q - exact).abs() < 1e-13, "n {n} deg {deg}: {q} vs {exact}");
+            }
+        }
+    }
+
+    fn tables_match<K: Kernel<f64>>(k: K) {
+        let t = KernelTables::new(&k);
+        let h = k.support_radius();
+        for i in 0..=997 {
+            // Off-node points: 997 does not divide 4096.
+            let d = -h + 2.0 * h * i as f64 / 997.0;
+            let (a, b) = (t.psi_plane(d), half_space_volume(&k, d));
+            // Hermite bound Δ⁴/384·max|f⁗| < 1e-13 (module docs) plus GL rounding.
+            assert!((a - b).abs() < 1e-12, "{} d {d}: {a} vs {b}", k.name());
+            let (a, b) = (
+                t.psi_plane_derivative(d),
+                half_space_volume_derivative(&k, d),
+            );
+            assert!((a - b).abs() * h < 1e-11, "{} d' {d}: {a} vs {b}", k.name());
+        }
+        // G(h) = ∫ W r² dr = 1/(4π) for a normalised 3D kernel: independent of the table.
+        assert!((t.g(h) * 4.0 * PI - 1.0).abs() < 1e-12);
+        // G₁(h) = ∫ W' r² dr = −2 ∫ W r dr (by parts, W(h) = 0) = Ψ_plane'(0)/π.
+        let ref_g1 = half_space_volume_derivative(&k, 0.0) / PI;
+        assert!((t.g1(h) - ref_g1).abs() * h < 1e-11, "{}", k.name());
+    }
+
+    #[test]
+    fn tables_agree_with_direct_quadrature() {
+        tables_match(Poly6::new(0.7).unwrap());
+        tables_match(Spiky::new(0.7).unwrap());
+        tables_match(CubicSpline::new(0.7).unwrap());
+        tables_match(WendlandC2::new(0.7).unwrap());
+    }
+}
