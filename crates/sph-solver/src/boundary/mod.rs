@@ -9,7 +9,6 @@
 //!   gradient `∇Ψ` to the pressure forces; see the module `volume_map` for the equations.
 
 mod collision;
-mod grid_standin;
 pub mod volume_map;
 
 pub use collision::CollisionBoundary;

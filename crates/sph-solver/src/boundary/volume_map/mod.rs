@@ -97,8 +97,7 @@ use std::time::{Duration, Instant};
 use rayon::prelude::*;
 use sph_core::{Aabb, Real, Sdf, Vec3};
 
-// Switch to `sph_core::grid::SampledGrid` when it lands.
-use super::grid_standin::SampledGrid;
+use sph_core::grid::SampledGrid;
 use crate::SolverError;
 use nalgebra::Matrix3;
 use quadrature::{looks_planar, node_correction, Directions, KernelTables, NodeCorrection};
@@ -232,7 +231,7 @@ const FAR: u32 = u32::MAX;
 const DEEP: u32 = u32::MAX - 1;
 
 #[derive(Debug, Clone)]
-enum Storage<R> {
+enum Storage<R: Real> {
     /// No grid (the band misses the domain).
     Empty,
     NodePlanes {
