@@ -148,9 +148,10 @@ fn mesh_fluid_volume_and_velocities() {
 }
 
 /// Building twice does not reload the meshes (they are shared through an `Arc`) and the
-/// grid SDF of a scene mesh builds quickly.
+/// grid SDF of a scene mesh agrees with the exact distance (build time is a benchmark's
+/// business, not a test's).
 #[test]
-fn meshes_are_cached_and_grids_build_fast() {
+fn meshes_are_cached_and_grids_match_exact_distance() {
     let s = Scene::load(&scene_path("armadillo_splash.toml")).unwrap();
     let FluidSpec::Mesh { mesh, .. } = &s.fluids[1] else {
         unreachable!()
@@ -163,14 +164,8 @@ fn meshes_are_cached_and_grids_build_fast() {
     let tris = mesh.mesh.triangles().len();
     // The dragon as a solid GridSdf at ~100 cells along its length.
     let cell = mesh.mesh.bounds().extent().x / 100.0;
-    let t = Instant::now();
     let g = sph_core::GridSdf::new(&mesh.mesh, cell, 2.0 * cell).unwrap();
-    let dt = t.elapsed().as_secs_f64();
-    println!(
-        "dragon: {tris} triangles, grid {:?}, build {dt:.3} s",
-        g.dims()
-    );
-    assert!(dt < 10.0);
+    println!("dragon: {tris} triangles, grid {:?}", g.dims());
     // Spot check against the exact distance.
     let b = g.grid_box();
     let mut worst: f64 = 0.0;
