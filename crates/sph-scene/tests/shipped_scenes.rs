@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use sph_core::{Sdf, Vec3};
-use sph_scene::{FluidSpec, Precision, Scene, SolverKind};
+use sph_scene::{BoundaryModel, FluidSpec, Precision, Scene, SolverSpec};
 
 fn scene_path(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -36,9 +36,13 @@ fn dam_break_matches_table_1() {
     let s = Scene::load(&scene_path("dam_break.toml")).unwrap();
     assert_eq!(s.name, "dam_break");
     assert_eq!(s.precision, Precision::F32);
-    assert_eq!(s.solver.kind, SolverKind::Pbf);
-    assert_eq!((s.solver.substeps, s.solver.iterations), (4, 3));
-    assert_eq!(s.solver.vorticity_epsilon, Some(0.0));
+    assert_eq!(s.solver.kind_name(), "pbf");
+    assert_eq!((s.solver.substeps(), s.solver.iterations()), (4, 3));
+    let SolverSpec::Pbf(pbf) = &s.solver else {
+        panic!("not PBF: {:?}", s.solver)
+    };
+    assert_eq!(pbf.vorticity_epsilon, Some(0.0));
+    assert_eq!(s.boundary.model, BoundaryModel::VolumeMap);
     assert_eq!((s.frame_dt_s, s.duration_s), (0.016, 6.0));
     assert_eq!(s.frame_count(), 375);
     let (full, quick) = counts(&s);
@@ -61,7 +65,7 @@ fn dam_break_matches_table_1() {
 fn bunny_drop_matches_fig_3() {
     let t = Instant::now();
     let s = Scene::load(&scene_path("bunny_drop.toml")).unwrap();
-    assert_eq!((s.solver.substeps, s.solver.iterations), (4, 10));
+    assert_eq!((s.solver.substeps(), s.solver.iterations()), (4, 10));
     assert!(matches!(s.fluids[1], FluidSpec::Mesh { .. }));
     let (full, quick) = counts(&s);
     println!(
@@ -77,7 +81,7 @@ fn bunny_drop_matches_fig_3() {
 fn armadillo_splash_matches_table_1() {
     let t = Instant::now();
     let s = Scene::load(&scene_path("armadillo_splash.toml")).unwrap();
-    assert_eq!((s.solver.substeps, s.solver.iterations), (2, 3));
+    assert_eq!((s.solver.substeps(), s.solver.iterations()), (2, 3));
     let (full, quick) = counts(&s);
     println!(
         "armadillo_splash: {full} particles, quick {quick} (load {:?})",
