@@ -73,7 +73,7 @@ impl SceneError {
 pub(crate) struct Ctx<'a> {
     /// The scene file.
     pub file: &'a Path,
-    /// Prefix for reasons (e.g. "with the [quick] overrides: ").
+    /// Prefix for reasons (e.g. `"with the [quick] overrides: "`).
     pub note: &'a str,
 }
 
