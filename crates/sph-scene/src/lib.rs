@@ -126,9 +126,6 @@
 //! `mesh_io.rs` OBJ loading and mesh placement, `build.rs` particle sampling and the solids'
 //! signed distance fields.
 
-// NaN-rejecting checks are written as `!(x > 0.0)` on purpose.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-
 mod build;
 mod error;
 mod mesh_io;

@@ -25,6 +25,9 @@ use crate::{
     SolverSpec, AXES,
 };
 
+/// The `[solver]` table as parsed (with spans), for [`solver::parse`].
+type SolverTable<'i> = Spanned<DeValue<'i>>;
+
 /// Gravity when `simulation.gravity` is absent (m/s²).
 const DEFAULT_GRAVITY: [f64; 3] = [0.0, -9.81, 0.0];
 
@@ -66,7 +69,8 @@ impl Scene {
     }
 }
 
-/// Checks every section of `raw` (in file-documentation order).
+/// Checks every section of `raw` but `[solver]` (already read and checked as `solver`), in
+/// file-documentation order.
 fn from_raw(
     ctx: &Ctx,
     raw: RawScene,
@@ -378,6 +382,3 @@ fn quick(ctx: &Ctx, q: &RawQuick, solver: &SolverSpec) -> Result<QuickSpec, Scen
         every_frames: q.every_frames,
     })
 }
-
-/// The solver table as parsed, for [`solver::parse`].
-type SolverTable<'i> = Spanned<DeValue<'i>>;

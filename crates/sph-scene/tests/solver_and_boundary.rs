@@ -259,3 +259,23 @@ fn unknown_boundary_field() {
         "unknown field `friction`",
     );
 }
+
+#[test]
+fn solver_must_be_a_table() {
+    // serde reads a struct from an array too; the parser insists on a table.
+    let text = VALID
+        .replacen(
+            "[solver]\nkind = \"pbf\"\nsubsteps = 2\niterations = 3\nxsph_c = 0.01\n",
+            "",
+            1,
+        )
+        .replacen(
+            "name = \"fixture\"\n",
+            "name = \"fixture\"\nsolver = [\"pbf\", 2, 3]\n",
+            1,
+        );
+    assert!(!text.contains("[solver]"));
+    let file = fixture_dir("solver_array").join("solver_array.toml");
+    let e = Scene::parse_str(&text, &file).unwrap_err();
+    assert_names(&e, "solver_array", "solver", "must be a table, not array");
+}

@@ -23,9 +23,12 @@ pub(super) fn parse(
     kind: SolverKind,
     mut table: SolverTable<'_>,
 ) -> Result<SolverSpec, SceneError> {
-    if let DeValue::Table(t) = table.get_mut() {
-        t.remove("kind");
-    }
+    // (serde also reads a struct from an array, so `solver = ["pbf", 1, 1]` got this far.)
+    let DeValue::Table(t) = table.get_mut() else {
+        let found = table.get_ref().type_str();
+        return Err(ctx.invalid("solver", format!("must be a table, not {found}")));
+    };
+    t.remove("kind");
     let spec = match kind {
         SolverKind::Pbf => SolverSpec::Pbf(variant(ctx, text, kind, table)?),
         SolverKind::Pcisph => SolverSpec::Pcisph(variant(ctx, text, kind, table)?),
