@@ -9,7 +9,7 @@ use anyhow::{ensure, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use pbf::{FluidSolver, Pbf, PbfParams, Pcisph, PcisphParams, StepStats};
 use sph_core::{apply_permutation, ParticleSet, Real, Vec3};
-use sph_scene::{Precision, Scene, SolverKind};
+use sph_scene::{PbfSpec, PcisphSpec, Precision, Scene, SolverSpec};
 
 use crate::helpers::vtk::{write_particle_frame, ParticleFrame};
 use crate::{workspace_root, Mode};
@@ -30,9 +30,9 @@ pub fn shipped_scene(name: &str, mode: Mode) -> Result<Scene> {
 }
 
 /// The PBF parameters a scene asks for: [`PbfParams::for_spacing`] at the scene's spacing,
-/// then the scene's frame length, gravity, substeps, iterations and overrides.
-pub fn pbf_params<R: Real>(scene: &Scene) -> Result<PbfParams<R>> {
-    let s = &scene.solver;
+/// then the scene's frame length, gravity, and the substeps, iterations and overrides of its
+/// `[solver]` settings `s` (`SolverSpec::Pbf(s)`).
+pub fn pbf_params<R: Real>(scene: &Scene, s: &PbfSpec) -> Result<PbfParams<R>> {
     let mut p = PbfParams::<R>::for_spacing(r(scene.particle_spacing));
     if let Some(ratio) = s.support_over_spacing {
         p.support_radius = r::<R>(scene.particle_spacing * ratio);
@@ -85,9 +85,9 @@ pub fn pbf_params<R: Real>(scene: &Scene) -> Result<PbfParams<R>> {
 }
 
 /// The PCISPH parameters a scene asks for: [`PcisphParams::for_spacing`] at the scene's
-/// spacing, then the scene's frame length, gravity, substeps, iterations and overrides.
-pub fn pcisph_params<R: Real>(scene: &Scene) -> Result<PcisphParams<R>> {
-    let s = &scene.solver;
+/// spacing, then the scene's frame length, gravity, and the substeps, iterations and
+/// overrides of its `[solver]` settings `s` (`SolverSpec::Pcisph(s)`).
+pub fn pcisph_params<R: Real>(scene: &Scene, s: &PcisphSpec) -> Result<PcisphParams<R>> {
     let mut p = PcisphParams::<R>::for_spacing(r(scene.particle_spacing));
     if let Some(ratio) = s.support_over_spacing {
         p.support_radius = r::<R>(scene.particle_spacing * ratio);
@@ -150,9 +150,9 @@ impl<R: Real> SceneSim<R> {
         let file = scene.source.display().to_string();
         let positions = scene.fluid_positions::<R>()?;
         let solids = scene.build_solids::<R>()?;
-        let (solver, mass, rho0): (Box<dyn FluidSolver<R>>, R, R) = match scene.solver.kind {
-            SolverKind::Pbf => {
-                let p = pbf_params::<R>(scene)?;
+        let (solver, mass, rho0): (Box<dyn FluidSolver<R>>, R, R) = match &scene.solver {
+            SolverSpec::Pbf(s) => {
+                let p = pbf_params::<R>(scene, s)?;
                 let (m, rho0) = (p.particle_mass(), p.rest_density);
                 (
                     Box::new(Pbf::new(p, solids).with_context(|| file.clone())?),
@@ -160,8 +160,8 @@ impl<R: Real> SceneSim<R> {
                     rho0,
                 )
             }
-            SolverKind::Pcisph => {
-                let p = pcisph_params::<R>(scene)?;
+            SolverSpec::Pcisph(s) => {
+                let p = pcisph_params::<R>(scene, s)?;
                 let (m, rho0) = (p.particle_mass(), p.rest_density);
                 (
                     Box::new(Pcisph::new(p, solids).with_context(|| file.clone())?),

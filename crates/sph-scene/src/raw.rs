@@ -2,14 +2,18 @@
 
 use serde::Deserialize;
 
-use crate::{Precision, SolverSpec};
+use crate::mesh_io::MeshFields;
+use crate::{BoundarySpec, Precision, SolverKind};
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct RawScene {
     pub name: String,
     pub simulation: RawSimulation,
-    pub solver: SolverSpec,
+    /// Only the tag here: the rest of the `[solver]` table is read by `parse::solver`.
+    pub solver: RawSolverTag,
+    #[serde(default)]
+    pub boundary: BoundarySpec,
     pub tank: Option<RawBox>,
     #[serde(default)]
     pub fluid: Vec<RawFluid>,
@@ -27,6 +31,14 @@ pub(crate) struct RawSimulation {
     pub duration: f64,
     pub frame_dt: f64,
     pub gravity: Option<[f64; 3]>,
+}
+
+/// The tag of the `[solver]` table. Its other fields are ignored here and read by
+/// `parse::solver` from the same table as the variant struct of this kind (see there why).
+#[derive(Debug, Deserialize)]
+#[serde(expecting = "a table with kind = \"pbf\" or \"pcisph\"")]
+pub(crate) struct RawSolverTag {
+    pub kind: SolverKind,
 }
 
 #[derive(Debug, Clone, Copy, Deserialize)]
@@ -65,6 +77,18 @@ pub(crate) enum RawSolidKind {
     Mesh,
 }
 
+impl RawFluid {
+    /// The mesh fields (`kind = "mesh"`).
+    pub fn mesh_fields(&self) -> MeshFields<'_> {
+        MeshFields {
+            path: self.path.as_deref(),
+            scale: self.scale,
+            translate: self.translate,
+            fit: self.fit,
+        }
+    }
+}
+
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct RawSolid {
@@ -80,6 +104,18 @@ pub(crate) struct RawSolid {
     pub translate: Option<[f64; 3]>,
     pub fit: Option<RawBox>,
     pub sdf_cell: Option<f64>,
+}
+
+impl RawSolid {
+    /// The mesh fields (`kind = "mesh"`).
+    pub fn mesh_fields(&self) -> MeshFields<'_> {
+        MeshFields {
+            path: self.path.as_deref(),
+            scale: self.scale,
+            translate: self.translate,
+            fit: self.fit,
+        }
+    }
 }
 
 #[derive(Debug, Deserialize)]

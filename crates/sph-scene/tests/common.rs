@@ -4,6 +4,8 @@
 
 use std::path::PathBuf;
 
+use sph_scene::{Scene, SceneError};
+
 /// A valid scene using a closed cube mesh as fluid and as solid (`cube.obj`).
 pub const VALID: &str = r#"
 name = "fixture"
@@ -81,4 +83,27 @@ pub fn fixture_dir(test: &str) -> PathBuf {
         .collect();
     std::fs::write(dir.join("open.obj"), format!("{CUBE_V}{open}")).unwrap();
     dir
+}
+
+/// Parses `VALID` with `from` replaced by `to` (which must occur) and returns the error.
+pub fn err_with(test: &str, from: &str, to: &str) -> SceneError {
+    assert!(VALID.contains(from), "fixture lacks {from:?}");
+    let text = VALID.replacen(from, to, 1);
+    let dir = fixture_dir(test);
+    let file = dir.join(format!("{test}.toml"));
+    match Scene::parse_str(&text, &file) {
+        Ok(_) => panic!("{test}: accepted"),
+        Err(e) => e,
+    }
+}
+
+/// The error names the file `<test>.toml`, the field path `field` (also as
+/// [`SceneError::field`]) and contains `reason`.
+pub fn assert_names(e: &SceneError, test: &str, field: &str, reason: &str) {
+    let msg = e.to_string();
+    println!("{msg}");
+    assert!(msg.contains(&format!("{test}.toml")), "no file in: {msg}");
+    assert!(msg.contains(field), "no field {field:?} in: {msg}");
+    assert_eq!(e.field(), field, "{msg}");
+    assert!(msg.contains(reason), "no reason {reason:?} in: {msg}");
 }

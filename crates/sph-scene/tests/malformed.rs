@@ -3,29 +3,8 @@
 
 mod common;
 
-use common::{fixture_dir, VALID};
+use common::{assert_names, err_with, fixture_dir, VALID};
 use sph_scene::{Scene, SceneError};
-
-/// Parses `VALID` with `from` replaced by `to` (which must occur) and returns the error.
-fn err_with(test: &str, from: &str, to: &str) -> SceneError {
-    assert!(VALID.contains(from), "fixture lacks {from:?}");
-    let text = VALID.replacen(from, to, 1);
-    let dir = fixture_dir(test);
-    let file = dir.join(format!("{test}.toml"));
-    match Scene::parse_str(&text, &file) {
-        Ok(_) => panic!("{test}: accepted"),
-        Err(e) => e,
-    }
-}
-
-fn assert_names(e: &SceneError, test: &str, field: &str, reason: &str) {
-    let msg = e.to_string();
-    println!("{msg}");
-    assert!(msg.contains(&format!("{test}.toml")), "no file in: {msg}");
-    assert!(msg.contains(field), "no field {field:?} in: {msg}");
-    assert_eq!(e.field(), field, "{msg}");
-    assert!(msg.contains(reason), "no reason {reason:?} in: {msg}");
-}
 
 #[test]
 fn valid_fixture_parses() {
@@ -322,36 +301,6 @@ fn field_of_another_kind() {
         "other_kind2",
         "fluid[0].path",
         "not a field of kind = \"block\"",
-    );
-}
-
-#[test]
-fn pcisph_option_on_pbf() {
-    let e = err_with(
-        "pcisph_only",
-        "xsph_c = 0.01",
-        "density_error_tolerance = 0.01",
-    );
-    assert_names(
-        &e,
-        "pcisph_only",
-        "solver.density_error_tolerance",
-        "only applies to kind = \"pcisph\"",
-    );
-}
-
-#[test]
-fn pbf_option_on_pcisph() {
-    let e = err_with(
-        "pbf_only",
-        "kind = \"pbf\"\nsubsteps = 2",
-        "kind = \"pcisph\"\nvorticity_epsilon = 0.1\nsubsteps = 2",
-    );
-    assert_names(
-        &e,
-        "pbf_only",
-        "solver.vorticity_epsilon",
-        "only applies to kind = \"pbf\"",
     );
 }
 

@@ -14,7 +14,17 @@ fn check(text: &str) {
         // A scene that parses also samples and builds without error.
         s.fluid_positions::<f32>().unwrap();
         s.quick().fluid_positions::<f64>().unwrap();
-        let _ = s.build_solids::<f32>();
+        // Validation builds the solids in f64, so that cannot fail; in f32 a value may not
+        // fit (e.g. a box too thin), which must be a named error on the tank or a solid.
+        s.build_solids::<f64>().unwrap();
+        if let Err(e) = s.build_solids::<f32>() {
+            let msg = e.to_string();
+            assert!(msg.contains("fuzz.toml"), "no file in: {msg}");
+            assert!(
+                e.field().starts_with("tank") || e.field().starts_with("solid["),
+                "unexpected field in: {msg}"
+            );
+        }
     }
 }
 

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use sph_core::{Sdf, Vec3};
-use sph_scene::{FluidSpec, Precision, Scene, SolverKind};
+use sph_scene::{BoundaryModel, FluidSpec, Precision, Scene, SolverSpec};
 
 fn scene_path(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -36,9 +36,13 @@ fn dam_break_matches_table_1() {
     let s = Scene::load(&scene_path("dam_break.toml")).unwrap();
     assert_eq!(s.name, "dam_break");
     assert_eq!(s.precision, Precision::F32);
-    assert_eq!(s.solver.kind, SolverKind::Pbf);
-    assert_eq!((s.solver.substeps, s.solver.iterations), (4, 3));
-    assert_eq!(s.solver.vorticity_epsilon, Some(0.0));
+    assert_eq!(s.solver.kind_name(), "pbf");
+    assert_eq!((s.solver.substeps(), s.solver.iterations()), (4, 3));
+    let SolverSpec::Pbf(pbf) = &s.solver else {
+        panic!("not PBF: {:?}", s.solver)
+    };
+    assert_eq!(pbf.vorticity_epsilon, Some(0.0));
+    assert_eq!(s.boundary.model, BoundaryModel::VolumeMap);
     assert_eq!((s.frame_dt_s, s.duration_s), (0.016, 6.0));
     assert_eq!(s.frame_count(), 375);
     let (full, quick) = counts(&s);
@@ -61,7 +65,7 @@ fn dam_break_matches_table_1() {
 fn bunny_drop_matches_fig_3() {
     let t = Instant::now();
     let s = Scene::load(&scene_path("bunny_drop.toml")).unwrap();
-    assert_eq!((s.solver.substeps, s.solver.iterations), (4, 10));
+    assert_eq!((s.solver.substeps(), s.solver.iterations()), (4, 10));
     assert!(matches!(s.fluids[1], FluidSpec::Mesh { .. }));
     let (full, quick) = counts(&s);
     println!(
@@ -77,7 +81,7 @@ fn bunny_drop_matches_fig_3() {
 fn armadillo_splash_matches_table_1() {
     let t = Instant::now();
     let s = Scene::load(&scene_path("armadillo_splash.toml")).unwrap();
-    assert_eq!((s.solver.substeps, s.solver.iterations), (2, 3));
+    assert_eq!((s.solver.substeps(), s.solver.iterations()), (2, 3));
     let (full, quick) = counts(&s);
     println!(
         "armadillo_splash: {full} particles, quick {quick} (load {:?})",
@@ -148,9 +152,10 @@ fn mesh_fluid_volume_and_velocities() {
 }
 
 /// Building twice does not reload the meshes (they are shared through an `Arc`) and the
-/// grid SDF of a scene mesh builds quickly.
+/// grid SDF of a scene mesh agrees with the exact distance (build time is a benchmark's
+/// business, not a test's).
 #[test]
-fn meshes_are_cached_and_grids_build_fast() {
+fn meshes_are_cached_and_grids_match_exact_distance() {
     let s = Scene::load(&scene_path("armadillo_splash.toml")).unwrap();
     let FluidSpec::Mesh { mesh, .. } = &s.fluids[1] else {
         unreachable!()
@@ -163,14 +168,8 @@ fn meshes_are_cached_and_grids_build_fast() {
     let tris = mesh.mesh.triangles().len();
     // The dragon as a solid GridSdf at ~100 cells along its length.
     let cell = mesh.mesh.bounds().extent().x / 100.0;
-    let t = Instant::now();
     let g = sph_core::GridSdf::new(&mesh.mesh, cell, 2.0 * cell).unwrap();
-    let dt = t.elapsed().as_secs_f64();
-    println!(
-        "dragon: {tris} triangles, grid {:?}, build {dt:.3} s",
-        g.dims()
-    );
-    assert!(dt < 10.0);
+    println!("dragon: {tris} triangles, grid {:?}", g.dims());
     // Spot check against the exact distance.
     let b = g.grid_box();
     let mut worst: f64 = 0.0;

@@ -183,8 +183,8 @@ impl Experiment for DamBreakFront {
         out.note(format!(
             "front = the {}-quantile of particle x plus the particle radius; a = {COLUMN_WIDTH_M} m; PBF {} substeps x {} iterations per 16 ms frame",
             1.0 - FRONT_QUANTILE,
-            scene.solver.substeps,
-            scene.solver.iterations
+            scene.solver.substeps(),
+            scene.solver.iterations()
         ));
         Ok(out)
     }

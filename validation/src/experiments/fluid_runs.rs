@@ -152,9 +152,9 @@ pub fn run_fluid(
     iterations: usize,
 ) -> Result<FluidRun> {
     let mut scene = scene.clone();
-    scene.solver.kind = kind;
-    scene.solver.substeps = substeps;
-    scene.solver.iterations = iterations;
+    scene.solver = scene.solver.with_kind(kind);
+    scene.solver.set_substeps(substeps);
+    scene.solver.set_iterations(iterations);
     let name = match kind {
         SolverKind::Pbf => "PBF",
         SolverKind::Pcisph => "PCISPH",

@@ -18,7 +18,7 @@
 use anyhow::Result;
 use pbf::{ParticleSet, Pbf};
 use sph_core::Real;
-use sph_scene::{Precision, Scene};
+use sph_scene::{Precision, Scene, SolverSpec};
 
 use crate::helpers::{plot_xy, write_csv_rows, Legend, PlotSpec, Series, SeriesStyle};
 use crate::sim::{pbf_params, shipped_scene, SceneSim};
@@ -70,7 +70,14 @@ fn sweep<R: Real>(ctx: &Context, scene: &Scene) -> Result<(Vec<Row>, usize)> {
         sim.advance()?;
         ctx.progress.inc(1);
     }
-    let base = pbf_params::<R>(scene)?;
+    let SolverSpec::Pbf(spec) = &scene.solver else {
+        anyhow::bail!(
+            "{}: the convergence sweep needs a PBF scene, not kind = \"{}\"",
+            scene.source.display(),
+            scene.solver.kind_name()
+        );
+    };
+    let base = pbf_params::<R>(scene, spec)?;
     let mut rows = Vec::new();
     for k in ITERATIONS {
         let mut p = base.clone();

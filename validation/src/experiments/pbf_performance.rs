@@ -66,11 +66,11 @@ fn time_scene<R: Real>(ctx: &Context, scene: &Scene) -> Result<Timing> {
         total += s.total_s();
         ctx.progress.inc(1);
     }
-    let steps = scene.solver.substeps;
+    let steps = scene.solver.substeps();
     Ok(Timing {
         particles: sim.state.len(),
         steps,
-        iterations: scene.solver.iterations,
+        iterations: scene.solver.iterations(),
         ms_per_step: 1e3 * total / (MEASURED_FRAMES * steps) as f64,
         percent: phases.map(|p| 100.0 * p / total),
         threads: rayon::current_num_threads(),

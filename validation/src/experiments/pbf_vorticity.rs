@@ -10,7 +10,7 @@
 
 use anyhow::Result;
 use sph_core::Real;
-use sph_scene::{Precision, Scene};
+use sph_scene::{Precision, Scene, SolverSpec};
 
 use crate::helpers::{plot_xy, side_view_png, write_csv_rows, Legend, PlotSpec, Series};
 use crate::sim::{shipped_scene, SceneSim};
@@ -74,7 +74,14 @@ fn simulate<R: Real>(ctx: &Context, scene: &Scene) -> Result<Run> {
 
 fn run_with(ctx: &Context, scene: &Scene, epsilon: f64) -> Result<Run> {
     let mut scene = scene.clone();
-    scene.solver.vorticity_epsilon = Some(epsilon);
+    let SolverSpec::Pbf(pbf) = &mut scene.solver else {
+        anyhow::bail!(
+            "{}: the vorticity experiment needs a PBF scene, not kind = \"{}\"",
+            scene.source.display(),
+            scene.solver.kind_name()
+        );
+    };
+    pbf.vorticity_epsilon = Some(epsilon);
     match scene.precision {
         Precision::F32 => simulate::<f32>(ctx, &scene),
         Precision::F64 => simulate::<f64>(ctx, &scene),

@@ -1,0 +1,224 @@
+//! Building from a validated scene: the initial fluid particles (lattice sampling of
+//! blocks and meshes), the boundary signed distance fields, and the particle-level checks
+//! the parser runs on them.
+
+// NaN-rejecting checks are written as `!(x > 0.0)` on purpose.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+use sph_core::{
+    sampling::cubic_lattice, Aabb, BoxSdf, GridSdf, Inverted, Plane, Real, Sdf, Sphere,
+    TriangleMesh, Vec3,
+};
+
+use crate::error::Ctx;
+use crate::{
+    cast3, fmt3, v3, FluidSpec, Scene, SceneError, SolidSpec, MAX_PARTICLES, MAX_SDF_NODES,
+};
+
+impl Scene {
+    /// Initial fluid particle positions (m), fluid by fluid in file order (see the crate
+    /// documentation for the sampling rules).
+    pub fn fluid_positions<R: Real>(&self) -> Result<Vec<Vec3<R>>, SceneError> {
+        let ctx = Ctx::new(&self.source);
+        let mut out = Vec::new();
+        for i in 0..self.fluids.len() {
+            out.extend(self.sample_fluid(&ctx, i)?.iter().map(cast3::<R>));
+        }
+        Ok(out)
+    }
+
+    /// Initial velocities (m/s), one per particle of [`Scene::fluid_positions`] (same order).
+    pub fn fluid_velocities<R: Real>(&self) -> Result<Vec<Vec3<R>>, SceneError> {
+        let ctx = Ctx::new(&self.source);
+        let mut out = Vec::new();
+        for (i, f) in self.fluids.iter().enumerate() {
+            let v = match f {
+                FluidSpec::Block { velocity, .. } | FluidSpec::Mesh { velocity, .. } => {
+                    cast3::<R>(&v3(*velocity))
+                }
+            };
+            let n = self.sample_fluid(&ctx, i)?.len();
+            out.extend(std::iter::repeat_n(v, n));
+        }
+        Ok(out)
+    }
+
+    /// Upper bound of the particle count of fluid `i` (lattice points over its box).
+    fn lattice_estimate(&self, i: usize) -> f64 {
+        let s = self.particle_spacing;
+        let b = match &self.fluids[i] {
+            FluidSpec::Block { min, max, .. } => Aabb {
+                min: v3(*min),
+                max: v3(*max),
+            },
+            FluidSpec::Mesh { mesh, .. } => mesh.mesh.bounds(),
+        };
+        let e = b.extent();
+        (0..3)
+            .map(|a| ((e[a] / s) + 1e-9).floor().max(1.0))
+            .product()
+    }
+
+    fn sample_fluid(&self, ctx: &Ctx, i: usize) -> Result<Vec<Vec3<f64>>, SceneError> {
+        let s = self.particle_spacing;
+        let field = format!("fluid[{i}]");
+        let lattice_err = |e: sph_core::CoreError| {
+            ctx.invalid(
+                field.clone(),
+                format!("sampling at particle_spacing {s} m: {e}"),
+            )
+        };
+        match &self.fluids[i] {
+            FluidSpec::Block { min, max, .. } => {
+                let b = Aabb {
+                    min: v3(*min),
+                    max: v3(*max),
+                };
+                cubic_lattice(&b, s, MAX_PARTICLES).map_err(lattice_err)
+            }
+            FluidSpec::Mesh { mesh, .. } => {
+                let b = mesh.mesh.bounds();
+                let grid = build_grid(ctx, &field, &mesh.mesh, s, 2.0 * s)?;
+                let pts = cubic_lattice(&b, s, MAX_PARTICLES).map_err(lattice_err)?;
+                Ok(pts
+                    .into_iter()
+                    .filter(|p| grid.signed_distance(p) < 0.0)
+                    .collect())
+            }
+        }
+    }
+
+    fn solid_sdf<R: Real>(&self, ctx: &Ctx, j: usize) -> Result<Box<dyn Sdf<R>>, SceneError> {
+        let field = format!("solid[{j}]");
+        let core = |sub: &str, e: sph_core::CoreError| {
+            ctx.invalid(format!("{field}.{sub}"), format!("in {}: {e}", R::NAME))
+        };
+        Ok(match &self.solids[j] {
+            SolidSpec::Sphere { center, radius } => Box::new(
+                Sphere::new(cast3::<R>(&v3(*center)), R::of_f64(*radius))
+                    .map_err(|e| core("radius", e))?,
+            ),
+            SolidSpec::Box { min, max } => {
+                let b = Aabb::new(cast3::<R>(&v3(*min)), cast3::<R>(&v3(*max)))
+                    .map_err(|e| core("min", e))?;
+                Box::new(BoxSdf::new(b).map_err(|e| core("min", e))?)
+            }
+            SolidSpec::Plane { point, normal } => Box::new(
+                Plane::new(cast3::<R>(&v3(*point)), cast3::<R>(&v3(*normal)))
+                    .map_err(|e| core("normal", e))?,
+            ),
+            SolidSpec::Mesh { mesh, sdf_cell } => {
+                let cell = sdf_cell.unwrap_or(self.particle_spacing * 0.5);
+                let m = &mesh.mesh;
+                let verts: Vec<Vec3<R>> = m.vertices().iter().map(cast3::<R>).collect();
+                let mr = TriangleMesh::new(verts, m.triangles().to_vec()).map_err(|e| {
+                    ctx.invalid(format!("{field}.path"), format!("in {}: {e}", R::NAME))
+                })?;
+                let margin = 2.0 * self.particle_spacing + 2.0 * cell;
+                Box::new(build_grid(ctx, &field, &mr, cell, margin)?)
+            }
+        })
+    }
+
+    /// The boundary signed distance fields in precision `R`: the tank first (as
+    /// `Inverted<BoxSdf>`, when there is one), then the solids in file order (meshes as
+    /// [`GridSdf`] with cell `sdf_cell`, default `particle_spacing / 2`, and margin
+    /// `2 · particle_spacing + 2 · cell`). Errors only when a value does not fit in `R`
+    /// (e.g. a box too thin for `f32`).
+    pub fn build_solids<R: Real>(&self) -> Result<Vec<Box<dyn Sdf<R>>>, SceneError> {
+        let ctx = Ctx::new(&self.source);
+        let mut out: Vec<Box<dyn Sdf<R>>> = Vec::with_capacity(self.solids.len() + 1);
+        if let Some(t) = &self.tank {
+            let b = Aabb::new(cast3::<R>(&t.min), cast3::<R>(&t.max))
+                .and_then(BoxSdf::new)
+                .map_err(|e| ctx.invalid("tank.min", format!("in {}: {e}", R::NAME)))?;
+            out.push(Box::new(Inverted(b)));
+        }
+        for j in 0..self.solids.len() {
+            out.push(self.solid_sdf::<R>(&ctx, j)?);
+        }
+        Ok(out)
+    }
+
+    /// Particle-level checks: count limit, non-empty fluids, inside the tank, outside solids.
+    pub(crate) fn validate_particles(&self, ctx: &Ctx) -> Result<(), SceneError> {
+        let mut total = 0.0;
+        for i in 0..self.fluids.len() {
+            total += self.lattice_estimate(i);
+            if !(total <= MAX_PARTICLES as f64) {
+                return Err(ctx.invalid(
+                    format!("fluid[{i}]"),
+                    format!(
+                        "the fluids up to this one need about {total:.3e} particles at particle_spacing {} m, more than the maximum of {MAX_PARTICLES}",
+                        self.particle_spacing
+                    ),
+                ));
+            }
+        }
+        let solids: Vec<Box<dyn Sdf<f64>>> = (0..self.solids.len())
+            .map(|j| self.solid_sdf::<f64>(ctx, j))
+            .collect::<Result<_, _>>()?;
+        for i in 0..self.fluids.len() {
+            let pts = self.sample_fluid(ctx, i)?;
+            let field = format!("fluid[{i}]");
+            if pts.is_empty() {
+                return Err(ctx.invalid(
+                    field,
+                    format!(
+                        "contains no particle at particle_spacing {} m (smaller than a spacing?)",
+                        self.particle_spacing
+                    ),
+                ));
+            }
+            if let Some(t) = &self.tank {
+                if let Some(p) = pts
+                    .iter()
+                    .find(|p| !(0..3).all(|a| p[a] > t.min[a] && p[a] < t.max[a]))
+                {
+                    return Err(ctx.invalid(
+                        field,
+                        format!("particle at {} is not strictly inside the tank", fmt3(p)),
+                    ));
+                }
+            }
+            for (j, sdf) in solids.iter().enumerate() {
+                if let Some(p) = pts.iter().find(|p| !(sdf.signed_distance(p) > 0.0)) {
+                    return Err(ctx.invalid(
+                        field,
+                        format!(
+                            "overlaps solid[{j}]: particle at {} has signed distance {:.6} m to it (fluids must lie outside solids)",
+                            fmt3(p),
+                            sdf.signed_distance(p)
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A [`GridSdf`] for a scene mesh, with the node count checked against [`MAX_SDF_NODES`]
+/// first.
+fn build_grid<R: Real>(
+    ctx: &Ctx,
+    field: &str,
+    mesh: &TriangleMesh<R>,
+    cell: f64,
+    margin: f64,
+) -> Result<GridSdf<R>, SceneError> {
+    let e = mesh.bounds().extent();
+    let nodes: f64 = (0..3)
+        .map(|a| ((e[a].as_f64() + 2.0 * margin) / cell).ceil() + 1.0)
+        .product();
+    if !(nodes <= MAX_SDF_NODES as f64) {
+        return Err(ctx.invalid(
+            field,
+            format!(
+                "the mesh's signed distance grid at cell {cell} m would have {nodes:.3e} nodes, more than the maximum of {MAX_SDF_NODES} (use a larger sdf_cell/particle_spacing or a smaller mesh)"
+            ),
+        ));
+    }
+    GridSdf::new(mesh, R::of_f64(cell), R::of_f64(margin))
+        .map_err(|e| ctx.invalid(field, format!("building the signed distance grid: {e}")))
+}

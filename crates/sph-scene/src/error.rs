@@ -1,0 +1,221 @@
+//! [`SceneError`] and the crate's helpers for building it: the error context [`Ctx`] with
+//! the value checks shared by the parser and the mesh placement, and the translation of
+//! TOML/serde errors into a field path and a reason with line and column.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use sph_core::Aabb;
+
+use crate::raw::RawBox;
+use crate::{v3, AXES};
+
+/// Errors of scene loading and building. Every variant names the scene file, the field path
+/// and the reason.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SceneError {
+    /// The scene file could not be read.
+    #[error("{}: cannot read the scene file: {reason}", file.display())]
+    Read {
+        /// The scene file.
+        file: PathBuf,
+        /// Operating-system reason.
+        reason: String,
+    },
+    /// TOML syntax error, wrong type, unknown or missing field.
+    #[error("{}: {field}: {reason}", file.display())]
+    Syntax {
+        /// The scene file.
+        file: PathBuf,
+        /// Field path (`solver.substeps`), or `<document>` for a syntax error.
+        field: String,
+        /// What is wrong, with line and column.
+        reason: String,
+    },
+    /// A value is out of range or inconsistent with others.
+    #[error("{}: {field}: {reason}", file.display())]
+    Invalid {
+        /// The scene file.
+        file: PathBuf,
+        /// Field path, e.g. `fluid[1].min`.
+        field: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A mesh file is missing, unreadable, malformed or not closed.
+    #[error("{}: {field}: mesh {}: {reason}", file.display(), mesh.display())]
+    Mesh {
+        /// The scene file.
+        file: PathBuf,
+        /// Field path of the mesh's `path`, e.g. `solid[0].path`.
+        field: String,
+        /// The mesh file, resolved against the scene file's directory.
+        mesh: PathBuf,
+        /// What is wrong (for an open mesh: the first offending edge).
+        reason: String,
+    },
+}
+
+impl SceneError {
+    /// The field path the error refers to.
+    pub fn field(&self) -> &str {
+        match self {
+            SceneError::Read { .. } => "<file>",
+            SceneError::Syntax { field, .. }
+            | SceneError::Invalid { field, .. }
+            | SceneError::Mesh { field, .. } => field,
+        }
+    }
+}
+
+/// Where errors are reported: the scene file, and a prefix for reasons.
+pub(crate) struct Ctx<'a> {
+    /// The scene file.
+    pub file: &'a Path,
+    /// Prefix for reasons (e.g. `"with the [quick] overrides: "`).
+    pub note: &'a str,
+}
+
+impl<'a> Ctx<'a> {
+    /// A context for `file` without a note.
+    pub fn new(file: &'a Path) -> Self {
+        Ctx { file, note: "" }
+    }
+
+    /// An [`SceneError::Invalid`] for `field`.
+    pub fn invalid(&self, field: impl Into<String>, reason: impl AsRef<str>) -> SceneError {
+        SceneError::Invalid {
+            file: self.file.to_path_buf(),
+            field: field.into(),
+            reason: format!("{}{}", self.note, reason.as_ref()),
+        }
+    }
+
+    /// `v` is finite and > 0.
+    pub fn positive(&self, field: &str, v: f64) -> Result<(), SceneError> {
+        if v.is_finite() && v > 0.0 {
+            Ok(())
+        } else {
+            Err(self.invalid(field, format!("must be finite and > 0, got {v}")))
+        }
+    }
+
+    /// Every component of `v` is finite.
+    pub fn finite3(&self, field: &str, v: &[f64; 3]) -> Result<(), SceneError> {
+        match (0..3).find(|&a| !v[a].is_finite()) {
+            Some(a) => Err(self.invalid(
+                field,
+                format!("component {} is not finite ({})", AXES[a], v[a]),
+            )),
+            None => Ok(()),
+        }
+    }
+
+    /// A box with finite corners and `min < max` on every axis.
+    pub fn check_box(&self, field: &str, b: &RawBox) -> Result<Aabb<f64>, SceneError> {
+        self.finite3(&format!("{field}.min"), &b.min)?;
+        self.finite3(&format!("{field}.max"), &b.max)?;
+        if let Some(a) = (0..3).find(|&a| b.min[a] >= b.max[a]) {
+            return Err(self.invalid(
+                format!("{field}.min"),
+                format!(
+                    "min must be < max on every axis ({}: min {} >= max {})",
+                    AXES[a], b.min[a], b.max[a]
+                ),
+            ));
+        }
+        Ok(Aabb {
+            min: v3(b.min),
+            max: v3(b.max),
+        })
+    }
+}
+
+/// Line and column (1-based) of a byte offset.
+fn line_col(text: &str, offset: usize) -> (usize, usize) {
+    let offset = offset.min(text.len());
+    let mut line = 1;
+    let mut col = 1;
+    for (i, ch) in text.char_indices() {
+        if i >= offset {
+            break;
+        }
+        if ch == '\n' {
+            line += 1;
+            col = 1;
+        } else {
+            col += 1;
+        }
+    }
+    (line, col)
+}
+
+/// The message of a TOML error with its line and column in `text`.
+pub(crate) fn toml_reason(text: &str, e: &toml::de::Error) -> String {
+    let mut s = e.message().trim().to_string();
+    if let Some(span) = e.span() {
+        let (l, c) = line_col(text, span.start);
+        let _ = write!(s, " (line {l}, column {c})");
+    }
+    s
+}
+
+/// A [`SceneError::Syntax`] for a TOML syntax error (no field).
+pub(crate) fn document_error(file: &Path, text: &str, e: &toml::de::Error) -> SceneError {
+    SceneError::Syntax {
+        file: file.to_path_buf(),
+        field: "<document>".into(),
+        reason: toml_reason(text, e),
+    }
+}
+
+/// A [`SceneError::Syntax`] for a serde error met while deserializing the value at field
+/// path `prefix` (`""` for the document): the field path is `prefix` + the path serde
+/// reports, with the field itself for unknown and missing fields; `note` (if not empty) is
+/// added to the reason of an unknown field.
+pub(crate) fn serde_error(
+    file: &Path,
+    text: &str,
+    prefix: &str,
+    note: &str,
+    e: &serde_path_to_error::Error<toml::de::Error>,
+) -> SceneError {
+    let mut field = e.path().to_string();
+    if field == "." {
+        field.clear();
+    }
+    let mut field = match (prefix.is_empty(), field.is_empty()) {
+        (true, _) => field,
+        (false, true) => prefix.to_string(),
+        (false, false) => format!("{prefix}.{field}"),
+    };
+    let mut reason = toml_reason(text, e.inner());
+    // Unknown and missing fields: name the field itself.
+    for prefix in ["unknown field `", "missing field `"] {
+        if let Some(rest) = reason.strip_prefix(prefix) {
+            if let Some(end) = rest.find('`') {
+                let name = &rest[..end];
+                let already = field == name || field.ends_with(&format!(".{name}"));
+                if !already {
+                    field = if field.is_empty() {
+                        name.to_string()
+                    } else {
+                        format!("{field}.{name}")
+                    };
+                }
+            }
+        }
+    }
+    if !note.is_empty() && reason.starts_with("unknown field `") {
+        reason = format!("{reason}; {note}");
+    }
+    if field.is_empty() {
+        field = "<document>".into();
+    }
+    SceneError::Syntax {
+        file: file.to_path_buf(),
+        field,
+        reason,
+    }
+}

@@ -1,0 +1,212 @@
+//! Mesh files: OBJ loading (closed meshes only) and placement in the scene (`scale` and
+//! `translate`, or `fit`), each file loaded once per scene.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use sph_core::{TriangleMesh, Vec3};
+
+use crate::error::Ctx;
+use crate::raw::RawBox;
+use crate::{v3, MeshPlacement, MeshSpec, SceneError};
+
+/// The mesh fields of a `[[fluid]]` or `[[solid]]` table of `kind = "mesh"`, as written.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct MeshFields<'a> {
+    /// Mesh file, relative to the scene file's directory.
+    pub path: Option<&'a str>,
+    /// Uniform scale.
+    pub scale: Option<f64>,
+    /// Translation (m).
+    pub translate: Option<[f64; 3]>,
+    /// Box to fit the mesh into, instead of scale/translate.
+    pub fit: Option<RawBox>,
+}
+
+/// Loads the meshes of one scene, each file once.
+pub(crate) struct MeshLoader<'a> {
+    /// Directory that mesh paths are relative to.
+    base: &'a Path,
+    /// Meshes loaded so far (as in the file), by resolved path.
+    cache: HashMap<PathBuf, Arc<TriangleMesh<f64>>>,
+}
+
+impl<'a> MeshLoader<'a> {
+    /// A loader resolving mesh paths against `base`.
+    pub fn new(base: &'a Path) -> Self {
+        MeshLoader {
+            base,
+            cache: HashMap::new(),
+        }
+    }
+
+    /// Loads (or reuses) and places the mesh of the table at `field`.
+    pub fn mesh_spec(
+        &mut self,
+        ctx: &Ctx,
+        field: &str,
+        m: MeshFields,
+    ) -> Result<MeshSpec, SceneError> {
+        let Some(path) = m.path else {
+            return Err(ctx.invalid(
+                format!("{field}.path"),
+                "missing (required for kind = \"mesh\")",
+            ));
+        };
+        let resolved = self.base.join(path);
+        let raw = self.load(ctx, field, &resolved)?;
+        let (placement, s, t) = match m.fit {
+            Some(fit) => {
+                if m.scale.is_some() || m.translate.is_some() {
+                    return Err(ctx.invalid(
+                        format!("{field}.fit"),
+                        "give either fit or scale/translate, not both",
+                    ));
+                }
+                fit_placement(ctx, field, &raw, &fit)?
+            }
+            None => {
+                let s = m.scale.unwrap_or(1.0);
+                ctx.positive(&format!("{field}.scale"), s)?;
+                let t = m.translate.unwrap_or([0.0; 3]);
+                ctx.finite3(&format!("{field}.translate"), &t)?;
+                let placement = MeshPlacement::Transform {
+                    scale: s,
+                    translate: t,
+                };
+                (placement, s, v3(t))
+            }
+        };
+        let placed = raw
+            .transformed(s, t)
+            .map_err(|e| ctx.invalid(format!("{field}.scale"), format!("placing the mesh: {e}")))?;
+        Ok(MeshSpec {
+            path: resolved,
+            placement,
+            mesh: Arc::new(placed),
+        })
+    }
+
+    /// The mesh file `resolved`, loaded on first use.
+    fn load(
+        &mut self,
+        ctx: &Ctx,
+        field: &str,
+        resolved: &Path,
+    ) -> Result<Arc<TriangleMesh<f64>>, SceneError> {
+        if let Some(m) = self.cache.get(resolved) {
+            return Ok(m.clone());
+        }
+        let m = Arc::new(load_obj(resolved).map_err(|reason| SceneError::Mesh {
+            file: ctx.file.to_path_buf(),
+            field: format!("{field}.path"),
+            mesh: resolved.to_path_buf(),
+            reason,
+        })?);
+        self.cache.insert(resolved.to_path_buf(), m.clone());
+        Ok(m)
+    }
+}
+
+/// The placement fitting `mesh` into the box `fit`: the placement, the scale and the
+/// translation.
+fn fit_placement(
+    ctx: &Ctx,
+    field: &str,
+    mesh: &TriangleMesh<f64>,
+    fit: &RawBox,
+) -> Result<(MeshPlacement, f64, Vec3<f64>), SceneError> {
+    let b = ctx.check_box(&format!("{field}.fit"), fit)?;
+    let mb = mesh.bounds();
+    let (me, be) = (mb.extent(), b.extent());
+    let mut s = f64::INFINITY;
+    for a in 0..3 {
+        if me[a] > 0.0 {
+            s = s.min(be[a] / me[a]);
+        }
+    }
+    if !(s.is_finite() && s > 0.0) {
+        return Err(ctx.invalid(
+            format!("{field}.fit"),
+            "cannot fit the mesh into this box (degenerate mesh or box)",
+        ));
+    }
+    let t = b.center() - mb.center() * s;
+    let placement = MeshPlacement::Fit {
+        min: fit.min,
+        max: fit.max,
+    };
+    Ok((placement, s, t))
+}
+
+/// The field an error about where a placed mesh lies should name: `fit` or `translate`.
+pub(crate) fn placement_field(field: &str, m: &MeshSpec) -> String {
+    match m.placement {
+        MeshPlacement::Fit { .. } => format!("{field}.fit"),
+        MeshPlacement::Transform { .. } => format!("{field}.translate"),
+    }
+}
+
+/// Reads a closed triangle mesh from an OBJ file (polygons triangulated; the vertices of
+/// several objects welded by exact position).
+fn load_obj(path: &Path) -> Result<TriangleMesh<f64>, String> {
+    if !path.is_file() {
+        return Err("file not found".into());
+    }
+    let opts = tobj::LoadOptions {
+        triangulate: true,
+        single_index: false,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    let file = std::fs::File::open(path).map_err(|e| format!("cannot open: {e}"))?;
+    let mut reader = std::io::BufReader::new(file);
+    let (models, _) = tobj::load_obj_buf(&mut reader, &opts, |_| {
+        Err(tobj::LoadError::MaterialParseError)
+    })
+    .map_err(|e| format!("not a valid OBJ file: {e}"))?;
+    let mut vertices: Vec<Vec3<f64>> = Vec::new();
+    let mut triangles: Vec<[u32; 3]> = Vec::new();
+    let weld = models.len() > 1;
+    let mut seen: HashMap<[u64; 3], u32> = HashMap::new();
+    for m in &models {
+        let mesh = &m.mesh;
+        if mesh.positions.len() % 3 != 0 || mesh.indices.len() % 3 != 0 {
+            return Err(format!(
+                "object {:?}: malformed position or index arrays",
+                m.name
+            ));
+        }
+        let mut local = Vec::with_capacity(mesh.positions.len() / 3);
+        for p in mesh.positions.chunks_exact(3) {
+            let v = Vec3::new(p[0], p[1], p[2]);
+            let id = if weld {
+                let key = [p[0].to_bits(), p[1].to_bits(), p[2].to_bits()];
+                *seen.entry(key).or_insert_with(|| {
+                    vertices.push(v);
+                    (vertices.len() - 1) as u32
+                })
+            } else {
+                vertices.push(v);
+                (vertices.len() - 1) as u32
+            };
+            local.push(id);
+        }
+        for t in mesh.indices.chunks_exact(3) {
+            let mut tri = [0u32; 3];
+            for c in 0..3 {
+                tri[c] = *local.get(t[c] as usize).ok_or_else(|| {
+                    format!("object {:?}: face index {} out of range", m.name, t[c])
+                })?;
+            }
+            triangles.push(tri);
+        }
+        if vertices.len() > u32::MAX as usize / 2 {
+            return Err("too many vertices".into());
+        }
+    }
+    let mesh = TriangleMesh::new(vertices, triangles).map_err(|e| e.to_string())?;
+    mesh.check_closed().map_err(|e| e.to_string())?;
+    Ok(mesh)
+}
