@@ -8,7 +8,8 @@
 //! SPlisHSPlasH) are in the `pbf` crate documentation, section "Performance and
 //! determinism".
 use criterion::{criterion_group, criterion_main, Criterion};
-use pbf::{FluidSolver, ParticleSet, Pbf, PbfParams, Pcisph, PcisphParams, Solids};
+use pbf::{FluidSolver, ParticleSet, Pbf, PbfParams, Solids};
+use pcisph::{Pcisph, PcisphParams};
 use sph_core::{BoxSdf, Inverted};
 
 /// Pressure/constraint iterations per step (SPlisHSPlasH's average, see the module docs).
@@ -26,12 +27,12 @@ fn solver_step(c: &mut Criterion) {
     group.sample_size(10);
     let (state0, _) = setup();
     let mut pbf_params = PbfParams::<f32>::for_spacing(0.025);
-    pbf_params.dt = 0.002;
-    pbf_params.substeps = 1;
+    pbf_params.common.dt = 0.002;
+    pbf_params.common.substeps = 1;
     pbf_params.solver_iterations = ITERATIONS;
     let mut pci_params = PcisphParams::<f32>::for_spacing(0.025);
-    pci_params.dt = 0.002;
-    pci_params.substeps = 1;
+    pci_params.common.dt = 0.002;
+    pci_params.common.substeps = 1;
     pci_params.pressure_iterations = ITERATIONS;
     let solvers: Vec<Box<dyn FluidSolver<f32>>> = vec![
         Box::new(Pbf::new(pbf_params, setup().1).expect("params")),

@@ -5,8 +5,13 @@
 //! iterations):
 //!
 //! ```text
-//! RAYON_NUM_THREADS=1 cargo run --release -p benches --example pbf_dambreak -- [STEPS] [ITERATIONS|tol=ETA] [pbf|pcisph] [unilateral]
+//! RAYON_NUM_THREADS=1 cargo run --release -p benches --example pbf_dambreak -- [STEPS] [ITERATIONS|tol=ETA] [pbf|pcisph] [unilateral] [volume-map]
 //! ```
+//!
+//! `volume-map` replaces the SDF collision walls by volume maps (Bender et al. 2019, the
+//! `sph_solver::VolumeMapBoundary`; the walls then take part in the density), as
+//! SPlisHSPlasH's `boundaryHandlingMethod` 2; the map's build time is printed and not
+//! counted in the time per step.
 //!
 //! `unilateral` (PBF) switches to SPlisHSPlasH's form of the constraint: `max(C_i, 0)`,
 //! `ε = 10⁻⁶ m⁻²`, no artificial pressure and its particle mass `0.8 ρ0 (2r)³`, instead of
@@ -23,8 +28,34 @@
 //! density it measures differs in that SPlisHSPlasH's includes its boundary particles).
 use std::time::Instant;
 
-use pbf::{FluidSolver, ParticleSet, Pbf, PbfParams, Pcisph, PcisphParams, Solids, StepStats};
+use pbf::{
+    Boundary, CollisionBoundary, CommonParams, FluidSolver, ParticleSet, Pbf, PbfParams, Solids,
+    StepStats,
+};
+use pcisph::{Pcisph, PcisphParams};
 use sph_core::{BoxSdf, Inverted};
+use sph_kernels::KernelKind;
+use sph_solver::boundary::{VolumeMapBoundary, VolumeMapOptions};
+
+/// The walls: SDF collision at the particle radius, or volume maps of Poly6 at `h`.
+fn walls(solids: Solids<f32>, tank: sph_core::Aabb<f32>, c: &CommonParams<f32>, volume_map: bool) -> Box<dyn Boundary<f32>> {
+    if volume_map {
+        let t = Instant::now();
+        let b = VolumeMapBoundary::new(
+            solids,
+            KernelKind::Poly6,
+            c.support_radius,
+            tank,
+            0.5 * c.particle_radius(),
+            VolumeMapOptions::default(),
+        )
+        .expect("volume map");
+        println!("volume map built in {:.2} s", t.elapsed().as_secs_f64());
+        Box::new(b)
+    } else {
+        Box::new(CollisionBoundary::new(solids, c.particle_radius()).expect("walls"))
+    }
+}
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -38,6 +69,7 @@ fn main() {
     let which = args.get(2).map_or("pbf", String::as_str);
     let (p, tank) = benches::dam_break_fluid::<f32>();
     let unilateral = args.iter().any(|a| a == "unilateral");
+    let volume_map = args.iter().any(|a| a == "volume-map");
     // SPlisHSPlasH's particle volume is 0.8 (2r)³ (`FluidModel`), so its lattice starts
     // under-dense and settles; the paper's form uses the full lattice volume s³.
     let volume = if unilateral { 0.8 } else { 1.0 } * 0.025f32.powi(3);
@@ -46,15 +78,16 @@ fn main() {
     let mut solver: Box<dyn FluidSolver<f32>> = match which {
         "pcisph" => {
             let mut q = PcisphParams::<f32>::for_spacing(0.025);
-            q.dt = 0.002;
-            q.substeps = 1;
+            q.common.dt = 0.002;
+            q.common.substeps = 1;
             q.pressure_iterations = iterations;
-            Box::new(Pcisph::new(q, solids).expect("params"))
+            let b = walls(solids, tank, &q.common, volume_map);
+            Box::new(Pcisph::with_boundary(q, b).expect("params"))
         }
         _ => {
             let mut q = PbfParams::<f32>::for_spacing(0.025);
-            q.dt = 0.002;
-            q.substeps = 1;
+            q.common.dt = 0.002;
+            q.common.substeps = 1;
             q.solver_iterations = iterations;
             if unilateral {
                 // SPlisHSPlasH's PBF constraint: max(C, 0), ε = 1e-6 m⁻², no s_corr.
@@ -66,20 +99,18 @@ fn main() {
                 q.mean_compression_tolerance = tolerance;
                 q.min_solver_iterations = 2;
             }
-            Box::new(Pbf::new(q, solids).expect("params"))
+            let b = walls(solids, tank, &q.common, volume_map);
+            Box::new(Pbf::with_boundary(q, b).expect("params"))
         }
     };
-    let mut sum = StepStats::default();
+    let mut sum = StepStats::new(solver.phase_names());
     let mut last = StepStats::default();
     let t = Instant::now();
     for _ in 0..steps {
         last = solver.step(&mut state).expect("step");
-        sum.integrate_s += last.integrate_s;
-        sum.create_hash_grid_s += last.create_hash_grid_s;
-        sum.detect_neighbours_s += last.detect_neighbours_s;
-        sum.constraint_solve_s += last.constraint_solve_s;
-        sum.velocity_update_s += last.velocity_update_s;
-        sum.reorder_s += last.reorder_s;
+        for (k, (_, secs)) in last.phases.iter().enumerate() {
+            sum.phases.add(k, secs);
+        }
         sum.iterations += last.iterations;
         sum.unconverged_substeps += last.unconverged_substeps;
     }
@@ -101,15 +132,17 @@ fn main() {
         sum.iterations as f64 / n,
         sum.unconverged_substeps
     );
+    let phases: Vec<String> = sum
+        .phases
+        .iter()
+        .map(|(name, secs)| format!("{name} {:.2}", 1e3 * secs / n))
+        .collect();
+    let solve = sum.phase_s("constraint_solve") + sum.phase_s("pressure_solve");
     println!(
-        "phases per step (ms): integrate {:.2}, hash grid {:.2}, neighbours {:.2}, solve {:.2} ({:.3} us per particle-iteration), velocity update {:.2}, reorder {:.2}",
-        1e3 * sum.integrate_s / n,
-        1e3 * sum.create_hash_grid_s / n,
-        1e3 * sum.detect_neighbours_s / n,
-        1e3 * sum.constraint_solve_s / n,
-        1e6 * sum.constraint_solve_s / (sum.iterations as f64 * state.len() as f64),
-        1e3 * sum.velocity_update_s / n,
-        1e3 * sum.reorder_s / n,
+        "phases per step (ms): {} (solve {:.3} us per particle-iteration); walls: {}",
+        phases.join(", "),
+        1e6 * solve / (sum.iterations as f64 * state.len() as f64),
+        solver.boundary().name()
     );
     println!(
         "end: max rho/rho0 {:.5}, mean rho/rho0 {:.5}, last iteration's mean compression {:.5}, neighbour pairs {}",
