@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use validation::runner::{self, RunOptions};
-use validation::sim::{run_scene, SceneRunOptions};
+use sph_sim::{run_scene, SceneRunOptions};
 use validation::{registry, workspace_root, Mode};
 
 #[derive(Parser)]
@@ -77,6 +77,7 @@ fn main() -> ExitCode {
                 max_frames: frames,
                 out_dir: out
                     .unwrap_or_else(|| workspace_root().join("target").join("scenes").join(stem)),
+                progress: true,
             };
             match run_scene(&path, &opts) {
                 Ok(()) => ExitCode::SUCCESS,

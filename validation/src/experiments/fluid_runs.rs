@@ -129,12 +129,12 @@ fn run_in<R: Real>(ctx: &Context, scene: &Scene, label: String) -> Result<FluidR
                     break;
                 }
             }
-            Err(e) => match e.downcast_ref::<SolverError>() {
+            Err(e) => match e.solver_error() {
                 Some(SolverError::BlowUp { .. }) => {
                     run.blow_up = Some(format!("{e:#}"));
                     break;
                 }
-                _ => return Err(e),
+                _ => return Err(e.into()),
             },
         }
         ctx.progress.inc(1);

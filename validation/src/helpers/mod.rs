@@ -10,5 +10,4 @@ pub use data::{load_reference_csv, write_csv_columns, write_csv_rows, ReferenceT
 pub use plot::{ensure_fonts, plot_xy, Legend, Marker, PlotSpec, Series, SeriesStyle};
 pub use rng::SplitMix64;
 mod particle_image;
-pub mod vtk;
 pub use particle_image::side_view_png;

@@ -3,8 +3,9 @@
 
 use std::path::Path;
 
-use anyhow::{ensure, Context, Result};
 use sph_core::{Real, Vec3};
+
+use crate::SimError;
 use vtkio::model::{
     Attribute, Attributes, ByteOrder, DataSet, PolyDataPiece, Version, VertexNumbers, Vtk,
 };
@@ -41,17 +42,25 @@ fn flat(v: &[Vec3<impl Real>]) -> Vec<f32> {
 /// Writes `frame` to `path` (`.vtk`): points with one vertex cell each, and the point data
 /// `velocity` (vectors), `speed`, `density` and `id` (scalars). Coordinates are stored in
 /// single precision (ParaView's default).
-pub fn write_particle_frame<R: Real>(path: &Path, frame: &ParticleFrame<'_, R>) -> Result<()> {
+pub fn write_particle_frame<R: Real>(
+    path: &Path,
+    frame: &ParticleFrame<'_, R>,
+) -> Result<(), SimError> {
     let n = frame.positions.len();
-    ensure!(
-        frame.velocities.len() == n && frame.densities.len() == n && frame.ids.len() == n,
-        "particle frame arrays differ in length ({} positions, {} velocities, {} densities, {} ids)",
-        n,
-        frame.velocities.len(),
-        frame.densities.len(),
-        frame.ids.len()
-    );
-    let n32 = u32::try_from(n).context("more than 2^32 particles in one VTK frame")?;
+    if !(frame.velocities.len() == n && frame.densities.len() == n && frame.ids.len() == n) {
+        return Err(SimError::output(
+            path,
+            format!(
+                "particle frame arrays differ in length ({} positions, {} velocities, {} densities, {} ids)",
+                n,
+                frame.velocities.len(),
+                frame.densities.len(),
+                frame.ids.len()
+            ),
+        ));
+    }
+    let n32 = u32::try_from(n)
+        .map_err(|_| SimError::output(path, "more than 2^32 particles in one VTK frame"))?;
     let mut verts = Vec::with_capacity(2 * n);
     for i in 0..n32 {
         verts.extend_from_slice(&[1, i]);
@@ -91,7 +100,7 @@ pub fn write_particle_frame<R: Real>(path: &Path, frame: &ParticleFrame<'_, R>) 
         file_path: None,
     };
     vtk.export_be(path)
-        .with_context(|| format!("writing VTK frame {}", path.display()))
+        .map_err(|e| SimError::output(path, format!("writing VTK frame: {e}")))
 }
 
 #[cfg(test)]

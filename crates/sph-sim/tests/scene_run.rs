@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use validation::sim::{run_scene, SceneRunOptions, STATS_HEADER};
+use sph_sim::{run_scene, stats_header, SceneRunOptions};
 
 fn temp_dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("scene-run-{name}-{}", std::process::id()));
@@ -36,10 +36,16 @@ vtk = true
 
 #[test]
 fn runs_a_scene_and_writes_frames_and_statistics() {
-    for kind in ["pbf", "pcisph"] {
-        let dir = temp_dir(kind);
+    for (kind, model) in [
+        ("pbf", "collision"),
+        ("pcisph", "collision"),
+        ("pbf", "volume-map"),
+        ("pcisph", "volume-map"),
+    ] {
+        let dir = temp_dir(&format!("{kind}-{model}"));
         let scene = dir.join("tiny.toml");
-        std::fs::write(&scene, SCENE.replace("KIND", kind)).unwrap();
+        let text = format!("{}\n[boundary]\nmodel = \"{model}\"\n", SCENE.replace("KIND", kind));
+        std::fs::write(&scene, text).unwrap();
         let out = dir.join("out");
         run_scene(
             &scene,
@@ -47,13 +53,19 @@ fn runs_a_scene_and_writes_frames_and_statistics() {
                 quick: false,
                 out_dir: out.clone(),
                 max_frames: None,
+                progress: false,
             },
         )
         .unwrap();
         // 0.08 s of 16 ms frames: 5 frames; VTK at frames 0, 2, 4.
         let stats = std::fs::read_to_string(out.join("stats.csv")).unwrap();
         let lines: Vec<&str> = stats.lines().collect();
-        assert_eq!(lines[0], STATS_HEADER.join(","));
+        let phases: &[&str] = if kind == "pbf" {
+            pbf::PBF_PHASES
+        } else {
+            pcisph::PCISPH_PHASES
+        };
+        assert_eq!(lines[0], stats_header(phases).join(","));
         assert_eq!(lines.len(), 1 + 5, "{stats}");
         let last: Vec<&str> = lines[5].split(',').collect();
         assert_eq!(last[0], "5");
@@ -61,7 +73,7 @@ fn runs_a_scene_and_writes_frames_and_statistics() {
         let max_ratio: f64 = last[3].parse().unwrap();
         assert!(
             max_ratio > 0.9 && max_ratio < 1.2,
-            "{kind}: max rho/rho0 {max_ratio}"
+            "{kind} {model}: max rho/rho0 {max_ratio}"
         );
         for f in [0, 2, 4] {
             let p = out.join(format!("frame_{f:05}.vtk"));
@@ -94,11 +106,32 @@ fn malformed_scene_names_file_and_field() {
             quick: false,
             out_dir: dir.join("out"),
             max_frames: None,
+            progress: false,
         },
     )
     .unwrap_err();
     let msg = format!("{err:#}");
     assert!(msg.contains("bad.toml"), "{msg}");
     assert!(msg.contains("particle_spacing"), "{msg}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn zero_frames_and_a_file_as_output_are_refused() {
+    let dir = temp_dir("refuse");
+    let scene = dir.join("tiny.toml");
+    std::fs::write(&scene, SCENE.replace("KIND", "pbf")).unwrap();
+    let opts = |out_dir, max_frames| SceneRunOptions {
+        quick: false,
+        out_dir,
+        max_frames,
+        progress: false,
+    };
+    let err = run_scene(&scene, &opts(dir.join("out"), Some(0))).unwrap_err();
+    assert!(err.to_string().contains("--frames 0"), "{err}");
+    let file = dir.join("a-file");
+    std::fs::write(&file, "x").unwrap();
+    let err = run_scene(&scene, &opts(file, None)).unwrap_err();
+    assert!(err.to_string().contains("not a directory"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -1,0 +1,111 @@
+//! A scene being simulated: its particles, the solver the factory built, and the ids that
+//! follow particles across the solver's reordering.
+
+use std::path::Path;
+
+use sph_core::{apply_permutation, ParticleSet, Real};
+use sph_scene::Scene;
+use sph_solver::{FluidSolver, StepStats};
+
+use crate::vtk::{write_particle_frame, ParticleFrame};
+use crate::{build_solver, SimError};
+
+/// A scene being simulated in precision `R`.
+pub struct SceneSim<R: Real> {
+    /// The scene (with quick-mode overrides applied if asked for).
+    pub scene: Scene,
+    /// The particles (reordered by cell by the solver from time to time).
+    pub state: ParticleSet<R>,
+    /// For each particle of `state`, its index in the scene's initial order.
+    pub ids: Vec<u32>,
+    /// Frames done.
+    pub frame: usize,
+    /// Simulated time (s).
+    pub time_s: f64,
+    solver: Box<dyn FluidSolver<R>>,
+    id_scratch: Vec<u32>,
+}
+
+impl<R: Real> std::fmt::Debug for SceneSim<R> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SceneSim")
+            .field("scene", &self.scene.name)
+            .field("particles", &self.state.len())
+            .field("solver", &self.solver.name())
+            .field("boundary", &self.solver.boundary().name())
+            .field("frame", &self.frame)
+            .finish()
+    }
+}
+
+impl<R: Real> SceneSim<R> {
+    /// Samples the scene's fluid (masses `ρ0 s³`, the scene's initial velocities) and builds
+    /// its solver and boundary ([`build_solver`]). Errors name the scene file.
+    pub fn new(scene: &Scene) -> Result<Self, SimError> {
+        let solver = build_solver::<R>(scene)?;
+        let common = solver.common();
+        let positions = scene.fluid_positions::<R>()?;
+        let mut state =
+            ParticleSet::from_positions(positions, common.particle_mass(), common.rest_density);
+        let velocities = scene.fluid_velocities::<R>()?;
+        if velocities.len() != state.len() {
+            return Err(SimError::Invalid(format!(
+                "{}: {} initial velocities for {} particles",
+                scene.source.display(),
+                velocities.len(),
+                state.len()
+            )));
+        }
+        state.velocities = velocities;
+        let n = state.len() as u32;
+        Ok(Self {
+            scene: scene.clone(),
+            state,
+            ids: (0..n).collect(),
+            frame: 0,
+            time_s: 0.0,
+            solver,
+            id_scratch: Vec::new(),
+        })
+    }
+
+    /// The solver.
+    pub fn solver(&self) -> &dyn FluidSolver<R> {
+        &*self.solver
+    }
+
+    /// Advances one frame (`frame_dt`); keeps [`SceneSim::ids`] in step with the solver's
+    /// reordering. A blow-up is a [`SimError::Frame`] naming the frame and the solver's step
+    /// and particle; the state then holds the last completed substep.
+    pub fn advance(&mut self) -> Result<StepStats, SimError> {
+        let stats = self
+            .solver
+            .step(&mut self.state)
+            .map_err(|source| SimError::Frame {
+                file: self.scene.source.display().to_string(),
+                frame: self.frame,
+                time_s: self.time_s,
+                source,
+            })?;
+        if let Some(perm) = self.solver.last_permutation() {
+            apply_permutation(&mut self.ids, perm, &mut self.id_scratch);
+        }
+        self.frame += 1;
+        self.time_s = self.frame as f64 * self.scene.frame_dt_s;
+        Ok(stats)
+    }
+
+    /// Writes the current frame to `path` (legacy VTK).
+    pub fn write_vtk(&self, path: &Path) -> Result<(), SimError> {
+        write_particle_frame(
+            path,
+            &ParticleFrame {
+                time_s: self.time_s,
+                positions: &self.state.positions,
+                velocities: &self.state.velocities,
+                densities: &self.state.densities,
+                ids: &self.ids,
+            },
+        )
+    }
+}
