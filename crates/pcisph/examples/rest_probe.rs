@@ -3,13 +3,15 @@
 //! `m g H` over time, split by region (within `h` of a side wall or the floor, the top two
 //! layers, the bulk), and the density statistics.
 //!
-//! `cargo run --release -p pcisph --example rest_probe -- [substeps] [iterations] [xsph_c]`
+//! `cargo run --release -p pcisph --example rest_probe -- [substeps] [iterations] [xsph_c] [volume-map] [unclamped]`
 
 use pcisph::{Pcisph, PcisphParams};
 use sph_core::Vec3;
 
 fn main() {
-    let args: Vec<f64> = std::env::args().skip(1).map(|a| a.parse().unwrap()).collect();
+    let raw: Vec<String> = std::env::args().skip(1).collect();
+    let volume_map = raw.iter().any(|a| a == "volume-map");
+    let args: Vec<f64> = raw.iter().filter_map(|a| a.parse().ok()).collect();
     let mut p = PcisphParams::<f64>::default();
     if let Some(&n) = args.first() {
         p.common.substeps = n as usize;
@@ -20,6 +22,7 @@ fn main() {
     if let Some(&c) = args.get(2) {
         p.xsph_c = c;
     }
+    p.clamp_negative_pressure = !raw.iter().any(|a| a == "unclamped");
     let n = [20usize, 32, 20];
     let (mut state, solids, tank) =
         sph_solver::testing::block_in_tank(&p.common, n, [20.0, 64.0, 20.0]);
@@ -27,7 +30,22 @@ fn main() {
     let h = p.common.support_radius;
     let height = n[1] as f64 * s;
     let mgh = p.particle_mass() * 9.81 * height;
-    let mut solver = Pcisph::new(p.clone(), solids).unwrap();
+    let boundary: Box<dyn sph_solver::Boundary<f64>> = if volume_map {
+        Box::new(
+            sph_solver::boundary::VolumeMapBoundary::new(
+                solids,
+                sph_kernels::KernelKind::Poly6,
+                h,
+                tank,
+                0.5 * p.particle_radius(),
+                Default::default(),
+            )
+            .unwrap(),
+        )
+    } else {
+        Box::new(sph_solver::CollisionBoundary::new(solids, p.particle_radius()).unwrap())
+    };
+    let mut solver = Pcisph::with_boundary(p.clone(), boundary).unwrap();
     let frames = (2.0 / p.common.dt).round() as usize;
     for f in 1..=frames {
         let st = solver.step(&mut state).unwrap();

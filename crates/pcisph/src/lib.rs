@@ -133,7 +133,7 @@
 mod params;
 mod solver;
 
-pub use params::PcisphParams;
+pub use params::{PcisphParams, DEFAULT_PCISPH_XSPH};
 pub use solver::{Pcisph, PCISPH_PHASES};
 
 pub use sph_core::{ParticleSet, Real, Vec3};

@@ -46,7 +46,6 @@
 //! #                                # `iterations` is then the maximum
 //! # min_iterations = 2             # with mean_compression_tolerance (>= 1, <= iterations)
 //! # kind = "pcisph" only:
-//! # viscosity = 0.0                # artificial viscosity coefficient, dimensionless (>= 0)
 //! # clamp_negative_pressure = true
 //! # density_error_tolerance = 0.01 # relative density error to stop at (> 0)
 //!

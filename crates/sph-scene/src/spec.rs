@@ -109,8 +109,6 @@ pub struct PcisphSpec {
     pub support_over_spacing: Option<f64>,
     /// XSPH viscosity `c`, in [0, 1].
     pub xsph_c: Option<f64>,
-    /// Artificial viscosity coefficient (dimensionless, finite and ≥ 0).
-    pub viscosity: Option<f64>,
     /// Reorder particles every this many frames (0 = never).
     pub reorder_every: Option<usize>,
     /// Clamp negative pressures to zero.
@@ -212,7 +210,6 @@ impl SolverSpec {
                 rest_density: s.rest_density,
                 support_over_spacing: s.support_over_spacing,
                 xsph_c: s.xsph_c,
-                viscosity: None,
                 reorder_every: s.reorder_every,
                 clamp_negative_pressure: None,
                 density_error_tolerance: None,

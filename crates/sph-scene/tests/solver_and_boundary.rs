@@ -36,7 +36,7 @@ fn pbf_fixture_reads_into_the_pbf_variant() {
 fn pcisph_scene_with_its_own_options() {
     let text = pcisph().replacen(
         "xsph_c = 0.01",
-        "xsph_c = 0.01\nviscosity = 2.5\nclamp_negative_pressure = true\ndensity_error_tolerance = 0.01\nrest_density = 998.0",
+        "xsph_c = 0.01\nclamp_negative_pressure = true\ndensity_error_tolerance = 0.01\nrest_density = 998.0",
         1,
     );
     let s = parse("pcisph_variant", &text);
@@ -44,8 +44,6 @@ fn pcisph_scene_with_its_own_options() {
     let SolverSpec::Pcisph(p) = &s.solver else {
         panic!("{:?}", s.solver)
     };
-    // No upper bound on the artificial viscosity.
-    assert_eq!(p.viscosity, Some(2.5));
     assert_eq!(p.clamp_negative_pressure, Some(true));
     assert_eq!(p.density_error_tolerance, Some(0.01));
     assert_eq!(s.solver.rest_density(), Some(998.0));
@@ -83,7 +81,6 @@ fn pcisph_field_under_pbf_is_refused_with_path_and_line() {
     for field in [
         "density_error_tolerance = 0.01",
         "clamp_negative_pressure = true",
-        "viscosity = 0.1",
     ] {
         let name = field.split(' ').next().unwrap();
         let e = err_with("pcisph_only", "xsph_c = 0.01", field);
@@ -128,16 +125,6 @@ fn wrong_type_in_a_variant_keeps_path_and_line() {
 fn pcisph_value_checks() {
     for (line, field, reason) in [
         (
-            "viscosity = -0.1",
-            "solver.viscosity",
-            "must be finite and >= 0, got -0.1",
-        ),
-        (
-            "viscosity = nan",
-            "solver.viscosity",
-            "must be finite and >= 0",
-        ),
-        (
             "xsph_c = 1.5",
             "solver.xsph_c",
             "must be in [0, 1], got 1.5",
@@ -169,11 +156,11 @@ fn pcisph_value_checks() {
 #[test]
 fn solver_spec_deserializes_as_an_internally_tagged_table() {
     let s: SolverSpec =
-        toml::from_str("kind = \"pcisph\"\nsubsteps = 1\niterations = 2\nviscosity = 0.5").unwrap();
+        toml::from_str("kind = \"pcisph\"\nsubsteps = 1\niterations = 2\nxsph_c = 0.5").unwrap();
     let SolverSpec::Pcisph(p) = &s else {
         panic!("{s:?}")
     };
-    assert_eq!((p.substeps, p.iterations, p.viscosity), (1, 2, Some(0.5)));
+    assert_eq!((p.substeps, p.iterations, p.xsph_c), (1, 2, Some(0.5)));
     let e = toml::from_str::<SolverSpec>(
         "kind = \"pcisph\"\nsubsteps = 1\niterations = 2\nscorr_k = 0.1",
     )
@@ -199,7 +186,7 @@ fn with_kind_keeps_the_shared_settings() {
     };
     assert_eq!((p.substeps, p.iterations), (2, 3));
     assert_eq!(
-        (p.xsph_c, p.rest_density, p.viscosity),
+        (p.xsph_c, p.rest_density, p.clamp_negative_pressure),
         (Some(0.01), Some(990.0), None)
     );
     let back = c.with_kind(SolverKind::Pbf);

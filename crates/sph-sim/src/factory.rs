@@ -140,9 +140,6 @@ pub fn pcisph_params<R: Real>(
     if let Some(c) = s.xsph_c {
         p.xsph_c = r(c);
     }
-    if let Some(v) = s.viscosity {
-        p.viscosity = r(v);
-    }
     if let Some(c) = s.clamp_negative_pressure {
         p.clamp_negative_pressure = c;
     }

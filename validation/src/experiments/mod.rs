@@ -1,31 +1,27 @@
-//! The experiments, one module each.
+//! The experiments, one module each, grouped by the paper or work they replay.
 
 use crate::Experiment;
 
-pub mod dam_break_front;
-mod fluid_runs;
-pub mod kernels;
-pub mod neighbour_search;
-pub mod pbf_bunny_density;
-pub mod pbf_convergence;
-pub mod pbf_performance;
-pub mod pbf_stability;
-pub mod pbf_vorticity;
-pub mod symplectic_100myr;
-pub mod symplectic_order;
+pub mod boundary;
+pub mod pbf;
+pub mod sph;
+pub mod symplectic;
+
+pub(crate) use pbf::fluid_runs;
 
 /// Every registered experiment, in run order.
 pub fn registry() -> Vec<Box<dyn Experiment>> {
     vec![
-        Box::new(kernels::Kernels),
-        Box::new(neighbour_search::NeighbourSearchExperiment),
-        Box::new(symplectic_100myr::Symplectic100Myr),
-        Box::new(symplectic_order::SymplecticOrder),
-        Box::new(pbf_bunny_density::PbfBunnyDensity),
-        Box::new(pbf_stability::PbfStability),
-        Box::new(pbf_convergence::PbfConvergence),
-        Box::new(pbf_vorticity::PbfVorticity),
-        Box::new(dam_break_front::DamBreakFront),
-        Box::new(pbf_performance::PbfPerformance),
+        Box::new(sph::kernels::Kernels),
+        Box::new(sph::neighbour_search::NeighbourSearchExperiment),
+        Box::new(symplectic::symplectic_100myr::Symplectic100Myr),
+        Box::new(symplectic::symplectic_order::SymplecticOrder),
+        Box::new(boundary::boundary_rest::BoundaryRest),
+        Box::new(pbf::pbf_bunny_density::PbfBunnyDensity),
+        Box::new(pbf::pbf_stability::PbfStability),
+        Box::new(pbf::pbf_convergence::PbfConvergence),
+        Box::new(pbf::pbf_vorticity::PbfVorticity),
+        Box::new(pbf::dam_break_front::DamBreakFront),
+        Box::new(pbf::pbf_performance::PbfPerformance),
     ]
 }

@@ -137,7 +137,6 @@ fn check_pcisph(ctx: &Ctx, s: &PcisphSpec) -> Result<(), SceneError> {
         s.support_over_spacing,
         s.xsph_c,
     )?;
-    non_negative(ctx, "viscosity", s.viscosity)?;
     positive(ctx, "density_error_tolerance", s.density_error_tolerance)
 }
 

@@ -5,7 +5,7 @@
 use anyhow::Result;
 use sph_scene::SolverKind;
 
-use super::fluid_runs::{run_fluid, FluidRun};
+use crate::experiments::fluid_runs::{run_fluid, FluidRun};
 use crate::helpers::{plot_xy, write_csv_rows, Legend, PlotSpec, Series, SeriesStyle};
 use crate::sim::shipped_scene;
 use crate::{Check, Context, Experiment, Outcome};

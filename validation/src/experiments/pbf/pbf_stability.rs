@@ -15,7 +15,7 @@
 use anyhow::Result;
 use sph_scene::SolverKind;
 
-use super::fluid_runs::{run_fluid, FluidRun};
+use crate::experiments::fluid_runs::{run_fluid, FluidRun};
 use crate::helpers::{plot_xy, write_csv_rows, Legend, PlotSpec, Series};
 use crate::sim::shipped_scene;
 use crate::{fmt_num, Check, Context, Experiment, Outcome};

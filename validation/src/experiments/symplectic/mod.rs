@@ -1,0 +1,4 @@
+//! Chegodaeva (2004): symplectic integration of small Solar System bodies.
+
+pub mod symplectic_100myr;
+pub mod symplectic_order;
