@@ -159,7 +159,11 @@ pub fn run_fluid(
         SolverKind::Pbf => "PBF",
         SolverKind::Pcisph => "PCISPH",
     };
-    let label = format!("{name} {substeps}×{iterations}");
+    let walls = match scene.boundary.model {
+        sph_scene::BoundaryModel::VolumeMap => "volume maps",
+        sph_scene::BoundaryModel::Collision => "collision walls",
+    };
+    let label = format!("{name} {substeps}×{iterations}, {walls}");
     match scene.precision {
         Precision::F32 => run_in::<f32>(ctx, &scene, label),
         Precision::F64 => run_in::<f64>(ctx, &scene, label),
