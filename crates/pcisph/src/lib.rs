@@ -70,14 +70,17 @@
 //! # Deviations from Solenthaler & Pajarola (2009)
 //!
 //! - **Viscosity.** S&P09 include an SPH viscosity force in the non-pressure forces `F^v`.
-//!   Here the viscosity is PBF's XSPH filter (Macklin & Müller eq. 17, `c = 0.01`, volumes
+//!   Here the viscosity is PBF's XSPH filter (Macklin & Müller eq. 17, `c = 0.05` by default,
+//!   see below; volumes
 //!   `m_j/ρ0`, Poly6), `v_i ← v_i + c Σ_j (m_j/ρ0) (v_j − v_i) W(x_i − x_j)`, applied as a
 //!   non-pressure velocity change at the start of each time step (at `x(t)`, with the
 //!   neighbours of step 1), so that the comparison with PBF isolates the pressure solver.
 //! - **Boundaries.** S&P09 handle boundaries with their own collision handling; here the
-//!   solids are signed distance fields with exactly PBF's response (projection to the
-//!   particle radius `s/2` along the SDF gradient, no friction or restitution), applied to
-//!   the predicted positions inside each iteration and to the final positions.
+//!   walls are a [`sph_solver::Boundary`]: [`Pcisph::new`] projects particles out of SDF
+//!   solids to the particle radius `s/2` (PBF's response, no friction or restitution),
+//!   [`Pcisph::with_boundary`] takes volume maps, whose walls also take part in the density
+//!   and the pressure force; the contact response is applied to the predicted positions
+//!   inside each iteration and to the final positions.
 //! - **Iteration count.** The paper iterates until the density error is below `η` (with a
 //!   minimum number of iterations; SPlisHSPlasH uses at least 3). Here `pressure_iterations`
 //!   is a fixed count by default (the PBF paper's comparison: 4), and
@@ -96,7 +99,7 @@
 //! - **Neighbours** for the predicted densities are those of `x(t)` (the paper's "once per
 //!   time step"), so a pair that only comes within `h` at the predicted positions is missed.
 //!
-//! # Measured behaviour (1000-particle block at rest in a tank, SDF walls)
+//! # Measured behaviour (1000-particle block at rest in a tank, SDF walls, XSPH `c` 0.01)
 //!
 //! 10 × 10 × 10 particles at `s = 0.025 m` filling the bottom of a tank of 10 × 20 × 10
 //! spacings, 10 substeps × 4 iterations per 16 ms frame (`tests/pcisph.rs`):
@@ -117,9 +120,43 @@
 //!   XSPH, supplies damping the scheme needs; their boundary handling, replaced by SDFs,
 //!   supplies wall density.
 //!
-//! Time per frame (10 × 4, 1000 particles, release build, 2 cores shared with other work):
-//! 28–41 ms, i.e. 3–4 ms per substep of 4 iterations.
+//! # Why a fluid at rest kept boiling, and the fix (measured)
 //!
+//! A block of 20 × 32 × 20 particles (`s = 0.025 m`, 12,800 particles) resting on the floor
+//! of a closed tank twice its height, 10 × 4 per 16 ms frame, 2 s, kinetic energy per
+//! particle in units of `m g H` (`H` the block height), split into the particles within `h`
+//! of a wall, the top two layers and the bulk (`cargo run --release -p pcisph --example
+//! rest_probe -- SUBSTEPS ITERATIONS XSPH [volume-map] [unclamped]`, f64):
+//!
+//! | walls | XSPH `c` | iterations | KE at 2 s | where |
+//! | --- | --- | --- | --- | --- |
+//! | collision | 0.01 | 4 | 6.1·10⁻² | walls 8.7·10⁻², bulk 4.0·10⁻²; splashes to 56 `s` (block 32 `s`) |
+//! | collision | 0.01 | 1 | 1.7·10⁻² | |
+//! | collision | 0.01 | 20 | 9.3·10⁻² | |
+//! | collision | 0 | 4 | 2.2·10⁻¹ | |
+//! | volume map | 0.01 | 4 | 1.3·10⁻² | bulk 1.5·10⁻², walls 1.1·10⁻²; no splash |
+//! | volume map | 0.01 | 1 | 7.2·10⁻⁴ | (max `ρ/ρ0` 1.07: under-resolved pressure) |
+//! | volume map | 0.01 | 20 | 2.8·10⁻² | |
+//! | volume map | 0.05 | 4 | **3.7·10⁻⁵** | the default |
+//! | volume map | 0.1 | 4 | 1.0·10⁻⁵ | |
+//! | collision | 0.1 | 4 | 1.8·10⁻⁴ | surface 29.8 `s` (particles stacked at the walls) |
+//!
+//! Two causes, each measured: (1) with collision walls the wall particles lack the wall's
+//! share of their density, so the energy concentrates at the walls (twice the bulk's) and
+//! the fluid splashes; volume maps remove that (5× less energy, no splash). (2) What
+//! remains grows with the number of pressure iterations (1 → 4 → 20: 7·10⁻⁴ → 1.3·10⁻² →
+//! 2.8·10⁻²), in the bulk: each iteration makes the correction of the per-step density
+//! fluctuations more complete, and the correction enters the velocity; S&P09 dissipate that
+//! with their viscosity force, for which PBF's XSPH with `c = 0.01` is far too weak. Tried
+//! and rejected by measurement: under-relaxing the pressure update (`ω = 0.5` at 20
+//! iterations: 2.5·10⁻², i.e. not a diverging Jacobi iteration), clamping the accumulated
+//! pressure instead of the density error (6.7·10⁻² with collision walls), and particle
+//! masses calibrated to the Poly6 lattice density (1.5·10⁻² with volume maps: the kernel's
+//! +0.98 % lattice bias is not the cause). Hence the defaults: volume-map walls (the scene
+//! default, `sph_scene::BoundaryModel`) and `c = 0.05` ([`DEFAULT_PCISPH_XSPH`]). The
+//! `boundary-rest` experiment checks the result on a smaller column (PCISPH 3·10⁻⁵ with
+//! volume maps against 7·10⁻³ with collision walls).
+
 //! # Robustness, performance, determinism
 //!
 //! Exactly as for the `pbf` crate's solver (both use `sph_solver::step`): invalid input is rejected naming the particle; divergence (a

@@ -186,6 +186,35 @@ impl HermiteTable {
         let h11 = s2 * (s - 1.0);
         h00 * y0 + h10 * self.dx * m0 + h01 * y1 + h11 * self.dx * m1
     }
+
+    /// The interpolant and its derivative at `t` (one table lookup for both).
+    #[inline]
+    pub(crate) fn eval_with_slope(&self, t: f64) -> (f64, f64) {
+        let n = self.nodes.len() - 1;
+        let u = t / self.dx;
+        if u.is_nan() || u <= 0.0 {
+            return (self.nodes[0].0, self.nodes[0].2);
+        }
+        if u >= n as f64 {
+            return (self.nodes[n].0, self.nodes[n].1);
+        }
+        let i = (u as usize).min(n - 1);
+        let s = u - i as f64;
+        let ((y0, _, m0), (y1, m1, _)) = (self.nodes[i], self.nodes[i + 1]);
+        let s2 = s * s;
+        let h00 = (1.0 + 2.0 * s) * (1.0 - s) * (1.0 - s);
+        let h10 = s * (1.0 - s) * (1.0 - s);
+        let h01 = s2 * (3.0 - 2.0 * s);
+        let h11 = s2 * (s - 1.0);
+        let value = h00 * y0 + h10 * self.dx * m0 + h01 * y1 + h11 * self.dx * m1;
+        // d/dt of the Hermite basis (per unit s, then / dx).
+        let d00 = 6.0 * s2 - 6.0 * s;
+        let d10 = 3.0 * s2 - 4.0 * s + 1.0;
+        let d01 = -d00;
+        let d11 = 3.0 * s2 - 2.0 * s;
+        let slope = (d00 * y0 + d01 * y1) / self.dx + d10 * m0 + d11 * m1;
+        (value, slope)
+    }
 }
 
 /// Intervals of each table (the Hermite error bound gives < 1e-13 for every kernel of
@@ -290,6 +319,23 @@ impl KernelTables {
             1.0 - self.plane.eval(-d)
         } else {
             self.plane.eval(d)
+        }
+    }
+
+    /// `Ψ_plane(d)` and `dΨ_plane/dd` (1/m) in one lookup of the `Ψ_plane` table (the
+    /// derivative is that of its cubic Hermite interpolant, whose node slopes are the exact
+    /// derivative).
+    #[inline]
+    pub(crate) fn psi_plane_with_derivative(&self, d: f64) -> (f64, f64) {
+        if d >= self.h {
+            (0.0, 0.0)
+        } else if d <= -self.h {
+            (1.0, 0.0)
+        } else if d < 0.0 {
+            let (v, dv) = self.plane.eval_with_slope(-d);
+            (1.0 - v, dv)
+        } else {
+            self.plane.eval_with_slope(d)
         }
     }
 
