@@ -137,29 +137,34 @@
 //!
 //! Side by side with SPlisHSPlasH 2.19 (`pip install pysplishsplash==2.19.0`, its PBF,
 //! `simulationMethod` 2, **volume maps**, `boundaryHandlingMethod` 2, iterating to 0.1 %
-//! mean density error, 2–100 iterations, fixed Δt = 2 ms) on its `DamBreakModel` scene at
-//! particle radius 0.0125 m (59,319 fluid particles, tank 4 × 3 × 1.5 m), 250 steps from
-//! rest, both on this 2-core machine, one run after the other from one script, 2026-11-23.
-//! Ours: `RAYON_NUM_THREADS=T cargo run --release -p benches --example pbf_dambreak -- 250
-//! tol=0.001 pbf unilateral [volume-map]` (SPlisHSPlasH's stopping rule and constraint form,
-//! see below):
+//! mean density error, 2–100 iterations, fixed Δt = 2 ms, no viscosity) on its
+//! `DamBreakModel` scene at particle radius 0.0125 m (59,319 fluid particles, tank 4 × 3 ×
+//! 1.5 m), 250 steps from rest, on this 2-core machine, one script running all six rows one
+//! after the other (2026-11-23). Ours: `RAYON_NUM_THREADS=T cargo run --release -p benches
+//! --example pbf_dambreak -- 250 tol=0.001 pbf unilateral [volume-map]` (SPlisHSPlasH's
+//! stopping rule and constraint form, see below; XSPH `c` 0.01, which SPlisHSPlasH does not
+//! apply):
 //!
 //! | threads | SPlisHSPlasH, volume maps | here, volume maps | ratio | here, SDF collision walls | ratio |
 //! | --- | --- | --- | --- | --- | --- |
-//! | 1 | 287.0 ms (5.29 it.) | 119.7 ms (4.61 it.) | 2.40× | 95.9 ms (4.68 it.) | 2.99× |
-//! | 2 | 151.4 ms (5.27 it.) | 61.3 ms (4.61 it.) | 2.47× | 49.3 ms (4.68 it.) | 3.07× |
+//! | 1 | 273.5 ms (5.29 it.) | 113.2 ms (4.61 it.) | 2.42× | 95.1 ms (4.68 it.) | 2.88× |
+//! | 2 | 149.3 ms (5.27 it.) | 57.3 ms (4.61 it.) | 2.60× | 48.6 ms (4.68 it.) | 3.07× |
 //!
-//! The volume maps cost 25 % per step here (the boundary's `Ψ` is sampled at every Jacobi
-//! iteration); the first version cost 85 % (177.6 ms), before a particle farther than `h`
-//! from a solid skipped the map (one distance evaluation) and cells whose eight nodes all
-//! lie on one flat wall took the half-space volume directly. The 2.5× aimed for is not
-//! reached (2.40× and 2.47×). Map construction is not counted: 30.6 s for the tank on one
-//! thread (15.7 s on two) against SPlisHSPlasH's 6.7 s (3.5 s): our map integrates the
-//! kernel over the solid at every node of a band with `h/4` cells by a 16 × 32-direction
-//! quadrature (`sph_solver::boundary::VolumeMap`), theirs stores a coarser volume field.
-//! SPlisHSPlasH's end state has max `ρ/ρ0` 1.31 against our 1.01 (its density at the walls
-//! uses its virtual boundary particle; both stop at 0.1 % mean compression).
-//!
+//! The volume maps cost 18–19 % per step here (the boundary's `Ψ` is sampled at every Jacobi
+//! iteration); the first version cost 85 % (177.6 ms on one thread), before a particle
+//! farther than `h` from a solid skipped the map (one distance evaluation) and cells whose
+//! eight nodes all lie on one flat wall (one bit per cell) took the half-space volume
+//! directly. The 2.5× aimed for is reached on two threads, not on one (2.42×). The runs do
+//! not end in the same state: ours ends denser (mean `ρ/ρ0` 0.929 against 0.883, 1.96 M
+//! ordered neighbour pairs against 1.50 M), i.e. with 30 % more pair work per iteration; both
+//! end at max `ρ/ρ0` 1.01–1.02 (SPlisHSPlasH's recomputed with Poly6, the constraint's
+//! kernel; its own density output uses the cubic spline). Map construction is not counted:
+//! 30.4 s for the tank on one thread (15.7 s on two) against SPlisHSPlasH's 6.7 s (3.5 s):
+//! our map integrates the kernel over the solid at every node of a band with `h/4` cells by
+//! a 16 × 32-direction quadrature (`sph_solver::boundary::VolumeMap`), SPlisHSPlasH's stores
+//! the volume of a smoothed wall indicator on a 40 × 30 × 15-cell grid and places one
+//! virtual boundary particle per fluid particle.
+
 //! # Earlier measurement, SPlisHSPlasH with boundary particles
 //!
 //! Measured side by side with SPlisHSPlasH 2.19 (`pip install pysplishsplash==2.19.0`, its

@@ -242,6 +242,10 @@ enum Storage<R: Real> {
         /// Per dense node: index into `models`, or [`FAR`] (Ψ = 0 nearby) / [`DEEP`] (Ψ = 1).
         index: Vec<u32>,
         models: Vec<NodeModel>,
+        /// One bit per cell: set where all eight corners are flat-wall nodes or [`FAR`],
+        /// so that `Ψ` is the half-space volume of the solid's own distance. A bit grid is
+        /// 1/32 of the index, small enough to stay in cache where the index is not.
+        flat_cells: Vec<u64>,
     },
     Trilinear(SampledGrid<R>),
 }
@@ -264,6 +268,30 @@ fn v64<R: Real>(v: &Vec3<R>) -> Vec3<f64> {
 
 fn vr<R: Real>(v: &Vec3<f64>) -> Vec3<R> {
     Vec3::new(R::of_f64(v.x), R::of_f64(v.y), R::of_f64(v.z))
+}
+
+/// The flat-cell bits of a node index (see `Storage::NodePlanes::flat_cells`).
+fn flat_cells(index: &[u32], dims: [usize; 3]) -> Vec<u64> {
+    let [nx, ny, nz] = dims;
+    let cells = (nx - 1) * (ny - 1) * (nz - 1);
+    let mut bits = vec![0u64; cells.div_ceil(64)];
+    let flat = |v: u32| v == FAR || (v < DEEP && v & PLANE_BIT != 0);
+    let mut cell = 0;
+    for k in 0..nz - 1 {
+        for j in 0..ny - 1 {
+            for i in 0..nx - 1 {
+                let all = (0..8).all(|c| {
+                    let (a, b, d) = (c & 1, (c >> 1) & 1, c >> 2);
+                    flat(index[(i + a) + nx * ((j + b) + ny * (k + d))])
+                });
+                if all {
+                    bits[cell / 64] |= 1 << (cell % 64);
+                }
+                cell += 1;
+            }
+        }
+    }
+    bits
 }
 
 fn unit_normal<R: Real>(sdf: &dyn Sdf<R>, p: &Vec3<R>) -> Vec3<f64> {
@@ -433,7 +461,12 @@ impl<R: Real> VolumeMap<R> {
                     );
                     models.extend(m);
                 }
-                Storage::NodePlanes { index, models }
+                let flat_cells = flat_cells(&index, dims);
+                Storage::NodePlanes {
+                    index,
+                    models,
+                    flat_cells,
+                }
             }
         };
         let stored_nodes = match &storage {
@@ -507,7 +540,14 @@ impl<R: Real> VolumeMap<R> {
         let p = v64(x);
         let u = self.grid_coords(&p);
         match (&self.storage, u) {
-            (Storage::NodePlanes { index, models }, Some(u)) => {
+            (
+                Storage::NodePlanes {
+                    index,
+                    models,
+                    flat_cells,
+                },
+                Some(u),
+            ) => {
                 // Beyond the support of the solid Ψ is exactly 0: one evaluation of the
                 // signed distance (a few flops for analytic solids) instead of eight
                 // scattered node reads (the dense node index of a tank is tens of MB).
@@ -515,7 +555,14 @@ impl<R: Real> VolumeMap<R> {
                 if phi >= self.tables.h {
                     return (0.0, Vec3::zeros());
                 }
-                self.blend(index, models, &p, &u).unwrap_or_else(|| {
+                let cell = self.cell_of(&u);
+                let flat = (flat_cells[cell / 64] >> (cell % 64)) & 1 == 1;
+                let blended = if flat {
+                    None
+                } else {
+                    self.blend(index, models, &p, &u)
+                };
+                blended.unwrap_or_else(|| {
                     // Flat wall around the whole cell: exact half-space volume.
                     let n = unit_normal(solid, x);
                     let (pv, pd) = self.tables.psi_plane_with_derivative(phi);
@@ -533,6 +580,14 @@ impl<R: Real> VolumeMap<R> {
             _ if self.bounded && self.dims[0] >= 2 => (0.0, Vec3::zeros()),
             _ => self.plane_only(solid, x),
         }
+    }
+
+    /// Linear index of the cell holding grid coordinates `u` (cells along x fastest).
+    #[inline]
+    fn cell_of(&self, u: &Vec3<f64>) -> usize {
+        let [nx, ny, _] = self.dims;
+        let c = |a: usize| (u[a].floor() as usize).min(self.dims[a] - 2);
+        c(0) + (nx - 1) * (c(1) + (ny - 1) * c(2))
     }
 
     fn blend(
