@@ -194,7 +194,7 @@ fn binned(points: impl Iterator<Item = (f64, f64)>, x0: f64, dx: f64) -> Vec<(f6
     let mut sums: Vec<(f64, usize)> = Vec::new();
     for (x, v) in points {
         let k = ((x - x0) / dx).floor();
-        if !(k >= 0.0 && k < 10_000.0) {
+        if !(0.0..10_000.0).contains(&k) {
             continue;
         }
         let k = k as usize;
