@@ -147,23 +147,27 @@
 //!
 //! | threads | SPlisHSPlasH, volume maps | here, volume maps | ratio | here, SDF collision walls | ratio |
 //! | --- | --- | --- | --- | --- | --- |
-//! | 1 | 273.5 ms (5.29 it.) | 113.2 ms (4.61 it.) | 2.42× | 95.1 ms (4.68 it.) | 2.88× |
-//! | 2 | 149.3 ms (5.27 it.) | 57.3 ms (4.61 it.) | 2.60× | 48.6 ms (4.68 it.) | 3.07× |
+//! | 1 | 285.7 ms (5.29 it.) | 107.0 ms (4.61 it.) | 2.67× | 90.2 ms (4.68 it.) | 3.17× |
+//! | 2 | 129.6 ms (5.27 it.) | 52.4 ms (4.61 it.) | 2.47× | 44.5 ms (4.68 it.) | 2.91× |
 //!
-//! The volume maps cost 18–19 % per step here (the boundary's `Ψ` is sampled at every Jacobi
-//! iteration); the first version cost 85 % (177.6 ms on one thread), before a particle
-//! farther than `h` from a solid skipped the map (one distance evaluation) and cells whose
-//! eight nodes all lie on one flat wall (one bit per cell) took the half-space volume
-//! directly. The 2.5× aimed for is reached on two threads, not on one (2.42×). The runs do
-//! not end in the same state: ours ends denser (mean `ρ/ρ0` 0.929 against 0.883, 1.96 M
-//! ordered neighbour pairs against 1.50 M), i.e. with 30 % more pair work per iteration; both
-//! end at max `ρ/ρ0` 1.01–1.02 (SPlisHSPlasH's recomputed with Poly6, the constraint's
-//! kernel; its own density output uses the cubic spline). Map construction is not counted:
-//! 30.4 s for the tank on one thread (15.7 s on two) against SPlisHSPlasH's 6.7 s (3.5 s):
-//! our map integrates the kernel over the solid at every node of a band with `h/4` cells by
-//! a 16 × 32-direction quadrature (`sph_solver::boundary::VolumeMap`), SPlisHSPlasH's stores
-//! the volume of a smoothed wall indicator on a 40 × 30 × 15-cell grid and places one
-//! virtual boundary particle per fluid particle.
+//! Spread: over three such runs the same day SPlisHSPlasH took 273.5–290.6 ms on one thread
+//! and 129.6–151.4 ms on two, so the volume-map ratio is 2.4–2.7× on one thread and 2.3–2.9×
+//! on two; the 2.5× aimed for is met in some runs and missed in others. The volume maps cost
+//! 18–19 % per step here against the SDF walls (the boundary's `Ψ` is sampled at every
+//! Jacobi iteration for the 15 % of the particles within `1.5 h` of a wall); the first
+//! version cost 85 % (177.6 ms on one thread), before a particle farther than `h` from a
+//! solid skipped the map, cells whose eight nodes all lie on one flat wall took the
+//! half-space volume directly, and each step's iterations skipped the particles out of reach
+//! of the walls. The runs do not end in the same state: ours ends denser (mean `ρ/ρ0` 0.929
+//! against 0.883, 1.96 M ordered neighbour pairs against 1.50 M), i.e. with 30 % more pair
+//! work per iteration; both end at max `ρ/ρ0` 1.01–1.02 (SPlisHSPlasH's recomputed with
+//! Poly6, the constraint's kernel; its own density output uses the cubic spline). Map
+//! construction is not counted: 29.0 s for the tank on one thread (14.6 s on two) against
+//! SPlisHSPlasH's 6.5 s (3.3 s): our map integrates the kernel over the solid at every node
+//! of a band with `h/4` cells by a 16 × 32-direction quadrature
+//! (`sph_solver::boundary::VolumeMap`), SPlisHSPlasH's stores the volume of a smoothed wall
+//! indicator on a 40 × 30 × 15-cell grid and places one virtual boundary particle per fluid
+//! particle.
 
 //! # Earlier measurement, SPlisHSPlasH with boundary particles
 //!

@@ -13,7 +13,9 @@ use sph_solver::step::{
 };
 use sph_solver::{Boundary, CollisionBoundary, SolverError, Solids, StepStats};
 
-use crate::passes::{delta_pass, lambda_pass, Consts, LambdaOut, PairCache, PassInput};
+use crate::passes::{
+    delta_pass, lambda_pass, near_boundary, Consts, LambdaOut, PairCache, PassInput,
+};
 use crate::PbfParams;
 
 /// The Position Based Fluids solver of
@@ -95,6 +97,7 @@ pub struct PbfScratch<R: Real> {
     delta_p: Vec<Vec3<R>>,
     density: Vec<R>,
     boundary_grad: Vec<Vec3<R>>,
+    near_boundary: Vec<bool>,
     velocity: Vec<Vec3<R>>,
     velocity_new: Vec<Vec3<R>>,
     vorticity: Vec<Vec3<R>>,
@@ -115,6 +118,7 @@ impl<R: Real> PbfScratch<R> {
         self.delta_p.resize(n, z);
         self.density.resize(n, R::zero());
         self.boundary_grad.resize(n, z);
+        self.near_boundary.resize(n, false);
         self.velocity.resize(n, z);
         self.velocity_new.resize(n, z);
         self.vorticity.resize(n, z);
@@ -265,6 +269,10 @@ impl<R: Real> Pbf<R> {
         s.predicted.copy_from_slice(positions);
         self.neighbours
             .find(&s.predicted, self.params.common.support_radius)?;
+        if let Some(b) = volume {
+            near_boundary(b, &s.predicted, self.params.common.support_radius, &mut s.near_boundary);
+        }
+        let volume = volume.map(|b| (b, &s.near_boundary[..]));
         let input = PassInput {
             c: &self.c,
             x: &s.predicted,
@@ -388,6 +396,10 @@ impl<R: Real> Pbf<R> {
 
         // Lines 8–19: Jacobi iterations with the contact response.
         let t = Instant::now();
+        if let Some(b) = volume {
+            near_boundary(b, &s.predicted, h, &mut s.near_boundary);
+        }
+        let reach = volume.map(|b| (b, &s.near_boundary[..]));
         let inv_n = 1.0 / (state.len().max(1) as f64);
         let mut done = 0;
         loop {
@@ -396,7 +408,7 @@ impl<R: Real> Pbf<R> {
                 x: &s.predicted,
                 m,
                 nb,
-                volume,
+                volume: reach,
             };
             let out = LambdaOut {
                 density: &mut s.density,

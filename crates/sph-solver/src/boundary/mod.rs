@@ -79,6 +79,13 @@ pub trait Boundary<R: Real>: Send + Sync {
     fn closest(&self, x: &Vec3<R>) -> Option<ClosestPoint<R>> {
         closest_of(self.solids(), x)
     }
+    /// The smallest signed distance from `x` to the solids (m; `+∞` without solids).
+    fn distance(&self, x: &Vec3<R>) -> R {
+        self.solids()
+            .iter()
+            .map(|s| s.signed_distance(x))
+            .fold(R::of_f64(f64::INFINITY), |a, b| if b < a { b } else { a })
+    }
 }
 
 /// [`Boundary::closest`] over a list of solids.
