@@ -154,7 +154,7 @@
 //! masses calibrated to the Poly6 lattice density (1.5·10⁻² with volume maps: the kernel's
 //! +0.98 % lattice bias is not the cause). Hence the defaults: volume-map walls (the scene
 //! default, `sph_scene::BoundaryModel`) and `c = 0.05` ([`DEFAULT_PCISPH_XSPH`]). The
-//! `boundary-rest` experiment checks the result on a smaller column (PCISPH 3·10⁻⁵ with
+//! `boundary-rest` experiment checks the result on a smaller column (PCISPH 4.5·10⁻⁵ with
 //! volume maps against 7·10⁻³ with collision walls).
 
 //! # Robustness, performance, determinism
