@@ -38,7 +38,12 @@ use sph_kernels::KernelKind;
 use sph_solver::boundary::{VolumeMapBoundary, VolumeMapOptions};
 
 /// The walls: SDF collision at the particle radius, or volume maps of Poly6 at `h`.
-fn walls(solids: Solids<f32>, tank: sph_core::Aabb<f32>, c: &CommonParams<f32>, volume_map: bool) -> Box<dyn Boundary<f32>> {
+fn walls(
+    solids: Solids<f32>,
+    tank: sph_core::Aabb<f32>,
+    c: &CommonParams<f32>,
+    volume_map: bool,
+) -> Box<dyn Boundary<f32>> {
     if volume_map {
         let t = Instant::now();
         let b = VolumeMapBoundary::new(

@@ -5,8 +5,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use validation::runner::{self, RunOptions};
 use sph_sim::{run_scene, SceneRunOptions};
+use validation::runner::{self, RunOptions};
 use validation::{registry, workspace_root, Mode};
 
 #[derive(Parser)]

@@ -216,7 +216,7 @@ pub use solver::{ConstraintEval, Pbf, PbfScratch, PBF_PHASES};
 pub use neighbour_search::Method;
 pub use sph_core::{ParticleSet, Real, Sdf, Vec3};
 pub use sph_solver::{
-    Boundary, CollisionBoundary, CommonParams, FluidSolver, SolverError, Solids, StepStats,
+    Boundary, CollisionBoundary, CommonParams, FluidSolver, Solids, SolverError, StepStats,
 };
 
 impl<R: Real> FluidSolver<R> for Pbf<R> {

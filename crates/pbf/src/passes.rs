@@ -265,7 +265,11 @@ pub(crate) fn delta_pass<R: Real>(
     next: &mut [Vec3<R>],
 ) {
     let PassInput {
-        c, x, m, nb, volume,
+        c,
+        x,
+        m,
+        nb,
+        volume,
     } = input;
     let half_unit = R::of_f64(0.5) * c.scorr_unit;
     let offsets = nb.offsets();

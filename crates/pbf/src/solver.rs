@@ -8,10 +8,10 @@ use rayon::prelude::*;
 use sph_core::{validate_finite_positions, CoreError, ParticleSet, Real, Sdf, Vec3};
 use sph_kernels::Kernel;
 use sph_solver::step::{
-    check_divergence, check_masses, check_predicted, check_state, density_energy_stats,
-    CellReorder, StepAt, StepNeighbours, MIN_LEN,
+    begin_frame, check_divergence, check_masses, check_predicted, end_frame, CellReorder,
+    FramePhases, StepAt, StepNeighbours, MIN_LEN,
 };
-use sph_solver::{Boundary, CollisionBoundary, SolverError, Solids, StepStats};
+use sph_solver::{Boundary, CollisionBoundary, Solids, SolverError, StepStats};
 
 use crate::passes::{
     delta_pass, lambda_pass, near_boundary, Consts, LambdaOut, PairCache, PassInput,
@@ -71,6 +71,11 @@ const DETECT_NEIGHBOURS: usize = 2;
 const CONSTRAINT_SOLVE: usize = 3;
 const VELOCITY_UPDATE: usize = 4;
 const REORDER: usize = 5;
+const FRAME: FramePhases = FramePhases {
+    checks: INTEGRATE,
+    reorder: REORDER,
+    statistics: VELOCITY_UPDATE,
+};
 
 const NAME: &str = "PBF";
 
@@ -270,7 +275,12 @@ impl<R: Real> Pbf<R> {
         self.neighbours
             .find(&s.predicted, self.params.common.support_radius)?;
         if let Some(b) = volume {
-            near_boundary(b, &s.predicted, self.params.common.support_radius, &mut s.near_boundary);
+            near_boundary(
+                b,
+                &s.predicted,
+                self.params.common.support_radius,
+                &mut s.near_boundary,
+            );
         }
         let volume = volume.map(|b| (b, &s.near_boundary[..]));
         let input = PassInput {
@@ -319,20 +329,9 @@ impl<R: Real> Pbf<R> {
         let step = self.steps;
         self.steps += 1;
         let mut stats = StepStats::new(PBF_PHASES);
-        let t = Instant::now();
-        check_state(state)?;
-        self.scratch.resize(state.len());
-        stats.phases.add(INTEGRATE, t.elapsed().as_secs_f64());
-
         let common = &self.params.common;
-        let secs = self.reorder.at_step(
-            state,
-            common.support_radius,
-            step,
-            common.reorder_every,
-        )?;
-        stats.phases.add(REORDER, secs);
-        stats.reordered = self.reorder.last_permutation().is_some();
+        begin_frame(state, &mut self.reorder, common, step, FRAME, &mut stats)?;
+        self.scratch.resize(state.len());
 
         for sub in 0..self.params.common.substeps {
             let at = StepAt {
@@ -343,14 +342,13 @@ impl<R: Real> Pbf<R> {
             self.substep(state, at, &mut stats)?;
         }
 
-        let t = Instant::now();
-        density_energy_stats(
+        end_frame(
             state,
             self.params.common.rest_density,
             &mut self.scratch.partials,
+            FRAME,
             &mut stats,
         );
-        stats.phases.add(VELOCITY_UPDATE, t.elapsed().as_secs_f64());
         Ok(stats)
     }
 
@@ -443,7 +441,9 @@ impl<R: Real> Pbf<R> {
                 break;
             }
         }
-        stats.phases.add(CONSTRAINT_SOLVE, t.elapsed().as_secs_f64());
+        stats
+            .phases
+            .add(CONSTRAINT_SOLVE, t.elapsed().as_secs_f64());
         stats.iterations += done;
 
         // Lines 20–24: velocity update, vorticity confinement, XSPH, position update.

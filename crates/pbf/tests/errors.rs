@@ -3,7 +3,7 @@
 
 mod common;
 
-use pbf::{Pbf, SolverError, PbfParams, Vec3};
+use pbf::{Pbf, PbfParams, SolverError, Vec3};
 use sph_core::CoreError;
 
 fn param_error(p: PbfParams<f64>) -> &'static str {
@@ -21,9 +21,18 @@ fn invalid_parameters_are_named() {
     ok.validate().unwrap();
     type Setter = Box<dyn Fn(&mut PbfParams<f64>)>;
     let cases: Vec<(&str, Setter)> = vec![
-        ("support_radius", Box::new(|p| p.common.support_radius = 0.0)),
-        ("support_radius", Box::new(|p| p.common.support_radius = -0.05)),
-        ("support_radius", Box::new(|p| p.common.support_radius = f64::NAN)),
+        (
+            "support_radius",
+            Box::new(|p| p.common.support_radius = 0.0),
+        ),
+        (
+            "support_radius",
+            Box::new(|p| p.common.support_radius = -0.05),
+        ),
+        (
+            "support_radius",
+            Box::new(|p| p.common.support_radius = f64::NAN),
+        ),
         (
             "support_radius",
             Box::new(|p| p.common.support_radius = p.common.particle_spacing),
@@ -51,7 +60,10 @@ fn invalid_parameters_are_named() {
             Box::new(|p| p.vorticity_epsilon = f64::NAN),
         ),
         ("xsph_c", Box::new(|p| p.xsph_c = 1.5)),
-        ("gravity", Box::new(|p| p.common.gravity.y = f64::NEG_INFINITY)),
+        (
+            "gravity",
+            Box::new(|p| p.common.gravity.y = f64::NEG_INFINITY),
+        ),
         (
             "mean_compression_tolerance",
             Box::new(|p| p.mean_compression_tolerance = Some(0.0)),

@@ -54,7 +54,8 @@ impl Oracle {
             k: p.scorr_k,
             n: p.scorr_n as i32,
             dq: p.scorr_delta_q * p.common.support_radius,
-            scorr_unit: 1.0 / lattice_denominator(p.common.particle_spacing, p.common.support_radius),
+            scorr_unit: 1.0
+                / lattice_denominator(p.common.particle_spacing, p.common.support_radius),
         }
     }
 

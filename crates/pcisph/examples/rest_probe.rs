@@ -57,10 +57,16 @@ fn main() {
                 top = top.max(x.y);
             }
             for (x, v) in state.positions.iter().zip(&state.velocities) {
-                let wall = [x.x - tank.min.x, tank.max.x - x.x, x.z - tank.min.z, tank.max.z - x.z, x.y - tank.min.y]
-                    .iter()
-                    .cloned()
-                    .fold(f64::MAX, f64::min);
+                let wall = [
+                    x.x - tank.min.x,
+                    tank.max.x - x.x,
+                    x.z - tank.min.z,
+                    tank.max.z - x.z,
+                    x.y - tank.min.y,
+                ]
+                .iter()
+                .cloned()
+                .fold(f64::MAX, f64::min);
                 let k = if wall < h {
                     0
                 } else if x.y > height - 2.0 * s {

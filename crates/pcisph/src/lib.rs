@@ -175,7 +175,7 @@ pub use solver::{Pcisph, PCISPH_PHASES};
 
 pub use sph_core::{ParticleSet, Real, Vec3};
 pub use sph_solver::{
-    Boundary, CollisionBoundary, CommonParams, FluidSolver, SolverError, Solids, StepStats,
+    Boundary, CollisionBoundary, CommonParams, FluidSolver, Solids, SolverError, StepStats,
 };
 
 impl<R: Real> FluidSolver<R> for Pcisph<R> {

@@ -8,10 +8,10 @@ use rayon::prelude::*;
 use sph_core::{ParticleSet, Real, Sdf, Vec3};
 use sph_kernels::{Kernel, Poly6, Spiky};
 use sph_solver::step::{
-    check_divergence, check_predicted, check_state, density_energy_stats, CellReorder, StepAt,
+    begin_frame, check_divergence, check_predicted, end_frame, CellReorder, FramePhases, StepAt,
     StepNeighbours, MIN_LEN,
 };
-use sph_solver::{Boundary, CollisionBoundary, SolverError, Solids, StepStats};
+use sph_solver::{Boundary, CollisionBoundary, Solids, SolverError, StepStats};
 
 use crate::PcisphParams;
 
@@ -30,6 +30,11 @@ const DETECT_NEIGHBOURS: usize = 2;
 const PRESSURE_SOLVE: usize = 3;
 const VELOCITY_UPDATE: usize = 4;
 const REORDER: usize = 5;
+const FRAME: FramePhases = FramePhases {
+    checks: INTEGRATE,
+    reorder: REORDER,
+    statistics: VELOCITY_UPDATE,
+};
 
 const NAME: &str = "PCISPH";
 
@@ -237,20 +242,9 @@ impl<R: Real> Pcisph<R> {
         let step = self.steps;
         self.steps += 1;
         let mut stats = StepStats::new(PCISPH_PHASES);
-        let t = Instant::now();
-        check_state(state)?;
-        self.scratch.resize(state.len());
-        stats.phases.add(INTEGRATE, t.elapsed().as_secs_f64());
-
         let common = &self.params.common;
-        let secs = self.reorder.at_step(
-            state,
-            common.support_radius,
-            step,
-            common.reorder_every,
-        )?;
-        stats.phases.add(REORDER, secs);
-        stats.reordered = self.reorder.last_permutation().is_some();
+        begin_frame(state, &mut self.reorder, common, step, FRAME, &mut stats)?;
+        self.scratch.resize(state.len());
 
         for sub in 0..self.params.common.substeps {
             let at = StepAt {
@@ -261,14 +255,13 @@ impl<R: Real> Pcisph<R> {
             self.substep(state, at, &mut stats)?;
         }
 
-        let t = Instant::now();
-        density_energy_stats(
+        end_frame(
             state,
             self.params.common.rest_density,
             &mut self.scratch.partials,
+            FRAME,
             &mut stats,
         );
-        stats.phases.add(VELOCITY_UPDATE, t.elapsed().as_secs_f64());
         Ok(stats)
     }
 

@@ -4,20 +4,20 @@
 //! determinism across thread counts, no allocation in a warm step, errors, and an unstable
 //! setup failing cleanly.
 
-
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
-use sph_solver::testing::formulas::{add, dot, norm, poly6, scale, spiky_grad, sub, to_v, V};
 use sph_solver::testing as common;
+use sph_solver::testing::formulas::{add, dot, norm, poly6, scale, spiky_grad, sub, to_v, V};
 
 use pcisph::{
-    CommonParams, FluidSolver, ParticleSet, Pcisph, PcisphParams, Real, SolverError, Solids, StepStats, Vec3,
+    CommonParams, FluidSolver, ParticleSet, Pcisph, PcisphParams, Real, Solids, SolverError,
+    StepStats, Vec3,
 };
-use sph_core::Sdf;
 use proptest::prelude::*;
+use sph_core::Sdf;
 use sph_core::{sampling::cubic_lattice, Aabb, BoxSdf, Inverted, Plane};
 
 // ---------------------------------------------------------------------------------------
@@ -593,8 +593,14 @@ fn invalid_parameters_are_named() {
             "particle_spacing",
             Box::new(|p| p.common.particle_spacing = f64::INFINITY),
         ),
-        ("support_radius", Box::new(|p| p.common.support_radius = 0.02)),
-        ("support_radius", Box::new(|p| p.common.support_radius = f64::NAN)),
+        (
+            "support_radius",
+            Box::new(|p| p.common.support_radius = 0.02),
+        ),
+        (
+            "support_radius",
+            Box::new(|p| p.common.support_radius = f64::NAN),
+        ),
         ("xsph_c", Box::new(|p| p.xsph_c = 1.5)),
         ("xsph_c", Box::new(|p| p.xsph_c = -0.1)),
         ("gravity", Box::new(|p| p.common.gravity.x = f64::NAN)),

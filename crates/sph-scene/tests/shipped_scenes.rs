@@ -42,7 +42,11 @@ fn dam_break_matches_table_1() {
         panic!("not PBF: {:?}", s.solver)
     };
     assert_eq!(pbf.vorticity_epsilon, Some(0.0));
-    assert_eq!(s.boundary.model, BoundaryModel::Collision, "the paper's walls");
+    assert_eq!(
+        s.boundary.model,
+        BoundaryModel::Collision,
+        "the paper's walls"
+    );
     assert_eq!((s.frame_dt_s, s.duration_s), (0.016, 6.0));
     assert_eq!(s.frame_count(), 375);
     let (full, quick) = counts(&s);

@@ -28,13 +28,18 @@ fn vec3<R: Real>(v: [f64; 3]) -> Vec3<R> {
     Vec3::new(r(v[0]), r(v[1]), r(v[2]))
 }
 
+/// A solver or boundary refusing `scene`'s parameters.
+fn setup_error(scene: &Scene, source: SolverError) -> SimError {
+    SimError::Setup {
+        file: scene.source.display().to_string(),
+        source,
+    }
+}
+
 /// The solver a scene describes, with its boundary, in precision `R`. Errors name the scene
 /// file and the refused parameter.
 pub fn build_solver<R: Real>(scene: &Scene) -> Result<Box<dyn FluidSolver<R>>, SimError> {
-    let setup = |source| SimError::Setup {
-        file: scene.source.display().to_string(),
-        source,
-    };
+    let setup = |source| setup_error(scene, source);
     match &scene.solver {
         SolverSpec::Pbf(s) => {
             let p = pbf_params::<R>(scene, s).map_err(setup)?;
@@ -187,10 +192,7 @@ pub fn build_boundary<R: Real>(
     c: &CommonParams<R>,
 ) -> Result<Box<dyn Boundary<R>>, SimError> {
     let solids = scene.build_solids::<R>()?;
-    let setup = |source| SimError::Setup {
-        file: scene.source.display().to_string(),
-        source,
-    };
+    let setup = |source| setup_error(scene, source);
     match scene.boundary.model {
         BoundaryModel::Collision => Ok(Box::new(
             CollisionBoundary::new(solids, c.particle_radius()).map_err(setup)?,

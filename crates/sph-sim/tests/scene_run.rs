@@ -44,7 +44,10 @@ fn runs_a_scene_and_writes_frames_and_statistics() {
     ] {
         let dir = temp_dir(&format!("{kind}-{model}"));
         let scene = dir.join("tiny.toml");
-        let text = format!("{}\n[boundary]\nmodel = \"{model}\"\n", SCENE.replace("KIND", kind));
+        let text = format!(
+            "{}\n[boundary]\nmodel = \"{model}\"\n",
+            SCENE.replace("KIND", kind)
+        );
         std::fs::write(&scene, text).unwrap();
         let out = dir.join("out");
         run_scene(

@@ -14,7 +14,7 @@ use neighbour_search::{
 use rayon::prelude::*;
 use sph_core::{ParticleSet, PermutationScratch, Real, Vec3};
 
-use crate::{Boundary, SolverError, StepStats};
+use crate::{Boundary, CommonParams, SolverError, StepStats};
 
 /// Smallest number of particles handed to one rayon task.
 pub const MIN_LEN: usize = 256;
@@ -321,4 +321,51 @@ impl<R: Real> CellReorder<R> {
     pub fn last_permutation(&self) -> Option<&[u32]> {
         self.reordered.then_some(&self.permutation[..])
     }
+}
+
+/// The phases [`begin_frame`] and [`end_frame`] time, as indices into the solver's
+/// phase list.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FramePhases {
+    /// Input checks (the solver's "integrate" phase).
+    pub checks: usize,
+    /// Reordering by cell.
+    pub reorder: usize,
+    /// End-of-frame statistics (the solver's "velocity update" phase).
+    pub statistics: usize,
+}
+
+/// The start of a solver's frame (call `step`): checks `state` ([`check_state`]) and
+/// reorders it by cell every `common.reorder_every` calls, timing both into `stats`.
+pub fn begin_frame<R: Real>(
+    state: &mut ParticleSet<R>,
+    reorder: &mut CellReorder<R>,
+    common: &CommonParams<R>,
+    step: u64,
+    phases: FramePhases,
+    stats: &mut StepStats,
+) -> Result<(), SolverError> {
+    let t = Instant::now();
+    check_state(state)?;
+    stats.phases.add(phases.checks, t.elapsed().as_secs_f64());
+    let secs = reorder.at_step(state, common.support_radius, step, common.reorder_every)?;
+    stats.phases.add(phases.reorder, secs);
+    stats.reordered = reorder.last_permutation().is_some();
+    Ok(())
+}
+
+/// The end of a solver's frame: the density and energy statistics of `state`
+/// ([`density_energy_stats`]), timed into `stats`.
+pub fn end_frame<R: Real>(
+    state: &ParticleSet<R>,
+    rest_density: R,
+    partials: &mut Vec<[f64; 3]>,
+    phases: FramePhases,
+    stats: &mut StepStats,
+) {
+    let t = Instant::now();
+    density_energy_stats(state, rest_density, partials, stats);
+    stats
+        .phases
+        .add(phases.statistics, t.elapsed().as_secs_f64());
 }

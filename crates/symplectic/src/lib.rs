@@ -5,7 +5,7 @@
 //! > Е. А. Чегодаева (E. A. Chegodaeva), «Метод симплектического интегрирования уравнений
 //! > движения малых тел Солнечной системы» ("A method of symplectic integration of the
 //! > equations of motion of small Solar System bodies"), 2004
-//! > (`../shared/papers/004_83a841cf9713bdd7.txt`; English summary in the papers' README),
+//! > (in Russian; full citation in `docs/papers.md`),
 //!
 //! in `f64` throughout:
 //!

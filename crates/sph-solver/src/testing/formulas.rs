@@ -8,7 +8,6 @@ use sph_core::Vec3;
 /// A 3-vector of the oracles.
 pub type V = [f64; 3];
 
-
 /// `a − b`.
 pub fn sub(a: V, b: V) -> V {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]

@@ -3,9 +3,11 @@
 
 pub mod formulas;
 
-use sph_core::{sampling::cubic_lattice, Aabb, BoxSdf, CoreError, Inverted, ParticleSet, Real, Vec3};
+use sph_core::{
+    sampling::cubic_lattice, Aabb, BoxSdf, CoreError, Inverted, ParticleSet, Real, Vec3,
+};
 
-use crate::{CommonParams, FluidSolver, SolverError, Solids};
+use crate::{CommonParams, FluidSolver, Solids, SolverError};
 
 /// A fluid block of `n = [nx, ny, nz]` particles at spacing `s`, at rest in the corner
 /// `(0, 0, 0)` of a tank of `tank = [tx, ty, tz]` spacings (an `Inverted<BoxSdf>`), with

@@ -91,7 +91,9 @@ fn run<R: Real>(ctx: &Context, scene: &Scene, label: String) -> Result<RestRun> 
         .iter()
         .map(|p| {
             let p = Vec3::new(p.x.as_f64(), p.y.as_f64(), p.z.as_f64());
-            solids.iter().all(|sd| sd.signed_distance(&p) >= 0.5 * s - 1e-9)
+            solids
+                .iter()
+                .all(|sd| sd.signed_distance(&p) >= 0.5 * s - 1e-9)
         })
         .collect();
     let mut state = ParticleSet::new();
@@ -99,7 +101,12 @@ fn run<R: Real>(ctx: &Context, scene: &Scene, label: String) -> Result<RestRun> 
     for (i, &k) in keep.iter().enumerate() {
         if k {
             let st = &sim.state;
-            state.push(st.positions[i], st.velocities[i], st.masses[i], st.densities[i]);
+            state.push(
+                st.positions[i],
+                st.velocities[i],
+                st.masses[i],
+                st.densities[i],
+            );
             ids.push(sim.ids[i]);
         }
     }
@@ -132,7 +139,11 @@ fn run<R: Real>(ctx: &Context, scene: &Scene, label: String) -> Result<RestRun> 
         label,
         solver,
         model,
-        case: if sphere_volume > 0.0 { "sphere" } else { "column" },
+        case: if sphere_volume > 0.0 {
+            "sphere"
+        } else {
+            "column"
+        },
         energy: Vec::new(),
         particles: Vec::new(),
         near_wall: f64::NAN,
@@ -154,9 +165,10 @@ fn run<R: Real>(ctx: &Context, scene: &Scene, label: String) -> Result<RestRun> 
     let rho0 = sim.solver().common().rest_density.as_f64();
     let boundary = sim.solver().boundary();
     for (p, rho) in sim.state.positions.iter().zip(&sim.state.densities) {
-        let d = boundary.closest(p).map_or(f64::INFINITY, |c| c.distance.as_f64());
-        out.particles
-            .push((p.y.as_f64(), rho.as_f64() / rho0, d));
+        let d = boundary
+            .closest(p)
+            .map_or(f64::INFINITY, |c| c.distance.as_f64());
+        out.particles.push((p.y.as_f64(), rho.as_f64() / rho0, d));
     }
     // The free surface: the mean height of the top layer plus half a spacing.
     let top = out.particles.iter().map(|q| q.0).fold(f64::MIN, f64::max);
@@ -239,7 +251,11 @@ impl Experiment for BoundaryRest {
             .set_length((combos.len() * base.frame_count()) as u64);
         for (kind, model, case) in combos {
             let scene = scene_for(&base, kind, model, case);
-            let label = format!("{} {} {case}", kind.name().to_uppercase(), model_name(model));
+            let label = format!(
+                "{} {} {case}",
+                kind.name().to_uppercase(),
+                model_name(model)
+            );
             let r = match scene.precision {
                 Precision::F32 => run::<f32>(ctx, &scene, label)?,
                 Precision::F64 => run::<f64>(ctx, &scene, label)?,
@@ -270,7 +286,10 @@ impl BoundaryRest {
             out.metric(format!("{key}/near_wall_density_ratio"), r.near_wall);
             out.metric(format!("{key}/bulk_density_ratio"), r.bulk);
             out.metric(format!("{key}/surface_height_m"), r.surface_m);
-            out.metric(format!("{key}/hydrostatic_surface_height_m"), r.expected_surface_m);
+            out.metric(
+                format!("{key}/hydrostatic_surface_height_m"),
+                r.expected_surface_m,
+            );
             if let Some(e) = &r.blow_up {
                 out.note(format!("{} blew up: {e}", r.label));
             }
@@ -284,9 +303,13 @@ impl BoundaryRest {
                 format!("{:.5}", r.surface_m),
                 format!("{:.5}", r.expected_surface_m),
             ]);
-            let origin = "solver-layer specification: at rest after 2 s means KE per particle < 1e-3 m g H";
+            let origin =
+                "solver-layer specification: at rest after 2 s means KE per particle < 1e-3 m g H";
             let ke_check = Check::less_than(
-                format!("{}: kinetic energy per particle / (m g H) at t = 2 s", r.label),
+                format!(
+                    "{}: kinetic energy per particle / (m g H) at t = 2 s",
+                    r.label
+                ),
                 ke_end,
                 REST_KE,
                 origin,
@@ -321,7 +344,10 @@ impl BoundaryRest {
             ],
             rows,
         )?;
-        ctx.add_file("summary.csv", "per run: kinetic energy at the end, near-wall and bulk density, surface height");
+        ctx.add_file(
+            "summary.csv",
+            "per run: kinetic energy at the end, near-wall and bulk density, surface height",
+        );
         self.plots(ctx, base, runs)?;
         Ok(out)
     }
@@ -389,7 +415,10 @@ impl BoundaryRest {
             spec.legend = Legend::LowerLeft;
             let f = format!("density_height_{case}.png");
             plot_xy(&ctx.path(&f), &spec)?;
-            ctx.add_plot(&f, format!("{case}: rho/rho0 against height at the end (layer means)"));
+            ctx.add_plot(
+                &f,
+                format!("{case}: rho/rho0 against height at the end (layer means)"),
+            );
             let mut spec = PlotSpec::new(
                 format!("Water {case} at rest: density against distance to the nearest wall"),
                 "distance to the nearest solid (m)",
@@ -399,7 +428,10 @@ impl BoundaryRest {
             spec.legend = Legend::LowerRight;
             let f = format!("density_wall_{case}.png");
             plot_xy(&ctx.path(&f), &spec)?;
-            ctx.add_plot(&f, format!("{case}: rho/rho0 against the distance to the nearest wall at the end"));
+            ctx.add_plot(
+                &f,
+                format!("{case}: rho/rho0 against the distance to the nearest wall at the end"),
+            );
         }
         Ok(())
     }

@@ -7,9 +7,9 @@
 //! states have hundreds of neighbours per particle, which makes every further step slow.
 
 use anyhow::Result;
-use sph_solver::SolverError;
 use sph_core::Real;
 use sph_scene::{Precision, Scene, SolverKind};
+use sph_solver::SolverError;
 
 use crate::sim::SceneSim;
 use crate::Context;

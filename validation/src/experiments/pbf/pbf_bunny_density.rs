@@ -101,10 +101,22 @@ impl Experiment for PbfBunnyDensity {
         let mean_after = |r: &FluidRun| r.mean_from(FROM_S, |s| s.mean_density_ratio);
         out.metric("pbf_mean_density_ratio_after_impact", mean_after(&pbf));
         out.metric("pcisph_mean_density_ratio_after_impact", mean_after(&pci));
-        out.metric("pbf_collision_mean_density_ratio_after_impact", mean_after(&pbf_c));
-        out.metric("pcisph_collision_mean_density_ratio_after_impact", mean_after(&pci_c));
-        out.metric("pbf_collision_mean_compression_after_impact", excess(&pbf_c));
-        out.metric("pcisph_collision_mean_compression_after_impact", excess(&pci_c));
+        out.metric(
+            "pbf_collision_mean_density_ratio_after_impact",
+            mean_after(&pbf_c),
+        );
+        out.metric(
+            "pcisph_collision_mean_density_ratio_after_impact",
+            mean_after(&pci_c),
+        );
+        out.metric(
+            "pbf_collision_mean_compression_after_impact",
+            excess(&pbf_c),
+        );
+        out.metric(
+            "pcisph_collision_mean_compression_after_impact",
+            excess(&pci_c),
+        );
         out.check(Check::equals(
             "runs completed without blow-up (count)",
             runs.iter().filter(|r| r.blow_up.is_some()).count() as f64,
@@ -158,56 +170,37 @@ impl Experiment for PbfBunnyDensity {
             )
         };
         let t_end = pbf.frames.last().map_or(1.0, |s| s.t_s);
-        let spec = PlotSpec {
-            legend: Legend::UpperRight,
-            series: vec![
-                Series::styled(
-                    "rest density",
-                    vec![(0.0, 1.0), (t_end, 1.0)],
-                    SeriesStyle::Line,
-                    0,
-                ),
-                series(&pci, 3, true),
-                series(&pci, 3, false),
-                series(&pbf, 2, true),
-                series(&pbf, 2, false),
-            ],
-            ..PlotSpec::new(
-                format!(
-                    "Bunny drop, volume-map walls: density over time ({} particles)",
-                    pbf.particles
-                ),
-                "t (s)",
-                "density / rest density",
-            )
-        };
-        plot_xy(&ctx.path("density.png"), &spec)?;
-        ctx.add_plot("density.png", "volume-map walls: max and average density over the bunny drop (Fig. 4: blue rest density, red PCISPH, green PBF)");
-        let spec = PlotSpec {
-            legend: Legend::UpperRight,
-            series: vec![
-                Series::styled(
-                    "rest density",
-                    vec![(0.0, 1.0), (t_end, 1.0)],
-                    SeriesStyle::Line,
-                    0,
-                ),
-                series(&pci_c, 3, true),
-                series(&pci_c, 3, false),
-                series(&pbf_c, 2, true),
-                series(&pbf_c, 2, false),
-            ],
-            ..PlotSpec::new(
-                format!(
-                    "Bunny drop, collision walls: density over time ({} particles)",
-                    pbf.particles
-                ),
-                "t (s)",
-                "density / rest density",
-            )
-        };
-        plot_xy(&ctx.path("density_collision.png"), &spec)?;
-        ctx.add_plot("density_collision.png", "collision walls (the paper's SDF handling): max and average density over the bunny drop");
+        let plots = [
+            (&pbf, &pci, "volume-map walls", "density.png", "volume-map walls: max and average density over the bunny drop (Fig. 4: blue rest density, red PCISPH, green PBF)"),
+            (&pbf_c, &pci_c, "collision walls", "density_collision.png", "collision walls (the paper's SDF handling): max and average density over the bunny drop"),
+        ];
+        for (p, c, walls, file, caption) in plots {
+            let spec = PlotSpec {
+                legend: Legend::UpperRight,
+                series: vec![
+                    Series::styled(
+                        "rest density",
+                        vec![(0.0, 1.0), (t_end, 1.0)],
+                        SeriesStyle::Line,
+                        0,
+                    ),
+                    series(c, 3, true),
+                    series(c, 3, false),
+                    series(p, 2, true),
+                    series(p, 2, false),
+                ],
+                ..PlotSpec::new(
+                    format!(
+                        "Bunny drop, {walls}: density over time ({} particles)",
+                        pbf.particles
+                    ),
+                    "t (s)",
+                    "density / rest density",
+                )
+            };
+            plot_xy(&ctx.path(file), &spec)?;
+            ctx.add_plot(file, caption);
+        }
         Ok(out)
     }
 }

@@ -2,7 +2,7 @@
 //! particles among the four giant planets for 100 Myr, with the second-order (S2) and the
 //! pseudo-sixth-order (S6) integrator.
 //!
-//! Set-up (paper, "Численные эксперименты"; English in `../shared/papers/README.md`): Jupiter,
+//! Set-up (paper, "Численные эксперименты"): Jupiter,
 //! Saturn, Uranus, Neptune (Hairer, Lubich & Wanner Table 2.1, rotated to the ecliptic), planet
 //! step 365 d, barycentric particle variant (eqs. 36–38), `B₀ = 0`, `B₁ = 0.21·10⁻⁶`, particle
 //! initial steps 298/310 d (S2) and 910/953 d (S6); particle initial states in

@@ -97,10 +97,10 @@ use std::time::{Duration, Instant};
 use rayon::prelude::*;
 use sph_core::{Aabb, Real, Sdf, Vec3};
 
-use sph_core::grid::SampledGrid;
 use crate::SolverError;
 use nalgebra::Matrix3;
 use quadrature::{looks_planar, node_correction, Directions, KernelTables, NodeCorrection};
+use sph_core::grid::SampledGrid;
 
 /// How `Ψ` is interpolated between grid nodes (see the module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -423,8 +423,11 @@ impl<R: Real> VolumeMap<R> {
                                 } else if phi <= -reach {
                                     index.push(DEEP);
                                 } else {
-                                    let pure = c == 0.0 && g == Vec3::zeros() && hs == Matrix3::zeros();
-                                    index.push(models.len() as u32 | if pure { PLANE_BIT } else { 0 });
+                                    let pure =
+                                        c == 0.0 && g == Vec3::zeros() && hs == Matrix3::zeros();
+                                    index.push(
+                                        models.len() as u32 | if pure { PLANE_BIT } else { 0 },
+                                    );
                                     models.push(NodeModel {
                                         phi: phi as f32,
                                         n: [n.x as f32, n.y as f32, n.z as f32],
@@ -455,10 +458,7 @@ impl<R: Real> VolumeMap<R> {
                 let mut models = Vec::with_capacity(stored);
                 for (idx, m) in slabs {
                     let off = models.len() as u32;
-                    index.extend(
-                        idx.into_iter()
-                            .map(|v| if v >= DEEP { v } else { v + off }),
-                    );
+                    index.extend(idx.into_iter().map(|v| if v >= DEEP { v } else { v + off }));
                     models.extend(m);
                 }
                 let flat_cells = flat_cells(&index, dims);
