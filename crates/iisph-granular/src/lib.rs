@@ -1,0 +1,2 @@
+//! Implicit incompressible SPH for water and granular matter (Neder 2024). Under
+//! construction: nothing public yet.
