@@ -14,8 +14,9 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 use indicatif::ProgressBar;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
+pub mod deviations;
 pub mod experiments;
 pub mod helpers;
 pub mod runner;
@@ -44,7 +45,7 @@ pub fn reference_data_dir() -> PathBuf {
 }
 
 /// How much work the experiments do.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Mode {
     /// Small sizes; every experiment finishes in seconds (the default).

@@ -21,7 +21,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Run experiments; exit code 1 when any check fails or an experiment errors.
+    /// Run experiments; exit code 1 when a check fails undocumented (not listed in
+    /// reference-data/deviations.toml), a documented deviation passes, or an experiment errors.
     Run {
         /// Paper-sized runs (minutes) instead of the quick ones (seconds).
         #[arg(long)]
@@ -94,7 +95,7 @@ fn main() -> ExitCode {
                 out: out.unwrap_or_else(|| workspace_root().join("target").join("validation")),
             };
             match runner::run(&all, &opts) {
-                Ok(verdicts) if runner::all_pass(&verdicts) => ExitCode::SUCCESS,
+                Ok(verdicts) if runner::succeeded(&verdicts) => ExitCode::SUCCESS,
                 Ok(_) => ExitCode::from(1),
                 Err(e) => {
                     eprintln!("error: {e:#}");

@@ -19,6 +19,7 @@ use anyhow::{bail, Context as _, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
+use crate::deviations::{CheckVerdict, Deviations};
 use crate::{fmt_num, reference_data_dir, Artifact, Check, Context, Experiment, Mode, Outcome};
 
 /// What to run and where to write.
@@ -38,20 +39,106 @@ pub struct RunOptions {
 pub enum Status {
     /// Ran, every check passed.
     Pass,
-    /// Ran, some check failed.
+    /// Ran, every miss is a documented deviation (see [`crate::deviations`]).
+    Deviation,
+    /// Ran, and some check failed undocumented, or a documented deviation passed or was not
+    /// produced (the deviations list is out of date).
     Fail,
     /// Returned an error or panicked.
     Error,
 }
 
 impl Status {
-    /// `"pass"`, `"fail"` or `"error"`.
+    /// `"pass"`, `"deviation"`, `"fail"` or `"error"`.
     pub fn as_str(self) -> &'static str {
         match self {
             Status::Pass => "pass",
+            Status::Deviation => "deviation",
             Status::Fail => "fail",
             Status::Error => "error",
         }
+    }
+
+    /// Console label (misses in capitals).
+    pub fn label(self) -> &'static str {
+        match self {
+            Status::Pass => "pass",
+            Status::Deviation => "deviation",
+            Status::Fail => "FAIL",
+            Status::Error => "ERROR",
+        }
+    }
+
+    /// Whether this status fails the run (exit code 1).
+    pub fn fails_run(self) -> bool {
+        matches!(self, Status::Fail | Status::Error)
+    }
+}
+
+/// A check with its verdict against the deviations list.
+#[derive(Debug, Clone, Serialize)]
+pub struct CheckRecord {
+    /// The check as the experiment reported it.
+    #[serde(flatten)]
+    pub check: Check,
+    /// pass / deviation / fail / unexpected-pass / stale-entry.
+    pub verdict: CheckVerdict,
+    /// The documented deviation's one-line summary, when listed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub deviation: Option<String>,
+}
+
+/// The checks of one run against the deviations documented for `id` in `mode`, with a
+/// stale-entry record for each documented check that was not produced (only when the
+/// experiment ran to the end: an error says nothing about its checks).
+pub fn judge(
+    id: &str,
+    mode: Mode,
+    checks: Vec<Check>,
+    deviations: &Deviations,
+    ran: bool,
+) -> Vec<CheckRecord> {
+    let mut records: Vec<CheckRecord> = checks
+        .into_iter()
+        .map(|check| {
+            let dev = deviations.find(id, &check.name, mode);
+            CheckRecord {
+                verdict: CheckVerdict::of(&check, dev.is_some()),
+                deviation: dev.map(|d| d.summary().to_string()),
+                check,
+            }
+        })
+        .collect();
+    if ran {
+        for d in deviations.for_experiment(id, mode) {
+            if !records.iter().any(|r| r.check.name == d.check) {
+                records.push(CheckRecord {
+                    check: Check {
+                        name: d.check.clone(),
+                        value: f64::NAN,
+                        bound: "(not produced)".into(),
+                        pass: false,
+                        origin: format!("{} lists it", crate::deviations::DEVIATIONS_FILE),
+                    },
+                    verdict: CheckVerdict::StaleEntry,
+                    deviation: Some(d.summary().to_string()),
+                });
+            }
+        }
+    }
+    records
+}
+
+/// The status of an experiment from its error and its judged checks.
+pub fn status_of(error: bool, checks: &[CheckRecord]) -> Status {
+    if error {
+        Status::Error
+    } else if checks.iter().any(|c| c.verdict.fails_run()) {
+        Status::Fail
+    } else if checks.iter().any(|c| c.verdict == CheckVerdict::Deviation) {
+        Status::Deviation
+    } else {
+        Status::Pass
     }
 }
 
@@ -62,14 +149,14 @@ pub struct Verdict {
     pub id: String,
     /// What it reproduces.
     pub source: String,
-    /// pass / fail / error.
+    /// pass / deviation / fail / error.
     pub status: Status,
     /// Wall-clock time of `run`, seconds.
     pub wall_s: f64,
     /// Metrics.
     pub metrics: BTreeMap<String, f64>,
-    /// Checks.
-    pub checks: Vec<Check>,
+    /// Checks, with their verdicts.
+    pub checks: Vec<CheckRecord>,
     /// Notes.
     pub notes: Vec<String>,
     /// Error or panic message when `status` is error.
@@ -134,6 +221,7 @@ pub fn run_one(
     mode: Mode,
     out: &Path,
     reference_dir: &Path,
+    deviations: &Deviations,
 ) -> Result<Verdict> {
     let dir = out.join(exp.id());
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
@@ -174,20 +262,15 @@ pub fn run_one(
             (Outcome::new(), Some(format!("panic: {text}")))
         }
     };
-    let status = if error.is_some() {
-        Status::Error
-    } else if outcome.all_pass() {
-        Status::Pass
-    } else {
-        Status::Fail
-    };
+    let checks = judge(exp.id(), mode, outcome.checks, deviations, error.is_none());
+    let status = status_of(error.is_some(), &checks);
     let verdict = Verdict {
         id: exp.id().to_string(),
         source: exp.source().to_string(),
         status,
         wall_s,
         metrics: outcome.metrics,
-        checks: outcome.checks,
+        checks,
         notes: outcome.notes,
         error,
         plots: ctx.plots().to_vec(),
@@ -202,32 +285,65 @@ fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<()> {
     std::fs::write(path, text + "\n").with_context(|| format!("writing {}", path.display()))
 }
 
+/// The deviations list of `reference_dir`, refusing entries that name no registered
+/// experiment.
+pub fn load_deviations(all: &[Box<dyn Experiment>], reference_dir: &Path) -> Result<Deviations> {
+    let deviations = Deviations::load(reference_dir)?;
+    for d in deviations.all() {
+        if !all.iter().any(|e| e.id() == d.experiment) {
+            bail!(
+                "{}: deviation {}/{} names no registered experiment",
+                reference_dir
+                    .join(crate::deviations::DEVIATIONS_FILE)
+                    .display(),
+                d.experiment,
+                d.check
+            );
+        }
+    }
+    Ok(deviations)
+}
+
 /// Runs the selected experiments, writes `summary.json` and `report.md`, prints the final
 /// table. Returns the verdicts.
 pub fn run(all: &[Box<dyn Experiment>], opts: &RunOptions) -> Result<Vec<Verdict>> {
+    let deviations = load_deviations(all, &reference_data_dir())?;
+    run_with(all, opts, &deviations)
+}
+
+/// [`run`] with a given deviations list.
+pub fn run_with(
+    all: &[Box<dyn Experiment>],
+    opts: &RunOptions,
+    deviations: &Deviations,
+) -> Result<Vec<Verdict>> {
     let selected = select(all, &opts.only)?;
     std::fs::create_dir_all(&opts.out)
         .with_context(|| format!("creating {}", opts.out.display()))?;
     let reference_dir = reference_data_dir();
     eprintln!(
-        "validation ({} mode): {} experiment(s) -> {}  [reference data: {}, rayon threads: {}]",
+        "validation ({} mode): {} experiment(s) -> {}  [reference data: {}, {} documented \
+         deviation(s), rayon threads: {}]",
         opts.mode,
         selected.len(),
         opts.out.display(),
         reference_dir.display(),
+        deviations.all().len(),
         rayon::current_num_threads()
     );
     let mut verdicts = Vec::new();
     for exp in selected {
-        let v = run_one(exp, opts.mode, &opts.out, &reference_dir)?;
-        let failed = v.checks.iter().filter(|c| !c.pass).count();
+        let v = run_one(exp, opts.mode, &opts.out, &reference_dir, deviations)?;
+        let count = |k: CheckVerdict| v.checks.iter().filter(|c| c.verdict == k).count();
         eprintln!(
-            "{:>18}: {} in {:.2} s ({} checks, {} failed)",
+            "{:>18}: {} in {:.2} s ({} checks: {} pass, {} deviation, {} fail)",
             v.id,
-            v.status.as_str(),
+            v.status.label(),
             v.wall_s,
             v.checks.len(),
-            failed
+            count(CheckVerdict::Pass),
+            count(CheckVerdict::Deviation),
+            v.checks.iter().filter(|c| c.verdict.fails_run()).count(),
         );
         verdicts.push(v);
     }
@@ -248,12 +364,14 @@ pub fn run(all: &[Box<dyn Experiment>], opts: &RunOptions) -> Result<Vec<Verdict
     Ok(verdicts)
 }
 
-/// `true` when every verdict passed.
-pub fn all_pass(verdicts: &[Verdict]) -> bool {
-    verdicts.iter().all(|v| v.status == Status::Pass)
+/// `true` when no experiment failed or errored (documented deviations allowed): the exit
+/// code of `cargo xtask validate`.
+pub fn succeeded(verdicts: &[Verdict]) -> bool {
+    verdicts.iter().all(|v| !v.status.fails_run())
 }
 
-/// The final terminal table: one row per experiment, then each failed check.
+/// The final terminal table: one row per experiment, then each check that is not a plain
+/// pass (deviations with their documented summary, failures with their figure).
 pub fn terminal_table(verdicts: &[Verdict]) -> String {
     let mut s = String::new();
     let w = verdicts
@@ -264,22 +382,21 @@ pub fn terminal_table(verdicts: &[Verdict]) -> String {
         .max(10);
     let _ = writeln!(
         s,
-        "\n{:<w$}  {:<6}  {:>9}  checks",
+        "\n{:<w$}  {:<9}  {:>9}  checks",
         "experiment", "status", "wall [s]"
     );
-    let _ = writeln!(s, "{}", "-".repeat(w + 30));
+    let _ = writeln!(s, "{}", "-".repeat(w + 34));
     for v in verdicts {
-        let passed = v.checks.iter().filter(|c| c.pass).count();
-        let status = match v.status {
-            Status::Pass => "pass",
-            Status::Fail => "FAIL",
-            Status::Error => "ERROR",
-        };
+        let passed = v
+            .checks
+            .iter()
+            .filter(|c| c.verdict == CheckVerdict::Pass)
+            .count();
         let _ = writeln!(
             s,
-            "{:<w$}  {:<6}  {:>9.2}  {}/{} pass",
+            "{:<w$}  {:<9}  {:>9.2}  {}/{} pass",
             v.id,
-            status,
+            v.status.label(),
             v.wall_s,
             passed,
             v.checks.len()
@@ -287,24 +404,33 @@ pub fn terminal_table(verdicts: &[Verdict]) -> String {
         if let Some(e) = &v.error {
             let _ = writeln!(s, "    error: {}", e.replace('\n', "\n           "));
         }
-        for c in v.checks.iter().filter(|c| !c.pass) {
+        for c in v.checks.iter().filter(|c| c.verdict != CheckVerdict::Pass) {
             let _ = writeln!(
                 s,
-                "    FAIL {}: value {} (bound {})",
-                c.name,
-                fmt_num(c.value),
-                c.bound
+                "    {} {}: value {} (bound {})",
+                c.verdict.label(),
+                c.check.name,
+                fmt_num(c.check.value),
+                c.check.bound
             );
+            if let Some(d) = &c.deviation {
+                let _ = writeln!(s, "        documented: {d}");
+            }
         }
     }
-    let bad = verdicts.iter().filter(|v| v.status != Status::Pass).count();
+    let count = |st: Status| verdicts.iter().filter(|v| v.status == st).count();
+    let bad = count(Status::Fail) + count(Status::Error);
     let _ = writeln!(
         s,
-        "{}",
+        "{} pass, {} with documented deviations, {} FAIL, {} ERROR: {}",
+        count(Status::Pass),
+        count(Status::Deviation),
+        count(Status::Fail),
+        count(Status::Error),
         if bad == 0 {
-            "all experiments pass".to_string()
+            "every miss is documented (reference-data/deviations.toml)"
         } else {
-            format!("{bad} experiment(s) FAIL or ERROR")
+            "undocumented failures"
         }
     );
     s
@@ -321,10 +447,12 @@ pub fn report_markdown(mode: Mode, verdicts: &[Verdict]) -> String {
     let _ = writeln!(s, "# Validation report\n");
     let _ = writeln!(
         s,
-        "Mode: **{mode}**. Experiments: {} — {} pass, {} fail, {} error. \
-         Generated by `cargo xtask validate{}`.\n",
+        "Mode: **{mode}**. Experiments: {} — {} pass, {} with documented deviations, {} fail, \
+         {} error. Generated by `cargo xtask validate{}`. A deviation is a miss documented, \
+         with its figures and evidence, in `reference-data/deviations.toml`.\n",
         verdicts.len(),
         count(Status::Pass),
+        count(Status::Deviation),
         count(Status::Fail),
         count(Status::Error),
         if mode == Mode::Full { " --full" } else { "" }
@@ -343,6 +471,30 @@ pub fn report_markdown(mode: Mode, verdicts: &[Verdict]) -> String {
             cell(&v.source)
         );
     }
+    let documented: Vec<(&Verdict, &CheckRecord)> = verdicts
+        .iter()
+        .flat_map(|v| v.checks.iter().map(move |c| (v, c)))
+        .filter(|(_, c)| c.deviation.is_some())
+        .collect();
+    if !documented.is_empty() {
+        let _ = writeln!(s, "\n## Documented deviations\n");
+        let _ = writeln!(
+            s,
+            "| experiment | check | value | bound | verdict | documented finding |\n| --- | --- | ---: | --- | --- | --- |"
+        );
+        for (v, c) in documented {
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {} | {} | {} |",
+                v.id,
+                cell(&c.check.name),
+                fmt_num(c.check.value),
+                cell(&c.check.bound),
+                c.verdict.label(),
+                cell(c.deviation.as_deref().unwrap_or(""))
+            );
+        }
+    }
     let _ = writeln!(s, "\n## Checks\n");
     let _ = writeln!(
         s,
@@ -350,15 +502,20 @@ pub fn report_markdown(mode: Mode, verdicts: &[Verdict]) -> String {
     );
     for v in verdicts {
         for c in &v.checks {
+            let result = match c.verdict {
+                CheckVerdict::Pass => "pass".to_string(),
+                CheckVerdict::Deviation => "deviation (documented)".to_string(),
+                other => format!("**{}**", other.label()),
+            };
             let _ = writeln!(
                 s,
                 "| {} | {} | {} | {} | {} | {} |",
                 v.id,
-                cell(&c.name),
-                fmt_num(c.value),
-                cell(&c.bound),
-                cell(&c.origin),
-                if c.pass { "pass" } else { "**FAIL**" }
+                cell(&c.check.name),
+                fmt_num(c.check.value),
+                cell(&c.check.bound),
+                cell(&c.check.origin),
+                result
             );
         }
     }
@@ -451,34 +608,130 @@ mod tests {
         }
     }
 
+    struct Documented;
+    impl Experiment for Documented {
+        fn id(&self) -> &'static str {
+            "documented"
+        }
+        fn source(&self) -> &'static str {
+            "test"
+        }
+        fn run(&self, _ctx: &mut Context) -> Result<Outcome> {
+            let mut o = Outcome::new();
+            o.check(Check::less_than("misses", 2.0, 1.0, "test"));
+            o.check(Check::less_than("passes", 0.0, 1.0, "test"));
+            Ok(o)
+        }
+    }
+
+    const DEVIATIONS: &str = r#"
+[[deviation]]
+experiment = "documented"
+check = "misses"
+modes = ["quick"]
+explanation = "A documented miss.\nWith details."
+evidence = "test"
+"#;
+
     #[test]
     fn statuses_and_files() {
-        let all: Vec<Box<dyn Experiment>> = vec![Box::new(Fails), Box::new(Panics), Box::new(Errs)];
+        let all: Vec<Box<dyn Experiment>> = vec![
+            Box::new(Fails),
+            Box::new(Panics),
+            Box::new(Errs),
+            Box::new(Documented),
+        ];
         let out = std::env::temp_dir().join(format!("validation-runner-{}", std::process::id()));
         let opts = RunOptions {
             mode: Mode::Quick,
             only: vec![],
             out: out.clone(),
         };
-        let v = run(&all, &opts).unwrap();
+        let deviations = Deviations::parse(DEVIATIONS, "test").unwrap();
+        let v = run_with(&all, &opts, &deviations).unwrap();
         assert_eq!(v[0].status, Status::Fail);
         assert_eq!(v[1].status, Status::Error);
         assert!(v[1].error.as_deref().unwrap().contains("boom"));
         assert_eq!(v[2].status, Status::Error);
-        assert!(!all_pass(&v));
+        assert_eq!(v[3].status, Status::Deviation);
+        assert_eq!(v[3].checks[0].verdict, CheckVerdict::Deviation);
+        assert_eq!(
+            v[3].checks[0].deviation.as_deref(),
+            Some("A documented miss.")
+        );
+        assert!(!succeeded(&v));
+        assert!(succeeded(&v[3..]));
         let summary: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
                 .unwrap();
         assert_eq!(summary["mode"], "quick");
         assert_eq!(summary["experiments"][0]["checks"][0]["pass"], false);
+        assert_eq!(summary["experiments"][0]["checks"][0]["verdict"], "fail");
+        assert_eq!(summary["experiments"][3]["status"], "deviation");
+        assert_eq!(
+            summary["experiments"][3]["checks"][0]["verdict"],
+            "deviation"
+        );
         assert_eq!(summary["experiments"][0]["metrics"]["m"], 1.0);
         assert!(out.join("fails/verdict.json").is_file());
-        assert!(out.join("report.md").is_file());
+        let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+        assert!(report.contains("## Documented deviations"), "{report}");
+        assert!(report.contains("A documented miss."), "{report}");
+        let table = terminal_table(&v);
+        assert!(table.contains("documented: A documented miss."), "{table}");
         let err = select(&all, &["nope".to_string()])
             .err()
             .unwrap()
             .to_string();
         assert!(err.contains("known: fails, panics, errs"), "{err}");
         std::fs::remove_dir_all(&out).ok();
+    }
+
+    #[test]
+    fn strict_deviations() {
+        // A documented deviation that passes, and one that is not produced, fail the run.
+        let stale = format!(
+            "{DEVIATIONS}\n[[deviation]]\nexperiment = \"documented\"\ncheck = \"gone\"\n\
+             modes = [\"quick\"]\nexplanation = \"x\"\nevidence = \"y\"\n\
+             [[deviation]]\nexperiment = \"documented\"\ncheck = \"passes\"\n\
+             modes = [\"quick\"]\nexplanation = \"x\"\nevidence = \"y\"\n"
+        );
+        let deviations = Deviations::parse(&stale, "test").unwrap();
+        let checks = vec![
+            Check::less_than("misses", 2.0, 1.0, "test"),
+            Check::less_than("passes", 0.0, 1.0, "test"),
+        ];
+        let judged = judge("documented", Mode::Quick, checks.clone(), &deviations, true);
+        let verdicts: Vec<CheckVerdict> = judged.iter().map(|c| c.verdict).collect();
+        assert_eq!(
+            verdicts,
+            [
+                CheckVerdict::Deviation,
+                CheckVerdict::UnexpectedPass,
+                CheckVerdict::StaleEntry
+            ]
+        );
+        assert_eq!(status_of(false, &judged), Status::Fail);
+        // Full mode lists nothing: the miss is an undocumented failure there.
+        let full = judge("documented", Mode::Full, checks.clone(), &deviations, true);
+        assert_eq!(full[0].verdict, CheckVerdict::Fail);
+        // An experiment that errored is not judged stale.
+        let errored = judge("documented", Mode::Quick, vec![], &deviations, false);
+        assert!(errored.is_empty());
+        assert_eq!(status_of(true, &errored), Status::Error);
+    }
+
+    #[test]
+    fn shipped_deviations_name_registered_experiments() {
+        let all = crate::registry();
+        let d = load_deviations(&all, &reference_data_dir()).unwrap();
+        for dev in d.all() {
+            assert!(
+                !dev.summary().is_empty(),
+                "{}/{}",
+                dev.experiment,
+                dev.check
+            );
+        }
     }
 }
