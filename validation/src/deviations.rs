@@ -149,6 +149,29 @@ impl Deviations {
     }
 }
 
+/// Marker lines around the README's list of deviations.
+pub const README_START: &str =
+    "<!-- deviations: generated from reference-data/deviations.toml; checked by cargo test -p validation -->";
+/// End marker of the README's list.
+pub const README_END: &str = "<!-- /deviations -->";
+
+/// The README's list of documented deviations: one line per entry, with its modes and its
+/// summary.
+pub fn readme_list(deviations: &Deviations) -> String {
+    let mut s = String::new();
+    for d in deviations.all() {
+        let modes: Vec<&str> = d.modes.iter().map(|m| m.as_str()).collect();
+        s.push_str(&format!(
+            "- `{}`, check \"{}\" ({}): {}\n",
+            d.experiment,
+            d.check,
+            modes.join(", "),
+            d.summary()
+        ));
+    }
+    s
+}
+
 /// How one check came out, against the deviations list.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -230,6 +253,23 @@ evidence = "a run"
         let empty = ONE.replace("\"a run\"", "\" \"");
         let e = Deviations::parse(&empty, "test").unwrap_err().to_string();
         assert!(e.contains("evidence"), "{e}");
+    }
+
+    #[test]
+    fn readme_lists_the_deviations() {
+        let root = crate::workspace_root();
+        let d = Deviations::load(&root.join("reference-data")).unwrap();
+        let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+        let expected = readme_list(&d);
+        let block = readme
+            .split_once(README_START)
+            .and_then(|(_, rest)| rest.split_once(README_END))
+            .map(|(block, _)| block.trim_start_matches('\n').to_string());
+        assert_eq!(
+            block.as_deref(),
+            Some(expected.as_str()),
+            "README.md's list between the deviation markers must be:\n{README_START}\n{expected}{README_END}"
+        );
     }
 
     #[test]

@@ -1,6 +1,9 @@
 //! Assembly of per-task neighbour buffers into [`NeighbourLists`], without allocation once
 //! the buffers have grown.
 
+// Unsafe: disjoint parallel writes through `SyncPtr` (each index written by one task), and unchecked indexing in the hot loop behind checked bounds; see the SAFETY comments.
+#![allow(unsafe_code)]
+
 use rayon::prelude::*;
 
 use crate::sync_ptr::SyncPtr;

@@ -21,28 +21,14 @@
 //! positions, `h <= 0`, cells that overflow `i32`, a bounding grid too large for
 //! [`CellStartGrid`]. No method panics on user input.
 //!
-//! ## Performance (measured 2026-11-21 on the project's 2-core x86-64 machine, AVX-512)
+//! ## Performance
 //!
 //! Anchor scene: SPlisHSPlasH's dam break at particle radius 0.0125 m — 59,319 fluid
 //! particles at spacing 0.025 m plus 131,976 tank-wall particles, `h = 0.05` m, f32,
 //! 22.7 neighbours and 113.5 candidate distance tests per particle ([`SearchStats`]).
-//! `cargo bench -p benches --bench neighbour_search -- dam-break-anchor` (criterion median,
-//! build + query, lists written):
-//!
-//! | input, threads | cell-start grid | hashed grid | relation table | kiddo k-d tree |
-//! | --- | --- | --- | --- | --- |
-//! | sorted by cell, 1 | 18.9 ms (0.099 µs/particle) | 22.5 ms | 178 ms | 278 ms |
-//! | sorted by cell, 2 | 17.5 ms | 20.8 ms | 104 ms | 140 ms |
-//! | generation order, 1 | 31.4 ms (0.164 µs/particle) | 43.2 ms | 170 ms | 251 ms |
-//!
-//! The machine's timings drift by up to ±30 % between runs (a first criterion run of the
-//! sorted 1-thread case gave 26.4 ms for the cell-start grid; a later one, after cells and
-//! their bounds were fused into one pass, 21.8 ms, i.e. 0.114 µs/particle, with kiddo at
-//! 229 ms; the single-run example `ns_profile` gives minima of 17.6 ms); quote ranges, not
-//! digits. The target of 0.1 µs/particle is thus met in the quieter runs only.
-//! For scale: CompactNSearch (SPlisHSPlasH 2.19) spends 45–54 ms per step on this scene on
-//! one thread of this machine (0.25 µs/particle), and the fastest method here is 10–15×
-//! faster than kiddo's fixed-radius queries on one thread.
+//! `cargo bench -p benches --bench neighbour_search -- dam-break-anchor` times every method
+//! (build + query, lists written); the figures, against SPlisHSPlasH's CompactNSearch on the
+//! same scene, are in the workspace's `docs/performance.md`.
 //!
 //! **Bound.** Per particle the cell-start grid tests 113.5 candidates (16 per AVX-512 step,
 //! about 12 instructions each: ~85 instructions), gathers its cell's ~216 candidates shared
@@ -50,8 +36,8 @@
 //! keys, cell-ordered positions, 91 bytes of neighbour indices, offsets). At the measured
 //! single-thread copy bandwidth of 11 GB/s (`cargo run --release -p benches --example
 //! bandwidth`) the memory part is ≈ 0.02 µs, and the instruction count at 2–3 per cycle is
-//! ≈ 0.03–0.04 µs: a bound of about 0.04 µs/particle, against the measured 0.10, i.e. about
-//! 2.5× from it. The rest is per-cell and per-particle overhead (locating the nine column
+//! ≈ 0.03–0.04 µs: a bound of about 0.04 µs/particle (the measured figure is about 2.5×
+//! that). The rest is per-cell and per-particle overhead (locating the nine column
 //! ranges, padding, reserving output). The relation table's cost is its 27 entries per
 //! particle: 27 × 12 bytes written and radix-sorted in two passes (≈ 250 MB of traffic for
 //! this scene, ≈ 25 ms at 11 GB/s even before the sort's scattered writes), which is why it

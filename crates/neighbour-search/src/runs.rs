@@ -1,5 +1,8 @@
 //! Parallel detection of runs of equal keys in a sorted array.
 
+// Unsafe: disjoint parallel writes through `SyncPtr` (each index written by one task), and unchecked indexing in the hot loop behind checked bounds; see the SAFETY comments.
+#![allow(unsafe_code)]
+
 use rayon::prelude::*;
 
 use crate::sync_ptr::SyncPtr;

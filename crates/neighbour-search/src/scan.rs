@@ -11,6 +11,9 @@
 //! `(dx·dx + dy·dy) + dz·dz < h²` with the same IEEE operations in the same order as
 //! [`crate::squared_distance`] (no fused multiply-add), so their results are identical.
 
+// Unsafe: disjoint parallel writes through `SyncPtr` (each index written by one task), and unchecked indexing in the hot loop behind checked bounds; see the SAFETY comments.
+#![allow(unsafe_code)]
+
 use std::any::TypeId;
 
 use sph_core::Real;

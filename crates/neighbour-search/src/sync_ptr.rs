@@ -1,5 +1,8 @@
 //! [`SyncPtr`], a raw pointer that parallel writers may share.
 
+// Unsafe: disjoint parallel writes through `SyncPtr` (each index written by one task), and unchecked indexing in the hot loop behind checked bounds; see the SAFETY comments.
+#![allow(unsafe_code)]
+
 /// A raw pointer into a buffer that several rayon tasks write to at the same time.
 ///
 /// `*mut T` is neither `Send` nor `Sync`; this wrapper is both, so a closure run on several

@@ -133,76 +133,30 @@
 //! rayon task owns its particles' contiguous range), and the second (`Δp`) reuses them at the
 //! same positions, so it needs no square root, division or kernel evaluation.
 //!
-//! # Performance against SPlisHSPlasH, with volume-map walls
+//! # Performance
 //!
-//! Side by side with SPlisHSPlasH 2.19 (`pip install pysplishsplash==2.19.0`, its PBF,
-//! `simulationMethod` 2, **volume maps**, `boundaryHandlingMethod` 2, iterating to 0.1 %
-//! mean density error, 2–100 iterations, fixed Δt = 2 ms, no viscosity) on its
-//! `DamBreakModel` scene at particle radius 0.0125 m (59,319 fluid particles, tank 4 × 3 ×
-//! 1.5 m), 250 steps from rest, on this 2-core machine, one script running all six rows one
-//! after the other (2026-11-23). Ours: `RAYON_NUM_THREADS=T cargo run --release -p benches
-//! --example pbf_dambreak -- 250 tol=0.001 pbf unilateral [volume-map]` (SPlisHSPlasH's
-//! stopping rule and constraint form, see below; XSPH `c` 0.01, which SPlisHSPlasH does not
-//! apply):
+//! Measured side by side with SPlisHSPlasH 2.19's PBF on its `DamBreakModel` scene (59,319
+//! fluid particles, Δt = 2 ms, 0.1 % mean density error) by
+//! `RAYON_NUM_THREADS=T cargo run --release -p benches --example pbf_dambreak -- 250
+//! tol=0.001 pbf unilateral [volume-map]`: the figures, dates and commands are in the
+//! workspace's `docs/performance.md`. The accuracy-matched comparison uses SPlisHSPlasH's
+//! stopping rule and tolerance ([`PbfParams::mean_compression_tolerance`] = 0.001, 2–100
+//! iterations) and its form of the constraint ([`PbfParams::clamp_negative_constraint`],
+//! `ε` = 10⁻⁶ m⁻², no `s_corr`). With the paper's form (bilateral `C_i`, `ε = D_ref`,
+//! `s_corr`) the Jacobi iterations converge far more slowly to a given tolerance; at a fixed
+//! iteration count (the paper's way of running) the cost per step is the same.
 //!
-//! | threads | SPlisHSPlasH, volume maps | here, volume maps | ratio | here, SDF collision walls | ratio |
-//! | --- | --- | --- | --- | --- | --- |
-//! | 1 | 285.7 ms (5.29 it.) | 107.0 ms (4.61 it.) | 2.67× | 90.2 ms (4.68 it.) | 3.17× |
-//! | 2 | 129.6 ms (5.27 it.) | 52.4 ms (4.61 it.) | 2.47× | 44.5 ms (4.68 it.) | 2.91× |
+//! With volume-map walls the boundary's `Ψ` is sampled at every Jacobi iteration only for
+//! the particles within `1.5 h` of a solid; a particle farther than `h` skips the map, and a
+//! map cell whose eight nodes lie on one flat wall takes the half-space volume directly.
 //!
-//! Spread: over three such runs the same day SPlisHSPlasH took 273.5–290.6 ms on one thread
-//! and 129.6–151.4 ms on two, so the volume-map ratio is 2.4–2.7× on one thread and 2.3–2.9×
-//! on two; the 2.5× aimed for is met in some runs and missed in others. The volume maps cost
-//! 18–19 % per step here against the SDF walls (the boundary's `Ψ` is sampled at every
-//! Jacobi iteration for the 15 % of the particles within `1.5 h` of a wall); the first
-//! version cost 85 % (177.6 ms on one thread), before a particle farther than `h` from a
-//! solid skipped the map, cells whose eight nodes all lie on one flat wall took the
-//! half-space volume directly, and each step's iterations skipped the particles out of reach
-//! of the walls. The runs do not end in the same state: ours ends denser (mean `ρ/ρ0` 0.929
-//! against 0.883, 1.96 M ordered neighbour pairs against 1.50 M), i.e. with 30 % more pair
-//! work per iteration; both end at max `ρ/ρ0` 1.01–1.02 (SPlisHSPlasH's recomputed with
-//! Poly6, the constraint's kernel; its own density output uses the cubic spline). Map
-//! construction is not counted: 29.0 s for the tank on one thread (14.6 s on two) against
-//! SPlisHSPlasH's 6.5 s (3.3 s): our map integrates the kernel over the solid at every node
-//! of a band with `h/4` cells by a 16 × 32-direction quadrature
-//! (`sph_solver::boundary::VolumeMap`), SPlisHSPlasH's stores the volume of a smoothed wall
-//! indicator on a 40 × 30 × 15-cell grid and places one virtual boundary particle per fluid
-//! particle.
-
-//! # Earlier measurement, SPlisHSPlasH with boundary particles
-//!
-//! Measured side by side with SPlisHSPlasH 2.19 (`pip install pysplishsplash==2.19.0`, its
-//! PBF, `simulationMethod` 2, iterating to 0.1 % mean density error, 2–100 iterations,
-//! boundary particles) on its `DamBreakModel` scene at particle radius 0.0125 m (59,319
-//! fluid particles, Δt = 0.002 s), 250 steps from rest, on this 2-core machine
-//! (`benches/examples/pbf_dambreak.rs`; one script ran all columns of a row one after the
-//! other, 2026-11-21):
-//!
-//! | threads | SPlisHSPlasH | here, SPlisHSPlasH's constraint, to 0.1 % | here, paper's form, to 0.1 % | here, paper's form, 5 iterations |
-//! | --- | --- | --- | --- | --- |
-//! | 1 | 462 ms (5.33 it.) | 168 ms (4.68 it.) | 1182 ms (42.7 it.) | 172 ms |
-//! | 2 | 287 ms (5.36 it.) | 76 ms (4.68 it.) | 601 ms (42.7 it.) | 93 ms |
-//!
-//! The accuracy-matched comparison is the second column: the same stopping rule and
-//! tolerance ([`PbfParams::mean_compression_tolerance`] = 0.001, 2–100 iterations) and
-//! SPlisHSPlasH's form of the constraint ([`PbfParams::clamp_negative_constraint`], `ε` =
-//! 10⁻⁶ m⁻², no `s_corr`, particle mass `0.8 ρ0 (2r)³`): 2.7× faster on one thread and 3.8×
-//! on two. The density both measure differs in that SPlisHSPlasH's includes its 129,454
-//! boundary particles (and it spends 93 ms of its 462 ms searching them; our walls are
-//! SDFs), which is also why it needs slightly more iterations. With the paper's form
-//! (bilateral `C_i`, `ε = D_ref`, `s_corr`) the Jacobi iterations converge far more slowly:
-//! reaching 0.1 % takes 43 iterations on average and 37 of the 250 steps stop at 100 without
-//! it, so this form is 2.1–2.6× *slower* than SPlisHSPlasH at equal accuracy; at a fixed
-//! 5 iterations (the last column, iteration-matched, the paper's way of running) it is
-//! 2.7–3.1× faster but ends with max `ρ/ρ0` 1.08. Results are bit-identical on one and two
-//! threads. The constraint solve costs 0.46–0.51 µs per particle-iteration on one thread (SPlisHSPlasH:
-//! 350.5 ms / (5.33 × 59,319) = 1.11 µs, boundary pairs included). Its memory-bandwidth
-//! bound: per iteration both passes stream the neighbour indices (2 × 4 B per pair), the pair cache is written and read
-//! (2 × 8 B per pair), about 64 B per particle of particle arrays: 47 MB per iteration for
-//! 1.81 M pairs, 4.7 ms at this machine's 10 GB/s single-thread copy bandwidth
-//! (`benches/examples/bandwidth.rs`), i.e. 0.08 µs per particle-iteration. The loops run
-//! 6.5× above that bound: they are compute-bound (about 28 cycles per pair evaluation), the
-//! positions of the neighbours being L2 hits after the cell reorder.
+//! **Bound.** Per iteration both passes stream the neighbour indices (2 × 4 B per pair), the
+//! pair cache is written and read (2 × 8 B per pair), and about 64 B per particle of particle
+//! arrays: 47 MB per iteration for the anchor scene's 1.81 M pairs, i.e. 0.08 µs per
+//! particle-iteration at 10 GB/s of single-thread copy bandwidth
+//! (`cargo run --release -p benches --example bandwidth`). The loops run several times above
+//! that bound: they are compute-bound (about 28 cycles per pair evaluation), the positions of
+//! the neighbours being L2 hits after the cell reorder.
 
 mod params;
 mod passes;

@@ -84,7 +84,9 @@ pub struct PbfParams<R: Real> {
     /// `|Δq|` of eq. 13 as a fraction of `h` (in (0, 1)).
     pub scorr_delta_q: R,
     /// Vorticity confinement strength `ε` of eq. 16 (m/s: the confinement acceleration is
-    /// `ε N × ω` with `ω` in 1/s; ≥ 0, 0 disables it).
+    /// `ε N × ω` with `ω` in 1/s; 0 disables it). A negative value reverses the force
+    /// (anti-confinement, which damps vortices): not a physical setting, but the negative
+    /// control of the `pbf-vorticity` experiment; scene files accept only `ε ≥ 0`.
     pub vorticity_epsilon: R,
     /// XSPH viscosity `c` of eq. 17 (dimensionless, in [0, 1]; 0 disables it).
     pub xsph_c: R,
@@ -227,7 +229,13 @@ impl<R: Real> PbfParams<R> {
                 "must be a fraction of h in (0, 1)",
             ));
         }
-        non_negative("vorticity_epsilon", self.vorticity_epsilon)?;
+        if !self.vorticity_epsilon.is_finite_value() {
+            return Err(invalid(
+                "vorticity_epsilon",
+                self.vorticity_epsilon.as_f64(),
+                "must be finite",
+            ));
+        }
         if !(self.xsph_c.is_finite_value() && self.xsph_c >= R::zero() && self.xsph_c <= R::one()) {
             return Err(invalid("xsph_c", self.xsph_c.as_f64(), "must be in [0, 1]"));
         }

@@ -503,7 +503,7 @@ fn velocity_update<R: Real>(input: VelocityInput<'_, R>, s: &mut PbfScratch<R>) 
         .enumerate()
         .with_min_len(MIN_LEN)
         .for_each(|(i, v)| *v = (x[i] - x_old[i]) * inv_dt);
-    let vort_on = p.vorticity_epsilon > R::zero();
+    let vort_on = p.vorticity_epsilon != R::zero();
     let xsph_on = p.xsph_c > R::zero();
     let v = &s.velocity[..];
     // Densities at the final positions and eq. 15; without vorticity confinement, XSPH

@@ -1,6 +1,9 @@
 //! `Pbf::step` does not allocate once its buffers have grown (counting global allocator;
 //! this file is its own test binary, with a single test so nothing else allocates).
 
+// Unsafe: the allocation counter is a `GlobalAlloc` wrapping `System` (the only way to count allocations).
+#![allow(unsafe_code)]
+
 mod common;
 
 use std::alloc::{GlobalAlloc, Layout, System};

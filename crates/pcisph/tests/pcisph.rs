@@ -4,6 +4,9 @@
 //! determinism across thread counts, no allocation in a warm step, errors, and an unstable
 //! setup failing cleanly.
 
+// Unsafe: the allocation counter is a `GlobalAlloc` wrapping `System` (the only way to count allocations).
+#![allow(unsafe_code)]
+
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::sync::atomic::{AtomicUsize, Ordering};

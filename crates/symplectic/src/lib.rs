@@ -23,12 +23,9 @@
 //!
 //! # Performance
 //!
-//! `cargo bench -p benches --bench symplectic` (one thread, this project's 2-core Xeon):
-//! S2 planet step (four giant planets, τ = 365 d, state synchronised after every step)
-//! 0.60 µs, S6 1.65 µs; particle step (barycentric, planets interpolated) S2 0.45–0.49 µs,
-//! S6 1.0–1.1 µs. REBOUND 5.2.2's WHFast in democratic heliocentric coordinates on the same
-//! system, measured in the same session: 0.71 µs per step with `safe_mode = 0` (unsynchronised
-//! between steps), 1.23 µs with `safe_mode = 1`. The Kepler drift uses Halley's iteration from
+//! `cargo bench -p benches --bench symplectic` times one S2 and one S6 step of the planets
+//! and of a test particle; the figures, beside REBOUND's WHFast on the same system, are in
+//! the workspace's `docs/performance.md`. The Kepler drift uses Halley's iteration from
 //! a third-order series start, which converges in two Stumpff evaluations for these steps.
 //!
 //! Units are the caller's; the experiments use AU, days and solar masses with

@@ -107,6 +107,8 @@ pub fn to_barycentric(planets: &Planets, position: Vec3, velocity: Vec3) -> (Vec
 }
 
 /// CPU time of the calling thread, seconds (falls back to wall time where unsupported).
+// Unsafe: the thread's CPU clock (`clock_gettime`) has no safe std API.
+#[allow(unsafe_code)]
 pub fn thread_cpu_seconds() -> f64 {
     #[cfg(unix)]
     {

@@ -11,6 +11,14 @@
 //! The front is the `x` of the leading free surface: the `k`-th largest particle `x`
 //! (`k` = 0.1 % of the particles, at least 1, so that a few droplets thrown ahead do not count)
 //! plus the particle radius `s/2`. `Z = x_front / a`, `T = t √(2g/a)`.
+//!
+//! Besides the pointwise band, the late-time front speed `dZ/dT` (least-squares slope over
+//! `T` ∈ [4.4, 9.2], the last eight measured points, where the surge runs at a nearly
+//! constant speed) is checked against the slope of the measurements (±10 %) and against
+//! Ritter's inviscid limit: the front of an ideal dam break on a dry bed runs at `2 √(g H)`,
+//! which with `H = 2a` is `dZ/dT = 2`. To see where a slower front loses its energy, the
+//! scene is also run (reported, not checked) without XSPH (`c = 0`) and with volume-map
+//! walls instead of the collision projection.
 
 use anyhow::Result;
 use sph_core::Real;
@@ -31,6 +39,43 @@ const COLUMN_WIDTH_M: f64 = 0.2;
 const FRONT_QUANTILE: f64 = 1e-3;
 /// A-priori band on `|Z_sim − Z_exp| / Z_exp` at every measured `T`; see [`DamBreakFront`].
 const Z_BAND: f64 = 0.15;
+
+/// The span of `T` over which the late front speed is fitted.
+const LATE_T: (f64, f64) = (4.4, 9.3);
+/// Band on the late front speed relative to the measured slope (±10 %): the measured points
+/// of the span lie on a line within about 1 % of Z (the fit's residual, reported), so a
+/// 10 % slope difference is a real difference in speed, not digitisation scatter.
+const LATE_SLOPE_BAND: f64 = 0.10;
+/// Ritter's (1892) inviscid dam-break front speed `2 √(g H)` in `dZ/dT` units for a column of
+/// height `H = 2a`: `2 √(2 g a) / √(2 g a) = 2`.
+const RITTER_DZ_DT: f64 = 2.0;
+
+/// Least-squares slope and rms residual of `(x, y)` points with `x` in `span`.
+pub fn fitted_slope(points: &[(f64, f64)], span: (f64, f64)) -> (f64, f64) {
+    let pts: Vec<(f64, f64)> = points
+        .iter()
+        .copied()
+        .filter(|p| p.0 >= span.0 && p.0 <= span.1 && p.1.is_finite())
+        .collect();
+    let n = pts.len() as f64;
+    if pts.len() < 2 {
+        return (f64::NAN, f64::NAN);
+    }
+    let (mx, my) = (
+        pts.iter().map(|p| p.0).sum::<f64>() / n,
+        pts.iter().map(|p| p.1).sum::<f64>() / n,
+    );
+    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    let slope = sxy / sxx;
+    let rms = (pts
+        .iter()
+        .map(|p| (p.1 - (my + slope * (p.0 - mx))).powi(2))
+        .sum::<f64>()
+        / n)
+        .sqrt();
+    (slope, rms)
+}
 
 /// `x` of the leading free surface: the `k`-th largest particle `x` (k = `FRONT_QUANTILE`
 /// of the particles, at least 1) plus `radius`.
@@ -60,7 +105,6 @@ fn simulate<R: Real>(ctx: &Context, scene: &Scene) -> Result<(Vec<(f64, f64)>, u
     let g = (scene.gravity[0].powi(2) + scene.gravity[1].powi(2) + scene.gravity[2].powi(2)).sqrt();
     let t_scale = (2.0 * g / COLUMN_WIDTH_M).sqrt();
     let x_wall = scene.tank.map_or(0.0, |t| t.min.x);
-    ctx.progress.set_length(frames as u64);
     let mut series = vec![(
         0.0,
         (front_x(&sim.state.positions, radius) - x_wall) / COLUMN_WIDTH_M,
@@ -91,10 +135,22 @@ impl Experiment for DamBreakFront {
             measured.push((reference.number(row, "T")?, reference.number(row, "Z")?));
         }
         let scene = shipped_scene("martin_moyce", ctx.mode)?;
-        let (series, particles) = match scene.precision {
-            Precision::F32 => simulate::<f32>(ctx, &scene)?,
-            Precision::F64 => simulate::<f64>(ctx, &scene)?,
+        let run = |ctx: &Context, scene: &Scene| match scene.precision {
+            Precision::F32 => simulate::<f32>(ctx, scene),
+            Precision::F64 => simulate::<f64>(ctx, scene),
         };
+        ctx.progress.set_length(3 * scene.frame_count() as u64);
+        ctx.progress
+            .set_message("frames of 3 runs (scene, no XSPH, volume-map walls)");
+        let (series, particles) = run(ctx, &scene)?;
+        let mut no_xsph = scene.clone();
+        if let sph_scene::SolverSpec::Pbf(p) = &mut no_xsph.solver {
+            p.xsph_c = Some(0.0);
+        }
+        let mut volume_walls = scene.clone();
+        volume_walls.boundary.model = sph_scene::BoundaryModel::VolumeMap;
+        let (series_no_xsph, _) = run(ctx, &no_xsph)?;
+        let (series_volume, _) = run(ctx, &volume_walls)?;
         write_csv_rows(
             &ctx.path("front.csv"),
             &["T", "Z"],
@@ -144,10 +200,54 @@ impl Experiment for DamBreakFront {
             "a-priori band of this project (15 %), set before the run: Martin & Moyce's run-to-run scatter \
              is not digitised, and the gate release delays the measured front at early T; not from the PBF paper",
         ));
+        let (slope_exp, rms_exp) = fitted_slope(&measured, LATE_T);
+        let (slope_sim, _) = fitted_slope(&series, LATE_T);
+        out.metric("late_front_speed_measured_dZ_dT", slope_exp);
+        out.metric("late_front_speed_measured_fit_rms_Z", rms_exp);
+        out.metric("late_front_speed_pbf_dZ_dT", slope_sim);
+        out.metric(
+            "late_front_speed_pbf_no_xsph_dZ_dT",
+            fitted_slope(&series_no_xsph, LATE_T).0,
+        );
+        out.metric(
+            "late_front_speed_pbf_volume_map_walls_dZ_dT",
+            fitted_slope(&series_volume, LATE_T).0,
+        );
+        out.check(Check::within(
+            "front/late speed dZ/dT over T in [4.4, 9.2], relative to the measured slope",
+            slope_sim / slope_exp,
+            1.0 - LATE_SLOPE_BAND,
+            1.0 + LATE_SLOPE_BAND,
+            "Martin & Moyce (1952), n^2 = 2: least-squares slope of the eight measured points with T in [4.4, 9.2] (1.68; they lie within about 1 % of Z of the line); 10 % is a real difference in speed",
+        ));
+        out.check(Check::at_most(
+            "front/late speed dZ/dT, Ritter's inviscid limit",
+            slope_sim,
+            RITTER_DZ_DT,
+            "Ritter (1892): an inviscid dam break on a dry bed advances at 2 sqrt(g H) (H = 2a: dZ/dT = 2); a faster front creates energy",
+        ));
         let spec = PlotSpec {
             legend: Legend::UpperLeft,
             series: vec![
                 Series::line(format!("PBF, {particles} particles"), series.clone(), 0),
+                Series::styled(
+                    "PBF without XSPH (c = 0)",
+                    series_no_xsph.clone(),
+                    SeriesStyle::Dashed,
+                    1,
+                ),
+                Series::styled(
+                    "PBF with volume-map walls",
+                    series_volume.clone(),
+                    SeriesStyle::Dashed,
+                    2,
+                ),
+                Series::styled(
+                    "Ritter (1892) inviscid front, dZ/dT = 2",
+                    vec![(0.0, 1.0), (10.0, 21.0)],
+                    SeriesStyle::Line,
+                    8,
+                ),
                 Series::markers(
                     "Martin & Moyce (1952), n² = 2",
                     measured.clone(),
@@ -173,6 +273,7 @@ impl Experiment for DamBreakFront {
                     7,
                 ),
             ],
+            y_range: Some((0.0, 16.0)),
             ..PlotSpec::new("Dam break: surge front", "T = t·sqrt(2g/a)", "Z = x/a")
         };
         plot_xy(&ctx.path("front.png"), &spec)?;

@@ -6,6 +6,17 @@
 //! [`WARM_UP_FRAMES`] frames, then [`MEASURED_FRAMES`] timed frames from which the time per
 //! step (frame time / steps per frame) and the phase percentages are taken. This is a CPU
 //! (rayon, this machine's cores) against the paper's GPU: the table is a record, not a race.
+//!
+//! What is checked is what a performance bug would change, on this machine, within one run:
+//! - the constraint solve's time per particle-iteration is the same in the three scenes within
+//!   [`SOLVE_COST_SPREAD`] (the solve costs `O(N × iterations × neighbours)` with the same
+//!   kernel, support and spacing ratio everywhere, so a scene-dependent slowdown — a lost
+//!   reordering, a neighbourhood blown up by clumping — shows as a spread);
+//! - the neighbour search (build + query) of the dam break, in thread-seconds per particle per
+//!   step, is no slower than the CompactNSearch anchor of
+//!   `reference-data/neighbour-search/compactnsearch_anchor.csv` (SPlisHSPlasH's search on the
+//!   same dam-break spacing and support, one thread of this machine). Thread-seconds (wall
+//!   time × threads) can only overstate a parallel search's single-thread cost.
 
 use anyhow::Result;
 use sph_core::Real;
@@ -24,6 +35,12 @@ pub const WARM_UP_FRAMES: usize = 3;
 pub const MEASURED_FRAMES: usize = 10;
 /// The scenes of Table 1, by file stem.
 const SCENES: [&str; 3] = ["armadillo_splash", "dam_break", "bunny_drop"];
+/// Largest ratio of the constraint solve's time per particle-iteration between two scenes:
+/// the scenes differ in their share of free-surface particles (fewer neighbours) and in the
+/// cache behaviour of their neighbourhoods, not in the work per neighbour; 1.5 leaves room
+/// for those (measured 1.1–1.2 on this machine) and is missed by a twofold scene-dependent
+/// slowdown.
+pub const SOLVE_COST_SPREAD: f64 = 1.5;
 /// Phase names of Table 2, in its order.
 const PHASES: [&str; 5] = [
     "integrate",
@@ -41,6 +58,10 @@ struct Timing {
     ms_per_step: f64,
     percent: [f64; 5],
     threads: usize,
+    /// Constraint-solve wall time per particle per iteration (µs).
+    solve_us_per_particle_iteration: f64,
+    /// Neighbour search (build + query) wall time per particle per step (µs).
+    search_us_per_particle: f64,
 }
 
 fn time_scene<R: Real>(ctx: &Context, scene: &Scene) -> Result<Timing> {
@@ -51,8 +72,10 @@ fn time_scene<R: Real>(ctx: &Context, scene: &Scene) -> Result<Timing> {
     }
     let mut phases = [0.0f64; 5];
     let mut total = 0.0;
+    let mut iterations_done = 0usize;
     for _ in 0..MEASURED_FRAMES {
         let s = sim.advance()?;
+        iterations_done += s.iterations;
         let p = [
             s.phase_s("integrate"),
             s.phase_s("create_hash_grid"),
@@ -67,7 +90,11 @@ fn time_scene<R: Real>(ctx: &Context, scene: &Scene) -> Result<Timing> {
         ctx.progress.inc(1);
     }
     let steps = scene.solver.substeps();
+    let n = sim.state.len() as f64;
     Ok(Timing {
+        solve_us_per_particle_iteration: 1e6 * phases[3] / (n * iterations_done.max(1) as f64),
+        search_us_per_particle: 1e6 * (phases[1] + phases[2])
+            / (n * (MEASURED_FRAMES * steps) as f64),
         particles: sim.state.len(),
         steps,
         iterations: scene.solver.iterations(),
@@ -100,8 +127,17 @@ impl Experiment for PbfPerformance {
         )?;
         ctx.progress
             .set_length((SCENES.len() * (WARM_UP_FRAMES + MEASURED_FRAMES)) as u64);
+        ctx.progress.set_message("frames of 3 scenes");
+        let anchor = load_reference_csv(
+            ctx,
+            "neighbour-search/compactnsearch_anchor.csv",
+            &["method", "us_per_particle", "threads"],
+        )?;
+        let anchor_row = anchor.find(&[("method", "compactnsearch")])?;
+        let anchor_us = anchor.number(anchor_row, "us_per_particle")?;
         let mut out = Outcome::new();
         let mut rows = Vec::new();
+        let mut solve_costs = Vec::new();
         let mut md = String::from(
             "| scene | particles (paper) | steps/frame | iters/step | time/step ms (paper, GTX 680) | µs per particle-step | Integrate % | Create Hash Grid % | Detect Neighbors % | Constraint Solve % | Velocity Update % |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
         );
@@ -129,14 +165,31 @@ impl Experiment for PbfPerformance {
             for (p, v) in PHASES.iter().zip(t.percent) {
                 out.metric(format!("{name}/{p}_percent"), v);
             }
-            // Table 2: the constraint solve is the largest phase in both scenes.
+            // Table 2: the constraint solve is the largest phase in both scenes (a record).
             let largest = t.percent.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
-            out.check(Check::equals(
-                format!("{name}/constraint solve is the largest phase (1 = yes)"),
+            out.metric(
+                format!("{name}/constraint_solve_is_largest_phase"),
                 (t.percent[3] == largest) as u8 as f64,
-                1.0,
-                "Table 2 of the paper: Constraint Solve is the largest share (38 %, 51 %)",
-            ));
+            );
+            out.metric(
+                format!("{name}/solve_us_per_particle_iteration"),
+                t.solve_us_per_particle_iteration,
+            );
+            out.metric(
+                format!("{name}/search_us_per_particle_step"),
+                t.search_us_per_particle,
+            );
+            solve_costs.push(t.solve_us_per_particle_iteration);
+            if name == "dam_break" {
+                let thread_us = t.search_us_per_particle * t.threads as f64;
+                out.metric("dam_break/search_thread_us_per_particle_step", thread_us);
+                out.check(Check::at_most(
+                    "dam_break/neighbour search, thread-µs per particle-step, over the CompactNSearch anchor",
+                    thread_us / anchor_us,
+                    1.0,
+                    "SPlisHSPlasH's CompactNSearch on the same dam-break spacing and support, one thread of this machine: 0.25 µs per particle per step (reference-data/neighbour-search/compactnsearch_anchor.csv); the cell-start grid (Green 2008) is meant to be no slower",
+                ));
+            }
             md.push_str(&format!(
                 "| {name} | {} ({}) | {} | {} | {} ({}) | {} | {} |\n",
                 t.particles,
@@ -179,6 +232,17 @@ impl Experiment for PbfPerformance {
             "constraint_solve" => "constraint_solve_percent",
             _ => "velocity_update_percent",
         }));
+        let (lo, hi) = solve_costs
+            .iter()
+            .fold((f64::INFINITY, 0.0f64), |(lo, hi), &c| {
+                (lo.min(c), hi.max(c))
+            });
+        out.check(Check::at_most(
+            "constraint solve time per particle-iteration, slowest scene over fastest",
+            hi / lo,
+            SOLVE_COST_SPREAD,
+            "the solve costs O(N x iterations x neighbours) with the same kernel, support and spacing ratio in the three scenes; 1.5 allows for free-surface share and cache effects (1.1-1.2 seen), a twofold scene-dependent slowdown misses it",
+        ));
         write_csv_rows(&ctx.path("performance.csv"), &header, rows)?;
         ctx.add_file(
             "performance.csv",

@@ -3,16 +3,27 @@
 //! are written as side-view images.
 //!
 //! The dam break (`scenes/dam_break.toml`; quick overrides in quick mode, the paper's
-//! `t = 6.0 s` in full mode) is run twice with identical settings but the confinement
-//! strength `ε` of eq. 16: 0 (off) and [`VORTICITY_EPSILON`]. The splash height of a frame
-//! is the `y` below which 99.9 % of the particles lie (so single droplets do not count);
-//! the kinetic energy is the solver's `Σ m v²/2`.
+//! `t = 6.0 s` in full mode) is run with identical settings but the confinement strength `ε`
+//! of eq. 16: 0 (off), [`VORTICITY_EPSILON`] (on), and `−`[`VORTICITY_EPSILON`] (the negative
+//! control: the reversed force must lower what the confinement raises). Two more runs with
+//! `ε = 0` start from positions perturbed by [`PERTURBATION_M`] (uniform in each coordinate,
+//! fixed seeds): a dam break is chaotic, and the spread of their results against the
+//! unperturbed run is the noise floor the on/off gap has to exceed.
+//!
+//! Per frame: the splash height, the `y` below which 99.9 % of the particles lie (so single
+//! droplets do not count); the kinetic energy `Σ m v²/2` (the solver's); and the enstrophy
+//! `½ Σ_i (m_i/ρ0) |ω_i|²` with the SPH vorticity `ω_i = Σ_j (m_j/ρ0) (v_j − v_i) × ∇W_ij`
+//! (Spiky gradient over the neighbours within `h`, computed here, independently of the
+//! solver), the quantity the confinement force exists to restore (§5, eqs. 15–16). Each is
+//! compared over the second half of the run, after the first impact on the far wall.
 
 use anyhow::Result;
 use sph_core::Real;
 use sph_scene::{Precision, Scene, SolverSpec};
 
-use crate::helpers::{plot_xy, side_view_png, write_csv_rows, Legend, PlotSpec, Series};
+use crate::helpers::{
+    plot_xy, side_view_png, write_csv_rows, Legend, PlotSpec, Series, SeriesStyle,
+};
 use crate::sim::{shipped_scene, SceneSim};
 use crate::{Check, Context, Experiment, Outcome};
 
@@ -25,6 +36,60 @@ pub struct PbfVorticity;
 pub const VORTICITY_EPSILON: f64 = 0.05;
 /// Fraction of the particles allowed above the splash height.
 const SPLASH_QUANTILE: f64 = 1e-3;
+/// Amplitude of the initial-position perturbation of the noise-floor runs (m).
+pub const PERTURBATION_M: f64 = 1e-6;
+/// Seeds of the noise-floor runs.
+const NOISE_SEEDS: [u64; 2] = [1, 2];
+/// How many times the noise floor the on/off gap must exceed ("clearly": a gap of one noise
+/// floor is what two unperturbed-equivalent runs already show).
+const NOISE_MULTIPLE: f64 = 3.0;
+
+/// Enstrophy `½ Σ_i (m_i/ρ0) |ω_i|²` (m³/s²) with the SPH vorticity
+/// `ω_i = Σ_j (m_j/ρ0) (v_j − v_i) × ∇W_ij` (Spiky gradient, support `h`).
+fn enstrophy<R: Real>(
+    state: &pbf::ParticleSet<R>,
+    h: f64,
+    rho0: f64,
+    lists: &mut neighbour_search::NeighbourLists,
+) -> Result<f64> {
+    use sph_kernels::{Kernel, KernelKind};
+    let spiky = KernelKind::Spiky.build(h)?;
+    let mut search = neighbour_search::Method::CellStartGrid.build::<R>();
+    search.search(&state.positions, R::of_f64(h), lists)?;
+    let (x, v, m) = (&state.positions, &state.velocities, &state.masses);
+    let mut total = 0.0;
+    for i in 0..state.len() {
+        let mut w = [0.0f64; 3];
+        for &j in lists.neighbours(i) {
+            let j = j as usize;
+            if j == i {
+                continue;
+            }
+            let d = [
+                (x[i].x - x[j].x).as_f64(),
+                (x[i].y - x[j].y).as_f64(),
+                (x[i].z - x[j].z).as_f64(),
+            ];
+            let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            if r <= 0.0 || r >= h {
+                continue;
+            }
+            let g = spiky.derivative(r).as_f64() / r;
+            let grad = [g * d[0], g * d[1], g * d[2]];
+            let dv = [
+                (v[j].x - v[i].x).as_f64(),
+                (v[j].y - v[i].y).as_f64(),
+                (v[j].z - v[i].z).as_f64(),
+            ];
+            let vol = m[j].as_f64() / rho0;
+            w[0] += vol * (dv[1] * grad[2] - dv[2] * grad[1]);
+            w[1] += vol * (dv[2] * grad[0] - dv[0] * grad[2]);
+            w[2] += vol * (dv[0] * grad[1] - dv[1] * grad[0]);
+        }
+        total += 0.5 * m[i].as_f64() / rho0 * (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    }
+    Ok(total)
+}
 
 fn quantile_y<R: Real>(positions: &[sph_core::Vec3<R>]) -> f64 {
     let mut ys: Vec<f64> = positions.iter().map(|p| p.y.as_f64()).collect();
@@ -38,23 +103,41 @@ fn quantile_y<R: Real>(positions: &[sph_core::Vec3<R>]) -> f64 {
 
 /// Time series of one run and its final frame for the image.
 struct Run {
-    /// (t, splash height m, kinetic energy J).
-    series: Vec<(f64, f64, f64)>,
+    /// (t, splash height m, kinetic energy J, enstrophy m³/s²; the enstrophy is NaN in the
+    /// first half, where it is not computed).
+    series: Vec<(f64, f64, f64, f64)>,
     /// (x, y, speed) of the final frame.
     last_frame: Vec<(f64, f64, f64)>,
     particles: usize,
 }
 
-fn simulate<R: Real>(ctx: &Context, scene: &Scene) -> Result<Run> {
+fn simulate<R: Real>(ctx: &Context, scene: &Scene, perturb_seed: Option<u64>) -> Result<Run> {
     let mut sim = SceneSim::<R>::new(scene)?;
+    if let Some(seed) = perturb_seed {
+        let mut rng = crate::helpers::SplitMix64::new(seed);
+        for p in sim.state.positions.iter_mut() {
+            for k in 0..3 {
+                p[k] += R::of_f64(rng.range(-PERTURBATION_M, PERTURBATION_M));
+            }
+        }
+    }
+    let h = sim.solver().common().support_radius.as_f64();
+    let rho0 = sim.solver().common().rest_density.as_f64();
+    let mut lists = neighbour_search::NeighbourLists::new();
     let frames = scene.frame_count();
     let mut series = Vec::with_capacity(frames);
-    for _ in 0..frames {
+    for k in 0..frames {
         let stats = sim.advance()?;
+        let ens = if k >= frames / 2 {
+            enstrophy(&sim.state, h, rho0, &mut lists)?
+        } else {
+            f64::NAN
+        };
         series.push((
             sim.time_s,
             quantile_y(&sim.state.positions),
             stats.kinetic_energy,
+            ens,
         ));
         ctx.progress.inc(1);
     }
@@ -72,7 +155,7 @@ fn simulate<R: Real>(ctx: &Context, scene: &Scene) -> Result<Run> {
     })
 }
 
-fn run_with(ctx: &Context, scene: &Scene, epsilon: f64) -> Result<Run> {
+fn run_with(ctx: &Context, scene: &Scene, epsilon: f64, perturb_seed: Option<u64>) -> Result<Run> {
     let mut scene = scene.clone();
     let SolverSpec::Pbf(pbf) = &mut scene.solver else {
         anyhow::bail!(
@@ -83,8 +166,8 @@ fn run_with(ctx: &Context, scene: &Scene, epsilon: f64) -> Result<Run> {
     };
     pbf.vorticity_epsilon = Some(epsilon);
     match scene.precision {
-        Precision::F32 => simulate::<f32>(ctx, &scene),
-        Precision::F64 => simulate::<f64>(ctx, &scene),
+        Precision::F32 => simulate::<f32>(ctx, &scene, perturb_seed),
+        Precision::F64 => simulate::<f64>(ctx, &scene, perturb_seed),
     }
 }
 
@@ -105,54 +188,112 @@ impl Experiment for PbfVorticity {
     fn run(&self, ctx: &mut Context) -> Result<Outcome> {
         let scene = shipped_scene("dam_break", ctx.mode)?;
         let frames = scene.frame_count() as u64;
-        ctx.progress.set_length(2 * frames);
-        let off = run_with(ctx, &scene, 0.0)?;
-        let on = run_with(ctx, &scene, VORTICITY_EPSILON)?;
+        let n_runs = 3 + NOISE_SEEDS.len();
+        ctx.progress.set_length(n_runs as u64 * frames);
+        ctx.progress.set_message(format!("frames of {n_runs} runs"));
+        let off = run_with(ctx, &scene, 0.0, None)?;
+        let on = run_with(ctx, &scene, VORTICITY_EPSILON, None)?;
+        let negative = run_with(ctx, &scene, -VORTICITY_EPSILON, None)?;
+        let noise_runs = NOISE_SEEDS
+            .iter()
+            .map(|&seed| run_with(ctx, &scene, 0.0, Some(seed)))
+            .collect::<Result<Vec<_>>>()?;
 
-        let rows = off.series.iter().zip(&on.series).map(|(a, b)| {
-            vec![
-                format!("{:.4}", a.0),
-                format!("{:.5}", a.1),
-                format!("{:.5}", b.1),
-                format!("{:.6e}", a.2),
-                format!("{:.6e}", b.2),
-            ]
+        let rows = (0..off.series.len()).map(|k| {
+            let mut row = vec![format!("{:.4}", off.series[k].0)];
+            for run in [&off, &on, &negative] {
+                let r = run.series[k];
+                row.push(format!("{:.5}", r.1));
+                row.push(format!("{:.6e}", r.2));
+                row.push(format!("{:.6e}", r.3));
+            }
+            row
         });
         write_csv_rows(
             &ctx.path("vorticity.csv"),
             &[
                 "t_s",
                 "splash_height_off_m",
-                "splash_height_on_m",
                 "kinetic_energy_off_j",
+                "enstrophy_off_m3_per_s2",
+                "splash_height_on_m",
                 "kinetic_energy_on_j",
+                "enstrophy_on_m3_per_s2",
+                "splash_height_negative_m",
+                "kinetic_energy_negative_j",
+                "enstrophy_negative_m3_per_s2",
             ],
             rows,
         )?;
         ctx.add_file(
             "vorticity.csv",
-            "splash height and kinetic energy per frame, confinement off and on",
+            "splash height, kinetic energy and enstrophy per frame: confinement off, on, and reversed (negative control); enstrophy over the second half only",
         );
 
         // The second half of the run: after the first impact on the far wall.
         let half = off.series.len() / 2;
-        let ke_off = mean(off.series[half..].iter().map(|r| r.2));
-        let ke_on = mean(on.series[half..].iter().map(|r| r.2));
-        let splash_off = off.series[half..]
-            .iter()
-            .map(|r| r.1)
-            .fold(f64::NEG_INFINITY, f64::max);
-        let splash_on = on.series[half..]
-            .iter()
-            .map(|r| r.1)
-            .fold(f64::NEG_INFINITY, f64::max);
+        let second = |run: &Run, col: fn(&(f64, f64, f64, f64)) -> f64, max: bool| {
+            let v = run.series[half..].iter().map(col);
+            if max {
+                v.fold(f64::NEG_INFINITY, f64::max)
+            } else {
+                mean(v)
+            }
+        };
+        let quantities: [(&str, &str, fn(&(f64, f64, f64, f64)) -> f64, bool, &str); 3] = [
+            (
+                "kinetic energy",
+                "mean_kinetic_energy_second_half",
+                |r| r.2,
+                false,
+                "§5 of the paper: confinement is used \"to replace lost energy\"",
+            ),
+            (
+                "max splash height",
+                "max_splash_height_second_half",
+                |r| r.1,
+                true,
+                "Fig. 5 of the paper: \"note the visibly higher splash\" with confinement",
+            ),
+            (
+                "enstrophy",
+                "mean_enstrophy_second_half",
+                |r| r.3,
+                false,
+                "§5, eqs. 15–16: the confinement force adds rotational energy where numerical damping removed it, i.e. restores vorticity",
+            ),
+        ];
         let mut out = Outcome::new();
         out.metric("particles", off.particles as f64);
         out.metric("vorticity_epsilon_m_per_s", VORTICITY_EPSILON);
-        out.metric("mean_kinetic_energy_second_half_off_j", ke_off);
-        out.metric("mean_kinetic_energy_second_half_on_j", ke_on);
-        out.metric("max_splash_height_second_half_off_m", splash_off);
-        out.metric("max_splash_height_second_half_on_m", splash_on);
+        out.metric("perturbation_m", PERTURBATION_M);
+        for (what, key, col, max, origin) in quantities {
+            let base = second(&off, col, max);
+            let ratio_on = second(&on, col, max) / base;
+            let ratio_neg = second(&negative, col, max) / base;
+            let noise = noise_runs
+                .iter()
+                .map(|r| (second(r, col, max) / base - 1.0).abs())
+                .fold(0.0, f64::max);
+            out.metric(format!("{key}_off"), base);
+            out.metric(format!("{key}_on"), second(&on, col, max));
+            out.metric(format!("{key}_negative"), second(&negative, col, max));
+            out.metric(format!("{what} ratio on/off"), ratio_on);
+            out.metric(format!("{what} ratio negative/off"), ratio_neg);
+            out.metric(format!("{what} noise floor |perturbed/off - 1|"), noise);
+            out.check(Check::greater_than(
+                format!("{what}: (ratio on/off - 1) over the noise floor"),
+                (ratio_on - 1.0) / noise,
+                NOISE_MULTIPLE,
+                format!("{origin}; the gap must exceed {NOISE_MULTIPLE} times the spread of two runs with eps = 0 started {PERTURBATION_M} m apart (a dam break is chaotic)"),
+            ));
+            out.check(Check::less_than(
+                format!("{what}: ratio negative/off (negative control)"),
+                ratio_neg,
+                1.0,
+                "the reversed confinement force (eps < 0) takes rotational energy out: if the on/off gap comes from eq. 16 and not from noise, the reversed force lowers the quantity",
+            ));
+        }
         out.metric(
             "final_splash_height_off_m",
             off.series.last().map_or(f64::NAN, |r| r.1),
@@ -161,34 +302,45 @@ impl Experiment for PbfVorticity {
             "final_splash_height_on_m",
             on.series.last().map_or(f64::NAN, |r| r.1),
         );
-        out.check(Check::greater_than(
-            "kinetic energy ratio on/off (second half)",
-            ke_on / ke_off,
-            1.0,
-            "§5 of the paper: confinement is used \"to replace lost energy\"",
-        ));
-        out.check(Check::greater_than(
-            "max splash height ratio on/off (second half)",
-            splash_on / splash_off,
-            1.0,
-            "Fig. 5 of the paper: \"note the visibly higher splash\" with confinement",
-        ));
 
-        let spec = |title: &str, col: fn(&(f64, f64, f64)) -> f64, y: &str| PlotSpec {
-            legend: Legend::UpperRight,
-            series: vec![
-                Series::line(
-                    "confinement off",
-                    off.series.iter().map(|r| (r.0, col(r))).collect(),
-                    0,
-                ),
+        let spec = |title: &str, col: fn(&(f64, f64, f64, f64)) -> f64, y: &str| {
+            let pts = |run: &Run| {
+                run.series
+                    .iter()
+                    .map(|r| (r.0, col(r)))
+                    .filter(|p| p.1.is_finite())
+                    .collect::<Vec<_>>()
+            };
+            let mut series = vec![
+                Series::line("confinement off", pts(&off), 0),
                 Series::line(
                     format!("confinement on (ε = {VORTICITY_EPSILON} m/s)"),
-                    on.series.iter().map(|r| (r.0, col(r))).collect(),
+                    pts(&on),
                     3,
                 ),
-            ],
-            ..PlotSpec::new(title, "t (s)", y)
+                Series::styled(
+                    format!("reversed (ε = −{VORTICITY_EPSILON} m/s)"),
+                    pts(&negative),
+                    SeriesStyle::Dashed,
+                    2,
+                ),
+            ];
+            for (k, r) in noise_runs.iter().enumerate() {
+                series.push(Series::styled(
+                    format!(
+                        "off, start perturbed by {PERTURBATION_M} m (seed {})",
+                        NOISE_SEEDS[k]
+                    ),
+                    pts(r),
+                    SeriesStyle::Line,
+                    7 + k,
+                ));
+            }
+            PlotSpec {
+                legend: Legend::UpperRight,
+                series,
+                ..PlotSpec::new(title, "t (s)", y)
+            }
         };
         plot_xy(
             &ctx.path("splash_height.png"),
@@ -209,6 +361,18 @@ impl Experiment for PbfVorticity {
         ctx.add_plot(
             "kinetic_energy.png",
             "kinetic energy with and without vorticity confinement",
+        );
+        plot_xy(
+            &ctx.path("enstrophy.png"),
+            &spec(
+                "Dam break: enstrophy (second half)",
+                |r| r.3,
+                "enstrophy 1/2 sum (m/rho0) |omega|^2 (m^3/s^2)",
+            ),
+        )?;
+        ctx.add_plot(
+            "enstrophy.png",
+            "enstrophy over the second half with and without vorticity confinement",
         );
         let tank = scene.tank.map_or(((0.0, 1.0), (0.0, 1.0)), |t| {
             ((t.min.x, t.max.x), (t.min.y, t.max.y))
