@@ -45,7 +45,7 @@ enum Task {
     /// List the experiments and the figure or claim each reproduces.
     List,
     /// Run a scene file (e.g. `scenes/dam_break.toml`): VTK frames for ParaView and a CSV of
-    /// per-frame statistics in `--out` [default: target/scenes/<scene name>].
+    /// per-frame statistics in `--out` [default: `target/scenes/SCENE_NAME`].
     Run {
         /// The scene file (TOML).
         scene: PathBuf,

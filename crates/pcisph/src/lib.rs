@@ -40,7 +40,7 @@
 //! prototype particle at the origin of a full simple cubic lattice of spacing
 //! `particle_spacing` (all lattice points within `h`) with the prototype mass
 //! `m = ρ0 s³` ([`PcisphParams::particle_mass`]) and the substep `Δt`. (The two sums are
-//! `D_ref / (m/ρ0)²` with PBF's [`PbfParams::reference_denominator`] `D_ref`, which is how
+//! `D_ref / (m/ρ0)²` with [`sph_solver::CommonParams::reference_denominator`] `D_ref`, which is how
 //! they are computed, so that `δ = 1 / (2 Δt² D_ref)`.) `δ` is in Pa·m³/kg = m²/s²; it is
 //! 327 m²/s² at `s = 0.025 m`, `h = 0.05 m`, `Δt = 1.6 ms`.
 //!

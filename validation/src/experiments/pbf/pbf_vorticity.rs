@@ -101,11 +101,16 @@ fn quantile_y<R: Real>(positions: &[sph_core::Vec3<R>]) -> f64 {
     *ys.select_nth_unstable_by(idx, f64::total_cmp).1
 }
 
+/// One frame of a run: (t s, splash height m, kinetic energy J, enstrophy m³/s²).
+type Frame = (f64, f64, f64, f64);
+/// A column of [`Frame`].
+type Column = fn(&Frame) -> f64;
+
 /// Time series of one run and its final frame for the image.
 struct Run {
     /// (t, splash height m, kinetic energy J, enstrophy m³/s²; the enstrophy is NaN in the
     /// first half, where it is not computed).
-    series: Vec<(f64, f64, f64, f64)>,
+    series: Vec<Frame>,
     /// (x, y, speed) of the final frame.
     last_frame: Vec<(f64, f64, f64)>,
     particles: usize,
@@ -232,7 +237,7 @@ impl Experiment for PbfVorticity {
 
         // The second half of the run: after the first impact on the far wall.
         let half = off.series.len() / 2;
-        let second = |run: &Run, col: fn(&(f64, f64, f64, f64)) -> f64, max: bool| {
+        let second = |run: &Run, col: Column, max: bool| {
             let v = run.series[half..].iter().map(col);
             if max {
                 v.fold(f64::NEG_INFINITY, f64::max)
@@ -240,7 +245,7 @@ impl Experiment for PbfVorticity {
                 mean(v)
             }
         };
-        let quantities: [(&str, &str, fn(&(f64, f64, f64, f64)) -> f64, bool, &str); 3] = [
+        let quantities: [(&str, &str, Column, bool, &str); 3] = [
             (
                 "kinetic energy",
                 "mean_kinetic_energy_second_half",
@@ -303,7 +308,7 @@ impl Experiment for PbfVorticity {
             on.series.last().map_or(f64::NAN, |r| r.1),
         );
 
-        let spec = |title: &str, col: fn(&(f64, f64, f64, f64)) -> f64, y: &str| {
+        let spec = |title: &str, col: Column, y: &str| {
             let pts = |run: &Run| {
                 run.series
                     .iter()
