@@ -3,7 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::{Integrator, Planets, SymplecticError, Vec3};
+use crate::{Integrator, Planets, SymplecticError, Vec3, WorkCounters};
 
 /// Barycentric positions, velocities and accelerations of the Sun (index 0) and the planets
 /// (1..=n) at one time, with `G m` of each body. Filled by [`Ephemeris::bodies_at`].
@@ -67,6 +67,10 @@ pub struct Ephemeris {
     /// the retained window starts at `offset` (the front is compacted now and then).
     grid: Vec<f64>,
     offset: usize,
+    /// Work of the grid states' accelerations and of the interpolations (the planets' own
+    /// steps are counted in `planets`).
+    #[serde(default)]
+    work: WorkCounters,
 }
 
 impl Ephemeris {
@@ -88,6 +92,7 @@ impl Ephemeris {
             first_index: 0,
             grid: Vec::new(),
             offset: 0,
+            work: WorkCounters::default(),
         };
         e.push_state();
         Ok(e)
@@ -100,6 +105,12 @@ impl Ephemeris {
     /// The planets at the newest grid time.
     pub fn planets(&self) -> &Planets {
         &self.planets
+    }
+
+    /// Work done so far: the planets' steps, the accelerations stored with each grid state
+    /// (`n(n+1)/2` force evaluations) and the interpolations ([`Ephemeris::bodies_at`]).
+    pub fn work(&self) -> WorkCounters {
+        self.work + self.planets.work()
     }
 
     /// The planets' integrator.
@@ -150,6 +161,7 @@ impl Ephemeris {
                 self.planets.masses()[j - 1]
             }
         };
+        self.work.force_evaluations += (n * (n + 1) / 2) as u64;
         for j in 0..=n {
             for k in j + 1..=n {
                 let d = self.vec_at(body(k)) - self.vec_at(body(j));
@@ -217,6 +229,7 @@ impl Ephemeris {
                     "precedes the retained window of planet states (discarded or before the start)",
             });
         }
+        self.work.interpolations += 1;
         let last = self.planet_steps();
         // Interval [k, k+1] containing t (the last interval if t is on the last grid point).
         let k = (rel.floor() as u64).clamp(
