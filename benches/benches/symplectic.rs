@@ -4,7 +4,8 @@
 //! The `symplectic-100myr` experiment weights its counted steps with these costs.
 //! Peer anchor: REBOUND 5.2 WHFast, democratic heliocentric, ≈ 0.55 µs per step on
 //! one core of this machine; measured here with REBOUND 5.2.2 (safe_mode 0, 1e6 steps):
-//! 0.71–0.85 µs per step (script outside the repository; the figures are recorded in the `symplectic` crate docs).
+//! 0.71–0.85 µs per step (script outside the repository; the figures belong in the workspace's
+//! performance table, `docs/performance.md`).
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
 use symplectic::{

@@ -232,8 +232,9 @@ fn particle_elements(
 }
 
 /// Writes `value` as JSON to `path` atomically: a temporary file in the same directory is
-/// written, flushed to disk and renamed over `path`, so a crash leaves either the old or the
-/// new checkpoint, never a torn one. `f64` values round-trip exactly.
+/// written, flushed to disk and renamed over `path` (then the directory is synced), so a
+/// crash leaves either the old or the new checkpoint, never a torn one. `f64` values
+/// round-trip exactly (`serde_json`'s `float_roundtrip`).
 pub fn save_checkpoint<T: Serialize>(path: &Path, value: &T) -> Result<(), SymplecticError> {
     let io = |e: std::io::Error| SymplecticError::Checkpoint {
         path: path.display().to_string(),
@@ -251,7 +252,15 @@ pub fn save_checkpoint<T: Serialize>(path: &Path, value: &T) -> Result<(), Sympl
         f.flush().map_err(io)?;
         f.sync_all().map_err(io)?;
     }
-    std::fs::rename(&tmp, path).map_err(io)
+    std::fs::rename(&tmp, path).map_err(io)?;
+    // Make the rename itself durable (Unix: sync the directory entry). Best effort: where a
+    // directory cannot be opened or synced, the rename has still happened atomically.
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        if let Ok(d) = std::fs::File::open(dir) {
+            d.sync_all().ok();
+        }
+    }
+    Ok(())
 }
 
 /// Reads a checkpoint written by [`save_checkpoint`].

@@ -15,7 +15,7 @@
 //!
 //! The ecliptic frame of J2000 (the frame of the paper's orbital elements) is reached by a
 //! rotation about `x` by the obliquity [`OBLIQUITY_J2000_RAD`](crate::OBLIQUITY_J2000_RAD)
-//! ([`equatorial_to_ecliptic`](crate::equatorial_to_ecliptic)).
+//! ([`equatorial_to_ecliptic`]).
 
 use crate::{equatorial_to_ecliptic, Planets, SymplecticError, Vec3};
 

@@ -126,7 +126,7 @@ fn s2_particle_map_converges_at_second_order() {
     for (variant, b0, b1) in [
         (Variant::Barycentric, 0.0, B1_PAPER),
         // The mixed variant needs larger constants for this orbit (the paper's condition 35:
-        // with B1 = 0.21e-6, K1/r turns negative within a few steps, see below).
+        // B1 = 0.21e-6 is refused with OutsideMixedDomain, see below).
         (Variant::Mixed, 0.0, 4e-6),
     ] {
         let integ = ParticleIntegrator::new(variant, Scheme::S2, b0, b1).unwrap();
