@@ -5,6 +5,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::{Integrator, Planets, SymplecticError, Vec3, WorkCounters};
 
+/// Largest number of planet steps an [`Ephemeris`] covers (2⁵²: its grid times `t₀ + kτ` stay
+/// exact, and 4.5·10¹⁵ steps of a year would take longer than anyone waits).
+const MAX_GRID_STEPS: f64 = 4_503_599_627_370_496.0;
+
 /// Barycentric positions, velocities and accelerations of the Sun (index 0) and the planets
 /// (1..=n) at one time, with `G m` of each body. Filled by [`Ephemeris::bodies_at`].
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -179,6 +183,16 @@ impl Ephemeris {
 
     /// Integrates the planets until the grid covers time `t`.
     pub fn extend_to(&mut self, t: f64) -> Result<(), SymplecticError> {
+        // Grid times are start + k·τ with an integer k: exact only below 2⁵³ steps, and a
+        // request that far out would run for ages. Refuse it by name instead.
+        let steps_needed = (t - self.start_time) / self.grid_step();
+        if steps_needed.is_nan() || steps_needed >= MAX_GRID_STEPS {
+            return Err(SymplecticError::InvalidParameter {
+                name: "ephemeris time",
+                value: t,
+                reason: "beyond 2^52 planet steps from the start (or not finite): grid times would lose exactness",
+            });
+        }
         while self.grid_time(self.planet_steps()) < t {
             let step = self.planet_steps();
             self.integrator.step(&mut self.planets)?;

@@ -128,6 +128,14 @@ fn named_errors() {
         let e = integ.step(&mut p, &mut eph, &mut scratch).unwrap_err();
         assert!(e.to_string().contains("B1"), "{e}");
     }
+    // A time 2^52 planet steps away is refused, not integrated for ages.
+    let mut far = Ephemeris::new(
+        outer_solar_system(Frame::EclipticJ2000),
+        Integrator::S2 { step: 365.0 },
+    )
+    .unwrap();
+    let e = far.extend_to(1e300).unwrap_err();
+    assert!(e.to_string().contains("2^52"), "{e}");
     // Non-finite end time and limits.
     let integ = ParticleIntegrator::new(Variant::Barycentric, Scheme::S2, 0.0, 0.21e-6).unwrap();
     let p = integ
