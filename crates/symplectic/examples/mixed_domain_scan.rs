@@ -42,7 +42,7 @@ fn main() {
             let dom = integ.mixed_domain(&pos, &vel, eph.planets()).unwrap();
             println!(
                 "domain ratio {:.3} at r {:.1}, b1 needed {:e}",
-                dom.0, dom.1, dom.2
+                dom.ratio, dom.at_distance, dom.b1_needed
             );
             let p = match integ.particle(pos, vel, 0.0, dt0, &mut eph, &mut scratch) {
                 Ok(p) => p,

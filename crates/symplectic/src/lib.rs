@@ -118,8 +118,9 @@ mod work;
 pub use ephemeris::{BodyStates, Ephemeris};
 pub use maps::{Integrator, Piece, Stage, S2_STAGES, S6_C1, S6_C2, S6_D1, S6_D2, S6_STAGES};
 pub use particles::{
-    ParticleIntegrator, ParticlePiece, ParticleScratch, ParticleStage, ParticleStepInfo, Scheme,
-    TestParticle, Variant, MIXED_DOMAIN_MIN_RATIO, PARTICLE_S2_STAGES, PARTICLE_S6_STAGES,
+    MixedDomain, ParticleIntegrator, ParticlePiece, ParticleScratch, ParticleStage,
+    ParticleStepInfo, Scheme, TestParticle, Variant, MIXED_DOMAIN_MIN_RATIO, PARTICLE_S2_STAGES,
+    PARTICLE_S6_STAGES,
 };
 pub use planets::Planets;
 pub use run::{

@@ -158,6 +158,18 @@ impl ParticleScratch {
     }
 }
 
+/// Where a mixed-variant orbit stands against its validity domain
+/// ([`ParticleIntegrator::mixed_domain`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MixedDomain {
+    /// Smallest `(B₀ + B₁/r)/(|V(r)| u☉)` over the orbit.
+    pub ratio: f64,
+    /// Heliocentric distance where it is smallest.
+    pub at_distance: f64,
+    /// Smallest `B₁` (with the integrator's `B₀`) that gives [`MIXED_DOMAIN_MIN_RATIO`].
+    pub b1_needed: f64,
+}
+
 /// Smallest ratio `(B₀ + B₁/r)/(|V| u☉)` over the orbit that the mixed variant accepts (see
 /// [`ParticleIntegrator::mixed_domain`]). Chegodaeva's condition 35 asks `B₀ + B₁/r` to
 /// dominate the perturbation far from the planets without a number; we read "dominate" as a
@@ -166,8 +178,10 @@ impl ParticleScratch {
 /// through the public API): ratios 0.16 and 0.13 (the paper's `B₁ = 0.21·10⁻⁶`, which it
 /// chose for the barycentric variant) lose `K₁/r > 0` after 9 and 5 years, and at about the same
 /// epochs with steps 10 and 50 times shorter (a property of the trajectory, not of the step);
-/// ratios 0.3–1.2 lose `K₀/r` or `K₁/r` within 5–1700 years; 1.2–1.8 held for 2 kyr but with
-/// steps swinging up to 1100 d and `|ΔH|` up to 3·10⁻³; 2.3–6.2 held with `|ΔH| ≤ 7·10⁻⁴`.
+/// ratios 0.31 and 0.39 lose `K₀/r > 0` within 5 and 20 years; 0.61–1.23 within 5–1700
+/// years, except 1.17 (particle 1), which held for 2 kyr; 1.56 and 1.84 held for 2 kyr but with
+/// steps swinging up to 1100 d and `|ΔH|` up to 3·10⁻³; 2.3–6.2 held with `|ΔH| ≤ 7·10⁻⁴`
+/// (`cargo run --release -p symplectic --example mixed_domain_scan`).
 pub const MIXED_DOMAIN_MIN_RATIO: f64 = 2.0;
 
 const GAUSS4_NODES: [f64; 4] = [
@@ -276,7 +290,8 @@ impl ParticleIntegrator {
     /// osculating orbit, of `(B₀ + B₁/r) / (|V(r)| · u☉)`, where `|V(r)|` is the speed on that
     /// orbit at distance `r` (vis-viva with `μ = G m₀`) and `u☉ = Σ m_i v_i,max / m₀` bounds the
     /// Sun's barycentric speed `|ΣP_i|/m₀` (`v_i,max` the perihelion speed of planet `i`).
-    /// Returns `(ratio, r at the minimum, smallest B₁ giving` [`MIXED_DOMAIN_MIN_RATIO`]`)`.
+    /// Returns the smallest ratio, where it occurs and the `B₁` that would meet
+    /// [`MIXED_DOMAIN_MIN_RATIO`] ([`MixedDomain`]).
     ///
     /// Why: in mixed coordinates `K₁/r = B₀ + B₁/r − V·ΣP_i/m₀ + Σ G m_i/|Q − Q_i|`
     /// (eqs. 19–22). The Sun term `H_Sun = −V·ΣP_i/m₀` changes sign with the phase of Jupiter
@@ -288,7 +303,7 @@ impl ParticleIntegrator {
         position: &Vec3,
         velocity: &Vec3,
         planets: &crate::Planets,
-    ) -> Result<(f64, f64, f64), SymplecticError> {
+    ) -> Result<MixedDomain, SymplecticError> {
         let g = planets.g();
         let m0 = planets.sun_mass();
         let mut sun_speed = 0.0;
@@ -323,7 +338,11 @@ impl ParticleIntegrator {
             }
             b1_needed = b1_needed.max((MIXED_DOMAIN_MIN_RATIO * sun_term - self.b0) * r);
         }
-        Ok((worst, at, b1_needed))
+        Ok(MixedDomain {
+            ratio: worst,
+            at_distance: at,
+            b1_needed,
+        })
     }
 
     fn check_mixed_domain(
@@ -332,7 +351,11 @@ impl ParticleIntegrator {
         velocity: &Vec3,
         planets: &crate::Planets,
     ) -> Result<(), SymplecticError> {
-        let (ratio, at_distance, b1_needed) = self.mixed_domain(position, velocity, planets)?;
+        let MixedDomain {
+            ratio,
+            at_distance,
+            b1_needed,
+        } = self.mixed_domain(position, velocity, planets)?;
         if ratio >= MIXED_DOMAIN_MIN_RATIO {
             return Ok(());
         }
