@@ -176,8 +176,9 @@ pub struct MixedDomain {
 /// factor 2, which keeps `K₁/r` above half its regularising part and the step within a factor
 /// 2 of its regular law. Measured on the paper's two particles (S2, steps 298/310 d, 2 kyr,
 /// through the public API): ratios 0.16 and 0.13 (the paper's `B₁ = 0.21·10⁻⁶`, which it
-/// chose for the barycentric variant) lose `K₁/r > 0` after 9 and 5 years, and at about the same
-/// epochs with steps 10 and 50 times shorter (a property of the trajectory, not of the step);
+/// chose for the barycentric variant) lose `K₁/r > 0` after 3284 and 1945 d, with steps 10
+/// times shorter after 3211 and 1835 d, 50 times shorter after 6768 and 1730 d (a property of
+/// the trajectory, not of the step);
 /// ratios 0.31 and 0.39 lose `K₀/r > 0` within 5 and 20 years; 0.61–1.23 within 5–1700
 /// years, except 1.17 (particle 1), which held for 2 kyr; 1.56 and 1.84 held for 2 kyr but with
 /// steps swinging up to 1100 d and `|ΔH|` up to 3·10⁻³; 2.3–6.2 held with `|ΔH| ≤ 7·10⁻⁴`
