@@ -1,9 +1,11 @@
 //! One planetary step of S2 and S6 (outer Solar System, four planets, τ = 365 d) and one
 //! test-particle step (Chegodaeva's particle 1, barycentric variant, B₁ = 0.21e-6, planets
 //! interpolated from a pre-computed ephemeris): `cargo bench -p benches --bench symplectic`.
+//! The `symplectic-100myr` experiment weights its counted steps with these costs.
 //! Peer anchor: REBOUND 5.2 WHFast, democratic heliocentric, ≈ 0.55 µs per step on
 //! one core of this machine; measured here with REBOUND 5.2.2 (safe_mode 0, 1e6 steps):
-//! 0.71–0.85 µs per step (script outside the repository; the figures are recorded in the `symplectic` crate docs).
+//! 0.71–0.85 µs per step (script outside the repository; the figures belong in the workspace's
+//! performance table, `docs/performance.md`).
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
 use symplectic::{

@@ -17,6 +17,29 @@
 //! that sorts particles by cell (lexicographic or Morton), to apply to the particle arrays
 //! for locality.
 //!
+//! # Example
+//!
+//! ```
+//! use neighbour_search::{BruteForce, CellStartGrid, NeighbourLists, NeighbourSearch, Vec3};
+//!
+//! // A 10×10×10 lattice of spacing s = 0.025 m, searched within h = 0.045 m.
+//! let positions: Vec<Vec3<f32>> = (0..1000)
+//!     .map(|i| Vec3::new((i % 10) as f32, (i / 10 % 10) as f32, (i / 100) as f32) * 0.025)
+//!     .collect();
+//! let mut grid = CellStartGrid::<f32>::new();
+//! let mut lists = NeighbourLists::new();
+//! grid.search(&positions, 0.045, &mut lists)?;
+//! // An interior particle has its 6 face, 12 edge and 8 corner neighbours (distances s, s√2,
+//! // s√3 = 0.0433 m < h); those at 2s = 0.05 m are beyond h.
+//! let centre = 5 + 10 * 5 + 100 * 5;
+//! assert_eq!(lists.neighbours(centre).len(), 26);
+//! // Same sets as the O(N²) oracle.
+//! let mut oracle = NeighbourLists::new();
+//! BruteForce::new().search(&positions, 0.045, &mut oracle)?;
+//! assert_eq!(lists.to_sorted_sets(), oracle.to_sorted_sets());
+//! # Ok::<(), neighbour_search::SearchError>(())
+//! ```
+//!
 //! Input errors ([`SearchError`]) name the offending particle or value: NaN/infinite
 //! positions, `h <= 0`, cells that overflow `i32`, a bounding grid too large for
 //! [`CellStartGrid`]. No method panics on user input.

@@ -1,4 +1,15 @@
 //! Every fast method returns exactly the oracle's neighbour sets (proptest), in f32 and f64.
+//!
+//! Negative controls: each of the following bugs was planted once (2026-11-23), one at a
+//! time, and `cargo test --release -p neighbour-search --test oracle` run; the tests that
+//! caught it are named at each test below.
+//! 1. cell-start grid visits x-columns −1..0 instead of −1..=1 (off-by-one cell range,
+//!    `grid.rs`, `CellStartGrid`'s `locate`);
+//! 2. hashed grid visits z-cells 0..=1 instead of −1..=1 (`HashedGrid`'s `locate`);
+//! 3. relation table writes only the z-offsets −1..0 of a particle's 27 entries
+//!    (`relation_table.rs`);
+//! 4. `<=` instead of `<` in the distance test (`scan.rs`: scalar, AVX2 and AVX-512 paths),
+//!    i.e. a particle at exactly `h` counted as a neighbour.
 
 use neighbour_search::{
     BruteForce, CellStartGrid, HashedGrid, Method, NeighbourLists, NeighbourSearch, Real,
@@ -86,9 +97,10 @@ macro_rules! for_both_precisions {
 }
 
 // Random clouds with random radius: from sparse to ~100 neighbours each.
+// Caught planted bugs 1, 2, 3 (not 4: an exact distance h has probability zero here).
 for_both_precisions!(random_clouds, (cloud(400, 3.0), 0.05..2.0f64));
 
-// Negative and offset coordinates.
+// Negative and offset coordinates. Caught planted bugs 1, 2, 3.
 for_both_precisions!(
     negative_coordinates,
     (cloud(300, 1.0), 0.1..1.0f64, -1e3..-1.0f64).prop_map(|(c, h, off)| (
@@ -100,6 +112,7 @@ for_both_precisions!(
 );
 
 // Two clusters 1e6 apart (the cell-start grid may refuse: its bounding grid is huge).
+// Caught planted bugs 1, 2, 3.
 for_both_precisions!(
     far_clusters,
     (
@@ -118,7 +131,7 @@ for_both_precisions!(
 
 // Points on a lattice of spacing h (distance exactly h between lattice neighbours, and on the
 // faces of cells of edge h) and on a lattice of the actual cell edge h(1 + CELL_MARGIN),
-// with duplicates.
+// with duplicates. Caught planted bugs 1, 2, 3 and 4 (the only proptest that sees 4).
 for_both_precisions!(
     lattice_faces_and_duplicates,
     (1usize..6, 0.01..3.0f64, any::<bool>(), 0usize..20, -5i32..5).prop_map(
@@ -145,7 +158,7 @@ for_both_precisions!(
     )
 );
 
-// Dense near-duplicates: many particles within a fraction of h.
+// Dense near-duplicates: many particles within a fraction of h. Caught planted bugs 1, 2, 3.
 for_both_precisions!(dense_blob, (cloud(300, 0.05), 0.01..0.2f64));
 
 #[test]
@@ -163,6 +176,7 @@ fn empty_and_single() {
     }
 }
 
+/// Caught planted bug 4 (`<=` in the distance test); blind to 1–3 (three points in one cell).
 #[test]
 fn distance_exactly_h_is_excluded_and_just_below_is_included() {
     let h = 0.1f64;
@@ -288,6 +302,7 @@ mod cell_sorted {
 
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(48))]
+        /// Caught planted bugs 1, 2, 3 (not 4, as for the random clouds).
         #[test]
         fn sorted_clouds_match_the_oracle(case in (cloud(3000, 2.0), 0.05..0.6f64), sparse in any::<bool>(), threads in 1usize..4) {
             // Sparse: stretch the cloud so that many relation-table runs hold no particle

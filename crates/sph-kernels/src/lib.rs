@@ -29,6 +29,38 @@
 //! - W. Dehnen, H. Aly, "Improving convergence in smoothed particle hydrodynamics
 //!   simulations without pairing instability", MNRAS 425 (2012) 1068–1082.
 //!
+//! # Example
+//!
+//! The summation density of a particle at rest in a simple cubic lattice of spacing `s`
+//! (mass `m = ρ0 s³`) with the poly6 kernel at `h = 4s` is `ρ0` to the lattice-sum deviation
+//! tabulated below (−2.2e-6), and a kernel can also be chosen by name at run time:
+//!
+//! ```
+//! use sph_kernels::{Kernel, KernelKind, Poly6};
+//!
+//! let (rho0, s) = (1000.0_f64, 0.025); // kg/m³, m
+//! let h = 4.0 * s;
+//! let w = Poly6::new(h)?;
+//! let mass = rho0 * s * s * s;
+//! let mut density = 0.0;
+//! for i in -4..=4 {
+//!     for j in -4..=4 {
+//!         for k in -4..=4 {
+//!             let r2 = ((i * i + j * j + k * k) as f64) * s * s;
+//!             density += mass * w.value_r2(r2);
+//!         }
+//!     }
+//! }
+//! assert!((density / rho0 - 1.0).abs() < 1e-5, "ρ/ρ0 = {}", density / rho0);
+//!
+//! // Runtime selection, and the gradient ∇W(x_i − x_j), zero beyond the support radius.
+//! let spiky = "spiky".parse::<KernelKind>()?.build(h)?;
+//! let r = nalgebra::Vector3::new(0.5 * h, 0.0, 0.0);
+//! assert!(spiky.gradient(&r).x < 0.0);
+//! assert_eq!(spiky.value(h), 0.0);
+//! # Ok::<(), sph_kernels::KernelError>(())
+//! ```
+//!
 //! # Derivatives
 //!
 //! [`Kernel::derivative`] is the analytic `dW/dr`; [`Kernel::gradient`] is `dW/dr · r̂` and the

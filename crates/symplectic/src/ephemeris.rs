@@ -3,7 +3,11 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::{Integrator, Planets, SymplecticError, Vec3};
+use crate::{Integrator, Planets, SymplecticError, Vec3, WorkCounters};
+
+/// Largest number of planet steps an [`Ephemeris`] covers (2⁵²: its grid times `t₀ + kτ` stay
+/// exact, and 4.5·10¹⁵ steps of a year would take longer than anyone waits).
+const MAX_GRID_STEPS: f64 = 4_503_599_627_370_496.0;
 
 /// Barycentric positions, velocities and accelerations of the Sun (index 0) and the planets
 /// (1..=n) at one time, with `G m` of each body. Filled by [`Ephemeris::bodies_at`].
@@ -67,6 +71,10 @@ pub struct Ephemeris {
     /// the retained window starts at `offset` (the front is compacted now and then).
     grid: Vec<f64>,
     offset: usize,
+    /// Work of the grid states' accelerations and of the interpolations (the planets' own
+    /// steps are counted in `planets`).
+    #[serde(default)]
+    work: WorkCounters,
 }
 
 impl Ephemeris {
@@ -88,6 +96,7 @@ impl Ephemeris {
             first_index: 0,
             grid: Vec::new(),
             offset: 0,
+            work: WorkCounters::default(),
         };
         e.push_state();
         Ok(e)
@@ -100,6 +109,12 @@ impl Ephemeris {
     /// The planets at the newest grid time.
     pub fn planets(&self) -> &Planets {
         &self.planets
+    }
+
+    /// Work done so far: the planets' steps, the accelerations stored with each grid state
+    /// (`n(n+1)/2` force evaluations) and the interpolations ([`Ephemeris::bodies_at`]).
+    pub fn work(&self) -> WorkCounters {
+        self.work + self.planets.work()
     }
 
     /// The planets' integrator.
@@ -150,6 +165,7 @@ impl Ephemeris {
                 self.planets.masses()[j - 1]
             }
         };
+        self.work.force_evaluations += (n * (n + 1) / 2) as u64;
         for j in 0..=n {
             for k in j + 1..=n {
                 let d = self.vec_at(body(k)) - self.vec_at(body(j));
@@ -167,6 +183,16 @@ impl Ephemeris {
 
     /// Integrates the planets until the grid covers time `t`.
     pub fn extend_to(&mut self, t: f64) -> Result<(), SymplecticError> {
+        // Grid times are start + k·τ with an integer k: exact only below 2⁵³ steps, and a
+        // request that far out would run for ages. Refuse it by name instead.
+        let steps_needed = (t - self.start_time) / self.grid_step();
+        if steps_needed.is_nan() || steps_needed >= MAX_GRID_STEPS {
+            return Err(SymplecticError::InvalidParameter {
+                name: "ephemeris time",
+                value: t,
+                reason: "beyond 2^52 planet steps from the start (or not finite): grid times would lose exactness",
+            });
+        }
         while self.grid_time(self.planet_steps()) < t {
             let step = self.planet_steps();
             self.integrator.step(&mut self.planets)?;
@@ -217,6 +243,7 @@ impl Ephemeris {
                     "precedes the retained window of planet states (discarded or before the start)",
             });
         }
+        self.work.interpolations += 1;
         let last = self.planet_steps();
         // Interval [k, k+1] containing t (the last interval if t is on the last grid point).
         let k = (rel.floor() as u64).clamp(

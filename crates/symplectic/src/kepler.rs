@@ -25,6 +25,10 @@ use crate::{SymplecticError, Vec3};
 /// The four Stumpff functions `c₀..c₃` at `z`.
 #[inline]
 pub fn stumpff(z: f64) -> [f64; 4] {
+    if !z.is_finite() {
+        // No reduction terminates for ±∞ or NaN: the caller sees non-finite values.
+        return [f64::NAN; 4];
+    }
     // Reduce |z| below 0.1 by quarter steps: c_k(z) from c_k(z/4^n).
     let mut n = 0;
     let mut x = z;

@@ -4,8 +4,15 @@
 //!
 //! > Е. А. Чегодаева (E. A. Chegodaeva), «Метод симплектического интегрирования уравнений
 //! > движения малых тел Солнечной системы» ("A method of symplectic integration of the
-//! > equations of motion of small Solar System bodies"), 2004
-//! > (in Russian; full citation in `docs/papers.md`),
+//! > equations of motion of small Solar System bodies"), 2004, in Russian,
+//!
+//! after J. Wisdom and M. Holman, "Symplectic maps for the N-body problem", *The Astronomical
+//! Journal* 102, 1528–1538, 1991 (doi:10.1086/115978); M. J. Duncan, H. F. Levison and
+//! M. H. Lee, "A multiple time step symplectic algorithm for integrating close encounters",
+//! *The Astronomical Journal* 116, 2067–2077, 1998 (doi:10.1086/300541); J. Laskar and
+//! P. Robutel, "High order symplectic integrators for perturbed Hamiltonian systems",
+//! *Celestial Mechanics and Dynamical Astronomy* 80, 39–62, 2001
+//! (doi:10.1023/A:1012098603882),
 //!
 //! in `f64` throughout:
 //!
@@ -19,14 +26,10 @@
 //! - [`Integrator`]: the maps assembled from those pieces with named coefficients:
 //!   [`Integrator::S2`] `= C/2 B/2 A B/2 C/2` (eq. 13) and the pseudo-sixth-order
 //!   [`Integrator::S6`] of Laskar & Robutel (eq. 7, coefficients [`S6_C1`], [`S6_C2`],
-//!   [`S6_D1`], [`S6_D2`]).
-//!
-//! # Performance
-//!
-//! `cargo bench -p benches --bench symplectic` times one S2 and one S6 step of the planets
-//! and of a test particle; the figures, beside REBOUND's WHFast on the same system, are in
-//! the workspace's `docs/performance.md`. The Kepler drift uses Halley's iteration from
-//! a third-order series start, which converges in two Stumpff evaluations for these steps.
+//!   [`S6_D1`], [`S6_D2`]);
+//! - [`outer_solar_system`]: the system of the paper's experiments (the Sun carrying the inner
+//!   planets' masses, Jupiter, Saturn, Uranus, Neptune; Hairer, Lubich & Wanner's Table 2.1),
+//!   with `G` ([`G_AU3_PER_MSUN_DAY2`]) and the rotation to the ecliptic ([`Frame`]).
 //!
 //! Units are the caller's; the experiments use AU, days and solar masses with
 //! `G = 2.95912208286e-4 AU³ M☉⁻¹ day⁻²`.
@@ -37,12 +40,71 @@
 //! - [`Ephemeris`]: the planets on their fixed-step grid, interpolated (quintic Hermite) to
 //!   any particle time, with velocities that are the exact derivative of positions;
 //! - [`ParticleIntegrator`]: the logarithmic-Hamiltonian maps of eqs. 21–32 (mixed
-//!   coordinates, [`Variant::Mixed`]) and eqs. 36–38 (barycentric, [`Variant::Barycentric`],
-//!   the paper's recommendation), with the second-order ([`Scheme::S2`], eq. 27) or
-//!   pseudo-sixth-order ([`Scheme::S6`], eq. 7) composition of the pieces
-//!   [`ParticleIntegrator::kepler_drift`] (`E₀`) and [`ParticleIntegrator::perturbation`] (`E₁`);
+//!   coordinates, [`Variant::Mixed`], with its validity domain checked up front) and
+//!   eqs. 36–38 (barycentric, [`Variant::Barycentric`], the paper's recommendation), with the
+//!   second-order ([`Scheme::S2`], eq. 27) or pseudo-sixth-order ([`Scheme::S6`], eq. 7)
+//!   composition of the pieces [`ParticleIntegrator::kepler_drift`] (`E₀`) and
+//!   [`ParticleIntegrator::perturbation`] (`E₁`);
 //! - [`CometRun`]: planets and particles advanced together, stop criteria ([`Limits`]), and
-//!   atomic checkpoints ([`save_checkpoint`], [`load_checkpoint`]) that resume bit for bit.
+//!   atomic checkpoints ([`save_checkpoint`], [`load_checkpoint`]: temporary file, `fsync`,
+//!   rename) that resume bit for bit.
+//!
+//! Every integration counts its work ([`WorkCounters`]: Kepler solves, their iterations,
+//! pairwise force evaluations, ephemeris interpolations): a cost measure that does not
+//! depend on the machine.
+//!
+//! # Example
+//!
+//! The paper's first comet (a = 60.91 AU, q = 30.01 AU, i = 16°, 91 AU from the Sun) among the
+//! four giant planets, second-order maps, for 1000 years:
+//!
+//! ```
+//! use symplectic::{
+//!     outer_solar_system, CometRun, Ephemeris, Frame, Integrator, Limits, ParticleIntegrator,
+//!     ParticleScratch, ParticleStatus, Scheme, Variant, Vec3,
+//! };
+//!
+//! // Planets in the ecliptic of J2000, advanced by S2 with the paper's 365-day step.
+//! let planets = outer_solar_system(Frame::EclipticJ2000);
+//! let (sun_position, sun_velocity) = planets.sun_barycentric_state();
+//! let mut ephemeris = Ephemeris::new(planets, Integrator::S2 { step: 365.0 })?;
+//!
+//! // The particle (heliocentric ecliptic state, AU and AU/day, from the paper's elements with
+//! // Ω = ω = 0 on the outbound branch), moved to the barycentre for the barycentric variant.
+//! let position = Vec3::new(-90.2133300970874, 11.477121391583594, 3.291011600830304);
+//! let velocity = Vec3::new(-3.3558225919028486e-4, -1.1900915840439576e-3, -3.4125327035499536e-4);
+//! let integrator = ParticleIntegrator::new(Variant::Barycentric, Scheme::S2, 0.0, 0.21e-6)?;
+//! let mut scratch = ParticleScratch::default();
+//! let comet = integrator.particle(
+//!     position + sun_position,
+//!     velocity + sun_velocity,
+//!     0.0,   // time (days)
+//!     298.0, // first step (days), as in the paper
+//!     &mut ephemeris,
+//!     &mut scratch,
+//! )?;
+//!
+//! let limits = Limits { min_perihelion: 26.0, ejection_distance: 1000.0 };
+//! let mut run = CometRun::new(ephemeris, integrator, vec![comet], limits);
+//! let mut worst = 0.0f64;
+//! run.advance_to(1000.0 * 365.25, |_, _, info| worst = worst.max(info.relative_error.abs()))?;
+//!
+//! assert_eq!(run.particles[0].status, ParticleStatus::Active);
+//! assert!(worst < 1e-5, "extended-Hamiltonian error {worst:e}");
+//! let a = run.elements(0)?.semi_major_axis;
+//! assert!((50.0..70.0).contains(&a), "a = {a} AU");
+//! println!("{} Kepler solves", run.work().kepler_solves);
+//! # Ok::<(), symplectic::SymplecticError>(())
+//! ```
+//!
+//! # Performance
+//!
+//! `cargo bench -p benches --bench symplectic` times one planet step of S2 and S6 (four giant
+//! planets, τ = 365 d, state synchronised after every step) and one particle step
+//! (barycentric, planets interpolated); the figures and the same-script comparison with
+//! REBOUND's WHFast are in the workspace's `docs/performance.md`. The Kepler drift uses Halley's
+//! iteration from a third-order series start, which converges in two Stumpff evaluations for
+//! these steps.
 
 pub mod ephemeris;
 pub mod kepler;
@@ -50,17 +112,22 @@ mod maps;
 mod particles;
 mod planets;
 mod run;
+pub mod solar_system;
+mod work;
 
 pub use ephemeris::{BodyStates, Ephemeris};
 pub use maps::{Integrator, Piece, Stage, S2_STAGES, S6_C1, S6_C2, S6_D1, S6_D2, S6_STAGES};
 pub use particles::{
-    ParticleIntegrator, ParticlePiece, ParticleScratch, ParticleStage, ParticleStepInfo, Scheme,
-    TestParticle, Variant, PARTICLE_S2_STAGES, PARTICLE_S6_STAGES,
+    MixedDomain, ParticleIntegrator, ParticlePiece, ParticleScratch, ParticleStage,
+    ParticleStepInfo, Scheme, TestParticle, Variant, MIXED_DOMAIN_MIN_RATIO, PARTICLE_S2_STAGES,
+    PARTICLE_S6_STAGES,
 };
 pub use planets::Planets;
 pub use run::{
     load_checkpoint, save_checkpoint, CometRun, Limits, ParticleStatus, TrackedParticle,
 };
+pub use solar_system::{outer_solar_system, Frame, G_AU3_PER_MSUN_DAY2};
+pub use work::WorkCounters;
 
 /// 3-vector of `f64` (nalgebra).
 pub type Vec3 = nalgebra::Vector3<f64>;
@@ -109,6 +176,28 @@ pub enum SymplecticError {
         value: f64,
         /// The particle's time.
         time: f64,
+    },
+    /// A test particle of the mixed variant ([`Variant::Mixed`]) outside the domain where its
+    /// `B₀, B₁` dominate the Sun term `H_Sun = −V·ΣP_i/m₀` (Chegodaeva 2004, condition 35):
+    /// `K₁/r` would turn negative on the trajectory. See [`ParticleIntegrator::mixed_domain`].
+    #[error(
+        "mixed variant outside its domain: (B0 + B1/r)/(|V| |sum P_i|/m0) = {ratio:.3} < {required} \
+         on this orbit (smallest at r = {at_distance:.2}) with B0 = {b0:e}, B1 = {b1:e}: \
+         H_Sun is not dominated (condition 35); use B1 >= {b1_needed:.3e} or Variant::Barycentric"
+    )]
+    OutsideMixedDomain {
+        /// Smallest ratio over the orbit.
+        ratio: f64,
+        /// Required ratio ([`MIXED_DOMAIN_MIN_RATIO`]).
+        required: f64,
+        /// Heliocentric distance where the ratio is smallest.
+        at_distance: f64,
+        /// `B₀` given.
+        b0: f64,
+        /// `B₁` given.
+        b1: f64,
+        /// Smallest `B₁` (with this `B₀`) that meets the requirement.
+        b1_needed: f64,
     },
     /// A checkpoint could not be written or read.
     #[error("checkpoint {path}: {reason}")]

@@ -3,7 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::ephemeris::{BodyStates, Ephemeris};
-use crate::{SymplecticError, Vec3, S6_C1, S6_C2, S6_D1, S6_D2};
+use crate::{SymplecticError, Vec3, WorkCounters, S6_C1, S6_C2, S6_D1, S6_D2};
 
 /// Which coordinates the particle is integrated in (Chegodaeva 2004).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -84,6 +84,10 @@ pub struct TestParticle {
     pub step: f64,
     /// Steps taken.
     pub steps: u64,
+    /// Work done on this particle: its Kepler solves and body–particle force evaluations (the
+    /// interpolations of the planets are counted by the [`Ephemeris`]).
+    #[serde(default)]
+    pub work: WorkCounters,
 }
 
 /// Emel'yanenko's explicit symplectic integrator with variable time step for a test
@@ -153,6 +157,33 @@ impl ParticleScratch {
         &self.bodies
     }
 }
+
+/// Where a mixed-variant orbit stands against its validity domain
+/// ([`ParticleIntegrator::mixed_domain`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MixedDomain {
+    /// Smallest `(B₀ + B₁/r)/(|V(r)| u☉)` over the orbit.
+    pub ratio: f64,
+    /// Heliocentric distance where it is smallest.
+    pub at_distance: f64,
+    /// Smallest `B₁` (with the integrator's `B₀`) that gives [`MIXED_DOMAIN_MIN_RATIO`].
+    pub b1_needed: f64,
+}
+
+/// Smallest ratio `(B₀ + B₁/r)/(|V| u☉)` over the orbit that the mixed variant accepts (see
+/// [`ParticleIntegrator::mixed_domain`]). Chegodaeva's condition 35 asks `B₀ + B₁/r` to
+/// dominate the perturbation far from the planets without a number; we read "dominate" as a
+/// factor 2, which keeps `K₁/r` above half its regularising part and the step within a factor
+/// 2 of its regular law. Measured on the paper's two particles (S2, steps 298/310 d, 2 kyr,
+/// through the public API): ratios 0.16 and 0.13 (the paper's `B₁ = 0.21·10⁻⁶`, which it
+/// chose for the barycentric variant) lose `K₁/r > 0` after 3284 and 1945 d, with steps 10
+/// times shorter after 3211 and 1835 d, 50 times shorter after 6768 and 1730 d (a property of
+/// the trajectory, not of the step);
+/// ratios 0.31 and 0.39 lose `K₀/r > 0` within 5 and 20 years; 0.61–1.23 within 5–1700
+/// years, except 1.17 (particle 1), which held for 2 kyr; 1.56 and 1.84 held for 2 kyr but with
+/// steps swinging up to 1100 d and `|ΔH|` up to 3·10⁻³; 2.3–6.2 held with `|ΔH| ≤ 7·10⁻⁴`
+/// (`cargo run --release -p symplectic --example mixed_domain_scan`).
+pub const MIXED_DOMAIN_MIN_RATIO: f64 = 2.0;
 
 const GAUSS4_NODES: [f64; 4] = [
     0.069_431_844_202_973_71,
@@ -238,6 +269,9 @@ impl ParticleIntegrator {
             });
         }
         ephemeris.bodies_at(time, &mut scratch.bodies)?;
+        if self.variant == Variant::Mixed {
+            self.check_mixed_domain(&position, &velocity, ephemeris.planets())?;
+        }
         let mut p = TestParticle {
             position,
             velocity,
@@ -245,11 +279,95 @@ impl ParticleIntegrator {
             p4: 0.0,
             step: 0.0,
             steps: 0,
+            work: WorkCounters::default(),
         };
         p.p4 = -self.hamiltonian(&p, &scratch.bodies);
         let f0 = self.f0(&p, &scratch.bodies)?;
         p.step = initial_dt * f0;
         Ok(p)
+    }
+
+    /// Validity domain of the mixed variant: the smallest, over the particle's heliocentric
+    /// osculating orbit, of `(B₀ + B₁/r) / (|V(r)| · u☉)`, where `|V(r)|` is the speed on that
+    /// orbit at distance `r` (vis-viva with `μ = G m₀`) and `u☉ = Σ m_i v_i,max / m₀` bounds the
+    /// Sun's barycentric speed `|ΣP_i|/m₀` (`v_i,max` the perihelion speed of planet `i`).
+    /// Returns the smallest ratio, where it occurs and the `B₁` that would meet
+    /// [`MIXED_DOMAIN_MIN_RATIO`] ([`MixedDomain`]).
+    ///
+    /// Why: in mixed coordinates `K₁/r = B₀ + B₁/r − V·ΣP_i/m₀ + Σ G m_i/|Q − Q_i|`
+    /// (eqs. 19–22). The Sun term `H_Sun = −V·ΣP_i/m₀` changes sign with the phase of Jupiter
+    /// and reaches `|V| u☉`; unless `B₀ + B₁/r` dominates it (the paper's condition 35) `K₁/r`
+    /// turns negative on the exact trajectory, and the physical step `Δt = h/(K₀/r)` swings
+    /// with Jupiter's phase by up to a factor `ρ/(ρ − 1)` for a ratio `ρ`.
+    pub fn mixed_domain(
+        &self,
+        position: &Vec3,
+        velocity: &Vec3,
+        planets: &crate::Planets,
+    ) -> Result<MixedDomain, SymplecticError> {
+        let g = planets.g();
+        let m0 = planets.sun_mass();
+        let mut sun_speed = 0.0;
+        for ((&m, q), v) in planets
+            .masses()
+            .iter()
+            .zip(planets.positions())
+            .zip(planets.heliocentric_velocities())
+        {
+            let mu = g * (m0 + m);
+            let el = crate::kepler::elements(q, &v, mu)?;
+            let v_max2 = mu * (2.0 / el.perihelion - 1.0 / el.semi_major_axis);
+            sun_speed += m * v_max2.max(0.0).sqrt() / m0;
+        }
+        let mu = g * m0;
+        let el = crate::kepler::elements(position, velocity, mu)?;
+        let q = el.perihelion;
+        let aphelion = if el.eccentricity < 1.0 {
+            el.semi_major_axis * (1.0 + el.eccentricity)
+        } else {
+            1e6 * q
+        };
+        const SAMPLES: usize = 512;
+        let (mut worst, mut at, mut b1_needed) = (f64::INFINITY, q, 0.0f64);
+        for k in 0..=SAMPLES {
+            let r = q * (aphelion / q).powf(k as f64 / SAMPLES as f64);
+            let speed = (mu * (2.0 / r - 1.0 / el.semi_major_axis)).max(0.0).sqrt();
+            let sun_term = speed * sun_speed;
+            let ratio = (self.b0 + self.b1 / r) / sun_term;
+            if ratio < worst {
+                (worst, at) = (ratio, r);
+            }
+            b1_needed = b1_needed.max((MIXED_DOMAIN_MIN_RATIO * sun_term - self.b0) * r);
+        }
+        Ok(MixedDomain {
+            ratio: worst,
+            at_distance: at,
+            b1_needed,
+        })
+    }
+
+    fn check_mixed_domain(
+        &self,
+        position: &Vec3,
+        velocity: &Vec3,
+        planets: &crate::Planets,
+    ) -> Result<(), SymplecticError> {
+        let MixedDomain {
+            ratio,
+            at_distance,
+            b1_needed,
+        } = self.mixed_domain(position, velocity, planets)?;
+        if ratio >= MIXED_DOMAIN_MIN_RATIO {
+            return Ok(());
+        }
+        Err(SymplecticError::OutsideMixedDomain {
+            ratio,
+            required: MIXED_DOMAIN_MIN_RATIO,
+            at_distance,
+            b0: self.b0,
+            b1: self.b1,
+            b1_needed,
+        })
     }
 
     /// The particle's Hamiltonian `H` at its time (bodies must be at that time).
@@ -309,7 +427,9 @@ impl ParticleIntegrator {
                 reason: "B1 must be smaller than G M (the Kepler part needs a positive μ)",
             });
         }
-        crate::kepler::drift(&mut p.position, &mut p.velocity, mu, dt)?;
+        let info = crate::kepler::drift(&mut p.position, &mut p.velocity, mu, dt)?;
+        p.work.kepler_solves += 1;
+        p.work.kepler_iterations += u64::from(info.iterations);
         p.time += dt;
         Ok(dt)
     }
@@ -342,6 +462,7 @@ impl ParticleIntegrator {
                     grad += (q_r3 - d / d3) * *gm;
                     dt_part += gm * d.dot(vj) / d3;
                 }
+                p.work.force_evaluations += bodies.gm.len() as u64;
                 let f1 = check_positive("K1/r", f1, p.time)?;
                 let sigma = h / f1;
                 p.velocity += grad * sigma;
@@ -353,6 +474,8 @@ impl ParticleIntegrator {
                 let sun_v = bodies.velocities[0];
                 let q0 = p.position;
                 let v0 = p.velocity;
+                // F1 (n potential terms) and the gradient at the 4 quadrature nodes (4n).
+                p.work.force_evaluations += 5 * (bodies.gm.len() as u64 - 1);
                 let f1 = check_positive("K1/r", self.mixed_f1(q0, v0, s_over_m0, bodies), p.time)?;
                 let sigma = h / f1;
                 // Q moves along a straight segment (eq. 29); V and p4 are line integrals of

@@ -1,4 +1,4 @@
-use crate::{kepler, SymplecticError, Vec3};
+use crate::{kepler, SymplecticError, Vec3, WorkCounters};
 
 /// The Sun and `n` planets in mixed (democratic heliocentric) variables, Chegodaeva (2004)
 /// eq. 9 after Duncan, Levison & Lee (1998): heliocentric positions `Q_i = q_i − q_0` and
@@ -23,6 +23,9 @@ pub struct Planets {
     momenta: Vec<Vec3>,
     /// Time.
     time: f64,
+    /// Work done so far (Kepler solves, pairwise forces).
+    #[serde(default)]
+    work: WorkCounters,
 }
 
 impl Planets {
@@ -88,6 +91,7 @@ impl Planets {
             positions: positions.to_vec(),
             momenta,
             time: 0.0,
+            work: WorkCounters::default(),
         })
     }
 
@@ -129,6 +133,13 @@ impl Planets {
     /// Time elapsed since the initial state.
     pub fn time(&self) -> f64 {
         self.time
+    }
+
+    /// Work done by the pieces applied to this state so far ([`WorkCounters`]): one Kepler
+    /// solve per planet and [`Planets::kepler_drift`], `n(n−1)/2` force evaluations per
+    /// [`Planets::interaction_kick`].
+    pub fn work(&self) -> WorkCounters {
+        self.work
     }
 
     /// Barycentric velocities `P_i/m_i` of the planets.
@@ -182,6 +193,16 @@ impl Planets {
                     "state vector of {} values for {} planets",
                     s.len(),
                     self.len()
+                ),
+            });
+        }
+        if let Some(k) = s.iter().position(|x| !x.is_finite()) {
+            return Err(SymplecticError::InvalidState {
+                what: "planets",
+                reason: format!(
+                    "state vector value {k} (planet {}) is {}: must be finite",
+                    k / 6 + 1,
+                    s[k]
                 ),
             });
         }
@@ -242,15 +263,16 @@ impl Planets {
             let m = self.masses[i];
             let factor = 1.0 / m + 1.0 / m0;
             let mut v = self.momenta[i] * factor;
-            kepler::drift(&mut self.positions[i], &mut v, self.g * (m0 + m), dt).map_err(|e| {
-                match e {
+            let info = kepler::drift(&mut self.positions[i], &mut v, self.g * (m0 + m), dt)
+                .map_err(|e| match e {
                     SymplecticError::InvalidState { reason, .. } => SymplecticError::InvalidState {
                         what: "planet Kepler drift",
                         reason: format!("planet {}: {reason}", i + 1),
                     },
                     other => other,
-                }
-            })?;
+                })?;
+            self.work.kepler_solves += 1;
+            self.work.kepler_iterations += u64::from(info.iterations);
             self.momenta[i] = v / factor;
         }
         self.time += dt;
@@ -260,6 +282,7 @@ impl Planets {
     /// Piece **B**: the exact flow of `H_Inter` for `dt` (positions fixed, momenta kicked).
     pub fn interaction_kick(&mut self, dt: f64) {
         let n = self.len();
+        self.work.force_evaluations += (n * n.saturating_sub(1) / 2) as u64;
         for i in 0..n {
             for j in i + 1..n {
                 let d = self.positions[j] - self.positions[i];

@@ -8,7 +8,7 @@ use serde::{de::DeserializeOwned, Deserialize, Serialize};
 use crate::ephemeris::Ephemeris;
 use crate::kepler::Elements;
 use crate::particles::{ParticleIntegrator, ParticleScratch, ParticleStepInfo, TestParticle};
-use crate::SymplecticError;
+use crate::{SymplecticError, WorkCounters};
 
 /// Why a particle stopped being integrated.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -108,9 +108,16 @@ impl CometRun {
     /// Errors if the particle's time precedes the ephemeris' retained window (a stopped
     /// particle left behind).
     pub fn elements(&mut self, i: usize) -> Result<Elements, SymplecticError> {
+        let Some(tracked) = self.particles.get(i) else {
+            return Err(SymplecticError::InvalidParameter {
+                name: "particle index",
+                value: i as f64,
+                reason: "no such particle in the run",
+            });
+        };
         let mut bodies = crate::ephemeris::BodyStates::default();
         self.ephemeris
-            .bodies_at(self.particles[i].particle.time, &mut bodies)?;
+            .bodies_at(tracked.particle.time, &mut bodies)?;
         particle_elements(&self.integrator, &self.particles[i].particle, &bodies)
     }
 
@@ -122,6 +129,25 @@ impl CometRun {
         t_end: f64,
         mut on_step: impl FnMut(usize, &TestParticle, &ParticleStepInfo),
     ) -> Result<(), SymplecticError> {
+        if !t_end.is_finite() {
+            return Err(SymplecticError::InvalidParameter {
+                name: "end time",
+                value: t_end,
+                reason: "must be finite",
+            });
+        }
+        for (name, value) in [
+            ("min_perihelion", self.limits.min_perihelion),
+            ("ejection_distance", self.limits.ejection_distance),
+        ] {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(SymplecticError::InvalidParameter {
+                    name,
+                    value,
+                    reason: "limit must be finite and >= 0",
+                });
+            }
+        }
         loop {
             let next = self
                 .particles
@@ -178,6 +204,11 @@ impl CometRun {
         Ok(())
     }
 
+    /// Work done so far by the planets, the ephemeris and every particle ([`WorkCounters`]).
+    pub fn work(&self) -> WorkCounters {
+        self.ephemeris.work() + self.particles.iter().map(|p| p.particle.work).sum()
+    }
+
     /// Time of the active particle furthest behind, if any particle is active.
     fn oldest_active_time(&self) -> Option<f64> {
         self.particles
@@ -201,8 +232,9 @@ fn particle_elements(
 }
 
 /// Writes `value` as JSON to `path` atomically: a temporary file in the same directory is
-/// written, flushed to disk and renamed over `path`, so a crash leaves either the old or the
-/// new checkpoint, never a torn one. `f64` values round-trip exactly.
+/// written, flushed to disk and renamed over `path` (then the directory is synced), so a
+/// crash leaves either the old or the new checkpoint, never a torn one. `f64` values
+/// round-trip exactly (`serde_json`'s `float_roundtrip`).
 pub fn save_checkpoint<T: Serialize>(path: &Path, value: &T) -> Result<(), SymplecticError> {
     let io = |e: std::io::Error| SymplecticError::Checkpoint {
         path: path.display().to_string(),
@@ -220,7 +252,15 @@ pub fn save_checkpoint<T: Serialize>(path: &Path, value: &T) -> Result<(), Sympl
         f.flush().map_err(io)?;
         f.sync_all().map_err(io)?;
     }
-    std::fs::rename(&tmp, path).map_err(io)
+    std::fs::rename(&tmp, path).map_err(io)?;
+    // Make the rename itself durable (Unix: sync the directory entry). Best effort: where a
+    // directory cannot be opened or synced, the rename has still happened atomically.
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        if let Ok(d) = std::fs::File::open(dir) {
+            d.sync_all().ok();
+        }
+    }
+    Ok(())
 }
 
 /// Reads a checkpoint written by [`save_checkpoint`].

@@ -126,7 +126,7 @@ fn s2_particle_map_converges_at_second_order() {
     for (variant, b0, b1) in [
         (Variant::Barycentric, 0.0, B1_PAPER),
         // The mixed variant needs larger constants for this orbit (the paper's condition 35:
-        // with B1 = 0.21e-6, K1/r turns negative within a few steps, see below).
+        // B1 = 0.21e-6 is refused with OutsideMixedDomain, see below).
         (Variant::Mixed, 0.0, 4e-6),
     ] {
         let integ = ParticleIntegrator::new(variant, Scheme::S2, b0, b1).unwrap();
@@ -390,18 +390,43 @@ fn checkpoint_resumes_bit_identically() {
 
 #[test]
 fn leaving_the_validity_domain_is_reported() {
-    // Mixed variant with the paper's B1: H_Sun's variation exceeds B1/r and K1/r turns
-    // negative, as the paper warns (condition 35).
+    // Mixed variant with the paper's B1 (chosen by the paper for the barycentric variant):
+    // H_Sun's swing exceeds B1/r on these orbits (condition 35) and K1/r would turn negative
+    // within 9 (particle 1) and 5 years (particle 2): refused up front with a named error.
     let integ = ParticleIntegrator::new(Variant::Mixed, Scheme::S2, 0.0, B1_PAPER).unwrap();
     let mut eph = ephemeris();
     let mut scratch = ParticleScratch::default();
-    let p = particle(&integ, 1, 310.0, &mut eph, &mut scratch);
+    for k in 0..2 {
+        let row = &particle_rows()[k];
+        let (_, v_bary) = barycentric_particle(eph.planets(), row.position, row.velocity);
+        match integ.particle(row.position, v_bary, 0.0, 300.0, &mut eph, &mut scratch) {
+            Err(SymplecticError::OutsideMixedDomain {
+                ratio, b1_needed, ..
+            }) => {
+                // Ratios 0.16 and 0.13; the B1 that would do: 2.6e-6 and 3.3e-6.
+                assert!(ratio < 0.2, "particle {k}: ratio {ratio}");
+                assert!((2e-6..4e-6).contains(&b1_needed), "{b1_needed:e}");
+            }
+            other => panic!("particle {k}: expected OutsideMixedDomain, got {other:?}"),
+        }
+    }
+    // The B1 the error names is accepted (and 4e-6, the value of the tests above).
+    for b1 in [3.3e-6, 4e-6] {
+        let integ = ParticleIntegrator::new(Variant::Mixed, Scheme::S2, 0.0, b1).unwrap();
+        particle(&integ, 1, 310.0, &mut eph, &mut scratch);
+    }
+    // K0/r turning negative during a run (here forced through p4) stops that particle with
+    // its status; the run goes on.
+    let integ = ParticleIntegrator::new(Variant::Barycentric, Scheme::S2, 0.0, B1_PAPER).unwrap();
+    let mut eph = ephemeris();
+    let mut p = particle(&integ, 0, 298.0, &mut eph, &mut scratch);
+    p.p4 -= 1.0;
     let mut run = comet_run(eph, integ, vec![p], 26.0);
-    run.advance_to(1000.0 * 365.25, |_, _, _| {}).unwrap();
+    run.advance_to(10.0 * 365.25, |_, _, _| {}).unwrap();
     assert!(
         matches!(
             run.particles[0].status,
-            ParticleStatus::RegularisationLost { .. }
+            ParticleStatus::RegularisationLost { ref quantity, .. } if quantity == "K0/r"
         ),
         "{:?}",
         run.particles[0].status

@@ -1,54 +1,14 @@
-//! The outer Solar System and the comet-like test particles of Chegodaeva (2004), read from
-//! `reference-data/symplectic/`.
+//! The comet-like test particles of Chegodaeva (2004), read from `reference-data/symplectic/`
+//! (the planets come from `symplectic::outer_solar_system`).
 
-use anyhow::{Context as _, Result};
+use anyhow::Result;
 use symplectic::{Planets, Vec3};
 
 use super::load_reference_csv;
 use crate::Context;
 
-/// `G` of Hairer, Lubich & Wanner (Table 2.1), AU³ M☉⁻¹ day⁻².
-pub const G_AU_DAY: f64 = 2.959_122_082_86e-4;
 /// Days per Julian year.
 pub const DAYS_PER_YEAR: f64 = 365.25;
-
-/// The Sun and the four giant planets of `outer_solar_system.csv` (heliocentric, equatorial
-/// as stored, or rotated to the ecliptic of J2000).
-pub fn outer_planets(ctx: &Context, ecliptic: bool) -> Result<Planets> {
-    let t = load_reference_csv(
-        ctx,
-        "symplectic/outer_solar_system.csv",
-        &["body", "m", "x", "y", "z", "vx", "vy", "vz"],
-    )?;
-    let sun = t.find(&[("body", "Sun")])?;
-    let (mut m, mut q, mut v) = (vec![], vec![], vec![]);
-    for row in 0..t.len() {
-        if row == sun {
-            continue;
-        }
-        let vec = |a: &str, b: &str, c: &str| -> Result<Vec3> {
-            Ok(Vec3::new(
-                t.number(row, a)?,
-                t.number(row, b)?,
-                t.number(row, c)?,
-            ))
-        };
-        let (pos, vel) = (vec("x", "y", "z")?, vec("vx", "vy", "vz")?);
-        let (pos, vel) = if ecliptic {
-            (
-                symplectic::equatorial_to_ecliptic(&pos),
-                symplectic::equatorial_to_ecliptic(&vel),
-            )
-        } else {
-            (pos, vel)
-        };
-        m.push(t.number(row, "m")?);
-        q.push(pos);
-        v.push(vel);
-    }
-    Planets::from_heliocentric(G_AU_DAY, t.number(sun, "m")?, &m, &q, &v)
-        .with_context(|| format!("building the planets from {}", t.path.display()))
-}
 
 /// One test particle of `particles.csv`.
 #[derive(Debug, Clone)]
