@@ -103,9 +103,11 @@
 //!   surface), so that `N s³` approximates the mesh volume without bias. The distance is a
 //!   [`GridSdf`](sph_core::GridSdf) with cell = `particle_spacing` (only its sign matters).
 //! * Meshes must be closed
-//!   ([`TriangleMesh::check_closed`](sph_core::TriangleMesh::check_closed)); OBJ files are
-//!   loaded with `tobj` (polygons triangulated; vertices of several objects welded by exact
-//!   position).
+//!   ([`TriangleMesh::check_closed`](sph_core::TriangleMesh::check_closed)). OBJ files are
+//!   read by the crate's own reader (`v` and `f` statements; polygons split into a fan of
+//!   triangles; vertices of several objects welded by exact position) so that every problem
+//!   in a mesh file is reported with its line: a malformed number, a face index that does not
+//!   exist, a file cut short before its faces, and the face an open edge belongs to.
 //! * After parsing, every value is checked: spacing, durations, radii and cells finite and
 //!   positive, every number finite, `min < max`, substeps/iterations ≥ 1, fluids inside the tank
 //!   (block or mesh bounds inside the tank box, every particle strictly inside it), no fluid
@@ -128,6 +130,7 @@
 mod build;
 mod error;
 mod mesh_io;
+mod obj;
 mod parse;
 mod raw;
 mod spec;
@@ -142,6 +145,10 @@ pub use spec::{
 
 /// Largest total number of fluid particles a scene may produce (20 M).
 pub const MAX_PARTICLES: usize = 20_000_000;
+
+/// Most frames (`duration / frame_dt`) a scene may have: 10 million, 44 hours of 16 ms
+/// frames; beyond it the frame length or the duration is a typing mistake.
+pub const MAX_FRAMES: f64 = 1e7;
 
 /// Largest number of nodes of a signed distance grid built for a mesh (16 M).
 pub const MAX_SDF_NODES: usize = 16 << 20;
