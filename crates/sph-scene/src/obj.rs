@@ -25,7 +25,51 @@ struct ObjMesh {
     triangles: Vec<[u32; 3]>,
     /// 1-based line of the face each triangle comes from.
     triangle_lines: Vec<usize>,
+    /// Whether the vertices of several objects were welded (vertex numbers then differ
+    /// from the file's).
+    welded: bool,
 }
+
+/// The OBJ statements other than `v`, `f`, `o`, `g`, ignored (Wavefront OBJ specification,
+/// appendix B1 of the Advanced Visualizer manual: texture and normal vertices, points and
+/// lines, grouping, display and render attributes, free-form geometry).
+const OTHER_STATEMENTS: &[&str] = &[
+    "vt",
+    "vn",
+    "vp",
+    "p",
+    "l",
+    "s",
+    "mg",
+    "usemtl",
+    "mtllib",
+    "cstype",
+    "deg",
+    "bmat",
+    "step",
+    "curv",
+    "curv2",
+    "surf",
+    "parm",
+    "trim",
+    "hole",
+    "scrv",
+    "sp",
+    "end",
+    "con",
+    "bevel",
+    "c_interp",
+    "d_interp",
+    "lod",
+    "shadow_obj",
+    "trace_obj",
+    "ctech",
+    "stech",
+    "maplib",
+    "usemap",
+    "call",
+    "csh",
+];
 
 /// Most vertices accepted (triangle corners are `u32`).
 const MAX_VERTICES: usize = (u32::MAX / 2) as usize;
@@ -33,25 +77,35 @@ const MAX_VERTICES: usize = (u32::MAX / 2) as usize;
 /// Reads a closed triangle mesh from OBJ text (see the module documentation).
 pub(crate) fn parse_closed_mesh(text: &str) -> Result<TriangleMesh<f64>, String> {
     let obj = parse(text)?;
-    let lines = obj.triangle_lines;
-    let mesh =
-        TriangleMesh::new(obj.vertices, obj.triangles).map_err(|e| with_face_lines(&e, &lines))?;
+    let (lines, welded) = (obj.triangle_lines, obj.welded);
+    let mesh = TriangleMesh::new(obj.vertices, obj.triangles)
+        .map_err(|e| with_face_lines(&e, &lines, welded))?;
     mesh.check_closed()
-        .map_err(|e| with_face_lines(&e, &lines))?;
+        .map_err(|e| with_face_lines(&e, &lines, welded))?;
     Ok(mesh)
 }
 
-/// The message of a mesh error with the OBJ line of each triangle it names.
-fn with_face_lines(e: &MeshError, lines: &[usize]) -> String {
+/// The message of a mesh error with the OBJ line of each triangle it names, and how its
+/// vertex numbers relate to the file's.
+fn with_face_lines(e: &MeshError, lines: &[usize], welded: bool) -> String {
     let line = |t: usize| lines.get(t).copied().unwrap_or(0);
+    let numbering = if welded {
+        "vertices numbered from 0 after welding the objects' shared positions"
+    } else {
+        "vertices numbered from 0: the file's numbers are one more"
+    };
     match e {
         MeshError::DegenerateTriangle { triangle, .. }
         | MeshError::OpenEdge { triangle, .. }
         | MeshError::IndexOutOfRange { triangle, .. } => {
-            format!("line {}: {e}", line(*triangle))
+            format!("line {}: {e} ({numbering})", line(*triangle))
         }
         MeshError::InconsistentOrientation { first, second, .. } => {
-            format!("lines {} and {}: {e}", line(*first), line(*second))
+            format!(
+                "lines {} and {}: {e} ({numbering})",
+                line(*first),
+                line(*second)
+            )
         }
         _ => e.to_string(),
     }
@@ -133,6 +187,14 @@ fn parse(text: &str) -> Result<ObjMesh, String> {
                         corners.len()
                     )));
                 }
+                for (k, &c) in corners.iter().enumerate() {
+                    if corners[..k].contains(&c) {
+                        return Err(at(format!(
+                            "face uses vertex {} twice (a degenerate face)",
+                            c + 1
+                        )));
+                    }
+                }
                 for k in 1..corners.len() - 1 {
                     triangles.push([corners[0], corners[k], corners[k + 1]]);
                     triangle_lines.push(line_no);
@@ -143,7 +205,13 @@ fn parse(text: &str) -> Result<ObjMesh, String> {
                 }
             }
             "o" | "g" => current_has_faces = false,
-            _ => {}
+            k if OTHER_STATEMENTS.contains(&k) => {}
+            k => {
+                let shown: String = k.chars().take(16).collect();
+                return Err(at(format!(
+                    "unknown OBJ statement {shown:?} (is this a text OBJ file?)"
+                )));
+            }
         }
     }
     if triangles.is_empty() {
@@ -152,13 +220,15 @@ fn parse(text: &str) -> Result<ObjMesh, String> {
             vertices.len()
         ));
     }
-    if objects_with_faces > 1 {
+    let welded = objects_with_faces > 1;
+    if welded {
         weld(&mut vertices, &mut triangles);
     }
     Ok(ObjMesh {
         vertices,
         triangles,
         triangle_lines,
+        welded,
     })
 }
 

@@ -55,9 +55,9 @@ pub(super) fn check(ctx: &Ctx, scene: &Scene, quick: Option<&QuickSpec>) -> Resu
         return Err(ctx.invalid(
             f_substeps,
             format!(
-                "{substeps} substeps per frame is more than the maximum of {MAX_SUBSTEPS} (a frame of {} s would take steps of {:.3e} s)",
-                scene.frame_dt_s,
-                scene.frame_dt_s / substeps as f64
+                "{substeps} substeps per frame is more than the maximum of {MAX_SUBSTEPS} (a frame of {} s would take steps of {} s)",
+                num(scene.frame_dt_s),
+                num(scene.frame_dt_s / substeps as f64)
             ),
         ));
     }
@@ -67,8 +67,10 @@ pub(super) fn check(ctx: &Ctx, scene: &Scene, quick: Option<&QuickSpec>) -> Resu
         return Err(ctx.invalid(
             f_duration,
             format!(
-                "duration {} s in frames of {} s is {frames:.3e} frames, more than the maximum of {MAX_FRAMES:.0e}",
-                scene.duration_s, scene.frame_dt_s
+                "duration {} s in frames of {} s is {} frames, more than the maximum of {MAX_FRAMES:.0e}",
+                num(scene.duration_s),
+                num(scene.frame_dt_s),
+                num(frames)
             ),
         ));
     }
@@ -101,29 +103,56 @@ pub(super) fn check(ctx: &Ctx, scene: &Scene, quick: Option<&QuickSpec>) -> Resu
         return Err(ctx.invalid(
             field,
             format!(
-                "a solver step of {dt:.3e} s (frame_dt {} s / {substeps} substeps) moves a particle starting at {v0} m/s under gravity {g} m/s² by {travel:.3e} m, more than the support radius h = {h} m: it would leave its neighbourhood within one step (CFL condition v·Δt <= h); use at least {} substeps per frame or a shorter frame_dt",
-                scene.frame_dt_s,
-                substeps_needed(scene.frame_dt_s, v0, g, h)
+                "a solver step of {} s (frame_dt {} s / {substeps} substeps) moves a particle starting at {} m/s under gravity {} m/s² by {} m, more than the support radius h = {} m: it would leave its neighbourhood within one step (CFL condition v·Δt <= h); {}",
+                num(dt),
+                num(scene.frame_dt_s),
+                num(v0),
+                num(g),
+                num(travel),
+                num(h),
+                advice(scene.frame_dt_s, substeps, v0, g, h)
             ),
         ));
     }
     Ok(())
 }
 
-/// The fewest substeps `n` with `(v0 + g T/n) T/n <= h` for a frame of `frame_dt` = `T`, as a
-/// string (`"more than <MAX_SUBSTEPS>"` when beyond the cap).
-fn substeps_needed(frame_dt: f64, v0: f64, g: f64, h: f64) -> String {
-    // Largest Δt with g Δt² + v0 Δt − h <= 0.
-    let dt_max = if g > 0.0 {
-        (-v0 + (v0 * v0 + 4.0 * g * h).sqrt()) / (2.0 * g)
+/// What to do: the fewest substeps `n` with `(v0 + g T/n) T/n <= h` for a frame of
+/// `frame_dt` = `T` (when within [`MAX_SUBSTEPS`]), and the longest frame that passes with
+/// the current `substeps`.
+fn advice(frame_dt: f64, substeps: usize, v0: f64, g: f64, h: f64) -> String {
+    let dt_max = longest_step(v0, g, h);
+    let n = (frame_dt / dt_max).ceil();
+    let frame = format!(
+        "a frame_dt of at most {} s with {substeps} substeps",
+        num(dt_max * substeps as f64)
+    );
+    if n.is_finite() && n <= MAX_SUBSTEPS as f64 {
+        format!(
+            "use at least {} substeps per frame or {frame}",
+            n.max(1.0) as usize
+        )
+    } else {
+        format!("use {frame} (more than {MAX_SUBSTEPS} substeps would be needed)")
+    }
+}
+
+/// The largest `Δt` with `g Δt² + v0 Δt − h <= 0`.
+fn longest_step(v0: f64, g: f64, h: f64) -> f64 {
+    if g > 0.0 {
+        // The positive root, written without cancellation.
+        2.0 * h / (v0 + (v0 * v0 + 4.0 * g * h).sqrt())
     } else {
         h / v0
-    };
-    let n = (frame_dt / dt_max).ceil();
-    if n.is_finite() && n <= MAX_SUBSTEPS as f64 {
-        format!("{}", n.max(1.0) as usize)
+    }
+}
+
+/// `x` for a message: plain when moderate, else in scientific notation with 4 digits.
+fn num(x: f64) -> String {
+    if x == 0.0 || (1e-4..1e6).contains(&x.abs()) {
+        format!("{}", (x * 1e6).round() / 1e6)
     } else {
-        format!("more than {MAX_SUBSTEPS}")
+        format!("{x:.3e}")
     }
 }
 
@@ -132,26 +161,14 @@ mod tests {
     use super::*;
 
     #[test]
-    fn substeps_needed_meets_the_rule() {
-        for &(t, v0, g, h) in &[
-            (0.016, 0.0, 9.81, 0.05),
-            (1.0, 0.0, 9.81, 0.05),
-            (0.1, 3.0, 9.81, 0.02),
-            (0.1, 3.0, 0.0, 0.02),
-        ] {
-            let n: f64 = substeps_needed(t, v0, g, h).parse().unwrap();
-            let dt = t / n;
-            assert!(
-                (v0 + g * dt) * dt <= h * (1.0 + 1e-12),
-                "{t} {v0} {g} {h}: {n}"
-            );
-            if n > 1.0 {
-                let dt = t / (n - 1.0);
-                assert!(
-                    (v0 + g * dt) * dt > h,
-                    "{t} {v0} {g} {h}: {n} is not the fewest"
-                );
-            }
+    fn longest_step_meets_the_rule() {
+        for &(v0, g, h) in &[(0.0, 9.81, 0.05), (3.0, 9.81, 0.02), (3.0, 0.0, 0.02)] {
+            let dt = longest_step(v0, g, h);
+            assert!(((v0 + g * dt) * dt - h).abs() <= 1e-12 * h, "{v0} {g} {h}");
         }
+        let a = advice(0.5, 2, 0.0, 9.81, 0.1);
+        assert!(a.starts_with("use at least 5 substeps"), "{a}");
+        // 4 substeps of 0.125 s travel 0.153 m > 0.1 m, 5 of 0.1 s travel 0.098 m.
+        assert!((9.81f64 * 0.125 * 0.125) > 0.1 && (9.81f64 * 0.1 * 0.1) <= 0.1);
     }
 }
