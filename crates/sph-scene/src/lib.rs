@@ -9,6 +9,69 @@
 //! textures" after Bridson et al. 2006 / SDFGen). [`Scene::quick`] applies the optional
 //! `[quick]` overrides used by `cargo xtask validate` and `run --quick`.
 //!
+//! # Example: a scene run with the PBF solver
+//!
+//! The workspace's scene runner (`sph-sim`, `cargo xtask run SCENE`) maps every setting of
+//! a scene to its solver; a program that lifts the crates can also do it by hand. Solvers
+//! reorder the particles by cell every `reorder_every` frames (for memory locality), so a
+//! particle's index in the state changes: `last_permutation()` says how after each call, and
+//! composing it into an index map follows the scene's particles across the whole run.
+//!
+//! ```
+//! use std::path::Path;
+//! use pbf::{ParticleSet, Pbf, PbfParams, Vec3};
+//! use sph_scene::Scene;
+//!
+//! let text = r#"
+//! name = "small_dam"
+//! [simulation]
+//! particle_spacing = 0.05          # m
+//! duration = 0.16                  # s: 10 frames
+//! frame_dt = 0.016
+//! [solver]
+//! kind = "pbf"
+//! substeps = 2
+//! iterations = 3
+//! [tank]
+//! min = [0.0, 0.0, 0.0]
+//! max = [1.0, 0.6, 0.3]
+//! [[fluid]]
+//! kind = "block"
+//! min = [0.0, 0.0, 0.0]
+//! max = [0.3, 0.4, 0.3]
+//! "#;
+//! // Mesh paths would be relative to the file's directory; this scene has none.
+//! let scene = Scene::parse_str(text, Path::new("small_dam.toml")).unwrap();
+//! let positions = scene.fluid_positions::<f64>().unwrap();
+//! assert_eq!(positions.len(), 6 * 8 * 6);
+//!
+//! let mut params = PbfParams::<f64>::for_spacing(scene.particle_spacing);
+//! params.common.dt = scene.frame_dt_s; // one `step` call = one frame ...
+//! params.common.substeps = scene.solver.substeps(); // ... of this many solver steps
+//! params.common.gravity = Vec3::from(scene.gravity);
+//! params.common.reorder_every = 3;
+//! params.solver_iterations = scene.solver.iterations();
+//! let (m, rho0) = (params.particle_mass(), params.common.rest_density);
+//! let mut state = ParticleSet::from_positions(positions, m, rho0);
+//! state.velocities = scene.fluid_velocities().unwrap();
+//! let mut solver = Pbf::new(params, scene.build_solids::<f64>().unwrap()).unwrap();
+//!
+//! // `ids[k]`: the scene's index of the particle stored at `k` now.
+//! let mut ids: Vec<u32> = (0..state.len() as u32).collect();
+//! for _ in 0..scene.frame_count() {
+//!     solver.step(&mut state).unwrap(); // a whole frame of `substeps` steps
+//!     if let Some(perm) = solver.last_permutation() {
+//!         // The call began by moving the particle at `perm[k]` to `k`.
+//!         ids = perm.iter().map(|&old| ids[old as usize]).collect();
+//!     }
+//! }
+//! // The scene's particle 0 started in the block's lower corner, half a spacing above the
+//! // floor; the block has slumped towards +x and it stays on the floor.
+//! let k = ids.iter().position(|&id| id == 0).unwrap();
+//! assert!(state.positions[k].y < 0.05, "{:?}", state.positions[k]);
+//! assert_ne!(ids, (0..state.len() as u32).collect::<Vec<_>>(), "reordered");
+//! ```
+//!
 //! # Format
 //!
 //! SI units throughout (m, s, kg/m³). Every table rejects unknown keys. Vectors are arrays of

@@ -15,8 +15,10 @@
 //!   Mathematische Annalen 100, 32–74, doi:10.1007/BF01448839; for SPH, Monaghan 1992,
 //!   "Smoothed particle hydrodynamics", Annu. Rev. Astron. Astrophys. 30, 543–574,
 //!   doi:10.1146/annurev.aa.30.090192.002551) with `λ = 1` at the first step, taken as a
-//!   refusal bound, not an accuracy bound: accurate runs use `λ ≈ 0.4` of the particle
-//!   spacing (Ihmsen et al. 2014), and speeds grow after the first step. The message says
+//!   refusal bound, not an accuracy bound: accurate runs use `λ ≈ 0.4` with respect to the
+//!   particle diameter (M. Ihmsen, J. Orthmann, B. Solenthaler, A. Kolb and M. Teschner,
+//!   "SPH Fluids in Computer Graphics", Eurographics 2014 State of the Art Reports,
+//!   doi:10.2312/egst.20141034), and speeds grow after the first step. The message says
 //!   how many substeps would pass.
 
 use sph_solver::{DEFAULT_SUPPORT_OVER_SPACING, MAX_SUBSTEPS};
