@@ -31,7 +31,7 @@ enum Command {
         #[arg(long, num_args = 1.., value_name = "ID")]
         only: Vec<String>,
         /// Output directory [default: target/validation under the workspace root].
-        #[arg(long, value_name = "DIR")]
+        #[arg(long, value_name = "DIR", value_parser = output_dir)]
         out: Option<PathBuf>,
     },
     /// List the experiments and what each reproduces.
@@ -43,13 +43,31 @@ enum Command {
         /// Apply the scene's `[quick]` overrides.
         #[arg(long)]
         quick: bool,
-        /// Stop after this many frames.
-        #[arg(long, value_name = "N")]
+        /// Stop after this many frames (>= 1).
+        #[arg(long, value_name = "N", value_parser = frame_count, allow_hyphen_values = true)]
         frames: Option<usize>,
         /// Output directory [default: target/scenes/<file stem> under the workspace root].
-        #[arg(long, value_name = "DIR")]
+        #[arg(long, value_name = "DIR", value_parser = output_dir)]
         out: Option<PathBuf>,
     },
+}
+
+/// `--out DIR`: refuses a path that exists and is not a directory (before any work).
+fn output_dir(s: &str) -> Result<PathBuf, String> {
+    let p = PathBuf::from(s);
+    if p.exists() && !p.is_dir() {
+        return Err("exists and is not a directory (give a directory for the output)".into());
+    }
+    Ok(p)
+}
+
+/// `--frames N`: a whole number >= 1.
+fn frame_count(s: &str) -> Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(0) => Err("0 frames would run nothing (give at least 1)".into()),
+        Ok(n) => Ok(n),
+        Err(e) => Err(format!("not a whole number of frames >= 1 ({e})")),
+    }
 }
 
 fn main() -> ExitCode {

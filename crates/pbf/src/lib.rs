@@ -28,11 +28,23 @@
 //! let mut state = ParticleSet::from_positions(positions, m, rho0);
 //! let solids: Solids<f32> = vec![Box::new(Inverted(BoxSdf::new(tank).unwrap()))];
 //! let mut solver = Pbf::new(params, solids).unwrap();
+//! // The solver reorders the particles by grid cell every `reorder_every` calls (10 by
+//! // default, starting with the first): `ids[k]` is the original index of the particle
+//! // stored at `k` now.
+//! let mut ids: Vec<u32> = (0..state.len() as u32).collect();
 //! for _ in 0..10 {
 //!     // One call advances a whole 16 ms frame of `substeps` steps.
 //!     let stats = solver.step(&mut state).unwrap();
 //!     assert!(stats.max_density_ratio < 1.5);
+//!     if let Some(perm) = solver.last_permutation() {
+//!         // The call began by moving the particle at `perm[k]` to `k`.
+//!         ids = perm.iter().map(|&old| ids[old as usize]).collect();
+//!     }
 //! }
+//! // Particle 0 started at the block's lower corner, half a spacing above the floor, and
+//! // is still on the floor.
+//! let k = ids.iter().position(|&id| id == 0).unwrap();
+//! assert!(state.positions[k].y < s);
 //! ```
 //!
 //! | paper | here |

@@ -313,8 +313,19 @@ impl<R: Real> Pbf<R> {
         })
     }
 
-    /// Advances `state` by one whole frame `dt`: `substeps` steps of Algorithm 1 (see
-    /// [`Pbf`]).
+    /// Advances `state` by one whole frame, `common.dt` (16 ms by default), made of
+    /// `common.substeps` time steps of Algorithm 1 (see [`Pbf`]): one call is a frame, not
+    /// one solver step.
+    ///
+    /// **Particle order.** Every `common.reorder_every` calls (the first call included), the
+    /// call begins by reordering the particles of `state` by grid cell for memory locality:
+    /// afterwards [`Pbf::last_permutation`] returns `perm` with `new[k] = old[perm[k]]`
+    /// (`None` when the call did not reorder). To follow particles across a run, keep an
+    /// index map `ids` (initially `0..n`) and compose it after each call,
+    /// `ids = perm.iter().map(|&o| ids[o as usize]).collect()`, so `ids[k]` is the original
+    /// index of the particle now at `k`; apply the same permutation to any per-particle data
+    /// kept beside the state (`sph_core::apply_permutation`). `reorder_every = 0` keeps the
+    /// input order. The crate-level example shows it.
     ///
     /// Checks the state first (array lengths, finite positions and velocities, positive
     /// masses: [`SolverError::InvalidState`], [`SolverError::InvalidMass`]), reorders it by

@@ -40,9 +40,16 @@ fn thread_count_does_not_change_results() {
 
 /// f32 and f64 run the same dam break (0.51 s) to the same flow: the density statistics,
 /// the centre of mass and the kinetic energy agree to within what f32 rounding, amplified
-/// by the splash, allows (measured: max ρ/ρ0 1.055 vs 1.041, mean 0.9898 vs 0.9894, centre
-/// of mass x 0.381 vs 0.376 m, kinetic energy 1.07 vs 1.05 J), and neither produces a
-/// non-finite value.
+/// by the splash, allows, and neither produces a non-finite value.
+///
+/// The bounds are 1.6× the largest gap measured (2026-11-23) over seven summation orders
+/// (`reorder_every` = 0, 1, 2, 3, 5, 7, 10, each changing the order of the neighbour sums
+/// and so the f32 rounding): max ρ/ρ0 0.0019–0.0150 (0.0138 at the test's order 5), mean
+/// ρ/ρ0 0.00005–0.00078 (0.00039), centre of mass x 0.43–1.52 % (1.20 %), kinetic energy
+/// 1.5–7.7 % (2.2 %). The kinetic energy of the splash is chaotic: two f64 runs differing
+/// only in summation order already differ by 1.4–2.2 %. A bound at the test's own gap
+/// would fail on any change of summation order; the margin of 1.6× keeps it failing on a
+/// precision-dependent bug of a few per cent.
 #[test]
 fn f32_and_f64_both_run() {
     fn summary<R: Real>() -> (f64, f64, f64, f64) {
@@ -67,14 +74,14 @@ fn f32_and_f64_both_run() {
     let a = summary::<f32>();
     let b = summary::<f64>();
     println!("f32 {a:?}\nf64 {b:?}");
-    assert!((a.1 - b.1).abs() < 0.01, "mean density {a:?} vs {b:?}");
-    assert!((a.0 - b.0).abs() < 0.05, "max density {a:?} vs {b:?}");
+    assert!((a.1 - b.1).abs() < 0.00125, "mean density {a:?} vs {b:?}");
+    assert!((a.0 - b.0).abs() < 0.024, "max density {a:?} vs {b:?}");
     assert!(
-        (a.3 - b.3).abs() < 0.05 * b.3,
+        (a.3 - b.3).abs() < 0.024 * b.3,
         "centre of mass x {a:?} vs {b:?}"
     );
     assert!(
-        (a.2 - b.2).abs() < 0.3 * b.2,
+        (a.2 - b.2).abs() < 0.123 * b.2,
         "kinetic energy {a:?} vs {b:?}"
     );
 }

@@ -1,6 +1,11 @@
 //! The solver against a naive O(N²) oracle written independently here in f64 from the paper's
 //! equations: brute-force neighbour loops, the Poly6 / Spiky formulas of Müller et al. (2003)
 //! written out, and Algorithm 1 of Macklin & Müller (2013) step by step.
+//!
+//! Planted bugs these tests catch (each planted once in `src/passes.rs`, the tests run, the
+//! code restored; 2026-11-23): the density without its self term `m_i W(0)`, a halved `λ_i`,
+//! the denominator of eq. 11 without `|∇_{p_i} C_i|²`: each fails all six tests; the sign of
+//! `λ_j` flipped in `Δp_i` (eq. 14): fails all but `unilateral_lambda`, which checks `λ` only.
 
 mod common;
 

@@ -1,25 +1,46 @@
 //! The adaptive iteration count of `PbfParams::mean_compression_tolerance` (SPlisHSPlasH's
-//! stopping rule), checked against an oracle: the mean compression of every iteration is
-//! recomputed here in f64, from positions obtained with a fixed iteration count and the
-//! step's own neighbour lists, and the iteration at which the solver stopped must be the
-//! first one (from the minimum on) within the tolerance, or the maximum.
+//! stopping rule), checked against an oracle written independently of the crate: the mean
+//! compression of every iteration is recomputed here in f64 with the Poly6 formula of
+//! `formulas` and brute-force neighbour sets (all pairs within `h` at the predicted
+//! positions, Algorithm 1 lines 5–7 of Macklin & Müller 2013), from positions obtained with a
+//! fixed iteration count; the iteration at which the solver stopped must be the first one
+//! (from the minimum on) within the tolerance, or the maximum.
+//!
+//! Planted bugs this catches (each planted once, the tests run, the code restored;
+//! 2026-11-23): the density without its self term `m_i W(0)` (three of the four tests fail:
+//! the reported compression and the decisions differ from the oracle's), and the minimum
+//! iteration count ignored by the stopping rule (`loose_tolerance_runs_the_minimum` and the
+//! property test fail). A halved `λ` or a wrong constraint gradient passes here by design:
+//! the positions come from the solver's own fixed-count steps, and `tests/oracle.rs` checks
+//! them.
 
 mod common;
 
+use common::formulas::{norm, poly6, sub, to_v, V};
 use pbf::{ParticleSet, Pbf, PbfParams, Vec3};
 use proptest::prelude::*;
-use sph_kernels::{Kernel, Poly6};
 
-/// Mean compression `(1/N) Σ max(ρ_i/ρ0 − 1, 0)` at positions `x`, with the neighbour lists
-/// `nb` (CSR of the step), in f64 and in particle order.
-fn mean_compression(p: &PbfParams<f64>, x: &[Vec3<f64>], m: &[f64], solver: &Pbf<f64>) -> f64 {
-    let poly6 = Poly6::new(p.common.support_radius).unwrap();
-    let nb = solver.neighbours();
+/// Brute-force neighbour sets: `j ≠ i` with `|x_i − x_j| < h`.
+fn brute_force_neighbours(x: &[V], h: f64) -> Vec<Vec<usize>> {
+    (0..x.len())
+        .map(|i| {
+            (0..x.len())
+                .filter(|&j| j != i && norm(sub(x[i], x[j])) < h)
+                .collect()
+        })
+        .collect()
+}
+
+/// Mean compression `(1/N) Σ max(ρ_i/ρ0 − 1, 0)` at positions `x`, with the neighbour sets
+/// `nb` fixed for the step, `ρ_i = m_i W(0) + Σ_j m_j W(|x_i − x_j|)` (eq. 2), in f64.
+fn mean_compression(p: &PbfParams<f64>, x: &[Vec3<f64>], m: &[f64], nb: &[Vec<usize>]) -> f64 {
+    let h = p.common.support_radius;
+    let x: Vec<V> = x.iter().map(to_v).collect();
     let mut sum = 0.0;
     for i in 0..x.len() {
-        let mut rho = m[i] * poly6.value(0.0);
-        for &j in nb.neighbours(i) {
-            rho += m[j as usize] * poly6.value((x[i] - x[j as usize]).norm());
+        let mut rho = m[i] * poly6([0.0; 3], h);
+        for &j in &nb[i] {
+            rho += m[j] * poly6(sub(x[i], x[j]), h);
         }
         sum += (rho / p.common.rest_density - 1.0).max(0.0);
     }
@@ -77,13 +98,15 @@ fn check_run(tol: f64, min: usize, max: usize, frames: usize) -> Vec<usize> {
             .zip(&before.velocities)
             .map(|(x, v)| x + (v + g * dt) * dt)
             .collect();
+        let predicted_v: Vec<V> = predicted.iter().map(to_v).collect();
+        let nb = brute_force_neighbours(&predicted_v, p.common.support_radius);
         for j in 1..=k {
             let x = if j == 1 {
                 predicted.clone()
             } else {
                 fixed_step(&p, &solids_of, &before, j - 1).0.positions
             };
-            let c = mean_compression(&p, &x, &before.masses, &adaptive);
+            let c = mean_compression(&p, &x, &before.masses, &nb);
             // Decisions closer to the tolerance than the f64 summation-order difference are
             // not judged.
             if (c - tol).abs() < 1e-12 {

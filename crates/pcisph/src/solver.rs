@@ -229,8 +229,18 @@ impl<R: Real> Pcisph<R> {
         self.reorder.last_permutation()
     }
 
-    /// Advances `state` by one whole frame `dt`: `substeps` PCISPH time steps (see the crate
-    /// documentation).
+    /// Advances `state` by one whole frame, `common.dt` (16 ms by default), made of
+    /// `common.substeps` PCISPH time steps (see the crate documentation): one call is a
+    /// frame, not one time step.
+    ///
+    /// **Particle order.** Every `common.reorder_every` calls (the first call included), the
+    /// call begins by reordering the particles of `state` by grid cell: afterwards
+    /// [`Pcisph::last_permutation`] returns `perm` with `new[k] = old[perm[k]]` (`None` when
+    /// the call did not reorder). To follow particles, keep an index map `ids` (initially
+    /// `0..n`) and compose it after each call, `ids = perm.iter().map(|&o| ids[o as
+    /// usize]).collect()`, so `ids[k]` is the original index of the particle now at `k`
+    /// (the `pbf` and `sph-scene` crate examples show it); `reorder_every = 0` keeps the
+    /// input order.
     ///
     /// Checks the state first ([`SolverError::InvalidState`], [`SolverError::InvalidMass`]),
     /// reorders it by cell every `reorder_every` calls, and after each time step checks for

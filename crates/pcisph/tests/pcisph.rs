@@ -3,6 +3,14 @@
 //! oracle written here from the paper's algorithm, a resting block settling, bitwise
 //! determinism across thread counts, no allocation in a warm step, errors, and an unstable
 //! setup failing cleanly.
+//!
+//! Planted bugs the oracle tests catch (each planted once in `src/`, the tests run, the code
+//! restored; 2026-11-23): the density without its self term `m_i W(0)` fails
+//! `one_step_matches_naive_oracle` (only it: the scene tests still pass); a halved `δ` (eq. 8
+//! with `β` doubled) fails `delta_equals_direct_eq8` and `one_step_matches_naive_oracle`; the
+//! pressure force's sign flipped, the pressure set to `δ ρ_err` instead of accumulated
+//! (`p += δ ρ_err`), and the negative-pressure clamp ignored each fail
+//! `one_step_matches_naive_oracle` and the resting-block tests.
 
 // Unsafe: the allocation counter is a `GlobalAlloc` wrapping `System` (the only way to count allocations).
 #![allow(unsafe_code)]

@@ -12,7 +12,7 @@ use sph_core::{
 
 use crate::error::Ctx;
 use crate::{
-    cast3, fmt3, v3, FluidSpec, Scene, SceneError, SolidSpec, MAX_PARTICLES, MAX_SDF_NODES,
+    cast3, fmt3, v3, FluidSpec, Scene, SceneError, SolidSpec, AXES, MAX_PARTICLES, MAX_SDF_NODES,
 };
 
 impl Scene {
@@ -159,8 +159,23 @@ impl Scene {
             .map(|j| self.solid_sdf::<f64>(ctx, j))
             .collect::<Result<_, _>>()?;
         for i in 0..self.fluids.len() {
-            let pts = self.sample_fluid(ctx, i)?;
             let field = format!("fluid[{i}]");
+            if let FluidSpec::Block { min, max, .. } = &self.fluids[i] {
+                // The lattice puts at least one layer per axis, half a spacing inside the
+                // lower corner: in a block thinner than a spacing that layer lies outside it.
+                let s = self.particle_spacing;
+                if let Some(a) = (0..3).find(|&a| max[a] - min[a] < s * (1.0 - 1e-9)) {
+                    return Err(ctx.invalid(
+                        format!("{field}.max"),
+                        format!(
+                            "the block is {} m thick along {}, less than one particle_spacing ({s} m): it cannot hold a layer of particles",
+                            max[a] - min[a],
+                            AXES[a]
+                        ),
+                    ));
+                }
+            }
+            let pts = self.sample_fluid(ctx, i)?;
             if pts.is_empty() {
                 return Err(ctx.invalid(
                     field,

@@ -2,6 +2,7 @@
 //! the value checks shared by the parser and the mesh placement, and the translation of
 //! TOML/serde errors into a field path and a reason with line and column.
 
+use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -69,26 +70,39 @@ impl SceneError {
     }
 }
 
-/// Where errors are reported: the scene file, and a prefix for reasons.
+/// Where errors are reported: the scene file, a prefix for reasons, and (while parsing) the
+/// line of each field.
 pub(crate) struct Ctx<'a> {
     /// The scene file.
     pub file: &'a Path,
     /// Prefix for reasons (e.g. `"with the [quick] overrides: "`).
     pub note: &'a str,
+    /// The line of each field path of the scene text, when parsing it.
+    pub lines: Option<&'a FieldLines>,
 }
 
 impl<'a> Ctx<'a> {
-    /// A context for `file` without a note.
+    /// A context for `file` without a note or lines.
     pub fn new(file: &'a Path) -> Self {
-        Ctx { file, note: "" }
+        Ctx {
+            file,
+            note: "",
+            lines: None,
+        }
     }
 
-    /// An [`SceneError::Invalid`] for `field`.
+    /// An [`SceneError::Invalid`] for `field`, its reason followed by the field's line when
+    /// known (or the line of the closest enclosing table or array element).
     pub fn invalid(&self, field: impl Into<String>, reason: impl AsRef<str>) -> SceneError {
+        let field = field.into();
+        let mut reason = format!("{}{}", self.note, reason.as_ref());
+        if let Some(line) = self.lines.and_then(|l| l.line_of(&field)) {
+            let _ = write!(reason, " (line {line})");
+        }
         SceneError::Invalid {
             file: self.file.to_path_buf(),
-            field: field.into(),
-            reason: format!("{}{}", self.note, reason.as_ref()),
+            field,
+            reason,
         }
     }
 
@@ -129,6 +143,62 @@ impl<'a> Ctx<'a> {
             min: v3(b.min),
             max: v3(b.max),
         })
+    }
+}
+
+/// The 1-based line of every field path of a TOML document (`simulation.frame_dt`,
+/// `fluid[1]`, `fluid[1].min`, ...): the line of its key, or for an element of an array of
+/// tables the line where the element starts.
+pub(crate) struct FieldLines(HashMap<String, usize>);
+
+impl FieldLines {
+    /// The lines of the fields of the parsed document `doc` of `text`.
+    pub fn new(text: &str, doc: &toml::de::DeTable<'_>) -> Self {
+        let mut map = HashMap::new();
+        collect_lines(text, doc, "", &mut map);
+        FieldLines(map)
+    }
+
+    /// The line of `field`, else of its closest parent path that has one.
+    pub fn line_of(&self, field: &str) -> Option<usize> {
+        let mut f = field;
+        loop {
+            if let Some(&l) = self.0.get(f) {
+                return Some(l);
+            }
+            let cut = f.rfind(['.', '['])?;
+            f = &f[..cut];
+        }
+    }
+}
+
+fn collect_lines(
+    text: &str,
+    table: &toml::de::DeTable<'_>,
+    prefix: &str,
+    out: &mut HashMap<String, usize>,
+) {
+    use toml::de::DeValue;
+    for (key, value) in table {
+        let path = if prefix.is_empty() {
+            key.get_ref().to_string()
+        } else {
+            format!("{prefix}.{}", key.get_ref())
+        };
+        out.insert(path.clone(), line_col(text, key.span().start).0);
+        match value.get_ref() {
+            DeValue::Table(t) => collect_lines(text, t, &path, out),
+            DeValue::Array(items) => {
+                for (i, item) in items.iter().enumerate() {
+                    if let DeValue::Table(t) = item.get_ref() {
+                        let p = format!("{path}[{i}]");
+                        out.insert(p.clone(), line_col(text, item.span().start).0);
+                        collect_lines(text, t, &p, out);
+                    }
+                }
+            }
+            _ => {}
+        }
     }
 }
 

@@ -9,6 +9,69 @@
 //! textures" after Bridson et al. 2006 / SDFGen). [`Scene::quick`] applies the optional
 //! `[quick]` overrides used by `cargo xtask validate` and `run --quick`.
 //!
+//! # Example: a scene run with the PBF solver
+//!
+//! The workspace's scene runner (`sph-sim`, `cargo xtask run SCENE`) maps every setting of
+//! a scene to its solver; a program that lifts the crates can also do it by hand. Solvers
+//! reorder the particles by cell every `reorder_every` frames (for memory locality), so a
+//! particle's index in the state changes: `last_permutation()` says how after each call, and
+//! composing it into an index map follows the scene's particles across the whole run.
+//!
+//! ```
+//! use std::path::Path;
+//! use pbf::{ParticleSet, Pbf, PbfParams, Vec3};
+//! use sph_scene::Scene;
+//!
+//! let text = r#"
+//! name = "small_dam"
+//! [simulation]
+//! particle_spacing = 0.05          # m
+//! duration = 0.16                  # s: 10 frames
+//! frame_dt = 0.016
+//! [solver]
+//! kind = "pbf"
+//! substeps = 2
+//! iterations = 3
+//! [tank]
+//! min = [0.0, 0.0, 0.0]
+//! max = [1.0, 0.6, 0.3]
+//! [[fluid]]
+//! kind = "block"
+//! min = [0.0, 0.0, 0.0]
+//! max = [0.3, 0.4, 0.3]
+//! "#;
+//! // Mesh paths would be relative to the file's directory; this scene has none.
+//! let scene = Scene::parse_str(text, Path::new("small_dam.toml")).unwrap();
+//! let positions = scene.fluid_positions::<f64>().unwrap();
+//! assert_eq!(positions.len(), 6 * 8 * 6);
+//!
+//! let mut params = PbfParams::<f64>::for_spacing(scene.particle_spacing);
+//! params.common.dt = scene.frame_dt_s; // one `step` call = one frame ...
+//! params.common.substeps = scene.solver.substeps(); // ... of this many solver steps
+//! params.common.gravity = Vec3::from(scene.gravity);
+//! params.common.reorder_every = 3;
+//! params.solver_iterations = scene.solver.iterations();
+//! let (m, rho0) = (params.particle_mass(), params.common.rest_density);
+//! let mut state = ParticleSet::from_positions(positions, m, rho0);
+//! state.velocities = scene.fluid_velocities().unwrap();
+//! let mut solver = Pbf::new(params, scene.build_solids::<f64>().unwrap()).unwrap();
+//!
+//! // `ids[k]`: the scene's index of the particle stored at `k` now.
+//! let mut ids: Vec<u32> = (0..state.len() as u32).collect();
+//! for _ in 0..scene.frame_count() {
+//!     solver.step(&mut state).unwrap(); // a whole frame of `substeps` steps
+//!     if let Some(perm) = solver.last_permutation() {
+//!         // The call began by moving the particle at `perm[k]` to `k`.
+//!         ids = perm.iter().map(|&old| ids[old as usize]).collect();
+//!     }
+//! }
+//! // The scene's particle 0 started in the block's lower corner, half a spacing above the
+//! // floor; the block has slumped towards +x and it stays on the floor.
+//! let k = ids.iter().position(|&id| id == 0).unwrap();
+//! assert!(state.positions[k].y < 0.05, "{:?}", state.positions[k]);
+//! assert_ne!(ids, (0..state.len() as u32).collect::<Vec<_>>(), "reordered");
+//! ```
+//!
 //! # Format
 //!
 //! SI units throughout (m, s, kg/m³). Every table rejects unknown keys. Vectors are arrays of
@@ -103,9 +166,11 @@
 //!   surface), so that `N s³` approximates the mesh volume without bias. The distance is a
 //!   [`GridSdf`](sph_core::GridSdf) with cell = `particle_spacing` (only its sign matters).
 //! * Meshes must be closed
-//!   ([`TriangleMesh::check_closed`](sph_core::TriangleMesh::check_closed)); OBJ files are
-//!   loaded with `tobj` (polygons triangulated; vertices of several objects welded by exact
-//!   position).
+//!   ([`TriangleMesh::check_closed`](sph_core::TriangleMesh::check_closed)). OBJ files are
+//!   read by the crate's own reader (`v` and `f` statements; polygons split into a fan of
+//!   triangles; vertices of several objects welded by exact position) so that every problem
+//!   in a mesh file is reported with its line: a malformed number, a face index that does not
+//!   exist, a file cut short before its faces, and the face an open edge belongs to.
 //! * After parsing, every value is checked: spacing, durations, radii and cells finite and
 //!   positive, every number finite, `min < max`, substeps/iterations ≥ 1, fluids inside the tank
 //!   (block or mesh bounds inside the tank box, every particle strictly inside it), no fluid
@@ -128,6 +193,7 @@
 mod build;
 mod error;
 mod mesh_io;
+mod obj;
 mod parse;
 mod raw;
 mod spec;
@@ -142,6 +208,10 @@ pub use spec::{
 
 /// Largest total number of fluid particles a scene may produce (20 M).
 pub const MAX_PARTICLES: usize = 20_000_000;
+
+/// Most frames (`duration / frame_dt`) a scene may have: 10 million, 44 hours of 16 ms
+/// frames; beyond it the frame length or the duration is a typing mistake.
+pub const MAX_FRAMES: f64 = 1e7;
 
 /// Largest number of nodes of a signed distance grid built for a mesh (16 M).
 pub const MAX_SDF_NODES: usize = 16 << 20;

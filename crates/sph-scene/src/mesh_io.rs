@@ -148,65 +148,20 @@ pub(crate) fn placement_field(field: &str, m: &MeshSpec) -> String {
     }
 }
 
-/// Reads a closed triangle mesh from an OBJ file (polygons triangulated; the vertices of
-/// several objects welded by exact position).
+/// Reads a closed triangle mesh from an OBJ file (see [`crate::obj`]; every error names the
+/// line).
 fn load_obj(path: &Path) -> Result<TriangleMesh<f64>, String> {
-    if !path.is_file() {
+    if !path.exists() {
         return Err("file not found".into());
     }
-    let opts = tobj::LoadOptions {
-        triangulate: true,
-        single_index: false,
-        ignore_points: true,
-        ignore_lines: true,
-    };
-    let file = std::fs::File::open(path).map_err(|e| format!("cannot open: {e}"))?;
-    let mut reader = std::io::BufReader::new(file);
-    let (models, _) = tobj::load_obj_buf(&mut reader, &opts, |_| {
-        Err(tobj::LoadError::MaterialParseError)
-    })
-    .map_err(|e| format!("not a valid OBJ file: {e}"))?;
-    let mut vertices: Vec<Vec3<f64>> = Vec::new();
-    let mut triangles: Vec<[u32; 3]> = Vec::new();
-    let weld = models.len() > 1;
-    let mut seen: HashMap<[u64; 3], u32> = HashMap::new();
-    for m in &models {
-        let mesh = &m.mesh;
-        if mesh.positions.len() % 3 != 0 || mesh.indices.len() % 3 != 0 {
-            return Err(format!(
-                "object {:?}: malformed position or index arrays",
-                m.name
-            ));
-        }
-        let mut local = Vec::with_capacity(mesh.positions.len() / 3);
-        for p in mesh.positions.chunks_exact(3) {
-            let v = Vec3::new(p[0], p[1], p[2]);
-            let id = if weld {
-                let key = [p[0].to_bits(), p[1].to_bits(), p[2].to_bits()];
-                *seen.entry(key).or_insert_with(|| {
-                    vertices.push(v);
-                    (vertices.len() - 1) as u32
-                })
-            } else {
-                vertices.push(v);
-                (vertices.len() - 1) as u32
-            };
-            local.push(id);
-        }
-        for t in mesh.indices.chunks_exact(3) {
-            let mut tri = [0u32; 3];
-            for c in 0..3 {
-                tri[c] = *local.get(t[c] as usize).ok_or_else(|| {
-                    format!("object {:?}: face index {} out of range", m.name, t[c])
-                })?;
-            }
-            triangles.push(tri);
-        }
-        if vertices.len() > u32::MAX as usize / 2 {
-            return Err("too many vertices".into());
-        }
+    if !path.is_file() {
+        return Err("not a file".into());
     }
-    let mesh = TriangleMesh::new(vertices, triangles).map_err(|e| e.to_string())?;
-    mesh.check_closed().map_err(|e| e.to_string())?;
-    Ok(mesh)
+    let bytes = std::fs::read(path).map_err(|e| format!("cannot read: {e}"))?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let line = e.as_bytes()[..at].iter().filter(|&&b| b == b'\n').count() + 1;
+        format!("line {line}: not UTF-8 text (is it an OBJ file?)")
+    })?;
+    crate::obj::parse_closed_mesh(&text)
 }

@@ -7,6 +7,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 mod solver;
+mod time_step;
 
 use std::path::Path;
 
@@ -14,7 +15,7 @@ use sph_core::Aabb;
 use toml::de::{DeTable, DeValue};
 use toml::Spanned;
 
-use crate::error::{document_error, serde_error, Ctx};
+use crate::error::{document_error, serde_error, Ctx, FieldLines};
 use crate::mesh_io::{placement_field, MeshLoader};
 use crate::raw::{
     RawBox, RawFluid, RawFluidKind, RawOutput, RawQuick, RawScene, RawSimulation, RawSolid,
@@ -45,8 +46,12 @@ impl Scene {
     /// Parses and validates scene text; `path` names the file in messages and is the base of
     /// relative mesh paths (its directory).
     pub fn parse_str(text: &str, path: &Path) -> Result<Scene, SceneError> {
-        let ctx = Ctx::new(path);
         let doc = DeTable::parse(text).map_err(|e| document_error(path, text, &e))?;
+        let lines = FieldLines::new(text, doc.get_ref());
+        let ctx = Ctx {
+            lines: Some(&lines),
+            ..Ctx::new(path)
+        };
         let solver_table = doc.get_ref().get("solver").cloned();
         let raw: RawScene = serde_path_to_error::deserialize(toml::de::Deserializer::from(doc))
             .map_err(|e| serde_error(path, text, "", "", &e))?;
@@ -57,13 +62,16 @@ impl Scene {
         };
         let base = path.parent().unwrap_or(Path::new(""));
         let scene = from_raw(&ctx, raw, solver, base)?;
+        time_step::check(&ctx, &scene, None)?;
         scene.validate_particles(&ctx)?;
-        if scene.quick_overrides.is_some() {
+        if let Some(overrides) = &scene.quick_overrides {
             let quick = scene.quick();
-            quick.validate_particles(&Ctx {
-                file: path,
+            let quick_ctx = Ctx {
                 note: "with the [quick] overrides: ",
-            })?;
+                ..ctx
+            };
+            time_step::check(&quick_ctx, &quick, Some(overrides))?;
+            quick.validate_particles(&quick_ctx)?;
         }
         Ok(scene)
     }

@@ -2,7 +2,6 @@
 //! comments (within ±15 % of the paper's targets), and build their solids.
 
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 use sph_core::{Sdf, Vec3};
 use sph_scene::{BoundaryModel, FluidSpec, Precision, Scene, SolverSpec};
@@ -32,7 +31,6 @@ fn check_inside(scene: &Scene) {
 
 #[test]
 fn dam_break_matches_table_1() {
-    let t = Instant::now();
     let s = Scene::load(&scene_path("dam_break.toml")).unwrap();
     assert_eq!(s.name, "dam_break");
     assert_eq!(s.precision, Precision::F32);
@@ -50,10 +48,7 @@ fn dam_break_matches_table_1() {
     assert_eq!((s.frame_dt_s, s.duration_s), (0.016, 6.0));
     assert_eq!(s.frame_count(), 375);
     let (full, quick) = counts(&s);
-    println!(
-        "dam_break: {full} particles, quick {quick} (load {:?})",
-        t.elapsed()
-    );
+    println!("dam_break: {full} particles, quick {quick}");
     assert_eq!(full, 98_304);
     assert_eq!(quick, 12_288);
     assert!((full as f64 - 100_000.0).abs() <= 15_000.0);
@@ -67,15 +62,11 @@ fn dam_break_matches_table_1() {
 
 #[test]
 fn bunny_drop_matches_fig_3() {
-    let t = Instant::now();
     let s = Scene::load(&scene_path("bunny_drop.toml")).unwrap();
     assert_eq!((s.solver.substeps(), s.solver.iterations()), (4, 10));
     assert!(matches!(s.fluids[1], FluidSpec::Mesh { .. }));
     let (full, quick) = counts(&s);
-    println!(
-        "bunny_drop: {full} particles, quick {quick} (load {:?})",
-        t.elapsed()
-    );
+    println!("bunny_drop: {full} particles, quick {quick}");
     assert!((full as f64 - 80_000.0).abs() <= 0.15 * 80_000.0, "{full}");
     assert!(quick <= 10_000, "{quick}");
     check_inside(&s);
@@ -83,14 +74,10 @@ fn bunny_drop_matches_fig_3() {
 
 #[test]
 fn armadillo_splash_matches_table_1() {
-    let t = Instant::now();
     let s = Scene::load(&scene_path("armadillo_splash.toml")).unwrap();
     assert_eq!((s.solver.substeps(), s.solver.iterations()), (2, 3));
     let (full, quick) = counts(&s);
-    println!(
-        "armadillo_splash: {full} particles, quick {quick} (load {:?})",
-        t.elapsed()
-    );
+    println!("armadillo_splash: {full} particles, quick {quick}");
     assert!(
         (full as f64 - 128_000.0).abs() <= 0.15 * 128_000.0,
         "{full}"
