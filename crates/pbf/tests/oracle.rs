@@ -5,7 +5,10 @@
 //! Planted bugs these tests catch (each planted once in `src/passes.rs`, the tests run, the
 //! code restored; 2026-11-23): the density without its self term `m_i W(0)`, a halved `λ_i`,
 //! the denominator of eq. 11 without `|∇_{p_i} C_i|²`: each fails all six tests; the sign of
-//! `λ_j` flipped in `Δp_i` (eq. 14): fails all but `unilateral_lambda`, which checks `λ` only.
+//! `λ_j` flipped in `Δp_i` (eq. 14): fails all but `unilateral_lambda`, which checks `λ` only;
+//! `s_corr` with exponent `n − 1` instead of `n` (eq. 13): fails the four tests that use
+//! `s_corr`; the collision projection skipped in the Jacobi loop (line 14): fails
+//! `full_step`, the one test with a solid.
 
 mod common;
 

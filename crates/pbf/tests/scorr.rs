@@ -1,4 +1,7 @@
 //! Eq. 13 (artificial pressure) at hand-computed points, and its unit in eq. 14.
+//!
+//! Planted bug these catch (planted once in `src/scorr.rs`, the tests run, the code
+//! restored; 2026-11-23): the exponent `n − 1` instead of `n` fails both tests.
 
 use std::f64::consts::PI;
 

@@ -41,7 +41,8 @@ pub enum SceneError {
         file: PathBuf,
         /// Field path, e.g. `fluid[1].min`.
         field: String,
-        /// What is wrong.
+        /// What is wrong, ending with the field's line in the scene file (`(line 7)`) when
+        /// the error was found while parsing it.
         reason: String,
     },
     /// A mesh file is missing, unreadable, malformed or not closed.
@@ -53,7 +54,8 @@ pub enum SceneError {
         field: String,
         /// The mesh file, resolved against the scene file's directory.
         mesh: PathBuf,
-        /// What is wrong (for an open mesh: the first offending edge).
+        /// What is wrong, with the line of the mesh file (for an open mesh: the first
+        /// offending edge and the face it belongs to).
         reason: String,
     },
 }

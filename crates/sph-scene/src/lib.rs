@@ -173,14 +173,23 @@
 //!   exist, a file cut short before its faces, and the face an open edge belongs to.
 //! * After parsing, every value is checked: spacing, durations, radii and cells finite and
 //!   positive, every number finite, `min < max`, substeps/iterations ≥ 1, fluids inside the tank
-//!   (block or mesh bounds inside the tank box, every particle strictly inside it), no fluid
-//!   particle inside (or on) a solid, at most [`MAX_PARTICLES`] particles, mesh files that
-//!   exist and are closed. The scene with its `[quick]` overrides is validated too, so
-//!   [`Scene::quick`] cannot fail.
+//!   (block or mesh bounds inside the tank box, every particle strictly inside it), blocks at
+//!   least one spacing thick, no fluid particle inside (or on) a solid, at most
+//!   [`MAX_PARTICLES`] particles, mesh files that exist and are closed. The scene with its
+//!   `[quick]` overrides is validated too, so [`Scene::quick`] cannot fail.
+//! * Time stepping: at most [`sph_solver::MAX_SUBSTEPS`] substeps per frame and
+//!   [`MAX_FRAMES`] frames, and a solver step of `Δt = frame_dt / substeps` must not carry a
+//!   particle farther than the support radius `h`: `(|v0| + |g| Δt) Δt <= h` with `|v0|` the
+//!   largest initial speed (the Courant–Friedrichs–Lewy condition at Courant number 1 with
+//!   respect to `h`, as a refusal bound: beyond it the neighbours found once per step cannot
+//!   see what a particle hits). The message gives the fewest substeps that pass and the
+//!   longest frame with the current ones. `frame_dt = 1e30` is refused here instead of
+//!   blowing up at the first step.
 //! * Every [`SceneError`] names the scene file, the field path (`fluid[1].min`,
-//!   `solver.substeps`, …) and the reason, with the line and column for errors found while
-//!   reading the TOML (syntax, types, unknown or missing fields). The library does not panic
-//!   on any input.
+//!   `solver.substeps`, …) and the reason, with the line (and column) of the field in the
+//!   scene file. Mesh errors name the OBJ file and its line (a malformed number, a face
+//!   index that does not exist, a face with fewer than 3 corners, a file cut short before
+//!   its faces, the face an open edge belongs to). The library does not panic on any input.
 //!
 //! # Modules
 //!
