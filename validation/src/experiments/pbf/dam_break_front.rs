@@ -46,14 +46,14 @@ pub fn front_x<R: Real>(positions: &[sph_core::Vec3<R>], radius: f64) -> f64 {
 }
 
 /// Linear interpolation of `y(x)` in points sorted by `x`; `None` outside their span.
-fn interpolate(points: &[(f64, f64)], x: f64) -> Option<f64> {
+pub(crate) fn interpolate(points: &[(f64, f64)], x: f64) -> Option<f64> {
     points.windows(2).find_map(|w| {
         let ((x0, y0), (x1, y1)) = (w[0], w[1]);
         (x0 <= x && x <= x1 && x1 > x0).then(|| y0 + (y1 - y0) * (x - x0) / (x1 - x0))
     })
 }
 
-fn simulate<R: Real>(ctx: &Context, scene: &Scene) -> Result<(Vec<(f64, f64)>, usize)> {
+pub(crate) fn simulate<R: Real>(ctx: &Context, scene: &Scene) -> Result<(Vec<(f64, f64)>, usize)> {
     let mut sim = SceneSim::<R>::new(scene)?;
     let frames = scene.frame_count();
     let radius = 0.5 * scene.particle_spacing;
@@ -144,7 +144,26 @@ impl Experiment for DamBreakFront {
             "a-priori band of this project (15 %), set before the run: Martin & Moyce's run-to-run scatter \
              is not digitised, and the gate release delays the measured front at early T; not from the PBF paper",
         ));
-        let spec = PlotSpec {
+        // IISPH beside PBF (crate iisph-granular; same scene and front, volume-map walls)
+        let iisph = crate::experiments::granular::iisph_front::run(ctx, &measured);
+        match &iisph {
+            Ok(i) => {
+                out.metric("iisph/worst_relative_error", i.worst_relative_error);
+                out.check(Check::at_most(
+                    "front/IISPH max |Z_sim - Z_exp| / Z_exp",
+                    i.worst_relative_error.abs(),
+                    Z_BAND,
+                    "the same a-priori band as PBF's (15 %)",
+                ));
+            }
+            Err(e) => out.check(Check::equals(
+                "front/IISPH run completed",
+                0.0,
+                1.0,
+                format!("{e:#}"),
+            )),
+        }
+        let mut spec = PlotSpec {
             legend: Legend::UpperLeft,
             series: vec![
                 Series::line(format!("PBF, {particles} particles"), series.clone(), 0),
@@ -175,6 +194,11 @@ impl Experiment for DamBreakFront {
             ],
             ..PlotSpec::new("Dam break: surge front", "T = t·sqrt(2g/a)", "Z = x/a")
         };
+        if let Ok(i) = &iisph {
+            let label = format!("IISPH, {} particles", i.particles);
+            spec.series
+                .insert(1, Series::line(label, i.series.clone(), 1));
+        }
         plot_xy(&ctx.path("front.png"), &spec)?;
         ctx.add_plot(
             "front.png",
