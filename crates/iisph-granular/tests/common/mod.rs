@@ -1,0 +1,45 @@
+//! Scenes shared by the tests.
+
+#![allow(dead_code)]
+
+use iisph_granular::{Iisph, IisphParams, ParticleSet, Real};
+use sph_core::{Aabb, BoxSdf, Inverted};
+use sph_kernels::KernelKind;
+use sph_solver::boundary::{VolumeMapBoundary, VolumeMapOptions};
+use sph_solver::testing as t;
+use sph_solver::Solids;
+
+/// A block of `n` particles in the corner of a tank of `tank` spacings, with volume-map
+/// walls of the solver's kernel (contact distance s/4).
+pub fn block_solver<R: Real>(
+    p: IisphParams<R>,
+    n: [usize; 3],
+    tank: [f64; 3],
+) -> (Iisph<R>, ParticleSet<R>) {
+    let (mut state, solids, tank_box) = t::block_in_tank(&p.common, n, tank);
+    // Lift the block off the corner walls by half a spacing (it starts touching them).
+    let s = p.common.particle_spacing;
+    for x in &mut state.positions {
+        x.x += s * R::of_f64(0.5);
+        x.y += s * R::of_f64(0.5);
+        x.z += s * R::of_f64(0.5);
+    }
+    let b = VolumeMapBoundary::new(
+        solids,
+        KernelKind::CubicSpline,
+        p.common.support_radius,
+        tank_box,
+        p.common.particle_radius() * R::of_f64(0.5),
+        VolumeMapOptions::default(),
+    )
+    .unwrap();
+    (Iisph::with_boundary(p, Box::new(b)).unwrap(), state)
+}
+
+/// Solids of a closed tank of `tank` spacings.
+pub fn tank<R: Real>(s: R, tank: [f64; 3]) -> (Solids<R>, Aabb<R>) {
+    let v =
+        |a: [f64; 3]| sph_core::Vec3::new(R::of_f64(a[0]), R::of_f64(a[1]), R::of_f64(a[2])) * s;
+    let b = Aabb::new(sph_core::Vec3::zeros(), v(tank)).unwrap();
+    (vec![Box::new(Inverted(BoxSdf::new(b).unwrap()))], b)
+}
