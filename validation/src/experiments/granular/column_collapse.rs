@@ -28,8 +28,8 @@ use anyhow::{bail, Result};
 use iisph_granular::measure::{normalised_runout, runout, RunoutOptions};
 use sph_scene::{FluidSpec, Scene};
 
-use super::run_scene;
 use super::scene_edit::SceneText;
+use super::{run_scene, solver_error_check};
 use crate::helpers::{
     load_reference_csv, plot_xy, write_csv_rows, Legend, Marker, PlotSpec, Series, SeriesStyle,
 };
@@ -164,12 +164,7 @@ impl Experiment for GranularColumnCollapse {
             let tag = format!("a={a}");
             out.metric(format!("{tag}/particles"), run.particles as f64);
             if let Some(e) = &run.blow_up {
-                out.check(Check::equals(
-                    format!("{tag}/completed without a solver error"),
-                    0.0,
-                    1.0,
-                    format!("a blow-up is an error, not a result: {e}"),
-                ));
+                out.check(solver_error_check(&tag, e));
                 continue;
             }
             let opts = RunoutOptions::connected(0.0, s);

@@ -20,6 +20,7 @@ use sph_core::Real;
 use sph_scene::{Precision, Scene};
 
 use super::scene_edit::SceneText;
+use super::solver_error_check;
 use crate::helpers::write_csv_rows;
 use crate::sim::SceneSim;
 use crate::{Check, Context, Experiment, Mode, Outcome};
@@ -129,11 +130,9 @@ impl Experiment for GranularPerformance {
             let t = match t {
                 Ok(t) => t,
                 Err(e) => {
-                    out.check(Check::equals(
-                        format!("threads={threads}/completed without a solver error"),
-                        0.0,
-                        1.0,
-                        format!("{e:#}"),
+                    out.check(solver_error_check(
+                        &format!("threads={threads}"),
+                        &format!("{e:#}"),
                     ));
                     continue;
                 }

@@ -16,7 +16,7 @@ use sph_core::{Real, Vec3};
 use sph_scene::{Precision, Scene};
 
 use crate::sim::SceneSim;
-use crate::Context;
+use crate::{Check, Context};
 
 /// One frame of a run.
 #[derive(Debug, Clone, Copy)]
@@ -120,4 +120,15 @@ pub fn run_scene(ctx: &Context, scene: &Scene, snapshot_frames: &[usize]) -> Res
         Precision::F32 => run_in::<f32>(ctx, scene, snapshot_frames),
         Precision::F64 => run_in::<f64>(ctx, scene, snapshot_frames),
     }
+}
+
+/// The failing check of a run that a solver error (a blow-up) ended early: a blow-up is an
+/// error, not a result.
+pub fn solver_error_check(tag: &str, error: &str) -> Check {
+    Check::equals(
+        format!("{tag}/completed without a solver error"),
+        0.0,
+        1.0,
+        format!("a blow-up is an error, not a result: {error}"),
+    )
 }

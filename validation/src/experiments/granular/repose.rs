@@ -31,7 +31,7 @@ use sph_core::Vec3;
 use sph_scene::Scene;
 
 use super::scene_edit::SceneText;
-use super::{run_scene, SceneRun};
+use super::{run_scene, solver_error_check, SceneRun};
 use crate::helpers::{plot_xy, write_csv_rows, Legend, Marker, PlotSpec, Series, SeriesStyle};
 use crate::{Check, Context, Experiment, Outcome};
 
@@ -101,12 +101,7 @@ impl Experiment for GranularRepose {
             let tag = format!("theta={theta:.0}");
             out.metric(format!("{tag}/particles"), case.run.particles as f64);
             if let Some(e) = &case.run.blow_up {
-                out.check(Check::equals(
-                    format!("{tag}/completed without a solver error"),
-                    0.0,
-                    1.0,
-                    format!("a blow-up is an error, not a result: {e}"),
-                ));
+                out.check(solver_error_check(&tag, e));
                 continue;
             }
             let pos = &case.run.final_positions;
