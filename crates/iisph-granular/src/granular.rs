@@ -145,3 +145,105 @@ pub fn occlusion<R: Real>(upstream: &Vec3<R>, d: &Vec3<R>, cos_cone: R) -> R {
         ((cos_phi - cos_cone) / (R::one() - cos_cone)).min(R::one())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+    use sph_kernels::CubicSpline;
+
+    fn full(s: &Sym3<f64>) -> [[f64; 3]; 3] {
+        [[s[0], s[3], s[4]], [s[3], s[1], s[5]], [s[4], s[5], s[2]]]
+    }
+
+    proptest! {
+        /// The deviatoric part is traceless and differs from `s` by a multiple of I; the
+        /// yield clamp never exceeds `α p` and leaves stresses inside the cone unchanged.
+        #[test]
+        fn deviatoric_and_yield(c in prop::array::uniform6(-1e3f64..1e3), alpha in 0.0f64..1.4, p in -10.0f64..1e3) {
+            let d = deviatoric(&c);
+            prop_assert!((d[0] + d[1] + d[2]).abs() < 1e-9);
+            let shift = c[0] - d[0];
+            prop_assert!((c[1] - d[1] - shift).abs() < 1e-9 && (c[2] - d[2] - shift).abs() < 1e-9);
+            let y = yield_clamp(&d, alpha, p);
+            let norm: f64 = full(&y).iter().flatten().map(|v| v * v).sum::<f64>().sqrt();
+            prop_assert!((norm - frobenius(&y)).abs() < 1e-9 * (1.0 + norm));
+            prop_assert!(norm <= (alpha * p).max(0.0) * (1.0 + 1e-12) + 1e-12);
+            if frobenius(&d) <= alpha * p {
+                prop_assert_eq!(y, d);
+            }
+        }
+
+        /// `S v` equals the full matrix product.
+        #[test]
+        fn sym_mul_is_matrix_product(c in prop::array::uniform6(-10.0f64..10.0), v in prop::array::uniform3(-10.0f64..10.0)) {
+            let m = full(&c);
+            let r = sym_mul(&c, &Vec3::new(v[0], v[1], v[2]));
+            for a in 0..3 {
+                let e: f64 = (0..3).map(|b| m[a][b] * v[b]).sum();
+                prop_assert!((r[a] - e).abs() < 1e-9);
+            }
+        }
+    }
+
+    /// The prototype `D` against an explicit lattice sum of the full 3×3 tensor: isotropic
+    /// (off-diagonals 0, equal diagonal) and equal to `d`.
+    #[test]
+    fn prototype_d_is_isotropic() {
+        let (s, rho0, dt) = (0.025, 1000.0, 0.002);
+        let k = CubicSpline::new(2.0 * s).unwrap();
+        let d = prototype_friction_coefficient(&k, s, rho0, dt).unwrap();
+        let mut t = [[0.0f64; 3]; 3];
+        for a in -2i32..=2 {
+            for b in -2i32..=2 {
+                for c in -2i32..=2 {
+                    let r = Vec3::new(a as f64, b as f64, c as f64) * s;
+                    let g = k.gradient(&r);
+                    for i in 0..3 {
+                        for j in 0..3 {
+                            t[i][j] += g[i] * g[j];
+                        }
+                    }
+                }
+            }
+        }
+        let m = rho0 * s * s * s;
+        let f = 2.0 * m * m * dt / (rho0 * rho0) / rho0;
+        for i in 0..3 {
+            assert!((f * t[i][i] - d).abs() < 1e-12 * d);
+            for j in 0..3 {
+                if i != j {
+                    assert!(t[i][j].abs() < 1e-9 * t[0][0]);
+                }
+            }
+        }
+    }
+
+    /// Occlusion: 1 straight upstream, 0 outside the cone, in between inside; drag along
+    /// the relative velocity with magnitude ½ ρ_a |v|² C_D ω A.
+    #[test]
+    fn occlusion_and_drag() {
+        let up = Vec3::new(1.0, 0.0, 0.0);
+        let cos30 = 30f64.to_radians().cos();
+        assert_eq!(occlusion(&up, &Vec3::new(0.02, 0.0, 0.0), cos30), 1.0);
+        assert_eq!(occlusion(&up, &Vec3::new(0.0, 0.02, 0.0), cos30), 0.0);
+        assert_eq!(occlusion(&up, &Vec3::new(-0.02, 0.0, 0.0), cos30), 0.0);
+        let o = occlusion(&up, &Vec3::new(1.0, 0.2, 0.0), cos30);
+        assert!(o > 0.0 && o < 1.0);
+        let f: Vec3<f64> = drag_force(Vec3::new(0.0, 3.0, 4.0), 1.2, 0.5, 0.01, 0.5);
+        let expect = 0.5 * 1.2 * 25.0 * 0.5 * 0.5 * 0.01;
+        assert!((f.norm() - expect).abs() < 1e-12);
+        assert!((f.normalize() - Vec3::new(0.0, 0.6, 0.8)).norm() < 1e-12);
+        assert_eq!(
+            drag_force(Vec3::<f64>::zeros(), 1.2, 0.5, 0.01, 1.0),
+            Vec3::zeros()
+        );
+    }
+
+    /// The strain rate of a linear field u = G x is the symmetric part of G.
+    #[test]
+    fn strain_rate_is_symmetric_part() {
+        let g = [[1.0, 2.0, 3.0], [4.0, 5.0, 6.0], [7.0, 8.0, 9.0]];
+        assert_eq!(strain_rate(&g), [1.0, 5.0, 9.0, 3.0, 5.0, 7.0]);
+    }
+}

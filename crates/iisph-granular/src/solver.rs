@@ -693,6 +693,14 @@ pub(crate) fn advection_pass<R: Real>(
             *aii = -dt2 / (rhoi * rhoi) * (gi.norm_squared() + mi * sum_grad_sq);
             *pr *= half;
             if granular {
+                // The static walls' share of the velocity gradient, Σ_b V_b (0 − u_i) ⊗
+                // ∇W_ib = −u_i ⊗ ∇Ψ_i (no-slip walls, as the fluid sees them in eq. 30).
+                let bg = bgrad[i];
+                for a in 0..3 {
+                    for b in 0..3 {
+                        vgrad[a][b] -= vi[a] * bg[b];
+                    }
+                }
                 // s = −D⁻¹ ε (eq. 10 with the sign of eq. 26), deviatoric (eqs. 11–12).
                 let eps = strain_rate(&vgrad);
                 let trial = deviatoric(&eps.map(|e| -e * c.inv_friction_d));

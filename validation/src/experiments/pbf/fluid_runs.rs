@@ -158,6 +158,8 @@ pub fn run_fluid(
     let name = match kind {
         SolverKind::Pbf => "PBF",
         SolverKind::Pcisph => "PCISPH",
+        SolverKind::Iisph => "IISPH",
+        SolverKind::Granular => "IISPH-granular",
     };
     let walls = match scene.boundary.model {
         sph_scene::BoundaryModel::VolumeMap => "volume maps",
