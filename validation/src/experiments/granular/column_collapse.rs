@@ -8,7 +8,7 @@
 //! (the `a = 2` column; its spacing, friction angle 30°, slab depth and boundary): a block
 //! `[0, L0] × [0, a L0]` against the end wall `x = 0`; the tank `L0 (1 + 1.6 r(a)) + 4 s` long
 //! (`r(a)` the law's runout, so the deposit has room) and `a L0 + 4 s` high; the duration
-//! `0.5 s + 8 √(H0/g)` (the collapse takes a few free-fall times `√(H0/g)`); the step scaled so
+//! `0.5 s + 6 √(H0/g)` (the collapse takes a few free-fall times `√(H0/g)`); the step scaled so
 //! that a particle at the free-fall speed `√(2 g H0)` moves the template's fraction of a
 //! spacing per step.
 //!
@@ -95,7 +95,7 @@ fn column_scene(template: &SceneText, base: &Scene, a: f64, laws: &[Regime; 2]) 
     let dt_template = base.frame_dt_s / base.solver.substeps() as f64;
     let courant = (2.0 * g * h0_template).sqrt() * dt_template / s;
     let substeps = (base.frame_dt_s * (2.0 * g * h0).sqrt() / (courant * s)).ceil() as i64;
-    let duration = 0.5 + 8.0 * (h0 / g).sqrt();
+    let duration = 0.5 + 6.0 * (h0 / g).sqrt();
     let mut text = template.clone();
     text.set_block_and_tank(
         [0.0, 0.0, 0.0],

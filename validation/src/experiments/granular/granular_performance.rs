@@ -4,7 +4,7 @@
 //! The pile: the 30° repose scene (`scenes/granular_repose_30.toml`) with a block of
 //! 0.4 × 0.25 × 0.125 m at a spacing of 5 mm (80 × 50 × 25 = 100,000 particles) resting on the
 //! floor of a 1.2 m long tank, 1 ms steps, one step per frame. [`WARM_UP_STEPS`] steps are run
-//! first (buffers grown, particles reordered by cell), then the measured steps (quick: 10,
+//! first (buffers grown, particles reordered by cell), then the measured steps (quick: 5,
 //! full: 50). Timings are metrics, not checks: they depend on the machine and its load.
 //!
 //! Checks (things that can fail for real): the steps complete without a solver error and
@@ -115,7 +115,7 @@ impl Experiment for GranularPerformance {
     }
 
     fn run(&self, ctx: &mut Context) -> Result<Outcome> {
-        let measured = ctx.mode.pick(10, 50);
+        let measured = ctx.mode.pick(5, 50);
         let scene = pile_scene(ctx.mode, measured)?;
         let thread_counts: Vec<usize> = ctx.mode.pick(vec![2], vec![1, 2]);
         ctx.progress
