@@ -65,15 +65,7 @@ fn to_f64<R: Real>(p: &[Vec3<R>]) -> Vec<Vec3<f64>> {
 fn run_in<R: Real>(ctx: &Context, scene: &Scene, snapshot_frames: &[usize]) -> Result<SceneRun> {
     let mut sim = SceneSim::<R>::new(scene)?;
     let frames = scene.frame_count();
-    let g = scene.gravity.iter().map(|x| x * x).sum::<f64>().sqrt();
-    let floor = scene.tank.map_or(0.0, |t| t.min.y);
-    let initial_potential_energy_j = sim
-        .state
-        .positions
-        .iter()
-        .zip(&sim.state.masses)
-        .map(|(p, m)| m.as_f64() * g * (p.y.as_f64() - floor))
-        .sum();
+    let initial_potential_energy_j = crate::experiments::fluid_runs::potential_energy_j(&sim);
     let mut run = SceneRun {
         particles: sim.state.len(),
         frames: Vec::with_capacity(frames),
