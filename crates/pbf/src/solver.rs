@@ -7,6 +7,7 @@ use neighbour_search::NeighbourLists;
 use rayon::prelude::*;
 use sph_core::{validate_finite_positions, CoreError, ParticleSet, Real, Sdf, Vec3};
 use sph_kernels::Kernel;
+use sph_solver::boundary::check_volume_kernel;
 use sph_solver::step::{
     begin_frame, check_divergence, check_masses, check_predicted, end_frame, CellReorder,
     FramePhases, StepAt, StepNeighbours, MIN_LEN,
@@ -187,7 +188,7 @@ impl<R: Real> Pbf<R> {
         boundary: Box<dyn Boundary<R>>,
     ) -> Result<Self, SolverError> {
         params.validate()?;
-        check_boundary_kernel(NAME, &*boundary, "poly6", params.common.support_radius)?;
+        check_volume_kernel(&*boundary, NAME, "poly6", params.common.support_radius)?;
         let c = Consts::new(&params)?;
         Ok(Self {
             neighbours: StepNeighbours::new(params.common.neighbour_method),
@@ -209,7 +210,7 @@ impl<R: Real> Pbf<R> {
     /// support radius must stay that of a volume boundary's kernel.
     pub fn set_params(&mut self, params: PbfParams<R>) -> Result<(), SolverError> {
         params.validate()?;
-        check_boundary_kernel(NAME, &*self.boundary, "poly6", params.common.support_radius)?;
+        check_volume_kernel(&*self.boundary, NAME, "poly6", params.common.support_radius)?;
         self.c = Consts::new(&params)?;
         self.neighbours.set_method(params.common.neighbour_method);
         self.params = params;
@@ -582,33 +583,5 @@ fn velocity_update<R: Real>(input: VelocityInput<'_, R>, s: &mut PbfScratch<R>) 
                 }
                 *vn = out;
             });
-    }
-}
-
-/// A boundary that takes part in the density must have been integrated with the solver's
-/// density kernel `kernel` of support radius `h`.
-pub(crate) fn check_boundary_kernel<R: Real>(
-    solver: &'static str,
-    boundary: &dyn Boundary<R>,
-    kernel: &'static str,
-    h: R,
-) -> Result<(), SolverError> {
-    if !boundary.has_volume() {
-        return Ok(());
-    }
-    match boundary.volume_kernel() {
-        Some((name, hb)) if name == kernel && (hb - h).abs() <= h * R::of_f64(1e-6) => Ok(()),
-        Some((_, hb)) => Err(SolverError::InvalidParameter {
-            solver,
-            name: "boundary",
-            value: hb.as_f64(),
-            reason: "the boundary's volumes were integrated with another kernel or support radius than the solver's density kernel",
-        }),
-        None => Err(SolverError::InvalidParameter {
-            solver,
-            name: "boundary",
-            value: f64::NAN,
-            reason: "a boundary with volume must name its kernel",
-        }),
     }
 }

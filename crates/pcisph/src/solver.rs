@@ -7,6 +7,7 @@ use neighbour_search::NeighbourLists;
 use rayon::prelude::*;
 use sph_core::{ParticleSet, Real, Sdf, Vec3};
 use sph_kernels::{Kernel, Poly6, Spiky};
+use sph_solver::boundary::check_volume_kernel;
 use sph_solver::step::{
     begin_frame, check_divergence, check_predicted, end_frame, CellReorder, FramePhases, StepAt,
     StepNeighbours, MIN_LEN,
@@ -174,7 +175,7 @@ impl<R: Real> Pcisph<R> {
         boundary: Box<dyn Boundary<R>>,
     ) -> Result<Self, SolverError> {
         params.validate()?;
-        check_boundary_kernel(&*boundary, params.common.support_radius)?;
+        check_volume_kernel(&*boundary, NAME, "poly6", params.common.support_radius)?;
         let c = Consts::new(&params)?;
         Ok(Self {
             neighbours: StepNeighbours::new(params.common.neighbour_method),
@@ -426,22 +427,5 @@ impl<R: Real> Pcisph<R> {
         stats.substeps += 1;
         stats.neighbour_pairs = nb.pair_count();
         Ok(())
-    }
-}
-
-/// A boundary that takes part in the density must have been integrated with Poly6 of
-/// support radius `h`.
-fn check_boundary_kernel<R: Real>(boundary: &dyn Boundary<R>, h: R) -> Result<(), SolverError> {
-    if !boundary.has_volume() {
-        return Ok(());
-    }
-    match boundary.volume_kernel() {
-        Some((name, hb)) if name == "poly6" && (hb - h).abs() <= h * R::of_f64(1e-6) => Ok(()),
-        other => Err(SolverError::InvalidParameter {
-            solver: NAME,
-            name: "boundary",
-            value: other.map_or(f64::NAN, |(_, hb)| hb.as_f64()),
-            reason: "the boundary's volumes were not integrated with Poly6 of the solver's support radius",
-        }),
     }
 }

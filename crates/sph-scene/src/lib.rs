@@ -89,7 +89,7 @@
 //!
 //! [solver]                         # one table per solver, selected by `kind`; the fields of
 //!                                  # another solver are refused (unknown field)
-//! kind = "pbf"                     # "pbf" | "pcisph"
+//! kind = "pbf"                     # "pbf" | "pcisph" | "iisph" | "granular"
 //! substeps = 4                     # solver steps per frame (>= 1)
 //! iterations = 3                   # PBF: constraint iterations per step; PCISPH: max
 //!                                  # pressure iterations per step (>= 1)
@@ -111,7 +111,29 @@
 //! # kind = "pcisph" only:
 //! # clamp_negative_pressure = true
 //! # density_error_tolerance = 0.01 # relative density error to stop at (> 0)
+//! ```
 //!
+//! The IISPH kinds (crate `iisph-granular`) have no `iterations` and no `xsph_c`:
+//!
+//! ```toml
+//! [solver]
+//! kind = "iisph"                   # water; "granular" adds the fields below
+//! substeps = 8                     # solver steps per frame (>= 1, required)
+//! # max_iterations = 100           # relaxed-Jacobi cap (>= min_iterations)
+//! # min_iterations = 2             # (>= 1)
+//! # density_error_tolerance = 0.001 # average relative compression to stop at (> 0)
+//! # relaxation = 0.5               # Jacobi ω, in (0, 1]
+//! # rest_density, support_over_spacing, reorder_every as above
+//! # viscosity = 0.0                # kinematic viscosity ν of an explicit SPH viscosity
+//! #                                # force, m²/s (>= 0)
+//! # kind = "granular" only:
+//! # friction_angle_deg = 30.0      # required, in [0, 90): Drucker–Prager α = √2 sin θ
+//! # drag_coefficient = 0.0         # C_D of the air drag (>= 0; 0 = off)
+//! # air_velocity = [0.0, 0.0, 0.0] # m/s, uniform
+//! # upscaling_factor = 8           # passive points per particle (>= 1; absent = off)
+//! ```
+//!
+//! ```toml
 //! [boundary]                       # optional
 //! model = "volume-map"             # "volume-map" | "collision" (default: BoundaryModel's
 //!                                  # Default, "volume-map")
@@ -211,8 +233,9 @@ use sph_core::{Real, Vec3};
 
 pub use error::SceneError;
 pub use spec::{
-    BoundaryModel, BoundarySpec, FluidSpec, MeshPlacement, MeshSpec, OutputSpec, PbfSpec,
-    PcisphSpec, Precision, QuickSpec, Scene, SolidSpec, SolverKind, SolverSpec,
+    BoundaryModel, BoundarySpec, FluidSpec, GranularSpec, IisphSpec, MeshPlacement, MeshSpec,
+    OutputSpec, PbfSpec, PcisphSpec, Precision, QuickSpec, Scene, SolidSpec, SolverKind,
+    SolverSpec, DEFAULT_IISPH_MAX_ITERATIONS, DEFAULT_IISPH_MIN_ITERATIONS,
 };
 
 /// Largest total number of fluid particles a scene may produce (20 M).

@@ -23,7 +23,7 @@ use crate::raw::{
 };
 use crate::{
     fmt3, v3, FluidSpec, OutputSpec, Precision, QuickSpec, Scene, SceneError, SolidSpec,
-    SolverSpec, AXES,
+    SolverSpec, AXES, DEFAULT_IISPH_MIN_ITERATIONS,
 };
 
 /// The `[solver]` table as parsed (with spans), for [`solver::parse`].
@@ -373,8 +373,14 @@ fn quick(ctx: &Ctx, q: &RawQuick, solver: &SolverSpec) -> Result<QuickSpec, Scen
             return Err(ctx.invalid(format!("quick.{name}"), "must be >= 1, got 0"));
         }
     }
-    if let (Some(k), SolverSpec::Pbf(p)) = (q.iterations, solver) {
-        if let Some(min) = p.min_iterations.filter(|&min| k < min) {
+    let min_iterations = match solver {
+        SolverSpec::Pbf(p) => p.min_iterations,
+        SolverSpec::Pcisph(_) => None,
+        SolverSpec::Iisph(p) => Some(p.min_iterations.unwrap_or(DEFAULT_IISPH_MIN_ITERATIONS)),
+        SolverSpec::Granular(p) => Some(p.min_iterations.unwrap_or(DEFAULT_IISPH_MIN_ITERATIONS)),
+    };
+    if let Some(k) = q.iterations {
+        if let Some(min) = min_iterations.filter(|&min| k < min) {
             return Err(ctx.invalid(
                 "quick.iterations",
                 format!("must be >= solver.min_iterations = {min}, got {k}"),

@@ -27,14 +27,21 @@ pub enum SolverKind {
     Pbf,
     /// Predictive-corrective incompressible SPH (Solenthaler & Pajarola 2009).
     Pcisph,
+    /// Implicit incompressible SPH (Ihmsen et al. 2014), water.
+    Iisph,
+    /// IISPH with Drucker–Prager friction, drag and upscaling for granular matter (Neder
+    /// 2024).
+    Granular,
 }
 
 impl SolverKind {
-    /// The name used in scene files: `"pbf"` or `"pcisph"`.
+    /// The name used in scene files: `"pbf"`, `"pcisph"`, `"iisph"` or `"granular"`.
     pub fn name(self) -> &'static str {
         match self {
             SolverKind::Pbf => "pbf",
             SolverKind::Pcisph => "pcisph",
+            SolverKind::Iisph => "iisph",
+            SolverKind::Granular => "granular",
         }
     }
 }
@@ -57,6 +64,10 @@ pub enum SolverSpec {
     Pbf(PbfSpec),
     /// PCISPH (`kind = "pcisph"`).
     Pcisph(PcisphSpec),
+    /// IISPH for water (`kind = "iisph"`).
+    Iisph(IisphSpec),
+    /// IISPH for granular matter (`kind = "granular"`).
+    Granular(GranularSpec),
 }
 
 /// PBF settings (`[solver] kind = "pbf"`).
@@ -117,12 +128,71 @@ pub struct PcisphSpec {
     pub density_error_tolerance: Option<f64>,
 }
 
+/// IISPH settings for water (`[solver] kind = "iisph"`); see the `iisph-granular` crate.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IisphSpec {
+    /// Solver steps per frame (≥ 1).
+    pub substeps: usize,
+    /// Most relaxed-Jacobi iterations per step (≥ `min_iterations`; default 100).
+    pub max_iterations: Option<usize>,
+    /// Fewest iterations per step (≥ 1; default 2).
+    pub min_iterations: Option<usize>,
+    /// Average relative density error at which the iterations stop (> 0; default 0.001).
+    pub density_error_tolerance: Option<f64>,
+    /// Jacobi relaxation `ω`, in (0, 1] (default 0.5).
+    pub relaxation: Option<f64>,
+    /// Rest density (kg/m³, > 0).
+    pub rest_density: Option<f64>,
+    /// Support radius over particle spacing (> 1).
+    pub support_over_spacing: Option<f64>,
+    /// Reorder particles every this many frames (0 = never).
+    pub reorder_every: Option<usize>,
+    /// Kinematic viscosity `ν` (m²/s, ≥ 0; default 0) of the explicit SPH viscosity force.
+    pub viscosity: Option<f64>,
+}
+
+/// IISPH settings for granular matter (`[solver] kind = "granular"`): those of
+/// [`IisphSpec`] plus friction, drag and upscaling.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GranularSpec {
+    /// Solver steps per frame (≥ 1).
+    pub substeps: usize,
+    /// Most relaxed-Jacobi iterations per step (≥ `min_iterations`; default 100).
+    pub max_iterations: Option<usize>,
+    /// Fewest iterations per step (≥ 1; default 2).
+    pub min_iterations: Option<usize>,
+    /// Average relative density error at which the iterations stop (> 0; default 0.001).
+    pub density_error_tolerance: Option<f64>,
+    /// Jacobi relaxation `ω`, in (0, 1] (default 0.5).
+    pub relaxation: Option<f64>,
+    /// Rest density (kg/m³, > 0).
+    pub rest_density: Option<f64>,
+    /// Support radius over particle spacing (> 1).
+    pub support_over_spacing: Option<f64>,
+    /// Reorder particles every this many frames (0 = never).
+    pub reorder_every: Option<usize>,
+    /// Kinematic viscosity `ν` (m²/s, ≥ 0; default 0) of the explicit SPH viscosity force.
+    pub viscosity: Option<f64>,
+    /// Friction angle `θ` (degrees, in [0, 90); required): Drucker–Prager `α = √2 sin θ`.
+    pub friction_angle_deg: f64,
+    /// Drag coefficient `C_D` (≥ 0; default 0 = no drag).
+    pub drag_coefficient: Option<f64>,
+    /// Uniform air velocity (m/s; default 0).
+    pub air_velocity: Option<[f64; 3]>,
+    /// Passive high-resolution points per simulation particle (≥ 1; absent = no upscaling).
+    pub upscaling_factor: Option<usize>,
+}
+
 impl SolverSpec {
     /// Which solver.
     pub fn kind(&self) -> SolverKind {
         match self {
             SolverSpec::Pbf(_) => SolverKind::Pbf,
             SolverSpec::Pcisph(_) => SolverKind::Pcisph,
+            SolverSpec::Iisph(_) => SolverKind::Iisph,
+            SolverSpec::Granular(_) => SolverKind::Granular,
         }
     }
 
@@ -136,14 +206,19 @@ impl SolverSpec {
         match self {
             SolverSpec::Pbf(s) => s.substeps,
             SolverSpec::Pcisph(s) => s.substeps,
+            SolverSpec::Iisph(s) => s.substeps,
+            SolverSpec::Granular(s) => s.substeps,
         }
     }
 
-    /// PBF: constraint iterations per step; PCISPH: maximum pressure iterations per step.
+    /// PBF: constraint iterations per step; PCISPH: maximum pressure iterations per step;
+    /// IISPH and granular: `max_iterations` (default [`DEFAULT_IISPH_MAX_ITERATIONS`]).
     pub fn iterations(&self) -> usize {
         match self {
             SolverSpec::Pbf(s) => s.iterations,
             SolverSpec::Pcisph(s) => s.iterations,
+            SolverSpec::Iisph(s) => s.max_iterations.unwrap_or(DEFAULT_IISPH_MAX_ITERATIONS),
+            SolverSpec::Granular(s) => s.max_iterations.unwrap_or(DEFAULT_IISPH_MAX_ITERATIONS),
         }
     }
 
@@ -152,6 +227,8 @@ impl SolverSpec {
         match self {
             SolverSpec::Pbf(s) => s.substeps = n,
             SolverSpec::Pcisph(s) => s.substeps = n,
+            SolverSpec::Iisph(s) => s.substeps = n,
+            SolverSpec::Granular(s) => s.substeps = n,
         }
     }
 
@@ -160,6 +237,8 @@ impl SolverSpec {
         match self {
             SolverSpec::Pbf(s) => s.iterations = n,
             SolverSpec::Pcisph(s) => s.iterations = n,
+            SolverSpec::Iisph(s) => s.max_iterations = Some(n),
+            SolverSpec::Granular(s) => s.max_iterations = Some(n),
         }
     }
 
@@ -168,6 +247,8 @@ impl SolverSpec {
         match self {
             SolverSpec::Pbf(s) => s.support_over_spacing,
             SolverSpec::Pcisph(s) => s.support_over_spacing,
+            SolverSpec::Iisph(s) => s.support_over_spacing,
+            SolverSpec::Granular(s) => s.support_over_spacing,
         }
     }
 
@@ -176,47 +257,108 @@ impl SolverSpec {
         match self {
             SolverSpec::Pbf(s) => s.rest_density,
             SolverSpec::Pcisph(s) => s.rest_density,
+            SolverSpec::Iisph(s) => s.rest_density,
+            SolverSpec::Granular(s) => s.rest_density,
         }
     }
 
     /// These settings for solver `kind`: a copy when `kind` is this solver's; otherwise the
-    /// settings both solvers have (substeps, iterations, rest density, support ratio, XSPH
-    /// `c`, reordering) carried over and this solver's own options dropped (the other
-    /// solver's defaults apply).
+    /// settings the solvers share (substeps, rest density, support ratio, reordering; the
+    /// iteration count and XSPH `c` between PBF and PCISPH; every IISPH setting between
+    /// `iisph` and `granular`) carried over and the rest left to the other solver's defaults
+    /// (a `granular` made from another kind gets `friction_angle_deg = 0`, i.e. no friction).
     pub fn with_kind(&self, kind: SolverKind) -> SolverSpec {
-        match (self, kind) {
-            (SolverSpec::Pbf(_), SolverKind::Pbf) | (SolverSpec::Pcisph(_), SolverKind::Pcisph) => {
-                self.clone()
-            }
-            (SolverSpec::Pcisph(s), SolverKind::Pbf) => SolverSpec::Pbf(PbfSpec {
+        if self.kind() == kind {
+            return self.clone();
+        }
+        let xsph_c = match self {
+            SolverSpec::Pbf(s) => s.xsph_c,
+            SolverSpec::Pcisph(s) => s.xsph_c,
+            _ => None,
+        };
+        let reorder_every = match self {
+            SolverSpec::Pbf(s) => s.reorder_every,
+            SolverSpec::Pcisph(s) => s.reorder_every,
+            SolverSpec::Iisph(s) => s.reorder_every,
+            SolverSpec::Granular(s) => s.reorder_every,
+        };
+        let iisph = match self {
+            SolverSpec::Iisph(s) => s.clone(),
+            SolverSpec::Granular(s) => IisphSpec {
                 substeps: s.substeps,
-                iterations: s.iterations,
+                max_iterations: s.max_iterations,
+                min_iterations: s.min_iterations,
+                density_error_tolerance: s.density_error_tolerance,
+                relaxation: s.relaxation,
                 rest_density: s.rest_density,
                 support_over_spacing: s.support_over_spacing,
+                reorder_every: s.reorder_every,
+                viscosity: s.viscosity,
+            },
+            _ => IisphSpec {
+                substeps: self.substeps(),
+                max_iterations: None,
+                min_iterations: None,
+                density_error_tolerance: None,
+                relaxation: None,
+                rest_density: self.rest_density(),
+                support_over_spacing: self.support_over_spacing(),
+                reorder_every,
+                viscosity: None,
+            },
+        };
+        match kind {
+            SolverKind::Pbf => SolverSpec::Pbf(PbfSpec {
+                substeps: self.substeps(),
+                iterations: self.iterations(),
+                rest_density: self.rest_density(),
+                support_over_spacing: self.support_over_spacing(),
                 relative_cfm: None,
                 scorr_k: None,
                 scorr_n: None,
                 scorr_delta_q: None,
                 vorticity_epsilon: None,
-                xsph_c: s.xsph_c,
-                reorder_every: s.reorder_every,
+                xsph_c,
+                reorder_every,
                 clamp_negative_constraint: None,
                 mean_compression_tolerance: None,
                 min_iterations: None,
             }),
-            (SolverSpec::Pbf(s), SolverKind::Pcisph) => SolverSpec::Pcisph(PcisphSpec {
-                substeps: s.substeps,
-                iterations: s.iterations,
-                rest_density: s.rest_density,
-                support_over_spacing: s.support_over_spacing,
-                xsph_c: s.xsph_c,
-                reorder_every: s.reorder_every,
+            SolverKind::Pcisph => SolverSpec::Pcisph(PcisphSpec {
+                substeps: self.substeps(),
+                iterations: self.iterations(),
+                rest_density: self.rest_density(),
+                support_over_spacing: self.support_over_spacing(),
+                xsph_c,
+                reorder_every,
                 clamp_negative_pressure: None,
                 density_error_tolerance: None,
+            }),
+            SolverKind::Iisph => SolverSpec::Iisph(iisph),
+            SolverKind::Granular => SolverSpec::Granular(GranularSpec {
+                substeps: iisph.substeps,
+                max_iterations: iisph.max_iterations,
+                min_iterations: iisph.min_iterations,
+                density_error_tolerance: iisph.density_error_tolerance,
+                relaxation: iisph.relaxation,
+                rest_density: iisph.rest_density,
+                support_over_spacing: iisph.support_over_spacing,
+                reorder_every: iisph.reorder_every,
+                viscosity: iisph.viscosity,
+                friction_angle_deg: 0.0,
+                drag_coefficient: None,
+                air_velocity: None,
+                upscaling_factor: None,
             }),
         }
     }
 }
+
+/// Default `max_iterations` of the IISPH kinds (SPlisHSPlasH's default cap).
+pub const DEFAULT_IISPH_MAX_ITERATIONS: usize = 100;
+
+/// Default `min_iterations` of the IISPH kinds (Ihmsen et al. 2014: at least two).
+pub const DEFAULT_IISPH_MIN_ITERATIONS: usize = 2;
 
 /// How the solver treats the tank and the solids (the `[boundary]` table's `model`).
 ///

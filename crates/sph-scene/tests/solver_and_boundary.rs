@@ -98,12 +98,12 @@ fn pcisph_field_under_pbf_is_refused_with_path_and_line() {
 
 #[test]
 fn unknown_solver_kind_names_the_allowed_kinds() {
-    let e = err_with("bad_solver_kind", "kind = \"pbf\"", "kind = \"iisph\"");
+    let e = err_with("bad_solver_kind", "kind = \"pbf\"", "kind = \"sph\"");
     assert_names(
         &e,
         "bad_solver_kind",
         "solver.kind",
-        "unknown variant `iisph`, expected `pbf` or `pcisph`",
+        "unknown variant `sph`, expected one of `pbf`, `pcisph`, `iisph`, `granular`",
     );
     assert!(e.to_string().contains(KIND_LINE), "{e}");
 }

@@ -5,11 +5,12 @@
 //! [`build_solver`] with the function that turns the variant's settings into the solver's
 //! parameters.
 
+use iisph_granular::{GranularParams, Iisph, IisphParams};
 use pbf::{Pbf, PbfParams};
 use pcisph::{Pcisph, PcisphParams};
 use sph_core::{Aabb, Real, Vec3};
 use sph_kernels::KernelKind;
-use sph_scene::{BoundaryModel, PbfSpec, PcisphSpec, Scene, SolverSpec};
+use sph_scene::{BoundaryModel, GranularSpec, IisphSpec, PbfSpec, PcisphSpec, Scene, SolverSpec};
 use sph_solver::boundary::{VolumeMapBoundary, VolumeMapOptions};
 use sph_solver::{Boundary, CollisionBoundary, CommonParams, FluidSolver, SolverError};
 
@@ -51,7 +52,80 @@ pub fn build_solver<R: Real>(scene: &Scene) -> Result<Box<dyn FluidSolver<R>>, S
             let b = build_boundary(scene, &p.common)?;
             Ok(Box::new(Pcisph::with_boundary(p, b).map_err(setup)?))
         }
+        SolverSpec::Iisph(s) => {
+            let p = iisph_params::<R>(scene, s).map_err(setup)?;
+            let b = build_boundary_with_kernel(scene, &p.common, KernelKind::CubicSpline)?;
+            Ok(Box::new(Iisph::with_boundary(p, b).map_err(setup)?))
+        }
+        SolverSpec::Granular(s) => {
+            let p = granular_params::<R>(scene, s).map_err(setup)?;
+            let b = build_boundary_with_kernel(scene, &p.common, KernelKind::CubicSpline)?;
+            Ok(Box::new(Iisph::with_boundary(p, b).map_err(setup)?))
+        }
     }
+}
+
+/// The IISPH (water) parameters a scene asks for: `IisphParams::for_spacing` at the scene's
+/// spacing, then the scene's frame length and gravity and the settings `s` of its
+/// `[solver]` section. Validated.
+pub fn iisph_params<R: Real>(scene: &Scene, s: &IisphSpec) -> Result<IisphParams<R>, SolverError> {
+    let mut p = IisphParams::<R>::for_spacing(r(scene.particle_spacing));
+    p.common = common_from_scene(
+        scene,
+        p.common,
+        s.substeps,
+        s.support_over_spacing,
+        s.rest_density,
+        s.reorder_every,
+    );
+    if let Some(k) = s.max_iterations {
+        p.max_iterations = k;
+    }
+    if let Some(k) = s.min_iterations {
+        p.min_iterations = k;
+    }
+    if let Some(t) = s.density_error_tolerance {
+        p.density_error_tolerance = r(t);
+    }
+    if let Some(w) = s.relaxation {
+        p.relaxation = r(w);
+    }
+    if let Some(nu) = s.viscosity {
+        p.viscosity = r(nu);
+    }
+    p.validate()?;
+    Ok(p)
+}
+
+/// The granular IISPH parameters a scene asks for: [`iisph_params`] of the shared settings,
+/// then friction angle, drag, air velocity and upscaling. Validated.
+pub fn granular_params<R: Real>(
+    scene: &Scene,
+    s: &GranularSpec,
+) -> Result<IisphParams<R>, SolverError> {
+    let shared = IisphSpec {
+        substeps: s.substeps,
+        max_iterations: s.max_iterations,
+        min_iterations: s.min_iterations,
+        density_error_tolerance: s.density_error_tolerance,
+        relaxation: s.relaxation,
+        rest_density: s.rest_density,
+        support_over_spacing: s.support_over_spacing,
+        reorder_every: s.reorder_every,
+        viscosity: s.viscosity,
+    };
+    let mut p = iisph_params::<R>(scene, &shared)?;
+    let mut g = GranularParams::with_friction_angle(r(s.friction_angle_deg));
+    if let Some(c) = s.drag_coefficient {
+        g.drag_coefficient = r(c);
+    }
+    if let Some(v) = s.air_velocity {
+        g.air_velocity = vec3(v);
+    }
+    p.granular = Some(g);
+    p.upscaling_factor = s.upscaling_factor;
+    p.validate()?;
+    Ok(p)
 }
 
 /// The parameters every solver takes from the scene: spacing, support radius, rest
@@ -184,12 +258,22 @@ fn domain<R: Real>(scene: &Scene) -> Result<Aabb<R>, SimError> {
 }
 
 /// The boundary a scene asks for (`[boundary] model`), for a solver with the parameters
-/// `c`: its solids as a [`CollisionBoundary`] at the particle radius, or as a
-/// [`VolumeMapBoundary`] of Poly6 at the support radius (the density kernel of PBF and
-/// PCISPH) with contact distance [`VOLUME_MAP_CONTACT_FRACTION`] of the particle radius.
+/// `c` and the density kernel Poly6 (PBF, PCISPH): [`build_boundary_with_kernel`].
 pub fn build_boundary<R: Real>(
     scene: &Scene,
     c: &CommonParams<R>,
+) -> Result<Box<dyn Boundary<R>>, SimError> {
+    build_boundary_with_kernel(scene, c, KernelKind::Poly6)
+}
+
+/// The boundary a scene asks for (`[boundary] model`), for a solver with the parameters
+/// `c` and the density kernel `kernel`: its solids as a [`CollisionBoundary`] at the
+/// particle radius, or as a [`VolumeMapBoundary`] of `kernel` at the support radius with
+/// contact distance [`VOLUME_MAP_CONTACT_FRACTION`] of the particle radius.
+pub fn build_boundary_with_kernel<R: Real>(
+    scene: &Scene,
+    c: &CommonParams<R>,
+    kernel: KernelKind,
 ) -> Result<Box<dyn Boundary<R>>, SimError> {
     let solids = scene.build_solids::<R>()?;
     let setup = |source| setup_error(scene, source);
@@ -200,7 +284,7 @@ pub fn build_boundary<R: Real>(
         BoundaryModel::VolumeMap => {
             let b = VolumeMapBoundary::new(
                 solids,
-                KernelKind::Poly6,
+                kernel,
                 c.support_radius,
                 domain(scene)?,
                 c.particle_radius() * r::<R>(VOLUME_MAP_CONTACT_FRACTION),

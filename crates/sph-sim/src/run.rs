@@ -78,7 +78,8 @@ pub fn create_output_dir(dir: &Path) -> Result<(), SimError> {
 }
 
 /// Loads the scene at `path` and runs it: a progress bar, `frame_NNNNN.vtk` every
-/// `output.every_frames` frames (when `output.vtk`), and `stats.csv` (one row per frame,
+/// `output.every_frames` frames (when `output.vtk`; with `passive_NNNNN.vtk` beside it when
+/// the solver advects passive points, e.g. a granular scene's upscaling), and `stats.csv` (one row per frame,
 /// [`stats_header`]) in `opts.out_dir`. A blow-up stops the run with an error naming the
 /// frame, step and particle; the statistics up to it are kept.
 pub fn run_scene(path: &Path, opts: &SceneRunOptions) -> Result<(), SimError> {
@@ -120,8 +121,10 @@ fn run_scene_in<R: Real>(scene: &Scene, opts: &SceneRunOptions) -> Result<(), Si
         .map_err(csv_err)?;
     let every = scene.output.every_frames.max(1);
     let vtk_path = |f: usize| opts.out_dir.join(format!("frame_{f:05}.vtk"));
+    let passive_path = |f: usize| opts.out_dir.join(format!("passive_{f:05}.vtk"));
     if scene.output.vtk {
         sim.write_vtk(&vtk_path(0))?;
+        sim.write_passive_vtk(&passive_path(0))?;
     }
     let bar = if opts.progress {
         ProgressBar::new(frames as u64)
@@ -147,6 +150,7 @@ fn run_scene_in<R: Real>(scene: &Scene, opts: &SceneRunOptions) -> Result<(), Si
                 ));
                 if scene.output.vtk && sim.frame % every == 0 {
                     sim.write_vtk(&vtk_path(sim.frame))?;
+                    sim.write_passive_vtk(&passive_path(sim.frame))?;
                 }
                 bar.inc(1);
             }

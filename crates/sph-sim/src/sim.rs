@@ -7,7 +7,7 @@ use sph_core::{apply_permutation, ParticleSet, Real};
 use sph_scene::Scene;
 use sph_solver::{FluidSolver, StepStats};
 
-use crate::vtk::{write_particle_frame, ParticleFrame};
+use crate::vtk::{write_particle_frame, write_point_frame, ParticleFrame};
 use crate::{build_solver, SimError};
 
 /// A scene being simulated in precision `R`.
@@ -93,6 +93,20 @@ impl<R: Real> SceneSim<R> {
         self.frame += 1;
         self.time_s = self.frame as f64 * self.scene.frame_dt_s;
         Ok(stats)
+    }
+
+    /// Writes the solver's passive points (upscaling) of the current frame to `path` (legacy
+    /// VTK, the format of [`SceneSim::write_vtk`]); returns `false` and writes nothing when
+    /// the solver has none ([`FluidSolver::passive_points`]; an upscaling solver seeds them
+    /// in its first step, so frame 0 has none).
+    pub fn write_passive_vtk(&self, path: &Path) -> Result<bool, SimError> {
+        match self.solver.passive_points() {
+            Some(points) => {
+                write_point_frame(path, self.time_s, points)?;
+                Ok(true)
+            }
+            None => Ok(false),
+        }
     }
 
     /// Writes the current frame to `path` (legacy VTK).

@@ -59,30 +59,60 @@ pub fn write_particle_frame<R: Real>(
             ),
         ));
     }
-    let n32 = u32::try_from(n)
-        .map_err(|_| SimError::output(path, "more than 2^32 particles in one VTK frame"))?;
-    let mut verts = Vec::with_capacity(2 * n);
-    for i in 0..n32 {
-        verts.extend_from_slice(&[1, i]);
-    }
     let speed: Vec<f32> = frame
         .velocities
         .iter()
         .map(|v| v.norm().as_f64() as f32)
         .collect();
     let density: Vec<f32> = frame.densities.iter().map(|d| d.as_f64() as f32).collect();
-    let data = Attributes {
-        point: vec![
-            Attribute::vectors("velocity").with_data(flat(frame.velocities)),
-            Attribute::scalars("speed", 1).with_data(speed),
-            Attribute::scalars("density", 1).with_data(density),
-            Attribute::scalars("id", 1)
-                .with_data(frame.ids.iter().map(|&i| i as i32).collect::<Vec<i32>>()),
-        ],
-        cell: Vec::new(),
-    };
+    let point = vec![
+        Attribute::vectors("velocity").with_data(flat(frame.velocities)),
+        Attribute::scalars("speed", 1).with_data(speed),
+        Attribute::scalars("density", 1).with_data(density),
+        Attribute::scalars("id", 1)
+            .with_data(frame.ids.iter().map(|&i| i as i32).collect::<Vec<i32>>()),
+    ];
+    write_points(
+        path,
+        frame.positions,
+        point,
+        format!("particles t = {} s", frame.time_s),
+    )
+}
+
+/// Writes passive points (e.g. the high-resolution points of an upscaling) to `path`
+/// (`.vtk`) in the format of [`write_particle_frame`]: points with one vertex cell each and
+/// the point data `id` (the index in the solver's list).
+pub fn write_point_frame<R: Real>(
+    path: &Path,
+    time_s: f64,
+    positions: &[Vec3<R>],
+) -> Result<(), SimError> {
+    let ids: Vec<i32> = (0..positions.len()).map(|i| i as i32).collect();
+    write_points(
+        path,
+        positions,
+        vec![Attribute::scalars("id", 1).with_data(ids)],
+        format!("passive points t = {time_s} s"),
+    )
+}
+
+/// Legacy VTK poly data: `positions` as vertices with the point attributes `point`.
+fn write_points<R: Real>(
+    path: &Path,
+    positions: &[Vec3<R>],
+    point: Vec<Attribute>,
+    title: String,
+) -> Result<(), SimError> {
+    let n = positions.len();
+    let n32 = u32::try_from(n)
+        .map_err(|_| SimError::output(path, "more than 2^32 particles in one VTK frame"))?;
+    let mut verts = Vec::with_capacity(2 * n);
+    for i in 0..n32 {
+        verts.extend_from_slice(&[1, i]);
+    }
     let piece = PolyDataPiece {
-        points: flat(frame.positions).into(),
+        points: flat(positions).into(),
         verts: Some(VertexNumbers::Legacy {
             num_cells: n32,
             vertices: verts,
@@ -90,11 +120,14 @@ pub fn write_particle_frame<R: Real>(
         lines: None,
         polys: None,
         strips: None,
-        data,
+        data: Attributes {
+            point,
+            cell: Vec::new(),
+        },
     };
     let vtk = Vtk {
         version: Version::new_legacy(4, 2),
-        title: format!("particles t = {} s", frame.time_s),
+        title,
         byte_order: ByteOrder::BigEndian,
         data: DataSet::inline(piece),
         file_path: None,

@@ -64,4 +64,10 @@ pub trait FluidSolver<R: Real>: Send {
     fn name(&self) -> &'static str;
     /// The names of the phases its [`StepStats::phases`] report, in order.
     fn phase_names(&self) -> &'static [&'static str];
+    /// Passive points the solver advects beside the particles (e.g. the high-resolution
+    /// points of an upscaling), to be written with the output; `None` (the default) when it
+    /// has none.
+    fn passive_points(&self) -> Option<&[Vec3<R>]> {
+        None
+    }
 }

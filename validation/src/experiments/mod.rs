@@ -3,6 +3,7 @@
 use crate::Experiment;
 
 pub mod boundary;
+pub mod granular;
 pub mod pbf;
 pub mod sph;
 pub mod symplectic;
@@ -23,5 +24,9 @@ pub fn registry() -> Vec<Box<dyn Experiment>> {
         Box::new(pbf::pbf_vorticity::PbfVorticity),
         Box::new(pbf::dam_break_front::DamBreakFront),
         Box::new(pbf::pbf_performance::PbfPerformance),
+        Box::new(granular::repose::GranularRepose),
+        Box::new(granular::column_collapse::GranularColumnCollapse),
+        Box::new(granular::iisph_convergence::IisphConvergence),
+        Box::new(granular::granular_performance::GranularPerformance),
     ]
 }

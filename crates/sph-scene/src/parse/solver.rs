@@ -12,8 +12,11 @@ use serde::de::DeserializeOwned;
 use toml::de::{DeValue, ValueDeserializer};
 
 use super::SolverTable;
-use crate::error::{serde_error, Ctx};
-use crate::{PbfSpec, PcisphSpec, SceneError, SolverKind, SolverSpec};
+use crate::error::{line_col, serde_error, Ctx};
+use crate::{
+    GranularSpec, IisphSpec, PbfSpec, PcisphSpec, SceneError, SolverKind, SolverSpec,
+    DEFAULT_IISPH_MIN_ITERATIONS,
+};
 
 /// Reads and checks the `[solver]` table `table` of the scene text `text`, whose `kind` has
 /// been read already.
@@ -29,13 +32,23 @@ pub(super) fn parse(
         return Err(ctx.invalid("solver", format!("must be a table, not {found}")));
     };
     t.remove("kind");
+    // The line of each field, for the range errors.
+    let lines = Lines(
+        t.iter()
+            .map(|(k, v)| (k.get_ref().to_string(), line_col(text, v.span().start).0))
+            .collect(),
+    );
     let spec = match kind {
         SolverKind::Pbf => SolverSpec::Pbf(variant(ctx, text, kind, table)?),
         SolverKind::Pcisph => SolverSpec::Pcisph(variant(ctx, text, kind, table)?),
+        SolverKind::Iisph => SolverSpec::Iisph(variant(ctx, text, kind, table)?),
+        SolverKind::Granular => SolverSpec::Granular(variant(ctx, text, kind, table)?),
     };
     match &spec {
         SolverSpec::Pbf(s) => check_pbf(ctx, s)?,
         SolverSpec::Pcisph(s) => check_pcisph(ctx, s)?,
+        SolverSpec::Iisph(s) => check_iisph(ctx, &lines, &IisphShared::of_iisph(s))?,
+        SolverSpec::Granular(s) => check_granular(ctx, &lines, s)?,
     }
     Ok(spec)
 }
@@ -138,6 +151,155 @@ fn check_pcisph(ctx: &Ctx, s: &PcisphSpec) -> Result<(), SceneError> {
         s.xsph_c,
     )?;
     positive(ctx, "density_error_tolerance", s.density_error_tolerance)
+}
+
+/// The line of each field of the `[solver]` table.
+struct Lines(Vec<(String, usize)>);
+
+impl Lines {
+    /// A [`SceneError::Invalid`] for `solver.<name>` with the field's line.
+    fn invalid(&self, ctx: &Ctx, name: &str, reason: String) -> SceneError {
+        match self.0.iter().find(|(k, _)| k == name) {
+            Some((_, l)) => ctx.invalid(format!("solver.{name}"), format!("{reason} (line {l})")),
+            None => ctx.invalid(format!("solver.{name}"), reason),
+        }
+    }
+}
+
+/// The settings both IISPH kinds have.
+struct IisphShared {
+    substeps: usize,
+    max_iterations: Option<usize>,
+    min_iterations: Option<usize>,
+    density_error_tolerance: Option<f64>,
+    relaxation: Option<f64>,
+    rest_density: Option<f64>,
+    support_over_spacing: Option<f64>,
+    viscosity: Option<f64>,
+}
+
+impl IisphShared {
+    fn of_iisph(s: &IisphSpec) -> Self {
+        Self {
+            substeps: s.substeps,
+            max_iterations: s.max_iterations,
+            min_iterations: s.min_iterations,
+            density_error_tolerance: s.density_error_tolerance,
+            relaxation: s.relaxation,
+            rest_density: s.rest_density,
+            support_over_spacing: s.support_over_spacing,
+            viscosity: s.viscosity,
+        }
+    }
+
+    fn of_granular(s: &GranularSpec) -> Self {
+        Self {
+            substeps: s.substeps,
+            max_iterations: s.max_iterations,
+            min_iterations: s.min_iterations,
+            density_error_tolerance: s.density_error_tolerance,
+            relaxation: s.relaxation,
+            rest_density: s.rest_density,
+            support_over_spacing: s.support_over_spacing,
+            viscosity: s.viscosity,
+        }
+    }
+}
+
+/// IISPH settings (`kind = "iisph"`, and the shared part of `"granular"`).
+fn check_iisph(ctx: &Ctx, lines: &Lines, s: &IisphShared) -> Result<(), SceneError> {
+    let finite_positive = |name: &str, v: Option<f64>| match v {
+        Some(v) if !(v.is_finite() && v > 0.0) => {
+            Err(lines.invalid(ctx, name, format!("must be finite and > 0, got {v}")))
+        }
+        _ => Ok(()),
+    };
+    if s.substeps == 0 {
+        return Err(lines.invalid(ctx, "substeps", "must be >= 1, got 0".into()));
+    }
+    let min = s.min_iterations.unwrap_or(DEFAULT_IISPH_MIN_ITERATIONS);
+    if s.min_iterations == Some(0) {
+        return Err(lines.invalid(ctx, "min_iterations", "must be >= 1, got 0".into()));
+    }
+    if let Some(max) = s.max_iterations {
+        if max < min {
+            return Err(lines.invalid(
+                ctx,
+                "max_iterations",
+                format!("must be >= min_iterations = {min}, got {max}"),
+            ));
+        }
+    }
+    finite_positive("density_error_tolerance", s.density_error_tolerance)?;
+    if let Some(w) = s.relaxation {
+        if !(w.is_finite() && w > 0.0 && w <= 1.0) {
+            return Err(lines.invalid(ctx, "relaxation", format!("must be in (0, 1], got {w}")));
+        }
+    }
+    finite_positive("rest_density", s.rest_density)?;
+    if let Some(v) = s.support_over_spacing {
+        if !(v.is_finite() && v > 1.0) {
+            return Err(lines.invalid(
+                ctx,
+                "support_over_spacing",
+                format!("must be finite and > 1, got {v}"),
+            ));
+        }
+    }
+    if let Some(v) = s.viscosity {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(lines.invalid(
+                ctx,
+                "viscosity",
+                format!("must be finite and >= 0 (m^2/s), got {v}"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Granular settings (`kind = "granular"`).
+fn check_granular(ctx: &Ctx, lines: &Lines, s: &GranularSpec) -> Result<(), SceneError> {
+    check_iisph(ctx, lines, &IisphShared::of_granular(s))?;
+    let th = s.friction_angle_deg;
+    if !(th.is_finite() && (0.0..90.0).contains(&th)) {
+        return Err(lines.invalid(
+            ctx,
+            "friction_angle_deg",
+            format!("must be in [0, 90) degrees, got {th}"),
+        ));
+    }
+    if let Some(c) = s.drag_coefficient {
+        if !(c.is_finite() && c >= 0.0) {
+            return Err(lines.invalid(
+                ctx,
+                "drag_coefficient",
+                format!("must be finite and >= 0, got {c}"),
+            ));
+        }
+    }
+    if let Some(v) = s.air_velocity {
+        if let Some(a) = (0..3).find(|&a| !v[a].is_finite()) {
+            return Err(lines.invalid(
+                ctx,
+                "air_velocity",
+                format!("component {a} is not finite ({})", v[a]),
+            ));
+        }
+    }
+    match s.upscaling_factor {
+        Some(0) => Err(lines.invalid(
+            ctx,
+            "upscaling_factor",
+            "must be >= 1 passive point per particle (omit it for no upscaling), got 0".into(),
+        )),
+        Some(k) if k > 4096 => Err(lines.invalid(
+            ctx,
+            "upscaling_factor",
+            format!("must be at most 4096 passive points per particle, got {k}"),
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// `solver.<name>`, if given, is ≥ 1.

@@ -19,6 +19,8 @@ pub use volume_map::{
 
 use sph_core::{Real, Sdf, Vec3};
 
+use crate::SolverError;
+
 /// What the boundary contributes to a particle at one position.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BoundarySample<R: Real> {
@@ -85,6 +87,36 @@ pub trait Boundary<R: Real>: Send + Sync {
             .iter()
             .map(|s| s.signed_distance(x))
             .fold(R::of_f64(f64::INFINITY), |a, b| if b < a { b } else { a })
+    }
+}
+
+/// A boundary that takes part in the density ([`Boundary::has_volume`]) must have been
+/// integrated with the solver's density kernel `kernel` (a `sph_kernels` name such as
+/// `"poly6"`) at the solver's support radius `h` (relative difference at most 1e-6);
+/// otherwise [`SolverError::InvalidParameter`] naming `solver` and `boundary`.
+pub fn check_volume_kernel<R: Real>(
+    boundary: &dyn Boundary<R>,
+    solver: &'static str,
+    kernel: &'static str,
+    h: R,
+) -> Result<(), SolverError> {
+    if !boundary.has_volume() {
+        return Ok(());
+    }
+    match boundary.volume_kernel() {
+        Some((name, hb)) if name == kernel && (hb - h).abs() <= h * R::of_f64(1e-6) => Ok(()),
+        Some((_, hb)) => Err(SolverError::InvalidParameter {
+            solver,
+            name: "boundary",
+            value: hb.as_f64(),
+            reason: "the boundary's volumes were integrated with another kernel or support radius than the solver's density kernel",
+        }),
+        None => Err(SolverError::InvalidParameter {
+            solver,
+            name: "boundary",
+            value: f64::NAN,
+            reason: "a boundary with volume must name its kernel",
+        }),
     }
 }
 

@@ -91,14 +91,14 @@ pub fn front_x<R: Real>(positions: &[sph_core::Vec3<R>], radius: f64) -> f64 {
 }
 
 /// Linear interpolation of `y(x)` in points sorted by `x`; `None` outside their span.
-fn interpolate(points: &[(f64, f64)], x: f64) -> Option<f64> {
+pub(crate) fn interpolate(points: &[(f64, f64)], x: f64) -> Option<f64> {
     points.windows(2).find_map(|w| {
         let ((x0, y0), (x1, y1)) = (w[0], w[1]);
         (x0 <= x && x <= x1 && x1 > x0).then(|| y0 + (y1 - y0) * (x - x0) / (x1 - x0))
     })
 }
 
-fn simulate<R: Real>(ctx: &Context, scene: &Scene) -> Result<(Vec<(f64, f64)>, usize)> {
+pub(crate) fn simulate<R: Real>(ctx: &Context, scene: &Scene) -> Result<(Vec<(f64, f64)>, usize)> {
     let mut sim = SceneSim::<R>::new(scene)?;
     let frames = scene.frame_count();
     let radius = 0.5 * scene.particle_spacing;
@@ -226,7 +226,30 @@ impl Experiment for DamBreakFront {
             RITTER_DZ_DT,
             "Ritter (1892): an inviscid dam break on a dry bed advances at 2 sqrt(g H) (H = 2a: dZ/dT = 2); a faster front creates energy",
         ));
-        let spec = PlotSpec {
+        // IISPH beside PBF (crate iisph-granular; same scene and front, volume-map walls)
+        let iisph = crate::experiments::granular::iisph_front::run(ctx, &measured);
+        match &iisph {
+            Ok(i) => {
+                out.metric("iisph/worst_relative_error", i.worst_relative_error);
+                out.metric(
+                    "late_front_speed_iisph_dZ_dT",
+                    fitted_slope(&i.series, LATE_T).0,
+                );
+                out.check(Check::at_most(
+                    "front/IISPH max |Z_sim - Z_exp| / Z_exp",
+                    i.worst_relative_error.abs(),
+                    Z_BAND,
+                    "the same a-priori band as PBF's (15 %)",
+                ));
+            }
+            Err(e) => out.check(Check::equals(
+                "front/IISPH run completed",
+                0.0,
+                1.0,
+                format!("{e:#}"),
+            )),
+        }
+        let mut spec = PlotSpec {
             legend: Legend::UpperLeft,
             series: vec![
                 Series::line(format!("PBF, {particles} particles"), series.clone(), 0),
@@ -276,6 +299,11 @@ impl Experiment for DamBreakFront {
             y_range: Some((0.0, 16.0)),
             ..PlotSpec::new("Dam break: surge front", "T = t·sqrt(2g/a)", "Z = x/a")
         };
+        if let Ok(i) = &iisph {
+            let label = format!("IISPH, {} particles", i.particles);
+            spec.series
+                .insert(1, Series::line(label, i.series.clone(), 4));
+        }
         plot_xy(&ctx.path("front.png"), &spec)?;
         ctx.add_plot(
             "front.png",

@@ -83,11 +83,11 @@ impl FluidRun {
     }
 }
 
-fn run_in<R: Real>(ctx: &Context, scene: &Scene, label: String) -> Result<FluidRun> {
-    let mut sim = SceneSim::<R>::new(scene)?;
-    let frames = scene.frame_count();
-    let g = scene.gravity.iter().map(|x| x * x).sum::<f64>().sqrt();
-    let floor = scene.tank.map_or_else(
+/// Potential energy `Σ m_i |g| (y_i − y_floor)` (J) of the particles of `sim` above the
+/// scene's tank floor (the lowest particle without a tank).
+pub fn potential_energy_j<R: Real>(sim: &SceneSim<R>) -> f64 {
+    let g = sim.scene.gravity.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let floor = sim.scene.tank.map_or_else(
         || {
             sim.state
                 .positions
@@ -97,13 +97,18 @@ fn run_in<R: Real>(ctx: &Context, scene: &Scene, label: String) -> Result<FluidR
         },
         |t| t.min.y,
     );
-    let initial_potential_energy_j = sim
-        .state
+    sim.state
         .positions
         .iter()
         .zip(&sim.state.masses)
         .map(|(p, m)| m.as_f64() * g * (p.y.as_f64() - floor))
-        .sum();
+        .sum()
+}
+
+fn run_in<R: Real>(ctx: &Context, scene: &Scene, label: String) -> Result<FluidRun> {
+    let mut sim = SceneSim::<R>::new(scene)?;
+    let frames = scene.frame_count();
+    let initial_potential_energy_j = potential_energy_j(&sim);
     let mut run = FluidRun {
         label,
         initial_potential_energy_j,
@@ -158,6 +163,8 @@ pub fn run_fluid(
     let name = match kind {
         SolverKind::Pbf => "PBF",
         SolverKind::Pcisph => "PCISPH",
+        SolverKind::Iisph => "IISPH",
+        SolverKind::Granular => "IISPH-granular",
     };
     let walls = match scene.boundary.model {
         sph_scene::BoundaryModel::VolumeMap => "volume maps",

@@ -1,0 +1,223 @@
+//! Parameters of the IISPH solver (water) and of its granular extension.
+
+use sph_core::{Real, Vec3};
+use sph_solver::{CommonParams, SolverError};
+
+/// Name of the solver in errors and reports.
+pub(crate) const NAME: &str = "IISPH";
+
+/// Density of air at 20 °C and 1 atm (kg/m³), the default surrounding medium of the drag
+/// force (Neder 2024 eq. 6's `ρ_a`).
+pub const AIR_DENSITY: f64 = 1.2041;
+
+/// Default half-angle (degrees) of the occlusion cone of the drag force (Neder 2024 §5.6 "a
+/// cone … defined by the direction of the relative velocity difference and a set angle"; the
+/// thesis gives no value, 30° is our choice).
+pub const DEFAULT_DRAG_CONE_HALF_ANGLE_DEG: f64 = 30.0;
+
+/// Parameters of [`crate::Iisph`]. Lengths absolute, in metres; SI units throughout.
+///
+/// | field | default ([`IisphParams::for_spacing`]) | source |
+/// | --- | --- | --- |
+/// | `common` | [`CommonParams::for_spacing`] with 8 substeps per 16 ms frame (Δt = 2 ms) | Δt of the SPlisHSPlasH dam-break comparison |
+/// | `min_iterations` | 2 | Ihmsen et al. 2014 §4 ("at least two iterations"); Neder 2024 Alg. 1 line 7 |
+/// | `max_iterations` | 100 | cap (SPlisHSPlasH's default); hitting it is counted in `StepStats::unconverged_substeps` |
+/// | `density_error_tolerance` | 0.001 (0.1 %) | Ihmsen et al. 2014 §5 (`η` = 0.1 % average density error) |
+/// | `relaxation` | 0.5 | Ihmsen et al. 2014 eq. 14 / Neder 2024 eq. 20 (`ω = 0.5`) |
+/// | `viscosity` | 0 m²/s | kinematic viscosity of an explicit SPH viscosity force (not in the thesis; see the crate docs) |
+/// | `granular` | `None` (water) | Neder 2024 §§5.6–5.9 |
+/// | `upscaling_factor` | `None` (off) | passive points per particle, Neder 2024 §5.12 |
+#[derive(Debug, Clone, PartialEq)]
+pub struct IisphParams<R: Real> {
+    /// The parameters every solver has.
+    pub common: CommonParams<R>,
+    /// Fewest relaxed-Jacobi iterations per time step (≥ 1; 2 in the paper).
+    pub min_iterations: usize,
+    /// Most relaxed-Jacobi iterations per time step (≥ `min_iterations`).
+    pub max_iterations: usize,
+    /// `η`: the iterations stop once the average predicted compression
+    /// `mean_i max(ρ_i^l − ρ0, 0) / ρ0` is below it (relative, > 0).
+    pub density_error_tolerance: R,
+    /// Relaxation `ω` of the Jacobi update, in (0, 1].
+    pub relaxation: R,
+    /// Kinematic viscosity `ν` (m²/s, ≥ 0) of the explicit viscosity force; 0 = off.
+    pub viscosity: R,
+    /// Friction, drag (granular matter); `None` for water.
+    pub granular: Option<GranularParams<R>>,
+    /// Passive high-resolution points per simulation particle (≥ 1), advected by the SPH
+    /// velocity field; `None` = no upscaling.
+    pub upscaling_factor: Option<usize>,
+}
+
+/// The granular part of [`IisphParams`] (Neder 2024 §§5.6–5.9).
+///
+/// | field | default ([`GranularParams::with_friction_angle`]) | source |
+/// | --- | --- | --- |
+/// | `friction_angle_deg` | given | `θ` of eq. 14 (degrees, in [0, 90)) |
+/// | `drag_coefficient` | 0 (off) | `C_D` of eq. 6 (dimensionless) |
+/// | `air_velocity` | 0 m/s | `v_a` of eq. 5 (a uniform field) |
+/// | `air_density` | 1.2041 kg/m³ ([`AIR_DENSITY`]) | `ρ_a` of eq. 6 |
+/// | `drag_cone_half_angle_deg` | 30° ([`DEFAULT_DRAG_CONE_HALF_ANGLE_DEG`]) | the occlusion cone of §5.6 (no value given) |
+#[derive(Debug, Clone, PartialEq)]
+pub struct GranularParams<R: Real> {
+    /// Friction angle `θ` (degrees, in [0, 90)): the Drucker–Prager coefficient is
+    /// `α = √2 sin θ`.
+    pub friction_angle_deg: R,
+    /// Drag coefficient `C_D` (dimensionless, ≥ 0); 0 switches the drag off.
+    pub drag_coefficient: R,
+    /// Velocity of the surrounding air (m/s), uniform.
+    pub air_velocity: Vec3<R>,
+    /// Density of the surrounding air `ρ_a` (kg/m³, ≥ 0).
+    pub air_density: R,
+    /// Half-angle of the occlusion cone (degrees, in (0, 90]).
+    pub drag_cone_half_angle_deg: R,
+}
+
+impl<R: Real> GranularParams<R> {
+    /// Friction angle `θ` (degrees), no drag, still air.
+    pub fn with_friction_angle(friction_angle_deg: R) -> Self {
+        Self {
+            friction_angle_deg,
+            drag_coefficient: R::zero(),
+            air_velocity: Vec3::zeros(),
+            air_density: R::of_f64(AIR_DENSITY),
+            drag_cone_half_angle_deg: R::of_f64(DEFAULT_DRAG_CONE_HALF_ANGLE_DEG),
+        }
+    }
+
+    /// The Drucker–Prager friction coefficient `α = √2 sin θ` (Neder 2024 eq. 14).
+    pub fn alpha(&self) -> R {
+        R::of_f64(std::f64::consts::SQRT_2 * self.friction_angle_deg.as_f64().to_radians().sin())
+    }
+
+    fn validate(&self) -> Result<(), SolverError> {
+        let th = self.friction_angle_deg;
+        if !(th.is_finite_value() && th >= R::zero() && th < R::of_f64(90.0)) {
+            return Err(invalid(
+                "friction_angle_deg",
+                th.as_f64(),
+                "must be in [0, 90) degrees",
+            ));
+        }
+        non_negative("drag_coefficient", self.drag_coefficient)?;
+        non_negative("air_density", self.air_density)?;
+        if let Some(a) = (0..3).find(|&a| !self.air_velocity[a].is_finite_value()) {
+            return Err(invalid(
+                "air_velocity",
+                self.air_velocity[a].as_f64(),
+                "components must be finite",
+            ));
+        }
+        let cone = self.drag_cone_half_angle_deg;
+        if !(cone.is_finite_value() && cone > R::zero() && cone <= R::of_f64(90.0)) {
+            return Err(invalid(
+                "drag_cone_half_angle_deg",
+                cone.as_f64(),
+                "must be in (0, 90] degrees",
+            ));
+        }
+        Ok(())
+    }
+}
+
+fn invalid(name: &'static str, value: f64, reason: &'static str) -> SolverError {
+    SolverError::InvalidParameter {
+        solver: NAME,
+        name,
+        value,
+        reason,
+    }
+}
+
+fn non_negative<R: Real>(name: &'static str, v: R) -> Result<(), SolverError> {
+    if v.is_finite_value() && v >= R::zero() {
+        Ok(())
+    } else {
+        Err(invalid(name, v.as_f64(), "must be finite and >= 0"))
+    }
+}
+
+impl<R: Real> Default for IisphParams<R> {
+    /// [`IisphParams::for_spacing`] with `s = 0.025 m`.
+    fn default() -> Self {
+        Self::for_spacing(R::of_f64(0.025))
+    }
+}
+
+impl<R: Real> IisphParams<R> {
+    /// The water defaults of the table above for particle spacing `s` (m). Not validated.
+    pub fn for_spacing(s: R) -> Self {
+        let mut common = CommonParams::for_spacing(s);
+        common.substeps = 8;
+        Self {
+            common,
+            min_iterations: 2,
+            max_iterations: 100,
+            density_error_tolerance: R::of_f64(0.001),
+            relaxation: R::of_f64(0.5),
+            viscosity: R::zero(),
+            granular: None,
+            upscaling_factor: None,
+        }
+    }
+
+    /// The same with granular friction at angle `θ` (degrees) and no drag.
+    pub fn granular(s: R, friction_angle_deg: R) -> Self {
+        Self {
+            granular: Some(GranularParams::with_friction_angle(friction_angle_deg)),
+            ..Self::for_spacing(s)
+        }
+    }
+
+    /// Length of one time step, `Δt = dt / substeps` (s).
+    pub fn substep_dt(&self) -> R {
+        self.common.substep_dt()
+    }
+
+    /// Checks every field; the error ([`SolverError::InvalidParameter`]) names the first
+    /// invalid one.
+    pub fn validate(&self) -> Result<(), SolverError> {
+        self.common.validate(NAME)?;
+        if self.min_iterations == 0 {
+            return Err(invalid("min_iterations", 0.0, "must be >= 1"));
+        }
+        if self.max_iterations < self.min_iterations {
+            return Err(invalid(
+                "max_iterations",
+                self.max_iterations as f64,
+                "must be >= min_iterations",
+            ));
+        }
+        let eta = self.density_error_tolerance;
+        if !(eta.is_finite_value() && eta > R::zero()) {
+            return Err(invalid(
+                "density_error_tolerance",
+                eta.as_f64(),
+                "must be finite and > 0",
+            ));
+        }
+        let w = self.relaxation;
+        if !(w.is_finite_value() && w > R::zero() && w <= R::one()) {
+            return Err(invalid("relaxation", w.as_f64(), "must be in (0, 1]"));
+        }
+        non_negative("viscosity", self.viscosity)?;
+        if let Some(g) = &self.granular {
+            g.validate()?;
+        }
+        if self.upscaling_factor == Some(0) {
+            return Err(invalid(
+                "upscaling_factor",
+                0.0,
+                "must be >= 1 passive point per particle (or None for no upscaling)",
+            ));
+        }
+        if self.upscaling_factor.is_some_and(|k| k > 4096) {
+            return Err(invalid(
+                "upscaling_factor",
+                self.upscaling_factor.unwrap_or(0) as f64,
+                "must be at most 4096 passive points per particle",
+            ));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,367 @@
+//! The measurements against analytic shapes sampled with particles: cones and wedges of a
+//! known slope angle, deposits of a known front. The oracles are the shapes' parameters; the
+//! tolerances are the sampling's resolution, derived here (not taken from the code under test):
+//!
+//! The highest lattice particle of a profile bin of width `w` lies between 0 and
+//! `δ = s + w tan α` below the true surface at its own horizontal position (the column nearest
+//! the bin's inner edge has its top within one spacing `s` of the surface, and the bin's highest
+//! particle is at most `w` further out). Jitter of amplitude `j` per coordinate adds `2j`
+//! vertically and `2j√2 < 3j` horizontally. For least-squares errors `eᵢ ∈ [0, δ]` on points
+//! spread over a run `D`, the slope is off by `(δ/2) Σ|dᵢ − d̄| / Σ(dᵢ − d̄)²`, `1.5 δ / D` for
+//! evenly spread points; the tests allow `2 δ / D` (points one per bin, not exactly even), with
+//! `D = (0.6 H − δ) / tan α` the run of the 20–80 % band.
+
+use iisph_granular::measure::{
+    angle_of_repose, normalised_runout, runout, surface_profile, FrontMethod, MeasureError,
+    PileShape, ReposeOptions, RunoutOptions,
+};
+use proptest::prelude::*;
+use sph_core::Vec3;
+
+/// A small deterministic generator for jitter (SplitMix64).
+struct Jitter(u64);
+
+impl Jitter {
+    fn unit(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        (z >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn offset(&mut self, amplitude: f64) -> f64 {
+        amplitude * (2.0 * self.unit() - 1.0)
+    }
+}
+
+/// A cone of slope `alpha` and height `h` on the floor `y = 0`, its axis at `(cx, cz)`,
+/// sampled on a cubic lattice of spacing `s` centred on the axis (jitter `j` per coordinate).
+fn cone(alpha_deg: f64, h: f64, s: f64, (cx, cz): (f64, f64), j: f64, seed: u64) -> Vec<Vec3<f64>> {
+    let tan = alpha_deg.to_radians().tan();
+    let r_base = h / tan;
+    let n = (r_base / s).ceil() as i64 + 1;
+    let mut rng = Jitter(seed);
+    let mut out = Vec::new();
+    for i in -n..=n {
+        for k in -n..=n {
+            let (dx, dz) = (i as f64 * s, k as f64 * s);
+            let r = dx.hypot(dz);
+            let mut l = 0;
+            loop {
+                let y = (l as f64 + 0.5) * s;
+                if y > h - r * tan {
+                    break;
+                }
+                out.push(Vec3::new(
+                    cx + dx + rng.offset(j),
+                    y + rng.offset(j),
+                    cz + dz + rng.offset(j),
+                ));
+                l += 1;
+            }
+        }
+    }
+    out
+}
+
+/// A planar heap along `x` (3 layers in `z`): flanks of slope `left_deg` rising from
+/// `x = x0` and `right_deg` falling to the +x side, apex height `h` at `x_apex`; `None` for a
+/// flank means a vertical wall there (a heap against a wall).
+fn wedge(
+    left_deg: Option<f64>,
+    right_deg: f64,
+    h: f64,
+    x_apex: f64,
+    s: f64,
+    j: f64,
+    seed: u64,
+) -> Vec<Vec3<f64>> {
+    let tan_r = right_deg.to_radians().tan();
+    let tan_l = left_deg.map(|a| a.to_radians().tan());
+    let x_lo = tan_l.map_or(x_apex, |t| x_apex - h / t);
+    let x_hi = x_apex + h / tan_r;
+    let mut rng = Jitter(seed);
+    let mut out = Vec::new();
+    let mut i = 0;
+    loop {
+        let x = x_lo + (i as f64 + 0.5) * s;
+        if x > x_hi {
+            break;
+        }
+        let top = if x <= x_apex {
+            tan_l.map_or(h, |t| h - (x_apex - x) * t)
+        } else {
+            h - (x - x_apex) * tan_r
+        };
+        let mut l = 0;
+        loop {
+            let y = (l as f64 + 0.5) * s;
+            if y > top {
+                break;
+            }
+            for k in 0..3 {
+                out.push(Vec3::new(
+                    x + rng.offset(j),
+                    y + rng.offset(j),
+                    (k as f64 + 0.5) * s + rng.offset(j),
+                ));
+            }
+            l += 1;
+        }
+        i += 1;
+    }
+    out
+}
+
+/// The slope tolerance of the module comment, on `tan`.
+fn tan_tolerance(alpha_deg: f64, h: f64, s: f64, w: f64, j: f64) -> f64 {
+    let tan = alpha_deg.to_radians().tan();
+    let delta = s + 2.0 * j + (w + 3.0 * j) * tan;
+    let run = (0.6 * h - delta) / tan;
+    2.0 * delta / run
+}
+
+fn assert_angle(measured_deg: f64, alpha_deg: f64, tol_tan: f64) {
+    let err = (measured_deg.to_radians().tan() - alpha_deg.to_radians().tan()).abs();
+    assert!(
+        err <= tol_tan,
+        "measured {measured_deg:.3} deg for a slope of {alpha_deg:.3} deg: |d tan| = {err:.4} > {tol_tan:.4}"
+    );
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    #[test]
+    fn cone_angle_within_sampling_resolution(
+        alpha in 15.0f64..60.0,
+        layers in 14.0f64..26.0,
+        bin_over_s in 0.7f64..1.5,
+        jitter_over_s in 0.0f64..0.2,
+        axis_given in any::<bool>(),
+        seed in any::<u64>(),
+    ) {
+        let s = 0.01;
+        let h = layers * s;
+        let (w, j) = (bin_over_s * s, jitter_over_s * s);
+        prop_assume!(0.6 * h / alpha.to_radians().tan() >= 6.0 * w);
+        let axis = (0.37, -0.21);
+        let pts = cone(alpha, h, s, axis, j, seed);
+        let mut opts = ReposeOptions::conical(0.0, w).with_spacing(s);
+        if axis_given {
+            opts.shape = PileShape::Conical { axis_xz: Some([axis.0, axis.1]) };
+        }
+        let m = angle_of_repose(&pts, &opts).unwrap();
+        assert_angle(m.angle_deg, alpha, tan_tolerance(alpha, h, s, w, j));
+        prop_assert_eq!(m.flanks.len(), 1);
+        // the pile height is the highest centre: within δ below h
+        prop_assert!(m.pile_height_m <= h + j && m.pile_height_m >= h - s - 2.0 * j - w * alpha.to_radians().tan());
+    }
+
+    #[test]
+    fn planar_heap_both_flanks(
+        left in 15.0f64..65.0,
+        right in 15.0f64..65.0,
+        layers in 16.0f64..60.0,
+        bin_over_s in 0.7f64..2.0,
+        jitter_over_s in 0.0f64..0.2,
+        seed in any::<u64>(),
+    ) {
+        let s = 0.005;
+        let h = layers * s;
+        let (w, j) = (bin_over_s * s, jitter_over_s * s);
+        // each flank's 20-80 % band must span enough bins for a fit (else Degenerate, below)
+        for a in [left, right] {
+            prop_assume!(0.6 * h / a.to_radians().tan() >= 6.0 * w);
+        }
+        let pts = wedge(Some(left), right, h, 1.3, s, j, seed);
+        let m = angle_of_repose(&pts, &ReposeOptions::planar(0.0, w)).unwrap();
+        prop_assert_eq!(m.flanks.len(), 2);
+        for f in &m.flanks {
+            let truth = if f.side < 0 { left } else { right };
+            assert_angle(f.angle_deg, truth, tan_tolerance(truth, h, s, w, j));
+        }
+        prop_assert!((m.angle_deg - 0.5 * (m.flanks[0].angle_deg + m.flanks[1].angle_deg)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn planar_heap_against_a_wall_has_one_flank(
+        alpha in 15.0f64..65.0,
+        layers in 16.0f64..60.0,
+        seed in any::<u64>(),
+    ) {
+        let s = 0.005;
+        let h = layers * s;
+        prop_assume!(0.6 * h / alpha.to_radians().tan() >= 6.0 * s);
+        let pts = wedge(None, alpha, h, 0.0, s, 0.1 * s, seed);
+        let m = angle_of_repose(&pts, &ReposeOptions::planar(0.0, s)).unwrap();
+        prop_assert_eq!(m.flanks.len(), 1);
+        prop_assert_eq!(m.flanks[0].side, 1);
+        assert_angle(m.angle_deg, alpha, tan_tolerance(alpha, h, s, s, 0.1 * s));
+    }
+
+    #[test]
+    fn runout_front_of_a_deposit(
+        length_over_s in 20.0f64..300.0,
+        s in 0.002f64..0.02,
+        stray in 0usize..5,
+    ) {
+        // A deposit from the wall x = 0.5 to x = 0.5 + L: a block two spacings high with a
+        // wedge on top near the wall, then grains thrown ahead beyond a gap of 3 spacings.
+        let (wall, l) = (0.5, length_over_s * s);
+        let mut pts = Vec::new();
+        let mut i = 0;
+        loop {
+            let x = wall + (i as f64 + 0.5) * s;
+            if x > wall + l {
+                break;
+            }
+            let top = 2.0 * s + (0.3 * l - (x - wall)).max(0.0);
+            let mut y = 0.5 * s;
+            while y <= top {
+                pts.push(Vec3::new(x, y, 0.5 * s));
+                y += s;
+            }
+            i += 1;
+        }
+        let last = pts.iter().map(|p| p.x).fold(f64::MIN, f64::max);
+        for k in 0..stray {
+            pts.push(Vec3::new(last + 3.0 * s + 4.0 * s * k as f64, 0.5 * s, 0.5 * s));
+        }
+        let front = runout(&pts, &RunoutOptions::connected(wall, s)).unwrap();
+        // the last lattice column lies in (L - s, L]; plus the radius s/2
+        prop_assert!(front > l - 0.5 * s - 1e-12 && front <= l + 0.5 * s + 1e-12, "front {} for L {}", front, l);
+        let q = runout(&pts, &RunoutOptions {
+            wall_x: wall,
+            method: FrontMethod::Quantile { fraction_ahead: 0.0 },
+            particle_radius_m: 0.5 * s,
+        }).unwrap();
+        let farthest = pts.iter().map(|p| p.x).fold(f64::MIN, f64::max) + 0.5 * s - wall;
+        prop_assert!((q - farthest).abs() < 1e-12);
+        let r = normalised_runout(front, 0.1 * l).unwrap();
+        prop_assert!((r - (front - 0.1 * l) / (0.1 * l)).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn flat_layer_is_degenerate() {
+    let s = 0.01;
+    let mut pts = Vec::new();
+    for i in 0..100 {
+        for l in 0..4 {
+            pts.push(Vec3::new((i as f64 + 0.5) * s, (l as f64 + 0.5) * s, 0.005));
+        }
+    }
+    let e = angle_of_repose(&pts, &ReposeOptions::planar(0.0, s)).unwrap_err();
+    assert!(matches!(e, MeasureError::Degenerate { .. }), "{e}");
+    // but its profile is flat at the top layer
+    let profile = surface_profile(&pts, PileShape::Planar, s).unwrap();
+    // 100 columns in 100 bins (floating-point edges may put two columns in one bin)
+    assert!(
+        profile.len() > 90 && profile.len() <= 100,
+        "{}",
+        profile.len()
+    );
+    assert!(profile.iter().all(|p| (p.y_m - 0.035).abs() < 1e-12));
+}
+
+#[test]
+fn too_narrow_a_band_is_degenerate_not_a_number() {
+    // 10 layers at 60 degrees: the 20-80 % band spans 6 s / tan 60 = 3.5 spacings, 2 bins of 2 s
+    let s = 0.01;
+    let pts = wedge(Some(60.0), 60.0, 10.0 * s, 0.5, s, 0.0, 1);
+    let e = angle_of_repose(&pts, &ReposeOptions::planar(0.0, 2.0 * s)).unwrap_err();
+    assert!(matches!(e, MeasureError::Degenerate { .. }), "{e}");
+    assert!(e.to_string().contains("points per flank"), "{e}");
+}
+
+#[test]
+fn bad_input_is_named() {
+    let empty: Vec<Vec3<f32>> = Vec::new();
+    assert!(matches!(
+        angle_of_repose(&empty, &ReposeOptions::conical(0.0, 0.01)),
+        Err(MeasureError::Empty { .. })
+    ));
+    assert!(matches!(
+        runout(&empty, &RunoutOptions::connected(0.0, 0.01)),
+        Err(MeasureError::Empty { .. })
+    ));
+    let mut pts = cone(30.0, 0.2, 0.01, (0.0, 0.0), 0.0, 1);
+    pts[17].y = f64::NAN;
+    let e = angle_of_repose(&pts, &ReposeOptions::conical(0.0, 0.01)).unwrap_err();
+    assert!(
+        matches!(e, MeasureError::NonFinite { index: 17, .. }),
+        "{e}"
+    );
+    assert!(e.to_string().contains("particle 17"));
+    let e = runout(&pts, &RunoutOptions::connected(0.0, 0.01)).unwrap_err();
+    assert!(matches!(e, MeasureError::NonFinite { index: 17, .. }));
+    pts[17].y = 0.005;
+    for (opts, name) in [
+        (ReposeOptions::conical(0.0, 0.0), "bin_width_m"),
+        (ReposeOptions::conical(f64::NAN, 0.01), "floor_y"),
+        (
+            ReposeOptions {
+                fit_band: [0.5, 0.4],
+                ..ReposeOptions::conical(0.0, 0.01)
+            },
+            "fit_band[1]",
+        ),
+        (
+            ReposeOptions {
+                min_fit_points: 2,
+                ..ReposeOptions::conical(0.0, 0.01)
+            },
+            "min_fit_points",
+        ),
+    ] {
+        match angle_of_repose(&pts, &opts) {
+            Err(MeasureError::InvalidOption { option, .. }) => assert_eq!(option, name),
+            other => panic!("{name}: {other:?}"),
+        }
+    }
+    // all particles below the floor
+    assert!(matches!(
+        angle_of_repose(&pts, &ReposeOptions::conical(1.0, 0.01)),
+        Err(MeasureError::Degenerate { .. })
+    ));
+    assert!(normalised_runout(1.0, 0.0).is_err());
+    assert!(normalised_runout(f64::NAN, 1.0).is_err());
+    assert!(runout(
+        &pts,
+        &RunoutOptions {
+            wall_x: 0.0,
+            method: FrontMethod::Quantile {
+                fraction_ahead: 0.7
+            },
+            particle_radius_m: 0.0
+        }
+    )
+    .is_err());
+}
+
+#[test]
+fn f32_positions_measure_like_f64() {
+    let pts = cone(35.0, 0.2, 0.01, (0.0, 0.0), 0.0, 3);
+    let pts32: Vec<Vec3<f32>> = pts.iter().map(|p| p.cast::<f32>()).collect();
+    let opts = ReposeOptions::conical(0.0, 0.01);
+    let a = angle_of_repose(&pts, &opts).unwrap().angle_deg;
+    let b = angle_of_repose(&pts32, &opts).unwrap().angle_deg;
+    assert!((a - b).abs() < 0.05, "{a} vs {b}");
+}
+
+#[test]
+fn resolution_estimate_covers_the_error_of_a_lattice_cone() {
+    for alpha in [20.0, 30.0, 40.0] {
+        let s = 0.01;
+        let pts = cone(alpha, 0.25, s, (0.0, 0.0), 0.0, 5);
+        let m = angle_of_repose(&pts, &ReposeOptions::conical(0.0, s).with_spacing(s)).unwrap();
+        let res = m.resolution_deg.unwrap();
+        assert!(
+            (m.angle_deg - alpha).abs() <= res,
+            "alpha {alpha}: measured {:.3}, resolution {res:.3}",
+            m.angle_deg
+        );
+    }
+}

@@ -1,0 +1,126 @@
+//! Experiments of the IISPH solver for water and granular matter (crate `iisph-granular`:
+//! Neder 2024, after Ihmsen et al. 2014 and Alduán & Otaduy 2011): the angle of repose, the
+//! collapse of granular columns against Lube et al. (2005), the convergence of the pressure
+//! solve, and the cost of a granular step. Shared here: scene variants edited from the shipped
+//! files ([`scene_edit`]) and a scene run that keeps a blow-up as a result ([`run_scene`]).
+
+pub mod column_collapse;
+pub mod granular_performance;
+pub mod iisph_convergence;
+pub mod iisph_front;
+pub mod repose;
+pub mod scene_edit;
+
+use anyhow::Result;
+use sph_core::{Real, Vec3};
+use sph_scene::{Precision, Scene};
+
+use crate::sim::SceneSim;
+use crate::{Check, Context};
+
+/// One frame of a run.
+#[derive(Debug, Clone, Copy)]
+pub struct FrameRow {
+    /// Time at the end of the frame (s).
+    pub t_s: f64,
+    /// Kinetic energy (J).
+    pub kinetic_energy_j: f64,
+    /// Pressure iterations over the frame's substeps.
+    pub iterations: usize,
+    /// Substeps of the frame.
+    pub substeps: usize,
+    /// Substeps that hit the iteration cap.
+    pub unconverged_substeps: usize,
+    /// `max ρ/ρ0` at the end of the frame.
+    pub max_density_ratio: f64,
+    /// The solver's stopping-rule density error in the frame's last iteration.
+    pub last_solve_error: f64,
+    /// Wall-clock time of the frame's phases (s).
+    pub wall_s: f64,
+}
+
+/// A scene run to its end (or to a blow-up).
+#[derive(Debug, Clone)]
+pub struct SceneRun {
+    /// Particles simulated.
+    pub particles: usize,
+    /// Per-frame statistics.
+    pub frames: Vec<FrameRow>,
+    /// Positions (m) at the requested frames, `(frame, positions)`; frame 0 = initial.
+    pub snapshots: Vec<(usize, Vec<Vec3<f64>>)>,
+    /// Positions at the end of the run.
+    pub final_positions: Vec<Vec3<f64>>,
+    /// Potential energy of the initial state above the tank floor (J).
+    pub initial_potential_energy_j: f64,
+    /// The solver's error that ended the run early, if any.
+    pub blow_up: Option<String>,
+}
+
+fn to_f64<R: Real>(p: &[Vec3<R>]) -> Vec<Vec3<f64>> {
+    p.iter()
+        .map(|v| Vec3::new(v.x.as_f64(), v.y.as_f64(), v.z.as_f64()))
+        .collect()
+}
+
+fn run_in<R: Real>(ctx: &Context, scene: &Scene, snapshot_frames: &[usize]) -> Result<SceneRun> {
+    let mut sim = SceneSim::<R>::new(scene)?;
+    let frames = scene.frame_count();
+    let initial_potential_energy_j = crate::experiments::fluid_runs::potential_energy_j(&sim);
+    let mut run = SceneRun {
+        particles: sim.state.len(),
+        frames: Vec::with_capacity(frames),
+        snapshots: Vec::new(),
+        final_positions: Vec::new(),
+        initial_potential_energy_j,
+        blow_up: None,
+    };
+    if snapshot_frames.contains(&0) {
+        run.snapshots.push((0, to_f64(&sim.state.positions)));
+    }
+    for _ in 0..frames {
+        match sim.advance() {
+            Ok(s) => run.frames.push(FrameRow {
+                t_s: sim.time_s,
+                kinetic_energy_j: s.kinetic_energy,
+                iterations: s.iterations,
+                substeps: s.substeps,
+                unconverged_substeps: s.unconverged_substeps,
+                max_density_ratio: s.max_density_ratio,
+                last_solve_error: s.last_solve_error,
+                wall_s: s.total_s(),
+            }),
+            Err(e) => {
+                run.blow_up = Some(format!("{e:#}"));
+                break;
+            }
+        }
+        if snapshot_frames.contains(&sim.frame) {
+            run.snapshots
+                .push((sim.frame, to_f64(&sim.state.positions)));
+        }
+        ctx.progress.inc(1);
+    }
+    run.final_positions = to_f64(&sim.state.positions);
+    Ok(run)
+}
+
+/// Runs `scene` to its end in its precision, keeping the positions at `snapshot_frames`. A
+/// solver error during a frame ends the run and is kept in [`SceneRun::blow_up`]; set-up
+/// errors (the scene, the solver factory) are returned.
+pub fn run_scene(ctx: &Context, scene: &Scene, snapshot_frames: &[usize]) -> Result<SceneRun> {
+    match scene.precision {
+        Precision::F32 => run_in::<f32>(ctx, scene, snapshot_frames),
+        Precision::F64 => run_in::<f64>(ctx, scene, snapshot_frames),
+    }
+}
+
+/// The failing check of a run that a solver error (a blow-up) ended early: a blow-up is an
+/// error, not a result.
+pub fn solver_error_check(tag: &str, error: &str) -> Check {
+    Check::equals(
+        format!("{tag}/completed without a solver error"),
+        0.0,
+        1.0,
+        format!("a blow-up is an error, not a result: {error}"),
+    )
+}
