@@ -117,6 +117,7 @@ fn from_raw(
         boundary: raw.boundary,
         output,
         quick_overrides,
+        render: raw.render,
     })
 }
 
