@@ -18,6 +18,7 @@ use serde::Serialize;
 
 pub mod experiments;
 pub mod helpers;
+pub mod render;
 pub mod runner;
 pub mod sim;
 

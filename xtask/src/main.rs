@@ -6,6 +6,9 @@
 //! - `cargo xtask list` — the experiments and the paper figure each reproduces.
 //! - `cargo xtask run SCENE [--quick] [--frames N] [--out DIR]` — builds `validation` in release
 //!   and runs a scene file (`validation scene ...`): ParaView frames and per-frame statistics.
+//!   With `--render`, the frames are also rendered (PNG in `OUT/render`) while it runs.
+//! - `cargo xtask render OUTPUT_DIR [--scene SCENE] [--quick] [--out DIR]` — renders a scene
+//!   run's VTK frames to PNG images with the screen-space renderer (`validation render ...`).
 //! - `cargo xtask bench [ARGS...]` — `cargo bench -p benches -- ARGS...` (criterion).
 //!
 //! Deliberately light: clap + anyhow + std. Cargo is the one running this (`$CARGO`), and
@@ -56,6 +59,24 @@ enum Task {
         #[arg(long, value_name = "N")]
         frames: Option<usize>,
         /// Output directory.
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// Also render the frames (PNG in OUT/render) while the scene runs.
+        #[arg(long)]
+        render: bool,
+    },
+    /// Render a scene run's VTK frames (`frame_*.vtk` in OUTPUT_DIR) to PNG images, with the
+    /// camera, light and background of the scene's `[render]` table.
+    Render {
+        /// The run's output directory (as given to `run --out`).
+        dir: PathBuf,
+        /// The scene file [default: the one recorded in OUTPUT_DIR by `run`].
+        #[arg(long, value_name = "SCENE")]
+        scene: Option<PathBuf>,
+        /// With --scene: apply its `[quick]` overrides.
+        #[arg(long)]
+        quick: bool,
+        /// Output directory for the PNGs [default: OUTPUT_DIR/render].
         #[arg(long, value_name = "DIR")]
         out: Option<PathBuf>,
     },
@@ -130,8 +151,12 @@ fn main() -> ExitCode {
             quick,
             frames,
             out,
+            render,
         } => {
             let mut a = os(&["run", "--release", "-p", "validation", "--", "scene"]);
+            if render {
+                a.push("--render".into());
+            }
             // Paths relative to where the user typed the command, not the workspace root.
             a.push(
                 std::path::absolute(&scene)
@@ -144,6 +169,31 @@ fn main() -> ExitCode {
             if let Some(n) = frames {
                 a.push("--frames".into());
                 a.push(n.to_string().into());
+            }
+            if let Some(out) = out {
+                a.push("--out".into());
+                a.push(std::path::absolute(&out).unwrap_or(out).into_os_string());
+            }
+            a
+        }
+        Task::Render {
+            dir,
+            scene,
+            quick,
+            out,
+        } => {
+            let mut a = os(&["run", "--release", "-p", "validation", "--", "render"]);
+            a.push(std::path::absolute(&dir).unwrap_or(dir).into_os_string());
+            if let Some(scene) = scene {
+                a.push("--scene".into());
+                a.push(
+                    std::path::absolute(&scene)
+                        .unwrap_or(scene)
+                        .into_os_string(),
+                );
+            }
+            if quick {
+                a.push("--quick".into());
             }
             if let Some(out) = out {
                 a.push("--out".into());

@@ -34,7 +34,7 @@
 //!
 //! [render.material]              # water by default
 //! ior_liquid = 1.33
-//! absorption = [2.2, 0.75, 0.35] # 1/m per RGB channel
+//! absorption = [4.0, 1.5, 0.7]  # 1/m per RGB channel
 //!
 //! [render.noise]                 # optional surface noise
 //! amplitude = 0.0005             # m
@@ -268,7 +268,7 @@ impl RenderConfig {
         let eye = cam_cfg.eye.unwrap_or_else(|| {
             let half_v = 0.5 * fov.to_radians();
             let half_h = (half_v.tan() * width as f32 / height as f32).atan();
-            let dist = 1.05 * radius / half_v.min(half_h).sin();
+            let dist = 0.9 * radius / half_v.min(half_h).sin();
             let dir = crate::V3::new(0.0, 0.55, 1.0).normalize();
             let e = crate::V3::from(target) + dir * dist;
             [e.x, e.y, e.z]

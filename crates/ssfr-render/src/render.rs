@@ -41,6 +41,9 @@ pub struct RenderParams {
     pub light: Light,
     /// The background scene.
     pub background: Background,
+    /// Radius of the particles' spheres (m), for callers that draw spheres of one size
+    /// ([`crate::ParticleView::spheres`]).
+    pub particle_radius_m: f32,
     /// Depth smoothing.
     pub smoothing: Smoothing,
     /// Radius (pixels) of the Gaussian blur of the thickness (0 = none).
@@ -62,6 +65,7 @@ impl RenderParams {
             camera,
             light: Light::default(),
             background,
+            particle_radius_m,
             smoothing: Smoothing::Bilateral(BilateralParams {
                 radius_m: 3.0 * particle_radius_m,
                 max_radius_px: 24,

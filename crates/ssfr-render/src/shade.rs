@@ -95,7 +95,7 @@ impl Default for Material {
         Self {
             ior_outside: 1.0,
             ior_liquid: 1.33,
-            absorption_per_m: [2.2, 0.75, 0.35],
+            absorption_per_m: [4.0, 1.5, 0.7],
             thickness_scale: 6.0 / std::f32::consts::PI,
             diffuse_colour: [0.15, 0.35, 0.6],
             diffuse: 0.1,
