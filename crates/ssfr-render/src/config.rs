@@ -5,7 +5,8 @@
 //! [render]
 //! width = 1280                   # pixels (default 1280)
 //! height = 720                   # pixels (default 720)
-//! particle_radius = 0.00625      # m (default: half the particle spacing)
+//! particle_radius = 0.009375     # m, sphere radius (default 0.75 x particle spacing,
+//!                                # see RADIUS_OVER_SPACING)
 //! thickness_blur_px = 4          # pixels (default 4)
 //! background = { ground = true, tank = true, obstacles = true, checker = 0.1 }
 //!
@@ -246,7 +247,9 @@ impl RenderConfig {
             field: field.into(),
             reason,
         };
-        let r = self.particle_radius.unwrap_or(0.5 * info.particle_spacing);
+        let r = self
+            .particle_radius
+            .unwrap_or(crate::RADIUS_OVER_SPACING * info.particle_spacing);
         if !(r.is_finite() && r > 0.0) {
             return Err(cfg(
                 "particle_radius",

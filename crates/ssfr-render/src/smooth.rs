@@ -222,9 +222,9 @@ pub fn curvature_flow(
                 } else {
                     n[1]
                 };
-                // ∂n_x/∂u ≈ n_x(i) − n_x(i−1); ∂n_y/∂y = −∂n_y/∂v ≈ −(n_y(j) − n_y(j−1))
-                // pairs with the forward differences above.
-                let div_px = (n[0] - nl) - (nu - n[1]);
+                // ∂n_x/∂x ∝ n_x(i) − n_x(i−1); ∂n_y/∂y = −∂n_y/∂v ∝ n_y(j−1) − n_y(j): the
+                // backward differences pair with the forward ones above.
+                let div_px = (n[0] - nl) + (nu - n[1]);
                 let pixel = z0 / focal_px;
                 // (z/f)² · ½ · (f/z) div_px
                 *z = z0 + CURVATURE_FLOW_STEP * 0.5 * pixel * div_px;

@@ -5,6 +5,7 @@ use crate::Experiment;
 pub mod boundary;
 pub mod pbf;
 pub mod sph;
+pub mod ssfr;
 pub mod symplectic;
 
 pub(crate) use pbf::fluid_runs;
@@ -23,5 +24,8 @@ pub fn registry() -> Vec<Box<dyn Experiment>> {
         Box::new(pbf::pbf_vorticity::PbfVorticity),
         Box::new(pbf::dam_break_front::DamBreakFront),
         Box::new(pbf::pbf_performance::PbfPerformance),
+        Box::new(ssfr::ssfr_depth_accuracy::SsfrDepthAccuracy),
+        Box::new(ssfr::ssfr_refraction::SsfrRefraction),
+        Box::new(ssfr::ssfr_performance::SsfrPerformance),
     ]
 }
