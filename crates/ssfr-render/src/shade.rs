@@ -139,13 +139,15 @@ pub fn refract(i: &V3, n: &V3, eta: f32) -> V3 {
 }
 
 /// Screen-space march of the view ray `p + s r` against the scene depth: the pixel
-/// coordinates where it first passes behind the scene (or where it leaves the image, or the
-/// last point tried).
-fn march(camera: &CameraFrame, scene: &SceneBuffer, p: &V3, r: &V3) -> (f32, f32) {
-    const MAX_STEPS: usize = 1024;
+/// coordinates where it first passes behind the scene (or where it leaves the image or the
+/// scene's depth range, or the last point tried). Steps advance [`MARCH_STEP_PX`] pixels on
+/// the screen, at most 10 % of the depth (a ray going straight away from the camera barely
+/// moves on the screen); the crossing is refined by 8 bisections.
+fn march(camera: &CameraFrame, scene: &SceneBuffer, max_depth: f32, p: &V3, r: &V3) -> (f32, f32) {
+    const MAX_STEPS: usize = 512;
     let (w, h) = (camera.width as f32, camera.height as f32);
     let behind = |q: &V3| -> Option<bool> {
-        if q.z <= 1e-4 {
+        if q.z <= 1e-4 || q.z > max_depth {
             return None;
         }
         let (u, v) = camera.project(q);
@@ -158,8 +160,12 @@ fn march(camera: &CameraFrame, scene: &SceneBuffer, p: &V3, r: &V3) -> (f32, f32
     let mut last = camera.project(p);
     for _ in 0..MAX_STEPS {
         let q0 = p + r * s0;
-        // One pixel along the image per step (at least), in metres along the ray.
-        let ds = camera.pixel_size_at(q0.z.max(1e-3));
+        // Screen speed of the ray (pixels per metre along it) at q0.
+        let eps = 1e-3 * q0.z.max(1e-3);
+        let (u0, v0) = camera.project(&q0);
+        let (u1, v1) = camera.project(&(q0 + r * eps));
+        let px_per_m = ((u1 - u0).powi(2) + (v1 - v0).powi(2)).sqrt() / eps;
+        let ds = (MARCH_STEP_PX / px_per_m.max(1e-6)).min(0.1 * q0.z.max(1e-3));
         let s1 = s0 + ds;
         let q1 = p + r * s1;
         match behind(&q1) {
@@ -184,6 +190,10 @@ fn march(camera: &CameraFrame, scene: &SceneBuffer, p: &V3, r: &V3) -> (f32, f32
     }
     last
 }
+
+/// Screen distance (pixels) of one step of the refraction march (the crossing is then
+/// refined by bisection; scene features thinner than this may be stepped over).
+pub const MARCH_STEP_PX: f32 = 4.0;
 
 /// Inputs of [`shade`].
 #[derive(Debug, Clone, Copy)]
@@ -229,6 +239,13 @@ pub fn shade(
     let f0 = ((m.ior_outside - m.ior_liquid) / (m.ior_outside + m.ior_liquid)).powi(2);
     let eta = m.ior_outside / m.ior_liquid;
     let kappa = V3::from(m.absorption_per_m);
+    let max_depth = inp
+        .scene
+        .depth
+        .iter()
+        .copied()
+        .filter(|z| z.is_finite())
+        .fold(0.0f32, f32::max);
     colour
         .par_chunks_mut(w)
         .zip(sample_px.par_chunks_mut(w))
@@ -266,7 +283,9 @@ pub fn shade(
                                         (u0, v0)
                                     }
                                 }
-                                RefractDistance::SceneDepth => march(cam, inp.scene, &p, &r),
+                                RefractDistance::SceneDepth => {
+                                    march(cam, inp.scene, max_depth, &p, &r)
+                                }
                             }
                         }
                     }

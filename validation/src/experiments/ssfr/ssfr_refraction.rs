@@ -46,6 +46,39 @@ const GOLDEN_FRACTION_TOL: f64 = 0.01;
 /// Channel difference counted as a changed pixel (8 levels of 255).
 const GOLDEN_PIXEL_THRESHOLD: f32 = 8.0 / 255.0;
 
+/// Particle spacing of the quick mode and of the golden image (m).
+const GOLDEN_SPACING: f32 = 0.02;
+/// The golden image under `reference-data/ssfr/`.
+const GOLDEN_FILE: &str = "golden_layer_8s_improved.png";
+
+/// The camera of the layer renders.
+fn layer_camera(w: usize, h: usize) -> Camera {
+    Camera {
+        eye: [0.0, 0.9, 1.3],
+        target: [0.0, 0.0, 0.0],
+        up: [0.0, 1.0, 0.0],
+        fov_y_deg: 40.0,
+        width: w,
+        height: h,
+    }
+}
+
+/// The golden image's render: the 8-layer flat layer at the quick mode's spacing and size,
+/// improved refraction (scene depth).
+fn golden_render(background: &Background) -> Result<RgbImage> {
+    let s = GOLDEN_SPACING;
+    let r = ssfr_render::RADIUS_OVER_SPACING * s;
+    let shape = Shape::Box {
+        min: [-0.5, 0.0, -0.5],
+        max: [0.5, 8.0 * s, 0.5],
+    };
+    let positions = shape.particles(s);
+    let params = RenderParams::new(layer_camera(480, 320), background.clone(), r);
+    let mut renderer = Renderer::default();
+    renderer.render(&params, &ParticleView::spheres(&positions, r))?;
+    Ok(renderer.image())
+}
+
 fn methods() -> [(&'static str, Refraction); 3] {
     [
         (
@@ -166,7 +199,7 @@ impl Experiment for SsfrRefraction {
     }
 
     fn run(&self, ctx: &mut Context) -> Result<Outcome> {
-        let s: f32 = ctx.mode.pick(0.02, 0.01);
+        let s: f32 = ctx.mode.pick(GOLDEN_SPACING, 0.01);
         let r = ssfr_render::RADIUS_OVER_SPACING * s;
         let (w, h) = ctx.mode.pick((480, 320), (1280, 720));
         let layers: Vec<usize> = vec![2, 4, 8, 16]; // depth H in spacings
@@ -174,14 +207,7 @@ impl Experiment for SsfrRefraction {
         ctx.progress.set_length(
             (layers.len() * 3) as u64 + *dam_frames.iter().max().unwrap_or(&0) as u64 + 1,
         );
-        let camera = Camera {
-            eye: [0.0, 0.9, 1.3],
-            target: [0.0, 0.0, 0.0],
-            up: [0.0, 1.0, 0.0],
-            fov_y_deg: 40.0,
-            width: w,
-            height: h,
-        };
+        let camera = layer_camera(w, h);
         let background = Background {
             tank: Some(TankWalls {
                 min: [-0.6, 0.0, -0.6],
@@ -194,6 +220,7 @@ impl Experiment for SsfrRefraction {
         let mut out = Outcome::new();
         let mut rows = Vec::new();
         let mut series: Vec<Vec<(f64, f64)>> = vec![Vec::new(); 3];
+        // The golden image is the quick mode's 8-layer improved render, in both modes.
         let mut golden_candidate = None;
         for &layers_deep in &layers {
             let depth_m = layers_deep as f32 * s;
@@ -227,7 +254,7 @@ impl Experiment for SsfrRefraction {
                     format!("{p95:.6}"),
                 ]);
                 series[c].push((depth_m as f64 * 1e3, mean * 1e3));
-                if layers_deep == 8 && label == "improved-scene-depth" {
+                if layers_deep == 8 && label == "improved-scene-depth" && s == GOLDEN_SPACING {
                     golden_candidate = Some(renderer.image());
                 }
                 images.push(renderer.image());
@@ -320,10 +347,10 @@ impl Experiment for SsfrRefraction {
         }
 
         // Golden image.
-        let golden_path = ctx.reference_dir.join("ssfr").join(ctx.mode.pick(
-            "golden_layer_8s_improved_quick.png",
-            "golden_layer_8s_improved_full.png",
-        ));
+        let golden_path = ctx.reference_dir.join("ssfr").join(GOLDEN_FILE);
+        if golden_candidate.is_none() {
+            golden_candidate = Some(golden_render(&background)?);
+        }
         if let Some(img) = golden_candidate {
             img.write_png(&ctx.path("golden_candidate.png"))?;
             match RgbImage::read_png(&golden_path) {
