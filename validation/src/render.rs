@@ -287,3 +287,26 @@ fn frame_index(p: &Path) -> usize {
         .and_then(|s| s.parse().ok())
         .unwrap_or(0)
 }
+
+/// Renders `positions` (a frame of `scene`) with the scene's `[render]` parameters to a PNG
+/// of `width` pixels (height from the scene's aspect ratio): the rendered frames experiments
+/// show beside their scatter plots.
+pub fn render_particles_png(
+    scene: &Scene,
+    positions: &[Vec3<f32>],
+    width: usize,
+    path: &Path,
+) -> Result<()> {
+    let mut params = render_params(scene)?;
+    let aspect = params.camera.height as f64 / params.camera.width as f64;
+    params.camera.width = width;
+    params.camera.height = ((width as f64 * aspect).round() as usize).max(1);
+    let mut r = Renderer::default();
+    r.render(
+        &params,
+        &ParticleView::spheres(positions, params.particle_radius_m),
+    )
+    .with_context(|| format!("rendering {}", path.display()))?;
+    r.image().write_png(path)?;
+    Ok(())
+}

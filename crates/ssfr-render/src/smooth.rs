@@ -235,6 +235,9 @@ pub fn curvature_flow(
 
 /// Separable Gaussian blur of `data` with `σ = radius_px / 2`, truncated at `radius_px`
 /// (in place; `scratch` is the intermediate). Out-of-image taps are dropped (renormalised).
+/// Only the rectangle of non-zero values grown by the radius is processed (outside it the
+/// blur of zeros is zero): for the thickness, the cost follows the liquid's screen box.
+/// The radius is capped at 64 pixels.
 pub fn gaussian_blur(
     data: &mut [f32],
     scratch: &mut Vec<f32>,
@@ -245,33 +248,55 @@ pub fn gaussian_blur(
     if radius_px == 0 {
         return;
     }
+    // The box of non-zero values.
+    let (mut i0, mut i1, mut j0, mut j1) = (w, 0, h, 0);
+    for (j, row) in data.chunks(w).enumerate() {
+        if let Some(a) = row.iter().position(|&x| x != 0.0) {
+            let b = row.iter().rposition(|&x| x != 0.0).unwrap_or(a);
+            i0 = i0.min(a);
+            i1 = i1.max(b + 1);
+            j0 = j0.min(j);
+            j1 = j1.max(j + 1);
+        }
+    }
+    if i0 >= i1 {
+        return;
+    }
+    let (i0, i1) = (i0.saturating_sub(radius_px), (i1 + radius_px).min(w));
+    let (j0, j1) = (j0.saturating_sub(radius_px), (j1 + radius_px).min(h));
     let sigma = 0.5 * radius_px as f32;
-    let weights: Vec<f32> = (0..=radius_px)
-        .map(|k| (-((k * k) as f32) / (2.0 * sigma * sigma)).exp())
-        .collect();
+    let mut weights = [0.0f32; 65];
+    let radius_px = radius_px.min(64);
+    for (k, wk) in weights.iter_mut().enumerate().take(radius_px + 1) {
+        *wk = (-((k * k) as f32) / (2.0 * sigma * sigma)).exp();
+    }
     scratch.clear();
     scratch.resize(data.len(), 0.0);
     let r = radius_px as isize;
     let pass = |src: &[f32], dst: &mut [f32], horizontal: bool| {
-        dst.par_chunks_mut(w).enumerate().for_each(|(j, row)| {
-            for (i, out) in row.iter_mut().enumerate() {
-                let (mut s, mut ws) = (0.0, 0.0);
-                for k in -r..=r {
-                    let (ii, jj) = if horizontal {
-                        (i as isize + k, j as isize)
-                    } else {
-                        (i as isize, j as isize + k)
-                    };
-                    if ii < 0 || jj < 0 || ii >= w as isize || jj >= h as isize {
-                        continue;
+        dst[j0 * w..j1 * w]
+            .par_chunks_mut(w)
+            .enumerate()
+            .for_each(|(jr, row)| {
+                let j = j0 + jr;
+                for (i, out) in row.iter_mut().enumerate().take(i1).skip(i0) {
+                    let (mut s, mut ws) = (0.0, 0.0);
+                    for k in -r..=r {
+                        let (ii, jj) = if horizontal {
+                            (i as isize + k, j as isize)
+                        } else {
+                            (i as isize, j as isize + k)
+                        };
+                        if ii < 0 || jj < 0 || ii >= w as isize || jj >= h as isize {
+                            continue;
+                        }
+                        let wt = weights[k.unsigned_abs()];
+                        s += wt * src[jj as usize * w + ii as usize];
+                        ws += wt;
                     }
-                    let wt = weights[k.unsigned_abs()];
-                    s += wt * src[jj as usize * w + ii as usize];
-                    ws += wt;
+                    *out = s / ws;
                 }
-                *out = s / ws;
-            }
-        });
+            });
     };
     pass(data, scratch, true);
     pass(scratch, data, false);
