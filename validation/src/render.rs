@@ -147,14 +147,35 @@ pub fn render_frame_file(
     png: &Path,
 ) -> Result<ssfr_render::FrameStats> {
     let positions = read_frame_positions(vtk)?;
-    let stats = renderer
-        .render(
-            params,
-            &ParticleView::spheres(&positions, params.particle_radius_m),
-        )
+    let stats = render_positions(renderer, params, &positions)
         .with_context(|| format!("rendering {}", vtk.display()))?;
     renderer.image().write_png(png)?;
     Ok(stats)
+}
+
+/// Renders `positions` as spheres, or as Yu & Turk ellipsoids when the parameters ask for
+/// them.
+pub fn render_positions(
+    renderer: &mut Renderer,
+    params: &RenderParams,
+    positions: &[Vec3<f32>],
+) -> Result<ssfr_render::FrameStats> {
+    let view = ParticleView::spheres(positions, params.particle_radius_m);
+    Ok(match &params.anisotropy {
+        None => renderer.render(params, &view)?,
+        Some(a) => {
+            let (centres, ellipsoids) =
+                ssfr_render::anisotropy::anisotropic_ellipsoids(positions, a)?;
+            renderer.render(
+                params,
+                &ParticleView {
+                    positions: &centres,
+                    ellipsoids: Some(&ellipsoids),
+                    ..view
+                },
+            )?
+        }
+    })
 }
 
 /// The frame files `frame_NNNNN.vtk` of a run directory, sorted.
@@ -302,11 +323,8 @@ pub fn render_particles_png(
     params.camera.width = width;
     params.camera.height = ((width as f64 * aspect).round() as usize).max(1);
     let mut r = Renderer::default();
-    r.render(
-        &params,
-        &ParticleView::spheres(positions, params.particle_radius_m),
-    )
-    .with_context(|| format!("rendering {}", path.display()))?;
+    render_positions(&mut r, &params, positions)
+        .with_context(|| format!("rendering {}", path.display()))?;
     r.image().write_png(path)?;
     Ok(())
 }

@@ -37,6 +37,10 @@
 //! ior_liquid = 1.33
 //! absorption = [4.0, 1.5, 0.7]  # 1/m per RGB channel
 //!
+//! [render.anisotropy]            # optional: ellipsoids (Yu & Turk 2013), all fields
+//! support = 0.05                 # optional: m (default 4 spacings), lambda = 0.9,
+//!                                # max_stretch = 4.0, min_neighbours = 25
+//!
 //! [render.noise]                 # optional surface noise
 //! amplitude = 0.0005             # m
 //! blur_px = 3
@@ -81,6 +85,22 @@ pub struct RenderConfig {
     pub material: Option<MaterialConfig>,
     /// Surface noise.
     pub noise: Option<NoiseConfig>,
+    /// Anisotropic ellipsoids (Yu & Turk 2013) instead of spheres.
+    pub anisotropy: Option<AnisotropyConfig>,
+}
+
+/// `[render.anisotropy]`: Yu & Turk's parameters (see [`crate::anisotropy`]).
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AnisotropyConfig {
+    /// Neighbourhood radius (m, default 4 particle spacings = twice an SPH support of 2 s).
+    pub support: Option<f32>,
+    /// Centre smoothing λ (default 0.9).
+    pub lambda: Option<f32>,
+    /// Largest stretch k_r (default 4).
+    pub max_stretch: Option<f32>,
+    /// Fewest neighbours N_ε (default 25).
+    pub min_neighbours: Option<usize>,
 }
 
 /// `[render.camera]`.
@@ -378,6 +398,16 @@ impl RenderConfig {
             SsfrError::Invalid { field, reason } => cfg(&field, reason),
             other => other,
         })?;
+        params.anisotropy = self.anisotropy.as_ref().map(|a| {
+            let d = crate::anisotropy::AnisotropyParams::new(r, 4.0 * info.particle_spacing);
+            crate::anisotropy::AnisotropyParams {
+                support_m: a.support.unwrap_or(d.support_m),
+                lambda: a.lambda.unwrap_or(d.lambda),
+                max_stretch: a.max_stretch.unwrap_or(d.max_stretch),
+                min_neighbours: a.min_neighbours.unwrap_or(d.min_neighbours),
+                ..d
+            }
+        });
         params.noise = self.noise.as_ref().map(|n| NoiseParams {
             amplitude_m: n.amplitude,
             blur_px: n.blur_px.unwrap_or(3),

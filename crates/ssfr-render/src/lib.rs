@@ -36,6 +36,9 @@
 //!    Laan's screen-space offset or by the paper's `refract(I, N, n₁/n₂)` (eq. 6)
 //!    ([`Refraction`]).
 //!
+//! Optional: [`anisotropy::anisotropic_ellipsoids`] turns particles into ellipsoids (Yu &
+//! Turk 2013) for [`ParticleView::ellipsoids`].
+//!
 //! [`Renderer`] owns the buffers and runs the steps, timing each ([`StageTimes`]);
 //! [`RenderConfig`] reads the `[render]` table of a scene file.
 //!
@@ -69,6 +72,7 @@
 //!   scene-depth refraction marches about one step per pixel of the refracted ray's screen
 //!   path).
 
+pub mod anisotropy;
 mod background;
 mod camera;
 pub mod config;

@@ -54,6 +54,10 @@ pub struct RenderParams {
     pub material: Material,
     /// The refraction method.
     pub refraction: Refraction,
+    /// Anisotropic ellipsoids (Yu & Turk 2013) for callers that draw them
+    /// ([`crate::anisotropy::anisotropic_ellipsoids`] then
+    /// [`crate::ParticleView::ellipsoids`]); `None` = spheres.
+    pub anisotropy: Option<crate::anisotropy::AnisotropyParams>,
 }
 
 impl RenderParams {
@@ -75,6 +79,7 @@ impl RenderParams {
             noise: None,
             material: Material::default(),
             refraction: Refraction::default(),
+            anisotropy: None,
         }
     }
 }

@@ -197,3 +197,33 @@ proptest! {
         }
     }
 }
+
+/// The grid-based anisotropy equals the all-pairs oracle, a flat sheet becomes flat
+/// ellipsoids, and a lone particle stays a sphere.
+#[test]
+fn anisotropy_matches_naive_and_flattens_a_sheet() {
+    use ssfr_render::anisotropy::{anisotropic_ellipsoids, anisotropic_ellipsoids_naive, AnisotropyParams};
+    let s = 0.02f32;
+    let mut pts: Vec<V3> = Vec::new();
+    for i in 0..20 {
+        for k in 0..20 {
+            pts.push(V3::new(i as f32 * s, 0.5 + 0.001 * ((i * 7 + k * 3) % 5) as f32, k as f32 * s));
+        }
+    }
+    pts.push(V3::new(2.0, 2.0, 2.0)); // alone
+    let p = AnisotropyParams::new(0.75 * s, 4.0 * s);
+    let (c, m) = anisotropic_ellipsoids(&pts, &p).unwrap();
+    let (cn, mn) = anisotropic_ellipsoids_naive(&pts, &p);
+    for k in 0..pts.len() {
+        assert!((c[k] - cn[k]).norm() < 1e-6, "centre {k}");
+        assert!((m[k] - mn[k]).norm() < 1e-5, "ellipsoid {k}");
+    }
+    // Interior of the sheet: the y extent is the shortest, 1/k_r of the longest.
+    let mid = 10 * 20 + 10;
+    let ext = |v: &nalgebra::Matrix3<f32>, a: usize| v.row(a).norm();
+    assert!(ext(&m[mid], 1) < 0.5 * ext(&m[mid], 0), "{}", m[mid]);
+    // Volume kept: det M = r³.
+    assert!((m[mid].determinant() - (0.75 * s).powi(3)).abs() < 1e-3 * (0.75 * s).powi(3));
+    let lone = pts.len() - 1;
+    assert_eq!(m[lone], nalgebra::Matrix3::identity() * 0.75 * s);
+}
