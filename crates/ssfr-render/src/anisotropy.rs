@@ -18,6 +18,9 @@
 //! tuning. The neighbour search is a hashed uniform grid of cell `r` (this crate depends on
 //! `sph-core` only); [`anisotropic_ellipsoids_naive`] is its all-pairs oracle.
 
+// NaN-rejecting checks are written as `!(x > 0.0)` on purpose.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use std::collections::HashMap;
 
 use nalgebra::{Matrix3, SymmetricEigen};
@@ -26,6 +29,9 @@ use sph_core::{Real, Vec3};
 
 use crate::error::positive;
 use crate::{SsfrError, V3};
+
+/// Smoothed centres and ellipsoid matrices, one per particle.
+pub type Ellipsoids = (Vec<Vec3<f32>>, Vec<Matrix3<f32>>);
 
 /// Parameters of the anisotropy (Yu & Turk 2013's defaults where they give them).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -134,17 +140,25 @@ fn cell_of(x: &V3, r: f32) -> (i32, i32, i32) {
 pub fn anisotropic_ellipsoids<R: Real>(
     positions: &[Vec3<R>],
     params: &AnisotropyParams,
-) -> Result<(Vec<Vec3<f32>>, Vec<Matrix3<f32>>), SsfrError> {
+) -> Result<Ellipsoids, SsfrError> {
     params.validate()?;
     let x: Vec<V3> = positions
         .iter()
         .map(|p| p.map(|c| c.as_f64() as f32))
         .collect();
-    if let Some((index, p)) = x.iter().enumerate().find(|(_, p)| !p.iter().all(|c| c.is_finite())) {
+    if let Some((index, p)) = x
+        .iter()
+        .enumerate()
+        .find(|(_, p)| !p.iter().all(|c| c.is_finite()))
+    {
         return Err(SsfrError::BadParticle {
             index,
             what: "position",
-            value: p.iter().find(|c| !c.is_finite()).copied().unwrap_or(f32::NAN) as f64,
+            value: p
+                .iter()
+                .find(|c| !c.is_finite())
+                .copied()
+                .unwrap_or(f32::NAN) as f64,
         });
     }
     let r = params.support_m;

@@ -153,6 +153,7 @@ pub struct Splatter {
     prims: Vec<Prim>,
     band_start: Vec<usize>,
     band_items: Vec<u32>,
+    band_fill: Vec<usize>,
     /// Pixel tests done by the last call (the cost measure).
     pub pixel_tests: u64,
     /// Particles drawn by the last call (inside the view).
@@ -281,14 +282,14 @@ impl Splatter {
         }
         self.band_items.clear();
         self.band_items.resize(self.band_start[bands], 0);
-        {
-            let mut fill = self.band_start.clone();
-            for (k, p) in self.prims.iter().enumerate() {
-                if p.j0 < p.j1 {
-                    for b in p.j0 as usize / BAND_ROWS..=(p.j1 as usize - 1) / BAND_ROWS {
-                        self.band_items[fill[b]] = k as u32;
-                        fill[b] += 1;
-                    }
+        self.band_fill.clear();
+        self.band_fill.extend_from_slice(&self.band_start);
+        for (k, p) in self.prims.iter().enumerate() {
+            if p.j0 < p.j1 {
+                let bands = p.j0 as usize / BAND_ROWS..=(p.j1 as usize - 1) / BAND_ROWS;
+                for slot in &mut self.band_fill[bands] {
+                    self.band_items[*slot] = k as u32;
+                    *slot += 1;
                 }
             }
         }

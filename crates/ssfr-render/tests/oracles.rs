@@ -202,12 +202,18 @@ proptest! {
 /// ellipsoids, and a lone particle stays a sphere.
 #[test]
 fn anisotropy_matches_naive_and_flattens_a_sheet() {
-    use ssfr_render::anisotropy::{anisotropic_ellipsoids, anisotropic_ellipsoids_naive, AnisotropyParams};
+    use ssfr_render::anisotropy::{
+        anisotropic_ellipsoids, anisotropic_ellipsoids_naive, AnisotropyParams,
+    };
     let s = 0.02f32;
     let mut pts: Vec<V3> = Vec::new();
     for i in 0..20 {
         for k in 0..20 {
-            pts.push(V3::new(i as f32 * s, 0.5 + 0.001 * ((i * 7 + k * 3) % 5) as f32, k as f32 * s));
+            pts.push(V3::new(
+                i as f32 * s,
+                0.5 + 0.001 * ((i * 7 + k * 3) % 5) as f32,
+                k as f32 * s,
+            ));
         }
     }
     pts.push(V3::new(2.0, 2.0, 2.0)); // alone
