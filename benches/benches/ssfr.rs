@@ -5,7 +5,7 @@
 //! left. The cost model of each stage (pixels touched) is in the `ssfr-render` crate
 //! documentation, section "Cost".
 use criterion::{criterion_group, criterion_main, Criterion};
-use sph_core::Vec3;
+use sph_core::{sampling::cubic_lattice, Aabb, Vec3};
 use ssfr_render::config::SceneInfo;
 use ssfr_render::normals::normals_from_depth;
 use ssfr_render::shade::{shade, ShadeInputs};
@@ -18,24 +18,8 @@ use ssfr_render::{
 /// About `n` particles on a cubic lattice filling the water column; positions and spacing.
 fn column(n: usize) -> (Vec<Vec3<f32>>, f32) {
     let s = (0.4f32 * 0.8 * 0.6 / n as f32).cbrt();
-    let (nx, ny, nz) = (
-        (0.4 / s).round() as usize,
-        (0.8 / s).round() as usize,
-        (0.6 / s).round() as usize,
-    );
-    let mut p = Vec::with_capacity(nx * ny * nz);
-    for i in 0..nx {
-        for j in 0..ny {
-            for k in 0..nz {
-                p.push(Vec3::new(
-                    (i as f32 + 0.5) * s,
-                    (j as f32 + 0.5) * s,
-                    (k as f32 + 0.5) * s,
-                ));
-            }
-        }
-    }
-    (p, s)
+    let column = Aabb::new(Vec3::zeros(), Vec3::new(0.4, 0.8, 0.6)).expect("box");
+    (cubic_lattice(&column, s, 4 * n).expect("lattice"), s)
 }
 
 fn params(s: f32) -> RenderParams {

@@ -122,6 +122,12 @@ fn run_cargo(args: &[OsString]) -> Result<u8> {
     })
 }
 
+/// `path` made absolute against the directory the user typed the command in (cargo runs
+/// the commands from the workspace root).
+fn abs(path: PathBuf) -> OsString {
+    std::path::absolute(&path).unwrap_or(path).into_os_string()
+}
+
 fn os(args: &[&str]) -> Vec<OsString> {
     args.iter().map(OsString::from).collect()
 }
@@ -183,21 +189,14 @@ fn main() -> ExitCode {
             out,
         } => {
             let mut a = os(&["run", "--release", "-p", "validation", "--", "render"]);
-            a.push(std::path::absolute(&dir).unwrap_or(dir).into_os_string());
-            if let Some(scene) = scene {
-                a.push("--scene".into());
-                a.push(
-                    std::path::absolute(&scene)
-                        .unwrap_or(scene)
-                        .into_os_string(),
-                );
+            a.push(abs(dir));
+            for (flag, path) in [("--scene", scene), ("--out", out)] {
+                if let Some(p) = path {
+                    a.extend([flag.into(), abs(p)]);
+                }
             }
             if quick {
                 a.push("--quick".into());
-            }
-            if let Some(out) = out {
-                a.push("--out".into());
-                a.push(std::path::absolute(&out).unwrap_or(out).into_os_string());
             }
             a
         }

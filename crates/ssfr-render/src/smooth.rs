@@ -41,6 +41,19 @@ pub struct BilateralParams {
     pub depth_falloff_m: f32,
 }
 
+/// The index of the pixel `k` steps from `(i, j)` along `x` (`horizontal`) or `y`, if it is
+/// inside the image.
+#[inline]
+fn tap(i: usize, j: usize, k: isize, w: usize, h: usize, horizontal: bool) -> Option<usize> {
+    let (ii, jj) = if horizontal {
+        (i as isize + k, j as isize)
+    } else {
+        (i as isize, j as isize + k)
+    };
+    (ii >= 0 && jj >= 0 && ii < w as isize && jj < h as isize)
+        .then(|| jj as usize * w + ii as usize)
+}
+
 /// One separable pass of the bilateral filter along `x` (`horizontal`) or `y`.
 fn bilateral_pass(
     src: &[f32],
@@ -69,15 +82,10 @@ fn bilateral_pass(
             let ri = r as isize;
             let (mut sum, mut wsum) = (0.0f32, 0.0f32);
             for k in -ri..=ri {
-                let (ii, jj) = if horizontal {
-                    (i as isize + k, j as isize)
-                } else {
-                    (i as isize, j as isize + k)
-                };
-                if ii < 0 || jj < 0 || ii >= w as isize || jj >= h as isize {
+                let Some(q) = tap(i, j, k, w, h, horizontal) else {
                     continue;
-                }
-                let zq = src[jj as usize * w + ii as usize];
+                };
+                let zq = src[q];
                 if !zq.is_finite() {
                     continue;
                 }
@@ -130,15 +138,10 @@ pub fn bilateral_pass_naive(
             let sigma = 0.5 * r as f64;
             let (mut s, mut ws) = (0.0f64, 0.0f64);
             for k in -(r as isize)..=(r as isize) {
-                let (ii, jj) = if horizontal {
-                    (i as isize + k, j as isize)
-                } else {
-                    (i as isize, j as isize + k)
-                };
-                if ii < 0 || jj < 0 || ii >= w as isize || jj >= h as isize {
+                let Some(q) = tap(i, j, k, w, h, horizontal) else {
                     continue;
-                }
-                let zq = src[jj as usize * w + ii as usize] as f64;
+                };
+                let zq = src[q] as f64;
                 if !zq.is_finite() {
                     continue;
                 }
@@ -282,16 +285,11 @@ pub fn gaussian_blur(
                 for (i, out) in row.iter_mut().enumerate().take(i1).skip(i0) {
                     let (mut s, mut ws) = (0.0, 0.0);
                     for k in -r..=r {
-                        let (ii, jj) = if horizontal {
-                            (i as isize + k, j as isize)
-                        } else {
-                            (i as isize, j as isize + k)
-                        };
-                        if ii < 0 || jj < 0 || ii >= w as isize || jj >= h as isize {
+                        let Some(q) = tap(i, j, k, w, h, horizontal) else {
                             continue;
-                        }
+                        };
                         let wt = weights[k.unsigned_abs()];
-                        s += wt * src[jj as usize * w + ii as usize];
+                        s += wt * src[q];
                         ws += wt;
                     }
                     *out = s / ws;

@@ -30,6 +30,18 @@ const MARGIN_PX: usize = 3;
 /// Smallest `n·v` of a measured pixel (incidence below 60°).
 const MIN_COS_INCIDENCE: f32 = 0.5;
 
+/// The statistics per shape and method, in order: mean and 95th percentile of `|Δz|/r`,
+/// of the normal angle (degrees), the mean signed `Δz/r` (bias) and the RMS of `Δz/r`
+/// about it (roughness).
+const STATS: [&str; 6] = [
+    "mean_depth_error_r",
+    "p95_depth_error_r",
+    "mean_normal_error_deg",
+    "p95_normal_error_deg",
+    "mean_signed_depth_error_r",
+    "depth_roughness_r",
+];
+
 /// Error statistics of one method on one shape.
 #[derive(Debug, Clone)]
 struct Errors {
@@ -196,17 +208,7 @@ impl Experiment for SsfrDepthAccuracy {
                     bias,
                     roughness,
                 ];
-                for (k, key) in [
-                    "mean_depth_error_r",
-                    "p95_depth_error_r",
-                    "mean_normal_error_deg",
-                    "p95_normal_error_deg",
-                    "mean_signed_depth_error_r",
-                    "depth_roughness_r",
-                ]
-                .iter()
-                .enumerate()
-                {
+                for (k, key) in STATS.iter().enumerate() {
                     out.metric(format!("{name}/{label}/{key}"), stats[k]);
                 }
                 out.metric(format!("{name}/{label}/pixels"), e.depth_r.len() as f64);
@@ -321,17 +323,10 @@ impl Experiment for SsfrDepthAccuracy {
         }
         write_csv_rows(
             &ctx.path("depth_accuracy.csv"),
-            &[
-                "shape",
-                "method",
-                "pixels",
-                "mean_depth_error_r",
-                "p95_depth_error_r",
-                "mean_normal_error_deg",
-                "p95_normal_error_deg",
-                "mean_signed_depth_error_r",
-                "depth_roughness_r",
-            ],
+            &["shape", "method", "pixels"]
+                .into_iter()
+                .chain(STATS)
+                .collect::<Vec<_>>(),
             rows.into_iter(),
         )?;
         ctx.add_file(

@@ -8,7 +8,7 @@
 use std::time::Instant;
 
 use anyhow::Result;
-use sph_core::Vec3;
+use sph_core::{sampling::cubic_lattice, Aabb, Vec3};
 use ssfr_render::{ParticleView, Renderer};
 
 use crate::helpers::write_csv_rows;
@@ -23,27 +23,10 @@ pub struct SsfrPerformance;
 const REPEATS: usize = 5;
 
 /// A lattice of about `n` particles filling the water column; returns positions and spacing.
-pub fn column_particles(n: usize) -> (Vec<Vec3<f32>>, f32) {
-    let (lx, ly, lz) = (0.4f32, 0.8f32, 0.6f32);
-    let s = (lx * ly * lz / n as f32).cbrt();
-    let (nx, ny, nz) = (
-        (lx / s).round() as usize,
-        (ly / s).round() as usize,
-        (lz / s).round() as usize,
-    );
-    let mut p = Vec::with_capacity(nx * ny * nz);
-    for i in 0..nx {
-        for j in 0..ny {
-            for k in 0..nz {
-                p.push(Vec3::new(
-                    (i as f32 + 0.5) * s,
-                    (j as f32 + 0.5) * s,
-                    (k as f32 + 0.5) * s,
-                ));
-            }
-        }
-    }
-    (p, s)
+pub fn column_particles(n: usize) -> Result<(Vec<Vec3<f32>>, f32)> {
+    let s = (0.4f32 * 0.8 * 0.6 / n as f32).cbrt();
+    let column = Aabb::new(Vec3::zeros(), Vec3::new(0.4, 0.8, 0.6))?;
+    Ok((cubic_lattice(&column, s, 4 * n)?, s))
 }
 
 impl Experiment for SsfrPerformance {
@@ -63,7 +46,7 @@ impl Experiment for SsfrPerformance {
         let mut rows = Vec::new();
         out.metric("threads", rayon::current_num_threads() as f64);
         for &n in &sizes {
-            let (positions, s) = column_particles(n);
+            let (positions, s) = column_particles(n)?;
             let mut params = render_params(&scene)?;
             params.camera.width = 1280;
             params.camera.height = 720;
