@@ -19,6 +19,7 @@ use serde::{Deserialize, Serialize};
 pub mod deviations;
 pub mod experiments;
 pub mod helpers;
+pub mod render;
 pub mod runner;
 pub mod sim;
 

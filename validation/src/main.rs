@@ -1,5 +1,6 @@
 //! `validation run [--full] [--only ID...] [--out DIR]`, `validation list` and
-//! `validation scene PATH [--quick] [--frames N] [--out DIR]`.
+//! `validation scene PATH [--quick] [--frames N] [--out DIR] [--render]` and
+//! `validation render DIR [--scene PATH] [--quick] [--out DIR]`.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -7,7 +8,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use sph_sim::{run_scene, SceneRunOptions};
 use validation::runner::{self, RunOptions};
-use validation::{registry, workspace_root, Mode};
+use validation::{registry, render, workspace_root, Mode};
 
 #[derive(Parser)]
 #[command(
@@ -49,7 +50,59 @@ enum Command {
         /// Output directory [default: target/scenes/<file stem> under the workspace root].
         #[arg(long, value_name = "DIR", value_parser = output_dir)]
         out: Option<PathBuf>,
+        /// Also render the frames (PNG, in DIR/render) while the scene runs.
+        #[arg(long)]
+        render: bool,
     },
+    /// Render the VTK frames of a scene run (`frame_*.vtk` in DIR) to PNG images.
+    Render {
+        /// The run's output directory.
+        dir: PathBuf,
+        /// The scene file [default: the one recorded by `scene` in DIR].
+        #[arg(long, value_name = "PATH")]
+        scene: Option<PathBuf>,
+        /// With --scene: apply its `[quick]` overrides (the particle radius follows them).
+        #[arg(long)]
+        quick: bool,
+        /// Output directory for the PNGs [default: DIR/render].
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+    },
+}
+
+fn report(r: anyhow::Result<()>) -> ExitCode {
+    match r {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// `scene PATH --render`: the scene runs on this thread, the renderer follows on another.
+fn run_and_render(path: &std::path::Path, opts: &SceneRunOptions) -> anyhow::Result<()> {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
+    let scene = render::run_scene_of(&opts.out_dir, Some(path), opts.quick)?;
+    let params = render::render_params(&scene)?;
+    let done = Arc::new(AtomicBool::new(false));
+    let (dir, out) = (opts.out_dir.clone(), opts.out_dir.join("render"));
+    let flag = done.clone();
+    let worker =
+        std::thread::spawn(move || render::render_while_running(&dir, &params, &out, flag));
+    let sim = run_scene(path, opts);
+    done.store(true, Ordering::Release);
+    let rendered = worker
+        .join()
+        .map_err(|_| anyhow::anyhow!("the rendering thread panicked"))?;
+    sim?;
+    let n = rendered?;
+    eprintln!(
+        "{n} frames rendered to {}",
+        opts.out_dir.join("render").display()
+    );
+    Ok(())
 }
 
 /// `--out DIR`: refuses a path that exists and is not a directory (before any work).
@@ -86,6 +139,7 @@ fn main() -> ExitCode {
             quick,
             frames,
             out,
+            render: with_render,
         } => {
             let stem = path
                 .file_stem()
@@ -98,14 +152,25 @@ fn main() -> ExitCode {
                     .unwrap_or_else(|| workspace_root().join("target").join("scenes").join(stem)),
                 progress: true,
             };
-            match run_scene(&path, &opts) {
-                Ok(()) => ExitCode::SUCCESS,
-                Err(e) => {
-                    eprintln!("error: {e:#}");
-                    ExitCode::from(1)
-                }
+            if let Err(e) = render::write_run_source(&opts.out_dir, &path, quick) {
+                return report(Err(e));
+            }
+            if with_render {
+                report(run_and_render(&path, &opts))
+            } else {
+                report(run_scene(&path, &opts).map_err(Into::into))
             }
         }
+        Command::Render {
+            dir,
+            scene,
+            quick,
+            out,
+        } => report((|| {
+            let scene = render::run_scene_of(&dir, scene.as_deref(), quick)?;
+            let out = out.unwrap_or_else(|| dir.join("render"));
+            render::render_run_dir(&dir, &scene, &out).map(|_| ())
+        })()),
         Command::Run { full, only, out } => {
             let opts = RunOptions {
                 mode: if full { Mode::Full } else { Mode::Quick },

@@ -6,6 +6,9 @@
 //! - `cargo xtask list` — the experiments and the paper figure each reproduces.
 //! - `cargo xtask run SCENE [--quick] [--frames N] [--out DIR]` — builds `validation` in release
 //!   and runs a scene file (`validation scene ...`): ParaView frames and per-frame statistics.
+//!   With `--render`, the frames are also rendered (PNG in `OUT/render`) while it runs.
+//! - `cargo xtask render OUTPUT_DIR [--scene SCENE] [--quick] [--out DIR]` — renders a scene
+//!   run's VTK frames to PNG images with the screen-space renderer (`validation render ...`).
 //! - `cargo xtask bench [ARGS...]` — `cargo bench -p benches -- ARGS...` (criterion).
 //!
 //! Deliberately light: clap + anyhow + std. Cargo is the one running this (`$CARGO`), and
@@ -58,6 +61,24 @@ enum Task {
         /// Output directory.
         #[arg(long, value_name = "DIR")]
         out: Option<PathBuf>,
+        /// Also render the frames (PNG in OUT/render) while the scene runs.
+        #[arg(long)]
+        render: bool,
+    },
+    /// Render a scene run's VTK frames (`frame_*.vtk` in OUTPUT_DIR) to PNG images, with the
+    /// camera, light and background of the scene's `[render]` table.
+    Render {
+        /// The run's output directory (as given to `run --out`).
+        dir: PathBuf,
+        /// The scene file [default: the one recorded in OUTPUT_DIR by `run`].
+        #[arg(long, value_name = "SCENE")]
+        scene: Option<PathBuf>,
+        /// With --scene: apply its `[quick]` overrides.
+        #[arg(long)]
+        quick: bool,
+        /// Output directory for the PNGs [default: OUTPUT_DIR/render].
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
     },
     /// Run the criterion benchmarks: `cargo bench -p benches -- ARGS...`.
     Bench {
@@ -101,6 +122,12 @@ fn run_cargo(args: &[OsString]) -> Result<u8> {
     })
 }
 
+/// `path` made absolute against the directory the user typed the command in (cargo runs
+/// the commands from the workspace root).
+fn abs(path: PathBuf) -> OsString {
+    std::path::absolute(&path).unwrap_or(path).into_os_string()
+}
+
 fn os(args: &[&str]) -> Vec<OsString> {
     args.iter().map(OsString::from).collect()
 }
@@ -130,8 +157,12 @@ fn main() -> ExitCode {
             quick,
             frames,
             out,
+            render,
         } => {
             let mut a = os(&["run", "--release", "-p", "validation", "--", "scene"]);
+            if render {
+                a.push("--render".into());
+            }
             // Paths relative to where the user typed the command, not the workspace root.
             a.push(
                 std::path::absolute(&scene)
@@ -148,6 +179,24 @@ fn main() -> ExitCode {
             if let Some(out) = out {
                 a.push("--out".into());
                 a.push(std::path::absolute(&out).unwrap_or(out).into_os_string());
+            }
+            a
+        }
+        Task::Render {
+            dir,
+            scene,
+            quick,
+            out,
+        } => {
+            let mut a = os(&["run", "--release", "-p", "validation", "--", "render"]);
+            a.push(abs(dir));
+            for (flag, path) in [("--scene", scene), ("--out", out)] {
+                if let Some(p) = path {
+                    a.extend([flag.into(), abs(p)]);
+                }
+            }
+            if quick {
+                a.push("--quick".into());
             }
             a
         }

@@ -172,6 +172,10 @@
 //! every_frames = 1                 # write a VTK frame every N frames (>= 1, default 1)
 //! vtk = true                       # default true
 //!
+//! [render]                         # optional: camera, light, background of the
+//!                                  # screen-space renderer (`cargo xtask render`); kept as
+//!                                  # a raw table here and checked by the `ssfr-render` crate
+//!
 //! [quick]                          # optional overrides for quick mode (all optional)
 //! particle_spacing = 0.05          # m
 //! duration = 1.0                   # s

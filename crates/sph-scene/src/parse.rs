@@ -125,6 +125,7 @@ fn from_raw(
         boundary: raw.boundary,
         output,
         quick_overrides,
+        render: raw.render,
     })
 }
 

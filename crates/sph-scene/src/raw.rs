@@ -21,6 +21,8 @@ pub(crate) struct RawScene {
     pub solid: Vec<RawSolid>,
     pub output: Option<RawOutput>,
     pub quick: Option<RawQuick>,
+    /// Read by the renderer (`ssfr-render`), kept as a raw table here.
+    pub render: Option<toml::Table>,
 }
 
 #[derive(Debug, Deserialize)]

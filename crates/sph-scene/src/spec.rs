@@ -529,6 +529,10 @@ pub struct Scene {
     /// The `[quick]` overrides (`None` when absent, and in the scene returned by
     /// [`Scene::quick`]).
     pub quick_overrides: Option<QuickSpec>,
+    /// The `[render]` table as written (`None` when absent): camera, light and background of
+    /// the screen-space renderer, parsed and checked by the `ssfr-render` crate
+    /// (`RenderConfig`), which reports its errors with the field path.
+    pub render: Option<toml::Table>,
 }
 
 impl Scene {

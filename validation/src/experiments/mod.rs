@@ -6,6 +6,7 @@ pub mod boundary;
 pub mod granular;
 pub mod pbf;
 pub mod sph;
+pub mod ssfr;
 pub mod symplectic;
 
 pub(crate) use pbf::fluid_runs;
@@ -28,5 +29,8 @@ pub fn registry() -> Vec<Box<dyn Experiment>> {
         Box::new(granular::column_collapse::GranularColumnCollapse),
         Box::new(granular::iisph_convergence::IisphConvergence),
         Box::new(granular::granular_performance::GranularPerformance),
+        Box::new(ssfr::ssfr_depth_accuracy::SsfrDepthAccuracy),
+        Box::new(ssfr::ssfr_refraction::SsfrRefraction),
+        Box::new(ssfr::ssfr_performance::SsfrPerformance),
     ]
 }

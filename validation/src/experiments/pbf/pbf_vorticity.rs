@@ -113,6 +113,8 @@ struct Run {
     series: Vec<Frame>,
     /// (x, y, speed) of the final frame.
     last_frame: Vec<(f64, f64, f64)>,
+    /// Positions of the final frame (for the rendered view).
+    last_positions: Vec<sph_core::Vec3<f32>>,
     particles: usize,
 }
 
@@ -153,9 +155,16 @@ fn simulate<R: Real>(ctx: &Context, scene: &Scene, perturb_seed: Option<u64>) ->
         .zip(&sim.state.velocities)
         .map(|(p, v)| (p.x.as_f64(), p.y.as_f64(), v.norm().as_f64()))
         .collect();
+    let last_positions = sim
+        .state
+        .positions
+        .iter()
+        .map(|p| p.map(|x| x.as_f64() as f32))
+        .collect();
     Ok(Run {
         series,
         last_frame,
+        last_positions,
         particles: sim.state.len(),
     })
 }
@@ -396,6 +405,23 @@ impl Experiment for PbfVorticity {
             ctx.add_plot(
                 name,
                 format!("final frame, confinement {label} (side view, colour = speed up to 3 m/s)"),
+            );
+        }
+        for (name, run, label) in [
+            ("render_off.png", &off, "off"),
+            ("render_on.png", &on, "on"),
+        ] {
+            crate::render::render_particles_png(
+                &scene,
+                &run.last_positions,
+                1000,
+                &ctx.path(name),
+            )?;
+            ctx.add_plot(
+                name,
+                format!(
+                    "final frame, confinement {label}, rendered (screen-space fluid rendering)"
+                ),
             );
         }
         Ok(out)

@@ -1,0 +1,313 @@
+//! The pipeline: [`RenderParams`] (a value with every parameter) and the [`Renderer`] that
+//! owns the buffers and runs the steps, timing each.
+
+use std::time::Instant;
+
+use sph_core::Real;
+
+use crate::background::{Background, Light, SceneBuffer};
+use crate::camera::{Camera, CameraFrame};
+use crate::image::RgbImage;
+use crate::normals::normals_from_depth;
+use crate::shade::{shade, Material, Refraction, ShadeInputs};
+use crate::smooth::{
+    add_surface_noise, bilateral_depth, curvature_flow, gaussian_blur, BilateralParams, NoiseParams,
+};
+use crate::splat::{ParticleView, SplatBuffers, Splatter};
+use crate::SsfrError;
+
+/// How the depth buffer is smoothed (the paper's step 3).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Smoothing {
+    /// No smoothing (the raw splats).
+    None,
+    /// The paper's two-pass bilateral filter.
+    Bilateral(BilateralParams),
+    /// Screen-space curvature flow (van der Laan et al. 2009).
+    CurvatureFlow {
+        /// Iterations.
+        iterations: usize,
+        /// Depth jump (m) treated as a silhouette.
+        depth_falloff_m: f32,
+    },
+}
+
+/// Everything a frame depends on.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RenderParams {
+    /// The camera (and image size).
+    pub camera: Camera,
+    /// The light.
+    pub light: Light,
+    /// The background scene.
+    pub background: Background,
+    /// Radius of the particles' spheres (m), for callers that draw spheres of one size
+    /// ([`crate::ParticleView::spheres`]).
+    pub particle_radius_m: f32,
+    /// Depth smoothing.
+    pub smoothing: Smoothing,
+    /// Radius (pixels) of the Gaussian blur of the thickness (0 = none).
+    pub thickness_blur_px: usize,
+    /// Optional surface noise.
+    pub noise: Option<NoiseParams>,
+    /// The liquid's optical parameters.
+    pub material: Material,
+    /// The refraction method.
+    pub refraction: Refraction,
+    /// Anisotropic ellipsoids (Yu & Turk 2013) for callers that draw them
+    /// ([`crate::anisotropy::anisotropic_ellipsoids`] then
+    /// [`crate::ParticleView::ellipsoids`]); `None` = spheres.
+    pub anisotropy: Option<crate::anisotropy::AnisotropyParams>,
+}
+
+impl RenderParams {
+    /// Defaults for particles of radius `particle_radius_m` seen by `camera`: the bilateral
+    /// filter with a radius of 3 particle radii and a depth fall-off of 2 radii, thickness
+    /// blurred over 4 pixels, no noise, water, the improved refraction.
+    pub fn new(camera: Camera, background: Background, particle_radius_m: f32) -> Self {
+        Self {
+            camera,
+            light: Light::default(),
+            background,
+            particle_radius_m,
+            smoothing: Smoothing::Bilateral(BilateralParams {
+                radius_m: 3.0 * particle_radius_m,
+                max_radius_px: 24,
+                depth_falloff_m: 2.0 * particle_radius_m,
+            }),
+            thickness_blur_px: 4,
+            noise: None,
+            material: Material::default(),
+            refraction: Refraction::default(),
+            anisotropy: None,
+        }
+    }
+}
+
+/// Wall-clock seconds of each stage of one frame.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct StageTimes {
+    /// Background (only when camera, light or background changed).
+    pub background_s: f64,
+    /// Depth and thickness splatting.
+    pub splat_s: f64,
+    /// Depth smoothing.
+    pub smooth_s: f64,
+    /// Thickness blur.
+    pub thickness_s: f64,
+    /// Surface noise.
+    pub noise_s: f64,
+    /// Normals.
+    pub normals_s: f64,
+    /// Shading and composition.
+    pub shade_s: f64,
+}
+
+impl StageTimes {
+    /// Stage names and seconds, in pipeline order.
+    pub fn stages(&self) -> [(&'static str, f64); 7] {
+        [
+            ("background", self.background_s),
+            ("splat", self.splat_s),
+            ("smooth", self.smooth_s),
+            ("thickness", self.thickness_s),
+            ("noise", self.noise_s),
+            ("normals", self.normals_s),
+            ("shade", self.shade_s),
+        ]
+    }
+
+    /// Sum of the stages.
+    pub fn total_s(&self) -> f64 {
+        self.stages().iter().map(|s| s.1).sum()
+    }
+}
+
+/// What one frame did.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct FrameStats {
+    /// Stage times.
+    pub times: StageTimes,
+    /// Particles drawn (inside the view).
+    pub particles_drawn: usize,
+    /// Pixel tests of the splatting.
+    pub splat_pixel_tests: u64,
+    /// Pixels covered by liquid.
+    pub liquid_pixels: usize,
+}
+
+/// The renderer: buffers kept between frames (no allocation once grown) and the steps.
+///
+/// ```
+/// use ssfr_render::{Background, Camera, ParticleView, RenderParams, Renderer};
+/// use sph_core::Vec3;
+///
+/// let camera = Camera { eye: [0.5, 0.6, 1.5], target: [0.5, 0.1, 0.0], up: [0.0, 1.0, 0.0],
+///                       fov_y_deg: 45.0, width: 64, height: 48 };
+/// let params = RenderParams::new(camera, Background::ground_only(0.0, 0.1), 0.02);
+/// let positions: Vec<Vec3<f32>> =
+///     (0..100).map(|k| Vec3::new(0.4 + 0.02 * (k % 10) as f32, 0.1, 0.02 * (k / 10) as f32)).collect();
+/// let mut r = Renderer::default();
+/// let stats = r.render(&params, &ParticleView::spheres(&positions, 0.02)).unwrap();
+/// assert!(stats.liquid_pixels > 0);
+/// let image = r.image();
+/// assert_eq!((image.width, image.height), (64, 48));
+/// ```
+#[derive(Debug, Default)]
+pub struct Renderer {
+    splatter: Splatter,
+    /// Depth (smoothed after [`Renderer::render`]) and thickness buffers.
+    pub splats: SplatBuffers,
+    /// The raw splatted depth of the last frame, before smoothing and noise.
+    pub raw_depth: Vec<f32>,
+    /// View-space normals of the last frame.
+    pub normals: Vec<[f32; 3]>,
+    /// The scene buffer.
+    pub scene: SceneBuffer,
+    /// Linear colour of the last frame.
+    pub colour: Vec<[f32; 3]>,
+    /// Pixel coordinates of the scene sample the refraction used per pixel (`NaN` without
+    /// liquid).
+    pub refraction_sample_px: Vec<[f32; 2]>,
+    scratch: Vec<f32>,
+    scratch2: Vec<f32>,
+    scratch_n: Vec<[f32; 2]>,
+    scene_key: Option<(Camera, Light, Background)>,
+    frame: Option<CameraFrame>,
+}
+
+impl Renderer {
+    /// The camera frame of the last render.
+    pub fn camera_frame(&self) -> Option<&CameraFrame> {
+        self.frame.as_ref()
+    }
+
+    /// Renders one frame of `particles` (steps 1–8); the background is re-rendered only when
+    /// the camera, light or background changed. Errors: bad parameters or particles, and
+    /// [`SsfrError::NothingVisible`] when no particle is in view.
+    pub fn render<R: Real>(
+        &mut self,
+        params: &RenderParams,
+        particles: &ParticleView<'_, R>,
+    ) -> Result<FrameStats, SsfrError> {
+        let cam = params.camera.frame()?;
+        params.material.validate()?;
+        let mut times = StageTimes::default();
+        let key = (params.camera, params.light, params.background.clone());
+        if self.scene_key.as_ref() != Some(&key) {
+            let t = Instant::now();
+            params
+                .background
+                .render(&cam, &params.light, &mut self.scene)?;
+            times.background_s = t.elapsed().as_secs_f64();
+            self.scene_key = Some(key);
+        }
+        self.frame = Some(cam);
+        let (w, h) = (cam.width, cam.height);
+
+        let t = Instant::now();
+        let drawn = self.splatter.splat(&cam, particles, &mut self.splats)?;
+        times.splat_s = t.elapsed().as_secs_f64();
+        if drawn == 0 {
+            return Err(SsfrError::NothingVisible {
+                particles: particles.positions.len(),
+                eye: params.camera.eye,
+                target: params.camera.target,
+            });
+        }
+        self.raw_depth.clear();
+        self.raw_depth.extend_from_slice(&self.splats.depth);
+
+        let t = Instant::now();
+        match params.smoothing {
+            Smoothing::None => {}
+            Smoothing::Bilateral(b) => {
+                crate::error::positive("smoothing.radius_m", b.radius_m)?;
+                crate::error::positive("smoothing.depth_falloff_m", b.depth_falloff_m)?;
+                bilateral_depth(
+                    &mut self.splats.depth,
+                    &mut self.scratch,
+                    w,
+                    h,
+                    cam.focal_px,
+                    &b,
+                )
+            }
+            Smoothing::CurvatureFlow {
+                iterations,
+                depth_falloff_m,
+            } => {
+                crate::error::positive("smoothing.depth_falloff_m", depth_falloff_m)?;
+                curvature_flow(
+                    &mut self.splats.depth,
+                    &mut self.scratch_n,
+                    &mut self.scratch,
+                    w,
+                    h,
+                    cam.focal_px,
+                    depth_falloff_m,
+                    iterations,
+                )
+            }
+        }
+        times.smooth_s = t.elapsed().as_secs_f64();
+
+        let t = Instant::now();
+        gaussian_blur(
+            &mut self.splats.thickness,
+            &mut self.scratch,
+            w,
+            h,
+            params.thickness_blur_px,
+        );
+        times.thickness_s = t.elapsed().as_secs_f64();
+
+        if let Some(noise) = &params.noise {
+            crate::error::non_negative("noise.amplitude_m", noise.amplitude_m)?;
+            let t = Instant::now();
+            add_surface_noise(
+                &mut self.splats.depth,
+                &mut self.scratch,
+                &mut self.scratch2,
+                w,
+                h,
+                noise,
+            );
+            times.noise_s = t.elapsed().as_secs_f64();
+        }
+
+        let t = Instant::now();
+        normals_from_depth(&cam, &self.splats.depth, &mut self.normals);
+        times.normals_s = t.elapsed().as_secs_f64();
+
+        let t = Instant::now();
+        shade(
+            &ShadeInputs {
+                camera: &cam,
+                background: &params.background,
+                scene: &self.scene,
+                light: &params.light,
+                material: &params.material,
+                refraction: &params.refraction,
+                depth: &self.splats.depth,
+                thickness: &self.splats.thickness,
+                normals: &self.normals,
+            },
+            &mut self.colour,
+            &mut self.refraction_sample_px,
+        )?;
+        times.shade_s = t.elapsed().as_secs_f64();
+        Ok(FrameStats {
+            times,
+            particles_drawn: drawn,
+            splat_pixel_tests: self.splatter.pixel_tests,
+            liquid_pixels: self.splats.depth.iter().filter(|z| z.is_finite()).count(),
+        })
+    }
+
+    /// The last frame as an 8-bit sRGB image.
+    pub fn image(&self) -> RgbImage {
+        let (w, h) = (self.splats.width, self.splats.height);
+        RgbImage::from_linear(w, h, &self.colour)
+    }
+}

@@ -1,0 +1,130 @@
+//! `ssfr-performance`: time per frame and per stage of the screen-space renderer at
+//! 1280 × 720, for 100k particles (quick and full) and 1M (full), on the threads rayon is
+//! given (2 on the project's machine). The particles fill the dam break's water column
+//! (0.4 × 0.8 × 0.6 m in the 1.6 × 1.0 × 0.6 m tank) on a cubic lattice, seen by the default
+//! camera of `scenes/dam_break.toml`. Timings are metrics, not checks (the machine is
+//! shared); the one check is that the pipeline draws every particle.
+
+use std::time::Instant;
+
+use anyhow::Result;
+use sph_core::{sampling::cubic_lattice, Aabb, Vec3};
+use ssfr_render::{ParticleView, Renderer};
+
+use crate::helpers::write_csv_rows;
+use crate::render::render_params;
+use crate::sim::shipped_scene;
+use crate::{Check, Context, Experiment, Outcome};
+
+/// The experiment.
+pub struct SsfrPerformance;
+
+/// Frames timed per size (the median is reported).
+const REPEATS: usize = 5;
+
+/// A lattice of about `n` particles filling the water column; returns positions and spacing.
+pub fn column_particles(n: usize) -> Result<(Vec<Vec3<f32>>, f32)> {
+    let s = (0.4f32 * 0.8 * 0.6 / n as f32).cbrt();
+    let column = Aabb::new(Vec3::zeros(), Vec3::new(0.4, 0.8, 0.6))?;
+    Ok((cubic_lattice(&column, s, 4 * n)?, s))
+}
+
+impl Experiment for SsfrPerformance {
+    fn id(&self) -> &'static str {
+        "ssfr-performance"
+    }
+
+    fn source(&self) -> &'static str {
+        "Im & Chan (2016) §V (real-time rendering): time per frame and per stage at 1280x720, 100k and 1M particles, CPU"
+    }
+
+    fn run(&self, ctx: &mut Context) -> Result<Outcome> {
+        let sizes: Vec<usize> = ctx.mode.pick(vec![100_000], vec![100_000, 1_000_000]);
+        ctx.progress.set_length((sizes.len() * REPEATS) as u64);
+        let scene = shipped_scene("dam_break", crate::Mode::Full)?;
+        let mut out = Outcome::new();
+        let mut rows = Vec::new();
+        out.metric("threads", rayon::current_num_threads() as f64);
+        for &n in &sizes {
+            let (positions, s) = column_particles(n)?;
+            let mut params = render_params(&scene)?;
+            params.camera.width = 1280;
+            params.camera.height = 720;
+            let r = ssfr_render::RADIUS_OVER_SPACING * s;
+            params = ssfr_render::RenderParams {
+                particle_radius_m: r,
+                ..ssfr_render::RenderParams::new(params.camera, params.background, r)
+            };
+            let mut renderer = Renderer::default();
+            let mut runs = Vec::new();
+            for _ in 0..REPEATS {
+                let t = Instant::now();
+                let stats = renderer.render(&params, &ParticleView::spheres(&positions, r))?;
+                runs.push((t.elapsed().as_secs_f64(), stats));
+                ctx.progress.inc(1);
+            }
+            // The first frame also renders the background; time the others.
+            let mut frames: Vec<f64> = runs[1..].iter().map(|x| x.0).collect();
+            frames.sort_by(f64::total_cmp);
+            let median = frames[frames.len() / 2];
+            let label = format!("{}k", positions.len() / 1000);
+            out.metric(format!("{label}/frame_median_s"), median);
+            out.metric(
+                format!("{label}/frame_spread_s"),
+                frames[frames.len() - 1] - frames[0],
+            );
+            let last = runs[runs.len() - 1].1;
+            out.metric(
+                format!("{label}/background_s"),
+                runs[0].1.times.background_s,
+            );
+            for (stage, secs) in last.times.stages() {
+                if stage != "background" {
+                    out.metric(format!("{label}/{stage}_s"), secs);
+                }
+                rows.push(vec![
+                    positions.len().to_string(),
+                    stage.to_string(),
+                    format!(
+                        "{:.6}",
+                        if stage == "background" {
+                            runs[0].1.times.background_s
+                        } else {
+                            secs
+                        }
+                    ),
+                ]);
+            }
+            out.metric(
+                format!("{label}/splat_pixel_tests"),
+                last.splat_pixel_tests as f64,
+            );
+            out.metric(format!("{label}/liquid_pixels"), last.liquid_pixels as f64);
+            out.check(Check::equals(
+                format!("{label}: particles drawn"),
+                last.particles_drawn as f64,
+                positions.len() as f64,
+                "the default camera frames the whole tank (definition of the framing)",
+            ));
+            renderer
+                .image()
+                .write_png(&ctx.path(&format!("frame_{label}.png")))?;
+            ctx.add_plot(
+                &format!("frame_{label}.png"),
+                format!("the timed frame, {} particles", positions.len()),
+            );
+        }
+        write_csv_rows(
+            &ctx.path("stages.csv"),
+            &["particles", "stage", "seconds"],
+            rows.into_iter(),
+        )?;
+        ctx.add_file("stages.csv", "seconds per stage of the last timed frame");
+        out.note(format!(
+            "{} rayon threads; median of {} frames after the first (which also renders the background); the machine may be shared, timings are not asserted",
+            rayon::current_num_threads(),
+            REPEATS - 1
+        ));
+        Ok(out)
+    }
+}
