@@ -18,6 +18,7 @@
 //! solver depends on another.
 
 pub mod boundary;
+pub mod csr;
 mod error;
 mod params;
 mod stats;
