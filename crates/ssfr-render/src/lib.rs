@@ -84,7 +84,7 @@ pub mod shade;
 pub mod smooth;
 pub mod splat;
 
-pub use background::{Background, Ground, Light, Obstacle, SceneBuffer, TankWalls};
+pub use background::{ray_box, Background, Ground, Light, Obstacle, SceneBuffer, TankWalls};
 pub use camera::{Camera, CameraFrame};
 pub use config::RenderConfig;
 pub use error::SsfrError;
