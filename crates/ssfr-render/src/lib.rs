@@ -73,9 +73,10 @@
 //!   path, [`shade::MARCH_STEP_PX`], then 8 bisections).
 //!
 //! For the benchmark frame (`benches/benches/ssfr.rs`: 98,304 particles filling the dam
-//! break's 0.4 × 0.8 × 0.6 m column, spheres of 8.5 mm, default camera, 1280 × 720) this is
+//! break's 0.4 × 0.8 × 0.6 m column, spacing 12.4 mm, spheres of 9.3 mm, default camera
+//! about 2.6 m away, 1280 × 720) this is
 //! 6.76 M splat pixel tests (counted), 75 k liquid pixels, a bilateral radius of about 11
-//! pixels (3 r f / z with f = 989 px, z ≈ 2.2 m) so about 3.5 M filter taps, 0.92 M background
+//! pixels (3 r f / z with f = 989 px, z ≈ 2.6 m) so about 3.3 M filter taps, 0.92 M background
 //! rays (once per camera), and one shading pass over the 75 k liquid pixels: the splatting
 //! and the refraction march dominate, as the benchmark's per-stage figures show.
 
