@@ -49,7 +49,7 @@ pub fn read_frame_positions(path: &Path) -> Result<Vec<Vec3<f32>>, SsfrError> {
             .clone()
             .cast_into()
             .ok_or_else(|| corrupt("points are not numbers".into()))?;
-        if pts.len() % 3 != 0 {
+        if !pts.len().is_multiple_of(3) {
             return Err(corrupt(format!(
                 "{} coordinates: not a multiple of 3",
                 pts.len()

@@ -194,7 +194,7 @@ impl Background {
         }
         if let Some(tk) = &self.tank {
             let (lo, hi) = (V3::from(tk.min), V3::from(tk.max));
-            if let Some((t0, t1, _, exit_axis)) = slab(eye, dir, &lo, &hi) {
+            if let Some((t0, t1, _, exit_axis)) = ray_box(eye, dir, &lo, &hi) {
                 if t1 > t0.max(0.0) {
                     let p = eye + dir * t1;
                     let mut n = V3::zeros();
@@ -227,7 +227,7 @@ impl Background {
             match *o {
                 Obstacle::Box { min, max, colour } => {
                     if let Some((t0, t1, entry_axis, _)) =
-                        slab(eye, dir, &V3::from(min), &V3::from(max))
+                        ray_box(eye, dir, &V3::from(min), &V3::from(max))
                     {
                         if t1 >= t0 && t0 > 0.0 {
                             let mut n = V3::zeros();
@@ -301,9 +301,10 @@ impl Background {
     }
 }
 
-/// Ray–box slabs: `(t_near, t_far, entry axis, exit axis)`, `None` for a ray parallel to and
-/// outside a slab.
-fn slab(eye: &V3, dir: &V3, lo: &V3, hi: &V3) -> Option<(f32, f32, usize, usize)> {
+/// Ray–box intersection by slabs for the ray `eye + t dir`: `(t_near, t_far, entry axis,
+/// exit axis)` (the ray meets the box when `t_near ≤ t_far`), `None` for a ray parallel to
+/// and outside a slab.
+pub fn ray_box(eye: &V3, dir: &V3, lo: &V3, hi: &V3) -> Option<(f32, f32, usize, usize)> {
     let (mut t0, mut t1) = (f32::NEG_INFINITY, f32::INFINITY);
     let (mut a0, mut a1) = (0, 0);
     for k in 0..3 {

@@ -124,8 +124,12 @@ impl<'a, R: Real> ParticleView<'a, R> {
 #[derive(Debug, Clone, Copy)]
 struct Prim {
     g: Matrix3<f32>,
+    /// Ellipsoid: `G c`; sphere: the centre `c` (view).
     s: V3,
+    /// Ellipsoid: `|G c|² − 1`; sphere: `|c|² − r²`.
     s2m1: f32,
+    /// A sphere: the cheaper test `Δ = (d·c)² − |d|²(|c|² − r²)` applies.
+    sphere: bool,
     /// Pixel box `[i0, i1) × [j0, j1)`; empty when not drawn.
     i0: u32,
     i1: u32,
@@ -191,6 +195,7 @@ impl Splatter {
                 g: Matrix3::identity(),
                 s: V3::zeros(),
                 s2m1: 0.0,
+                sphere: false,
                 i0: 0,
                 i1: 0,
                 j0: 0,
@@ -205,25 +210,32 @@ impl Splatter {
                 p.z.as_f64() as f32,
             );
             let c = camera.to_view(&pw);
-            let (g, ext) = match particles.ellipsoids {
+            let (g, ext, radius) = match particles.ellipsoids {
                 Some(e) => {
                     let mv = rot * e[k];
                     let g = mv.try_inverse().unwrap_or_else(Matrix3::zeros);
                     let ext = V3::new(mv.row(0).norm(), mv.row(1).norm(), mv.row(2).norm());
-                    (g, ext)
+                    (g, ext, None)
                 }
                 None => {
                     let r = particles
                         .radii
                         .map_or(particles.radius, |r| r[k].as_f64() as f32);
-                    (Matrix3::identity() / r, V3::repeat(r))
+                    (Matrix3::identity() / r, V3::repeat(r), Some(r))
                 }
             };
-            let s = g * c;
+            let (s, s2m1) = match radius {
+                Some(r) => (c, c.norm_squared() - r * r),
+                None => {
+                    let s = g * c;
+                    (s, s.norm_squared() - 1.0)
+                }
+            };
             *prim = Prim {
                 g,
                 s,
-                s2m1: s.norm_squared() - 1.0,
+                s2m1,
+                sphere: radius.is_some(),
                 i0: 0,
                 i1: 0,
                 j0: 0,
@@ -296,6 +308,7 @@ impl Splatter {
         let prims = &self.prims;
         let band_start = &self.band_start;
         let band_items = &self.band_items;
+        let inv_f = 1.0 / camera.focal_px;
         let tests: u64 = out
             .depth
             .par_chunks_mut(w * BAND_ROWS)
@@ -309,6 +322,33 @@ impl Splatter {
                     let p = &prims[k as usize];
                     let j0 = (p.j0 as usize).max(row0);
                     let j1 = (p.j1 as usize).min(row0 + rows);
+                    tests += ((j1 - j0) * (p.i1 - p.i0) as usize) as u64;
+                    if p.sphere {
+                        // d = (a, b, 1): Δ = (d·c)² − |d|²(|c|² − r²), z = (d·c − √Δ)/|d|²,
+                        // chord = 2√Δ/|d|.
+                        let c = p.s;
+                        for j in j0..j1 {
+                            let bv = (camera.cy - (j as f32 + 0.5)) * inv_f;
+                            let (bc, bb) = (bv * c.y + c.z, bv * bv + 1.0);
+                            let off = (j - row0) * w;
+                            for i in p.i0 as usize..p.i1 as usize {
+                                let a = (i as f32 + 0.5 - camera.cx) * inv_f;
+                                let dc = a * c.x + bc;
+                                let dd = a * a + bb;
+                                let disc = dc * dc - dd * p.s2m1;
+                                if disc >= 0.0 {
+                                    let sq = disc.sqrt();
+                                    let z = (dc - sq) / dd;
+                                    let px = off + i;
+                                    if z < depth[px] {
+                                        depth[px] = z;
+                                    }
+                                    thick[px] += 2.0 * sq / dd.sqrt();
+                                }
+                            }
+                        }
+                        continue;
+                    }
                     let (g0, g1, g2) = (p.g.column(0), p.g.column(1), p.g.column(2));
                     for j in j0..j1 {
                         let bv = (camera.cy - (j as f32 + 0.5)) / camera.focal_px;
@@ -331,7 +371,6 @@ impl Splatter {
                             }
                         }
                     }
-                    tests += ((j1 - j0) * (p.i1 - p.i0) as usize) as u64;
                 }
                 tests
             })

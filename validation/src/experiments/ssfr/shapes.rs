@@ -81,24 +81,8 @@ impl Shape {
                 (t > 0.0).then(|| (t, cam.dir_to_view(&n), 0))
             }
             Shape::Box { min, max } => {
-                let (mut t0, mut t1, mut axis) = (f32::NEG_INFINITY, f32::INFINITY, 0);
-                for k in 0..3 {
-                    if d[k] == 0.0 {
-                        if e[k] < min[k] || e[k] > max[k] {
-                            return None;
-                        }
-                        continue;
-                    }
-                    let (mut a, mut b) = ((min[k] - e[k]) / d[k], (max[k] - e[k]) / d[k]);
-                    if a > b {
-                        std::mem::swap(&mut a, &mut b);
-                    }
-                    if a > t0 {
-                        t0 = a;
-                        axis = k;
-                    }
-                    t1 = t1.min(b);
-                }
+                let (t0, t1, axis, _) =
+                    ssfr_render::ray_box(&e, &d, &V3::from(min), &V3::from(max))?;
                 if t0 > t1 || t0 <= 0.0 {
                     return None;
                 }

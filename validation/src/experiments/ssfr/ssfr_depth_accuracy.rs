@@ -327,7 +327,7 @@ impl Experiment for SsfrDepthAccuracy {
                 .into_iter()
                 .chain(STATS)
                 .collect::<Vec<_>>(),
-            rows.into_iter(),
+            rows,
         )?;
         ctx.add_file(
             "depth_accuracy.csv",

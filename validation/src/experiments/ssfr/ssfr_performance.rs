@@ -117,7 +117,7 @@ impl Experiment for SsfrPerformance {
         write_csv_rows(
             &ctx.path("stages.csv"),
             &["particles", "stage", "seconds"],
-            rows.into_iter(),
+            rows,
         )?;
         ctx.add_file("stages.csv", "seconds per stage of the last timed frame");
         out.note(format!(

@@ -280,7 +280,7 @@ impl Experiment for SsfrRefraction {
                 "mean_error_m",
                 "p95_error_m",
             ],
-            rows.into_iter(),
+            rows,
         )?;
         ctx.add_file(
             "refraction_error.csv",
