@@ -378,6 +378,7 @@ impl<R: Real> Iisph<R> {
         let s = &mut self.scratch;
         s.pressure.iter_mut().for_each(|p| *p = R::zero());
         s.p_over_rho2.iter_mut().for_each(|p| *p = R::zero());
+        s.accel.iter_mut().for_each(|a| *a = Vec3::zeros());
         pressure_solve(
             &self.c,
             &self.params,
@@ -554,7 +555,10 @@ pub(crate) fn density_at<R: Real>(
     sum
 }
 
-/// Eq. 3 + eq. 29: `ρ_i`, `∇Ψ_i`, and `W'(r)/r` of every pair.
+/// Eq. 3 + eq. 29: `ρ_i`, `∇Ψ_i`, `W'(r)/r` of every pair, and the diagonal `a_ii` of
+/// eq. 24 (it needs only `x`, `m` and the particle's own density):
+/// `a_ii = Σ_j m_j (d_ii − d_ji)·∇W_ij + ρ0 d_ii·∇Ψ_i
+///       = −Δt²/ρ_i² (|Σ_j m_j ∇W_ij + ρ0 ∇Ψ_i|² + m_i Σ_j m_j |∇W_ij|²)`.
 pub(crate) fn density_pass<R: Real>(
     c: &Consts<R>,
     x: &[Vec3<R>],
@@ -567,18 +571,23 @@ pub(crate) fn density_pass<R: Real>(
     let indices = nb.indices();
     s.grad_scale.resize(indices.len(), R::zero());
     let gs = SharedSlice(s.grad_scale.as_mut_ptr());
+    let dt2 = c.dt * c.dt;
     s.density
         .par_iter_mut()
         .zip(s.bgrad.par_iter_mut())
+        .zip(s.aii.par_iter_mut())
         .enumerate()
         .with_min_len(MIN_LEN)
-        .for_each(|(i, (rho, bg))| {
+        .for_each(|(i, ((rho, bg), aii))| {
             let gs = gs;
-            let xi = x[i];
-            let mut sum = m[i] * c.w0;
+            let (xi, mi) = (x[i], m[i]);
+            let mut sum = mi * c.w0;
+            let mut sum_grad = Vec3::zeros();
+            let mut sum_grad_sq = R::zero();
             for k in offsets[i]..offsets[i + 1] {
                 let j = indices[k] as usize;
-                let r = (xi - x[j]).norm();
+                let d = xi - x[j];
+                let r = d.norm();
                 sum += m[j] * c.kernel.value(r);
                 let f = if r > R::zero() {
                     c.kernel.derivative(r) / r
@@ -587,6 +596,9 @@ pub(crate) fn density_pass<R: Real>(
                 };
                 // SAFETY: k lies in particle i's CSR range, written only by this task.
                 unsafe { *gs.0.add(k) = f };
+                let gw = d * f;
+                sum_grad += gw * m[j];
+                sum_grad_sq += m[j] * gw.norm_squared();
             }
             if let Some(b) = volume {
                 let smp = b.sample(&xi);
@@ -596,12 +608,13 @@ pub(crate) fn density_pass<R: Real>(
                 *bg = Vec3::zeros();
             }
             *rho = sum;
+            let gi = sum_grad + *bg * c.rho0;
+            *aii = -dt2 / (sum * sum) * (gi.norm_squared() + mi * sum_grad_sq);
         });
 }
 
-/// Eqs. 5–10, 17–18 and 24: drag, viscosity, strain rate and trial stress, `v^adv`, `a_ii`,
-/// and the warm start `p⁰ = p(t − Δt) / 2`.
-#[allow(clippy::too_many_arguments)]
+/// Eqs. 5–10 and 17–18: drag, viscosity, strain rate and trial stress, `v^adv`; the warm
+/// start `p⁰ = p(t − Δt) / 2` and its `p/ρ²`.
 pub(crate) fn advection_pass<R: Real>(
     c: &Consts<R>,
     g: Vec3<R>,
@@ -615,7 +628,6 @@ pub(crate) fn advection_pass<R: Real>(
     let indices = nb.indices();
     let (rho, gs, bgrad) = (&s.density[..], &s.grad_scale[..], &s.bgrad[..]);
     let half = R::of_f64(0.5);
-    let dt2 = c.dt * c.dt;
     let eps_h2 = R::of_f64(0.01) * c.h * c.h;
     let mut stress_dummy: [Sym3<R>; 0] = [];
     let stress: &mut [Sym3<R>] = if c.granular {
@@ -625,17 +637,22 @@ pub(crate) fn advection_pass<R: Real>(
     };
     let stress_ptr = SharedSlice(stress.as_mut_ptr());
     let granular = c.granular;
+    let neighbour_terms = granular || c.drag || c.visc > R::zero();
     s.v_adv
         .par_iter_mut()
-        .zip(s.aii.par_iter_mut())
         .zip(s.pressure.par_iter_mut())
+        .zip(s.p_over_rho2.par_iter_mut())
         .enumerate()
         .with_min_len(MIN_LEN)
-        .for_each(|(i, ((va, aii), pr))| {
+        .for_each(|(i, ((va, pr), pi))| {
             let stress_ptr = stress_ptr;
             let (xi, vi, mi, rhoi) = (x[i], v[i], m[i], rho[i]);
-            let mut sum_grad = Vec3::zeros();
-            let mut sum_grad_sq = R::zero();
+            *pr *= half;
+            *pi = *pr / (rhoi * rhoi);
+            if !neighbour_terms {
+                *va = vi + g * c.dt;
+                return;
+            }
             let mut visc = Vec3::zeros();
             let mut vgrad = [[R::zero(); 3]; 3];
             let upstream = {
@@ -651,10 +668,8 @@ pub(crate) fn advection_pass<R: Real>(
             for k in offsets[i]..offsets[i + 1] {
                 let j = indices[k] as usize;
                 let xj = x[j];
-                let gw = grad(&xi, &xj, gs[k]);
-                sum_grad += gw * m[j];
-                sum_grad_sq += m[j] * gw.norm_squared();
                 if c.visc > R::zero() || granular {
+                    let gw = grad(&xi, &xj, gs[k]);
                     let vol_j = m[j] / rho[j];
                     let vij = vi - v[j];
                     if c.visc > R::zero() {
@@ -687,11 +702,6 @@ pub(crate) fn advection_pass<R: Real>(
                 acc += f / mi;
             }
             *va = vi + acc * c.dt;
-            // a_ii = Σ_j m_j (d_ii − d_ji)·∇W_ij + ρ0 d_ii·∇Ψ_i
-            //      = −Δt²/ρ_i² (|Σ_j m_j ∇W_ij + ρ0 ∇Ψ_i|² + m_i Σ_j m_j |∇W_ij|²).
-            let gi = sum_grad + bgrad[i] * c.rho0;
-            *aii = -dt2 / (rhoi * rhoi) * (gi.norm_squared() + mi * sum_grad_sq);
-            *pr *= half;
             if granular {
                 // The static walls' share of the velocity gradient, Σ_b V_b (0 − u_i) ⊗
                 // ∇W_ib = −u_i ⊗ ∇Ψ_i (no-slip walls, as the fluid sees them in eq. 30).
@@ -710,7 +720,9 @@ pub(crate) fn advection_pass<R: Real>(
         });
 }
 
-/// Eq. 19 (with the boundary term): the source `ρ0 − ρ_i^adv`; and `p_i/ρ_i²`.
+/// Eq. 19 (with the boundary term): the source `ρ0 − ρ_i^adv`; fused with the pressure
+/// accelerations of the warm start `p⁰` (the first half of the first Jacobi iteration,
+/// which reads the same neighbour data).
 pub(crate) fn predicted_density_pass<R: Real>(
     c: &Consts<R>,
     x: &[Vec3<R>],
@@ -720,29 +732,32 @@ pub(crate) fn predicted_density_pass<R: Real>(
 ) {
     let offsets = nb.offsets();
     let indices = nb.indices();
-    let (rho, gs, bgrad, va, pr) = (
+    let (rho, gs, bgrad, va, pi) = (
         &s.density[..],
         &s.grad_scale[..],
         &s.bgrad[..],
         &s.v_adv[..],
-        &s.pressure[..],
+        &s.p_over_rho2[..],
     );
     s.source
         .par_iter_mut()
-        .zip(s.p_over_rho2.par_iter_mut())
+        .zip(s.accel.par_iter_mut())
         .enumerate()
         .with_min_len(MIN_LEN)
-        .for_each(|(i, (src, pi))| {
-            let (xi, vai) = (x[i], va[i]);
+        .for_each(|(i, (src, acc))| {
+            let (xi, vai, p_i) = (x[i], va[i], pi[i]);
             let mut div = R::zero();
+            let mut a = Vec3::zeros();
             for k in offsets[i]..offsets[i + 1] {
                 let j = indices[k] as usize;
-                div += m[j] * (vai - va[j]).dot(&grad(&xi, &x[j], gs[k]));
+                let gw = grad(&xi, &x[j], gs[k]);
+                div += m[j] * (vai - va[j]).dot(&gw);
+                a -= gw * (m[j] * (p_i + pi[j]));
             }
             div += c.rho0 * vai.dot(&bgrad[i]);
             let rho_adv = rho[i] + c.dt * div;
             *src = c.rho0 - rho_adv;
-            *pi = pr[i] / (rho[i] * rho[i]);
+            *acc = a - bgrad[i] * (c.rho0 * p_i);
         });
 }
 
@@ -796,8 +811,9 @@ fn a_times_p<R: Real>(
 
 /// Relaxed Jacobi (Ihmsen et al. 2014 eq. 14, Neder 2024 eq. 20) with the unilateral
 /// projection `p ≥ 0` (eq. 4): at least `min_iterations`, then until the average predicted
-/// compression is below `η`, at most `max_iterations`. Returns `(iterations, last average
-/// error, converged)`.
+/// compression is below `η`, at most `max_iterations`. Expects `accel` to hold the pressure
+/// accelerations of the starting pressures. Returns `(iterations, last average error,
+/// converged)`.
 pub(crate) fn pressure_solve<R: Real>(
     c: &Consts<R>,
     p: &IisphParams<R>,
@@ -817,8 +833,9 @@ pub(crate) fn pressure_solve<R: Real>(
     let inv_rho0 = 1.0 / c.rho0.as_f64();
     let mut error = 0.0;
     for l in 0..p.max_iterations {
-        // Pressure accelerations of the iterate p^l.
-        {
+        // Pressure accelerations of the iterate p^l (for l = 0 computed by
+        // `predicted_density_pass`).
+        if l > 0 {
             let (gs, pi, bgrad) = (&s.grad_scale[..], &s.p_over_rho2[..], &s.bgrad[..]);
             s.accel
                 .par_iter_mut()
