@@ -10,8 +10,8 @@ use sph_core::{apply_permutation, ParticleSet, Real, Vec3};
 use sph_kernels::{CubicSpline, Kernel};
 use sph_solver::boundary::check_volume_kernel;
 use sph_solver::step::{
-    begin_frame, check_divergence, end_frame, CellReorder, FramePhases, StepAt, StepNeighbours,
-    MIN_LEN, REDUCE_CHUNK,
+    begin_frame, check_divergence, density_at, end_frame, CellReorder, FramePhases, StepAt,
+    StepNeighbours, MIN_LEN, REDUCE_CHUNK,
 };
 use sph_solver::{Boundary, CollisionBoundary, Solids, SolverError, StepStats};
 
@@ -180,6 +180,14 @@ struct SharedSlice<T>(*mut T);
 // the task that handles `i`), never to read another task's range.
 unsafe impl<T: Send> Send for SharedSlice<T> {}
 unsafe impl<T: Send> Sync for SharedSlice<T> {}
+
+impl<T> SharedSlice<T> {
+    /// The pointer (a method, so that closures capture the whole `Sync` wrapper).
+    #[inline(always)]
+    fn get(&self) -> *mut T {
+        self.0
+    }
+}
 
 /// `∇W_ij` from the cached `W'(r)/r` of the pair.
 #[inline(always)]
@@ -356,8 +364,8 @@ impl<R: Real> Iisph<R> {
         let (x, m) = (&state.positions[..], &state.masses[..]);
         let c = &self.c;
         let s = &mut self.scratch;
-        for i in 0..n {
-            s.p_over_rho2[i] = p[i] / (s.density[i] * s.density[i]);
+        for ((pi, &pr), &rho) in s.p_over_rho2.iter_mut().zip(p).zip(&s.density) {
+            *pi = pr / (rho * rho);
         }
         let (offsets, indices) = (nb.offsets(), nb.indices());
         let (gs, pi, bgrad) = (&s.grad_scale[..], &s.p_over_rho2[..], &s.bgrad[..]);
@@ -500,7 +508,7 @@ impl<R: Real> Iisph<R> {
                 .par_iter_mut()
                 .enumerate()
                 .with_min_len(MIN_LEN)
-                .for_each(|(i, rho)| *rho = density_at(&c, xn, m, nb, volume, i));
+                .for_each(|(i, rho)| *rho = density_at(&c.kernel, c.rho0, xn, m, nb, volume, i));
         }
         check_divergence(at, &s.x_new, &s.v_new, &*self.boundary, h)?;
         state.positions.copy_from_slice(&s.x_new);
@@ -533,32 +541,11 @@ impl<R: Real> Iisph<R> {
     }
 }
 
-/// Density `Σ_j m_j W(x_i − x_j) + ρ0 Ψ(x_i)` at positions `x` (self term included).
-#[inline]
-pub(crate) fn density_at<R: Real>(
-    c: &Consts<R>,
-    x: &[Vec3<R>],
-    m: &[R],
-    nb: &NeighbourLists,
-    volume: Option<&dyn Boundary<R>>,
-    i: usize,
-) -> R {
-    let xi = x[i];
-    let mut sum = m[i] * c.w0;
-    for &j in nb.neighbours(i) {
-        let j = j as usize;
-        sum += m[j] * c.kernel.value_r2((xi - x[j]).norm_squared());
-    }
-    if let Some(b) = volume {
-        sum += c.rho0 * b.sample(&xi).volume;
-    }
-    sum
-}
-
 /// Eq. 3 + eq. 29: `ρ_i`, `∇Ψ_i`, `W'(r)/r` of every pair, and the diagonal `a_ii` of
 /// eq. 24 (it needs only `x`, `m` and the particle's own density):
 /// `a_ii = Σ_j m_j (d_ii − d_ji)·∇W_ij + ρ0 d_ii·∇Ψ_i
 ///       = −Δt²/ρ_i² (|Σ_j m_j ∇W_ij + ρ0 ∇Ψ_i|² + m_i Σ_j m_j |∇W_ij|²)`.
+#[allow(clippy::needless_range_loop)] // k addresses the CSR pair arrays (indices, scales)
 pub(crate) fn density_pass<R: Real>(
     c: &Consts<R>,
     x: &[Vec3<R>],
@@ -579,7 +566,6 @@ pub(crate) fn density_pass<R: Real>(
         .enumerate()
         .with_min_len(MIN_LEN)
         .for_each(|(i, ((rho, bg), aii))| {
-            let gs = gs;
             let (xi, mi) = (x[i], m[i]);
             let mut sum = mi * c.w0;
             let mut sum_grad = Vec3::zeros();
@@ -595,7 +581,7 @@ pub(crate) fn density_pass<R: Real>(
                     R::zero()
                 };
                 // SAFETY: k lies in particle i's CSR range, written only by this task.
-                unsafe { *gs.0.add(k) = f };
+                unsafe { *gs.get().add(k) = f };
                 let gw = d * f;
                 sum_grad += gw * m[j];
                 sum_grad_sq += m[j] * gw.norm_squared();
@@ -645,7 +631,6 @@ pub(crate) fn advection_pass<R: Real>(
         .enumerate()
         .with_min_len(MIN_LEN)
         .for_each(|(i, ((va, pr), pi))| {
-            let stress_ptr = stress_ptr;
             let (xi, vi, mi, rhoi) = (x[i], v[i], m[i], rho[i]);
             *pr *= half;
             *pi = *pr / (rhoi * rhoi);
@@ -715,7 +700,7 @@ pub(crate) fn advection_pass<R: Real>(
                 let eps = strain_rate(&vgrad);
                 let trial = deviatoric(&eps.map(|e| -e * c.inv_friction_d));
                 // SAFETY: index i is written only by this task.
-                unsafe { *stress_ptr.0.add(i) = trial };
+                unsafe { *stress_ptr.get().add(i) = trial };
             }
         });
 }
@@ -764,6 +749,7 @@ pub(crate) fn predicted_density_pass<R: Real>(
 /// The pressure acceleration `F^p_i/m_i = −Σ_j m_j (p_i/ρ_i² + p_j/ρ_j²) ∇W_ij − ρ0 (p_i/ρ_i²)
 /// ∇Ψ_i` (eqs. 25 and 31) from `p/ρ²`.
 #[inline]
+#[allow(clippy::too_many_arguments)]
 fn pressure_accel<R: Real>(
     c: &Consts<R>,
     x: &[Vec3<R>],
@@ -788,6 +774,7 @@ fn pressure_accel<R: Real>(
 /// `a` of `p`: the predicted density change due to pressure, `ρ_i^{l} − ρ_i^adv`, i.e. the
 /// left side of Ihmsen et al.'s eq. 12 / Neder 2024 eqs. 20–23 (`a_ii p_i + ψ_i`).
 #[inline]
+#[allow(clippy::too_many_arguments)]
 fn a_times_p<R: Real>(
     c: &Consts<R>,
     x: &[Vec3<R>],
