@@ -6,7 +6,7 @@
 //! sorted, pressures warm-started). The side-by-side with SPlisHSPlasH is
 //! `examples/iisph_dambreak.rs`.
 use criterion::{criterion_group, criterion_main, Criterion};
-use iisph_granular::{FluidSolver, Iisph, IisphParams, ParticleSet, Vec3};
+use iisph_granular::{Iisph, IisphParams, ParticleSet, Vec3};
 use sph_core::{sampling::cubic_lattice, Aabb, BoxSdf, Inverted};
 use sph_kernels::KernelKind;
 use sph_solver::boundary::{VolumeMapBoundary, VolumeMapOptions};

@@ -119,7 +119,7 @@ pub fn drag_force<R: Real>(
     omega: R,
 ) -> Vec3<R> {
     let speed = relative_velocity.norm();
-    if !(speed > R::zero()) {
+    if !speed.is_finite_value() || speed <= R::zero() {
         return Vec3::zeros();
     }
     // ½ ρ_a |v_rel|² C_D ω A along v_rel/|v_rel|.
@@ -135,7 +135,7 @@ pub fn drag_force<R: Real>(
 #[inline]
 pub fn occlusion<R: Real>(upstream: &Vec3<R>, d: &Vec3<R>, cos_cone: R) -> R {
     let len = d.norm();
-    if !(len > R::zero()) {
+    if !len.is_finite_value() || len <= R::zero() {
         return R::zero();
     }
     let cos_phi = upstream.dot(d) / len;

@@ -10,8 +10,8 @@ use sph_core::{apply_permutation, ParticleSet, Real, Vec3};
 use sph_kernels::{CubicSpline, Kernel};
 use sph_solver::boundary::check_volume_kernel;
 use sph_solver::step::{
-    begin_frame, check_divergence, end_frame, CellReorder, FramePhases, StepAt, StepNeighbours,
-    MIN_LEN, REDUCE_CHUNK,
+    begin_frame, check_divergence, density_at, end_frame, CellReorder, FramePhases, StepAt,
+    StepNeighbours, MIN_LEN, REDUCE_CHUNK,
 };
 use sph_solver::{Boundary, CollisionBoundary, Solids, SolverError, StepStats};
 
@@ -180,6 +180,14 @@ struct SharedSlice<T>(*mut T);
 // the task that handles `i`), never to read another task's range.
 unsafe impl<T: Send> Send for SharedSlice<T> {}
 unsafe impl<T: Send> Sync for SharedSlice<T> {}
+
+impl<T> SharedSlice<T> {
+    /// The pointer (a method, so that closures capture the whole `Sync` wrapper).
+    #[inline(always)]
+    fn get(&self) -> *mut T {
+        self.0
+    }
+}
 
 /// `∇W_ij` from the cached `W'(r)/r` of the pair.
 #[inline(always)]
@@ -356,8 +364,8 @@ impl<R: Real> Iisph<R> {
         let (x, m) = (&state.positions[..], &state.masses[..]);
         let c = &self.c;
         let s = &mut self.scratch;
-        for i in 0..n {
-            s.p_over_rho2[i] = p[i] / (s.density[i] * s.density[i]);
+        for ((pi, &pr), &rho) in s.p_over_rho2.iter_mut().zip(p).zip(&s.density) {
+            *pi = pr / (rho * rho);
         }
         let (offsets, indices) = (nb.offsets(), nb.indices());
         let (gs, pi, bgrad) = (&s.grad_scale[..], &s.p_over_rho2[..], &s.bgrad[..]);
@@ -378,6 +386,7 @@ impl<R: Real> Iisph<R> {
         let s = &mut self.scratch;
         s.pressure.iter_mut().for_each(|p| *p = R::zero());
         s.p_over_rho2.iter_mut().for_each(|p| *p = R::zero());
+        s.accel.iter_mut().for_each(|a| *a = Vec3::zeros());
         pressure_solve(
             &self.c,
             &self.params,
@@ -499,7 +508,7 @@ impl<R: Real> Iisph<R> {
                 .par_iter_mut()
                 .enumerate()
                 .with_min_len(MIN_LEN)
-                .for_each(|(i, rho)| *rho = density_at(&c, xn, m, nb, volume, i));
+                .for_each(|(i, rho)| *rho = density_at(&c.kernel, c.rho0, xn, m, nb, volume, i));
         }
         check_divergence(at, &s.x_new, &s.v_new, &*self.boundary, h)?;
         state.positions.copy_from_slice(&s.x_new);
@@ -532,29 +541,11 @@ impl<R: Real> Iisph<R> {
     }
 }
 
-/// Density `Σ_j m_j W(x_i − x_j) + ρ0 Ψ(x_i)` at positions `x` (self term included).
-#[inline]
-pub(crate) fn density_at<R: Real>(
-    c: &Consts<R>,
-    x: &[Vec3<R>],
-    m: &[R],
-    nb: &NeighbourLists,
-    volume: Option<&dyn Boundary<R>>,
-    i: usize,
-) -> R {
-    let xi = x[i];
-    let mut sum = m[i] * c.w0;
-    for &j in nb.neighbours(i) {
-        let j = j as usize;
-        sum += m[j] * c.kernel.value_r2((xi - x[j]).norm_squared());
-    }
-    if let Some(b) = volume {
-        sum += c.rho0 * b.sample(&xi).volume;
-    }
-    sum
-}
-
-/// Eq. 3 + eq. 29: `ρ_i`, `∇Ψ_i`, and `W'(r)/r` of every pair.
+/// Eq. 3 + eq. 29: `ρ_i`, `∇Ψ_i`, `W'(r)/r` of every pair, and the diagonal `a_ii` of
+/// eq. 24 (it needs only `x`, `m` and the particle's own density):
+/// `a_ii = Σ_j m_j (d_ii − d_ji)·∇W_ij + ρ0 d_ii·∇Ψ_i
+///       = −Δt²/ρ_i² (|Σ_j m_j ∇W_ij + ρ0 ∇Ψ_i|² + m_i Σ_j m_j |∇W_ij|²)`.
+#[allow(clippy::needless_range_loop)] // k addresses the CSR pair arrays (indices, scales)
 pub(crate) fn density_pass<R: Real>(
     c: &Consts<R>,
     x: &[Vec3<R>],
@@ -567,18 +558,22 @@ pub(crate) fn density_pass<R: Real>(
     let indices = nb.indices();
     s.grad_scale.resize(indices.len(), R::zero());
     let gs = SharedSlice(s.grad_scale.as_mut_ptr());
+    let dt2 = c.dt * c.dt;
     s.density
         .par_iter_mut()
         .zip(s.bgrad.par_iter_mut())
+        .zip(s.aii.par_iter_mut())
         .enumerate()
         .with_min_len(MIN_LEN)
-        .for_each(|(i, (rho, bg))| {
-            let gs = gs;
-            let xi = x[i];
-            let mut sum = m[i] * c.w0;
+        .for_each(|(i, ((rho, bg), aii))| {
+            let (xi, mi) = (x[i], m[i]);
+            let mut sum = mi * c.w0;
+            let mut sum_grad = Vec3::zeros();
+            let mut sum_grad_sq = R::zero();
             for k in offsets[i]..offsets[i + 1] {
                 let j = indices[k] as usize;
-                let r = (xi - x[j]).norm();
+                let d = xi - x[j];
+                let r = d.norm();
                 sum += m[j] * c.kernel.value(r);
                 let f = if r > R::zero() {
                     c.kernel.derivative(r) / r
@@ -586,7 +581,10 @@ pub(crate) fn density_pass<R: Real>(
                     R::zero()
                 };
                 // SAFETY: k lies in particle i's CSR range, written only by this task.
-                unsafe { *gs.0.add(k) = f };
+                unsafe { *gs.get().add(k) = f };
+                let gw = d * f;
+                sum_grad += gw * m[j];
+                sum_grad_sq += m[j] * gw.norm_squared();
             }
             if let Some(b) = volume {
                 let smp = b.sample(&xi);
@@ -596,12 +594,13 @@ pub(crate) fn density_pass<R: Real>(
                 *bg = Vec3::zeros();
             }
             *rho = sum;
+            let gi = sum_grad + *bg * c.rho0;
+            *aii = -dt2 / (sum * sum) * (gi.norm_squared() + mi * sum_grad_sq);
         });
 }
 
-/// Eqs. 5–10, 17–18 and 24: drag, viscosity, strain rate and trial stress, `v^adv`, `a_ii`,
-/// and the warm start `p⁰ = p(t − Δt) / 2`.
-#[allow(clippy::too_many_arguments)]
+/// Eqs. 5–10 and 17–18: drag, viscosity, strain rate and trial stress, `v^adv`; the warm
+/// start `p⁰ = p(t − Δt) / 2` and its `p/ρ²`.
 pub(crate) fn advection_pass<R: Real>(
     c: &Consts<R>,
     g: Vec3<R>,
@@ -615,7 +614,6 @@ pub(crate) fn advection_pass<R: Real>(
     let indices = nb.indices();
     let (rho, gs, bgrad) = (&s.density[..], &s.grad_scale[..], &s.bgrad[..]);
     let half = R::of_f64(0.5);
-    let dt2 = c.dt * c.dt;
     let eps_h2 = R::of_f64(0.01) * c.h * c.h;
     let mut stress_dummy: [Sym3<R>; 0] = [];
     let stress: &mut [Sym3<R>] = if c.granular {
@@ -625,17 +623,21 @@ pub(crate) fn advection_pass<R: Real>(
     };
     let stress_ptr = SharedSlice(stress.as_mut_ptr());
     let granular = c.granular;
+    let neighbour_terms = granular || c.drag || c.visc > R::zero();
     s.v_adv
         .par_iter_mut()
-        .zip(s.aii.par_iter_mut())
         .zip(s.pressure.par_iter_mut())
+        .zip(s.p_over_rho2.par_iter_mut())
         .enumerate()
         .with_min_len(MIN_LEN)
-        .for_each(|(i, ((va, aii), pr))| {
-            let stress_ptr = stress_ptr;
+        .for_each(|(i, ((va, pr), pi))| {
             let (xi, vi, mi, rhoi) = (x[i], v[i], m[i], rho[i]);
-            let mut sum_grad = Vec3::zeros();
-            let mut sum_grad_sq = R::zero();
+            *pr *= half;
+            *pi = *pr / (rhoi * rhoi);
+            if !neighbour_terms {
+                *va = vi + g * c.dt;
+                return;
+            }
             let mut visc = Vec3::zeros();
             let mut vgrad = [[R::zero(); 3]; 3];
             let upstream = {
@@ -651,10 +653,8 @@ pub(crate) fn advection_pass<R: Real>(
             for k in offsets[i]..offsets[i + 1] {
                 let j = indices[k] as usize;
                 let xj = x[j];
-                let gw = grad(&xi, &xj, gs[k]);
-                sum_grad += gw * m[j];
-                sum_grad_sq += m[j] * gw.norm_squared();
                 if c.visc > R::zero() || granular {
+                    let gw = grad(&xi, &xj, gs[k]);
                     let vol_j = m[j] / rho[j];
                     let vij = vi - v[j];
                     if c.visc > R::zero() {
@@ -687,11 +687,6 @@ pub(crate) fn advection_pass<R: Real>(
                 acc += f / mi;
             }
             *va = vi + acc * c.dt;
-            // a_ii = Σ_j m_j (d_ii − d_ji)·∇W_ij + ρ0 d_ii·∇Ψ_i
-            //      = −Δt²/ρ_i² (|Σ_j m_j ∇W_ij + ρ0 ∇Ψ_i|² + m_i Σ_j m_j |∇W_ij|²).
-            let gi = sum_grad + bgrad[i] * c.rho0;
-            *aii = -dt2 / (rhoi * rhoi) * (gi.norm_squared() + mi * sum_grad_sq);
-            *pr *= half;
             if granular {
                 // The static walls' share of the velocity gradient, Σ_b V_b (0 − u_i) ⊗
                 // ∇W_ib = −u_i ⊗ ∇Ψ_i (no-slip walls, as the fluid sees them in eq. 30).
@@ -705,12 +700,14 @@ pub(crate) fn advection_pass<R: Real>(
                 let eps = strain_rate(&vgrad);
                 let trial = deviatoric(&eps.map(|e| -e * c.inv_friction_d));
                 // SAFETY: index i is written only by this task.
-                unsafe { *stress_ptr.0.add(i) = trial };
+                unsafe { *stress_ptr.get().add(i) = trial };
             }
         });
 }
 
-/// Eq. 19 (with the boundary term): the source `ρ0 − ρ_i^adv`; and `p_i/ρ_i²`.
+/// Eq. 19 (with the boundary term): the source `ρ0 − ρ_i^adv`; fused with the pressure
+/// accelerations of the warm start `p⁰` (the first half of the first Jacobi iteration,
+/// which reads the same neighbour data).
 pub(crate) fn predicted_density_pass<R: Real>(
     c: &Consts<R>,
     x: &[Vec3<R>],
@@ -720,35 +717,39 @@ pub(crate) fn predicted_density_pass<R: Real>(
 ) {
     let offsets = nb.offsets();
     let indices = nb.indices();
-    let (rho, gs, bgrad, va, pr) = (
+    let (rho, gs, bgrad, va, pi) = (
         &s.density[..],
         &s.grad_scale[..],
         &s.bgrad[..],
         &s.v_adv[..],
-        &s.pressure[..],
+        &s.p_over_rho2[..],
     );
     s.source
         .par_iter_mut()
-        .zip(s.p_over_rho2.par_iter_mut())
+        .zip(s.accel.par_iter_mut())
         .enumerate()
         .with_min_len(MIN_LEN)
-        .for_each(|(i, (src, pi))| {
-            let (xi, vai) = (x[i], va[i]);
+        .for_each(|(i, (src, acc))| {
+            let (xi, vai, p_i) = (x[i], va[i], pi[i]);
             let mut div = R::zero();
+            let mut a = Vec3::zeros();
             for k in offsets[i]..offsets[i + 1] {
                 let j = indices[k] as usize;
-                div += m[j] * (vai - va[j]).dot(&grad(&xi, &x[j], gs[k]));
+                let gw = grad(&xi, &x[j], gs[k]);
+                div += m[j] * (vai - va[j]).dot(&gw);
+                a -= gw * (m[j] * (p_i + pi[j]));
             }
             div += c.rho0 * vai.dot(&bgrad[i]);
             let rho_adv = rho[i] + c.dt * div;
             *src = c.rho0 - rho_adv;
-            *pi = pr[i] / (rho[i] * rho[i]);
+            *acc = a - bgrad[i] * (c.rho0 * p_i);
         });
 }
 
 /// The pressure acceleration `F^p_i/m_i = −Σ_j m_j (p_i/ρ_i² + p_j/ρ_j²) ∇W_ij − ρ0 (p_i/ρ_i²)
 /// ∇Ψ_i` (eqs. 25 and 31) from `p/ρ²`.
 #[inline]
+#[allow(clippy::too_many_arguments)]
 fn pressure_accel<R: Real>(
     c: &Consts<R>,
     x: &[Vec3<R>],
@@ -773,6 +774,7 @@ fn pressure_accel<R: Real>(
 /// `a` of `p`: the predicted density change due to pressure, `ρ_i^{l} − ρ_i^adv`, i.e. the
 /// left side of Ihmsen et al.'s eq. 12 / Neder 2024 eqs. 20–23 (`a_ii p_i + ψ_i`).
 #[inline]
+#[allow(clippy::too_many_arguments)]
 fn a_times_p<R: Real>(
     c: &Consts<R>,
     x: &[Vec3<R>],
@@ -796,8 +798,9 @@ fn a_times_p<R: Real>(
 
 /// Relaxed Jacobi (Ihmsen et al. 2014 eq. 14, Neder 2024 eq. 20) with the unilateral
 /// projection `p ≥ 0` (eq. 4): at least `min_iterations`, then until the average predicted
-/// compression is below `η`, at most `max_iterations`. Returns `(iterations, last average
-/// error, converged)`.
+/// compression is below `η`, at most `max_iterations`. Expects `accel` to hold the pressure
+/// accelerations of the starting pressures. Returns `(iterations, last average error,
+/// converged)`.
 pub(crate) fn pressure_solve<R: Real>(
     c: &Consts<R>,
     p: &IisphParams<R>,
@@ -817,8 +820,9 @@ pub(crate) fn pressure_solve<R: Real>(
     let inv_rho0 = 1.0 / c.rho0.as_f64();
     let mut error = 0.0;
     for l in 0..p.max_iterations {
-        // Pressure accelerations of the iterate p^l.
-        {
+        // Pressure accelerations of the iterate p^l (for l = 0 computed by
+        // `predicted_density_pass`).
+        if l > 0 {
             let (gs, pi, bgrad) = (&s.grad_scale[..], &s.p_over_rho2[..], &s.bgrad[..]);
             s.accel
                 .par_iter_mut()

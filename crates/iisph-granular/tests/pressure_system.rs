@@ -163,11 +163,11 @@ proptest! {
         let rho0 = params.common.rest_density;
         let a_scale = o.aii.iter().fold(0.0f64, |m, a| m.max(a.abs()));
         let p_scale = 2000.0 * a_scale;
-        for i in 0..n {
+        for (i, &api) in ap.iter().enumerate() {
             close(solver.system_density()[i], o.rho[i], rho0, "rho", i);
             close(solver.system_source()[i], o.source[i], rho0, "source", i);
             close(solver.system_diagonal()[i], o.aii[i], a_scale, "a_ii", i);
-            close(ap[i], o.ap[i], p_scale, "A p", i);
+            close(api, o.ap[i], p_scale, "A p", i);
         }
     }
 }

@@ -9,8 +9,8 @@ use sph_core::{ParticleSet, Real, Sdf, Vec3};
 use sph_kernels::{Kernel, Poly6, Spiky};
 use sph_solver::boundary::check_volume_kernel;
 use sph_solver::step::{
-    begin_frame, check_divergence, check_predicted, end_frame, CellReorder, FramePhases, StepAt,
-    StepNeighbours, MIN_LEN,
+    begin_frame, check_divergence, check_predicted, density_at, end_frame, CellReorder,
+    FramePhases, StepAt, StepNeighbours, MIN_LEN,
 };
 use sph_solver::{Boundary, CollisionBoundary, Solids, SolverError, StepStats};
 
@@ -44,8 +44,6 @@ const NAME: &str = "PCISPH";
 struct Consts<R: Real> {
     poly6: Poly6<R>,
     spiky: Spiky<R>,
-    /// `W(0)` of Poly6: the self term of the density sum.
-    w0: R,
     rho0: R,
     inv_rho0: R,
     /// `1/ρ0²` of the pressure force.
@@ -62,7 +60,6 @@ impl<R: Real> Consts<R> {
         Ok(Self {
             poly6,
             spiky: Spiky::new(h)?,
-            w0: poly6.value_r2(R::zero()),
             rho0,
             inv_rho0,
             inv_rho0_sq: inv_rho0 * inv_rho0,
@@ -135,28 +132,6 @@ impl<R: Real> fmt::Debug for Pcisph<R> {
 fn advance<R: Real>(x: Vec3<R>, v: Vec3<R>, a: Vec3<R>, dt: R) -> (Vec3<R>, Vec3<R>) {
     let v_star = v + a * dt;
     (v_star, x + v_star * dt)
-}
-
-/// Density `Σ_j m_j W(x_i − x_j) + ρ0 Ψ(x_i)` (Poly6, self term included) at positions `x`.
-#[inline]
-fn density_at<R: Real>(
-    c: &Consts<R>,
-    x: &[Vec3<R>],
-    m: &[R],
-    nb: &NeighbourLists,
-    volume: Option<&dyn Boundary<R>>,
-    i: usize,
-) -> R {
-    let xi = x[i];
-    let mut sum = m[i] * c.w0;
-    for &j in nb.neighbours(i) {
-        let j = j as usize;
-        sum += m[j] * c.poly6.value_r2((xi - x[j]).norm_squared());
-    }
-    if let Some(b) = volume {
-        sum += c.rho0 * b.sample(&xi).volume;
-    }
-    sum
 }
 
 impl<R: Real> Pcisph<R> {
@@ -351,7 +326,7 @@ impl<R: Real> Pcisph<R> {
                 .enumerate()
                 .with_min_len(MIN_LEN)
                 .for_each(|(i, (rho, pr))| {
-                    let r = density_at(&c, xp, m, nb, volume, i);
+                    let r = density_at(&c.poly6, c.rho0, xp, m, nb, volume, i);
                     let mut err = r - rho0;
                     if clamp && err < R::zero() {
                         err = R::zero();
@@ -417,7 +392,7 @@ impl<R: Real> Pcisph<R> {
                 // xp[i] is project(y): the last prediction used the same acceleration.
                 let (v_star, y) = advance(x[i], vel[i], g + acc[i], dt);
                 *vn = v_star + (xp[i] - y) * inv_dt;
-                *rho = density_at(&c, xp, m, nb, volume, i);
+                *rho = density_at(&c.poly6, c.rho0, xp, m, nb, volume, i);
             });
         check_divergence(at, xp, &s.velocity_new, boundary, h)?;
         state.positions.copy_from_slice(xp);

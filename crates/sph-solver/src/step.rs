@@ -13,6 +13,7 @@ use neighbour_search::{
 };
 use rayon::prelude::*;
 use sph_core::{ParticleSet, PermutationScratch, Real, Vec3};
+use sph_kernels::Kernel;
 
 use crate::{Boundary, CommonParams, SolverError, StepStats};
 
@@ -146,6 +147,31 @@ impl<R: Real> StepNeighbours<R> {
             e => e.into(),
         })
     }
+}
+
+/// The SPH density `Σ_j m_j W(x_i − x_j) + ρ0 Ψ(x_i)` of particle `i` at positions `x`
+/// (kernel `kernel`, self term `m_i W(0)` included, the neighbours of `nb`; `Ψ` of a
+/// boundary that takes part in the density, none when `volume` is `None`).
+#[inline]
+pub fn density_at<R: Real, K: Kernel<R>>(
+    kernel: &K,
+    rest_density: R,
+    x: &[Vec3<R>],
+    m: &[R],
+    nb: &NeighbourLists,
+    volume: Option<&dyn Boundary<R>>,
+    i: usize,
+) -> R {
+    let xi = x[i];
+    let mut sum = m[i] * kernel.value(R::zero());
+    for &j in nb.neighbours(i) {
+        let j = j as usize;
+        sum += m[j] * kernel.value_r2((xi - x[j]).norm_squared());
+    }
+    if let Some(b) = volume {
+        sum += rest_density * b.sample(&xi).volume;
+    }
+    sum
 }
 
 /// Where in a run a check happens: the solver, its `step` call (0-based) and the substep.
