@@ -150,7 +150,6 @@
 pub mod granular;
 pub mod measure;
 mod params;
-#[allow(unsafe_code)] // TEMPORARY while merging: replaced by sph_solver::csr below
 mod solver;
 pub mod upscale;
 

@@ -9,6 +9,7 @@ use rayon::prelude::*;
 use sph_core::{apply_permutation, ParticleSet, Real, Vec3};
 use sph_kernels::{CubicSpline, Kernel};
 use sph_solver::boundary::check_volume_kernel;
+use sph_solver::csr::par_csr_blocks;
 use sph_solver::step::{
     begin_frame, check_divergence, density_at, end_frame, CellReorder, FramePhases, StepAt,
     StepNeighbours, MIN_LEN, REDUCE_CHUNK,
@@ -170,22 +171,6 @@ impl<R: Real> Scratch<R> {
         self.v_new.resize(n, z);
         self.density_new.resize(n, R::zero());
         self.error_partials.resize(n.div_ceil(REDUCE_CHUNK), 0.0);
-    }
-}
-
-/// A raw pointer to a buffer whose disjoint ranges are written by different rayon tasks.
-#[derive(Clone, Copy)]
-struct SharedSlice<T>(*mut T);
-// SAFETY: used only to write disjoint index ranges (the CSR range of particle `i`, written by
-// the task that handles `i`), never to read another task's range.
-unsafe impl<T: Send> Send for SharedSlice<T> {}
-unsafe impl<T: Send> Sync for SharedSlice<T> {}
-
-impl<T> SharedSlice<T> {
-    /// The pointer (a method, so that closures capture the whole `Sync` wrapper).
-    #[inline(always)]
-    fn get(&self) -> *mut T {
-        self.0
     }
 }
 
@@ -557,46 +542,50 @@ pub(crate) fn density_pass<R: Real>(
     let offsets = nb.offsets();
     let indices = nb.indices();
     s.grad_scale.resize(indices.len(), R::zero());
-    let gs = SharedSlice(s.grad_scale.as_mut_ptr());
     let dt2 = c.dt * c.dt;
-    s.density
-        .par_iter_mut()
-        .zip(s.bgrad.par_iter_mut())
-        .zip(s.aii.par_iter_mut())
-        .enumerate()
-        .with_min_len(MIN_LEN)
-        .for_each(|(i, ((rho, bg), aii))| {
-            let (xi, mi) = (x[i], m[i]);
-            let mut sum = mi * c.w0;
-            let mut sum_grad = Vec3::zeros();
-            let mut sum_grad_sq = R::zero();
-            for k in offsets[i]..offsets[i + 1] {
-                let j = indices[k] as usize;
-                let d = xi - x[j];
-                let r = d.norm();
-                sum += m[j] * c.kernel.value(r);
-                let f = if r > R::zero() {
-                    c.kernel.derivative(r) / r
+    let outputs = (&mut s.density[..], &mut s.bgrad[..], &mut s.aii[..]);
+    par_csr_blocks(
+        offsets,
+        outputs,
+        &mut s.grad_scale[..],
+        &|first, (rho_b, bg_b, aii_b): (&mut [R], &mut [Vec3<R>], &mut [R]), gs: &mut [R]| {
+            let base = offsets[first];
+            let block = rho_b.iter_mut().zip(bg_b.iter_mut()).zip(aii_b.iter_mut());
+            for (l, ((rho, bg), aii)) in block.enumerate() {
+                let i = first + l;
+                let (xi, mi) = (x[i], m[i]);
+                let mut sum = mi * c.w0;
+                let mut sum_grad = Vec3::zeros();
+                let mut sum_grad_sq = R::zero();
+                for k in offsets[i]..offsets[i + 1] {
+                    let j = indices[k] as usize;
+                    let d = xi - x[j];
+                    let r = d.norm();
+                    sum += m[j] * c.kernel.value(r);
+                    let f = if r > R::zero() {
+                        c.kernel.derivative(r) / r
+                    } else {
+                        R::zero()
+                    };
+                    gs[k - base] = f;
+                    let gw = d * f;
+                    sum_grad += gw * m[j];
+                    sum_grad_sq += m[j] * gw.norm_squared();
+                }
+                if let Some(b) = volume {
+                    let smp = b.sample(&xi);
+                    sum += c.rho0 * smp.volume;
+                    *bg = smp.volume_gradient;
                 } else {
-                    R::zero()
-                };
-                // SAFETY: k lies in particle i's CSR range, written only by this task.
-                unsafe { *gs.get().add(k) = f };
-                let gw = d * f;
-                sum_grad += gw * m[j];
-                sum_grad_sq += m[j] * gw.norm_squared();
+                    *bg = Vec3::zeros();
+                }
+                *rho = sum;
+                let gi = sum_grad + *bg * c.rho0;
+                *aii = -dt2 / (sum * sum) * (gi.norm_squared() + mi * sum_grad_sq);
             }
-            if let Some(b) = volume {
-                let smp = b.sample(&xi);
-                sum += c.rho0 * smp.volume;
-                *bg = smp.volume_gradient;
-            } else {
-                *bg = Vec3::zeros();
-            }
-            *rho = sum;
-            let gi = sum_grad + *bg * c.rho0;
-            *aii = -dt2 / (sum * sum) * (gi.norm_squared() + mi * sum_grad_sq);
-        });
+            0.0
+        },
+    );
 }
 
 /// Eqs. 5–10 and 17–18: drag, viscosity, strain rate and trial stress, `v^adv`; the warm
@@ -615,94 +604,107 @@ pub(crate) fn advection_pass<R: Real>(
     let (rho, gs, bgrad) = (&s.density[..], &s.grad_scale[..], &s.bgrad[..]);
     let half = R::of_f64(0.5);
     let eps_h2 = R::of_f64(0.01) * c.h * c.h;
-    let mut stress_dummy: [Sym3<R>; 0] = [];
-    let stress: &mut [Sym3<R>] = if c.granular {
-        &mut s.stress
-    } else {
-        &mut stress_dummy
-    };
-    let stress_ptr = SharedSlice(stress.as_mut_ptr());
     let granular = c.granular;
     let neighbour_terms = granular || c.drag || c.visc > R::zero();
-    s.v_adv
-        .par_iter_mut()
-        .zip(s.pressure.par_iter_mut())
-        .zip(s.p_over_rho2.par_iter_mut())
-        .enumerate()
-        .with_min_len(MIN_LEN)
-        .for_each(|(i, ((va, pr), pi))| {
-            let (xi, vi, mi, rhoi) = (x[i], v[i], m[i], rho[i]);
-            *pr *= half;
-            *pi = *pr / (rhoi * rhoi);
-            if !neighbour_terms {
-                *va = vi + g * c.dt;
-                return;
+    // The body for particle i: writes v^adv, the warm start and p/ρ², and returns the trial
+    // stress of a granular material.
+    let body = |i: usize, va: &mut Vec3<R>, pr: &mut R, pi: &mut R| -> Option<Sym3<R>> {
+        let (xi, vi, mi, rhoi) = (x[i], v[i], m[i], rho[i]);
+        *pr *= half;
+        *pi = *pr / (rhoi * rhoi);
+        if !neighbour_terms {
+            *va = vi + g * c.dt;
+            return None;
+        }
+        let mut visc = Vec3::zeros();
+        let mut vgrad = [[R::zero(); 3]; 3];
+        let upstream = {
+            let rel = c.air_velocity - vi;
+            let len = rel.norm();
+            if c.drag && len > R::zero() {
+                -rel / len
+            } else {
+                Vec3::zeros()
             }
-            let mut visc = Vec3::zeros();
-            let mut vgrad = [[R::zero(); 3]; 3];
-            let upstream = {
-                let rel = c.air_velocity - vi;
-                let len = rel.norm();
-                if c.drag && len > R::zero() {
-                    -rel / len
-                } else {
-                    Vec3::zeros()
+        };
+        let mut occ = R::zero();
+        for k in offsets[i]..offsets[i + 1] {
+            let j = indices[k] as usize;
+            let xj = x[j];
+            if c.visc > R::zero() || granular {
+                let gw = grad(&xi, &xj, gs[k]);
+                let vol_j = m[j] / rho[j];
+                let vij = vi - v[j];
+                if c.visc > R::zero() {
+                    let xij = xi - xj;
+                    visc += gw * (vol_j * vij.dot(&xij) / (xij.norm_squared() + eps_h2));
                 }
-            };
-            let mut occ = R::zero();
-            for k in offsets[i]..offsets[i + 1] {
-                let j = indices[k] as usize;
-                let xj = x[j];
-                if c.visc > R::zero() || granular {
-                    let gw = grad(&xi, &xj, gs[k]);
-                    let vol_j = m[j] / rho[j];
-                    let vij = vi - v[j];
-                    if c.visc > R::zero() {
-                        let xij = xi - xj;
-                        visc += gw * (vol_j * vij.dot(&xij) / (xij.norm_squared() + eps_h2));
-                    }
-                    if granular {
-                        // ∇u_i = Σ_j V_j (u_j − u_i) ⊗ ∇W_ij (eq. 7, difference form).
-                        let du = -vij * vol_j;
-                        for a in 0..3 {
-                            for b in 0..3 {
-                                vgrad[a][b] += du[a] * gw[b];
-                            }
+                if granular {
+                    // ∇u_i = Σ_j V_j (u_j − u_i) ⊗ ∇W_ij (eq. 7, difference form).
+                    let du = -vij * vol_j;
+                    for a in 0..3 {
+                        for b in 0..3 {
+                            vgrad[a][b] += du[a] * gw[b];
                         }
                     }
                 }
-                if c.drag {
-                    occ = occ.max(occlusion(&upstream, &(xj - xi), c.cos_cone));
-                }
             }
-            let mut acc = g + visc * c.visc;
             if c.drag {
-                let f = drag_force(
-                    c.air_velocity - vi,
-                    c.air_density,
-                    c.drag_coefficient,
-                    c.area,
-                    R::one() - occ,
-                );
-                acc += f / mi;
+                occ = occ.max(occlusion(&upstream, &(xj - xi), c.cos_cone));
             }
-            *va = vi + acc * c.dt;
-            if granular {
-                // The static walls' share of the velocity gradient, Σ_b V_b (0 − u_i) ⊗
-                // ∇W_ib = −u_i ⊗ ∇Ψ_i (no-slip walls, as the fluid sees them in eq. 30).
-                let bg = bgrad[i];
-                for a in 0..3 {
-                    for b in 0..3 {
-                        vgrad[a][b] -= vi[a] * bg[b];
-                    }
+        }
+        let mut acc = g + visc * c.visc;
+        if c.drag {
+            let f = drag_force(
+                c.air_velocity - vi,
+                c.air_density,
+                c.drag_coefficient,
+                c.area,
+                R::one() - occ,
+            );
+            acc += f / mi;
+        }
+        *va = vi + acc * c.dt;
+        if granular {
+            // The static walls' share of the velocity gradient, Σ_b V_b (0 − u_i) ⊗
+            // ∇W_ib = −u_i ⊗ ∇Ψ_i (no-slip walls, as the fluid sees them in eq. 30).
+            let bg = bgrad[i];
+            for a in 0..3 {
+                for b in 0..3 {
+                    vgrad[a][b] -= vi[a] * bg[b];
                 }
-                // s = −D⁻¹ ε (eq. 10 with the sign of eq. 26), deviatoric (eqs. 11–12).
-                let eps = strain_rate(&vgrad);
-                let trial = deviatoric(&eps.map(|e| -e * c.inv_friction_d));
-                // SAFETY: index i is written only by this task.
-                unsafe { *stress_ptr.get().add(i) = trial };
             }
-        });
+            // s = −D⁻¹ ε (eq. 10 with the sign of eq. 26), deviatoric (eqs. 11–12).
+            let eps = strain_rate(&vgrad);
+            let trial = deviatoric(&eps.map(|e| -e * c.inv_friction_d));
+            Some(trial)
+        } else {
+            None
+        }
+    };
+    let per_particle = s
+        .v_adv
+        .par_iter_mut()
+        .zip(s.pressure.par_iter_mut())
+        .zip(s.p_over_rho2.par_iter_mut());
+    if granular {
+        per_particle
+            .zip(s.stress.par_iter_mut())
+            .enumerate()
+            .with_min_len(MIN_LEN)
+            .for_each(|(i, (((va, pr), pi), st))| {
+                if let Some(trial) = body(i, va, pr, pi) {
+                    *st = trial;
+                }
+            });
+    } else {
+        per_particle
+            .enumerate()
+            .with_min_len(MIN_LEN)
+            .for_each(|(i, ((va, pr), pi))| {
+                body(i, va, pr, pi);
+            });
+    }
 }
 
 /// Eq. 19 (with the boundary term): the source `ρ0 − ρ_i^adv`; fused with the pressure
