@@ -113,7 +113,7 @@ pub fn kiddo_search(points: &[Vec3<f32>], radius: f32) -> usize {
         .sum()
 }
 
-/// The fluid of SPlisHSPlasH's `DamBreakModel.json` at particle radius 0.0125 m (the issue's
+/// The fluid of SPlisHSPlasH's `DamBreakModel.json` at particle radius 0.0125 m (the
 /// side-by-side scene): the 39³ = 59,319 particles of [`dam_break_anchor`] without the
 /// boundary samples, and the tank 4 × 3 × 1.5 m centred at (0, 1.5, 0) as an inverted box
 /// (the solvers here use signed distance fields instead of boundary particles).
