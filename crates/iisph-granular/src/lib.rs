@@ -137,7 +137,7 @@
 //! `(A p)_i` and the update read the index, the scale, `x_j`, `m_j` and `a^p_j` (3R). The
 //! per-particle arrays (`x`, `m`, `p/ρ²`, `a^p`: 8R = 32 B in f32) of 10⁵ particles fit in
 //! the last-level cache, so the memory traffic per iteration is the streamed index and
-//! scale arrays, 2 × (4 + size_of::<R>()) = 16 B (f32) or 24 B (f64) per neighbour pair
+//! scale arrays, `2 × (4 + size_of::<R>())` = 16 B (f32) or 24 B (f64) per neighbour pair
 //! (≈ 30 MB per iteration for the 59k-particle dam break's 1.9 M pairs in f32), plus
 //! 2 × 32 B per particle; a pass does about 20 flops per pair, so on one core it is bound
 //! by the arithmetic, not by memory bandwidth. A water step with `k` iterations is

@@ -47,7 +47,7 @@
 //! * CPU, not GPU: every pixel of a splat intersects its own ray with the sphere exactly
 //!   (a point sprite approximates the sphere by a screen-aligned hemisphere); the thickness
 //!   is the exact chord length. Parallel over bands of rows (rayon), deterministic.
-//! * The paper's text of step 1 is lost in the extraction ("the method in [21]"); we follow
+//! * The paper's text of step 1 is lost in the extraction ("the method in \[21\]"); we follow
 //!   van der Laan 2009 §3.1 (spheres into the depth buffer).
 //! * The bilateral filter's radius is in metres (converted per pixel by its depth), its range
 //!   kernel a Gaussian of `σ_z` metres; both are parameters ([`BilateralParams`]).

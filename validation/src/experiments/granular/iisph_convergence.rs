@@ -12,12 +12,12 @@
 //! 1. **Over the dam break**: the reference run at `Δt = 2 ms` (quick) / `1 ms` (full);
 //!    iterations per step against time.
 //! 2. **Against iterations**: from the reference run's states at three times during the
-//!    impact, [`WINDOW_STEPS`] steps each with exactly `k` iterations (`min_iterations =
+//!    impact, `WINDOW_STEPS` steps each with exactly `k` iterations (`min_iterations =
 //!    max_iterations = k`, a tolerance too small to stop earlier); the solver's average density
 //!    error at the end of each step's solve (`StepStats::last_solve_error`) and the largest
 //!    density ratio `max ρ/ρ0 − 1`, averaged over the windows' steps after the first (whose
 //!    pressures start from another state's).
-//! 3. **Against the time step**: from the same states, [`WINDOW_S`] of simulation with
+//! 3. **Against the time step**: from the same states, `WINDOW_S` of simulation with
 //!    `Δt ∈ {0.5, 1, 2, 4} ms` at η = 0.1 %; iterations per step (after the first) and the
 //!    largest density error.
 //!

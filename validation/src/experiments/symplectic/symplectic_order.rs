@@ -6,7 +6,7 @@
 //!     REBOUND 5.2.2, accurate to 5e-11 AU), for S2 (eq. 13) and S6 (eq. 7) at steps
 //!     τ = 730.5 … 45.66 d. Expected: S2 ∝ τ² (error `O(ε τ²)`); S6 `ε² τ² (13 − 5√5)/288 + O(ε τ⁶)`,
 //!     i.e. about `ε ≈ 10⁻³` times S2's error at the same τ. The bounds, derived from these
-//!     estimates (see [`S6_OVER_S2_BOUND`], [`wisdom_holman_estimate`]), are checked at the
+//!     estimates (see `S6_OVER_S2_BOUND` and `wisdom_holman_estimate` below), are checked at the
 //!     paper's step and, for the `ε` scaling, with the planet masses divided by 4.
 //! (b) **Particle 1** (a = 60.91 AU, barycentric variant, B₀ = 0, B₁ = 0.21·10⁻⁶), 2 kyr, the
 //!     planets fixed (S6, τ = 36.525 d): the largest |ΔH| = |H + p₄|/|H| against the initial
