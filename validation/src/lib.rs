@@ -20,6 +20,7 @@ pub mod deviations;
 pub mod experiments;
 pub mod helpers;
 pub mod render;
+pub mod repose_cmd;
 pub mod runner;
 pub mod sim;
 

@@ -8,7 +8,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use sph_sim::{run_scene, SceneRunOptions};
 use validation::runner::{self, RunOptions};
-use validation::{registry, render, workspace_root, Mode};
+use validation::{registry, render, repose_cmd, workspace_root, Mode};
 
 #[derive(Parser)]
 #[command(
@@ -53,6 +53,23 @@ enum Command {
         /// Also render the frames (PNG, in DIR/render) while the scene runs.
         #[arg(long)]
         render: bool,
+    },
+    /// Measure the angle of repose of a scene run's last frame (or `--frame FILE`).
+    Repose {
+        /// The run's output directory.
+        dir: PathBuf,
+        /// The frame to measure [default: the last `frame_*.vtk` in DIR].
+        #[arg(long, value_name = "FILE")]
+        frame: Option<PathBuf>,
+        /// Planar heap (profile along x) or conical pile.
+        #[arg(long, value_enum, default_value = "planar")]
+        shape: repose_cmd::Shape,
+        /// The scene file [default: the one recorded by `scene` in DIR].
+        #[arg(long, value_name = "PATH")]
+        scene: Option<PathBuf>,
+        /// With --scene: apply its `[quick]` overrides.
+        #[arg(long)]
+        quick: bool,
     },
     /// Render the VTK frames of a scene run (`frame_*.vtk` in DIR) to PNG images.
     Render {
@@ -161,6 +178,19 @@ fn main() -> ExitCode {
                 report(run_scene(&path, &opts).map_err(Into::into))
             }
         }
+        Command::Repose {
+            dir,
+            frame,
+            shape,
+            scene,
+            quick,
+        } => report(repose_cmd::measure_run(
+            &dir,
+            frame,
+            shape,
+            scene.as_deref(),
+            quick,
+        )),
         Command::Render {
             dir,
             scene,

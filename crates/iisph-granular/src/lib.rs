@@ -147,13 +147,17 @@
 //! Every parallel loop writes one particle's values and reduces in fixed chunks, so results
 //! are bitwise identical for any number of threads.
 
+mod friction;
 pub mod granular;
 pub mod measure;
 mod params;
 mod solver;
 pub mod upscale;
 
-pub use params::{GranularParams, IisphParams, AIR_DENSITY, DEFAULT_DRAG_CONE_HALF_ANGLE_DEG};
+pub use params::{
+    GranularParams, IisphParams, AIR_DENSITY, DEFAULT_DRAG_CONE_HALF_ANGLE_DEG,
+    DEFAULT_FRICTION_MAX_ITERATIONS, DEFAULT_FRICTION_TOLERANCE,
+};
 pub use solver::{Iisph, IISPH_KERNEL, IISPH_PHASES};
 
 pub use sph_core::{ParticleSet, Real, Vec3};

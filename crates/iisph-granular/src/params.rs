@@ -15,6 +15,13 @@ pub const AIR_DENSITY: f64 = 1.2041;
 /// thesis gives no value, 30° is our choice).
 pub const DEFAULT_DRAG_CONE_HALF_ANGLE_DEG: f64 = 30.0;
 
+/// Default cap of the friction-stress iterations per time step.
+pub const DEFAULT_FRICTION_MAX_ITERATIONS: usize = 20;
+
+/// Default tolerance of the friction solve: mean strain per time step of the unyielded
+/// particles (dimensionless).
+pub const DEFAULT_FRICTION_TOLERANCE: f64 = 1e-4;
+
 /// Parameters of [`crate::Iisph`]. Lengths absolute, in metres; SI units throughout.
 ///
 /// | field | default ([`IisphParams::for_spacing`]) | source |
@@ -58,6 +65,8 @@ pub struct IisphParams<R: Real> {
 /// | `air_velocity` | 0 m/s | `v_a` of eq. 5 (a uniform field) |
 /// | `air_density` | 1.2041 kg/m³ ([`AIR_DENSITY`]) | `ρ_a` of eq. 6 |
 /// | `drag_cone_half_angle_deg` | 30° ([`DEFAULT_DRAG_CONE_HALF_ANGLE_DEG`]) | the occlusion cone of §5.6 (no value given) |
+/// | `friction_max_iterations` | [`DEFAULT_FRICTION_MAX_ITERATIONS`] | cap of the friction-stress solve (our choice; hitting it is counted in `StepStats::unconverged_friction_substeps`) |
+/// | `friction_tolerance` | [`DEFAULT_FRICTION_TOLERANCE`] | mean unyielded strain per step at which the friction solve stops (our choice, see the crate docs) |
 #[derive(Debug, Clone, PartialEq)]
 pub struct GranularParams<R: Real> {
     /// Friction angle `θ` (degrees, in [0, 90)): the Drucker–Prager coefficient is
@@ -71,6 +80,11 @@ pub struct GranularParams<R: Real> {
     pub air_density: R,
     /// Half-angle of the occlusion cone (degrees, in (0, 90]).
     pub drag_cone_half_angle_deg: R,
+    /// Most iterations of the friction-stress solve per time step (≥ 1).
+    pub friction_max_iterations: usize,
+    /// The friction solve stops once the mean strain per time step of the particles inside
+    /// the yield surface, `Σ_i ‖dev ε_i‖ Δt / N` (dimensionless), is at most this (> 0).
+    pub friction_tolerance: R,
 }
 
 impl<R: Real> GranularParams<R> {
@@ -82,6 +96,8 @@ impl<R: Real> GranularParams<R> {
             air_velocity: Vec3::zeros(),
             air_density: R::of_f64(AIR_DENSITY),
             drag_cone_half_angle_deg: R::of_f64(DEFAULT_DRAG_CONE_HALF_ANGLE_DEG),
+            friction_max_iterations: DEFAULT_FRICTION_MAX_ITERATIONS,
+            friction_tolerance: R::of_f64(DEFAULT_FRICTION_TOLERANCE),
         }
     }
 
@@ -114,6 +130,17 @@ impl<R: Real> GranularParams<R> {
                 "drag_cone_half_angle_deg",
                 cone.as_f64(),
                 "must be in (0, 90] degrees",
+            ));
+        }
+        if self.friction_max_iterations == 0 {
+            return Err(invalid("friction_max_iterations", 0.0, "must be >= 1"));
+        }
+        let tol = self.friction_tolerance;
+        if !(tol.is_finite_value() && tol > R::zero()) {
+            return Err(invalid(
+                "friction_tolerance",
+                tol.as_f64(),
+                "must be finite and > 0",
             ));
         }
         Ok(())

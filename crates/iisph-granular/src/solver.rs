@@ -16,10 +16,8 @@ use sph_solver::step::{
 };
 use sph_solver::{Boundary, CollisionBoundary, Solids, SolverError, StepStats};
 
-use crate::granular::{
-    deviatoric, drag_force, occlusion, prototype_friction_coefficient, strain_rate, sym_mul,
-    yield_clamp, Sym3,
-};
+use crate::friction;
+use crate::granular::{drag_force, occlusion, prototype_friction_coefficient, Sym3};
 use crate::params::NAME;
 use crate::upscale::Upscaler;
 use crate::IisphParams;
@@ -31,6 +29,7 @@ pub const IISPH_PHASES: &[&str] = &[
     "detect_neighbours",
     "advection",
     "pressure_solve",
+    "friction_solve",
     "forces",
     "upscaling",
     "reorder",
@@ -40,9 +39,10 @@ const CREATE_HASH_GRID: usize = 1;
 const DETECT_NEIGHBOURS: usize = 2;
 const ADVECTION: usize = 3;
 const PRESSURE_SOLVE: usize = 4;
-const FORCES: usize = 5;
-const UPSCALING: usize = 6;
-const REORDER: usize = 7;
+const FRICTION_SOLVE: usize = 5;
+const FORCES: usize = 6;
+const UPSCALING: usize = 7;
+const REORDER: usize = 8;
 const FRAME: FramePhases = FramePhases {
     checks: INTEGRATE,
     reorder: REORDER,
@@ -65,6 +65,8 @@ pub(crate) struct Consts<R: Real> {
     pub inv_friction_d: R,
     /// Drucker–Prager `α = √2 sin θ` (0 for water).
     pub alpha: R,
+    /// Coulomb coefficient `tan θ` of the contact response (0 for water).
+    pub wall_friction: R,
     /// Drag: `C_D`, `ρ_a`, cross-section `π r²`, `cos` of the cone half-angle, air velocity.
     pub drag_coefficient: R,
     pub air_density: R,
@@ -107,6 +109,9 @@ impl<R: Real> Consts<R> {
             h,
             inv_friction_d,
             alpha: g.map_or(R::zero(), |g| g.alpha()),
+            wall_friction: g.map_or(R::zero(), |g| {
+                R::of_f64(g.friction_angle_deg.as_f64().to_radians().tan())
+            }),
             drag_coefficient: g.map_or(R::zero(), |g| g.drag_coefficient),
             air_density: g.map_or(R::zero(), |g| g.air_density),
             area: R::pi() * r * r,
@@ -143,8 +148,18 @@ pub(crate) struct Scratch<R: Real> {
     pub p_over_rho2: Vec<R>,
     /// Pressure acceleration `F^p_i / m_i` of the current iterate.
     pub accel: Vec<Vec3<R>>,
-    /// Frictional stress `s_i` (trial, then clamped, then divided by `ρ_i²`).
+    /// Frictional stress `s_i` (Pa, deviatoric, inside the yield surface); kept between
+    /// steps (the friction solve's warm start).
     pub stress: Vec<Sym3<R>>,
+    /// `s_i / ρ_i²`.
+    pub stress_over_rho2: Vec<Sym3<R>>,
+    /// Friction acceleration `F^f_i / m_i` of the current stress.
+    pub friction_accel: Vec<Vec3<R>>,
+    /// Velocity at the step's end without friction, `v^adv + Δt (a^p − a^f_prev)`.
+    pub v_base: Vec<Vec3<R>>,
+    /// Velocity at the step's end with the current stress iterate.
+    pub v_trial: Vec<Vec3<R>>,
+    pub perm_sym: Vec<Sym3<R>>,
     pub x_new: Vec<Vec3<R>>,
     pub v_new: Vec<Vec3<R>>,
     pub density_new: Vec<R>,
@@ -165,8 +180,12 @@ impl<R: Real> Scratch<R> {
         self.pressure.resize(n, R::zero());
         self.p_over_rho2.resize(n, R::zero());
         self.accel.resize(n, z);
-        self.stress
-            .resize(if granular { n } else { 0 }, [R::zero(); 6]);
+        let ng = if granular { n } else { 0 };
+        self.stress.resize(ng, [R::zero(); 6]);
+        self.stress_over_rho2.resize(ng, [R::zero(); 6]);
+        self.friction_accel.resize(ng, z);
+        self.v_base.resize(ng, z);
+        self.v_trial.resize(ng, z);
         self.x_new.resize(n, z);
         self.v_new.resize(n, z);
         self.density_new.resize(n, R::zero());
@@ -176,7 +195,7 @@ impl<R: Real> Scratch<R> {
 
 /// `∇W_ij` from the cached `W'(r)/r` of the pair.
 #[inline(always)]
-fn grad<R: Real>(xi: &Vec3<R>, xj: &Vec3<R>, f: R) -> Vec3<R> {
+pub(crate) fn grad<R: Real>(xi: &Vec3<R>, xj: &Vec3<R>, f: R) -> Vec3<R> {
     (xi - xj) * f
 }
 
@@ -254,9 +273,9 @@ impl<R: Real> Iisph<R> {
         &self.scratch.pressure
     }
 
-    /// The frictional stresses `s_i / ρ_i²` (Pa·m⁶/kg²) the last time step applied (empty
-    /// for water).
-    pub fn stress_over_rho2(&self) -> &[Sym3<R>] {
+    /// The frictional stresses `s_i` (Pa, symmetric `[xx, yy, zz, xy, xz, yz]`,
+    /// deviatoric, `‖s_i‖ ≤ α p_i`) the last time step applied (empty for water).
+    pub fn stress(&self) -> &[Sym3<R>] {
         &self.scratch.stress
     }
 
@@ -404,12 +423,13 @@ impl<R: Real> Iisph<R> {
         let n = state.len();
         if self.scratch.pressure.len() != n {
             self.scratch.pressure.clear();
+            self.scratch.stress.clear();
         } else if let Some(perm) = self.reorder.last_permutation() {
-            apply_permutation(
-                &mut self.scratch.pressure,
-                perm,
-                &mut self.scratch.perm_scalar,
-            );
+            let s = &mut self.scratch;
+            apply_permutation(&mut s.pressure, perm, &mut s.perm_scalar);
+            if s.stress.len() == n {
+                apply_permutation(&mut s.stress, perm, &mut s.perm_sym);
+            }
         }
         self.scratch.resize(n, self.c.granular);
         if let Some(u) = self.upscaler.as_mut() {
@@ -463,10 +483,14 @@ impl<R: Real> Iisph<R> {
         let p = &self.params;
         let g = p.common.gravity;
 
-        // Algorithm 1, lines 2–5: density, drag, stress, advection, predicted density, a_ii.
+        // Algorithm 1, lines 2–5: density, drag, advection (with the friction of the kept
+        // stress), predicted density, a_ii.
         let t = Instant::now();
         density_pass(&c, x, m, nb, volume, s);
         advection_pass(&c, g, x, v, m, nb, s);
+        if c.granular {
+            friction::predict(&c, x, m, nb, s);
+        }
         predicted_density_pass(&c, x, m, nb, s);
         stats.phases.add(ADVECTION, t.elapsed().as_secs_f64());
 
@@ -480,8 +504,27 @@ impl<R: Real> Iisph<R> {
         }
         stats.phases.add(PRESSURE_SOLVE, t.elapsed().as_secs_f64());
 
-        // Line 11 (yield, with the final pressure) and line 14: pressure and friction
-        // forces; line 15: integration.
+        // Lines 3 and 11 (stress and yield), solved after the pressure: see `friction`.
+        if let Some(gp) = &p.granular {
+            let t = Instant::now();
+            let f = friction::solve(
+                &c,
+                gp.friction_max_iterations,
+                gp.friction_tolerance.as_f64(),
+                x,
+                m,
+                nb,
+                s,
+            );
+            stats.friction_iterations += f.iterations;
+            stats.last_friction_residual = f.residual;
+            if !f.converged {
+                stats.unconverged_friction_substeps += 1;
+            }
+            stats.phases.add(FRICTION_SOLVE, t.elapsed().as_secs_f64());
+        }
+
+        // Line 14: pressure and friction forces; line 15: integration.
         let t = Instant::now();
         forces_pass(&c, x, m, nb, &*self.boundary, s);
         stats.phases.add(FORCES, t.elapsed().as_secs_f64());
@@ -588,8 +631,8 @@ pub(crate) fn density_pass<R: Real>(
     );
 }
 
-/// Eqs. 5–10 and 17–18: drag, viscosity, strain rate and trial stress, `v^adv`; the warm
-/// start `p⁰ = p(t − Δt) / 2` and its `p/ρ²`.
+/// Eqs. 5–6 and 17–18: drag, viscosity, `v^adv`; the warm start `p⁰ = p(t − Δt) / 2` and
+/// its `p/ρ²`.
 pub(crate) fn advection_pass<R: Real>(
     c: &Consts<R>,
     g: Vec3<R>,
@@ -601,23 +644,20 @@ pub(crate) fn advection_pass<R: Real>(
 ) {
     let offsets = nb.offsets();
     let indices = nb.indices();
-    let (rho, gs, bgrad) = (&s.density[..], &s.grad_scale[..], &s.bgrad[..]);
+    let (rho, gs) = (&s.density[..], &s.grad_scale[..]);
     let half = R::of_f64(0.5);
     let eps_h2 = R::of_f64(0.01) * c.h * c.h;
-    let granular = c.granular;
-    let neighbour_terms = granular || c.drag || c.visc > R::zero();
-    // The body for particle i: writes v^adv, the warm start and p/ρ², and returns the trial
-    // stress of a granular material.
-    let body = |i: usize, va: &mut Vec3<R>, pr: &mut R, pi: &mut R| -> Option<Sym3<R>> {
+    let neighbour_terms = c.drag || c.visc > R::zero();
+    // The body for particle i: writes v^adv, the warm start and p/ρ².
+    let body = |i: usize, va: &mut Vec3<R>, pr: &mut R, pi: &mut R| {
         let (xi, vi, mi, rhoi) = (x[i], v[i], m[i], rho[i]);
         *pr *= half;
         *pi = *pr / (rhoi * rhoi);
         if !neighbour_terms {
             *va = vi + g * c.dt;
-            return None;
+            return;
         }
         let mut visc = Vec3::zeros();
-        let mut vgrad = [[R::zero(); 3]; 3];
         let upstream = {
             let rel = c.air_velocity - vi;
             let len = rel.norm();
@@ -631,23 +671,11 @@ pub(crate) fn advection_pass<R: Real>(
         for k in offsets[i]..offsets[i + 1] {
             let j = indices[k] as usize;
             let xj = x[j];
-            if c.visc > R::zero() || granular {
+            if c.visc > R::zero() {
                 let gw = grad(&xi, &xj, gs[k]);
                 let vol_j = m[j] / rho[j];
-                let vij = vi - v[j];
-                if c.visc > R::zero() {
-                    let xij = xi - xj;
-                    visc += gw * (vol_j * vij.dot(&xij) / (xij.norm_squared() + eps_h2));
-                }
-                if granular {
-                    // ∇u_i = Σ_j V_j (u_j − u_i) ⊗ ∇W_ij (eq. 7, difference form).
-                    let du = -vij * vol_j;
-                    for a in 0..3 {
-                        for b in 0..3 {
-                            vgrad[a][b] += du[a] * gw[b];
-                        }
-                    }
-                }
+                let xij = xi - xj;
+                visc += gw * (vol_j * (vi - v[j]).dot(&xij) / (xij.norm_squared() + eps_h2));
             }
             if c.drag {
                 occ = occ.max(occlusion(&upstream, &(xj - xi), c.cos_cone));
@@ -665,46 +693,14 @@ pub(crate) fn advection_pass<R: Real>(
             acc += f / mi;
         }
         *va = vi + acc * c.dt;
-        if granular {
-            // The static walls' share of the velocity gradient, Σ_b V_b (0 − u_i) ⊗
-            // ∇W_ib = −u_i ⊗ ∇Ψ_i (no-slip walls, as the fluid sees them in eq. 30).
-            let bg = bgrad[i];
-            for a in 0..3 {
-                for b in 0..3 {
-                    vgrad[a][b] -= vi[a] * bg[b];
-                }
-            }
-            // s = −D⁻¹ ε (eq. 10 with the sign of eq. 26), deviatoric (eqs. 11–12).
-            let eps = strain_rate(&vgrad);
-            let trial = deviatoric(&eps.map(|e| -e * c.inv_friction_d));
-            Some(trial)
-        } else {
-            None
-        }
     };
-    let per_particle = s
-        .v_adv
+    s.v_adv
         .par_iter_mut()
         .zip(s.pressure.par_iter_mut())
-        .zip(s.p_over_rho2.par_iter_mut());
-    if granular {
-        per_particle
-            .zip(s.stress.par_iter_mut())
-            .enumerate()
-            .with_min_len(MIN_LEN)
-            .for_each(|(i, (((va, pr), pi), st))| {
-                if let Some(trial) = body(i, va, pr, pi) {
-                    *st = trial;
-                }
-            });
-    } else {
-        per_particle
-            .enumerate()
-            .with_min_len(MIN_LEN)
-            .for_each(|(i, ((va, pr), pi))| {
-                body(i, va, pr, pi);
-            });
-    }
+        .zip(s.p_over_rho2.par_iter_mut())
+        .enumerate()
+        .with_min_len(MIN_LEN)
+        .for_each(|(i, ((va, pr), pi))| body(i, va, pr, pi));
 }
 
 /// Eq. 19 (with the boundary term): the source `ρ0 − ρ_i^adv`; fused with the pressure
@@ -752,7 +748,7 @@ pub(crate) fn predicted_density_pass<R: Real>(
 /// ∇Ψ_i` (eqs. 25 and 31) from `p/ρ²`.
 #[inline]
 #[allow(clippy::too_many_arguments)]
-fn pressure_accel<R: Real>(
+pub(crate) fn pressure_accel<R: Real>(
     c: &Consts<R>,
     x: &[Vec3<R>],
     m: &[R],
@@ -885,9 +881,10 @@ pub(crate) fn pressure_solve<R: Real>(
     (p.max_iterations, error, false)
 }
 
-/// Line 11 with the final pressure (the yield criterion), then line 14 (pressure and
-/// friction forces, eqs. 25–26 and 30–31) and line 15 (symplectic Euler, eqs. 27–28), with
-/// the boundary's contact response on the new positions.
+/// Line 14 (pressure and friction forces, eqs. 25–26 and 30–31) and line 15 (symplectic
+/// Euler, eqs. 27–28), with the boundary's contact response on the new positions. A
+/// granular step takes the velocity the friction solve left in `v_trial` (which holds both
+/// forces); water adds the pressure acceleration to `v^adv`.
 pub(crate) fn forces_pass<R: Real>(
     c: &Consts<R>,
     x: &[Vec3<R>],
@@ -898,24 +895,12 @@ pub(crate) fn forces_pass<R: Real>(
 ) {
     let offsets = nb.offsets();
     let indices = nb.indices();
-    if c.granular {
-        let (pr, rho) = (&s.pressure[..], &s.density[..]);
-        s.stress
-            .par_iter_mut()
-            .enumerate()
-            .with_min_len(MIN_LEN)
-            .for_each(|(i, st)| {
-                let clamped = yield_clamp(st, c.alpha, pr[i]);
-                let inv = R::one() / (rho[i] * rho[i]);
-                *st = clamped.map(|e| e * inv);
-            });
-    }
-    let (gs, pi, bgrad, va, st) = (
+    let (gs, pi, bgrad, va, vt) = (
         &s.grad_scale[..],
         &s.p_over_rho2[..],
         &s.bgrad[..],
         &s.v_adv[..],
-        &s.stress[..],
+        &s.v_trial[..],
     );
     let inv_dt = R::one() / c.dt;
     s.x_new
@@ -924,24 +909,65 @@ pub(crate) fn forces_pass<R: Real>(
         .enumerate()
         .with_min_len(MIN_LEN)
         .for_each(|(i, (xn, vn))| {
-            let mut a = pressure_accel(c, x, m, offsets, indices, gs, pi, bgrad, i);
-            if c.granular {
-                // F^f_i/m_i = −Σ_j m_j (s_i/ρ_i² + s_j/ρ_j²) ∇W_ij − ρ0 (s_i/ρ_i²) ∇Ψ_i.
-                let (xi, si) = (x[i], st[i]);
-                let mut f = Vec3::zeros();
-                for k in offsets[i]..offsets[i + 1] {
-                    let j = indices[k] as usize;
-                    let sj = st[j];
-                    let sum: Sym3<R> = std::array::from_fn(|e| si[e] + sj[e]);
-                    f -= sym_mul(&sum, &grad(&xi, &x[j], gs[k])) * m[j];
-                }
-                f -= sym_mul(&si, &bgrad[i]) * c.rho0;
-                a += f;
-            }
-            let v_new = va[i] + a * c.dt;
+            let v_new = if c.granular {
+                vt[i]
+            } else {
+                va[i] + pressure_accel(c, x, m, offsets, indices, gs, pi, bgrad, i) * c.dt
+            };
             let y = x[i] + v_new * c.dt;
             let projected = boundary.project(y);
-            *vn = v_new + (projected - y) * inv_dt;
+            let push = projected - y;
+            let mut v_out = v_new + push * inv_dt;
+            if c.granular {
+                v_out = coulomb_contact(v_out, push * inv_dt, c.wall_friction);
+            }
+            *vn = v_out;
             *xn = projected;
         });
+}
+
+/// Coulomb friction of the contact response (granular only): a particle the boundary pushed
+/// out with the velocity change `dv_n` (along the wall normal) loses up to `μ |dv_n|` of
+/// its tangential velocity, `μ = tan θ`. It acts only where the contact safety net acts
+/// (particles the volume map's pressure did not hold off the wall, which have no
+/// confining pressure and so no Drucker–Prager friction).
+#[inline]
+fn coulomb_contact<R: Real>(v: Vec3<R>, dv_n: Vec3<R>, mu: R) -> Vec3<R> {
+    let push = dv_n.norm();
+    if push <= R::zero() || mu <= R::zero() {
+        return v;
+    }
+    let n = dv_n / push;
+    let vn = n * v.dot(&n);
+    let vt = v - vn;
+    let speed_t = vt.norm();
+    let loss = mu * push;
+    if speed_t <= loss {
+        vn
+    } else {
+        vn + vt * ((speed_t - loss) / speed_t)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::coulomb_contact;
+    use sph_core::Vec3;
+
+    /// Coulomb's law at a contact: the tangential speed drops by `μ |Δv_n|` (to zero at
+    /// most), the normal velocity is kept, and without a push nothing changes.
+    #[test]
+    fn coulomb_contact_follows_coulombs_law() {
+        let v = Vec3::new(2.0, 0.5, 0.0);
+        let push = Vec3::new(0.0, 1.0, 0.0);
+        let out = coulomb_contact(v, push, 0.5);
+        assert!((out - Vec3::new(1.5, 0.5, 0.0)).norm() < 1e-12, "{out}");
+        let stopped = coulomb_contact(v, push * 10.0, 0.5);
+        assert!(
+            (stopped - Vec3::new(0.0, 0.5, 0.0)).norm() < 1e-12,
+            "{stopped}"
+        );
+        assert_eq!(coulomb_contact(v, Vec3::zeros(), 0.5), v);
+        assert_eq!(coulomb_contact(v, push, 0.0), v);
+    }
 }

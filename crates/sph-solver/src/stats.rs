@@ -1,7 +1,7 @@
 //! Solver-neutral step statistics.
 
 /// Most phases a solver can time (see [`PhaseTimes`]).
-pub const MAX_PHASES: usize = 8;
+pub const MAX_PHASES: usize = 10;
 
 /// Wall-clock seconds spent in each named phase of one [`crate::FluidSolver::step`] call.
 ///
@@ -87,6 +87,15 @@ pub struct StepStats {
     /// The density error the stopping rule saw in the last iteration of the last substep
     /// (its definition is the solver's; 0 without a tolerance).
     pub last_solve_error: f64,
+    /// Iterations of a friction-stress solve in total over the substeps (granular solvers;
+    /// 0 otherwise).
+    pub friction_iterations: usize,
+    /// Substeps whose friction-stress solve reached its maximum iterations without meeting
+    /// its tolerance.
+    pub unconverged_friction_substeps: usize,
+    /// The residual the friction solve's stopping rule saw in the last iteration of the
+    /// last substep (its definition is the solver's; 0 without one).
+    pub last_friction_residual: f64,
     /// Ordered neighbour pairs found in the last substep.
     pub neighbour_pairs: usize,
     /// `max_i ρ_i / ρ0` at the end of the call (boundary contribution included). 0 without
@@ -110,6 +119,9 @@ impl StepStats {
             iterations: 0,
             unconverged_substeps: 0,
             last_solve_error: 0.0,
+            friction_iterations: 0,
+            unconverged_friction_substeps: 0,
+            last_friction_residual: 0.0,
             neighbour_pairs: 0,
             max_density_ratio: 0.0,
             mean_density_ratio: 0.0,

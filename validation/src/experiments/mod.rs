@@ -25,11 +25,8 @@ pub fn registry() -> Vec<Box<dyn Experiment>> {
         Box::new(pbf::pbf_vorticity::PbfVorticity),
         Box::new(pbf::dam_break_front::DamBreakFront),
         Box::new(pbf::pbf_performance::PbfPerformance),
-        // Not registered yet: `granular::repose::GranularRepose` and
-        // `granular::column_collapse::GranularColumnCollapse` run and measure, but the
-        // granular friction of `iisph-granular` does not yet hold a slope (heaps settle at
-        // 7-11° for θ = 20-40°, every column runs into the far wall), so they would only
-        // report that defect; they join the registry with the fix.
+        Box::new(granular::repose::GranularRepose),
+        Box::new(granular::column_collapse::GranularColumnCollapse),
         Box::new(granular::iisph_convergence::IisphConvergence),
         Box::new(granular::granular_performance::GranularPerformance),
         Box::new(ssfr::ssfr_depth_accuracy::SsfrDepthAccuracy),

@@ -1,0 +1,249 @@
+//! The friction-stress solve of the granular model: the Drucker–Prager-bounded stress that
+//! keeps the material rigid (Neder 2024 eqs. 7–14 and 26; solved implicitly as Alduán &
+//! Otaduy 2011 intend, see the crate documentation).
+//!
+//! The stress `s_i` (Pa, symmetric, deviatoric) is a state of the particle: it is kept from
+//! one time step to the next (permuted with the particles) and corrected each step until the
+//! velocity field it produces has no strain rate where the material is not yielding:
+//!
+//! 1. [`predict`]: `a^f_i` of the kept stress enters the advection velocity, so the pressure
+//!    solve sees the friction of the last step;
+//! 2. [`solve`], after the pressure solve: `v^base_i = v^adv_i + Δt (a^p_i − a^f_i)` is the
+//!    velocity without friction; then, per iteration, the strain rate `ε_i` of `v = v^base +
+//!    Δt a^f(s)` (eqs. 7–8, walls no-slip), the update `s_i ← Y_i(dev(s_i − D⁻¹ ε_i))`
+//!    (eqs. 10–14: `Y_i` the radial return to `‖s‖ ≤ α p_i`), and the new `a^f(s)` (eq. 26
+//!    with eq. 31). It stops once the mean unyielded strain per step is below the tolerance.
+//!
+//! The factor 2 in the prototype `D` (eq. 9) makes `s ← s − D⁻¹ε` a Jacobi step relaxed by
+//! ½ on the exact self-coupling `Δε_i = (D/2) Δs_i` (see [`crate::granular`]), as IISPH
+//! relaxes its pressure Jacobi by `ω = ½`.
+
+use neighbour_search::NeighbourLists;
+use rayon::prelude::*;
+use sph_core::{Real, Vec3};
+use sph_solver::step::{MIN_LEN, REDUCE_CHUNK};
+
+use crate::granular::{deviatoric, frobenius, strain_rate, sym_mul, yield_clamp, Sym3};
+use crate::solver::{grad, pressure_accel, Consts, Scratch};
+
+/// How a friction solve ended.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct FrictionOutcome {
+    /// Iterations done (≥ 1 for a non-empty set).
+    pub iterations: usize,
+    /// Mean unyielded strain per step `Σ_i ‖dev ε_i‖ Δt / N` of the last iteration.
+    pub residual: f64,
+    /// Whether `residual` met the tolerance.
+    pub converged: bool,
+}
+
+/// The friction acceleration `F^f_i/m_i = −Σ_j m_j (s_i/ρ_i² + s_j/ρ_j²) ∇W_ij − ρ0
+/// (s_i/ρ_i²) ∇Ψ_i` (Neder 2024 eqs. 26 and 31) from `s/ρ²`.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+fn friction_accel<R: Real>(
+    c: &Consts<R>,
+    x: &[Vec3<R>],
+    m: &[R],
+    offsets: &[usize],
+    indices: &[u32],
+    gs: &[R],
+    st: &[Sym3<R>],
+    bgrad: &[Vec3<R>],
+    i: usize,
+) -> Vec3<R> {
+    let (xi, si) = (x[i], st[i]);
+    let mut f = Vec3::zeros();
+    for k in offsets[i]..offsets[i + 1] {
+        let j = indices[k] as usize;
+        let sj = st[j];
+        let sum: Sym3<R> = std::array::from_fn(|e| si[e] + sj[e]);
+        f -= sym_mul(&sum, &grad(&xi, &x[j], gs[k])) * m[j];
+    }
+    f - sym_mul(&si, &bgrad[i]) * c.rho0
+}
+
+/// The strain rate `ε_i` (eqs. 7–8) of the velocity field `v`: `∇u_i = Σ_j V_j (u_j − u_i)
+/// ⊗ ∇W_ij − u_i ⊗ ∇Ψ_i` (`V_j = m_j/ρ_j`; the static walls' share `Σ_b V_b (0 − u_i) ⊗
+/// ∇W_ib` makes them no-slip, as the friction force of eq. 31 treats them).
+#[inline]
+#[allow(clippy::too_many_arguments)]
+fn strain_rate_at<R: Real>(
+    x: &[Vec3<R>],
+    v: &[Vec3<R>],
+    m: &[R],
+    rho: &[R],
+    offsets: &[usize],
+    indices: &[u32],
+    gs: &[R],
+    bgrad: &[Vec3<R>],
+    i: usize,
+) -> Sym3<R> {
+    let (xi, vi) = (x[i], v[i]);
+    let mut g = [[R::zero(); 3]; 3];
+    for k in offsets[i]..offsets[i + 1] {
+        let j = indices[k] as usize;
+        let gw = grad(&xi, &x[j], gs[k]);
+        let du = (v[j] - vi) * (m[j] / rho[j]);
+        for a in 0..3 {
+            for b in 0..3 {
+                g[a][b] += du[a] * gw[b];
+            }
+        }
+    }
+    let bg = bgrad[i];
+    for a in 0..3 {
+        for b in 0..3 {
+            g[a][b] -= vi[a] * bg[b];
+        }
+    }
+    strain_rate(&g)
+}
+
+/// `out_i = s_i / ρ_i²` for the densities of the step.
+fn divide_by_rho2<R: Real>(stress: &[Sym3<R>], rho: &[R], out: &mut [Sym3<R>]) {
+    out.par_iter_mut()
+        .zip(stress.par_iter())
+        .zip(rho.par_iter())
+        .with_min_len(MIN_LEN)
+        .for_each(|((o, s), &r)| {
+            let inv = R::one() / (r * r);
+            *o = s.map(|e| e * inv);
+        });
+}
+
+/// `friction_accel = a^f(s)` of the current stress.
+fn accelerations<R: Real>(
+    c: &Consts<R>,
+    x: &[Vec3<R>],
+    m: &[R],
+    nb: &NeighbourLists,
+    s: &mut Scratch<R>,
+) {
+    let (offsets, indices) = (nb.offsets(), nb.indices());
+    let (gs, st, bgrad) = (&s.grad_scale[..], &s.stress_over_rho2[..], &s.bgrad[..]);
+    s.friction_accel
+        .par_iter_mut()
+        .enumerate()
+        .with_min_len(MIN_LEN)
+        .for_each(|(i, a)| *a = friction_accel(c, x, m, offsets, indices, gs, st, bgrad, i));
+}
+
+/// Step 1: `a^f` of the kept stress (at this step's positions and densities), added to the
+/// advection velocity `v^adv`. Expects the densities of the step.
+pub(crate) fn predict<R: Real>(
+    c: &Consts<R>,
+    x: &[Vec3<R>],
+    m: &[R],
+    nb: &NeighbourLists,
+    s: &mut Scratch<R>,
+) {
+    divide_by_rho2(&s.stress, &s.density, &mut s.stress_over_rho2);
+    accelerations(c, x, m, nb, s);
+    let dt = c.dt;
+    s.v_adv
+        .par_iter_mut()
+        .zip(s.friction_accel.par_iter())
+        .with_min_len(MIN_LEN)
+        .for_each(|(v, a)| *v += a * dt);
+}
+
+/// Step 2, after the pressure solve (`p/ρ²` final): iterates the stress to the tolerance
+/// and leaves the final velocity `v^base + Δt a^f(s)` in `v_trial`.
+pub(crate) fn solve<R: Real>(
+    c: &Consts<R>,
+    max_iterations: usize,
+    tolerance: f64,
+    x: &[Vec3<R>],
+    m: &[R],
+    nb: &NeighbourLists,
+    s: &mut Scratch<R>,
+) -> FrictionOutcome {
+    let n = x.len();
+    let (offsets, indices) = (nb.offsets(), nb.indices());
+    let dt = c.dt;
+    // v^base = v^adv + Δt (a^p − a^f_prev); the trial velocity of the kept stress is
+    // v^adv + Δt a^p.
+    {
+        let (gs, pi, bgrad, va, af) = (
+            &s.grad_scale[..],
+            &s.p_over_rho2[..],
+            &s.bgrad[..],
+            &s.v_adv[..],
+            &s.friction_accel[..],
+        );
+        s.v_base
+            .par_iter_mut()
+            .zip(s.v_trial.par_iter_mut())
+            .enumerate()
+            .with_min_len(MIN_LEN)
+            .for_each(|(i, (vb, vt))| {
+                let ap = pressure_accel(c, x, m, offsets, indices, gs, pi, bgrad, i);
+                *vt = va[i] + ap * dt;
+                *vb = *vt - af[i] * dt;
+            });
+    }
+    let mut outcome = FrictionOutcome {
+        iterations: 0,
+        residual: 0.0,
+        converged: true,
+    };
+    if n == 0 {
+        return outcome;
+    }
+    let inv_d = c.inv_friction_d;
+    for k in 0..max_iterations {
+        // The strain rate of the trial velocities and the stress update.
+        {
+            let (gs, bgrad, rho, pr, vt) = (
+                &s.grad_scale[..],
+                &s.bgrad[..],
+                &s.density[..],
+                &s.pressure[..],
+                &s.v_trial[..],
+            );
+            s.stress
+                .par_chunks_mut(REDUCE_CHUNK)
+                .zip(s.stress_over_rho2.par_chunks_mut(REDUCE_CHUNK))
+                .zip(s.error_partials.par_iter_mut())
+                .enumerate()
+                .for_each(|(ch, ((sc, sr), part))| {
+                    let base = ch * REDUCE_CHUNK;
+                    let mut sum = 0.0;
+                    for (o, (st, so)) in sc.iter_mut().zip(sr.iter_mut()).enumerate() {
+                        let i = base + o;
+                        let eps = deviatoric(&strain_rate_at(
+                            x, vt, m, rho, offsets, indices, gs, bgrad, i,
+                        ));
+                        let trial: Sym3<R> = std::array::from_fn(|e| st[e] - eps[e] * inv_d);
+                        let bound = c.alpha * pr[i];
+                        let next = yield_clamp(&trial, c.alpha, pr[i]);
+                        // Strain counts as residual where the material should be rigid:
+                        // inside the yield surface (a yielding particle flows).
+                        if bound > R::zero() && frobenius(&trial) <= bound {
+                            sum += (frobenius(&eps) * dt).as_f64();
+                        }
+                        *st = next;
+                        let inv = R::one() / (rho[i] * rho[i]);
+                        *so = next.map(|e| e * inv);
+                    }
+                    *part = sum;
+                });
+        }
+        outcome.iterations = k + 1;
+        outcome.residual = s.error_partials.iter().sum::<f64>() / n as f64;
+        // a^f of the new stress and the velocities it gives.
+        accelerations(c, x, m, nb, s);
+        s.v_trial
+            .par_iter_mut()
+            .zip(s.v_base.par_iter())
+            .zip(s.friction_accel.par_iter())
+            .with_min_len(MIN_LEN)
+            .for_each(|((vt, vb), a)| *vt = vb + a * dt);
+        if outcome.residual <= tolerance {
+            return outcome;
+        }
+    }
+    outcome.converged = false;
+    outcome
+}
