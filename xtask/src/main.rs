@@ -9,6 +9,8 @@
 //!   With `--render`, the frames are also rendered (PNG in `OUT/render`) while it runs.
 //! - `cargo xtask render OUTPUT_DIR [--scene SCENE] [--quick] [--out DIR]` — renders a scene
 //!   run's VTK frames to PNG images with the screen-space renderer (`validation render ...`).
+//! - `cargo xtask repose OUTPUT_DIR [--frame FILE] [--shape planar|conical]` — the angle of
+//!   repose of a granular scene run's last frame (`validation repose ...`).
 //! - `cargo xtask bench [ARGS...]` — `cargo bench -p benches -- ARGS...` (criterion).
 //!
 //! Deliberately light: clap + anyhow + std. Cargo is the one running this (`$CARGO`), and
@@ -79,6 +81,17 @@ enum Task {
         /// Output directory for the PNGs [default: OUTPUT_DIR/render].
         #[arg(long, value_name = "DIR")]
         out: Option<PathBuf>,
+    },
+    /// Measure the angle of repose of a granular scene run's last frame (or `--frame FILE`).
+    Repose {
+        /// The run's output directory (as given to `run --out`).
+        dir: PathBuf,
+        /// The frame to measure [default: the last `frame_*.vtk` in OUTPUT_DIR].
+        #[arg(long, value_name = "FILE")]
+        frame: Option<PathBuf>,
+        /// `planar` (a 2.5D heap, profile along x) or `conical`.
+        #[arg(long, default_value = "planar")]
+        shape: String,
     },
     /// Run the criterion benchmarks: `cargo bench -p benches -- ARGS...`.
     Bench {
@@ -198,6 +211,15 @@ fn main() -> ExitCode {
             if quick {
                 a.push("--quick".into());
             }
+            a
+        }
+        Task::Repose { dir, frame, shape } => {
+            let mut a = os(&["run", "--release", "-p", "validation", "--", "repose"]);
+            a.push(abs(dir));
+            if let Some(f) = frame {
+                a.extend(["--frame".into(), abs(f)]);
+            }
+            a.extend(["--shape".into(), shape.into()]);
             a
         }
         Task::List => os(&["run", "--release", "-p", "validation", "--", "list"]),

@@ -131,6 +131,8 @@
 //! # drag_coefficient = 0.0         # C_D of the air drag (>= 0; 0 = off)
 //! # air_velocity = [0.0, 0.0, 0.0] # m/s, uniform
 //! # upscaling_factor = 8           # passive points per particle (>= 1; absent = off)
+//! # friction_max_iterations = 20   # friction-stress iterations per step at most (>= 1)
+//! # friction_tolerance = 1e-4      # mean unyielded strain per step to stop at (> 0)
 //! ```
 //!
 //! ```toml

@@ -183,6 +183,11 @@ pub struct GranularSpec {
     pub air_velocity: Option<[f64; 3]>,
     /// Passive high-resolution points per simulation particle (≥ 1; absent = no upscaling).
     pub upscaling_factor: Option<usize>,
+    /// Most friction-stress iterations per step (≥ 1; default 20).
+    pub friction_max_iterations: Option<usize>,
+    /// Mean unyielded strain per step at which the friction iterations stop (> 0; default
+    /// 1e-4).
+    pub friction_tolerance: Option<f64>,
 }
 
 impl SolverSpec {
@@ -349,6 +354,8 @@ impl SolverSpec {
                 drag_coefficient: None,
                 air_velocity: None,
                 upscaling_factor: None,
+                friction_max_iterations: None,
+                friction_tolerance: None,
             }),
         }
     }

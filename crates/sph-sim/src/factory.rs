@@ -122,6 +122,12 @@ pub fn granular_params<R: Real>(
     if let Some(v) = s.air_velocity {
         g.air_velocity = vec3(v);
     }
+    if let Some(n) = s.friction_max_iterations {
+        g.friction_max_iterations = n;
+    }
+    if let Some(t) = s.friction_tolerance {
+        g.friction_tolerance = r(t);
+    }
     p.granular = Some(g);
     p.upscaling_factor = s.upscaling_factor;
     p.validate()?;

@@ -63,6 +63,8 @@ struct Timed {
     steps: usize,
     iterations: usize,
     unconverged: usize,
+    friction_iterations: usize,
+    friction_unconverged: usize,
 }
 
 fn time_in<R: Real>(ctx: &Context, scene: &Scene, threads: usize) -> Result<Timed> {
@@ -81,6 +83,8 @@ fn time_in<R: Real>(ctx: &Context, scene: &Scene, threads: usize) -> Result<Time
             steps: 0,
             iterations: 0,
             unconverged: 0,
+            friction_iterations: 0,
+            friction_unconverged: 0,
         };
         for i in 0..steps {
             let t0 = Instant::now();
@@ -100,6 +104,8 @@ fn time_in<R: Real>(ctx: &Context, scene: &Scene, threads: usize) -> Result<Time
             t.steps += s.substeps;
             t.iterations += s.iterations;
             t.unconverged += s.unconverged_substeps;
+            t.friction_iterations += s.friction_iterations;
+            t.friction_unconverged += s.unconverged_friction_substeps;
         }
         Ok(t)
     })
@@ -147,6 +153,14 @@ impl Experiment for GranularPerformance {
                 format!("{tag}/iterations_per_step"),
                 t.iterations as f64 / steps,
             );
+            out.metric(
+                format!("{tag}/friction_iterations_per_step"),
+                t.friction_iterations as f64 / steps,
+            );
+            out.metric(
+                format!("{tag}/steps_at_the_friction_cap"),
+                t.friction_unconverged as f64,
+            );
             let phase_sum: f64 = t.phases.iter().map(|p| p.1).sum();
             for (name, secs) in &t.phases {
                 out.metric(format!("{tag}/{name}_ms_per_step"), 1e3 * secs / steps);
@@ -185,9 +199,10 @@ impl Experiment for GranularPerformance {
                 "definition: the phases must account for the step (10 % allowed for the call and statistics overhead)",
             ));
             out.note(format!(
-                "{} threads: {per_step_ms:.1} ms per step, {per_particle_ns:.0} ns per particle and step, {:.2} iterations per step ({} particles, {} measured steps)",
+                "{} threads: {per_step_ms:.1} ms per step, {per_particle_ns:.0} ns per particle and step, {:.2} pressure and {:.2} friction iterations per step ({} particles, {} measured steps)",
                 t.threads,
                 t.iterations as f64 / steps,
+                t.friction_iterations as f64 / steps,
                 t.particles,
                 t.steps
             ));
