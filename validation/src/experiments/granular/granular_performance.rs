@@ -7,6 +7,10 @@
 //! first (buffers grown, particles reordered by cell), then the measured steps (quick: 5,
 //! full: 50). Timings are metrics, not checks: they depend on the machine and its load.
 //!
+//! The same pile as water (`kind = "iisph"`, every other setting equal) is timed beside it;
+//! the ratio of the step times is a metric (the task's target: the granular step within
+//! 1.5× of the water step).
+//!
 //! Checks (things that can fail for real): the steps complete without a solver error and
 //! without a step at the iteration cap, the pile has the 100,000 particles the task states, and
 //! the solver's phase breakdown accounts for the step (the sum of the phase times is 90–100 %
@@ -17,7 +21,7 @@ use std::time::Instant;
 
 use anyhow::{anyhow, Result};
 use sph_core::Real;
-use sph_scene::{Precision, Scene};
+use sph_scene::{Precision, Scene, SolverKind};
 
 use super::scene_edit::SceneText;
 use super::solver_error_check;
@@ -123,12 +127,28 @@ impl Experiment for GranularPerformance {
     fn run(&self, ctx: &mut Context) -> Result<Outcome> {
         let measured = ctx.mode.pick(5, 50);
         let scene = pile_scene(ctx.mode, measured)?;
+        // The same pile as water (friction off, every other setting equal): the reference of
+        // the granular step's cost.
+        let water = Scene {
+            solver: scene.solver.with_kind(SolverKind::Iisph),
+            ..scene.clone()
+        };
         let thread_counts: Vec<usize> = ctx.mode.pick(vec![2], vec![1, 2]);
         ctx.progress
-            .set_length((thread_counts.len() * scene.frame_count()) as u64);
+            .set_length((2 * thread_counts.len() * scene.frame_count()) as u64);
         let mut out = Outcome::new();
         let mut rows = Vec::new();
         for &threads in &thread_counts {
+            let water_ms = match water.precision {
+                Precision::F32 => time_in::<f32>(ctx, &water, threads),
+                Precision::F64 => time_in::<f64>(ctx, &water, threads),
+            }
+            .map(|w| {
+                (
+                    1e3 * w.wall_s / w.steps.max(1) as f64,
+                    w.iterations as f64 / w.steps.max(1) as f64,
+                )
+            });
             let t = match scene.precision {
                 Precision::F32 => time_in::<f32>(ctx, &scene, threads),
                 Precision::F64 => time_in::<f64>(ctx, &scene, threads),
@@ -153,6 +173,21 @@ impl Experiment for GranularPerformance {
                 format!("{tag}/iterations_per_step"),
                 t.iterations as f64 / steps,
             );
+            match water_ms {
+                Ok((ms, iterations)) => {
+                    out.metric(format!("{tag}/water_ms_per_step"), ms);
+                    out.metric(format!("{tag}/water_iterations_per_step"), iterations);
+                    out.metric(format!("{tag}/granular_over_water_step"), per_step_ms / ms);
+                    out.note(format!(
+                        "{threads} threads: the same pile as water takes {ms:.1} ms per step ({iterations:.2} iterations); granular / water = {:.2} (the task's target: at most 1.5)",
+                        per_step_ms / ms
+                    ));
+                }
+                Err(e) => out.check(solver_error_check(
+                    &format!("water threads={threads}"),
+                    &format!("{e:#}"),
+                )),
+            }
             out.metric(
                 format!("{tag}/friction_iterations_per_step"),
                 t.friction_iterations as f64 / steps,
