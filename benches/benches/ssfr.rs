@@ -119,6 +119,7 @@ fn stages(c: &mut Criterion) {
                         camera: &cam,
                         background: &p.background,
                         scene: &renderer.scene,
+                        scene_tiles: &renderer.scene_tiles,
                         light: &p.light,
                         material: &p.material,
                         refraction: &refraction,

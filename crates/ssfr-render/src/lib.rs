@@ -69,8 +69,8 @@
 //! * Bilateral filter: `2 Σ_p (2 R_px(p) + 1)` taps over the liquid pixels.
 //! * Curvature flow: `2 × iterations` passes over the pixels.
 //! * Thickness blur: `2 (2 R + 1)` taps per pixel; normals and shading: one pass (the
-//!   scene-depth refraction marches one step per 4 pixels of the refracted ray's screen
-//!   path, [`shade::MARCH_STEP_PX`], then 8 bisections).
+//!   scene-depth refraction walks a min-depth pyramid along the refracted ray's screen
+//!   path, a few cells per level, [`march`]).
 //!
 //! For the benchmark frame (`benches/benches/ssfr.rs`: 98,304 particles filling the dam
 //! break's 0.4 × 0.8 × 0.6 m column, spacing 12.4 mm, spheres of 9.3 mm, default camera
@@ -86,6 +86,7 @@ mod camera;
 pub mod config;
 mod error;
 mod image;
+pub mod march;
 pub mod normals;
 mod render;
 pub mod shade;
@@ -97,6 +98,7 @@ pub use camera::{Camera, CameraFrame};
 pub use config::RenderConfig;
 pub use error::SsfrError;
 pub use image::{image_difference, RgbImage};
+pub use march::DepthTiles;
 pub use render::{FrameStats, RenderParams, Renderer, Smoothing, StageTimes};
 pub use shade::{Material, RefractDistance, Refraction};
 pub use smooth::{BilateralParams, NoiseParams};
