@@ -123,6 +123,7 @@ impl<'a, R: Real> ParticleView<'a, R> {
 /// One particle ready to draw: `G` (view), `s = G c`, `|s|² − 1` and its pixel box.
 #[derive(Debug, Clone, Copy)]
 struct Prim {
+    /// Ellipsoid: `G = M⁻¹` in view space (unused for a sphere).
     g: Matrix3<f32>,
     /// Ellipsoid: `G c`; sphere: the centre `c` (view).
     s: V3,
@@ -296,7 +297,8 @@ impl Splatter {
                     let r = particles
                         .radii
                         .map_or(particles.radius, |r| r[k].as_f64() as f32);
-                    (Matrix3::identity() / r, V3::repeat(r), Some(r))
+                    // The sphere path does not use `g`.
+                    (Matrix3::identity(), V3::repeat(r), Some(r))
                 }
             };
             let (s, s2m1) = match radius {
