@@ -186,10 +186,18 @@ pub fn march(camera: &CameraFrame, tiles: &DepthTiles, p: &V3, r: &V3) -> (f32, 
         (lv.nx - 1, lv.ny - 1),
         |i, j, a, b| ray.visit(tiles, top, i, j, a, b),
     );
-    match hit {
-        Some(a) => (start.0 + a * ray.delta.0, start.1 + a * ray.delta.1),
-        None => end,
-    }
+    hit.unwrap_or(end)
+}
+
+/// Margin (pixels) that keeps a crossing inside its pixel, see [`in_pixel`].
+const PIXEL_MARGIN: f32 = 1.0 / 256.0;
+
+/// Coordinate `x` moved inside pixel `i`, [`PIXEL_MARGIN`] from its edges: a crossing where
+/// the ray enters a pixel behind a depth step lies on the pixel's edge, and rounding must
+/// not hand the sample (and the depth read there) to the neighbour it came from.
+#[inline]
+fn in_pixel(x: f32, i: usize) -> f32 {
+    x.clamp(i as f32 + PIXEL_MARGIN, (i + 1) as f32 - PIXEL_MARGIN)
 }
 
 /// The clipped ray on the screen: `start + α delta`, `1/z` from `iz0` to `iz1`.
@@ -287,11 +295,15 @@ impl ScreenRay {
         j: usize,
         a: f32,
         b: f32,
-    ) -> Option<f32> {
+    ) -> Option<(f32, f32)> {
         let lv = &tiles.levels[level];
         let first = self.crossing(lv.inv_depth[j * lv.nx + i], a, b)?;
         if level == 0 {
-            return Some(first);
+            let (u, v) = (
+                self.start.0 + first * self.delta.0,
+                self.start.1 + first * self.delta.1,
+            );
+            return Some((in_pixel(u, i), in_pixel(v, j)));
         }
         let fine = &tiles.levels[level - 1];
         let lo = (i * TILE_FACTOR, j * TILE_FACTOR);
@@ -361,6 +373,7 @@ pub fn march_naive(camera: &CameraFrame, scene: &SceneBuffer, p: &V3, r: &V3) ->
         }
     };
     let mut best = f64::INFINITY;
+    let mut best_px = (0, 0);
     for j in 0..scene.height {
         let (ja, jb) = slab(start.1, dv, j as f64);
         if ja > jb {
@@ -375,15 +388,22 @@ pub fn march_naive(camera: &CameraFrame, scene: &SceneBuffer, p: &V3, r: &V3) ->
             }
             let id = 1.0 / depth;
             let iz = |t: f64| iz0 + t * (iz1 - iz0);
-            if iz(a) <= id {
-                best = a;
+            let hit = if iz(a) <= id {
+                a
             } else if iz(b) <= id {
-                best = best.min((iz0 - id) / (iz0 - iz1));
+                (iz0 - id) / (iz0 - iz1)
+            } else {
+                continue;
+            };
+            if hit < best {
+                best = hit;
+                best_px = (i, j);
             }
         }
     }
     if best.is_finite() {
-        out((start.0 + best * du, start.1 + best * dv))
+        let (u, v) = out((start.0 + best * du, start.1 + best * dv));
+        (in_pixel(u, best_px.0), in_pixel(v, best_px.1))
     } else {
         out(end)
     }
