@@ -120,11 +120,10 @@ impl<'a, R: Real> ParticleView<'a, R> {
     }
 }
 
-/// One particle ready to draw: `G` (view), `s = G c`, `|s|² − 1` and its pixel box.
+/// One particle ready to draw: `s = G c`, `|s|² − 1` and its pixel box (an ellipsoid's `G`
+/// is kept apart, [`Splatter`]'s `ellipsoid_g`, so that spheres move 36 bytes each).
 #[derive(Debug, Clone, Copy)]
 struct Prim {
-    /// Ellipsoid: `G = M⁻¹` in view space (unused for a sphere).
-    g: Matrix3<f32>,
     /// Ellipsoid: `G c`; sphere: the centre `c` (view).
     s: V3,
     /// Ellipsoid: `|G c|² − 1`; sphere: `|c|² − r²`.
@@ -226,11 +225,36 @@ fn sphere_row(
     }
 }
 
+/// `⌈x⌉` clamped to `[0, hi]` (0 for NaN), by integer truncation: `f32::ceil` is a libm
+/// call on the x86-64 baseline.
+#[inline]
+fn ceil_in(x: f32, hi: usize) -> u32 {
+    let x = x.clamp(0.0, hi as f32);
+    let t = x as u32;
+    if (t as f32) < x {
+        t + 1
+    } else {
+        t
+    }
+}
+
+/// `⌊x⌋ + 1` clamped to `[0, hi]` (0 for NaN), by integer truncation.
+#[inline]
+fn floor_plus_one_in(x: f32, hi: usize) -> u32 {
+    if x.is_nan() || x < 0.0 {
+        0
+    } else {
+        (x.min(hi as f32) as u32 + 1).min(hi as u32)
+    }
+}
+
 /// Scratch of the splatting (kept between frames: no allocation once grown).
 #[derive(Debug, Default)]
 pub struct Splatter {
     rays: RayTables,
     prims: Vec<Prim>,
+    /// Per particle, an ellipsoid's `G = M⁻¹` (view space); empty for spheres.
+    ellipsoid_g: Vec<Matrix3<f32>>,
     band_start: Vec<usize>,
     band_items: Vec<u32>,
     band_fill: Vec<usize>,
@@ -268,7 +292,6 @@ impl Splatter {
         self.prims.resize(
             n,
             Prim {
-                g: Matrix3::identity(),
                 s: V3::zeros(),
                 s2m1: 0.0,
                 sphere: false,
@@ -278,6 +301,15 @@ impl Splatter {
                 j1: 0,
             },
         );
+        self.ellipsoid_g.clear();
+        if let Some(e) = particles.ellipsoids {
+            self.ellipsoid_g.resize(n, Matrix3::zeros());
+            self.ellipsoid_g
+                .par_iter_mut()
+                .zip(e.par_iter())
+                .for_each(|(g, m)| *g = (rot * m).try_inverse().unwrap_or_else(Matrix3::zeros));
+        }
+        let ellipsoid_g = &self.ellipsoid_g;
         self.prims.par_iter_mut().enumerate().for_each(|(k, prim)| {
             let p = &particles.positions[k];
             let pw = V3::new(
@@ -286,30 +318,27 @@ impl Splatter {
                 p.z.as_f64() as f32,
             );
             let c = camera.to_view(&pw);
-            let (g, ext, radius) = match particles.ellipsoids {
+            let (ext, radius) = match particles.ellipsoids {
                 Some(e) => {
                     let mv = rot * e[k];
-                    let g = mv.try_inverse().unwrap_or_else(Matrix3::zeros);
                     let ext = V3::new(mv.row(0).norm(), mv.row(1).norm(), mv.row(2).norm());
-                    (g, ext, None)
+                    (ext, None)
                 }
                 None => {
                     let r = particles
                         .radii
                         .map_or(particles.radius, |r| r[k].as_f64() as f32);
-                    // The sphere path does not use `g`.
-                    (Matrix3::identity(), V3::repeat(r), Some(r))
+                    (V3::repeat(r), Some(r))
                 }
             };
             let (s, s2m1) = match radius {
                 Some(r) => (c, c.norm_squared() - r * r),
                 None => {
-                    let s = g * c;
+                    let s = ellipsoid_g[k] * c;
                     (s, s.norm_squared() - 1.0)
                 }
             };
             *prim = Prim {
-                g,
                 s,
                 s2m1,
                 sphere: radius.is_some(),
@@ -341,11 +370,10 @@ impl Splatter {
                 }
             }
             // Pixel centres i + 1/2 in [umin, umax].
-            let clampi = |x: f32, hi: usize| x.clamp(0.0, hi as f32) as u32;
-            let i0 = clampi((umin - 0.5).ceil(), w);
-            let i1 = clampi((umax - 0.5).floor() + 1.0, w);
-            let j0 = clampi((vmin - 0.5).ceil(), h);
-            let j1 = clampi((vmax - 0.5).floor() + 1.0, h);
+            let i0 = ceil_in(umin - 0.5, w);
+            let i1 = floor_plus_one_in(umax - 0.5, w);
+            let j0 = ceil_in(vmin - 0.5, h);
+            let j1 = floor_plus_one_in(vmax - 0.5, h);
             if i0 < i1 && j0 < j1 {
                 prim.i0 = i0;
                 prim.i1 = i1;
@@ -418,7 +446,8 @@ impl Splatter {
                         }
                         continue;
                     }
-                    let (g0, g1, g2) = (p.g.column(0), p.g.column(1), p.g.column(2));
+                    let g = &ellipsoid_g[k as usize];
+                    let (g0, g1, g2) = (g.column(0), g.column(1), g.column(2));
                     for j in j0..j1 {
                         let bv = (camera.cy - (j as f32 + 0.5)) / camera.focal_px;
                         let qrow = g1 * bv + g2;
