@@ -1,5 +1,5 @@
 //! The screen-space renderer per stage at 1280 × 720: 100k particles filling the dam break's
-//! water column (0.4 × 0.8 × 0.6 m, spacing 11.3 mm, spheres of 0.75 × spacing) in the
+//! water column (0.4 × 0.8 × 0.6 m, spacing 12.4 mm, spheres of 0.75 × spacing) in the
 //! 1.6 × 1.0 × 0.6 m tank, seen from the front and above by a camera framing the tank
 //! (`cargo bench -p benches --bench ssfr`). Each stage runs on the buffers a full frame
 //! left. The cost model of each stage (pixels touched) is in the `ssfr-render` crate
@@ -119,6 +119,7 @@ fn stages(c: &mut Criterion) {
                         camera: &cam,
                         background: &p.background,
                         scene: &renderer.scene,
+                        scene_tiles: &renderer.scene_tiles,
                         light: &p.light,
                         material: &p.material,
                         refraction: &refraction,

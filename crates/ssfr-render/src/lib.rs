@@ -63,22 +63,37 @@
 //!
 //! # Cost (1280 × 720 = 0.92 M pixels)
 //!
-//! * Background: one ray per pixel (0.92 M), once per camera.
-//! * Splatting: `Σ_i (box of particle i in pixels)`, about `N (2 f r/z)²` pixel tests
-//!   ([`FrameStats::splat_pixel_tests`] counts them); binning `O(N)`.
-//! * Bilateral filter: `2 Σ_p (2 R_px(p) + 1)` taps over the liquid pixels.
-//! * Curvature flow: `2 × iterations` passes over the pixels.
-//! * Thickness blur: `2 (2 R + 1)` taps per pixel; normals and shading: one pass (the
-//!   scene-depth refraction marches one step per 4 pixels of the refracted ray's screen
-//!   path, [`shade::MARCH_STEP_PX`], then 8 bisections).
+//! Pixels touched per stage, for `N` particles of radius `r` at depth `z` seen with focal
+//! length `f` pixels, `P` liquid pixels:
 //!
-//! For the benchmark frame (`benches/benches/ssfr.rs`: 98,304 particles filling the dam
-//! break's 0.4 × 0.8 × 0.6 m column, spacing 12.4 mm, spheres of 9.3 mm, default camera
-//! about 2.6 m away, 1280 × 720) this is
-//! 6.76 M splat pixel tests (counted), 75 k liquid pixels, a bilateral radius of about 11
-//! pixels (3 r f / z with f = 989 px, z ≈ 2.6 m) so about 3.3 M filter taps, 0.92 M background
-//! rays (once per camera), and one shading pass over the 75 k liquid pixels: the splatting
-//! and the refraction march dominate, as the benchmark's per-stage figures show.
+//! * Background: one ray per pixel (0.92 M), once per camera (with one pass to build the
+//!   refraction's depth pyramid, [`DepthTiles`]).
+//! * Splatting: `Σ_i (box of particle i in pixels)`, about `N (2 f r/z)²` pixel tests
+//!   ([`FrameStats::splat_pixel_tests`] counts them), each a square root and, where the ray
+//!   hits, two divisions; the per-pixel ray terms are tabulated once per camera; particle
+//!   set-up and binning `O(N)` (36 bytes per sphere).
+//! * Bilateral filter: `2 Σ_p (2 R_px(p) + 1)` taps over the liquid pixels, one `exp` each
+//!   (`R_px = radius_m f / z`, clamped to `max_radius_px`), plus two passes over the image.
+//! * Curvature flow: `2 × iterations` passes over the pixels.
+//! * Thickness blur: `2 (2 R + 1)` taps per pixel of the liquid's screen box grown by `R`.
+//! * Normals: one pass over the pixels.
+//! * Shading: one pass over the pixels (12 bytes of colour read and written, 8 of sample
+//!   coordinates written per pixel) and, per liquid pixel, a few `exp`/`powf` and the
+//!   scene-depth refraction's walk of the depth pyramid ([`march`]): the coarse cells of
+//!   the refracted ray's screen path plus about `2 × 4` cells per level where it comes near
+//!   the scene, instead of one projected sample per 4 pixels of the path.
+//!
+//! For the benchmark frame (`benches/benches/ssfr.rs` and the `ssfr-performance`
+//! experiment: 98,304 particles filling the dam break's 0.4 × 0.8 × 0.6 m column, spacing
+//! 12.4 mm, spheres of 9.3 mm, default camera about 2.6 m away, 1280 × 720) this is
+//! 6.76 M splat pixel tests (counted), `P` = 75 k liquid pixels, a bilateral radius of about
+//! 11 pixels (3 r f / z with f = 989 px, z ≈ 2.6 m) so about 3.5 M filter taps and
+//! `exp`s, about 0.6 M pyramid cells for the 75 k refracted rays (counted, 8 per ray),
+//! 0.92 M pixels per full-image pass (about 20 MB of memory traffic in the shading), and
+//! 0.92 M background rays once per camera. The bound is arithmetic, not memory: the
+//! splatting's square roots and divisions and the filter's exponentials (about 10 M
+//! transcendental operations per frame) dominate, followed by the shading's per-pixel
+//! lighting and walk.
 
 pub mod anisotropy;
 mod background;
@@ -86,6 +101,7 @@ mod camera;
 pub mod config;
 mod error;
 mod image;
+pub mod march;
 pub mod normals;
 mod render;
 pub mod shade;
@@ -97,6 +113,7 @@ pub use camera::{Camera, CameraFrame};
 pub use config::RenderConfig;
 pub use error::SsfrError;
 pub use image::{image_difference, RgbImage};
+pub use march::DepthTiles;
 pub use render::{FrameStats, RenderParams, Renderer, Smoothing, StageTimes};
 pub use shade::{Material, RefractDistance, Refraction};
 pub use smooth::{BilateralParams, NoiseParams};

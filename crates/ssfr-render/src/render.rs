@@ -8,6 +8,7 @@ use sph_core::Real;
 use crate::background::{Background, Light, SceneBuffer};
 use crate::camera::{Camera, CameraFrame};
 use crate::image::RgbImage;
+use crate::march::DepthTiles;
 use crate::normals::normals_from_depth;
 use crate::shade::{shade, Material, Refraction, ShadeInputs};
 use crate::smooth::{
@@ -164,6 +165,8 @@ pub struct Renderer {
     pub normals: Vec<[f32; 3]>,
     /// The scene buffer.
     pub scene: SceneBuffer,
+    /// The scene buffer's depth per tile (built with it), for the refraction march.
+    pub scene_tiles: DepthTiles,
     /// Linear colour of the last frame.
     pub colour: Vec<[f32; 3]>,
     /// Pixel coordinates of the scene sample the refraction used per pixel (`NaN` without
@@ -199,6 +202,7 @@ impl Renderer {
             params
                 .background
                 .render(&cam, &params.light, &mut self.scene)?;
+            self.scene_tiles.build(&self.scene);
             times.background_s = t.elapsed().as_secs_f64();
             self.scene_key = Some(key);
         }
@@ -286,6 +290,7 @@ impl Renderer {
                 camera: &cam,
                 background: &params.background,
                 scene: &self.scene,
+                scene_tiles: &self.scene_tiles,
                 light: &params.light,
                 material: &params.material,
                 refraction: &params.refraction,

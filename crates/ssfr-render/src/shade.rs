@@ -14,9 +14,9 @@
 //!     pixel), followed from `P`. The paper does not say how far: we offer
 //!     [`RefractDistance::Thickness`] (the sample is the projection of `P + R · t · s`, `s`
 //!     the thickness scale below) and [`RefractDistance::SceneDepth`] (the paper's Fig. 7
-//!     caption, "with better scene depth": the ray is marched in screen space against the
-//!     scene's depth buffer, one pixel per step, and the crossing refined by bisection, as in
-//!     screen-space ray tracing). `SceneDepth` is the default.
+//!     caption, "with better scene depth": the first crossing of the ray with the scene's
+//!     depth buffer, found by walking the pixels of its screen path, see [`crate::march`]).
+//!     `SceneDepth` is the default.
 //! * **Absorption** (Beer–Lambert, step 7): the refracted colour is multiplied by
 //!   `exp(−κ · s · t)` per channel (`κ` in 1/m). The thickness buffer sums the chords of the
 //!   particles' spheres, which fill only part of the liquid (`π/6` of a cubic lattice of
@@ -35,6 +35,7 @@ use rayon::prelude::*;
 use crate::background::{Background, Light, SceneBuffer};
 use crate::camera::CameraFrame;
 use crate::error::{non_negative, positive};
+use crate::march::{march, DepthTiles};
 use crate::{SsfrError, V3};
 
 /// How far the improved refraction follows the refracted ray.
@@ -138,63 +139,6 @@ pub fn refract(i: &V3, n: &V3, eta: f32) -> V3 {
     }
 }
 
-/// Screen-space march of the view ray `p + s r` against the scene depth: the pixel
-/// coordinates where it first passes behind the scene (or where it leaves the image or the
-/// scene's depth range, or the last point tried). Steps advance [`MARCH_STEP_PX`] pixels on
-/// the screen, at most 10 % of the depth (a ray going straight away from the camera barely
-/// moves on the screen); the crossing is refined by 8 bisections.
-fn march(camera: &CameraFrame, scene: &SceneBuffer, max_depth: f32, p: &V3, r: &V3) -> (f32, f32) {
-    const MAX_STEPS: usize = 512;
-    let (w, h) = (camera.width as f32, camera.height as f32);
-    let behind = |q: &V3| -> Option<bool> {
-        if q.z <= 1e-4 || q.z > max_depth {
-            return None;
-        }
-        let (u, v) = camera.project(q);
-        if !(0.0..w).contains(&u) || !(0.0..h).contains(&v) {
-            return None;
-        }
-        Some(q.z >= scene.depth_at(u, v))
-    };
-    let mut s0 = 0.0f32;
-    let mut last = camera.project(p);
-    for _ in 0..MAX_STEPS {
-        let q0 = p + r * s0;
-        // Screen speed of the ray (pixels per metre along it) at q0.
-        let eps = 1e-3 * q0.z.max(1e-3);
-        let (u0, v0) = camera.project(&q0);
-        let (u1, v1) = camera.project(&(q0 + r * eps));
-        let px_per_m = ((u1 - u0).powi(2) + (v1 - v0).powi(2)).sqrt() / eps;
-        let ds = (MARCH_STEP_PX / px_per_m.max(1e-6)).min(0.1 * q0.z.max(1e-3));
-        let s1 = s0 + ds;
-        let q1 = p + r * s1;
-        match behind(&q1) {
-            None => return last,
-            Some(false) => {
-                last = camera.project(&q1);
-                s0 = s1;
-            }
-            Some(true) => {
-                let (mut a, mut b) = (s0, s1);
-                for _ in 0..8 {
-                    let m = 0.5 * (a + b);
-                    if behind(&(p + r * m)) == Some(true) {
-                        b = m;
-                    } else {
-                        a = m;
-                    }
-                }
-                return camera.project(&(p + r * b));
-            }
-        }
-    }
-    last
-}
-
-/// Screen distance (pixels) of one step of the refraction march (the crossing is then
-/// refined by bisection; scene features thinner than this may be stepped over).
-pub const MARCH_STEP_PX: f32 = 4.0;
-
 /// Inputs of [`shade`].
 #[derive(Debug, Clone, Copy)]
 pub struct ShadeInputs<'a> {
@@ -204,6 +148,8 @@ pub struct ShadeInputs<'a> {
     pub background: &'a Background,
     /// The scene buffer.
     pub scene: &'a SceneBuffer,
+    /// `scene`'s depth per tile ([`DepthTiles::build`]), for the scene-depth refraction.
+    pub scene_tiles: &'a DepthTiles,
     /// The light.
     pub light: &'a Light,
     /// The material.
@@ -228,9 +174,8 @@ pub fn shade(
     inp.material.validate()?;
     let cam = inp.camera;
     let (w, h) = (cam.width, cam.height);
-    colour.clear();
+    // Every pixel is written below: no clearing pass.
     colour.resize(w * h, [0.0; 3]);
-    sample_px.clear();
     sample_px.resize(w * h, [f32::NAN; 2]);
     let m = inp.material;
     let l = cam.dir_to_view(&inp.light.unit_direction()?);
@@ -239,13 +184,12 @@ pub fn shade(
     let f0 = ((m.ior_outside - m.ior_liquid) / (m.ior_outside + m.ior_liquid)).powi(2);
     let eta = m.ior_outside / m.ior_liquid;
     let kappa = V3::from(m.absorption_per_m);
-    let max_depth = inp
-        .scene
-        .depth
-        .iter()
-        .copied()
-        .filter(|z| z.is_finite())
-        .fold(0.0f32, f32::max);
+    if !inp.scene_tiles.fits(w, h) {
+        return Err(SsfrError::invalid(
+            "scene_tiles",
+            format!("not built for the {w}x{h} scene buffer (rebuild with DepthTiles::build)"),
+        ));
+    }
     colour
         .par_chunks_mut(w)
         .zip(sample_px.par_chunks_mut(w))
@@ -256,6 +200,7 @@ pub fn shade(
                 let z = inp.depth[k];
                 if !z.is_finite() {
                     crow[i] = inp.scene.colour[k];
+                    srow[i] = [f32::NAN; 2];
                     continue;
                 }
                 let p = cam.unproject_pixel(i, j, z);
@@ -283,9 +228,7 @@ pub fn shade(
                                         (u0, v0)
                                     }
                                 }
-                                RefractDistance::SceneDepth => {
-                                    march(cam, inp.scene, max_depth, &p, &r)
-                                }
+                                RefractDistance::SceneDepth => march(cam, inp.scene_tiles, &p, &r),
                             }
                         }
                     }

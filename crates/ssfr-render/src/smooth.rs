@@ -54,7 +54,9 @@ fn tap(i: usize, j: usize, k: isize, w: usize, h: usize, horizontal: bool) -> Op
         .then(|| jj as usize * w + ii as usize)
 }
 
-/// One separable pass of the bilateral filter along `x` (`horizontal`) or `y`.
+/// One separable pass of the bilateral filter along `x` (`horizontal`) or `y`: per liquid
+/// pixel, the taps inside the image (range clamped once) weighted by
+/// `exp(−k²/(2σ_s²) − Δz²/(2σ_z²))`.
 fn bilateral_pass(
     src: &[f32],
     dst: &mut [f32],
@@ -65,9 +67,12 @@ fn bilateral_pass(
     horizontal: bool,
 ) {
     let inv_2sz2 = 1.0 / (2.0 * p.depth_falloff_m * p.depth_falloff_m);
+    // Tap k of pixel q is q + k · stride; n pixels along the pass.
+    let (stride, n) = if horizontal { (1, w) } else { (w, h) };
     dst.par_chunks_mut(w).enumerate().for_each(|(j, row)| {
         for (i, out) in row.iter_mut().enumerate() {
-            let z = src[j * w + i];
+            let q = j * w + i;
+            let z = src[q];
             if !z.is_finite() {
                 *out = z;
                 continue;
@@ -79,18 +84,22 @@ fn bilateral_pass(
             }
             let sigma = 0.5 * r;
             let inv_2ss2 = 1.0 / (2.0 * sigma * sigma);
-            let ri = r as isize;
+            let ri = r as usize;
+            let pos = if horizontal { i } else { j };
+            let (k0, k1) = (pos.min(ri), (n - 1 - pos).min(ri));
             let (mut sum, mut wsum) = (0.0f32, 0.0f32);
-            for k in -ri..=ri {
-                let Some(q) = tap(i, j, k, w, h, horizontal) else {
-                    continue;
-                };
-                let zq = src[q];
+            let base = q - k0 * stride;
+            for (t, zq) in src[base..=q + k1 * stride]
+                .iter()
+                .step_by(stride)
+                .enumerate()
+            {
                 if !zq.is_finite() {
                     continue;
                 }
+                let k = t as f32 - k0 as f32;
                 let dz = zq - z;
-                let wt = (-(k * k) as f32 * inv_2ss2 - dz * dz * inv_2sz2).exp();
+                let wt = (-(k * k) * inv_2ss2 - dz * dz * inv_2sz2).exp();
                 sum += wt * zq;
                 wsum += wt;
             }

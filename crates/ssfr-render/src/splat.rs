@@ -120,10 +120,10 @@ impl<'a, R: Real> ParticleView<'a, R> {
     }
 }
 
-/// One particle ready to draw: `G` (view), `s = G c`, `|s|² − 1` and its pixel box.
+/// One particle ready to draw: `s = G c`, `|s|² − 1` and its pixel box (an ellipsoid's `G`
+/// is kept apart, [`Splatter`]'s `ellipsoid_g`, so that spheres move 36 bytes each).
 #[derive(Debug, Clone, Copy)]
 struct Prim {
-    g: Matrix3<f32>,
     /// Ellipsoid: `G c`; sphere: the centre `c` (view).
     s: V3,
     /// Ellipsoid: `|G c|² − 1`; sphere: `|c|² − r²`.
@@ -151,10 +151,110 @@ pub struct SplatBuffers {
     pub thickness: Vec<f32>,
 }
 
+/// Per-pixel view rays `d = (a, b, 1)` of a camera, kept while the camera stays: `a` per
+/// column, `b` per row, `|d|²` and `|d|` per pixel.
+#[derive(Debug, Default)]
+struct RayTables {
+    camera: Option<CameraFrame>,
+    a: Vec<f32>,
+    b: Vec<f32>,
+    dd: Vec<f32>,
+    norm: Vec<f32>,
+}
+
+impl RayTables {
+    fn update(&mut self, camera: &CameraFrame) {
+        if self.camera.as_ref() == Some(camera) {
+            return;
+        }
+        let (w, h) = (camera.width, camera.height);
+        let inv_f = 1.0 / camera.focal_px;
+        self.a.clear();
+        self.a
+            .extend((0..w).map(|i| (i as f32 + 0.5 - camera.cx) * inv_f));
+        self.b.clear();
+        self.b
+            .extend((0..h).map(|j| (camera.cy - (j as f32 + 0.5)) * inv_f));
+        self.dd.resize(w * h, 0.0);
+        self.norm.resize(w * h, 0.0);
+        let a = &self.a;
+        let b = &self.b;
+        self.dd
+            .par_chunks_mut(w)
+            .zip(self.norm.par_chunks_mut(w))
+            .enumerate()
+            .for_each(|(j, (dd, norm))| {
+                let bb = b[j] * b[j] + 1.0;
+                for ((dd, norm), a) in dd.iter_mut().zip(norm.iter_mut()).zip(a) {
+                    *dd = a * a + bb;
+                    *norm = dd.sqrt();
+                }
+            });
+        self.camera = Some(*camera);
+    }
+}
+
+/// One row of a sphere's box: `d = (a, b, 1)`, `Δ = (d·c)² − |d|²(|c|² − r²)`; where
+/// `Δ ≥ 0`, the depth `z = (d·c − √Δ)/|d|²` enters the nearest-depth test and the chord
+/// `2√Δ/|d|` is added to the thickness. Branch-free over the row (the compiler vectorises
+/// it); the arithmetic per pixel is that of a per-pixel loop, so the result is too.
+#[inline]
+fn sphere_row(
+    p: &Prim,
+    b: f32,
+    a: &[f32],
+    dd: &[f32],
+    norm: &[f32],
+    depth: &mut [f32],
+    thick: &mut [f32],
+) {
+    let c = p.s;
+    let bc = b * c.y + c.z;
+    let s2m1 = p.s2m1;
+    let n = a.len();
+    let (dd, norm, depth, thick) = (&dd[..n], &norm[..n], &mut depth[..n], &mut thick[..n]);
+    for k in 0..n {
+        let dc = a[k] * c.x + bc;
+        let disc = dc * dc - dd[k] * s2m1;
+        let hit = disc >= 0.0;
+        let sq = if hit { disc } else { 0.0 }.sqrt();
+        let z = (dc - sq) / dd[k];
+        let zd = depth[k];
+        depth[k] = if hit && z < zd { z } else { zd };
+        thick[k] += if hit { 2.0 * sq / norm[k] } else { 0.0 };
+    }
+}
+
+/// `⌈x⌉` clamped to `[0, hi]` (0 for NaN), by integer truncation: `f32::ceil` is a libm
+/// call on the x86-64 baseline.
+#[inline]
+fn ceil_in(x: f32, hi: usize) -> u32 {
+    let x = x.clamp(0.0, hi as f32);
+    let t = x as u32;
+    if (t as f32) < x {
+        t + 1
+    } else {
+        t
+    }
+}
+
+/// `⌊x⌋ + 1` clamped to `[0, hi]` (0 for NaN), by integer truncation.
+#[inline]
+fn floor_plus_one_in(x: f32, hi: usize) -> u32 {
+    if x.is_nan() || x < 0.0 {
+        0
+    } else {
+        (x.min(hi as f32) as u32 + 1).min(hi as u32)
+    }
+}
+
 /// Scratch of the splatting (kept between frames: no allocation once grown).
 #[derive(Debug, Default)]
 pub struct Splatter {
+    rays: RayTables,
     prims: Vec<Prim>,
+    /// Per particle, an ellipsoid's `G = M⁻¹` (view space); empty for spheres.
+    ellipsoid_g: Vec<Matrix3<f32>>,
     band_start: Vec<usize>,
     band_items: Vec<u32>,
     band_fill: Vec<usize>,
@@ -192,7 +292,6 @@ impl Splatter {
         self.prims.resize(
             n,
             Prim {
-                g: Matrix3::identity(),
                 s: V3::zeros(),
                 s2m1: 0.0,
                 sphere: false,
@@ -202,6 +301,15 @@ impl Splatter {
                 j1: 0,
             },
         );
+        self.ellipsoid_g.clear();
+        if let Some(e) = particles.ellipsoids {
+            self.ellipsoid_g.resize(n, Matrix3::zeros());
+            self.ellipsoid_g
+                .par_iter_mut()
+                .zip(e.par_iter())
+                .for_each(|(g, m)| *g = (rot * m).try_inverse().unwrap_or_else(Matrix3::zeros));
+        }
+        let ellipsoid_g = &self.ellipsoid_g;
         self.prims.par_iter_mut().enumerate().for_each(|(k, prim)| {
             let p = &particles.positions[k];
             let pw = V3::new(
@@ -210,29 +318,27 @@ impl Splatter {
                 p.z.as_f64() as f32,
             );
             let c = camera.to_view(&pw);
-            let (g, ext, radius) = match particles.ellipsoids {
+            let (ext, radius) = match particles.ellipsoids {
                 Some(e) => {
                     let mv = rot * e[k];
-                    let g = mv.try_inverse().unwrap_or_else(Matrix3::zeros);
                     let ext = V3::new(mv.row(0).norm(), mv.row(1).norm(), mv.row(2).norm());
-                    (g, ext, None)
+                    (ext, None)
                 }
                 None => {
                     let r = particles
                         .radii
                         .map_or(particles.radius, |r| r[k].as_f64() as f32);
-                    (Matrix3::identity() / r, V3::repeat(r), Some(r))
+                    (V3::repeat(r), Some(r))
                 }
             };
             let (s, s2m1) = match radius {
                 Some(r) => (c, c.norm_squared() - r * r),
                 None => {
-                    let s = g * c;
+                    let s = ellipsoid_g[k] * c;
                     (s, s.norm_squared() - 1.0)
                 }
             };
             *prim = Prim {
-                g,
                 s,
                 s2m1,
                 sphere: radius.is_some(),
@@ -264,11 +370,10 @@ impl Splatter {
                 }
             }
             // Pixel centres i + 1/2 in [umin, umax].
-            let clampi = |x: f32, hi: usize| x.clamp(0.0, hi as f32) as u32;
-            let i0 = clampi((umin - 0.5).ceil(), w);
-            let i1 = clampi((umax - 0.5).floor() + 1.0, w);
-            let j0 = clampi((vmin - 0.5).ceil(), h);
-            let j1 = clampi((vmax - 0.5).floor() + 1.0, h);
+            let i0 = ceil_in(umin - 0.5, w);
+            let i1 = floor_plus_one_in(umax - 0.5, w);
+            let j0 = ceil_in(vmin - 0.5, h);
+            let j1 = floor_plus_one_in(vmax - 0.5, h);
             if i0 < i1 && j0 < j1 {
                 prim.i0 = i0;
                 prim.i1 = i1;
@@ -308,7 +413,8 @@ impl Splatter {
         let prims = &self.prims;
         let band_start = &self.band_start;
         let band_items = &self.band_items;
-        let inv_f = 1.0 / camera.focal_px;
+        self.rays.update(camera);
+        let rays = &self.rays;
         let tests: u64 = out
             .depth
             .par_chunks_mut(w * BAND_ROWS)
@@ -324,32 +430,24 @@ impl Splatter {
                     let j1 = (p.j1 as usize).min(row0 + rows);
                     tests += ((j1 - j0) * (p.i1 - p.i0) as usize) as u64;
                     if p.sphere {
-                        // d = (a, b, 1): Δ = (d·c)² − |d|²(|c|² − r²), z = (d·c − √Δ)/|d|²,
-                        // chord = 2√Δ/|d|.
-                        let c = p.s;
+                        let (i0, i1) = (p.i0 as usize, p.i1 as usize);
                         for j in j0..j1 {
-                            let bv = (camera.cy - (j as f32 + 0.5)) * inv_f;
-                            let (bc, bb) = (bv * c.y + c.z, bv * bv + 1.0);
                             let off = (j - row0) * w;
-                            for i in p.i0 as usize..p.i1 as usize {
-                                let a = (i as f32 + 0.5 - camera.cx) * inv_f;
-                                let dc = a * c.x + bc;
-                                let dd = a * a + bb;
-                                let disc = dc * dc - dd * p.s2m1;
-                                if disc >= 0.0 {
-                                    let sq = disc.sqrt();
-                                    let z = (dc - sq) / dd;
-                                    let px = off + i;
-                                    if z < depth[px] {
-                                        depth[px] = z;
-                                    }
-                                    thick[px] += 2.0 * sq / dd.sqrt();
-                                }
-                            }
+                            let ray_off = j * w;
+                            sphere_row(
+                                p,
+                                rays.b[j],
+                                &rays.a[i0..i1],
+                                &rays.dd[ray_off + i0..ray_off + i1],
+                                &rays.norm[ray_off + i0..ray_off + i1],
+                                &mut depth[off + i0..off + i1],
+                                &mut thick[off + i0..off + i1],
+                            );
                         }
                         continue;
                     }
-                    let (g0, g1, g2) = (p.g.column(0), p.g.column(1), p.g.column(2));
+                    let g = &ellipsoid_g[k as usize];
+                    let (g0, g1, g2) = (g.column(0), g.column(1), g.column(2));
                     for j in j0..j1 {
                         let bv = (camera.cy - (j as f32 + 0.5)) / camera.focal_px;
                         let qrow = g1 * bv + g2;

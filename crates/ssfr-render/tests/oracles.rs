@@ -290,3 +290,66 @@ proptest! {
         }
     }
 }
+
+/// A scene with a floor, the tank's walls and two obstacles, at a small size.
+fn march_scene(w: usize, h: usize) -> (ssfr_render::CameraFrame, ssfr_render::SceneBuffer) {
+    use ssfr_render::{Background, Light, Obstacle, SceneBuffer, TankWalls};
+    let cam = camera(w, h);
+    let mut bg = Background::ground_only(-0.2, 0.1);
+    bg.tank = Some(TankWalls {
+        min: [-0.5, -0.2, -0.4],
+        max: [0.5, 0.6, 0.3],
+        colour: [0.5; 3],
+        grid_m: 0.1,
+    });
+    bg.obstacles = vec![
+        Obstacle::Sphere {
+            center: [0.1, 0.0, -0.1],
+            radius: 0.12,
+            colour: [0.9, 0.2, 0.2],
+        },
+        Obstacle::Box {
+            min: [-0.35, -0.2, -0.3],
+            max: [-0.3, 0.3, 0.1],
+            colour: [0.2, 0.9, 0.2],
+        },
+    ];
+    let mut scene = SceneBuffer::default();
+    bg.render(&cam, &Light::default(), &mut scene).unwrap();
+    (cam, scene)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    /// The tiled pixel walk of the refraction march finds the crossing the every-pixel
+    /// oracle (f64) finds.
+    #[test]
+    fn march_matches_naive(
+        w in 16usize..96,
+        h in 12usize..64,
+        rays in prop::collection::vec(
+            (0.0f32..1.0, 0.0f32..1.0, 0.02f32..0.98, -1.0f32..1.0, -1.0f32..1.0, -1.0f32..1.0),
+            1..24,
+        ),
+    ) {
+        let (cam, scene) = march_scene(w, h);
+        let mut tiles = ssfr_render::DepthTiles::default();
+        tiles.build(&scene);
+        for &(x, y, frac, rx, ry, rz) in &rays {
+            let (i, j) = (((x * w as f32) as usize).min(w - 1), ((y * h as f32) as usize).min(h - 1));
+            let zs = scene.depth[j * w + i];
+            let z = if zs.is_finite() { frac * zs } else { 3.0 * frac };
+            let p = cam.unproject_pixel(i, j, z);
+            let r = V3::new(rx, ry, rz);
+            prop_assume!(r.norm() > 0.1);
+            let r = r.normalize();
+            let fast = ssfr_render::march::march(&cam, &tiles, &p, &r);
+            let naive = ssfr_render::march::march_naive(&cam, &scene, &p, &r);
+            // f32 rounding of the clipped segment and of 1/z: 1e-3 pixels.
+            let d = ((fast.0 - naive.0).powi(2) + (fast.1 - naive.1).powi(2)).sqrt();
+            prop_assert!(d < 1e-3 * (1.0 + naive.0.abs().max(naive.1.abs()) / 64.0),
+                "pixel ({i}, {j}) z {z} r {r:?}: {fast:?} vs {naive:?}");
+        }
+    }
+}

@@ -19,8 +19,15 @@ use crate::{Check, Context, Experiment, Outcome};
 /// The experiment.
 pub struct SsfrPerformance;
 
-/// Frames timed per size (the median is reported).
-const REPEATS: usize = 5;
+/// Frames rendered per size; the first also renders the background, the others are timed
+/// (medians of the frame and of each stage are reported).
+const REPEATS: usize = 11;
+
+/// Median and spread (largest − smallest) of `xs`.
+fn median_spread(xs: &mut [f64]) -> (f64, f64) {
+    xs.sort_by(f64::total_cmp);
+    (xs[xs.len() / 2], xs[xs.len() - 1] - xs[0])
+}
 
 /// A lattice of about `n` particles filling the water column; returns positions and spacing.
 pub fn column_particles(n: usize) -> Result<(Vec<Vec3<f32>>, f32)> {
@@ -64,35 +71,33 @@ impl Experiment for SsfrPerformance {
                 ctx.progress.inc(1);
             }
             // The first frame also renders the background; time the others.
-            let mut frames: Vec<f64> = runs[1..].iter().map(|x| x.0).collect();
-            frames.sort_by(f64::total_cmp);
-            let median = frames[frames.len() / 2];
+            let timed = &runs[1..];
+            let (median, spread) =
+                median_spread(&mut timed.iter().map(|x| x.0).collect::<Vec<_>>());
             let label = format!("{}k", positions.len() / 1000);
             out.metric(format!("{label}/frame_median_s"), median);
-            out.metric(
-                format!("{label}/frame_spread_s"),
-                frames[frames.len() - 1] - frames[0],
-            );
+            out.metric(format!("{label}/frame_spread_s"), spread);
             let last = runs[runs.len() - 1].1;
-            out.metric(
-                format!("{label}/background_s"),
-                runs[0].1.times.background_s,
-            );
-            for (stage, secs) in last.times.stages() {
-                if stage != "background" {
-                    out.metric(format!("{label}/{stage}_s"), secs);
-                }
+            let background_s = runs[0].1.times.background_s;
+            out.metric(format!("{label}/background_s"), background_s);
+            for (k, (stage, _)) in last.times.stages().into_iter().enumerate() {
+                let secs = if stage == "background" {
+                    background_s
+                } else {
+                    let (m, spread) = median_spread(
+                        &mut timed
+                            .iter()
+                            .map(|x| x.1.times.stages()[k].1)
+                            .collect::<Vec<_>>(),
+                    );
+                    out.metric(format!("{label}/{stage}_s"), m);
+                    out.metric(format!("{label}/{stage}_spread_s"), spread);
+                    m
+                };
                 rows.push(vec![
                     positions.len().to_string(),
                     stage.to_string(),
-                    format!(
-                        "{:.6}",
-                        if stage == "background" {
-                            runs[0].1.times.background_s
-                        } else {
-                            secs
-                        }
-                    ),
+                    format!("{secs:.6}"),
                 ]);
             }
             out.metric(
@@ -119,7 +124,10 @@ impl Experiment for SsfrPerformance {
             &["particles", "stage", "seconds"],
             rows,
         )?;
-        ctx.add_file("stages.csv", "seconds per stage of the last timed frame");
+        ctx.add_file(
+            "stages.csv",
+            "seconds per stage: median over the timed frames (background: the first frame)",
+        );
         out.note(format!(
             "{} rayon threads; median of {} frames after the first (which also renders the background); the machine may be shared, timings are not asserted",
             rayon::current_num_threads(),
