@@ -21,7 +21,7 @@
 use neighbour_search::NeighbourLists;
 use rayon::prelude::*;
 use sph_core::{Real, Vec3};
-use sph_solver::step::{MIN_LEN, REDUCE_CHUNK};
+use sph_solver::step::{par_update_sum, MIN_LEN};
 
 use crate::granular::{deviatoric, frobenius, strain_rate, sym_mul, yield_clamp, Sym3};
 use crate::solver::{grad, pressure_accel, Consts, Scratch};
@@ -202,36 +202,32 @@ pub(crate) fn solve<R: Real>(
                 &s.pressure[..],
                 &s.v_trial[..],
             );
-            s.stress
-                .par_chunks_mut(REDUCE_CHUNK)
-                .zip(s.stress_over_rho2.par_chunks_mut(REDUCE_CHUNK))
-                .zip(s.error_partials.par_iter_mut())
-                .enumerate()
-                .for_each(|(ch, ((sc, sr), part))| {
-                    let base = ch * REDUCE_CHUNK;
-                    let mut sum = 0.0;
-                    for (o, (st, so)) in sc.iter_mut().zip(sr.iter_mut()).enumerate() {
-                        let i = base + o;
-                        let eps = deviatoric(&strain_rate_at(
-                            x, vt, m, rho, offsets, indices, gs, bgrad, i,
-                        ));
-                        let trial: Sym3<R> = std::array::from_fn(|e| st[e] - eps[e] * inv_d);
-                        let bound = c.alpha * pr[i];
-                        let next = yield_clamp(&trial, c.alpha, pr[i]);
-                        // Strain counts as residual where the material should be rigid:
-                        // inside the yield surface (a yielding particle flows).
-                        if bound > R::zero() && frobenius(&trial) <= bound {
-                            sum += (frobenius(&eps) * dt).as_f64();
-                        }
-                        *st = next;
-                        let inv = R::one() / (rho[i] * rho[i]);
-                        *so = next.map(|e| e * inv);
-                    }
-                    *part = sum;
-                });
+            let update = |i: usize, st: &mut Sym3<R>, so: &mut Sym3<R>| -> f64 {
+                let eps = deviatoric(&strain_rate_at(
+                    x, vt, m, rho, offsets, indices, gs, bgrad, i,
+                ));
+                let trial: Sym3<R> = std::array::from_fn(|e| st[e] - eps[e] * inv_d);
+                let bound = c.alpha * pr[i];
+                *st = yield_clamp(&trial, c.alpha, pr[i]);
+                let inv = R::one() / (rho[i] * rho[i]);
+                *so = st.map(|e| e * inv);
+                // Strain counts as residual where the material should be rigid: inside the
+                // yield surface (a yielding particle flows).
+                if bound > R::zero() && frobenius(&trial) <= bound {
+                    (frobenius(&eps) * dt).as_f64()
+                } else {
+                    0.0
+                }
+            };
+            let total = par_update_sum(
+                &mut s.stress,
+                &mut s.stress_over_rho2,
+                &mut s.error_partials,
+                update,
+            );
+            outcome.residual = total / n as f64;
         }
         outcome.iterations = k + 1;
-        outcome.residual = s.error_partials.iter().sum::<f64>() / n as f64;
         // a^f of the new stress and the velocities it gives.
         accelerations(c, x, m, nb, s);
         s.v_trial

@@ -11,8 +11,8 @@ use sph_kernels::{CubicSpline, Kernel};
 use sph_solver::boundary::check_volume_kernel;
 use sph_solver::csr::par_csr_blocks;
 use sph_solver::step::{
-    begin_frame, check_divergence, density_at, end_frame, CellReorder, FramePhases, StepAt,
-    StepNeighbours, MIN_LEN, REDUCE_CHUNK,
+    begin_frame, check_divergence, density_at, end_frame, par_update_sum, CellReorder, FramePhases,
+    StepAt, StepNeighbours, MIN_LEN, REDUCE_CHUNK,
 };
 use sph_solver::{Boundary, CollisionBoundary, Solids, SolverError, StepStats};
 
@@ -840,40 +840,32 @@ pub(crate) fn pressure_solve<R: Real>(
                 &s.aii[..],
                 &s.density[..],
             );
-            s.pressure
-                .par_chunks_mut(REDUCE_CHUNK)
-                .zip(s.p_over_rho2.par_chunks_mut(REDUCE_CHUNK))
-                .zip(s.error_partials.par_iter_mut())
-                .enumerate()
-                .for_each(|(ch, ((pc, pic), part))| {
-                    let base = ch * REDUCE_CHUNK;
-                    let mut sum = 0.0;
-                    for (o, (pr, pi)) in pc.iter_mut().zip(pic.iter_mut()).enumerate() {
-                        let i = base + o;
-                        let ap = a_times_p(c, x, m, offsets, indices, gs, acc, bgrad, i);
-                        // ρ_i^l − ρ0 = (A p)_i − (ρ0 − ρ_i^adv).
-                        let compression = (ap - src[i]).as_f64();
-                        if compression > 0.0 {
-                            sum += compression;
-                        }
-                        let a = aii[i];
-                        let next = if a < R::zero() {
-                            let q = *pr + omega * (src[i] - ap) / a;
-                            if q > R::zero() {
-                                q
-                            } else {
-                                R::zero()
-                            }
-                        } else {
-                            R::zero()
-                        };
-                        *pr = next;
-                        *pi = next / (rho[i] * rho[i]);
+            let update = |i: usize, pr: &mut R, pi: &mut R| -> f64 {
+                let ap = a_times_p(c, x, m, offsets, indices, gs, acc, bgrad, i);
+                let a = aii[i];
+                let next = if a < R::zero() {
+                    let q = *pr + omega * (src[i] - ap) / a;
+                    if q > R::zero() {
+                        q
+                    } else {
+                        R::zero()
                     }
-                    *part = sum;
-                });
+                } else {
+                    R::zero()
+                };
+                *pr = next;
+                *pi = next / (rho[i] * rho[i]);
+                // ρ_i^l − ρ0 = (A p)_i − (ρ0 − ρ_i^adv), counted where positive.
+                (ap - src[i]).as_f64().max(0.0)
+            };
+            let total = par_update_sum(
+                &mut s.pressure,
+                &mut s.p_over_rho2,
+                &mut s.error_partials,
+                update,
+            );
+            error = total / n as f64 * inv_rho0;
         }
-        error = s.error_partials.iter().sum::<f64>() / n as f64 * inv_rho0;
         if l + 1 >= p.min_iterations && error <= eta {
             return (l + 1, error, true);
         }

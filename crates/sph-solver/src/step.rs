@@ -23,6 +23,36 @@ pub const MIN_LEN: usize = 256;
 /// not depend on the number of threads).
 pub const REDUCE_CHUNK: usize = 4096;
 
+/// Updates two per-particle arrays in parallel, `f(i, &mut a[i], &mut b[i])` for every
+/// particle `i`, and returns the sum of what `f` returns, added up in fixed chunks of
+/// [`REDUCE_CHUNK`] particles (one entry of `partials` each, which must have
+/// `a.len().div_ceil(REDUCE_CHUNK)` entries) and then in chunk order, so that the sum does
+/// not depend on the number of threads. The iterative solvers use it for an update and the
+/// residual of its stopping rule in one pass.
+pub fn par_update_sum<A: Send, B: Send>(
+    a: &mut [A],
+    b: &mut [B],
+    partials: &mut [f64],
+    f: impl Fn(usize, &mut A, &mut B) -> f64 + Sync,
+) -> f64 {
+    debug_assert_eq!(a.len(), b.len());
+    debug_assert_eq!(partials.len(), a.len().div_ceil(REDUCE_CHUNK));
+    a.par_chunks_mut(REDUCE_CHUNK)
+        .zip(b.par_chunks_mut(REDUCE_CHUNK))
+        .zip(partials.par_iter_mut())
+        .enumerate()
+        .for_each(|(ch, ((ac, bc), part))| {
+            let base = ch * REDUCE_CHUNK;
+            *part = ac
+                .iter_mut()
+                .zip(bc.iter_mut())
+                .enumerate()
+                .map(|(o, (x, y))| f(base + o, x, y))
+                .sum();
+        });
+    partials.iter().sum()
+}
+
 /// The first non-finite axis of `v`.
 #[inline]
 pub fn non_finite<R: Real>(v: &Vec3<R>) -> Option<usize> {
@@ -394,4 +424,45 @@ pub fn end_frame<R: Real>(
     stats
         .phases
         .add(phases.statistics, t.elapsed().as_secs_f64());
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{par_update_sum, REDUCE_CHUNK};
+
+    /// Every element is updated once with its own index, and the sum is the chunked
+    /// sequential sum, bitwise the same on 1 and 3 threads.
+    #[test]
+    fn par_update_sum_updates_all_and_sums_in_chunks() {
+        let n = 3 * REDUCE_CHUNK + 17;
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let mut a = vec![0usize; n];
+                let mut b = vec![0.0f64; n];
+                let mut partials = vec![0.0; n.div_ceil(REDUCE_CHUNK)];
+                let total = par_update_sum(&mut a, &mut b, &mut partials, |i, x, y| {
+                    *x = i;
+                    *y = 0.1 * i as f64;
+                    1.0 / (1.0 + i as f64)
+                });
+                (a, b, total)
+            })
+        };
+        let (a, b, total) = run(1);
+        assert!(a.iter().enumerate().all(|(i, &x)| x == i));
+        assert!(b.iter().enumerate().all(|(i, &y)| y == 0.1 * i as f64));
+        let expect: f64 = (0..n.div_ceil(REDUCE_CHUNK))
+            .map(|c| {
+                (c * REDUCE_CHUNK..((c + 1) * REDUCE_CHUNK).min(n))
+                    .map(|i| 1.0 / (1.0 + i as f64))
+                    .sum::<f64>()
+            })
+            .sum();
+        assert_eq!(total.to_bits(), expect.to_bits());
+        assert_eq!(run(3).2.to_bits(), total.to_bits());
+    }
 }
