@@ -1,0 +1,75 @@
+//! `Iisph::step` does not allocate once its buffers have grown, for water and for granular
+//! matter (friction, drag): counting global allocator. This file is its own test binary,
+//! with a single test so that nothing else allocates while it counts.
+
+// Unsafe: the allocation counter is a `GlobalAlloc` wrapping `System` (the only way to count allocations).
+#![allow(unsafe_code)]
+
+mod common;
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use iisph_granular::IisphParams;
+use sph_solver::testing::in_pool;
+
+struct Counting;
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn step_does_not_allocate_when_warm() {
+    in_pool(2, || {
+        for (name, mut p) in [
+            ("water", IisphParams::<f32>::for_spacing(0.025)),
+            ("granular", {
+                let mut p = IisphParams::<f32>::granular(0.025, 30.0);
+                p.granular.as_mut().unwrap().drag_coefficient = 1.0;
+                p
+            }),
+        ] {
+            // a 12 × 16 × 10 block in the corner of a 24 × 20 × 10 tank: it collapses
+            // along x, so neighbour pairs and contacts change from step to step
+            p.common.dt = 0.004;
+            p.common.substeps = 2;
+            p.common.reorder_every = 3;
+            let (mut solver, mut state) = common::block_solver(p, [12, 16, 10], [24.0, 20.0, 10.0]);
+            let start = ALLOCATIONS.load(Ordering::SeqCst);
+            solver.step(&mut state).unwrap();
+            assert!(
+                ALLOCATIONS.load(Ordering::SeqCst) > start,
+                "{name}: the counter sees the first step's buffers"
+            );
+            // Warm up: buffers grow to the particle count and the neighbour lists to the
+            // largest pair count of the run so far.
+            for _ in 0..19 {
+                solver.step(&mut state).unwrap();
+            }
+            let before = ALLOCATIONS.load(Ordering::SeqCst);
+            for _ in 0..6 {
+                solver.step(&mut state).unwrap();
+            }
+            let count = ALLOCATIONS.load(Ordering::SeqCst) - before;
+            assert_eq!(
+                count, 0,
+                "{name}: {count} allocations in 6 warm steps (with 2 reorders)"
+            );
+        }
+    });
+}
