@@ -19,6 +19,10 @@
 //! which with `H = 2a` is `dZ/dT = 2`. To see where a slower front loses its energy, the
 //! scene is also run (reported, not checked) without XSPH (`c = 0`) and with volume-map
 //! walls instead of the collision projection.
+//!
+//! The IISPH curve (`granular::iisph_front`: the same scene with `kind = "iisph"`,
+//! volume-map walls and calibrated initial masses) gets the same three checks, named
+//! `front/IISPH …`.
 
 use anyhow::Result;
 use sph_core::Real;
