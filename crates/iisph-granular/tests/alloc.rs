@@ -13,36 +13,13 @@
 //! after 50; every such allocation traced to the neighbour search, none to the solver's own
 //! buffers.
 
-// Unsafe: the allocation counter is a `GlobalAlloc` wrapping `System` (the only way to count allocations).
-#![allow(unsafe_code)]
-
 mod common;
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
-
 use iisph_granular::{IisphParams, Vec3};
-use sph_solver::testing::in_pool;
-
-struct Counting;
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
+use sph_solver::testing::{in_pool, CountingAllocator};
 
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: CountingAllocator = CountingAllocator::new();
 
 #[test]
 fn step_does_not_allocate_when_warm() {
@@ -63,10 +40,10 @@ fn step_does_not_allocate_when_warm() {
             p.common.reorder_every = 3;
             let (mut solver, mut state) =
                 common::relaxed_block_solver(p, [10, 12, 10], [10.0, 16.0, 10.0]);
-            let start = ALLOCATIONS.load(Ordering::SeqCst);
+            let start = GLOBAL.count();
             solver.step(&mut state).unwrap();
             assert!(
-                ALLOCATIONS.load(Ordering::SeqCst) > start,
+                GLOBAL.count() > start,
                 "{name}: the counter sees the first step's buffers"
             );
             // Warm up: buffers grow to the particle count and the neighbour lists to the
@@ -74,11 +51,11 @@ fn step_does_not_allocate_when_warm() {
             for _ in 0..19 {
                 solver.step(&mut state).unwrap();
             }
-            let before = ALLOCATIONS.load(Ordering::SeqCst);
+            let before = GLOBAL.count();
             for _ in 0..6 {
                 solver.step(&mut state).unwrap();
             }
-            let count = ALLOCATIONS.load(Ordering::SeqCst) - before;
+            let count = GLOBAL.count() - before;
             assert_eq!(
                 count, 0,
                 "{name}: {count} allocations in 6 warm steps (with 2 reorders)"

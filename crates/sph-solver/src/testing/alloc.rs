@@ -1,0 +1,49 @@
+//! A global allocator that counts allocations, for the solvers' "a warm step allocates
+//! nothing" tests. Install it in a test binary of its own (one test, so that nothing else
+//! allocates while it counts):
+//!
+//! ```ignore
+//! #[global_allocator]
+//! static GLOBAL: CountingAllocator = CountingAllocator::new();
+//! ```
+
+// Unsafe: counting allocations needs a `GlobalAlloc`, which wraps `System` here (the trait's
+// methods are unsafe to implement and to call).
+#![allow(unsafe_code)]
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// `System`, counting every `alloc` and `realloc` (not `dealloc`).
+#[derive(Debug, Default)]
+pub struct CountingAllocator {
+    allocations: AtomicUsize,
+}
+
+impl CountingAllocator {
+    /// A counter at zero.
+    pub const fn new() -> Self {
+        Self {
+            allocations: AtomicUsize::new(0),
+        }
+    }
+
+    /// Allocations and reallocations so far.
+    pub fn count(&self) -> usize {
+        self.allocations.load(Ordering::SeqCst)
+    }
+}
+
+unsafe impl GlobalAlloc for CountingAllocator {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        self.allocations.fetch_add(1, Ordering::Relaxed);
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        self.allocations.fetch_add(1, Ordering::Relaxed);
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
