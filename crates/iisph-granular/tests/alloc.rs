@@ -16,7 +16,7 @@
 mod common;
 
 use iisph_granular::{IisphParams, Vec3};
-use sph_solver::testing::{in_pool, CountingAllocator};
+use sph_solver::testing::{assert_warm_steps_do_not_allocate, in_pool, CountingAllocator};
 
 #[global_allocator]
 static GLOBAL: CountingAllocator = CountingAllocator::new();
@@ -40,26 +40,7 @@ fn step_does_not_allocate_when_warm() {
             p.common.reorder_every = 3;
             let (mut solver, mut state) =
                 common::relaxed_block_solver(p, [10, 12, 10], [10.0, 16.0, 10.0]);
-            let start = GLOBAL.count();
-            solver.step(&mut state).unwrap();
-            assert!(
-                GLOBAL.count() > start,
-                "{name}: the counter sees the first step's buffers"
-            );
-            // Warm up: buffers grow to the particle count and the neighbour lists to the
-            // largest pair count of the run so far, while the block settles.
-            for _ in 0..19 {
-                solver.step(&mut state).unwrap();
-            }
-            let before = GLOBAL.count();
-            for _ in 0..6 {
-                solver.step(&mut state).unwrap();
-            }
-            let count = GLOBAL.count() - before;
-            assert_eq!(
-                count, 0,
-                "{name}: {count} allocations in 6 warm steps (with 2 reorders)"
-            );
+            assert_warm_steps_do_not_allocate(&GLOBAL, name, &mut solver, &mut state);
         }
     });
 }

@@ -10,8 +10,8 @@
 //! lattice layers it stands for (the discrete sum of the missing layers is smaller than the
 //! continuous integral over the solid), so the lattice starts compressed at the walls:
 //! measured on the dam break of `scenes/dam_break_iisph.toml` (cubic spline, `h = 2 s`):
-//! `ρ/ρ0` = 1.038 at a wall, 1.061 at an edge and 1.075 in a corner (the layer behind the
-//! wall layer, `1.5 s` from it, 1.004). A unilateral pressure solver (IISPH with `p ≥ 0`,
+//! `ρ/ρ0` = 1.038 at a wall, 1.061 at an edge and 1.075 in a corner (particles farther than
+//! `0.75 s` from every wall: up to 1.004). A unilateral pressure solver (IISPH with `p ≥ 0`,
 //! PBF with the clamped constraint) releases that compression in its first steps as a jet
 //! along the walls: with IISPH the largest speed after the first 16 ms frame is 3.1 m/s
 //! (free fall: `g t` = 0.16 m/s), 0.29 m/s with calibrated masses. With collision walls (no

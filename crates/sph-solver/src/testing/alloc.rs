@@ -47,3 +47,30 @@ unsafe impl GlobalAlloc for CountingAllocator {
         unsafe { System.realloc(ptr, layout, new_size) }
     }
 }
+
+/// Runs `solver` on `state` for one step (whose buffers `counter` must see allocated), 19
+/// warm-up steps (buffers grow to the particle count and the neighbour lists to the largest
+/// pair count so far), then 6 more, and asserts that those 6 allocate nothing (`what`
+/// names the case in the message; with `reorder_every = 3` they include 2 reorders).
+pub fn assert_warm_steps_do_not_allocate<R: sph_core::Real>(
+    counter: &CountingAllocator,
+    what: &str,
+    solver: &mut dyn crate::FluidSolver<R>,
+    state: &mut sph_core::ParticleSet<R>,
+) {
+    let start = counter.count();
+    solver.step(state).unwrap();
+    assert!(
+        counter.count() > start,
+        "{what}: the counter sees the first step's buffers"
+    );
+    for _ in 0..19 {
+        solver.step(state).unwrap();
+    }
+    let before = counter.count();
+    for _ in 0..6 {
+        solver.step(state).unwrap();
+    }
+    let count = counter.count() - before;
+    assert_eq!(count, 0, "{what}: {count} allocations in 6 warm steps");
+}

@@ -4,7 +4,7 @@
 mod alloc;
 pub mod formulas;
 
-pub use alloc::CountingAllocator;
+pub use alloc::{assert_warm_steps_do_not_allocate, CountingAllocator};
 
 use sph_core::{
     sampling::cubic_lattice, Aabb, BoxSdf, CoreError, Inverted, ParticleSet, Real, Vec3,
