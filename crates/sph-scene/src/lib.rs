@@ -139,6 +139,10 @@
 //! [boundary]                       # optional
 //! model = "volume-map"             # "volume-map" | "collision" (default: BoundaryModel's
 //!                                  # Default, "volume-map")
+//! initial_masses = "lattice"       # "lattice" (default): every particle ρ0 s³;
+//!                                  # "calibrated": those masses lowered where the lattice
+//!                                  # plus the walls' share ρ0 Ψ would start above ρ0 (see
+//!                                  # InitialMasses; positions are not moved)
 //!
 //! [tank]                           # optional: the container, a closed box (particles inside)
 //! min = [0.0, 0.0, 0.0]            # m
@@ -239,8 +243,8 @@ use sph_core::{Real, Vec3};
 
 pub use error::SceneError;
 pub use spec::{
-    BoundaryModel, BoundarySpec, FluidSpec, GranularSpec, IisphSpec, MeshPlacement, MeshSpec,
-    OutputSpec, PbfSpec, PcisphSpec, Precision, QuickSpec, Scene, SolidSpec, SolverKind,
+    BoundaryModel, BoundarySpec, FluidSpec, GranularSpec, IisphSpec, InitialMasses, MeshPlacement,
+    MeshSpec, OutputSpec, PbfSpec, PcisphSpec, Precision, QuickSpec, Scene, SolidSpec, SolverKind,
     SolverSpec, DEFAULT_IISPH_MAX_ITERATIONS, DEFAULT_IISPH_MIN_ITERATIONS,
 };
 

@@ -391,6 +391,31 @@ pub struct BoundarySpec {
     /// The boundary model (default [`BoundaryModel::default`]).
     #[serde(default)]
     pub model: BoundaryModel,
+    /// The fluid's initial masses with respect to the density the solver sees at the start,
+    /// the lattice's plus the boundary's (`initial_masses`; default
+    /// [`InitialMasses::Lattice`]).
+    #[serde(default)]
+    pub initial_masses: InitialMasses,
+}
+
+/// The fluid's initial particle masses (the `[boundary]` table's `initial_masses`).
+///
+/// With volume-map walls a lattice of masses `ρ0 s³` starts compressed next to the walls
+/// (its first layer, half a spacing from a wall, sees the wall's share `ρ0 Ψ` on top of the
+/// lattice's: `ρ/ρ0` ≈ 1.038 at a wall, 1.075 in a corner for the cubic spline at `h = 2 s`),
+/// and a unilateral pressure solver releases that compression as a jet along the walls in
+/// its first steps. [`InitialMasses::Calibrated`] lowers the masses of those particles until
+/// none starts above `ρ0` (`sph_solver::initial::calibrate_masses`); positions are not moved.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum InitialMasses {
+    /// Every particle `ρ0 s³` (`initial_masses = "lattice"`, the default): the lattice's mass
+    /// per cell, whatever the walls add.
+    #[default]
+    Lattice,
+    /// `ρ0 s³`, lowered where the lattice plus the boundary would start above `ρ0`, so that
+    /// no particle does (`initial_masses = "calibrated"`).
+    Calibrated,
 }
 
 /// Output settings.

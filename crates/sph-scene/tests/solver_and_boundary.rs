@@ -4,7 +4,7 @@
 mod common;
 
 use common::{assert_names, err_with, fixture_dir, VALID};
-use sph_scene::{BoundaryModel, BoundarySpec, Scene, SolverKind, SolverSpec};
+use sph_scene::{BoundaryModel, BoundarySpec, InitialMasses, Scene, SolverKind, SolverSpec};
 
 /// Line 12 of `VALID` is `kind = "pbf"`, line 15 `xsph_c = 0.01`.
 const KIND_LINE: &str = "(line 12, column 8)";
@@ -215,6 +215,30 @@ fn boundary_model_values() {
     assert_eq!(
         parse("boundary_empty", &text).boundary.model,
         BoundaryModel::default()
+    );
+}
+
+#[test]
+fn initial_masses_values() {
+    let absent = parse("masses_absent", VALID);
+    assert_eq!(absent.boundary.initial_masses, InitialMasses::Lattice);
+    for (value, masses) in [
+        ("lattice", InitialMasses::Lattice),
+        ("calibrated", InitialMasses::Calibrated),
+    ] {
+        let text = format!("{VALID}\n[boundary]\ninitial_masses = \"{value}\"\n");
+        let s = parse("initial_masses", &text);
+        assert_eq!(s.boundary.initial_masses, masses);
+        assert_eq!(s.boundary.model, BoundaryModel::default());
+    }
+    let file = fixture_dir("bad_masses").join("bad_masses.toml");
+    let text = format!("{VALID}\n[boundary]\ninitial_masses = \"calibrate\"\n");
+    let e = Scene::parse_str(&text, &file).unwrap_err();
+    assert_names(
+        &e,
+        "bad_masses",
+        "boundary.initial_masses",
+        "unknown variant `calibrate`, expected `lattice` or `calibrated`",
     );
 }
 

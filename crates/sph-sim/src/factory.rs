@@ -54,14 +54,23 @@ pub fn build_solver<R: Real>(scene: &Scene) -> Result<Box<dyn FluidSolver<R>>, S
         }
         SolverSpec::Iisph(s) => {
             let p = iisph_params::<R>(scene, s).map_err(setup)?;
-            let b = build_boundary_with_kernel(scene, &p.common, KernelKind::CubicSpline)?;
+            let b = build_boundary_with_kernel(scene, &p.common, density_kernel(scene))?;
             Ok(Box::new(Iisph::with_boundary(p, b).map_err(setup)?))
         }
         SolverSpec::Granular(s) => {
             let p = granular_params::<R>(scene, s).map_err(setup)?;
-            let b = build_boundary_with_kernel(scene, &p.common, KernelKind::CubicSpline)?;
+            let b = build_boundary_with_kernel(scene, &p.common, density_kernel(scene))?;
             Ok(Box::new(Iisph::with_boundary(p, b).map_err(setup)?))
         }
+    }
+}
+
+/// The density kernel of the solver a scene asks for (the kernel its volume maps are
+/// integrated with): Poly6 for PBF and PCISPH, the cubic spline for the IISPH kinds.
+pub fn density_kernel(scene: &Scene) -> KernelKind {
+    match scene.solver {
+        SolverSpec::Pbf(_) | SolverSpec::Pcisph(_) => KernelKind::Poly6,
+        SolverSpec::Iisph(_) | SolverSpec::Granular(_) => KernelKind::CubicSpline,
     }
 }
 
@@ -264,12 +273,13 @@ fn domain<R: Real>(scene: &Scene) -> Result<Aabb<R>, SimError> {
 }
 
 /// The boundary a scene asks for (`[boundary] model`), for a solver with the parameters
-/// `c` and the density kernel Poly6 (PBF, PCISPH): [`build_boundary_with_kernel`].
+/// `c` and the density kernel of the scene's solver ([`density_kernel`]):
+/// [`build_boundary_with_kernel`].
 pub fn build_boundary<R: Real>(
     scene: &Scene,
     c: &CommonParams<R>,
 ) -> Result<Box<dyn Boundary<R>>, SimError> {
-    build_boundary_with_kernel(scene, c, KernelKind::Poly6)
+    build_boundary_with_kernel(scene, c, density_kernel(scene))
 }
 
 /// The boundary a scene asks for (`[boundary] model`), for a solver with the parameters

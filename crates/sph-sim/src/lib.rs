@@ -29,8 +29,8 @@ pub mod vtk;
 
 pub use error::SimError;
 pub use factory::{
-    build_boundary, build_boundary_with_kernel, build_solver, granular_params, iisph_params,
-    pbf_params, pcisph_params, VOLUME_MAP_CONTACT_FRACTION,
+    build_boundary, build_boundary_with_kernel, build_solver, density_kernel, granular_params,
+    iisph_params, pbf_params, pcisph_params, VOLUME_MAP_CONTACT_FRACTION,
 };
 pub use run::{
     create_output_dir, run_scene, stats_header, stats_row, SceneRunOptions, STATS_COLUMNS,

@@ -114,6 +114,17 @@ fn run_scene_in<R: Real>(scene: &Scene, opts: &SceneRunOptions) -> Result<(), Si
         t0.elapsed().as_secs_f64(),
         opts.out_dir.display()
     );
+    if let Some(c) = &sim.calibration {
+        eprintln!(
+            "initial masses calibrated: max rho/rho0 {:.4} -> {:.6} in {} iterations, {} particles lowered (smallest mass x{:.3}), total mass x{:.4}",
+            c.max_density_ratio_before,
+            c.max_density_ratio_after,
+            c.iterations,
+            c.lowered,
+            c.min_mass_ratio,
+            c.total_mass_ratio
+        );
+    }
     let stats_path = opts.out_dir.join("stats.csv");
     let csv_err = |e: csv::Error| SimError::output(&stats_path, e);
     let mut csv = csv::Writer::from_path(&stats_path).map_err(csv_err)?;

@@ -4,11 +4,12 @@
 use std::path::Path;
 
 use sph_core::{apply_permutation, ParticleSet, Real};
-use sph_scene::Scene;
+use sph_scene::{InitialMasses, Scene};
+use sph_solver::initial::{calibrate_masses, MassCalibration};
 use sph_solver::{FluidSolver, StepStats};
 
 use crate::vtk::{write_particle_frame, write_point_frame, ParticleFrame};
-use crate::{build_solver, SimError};
+use crate::{build_solver, density_kernel, SimError};
 
 /// A scene being simulated in precision `R`.
 pub struct SceneSim<R: Real> {
@@ -22,6 +23,9 @@ pub struct SceneSim<R: Real> {
     pub frame: usize,
     /// Simulated time (s).
     pub time_s: f64,
+    /// What the mass calibration did (`[boundary] initial_masses = "calibrated"`), `None`
+    /// for lattice masses.
+    pub calibration: Option<MassCalibration>,
     solver: Box<dyn FluidSolver<R>>,
     id_scratch: Vec<u32>,
 }
@@ -40,13 +44,26 @@ impl<R: Real> std::fmt::Debug for SceneSim<R> {
 
 impl<R: Real> SceneSim<R> {
     /// Samples the scene's fluid (masses `ρ0 s³`, the scene's initial velocities) and builds
-    /// its solver and boundary ([`build_solver`]). Errors name the scene file.
+    /// its solver and boundary ([`build_solver`]). With `[boundary] initial_masses =
+    /// "calibrated"` the masses of the particles that the lattice plus the boundary put above
+    /// `ρ0` are lowered until none is ([`calibrate_masses`] with the solver's density kernel,
+    /// [`density_kernel`]). Errors name the scene file.
     pub fn new(scene: &Scene) -> Result<Self, SimError> {
         let solver = build_solver::<R>(scene)?;
         let common = solver.common();
         let positions = scene.fluid_positions::<R>()?;
         let mut state =
             ParticleSet::from_positions(positions, common.particle_mass(), common.rest_density);
+        let calibration = match scene.boundary.initial_masses {
+            InitialMasses::Lattice => None,
+            InitialMasses::Calibrated => Some(
+                calibrate_masses(density_kernel(scene), common, solver.boundary(), &mut state)
+                    .map_err(|source| SimError::Setup {
+                        file: scene.source.display().to_string(),
+                        source,
+                    })?,
+            ),
+        };
         let velocities = scene.fluid_velocities::<R>()?;
         if velocities.len() != state.len() {
             return Err(SimError::Invalid(format!(
@@ -64,6 +81,7 @@ impl<R: Real> SceneSim<R> {
             ids: (0..n).collect(),
             frame: 0,
             time_s: 0.0,
+            calibration,
             solver,
             id_scratch: Vec::new(),
         })

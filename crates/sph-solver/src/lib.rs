@@ -8,6 +8,8 @@
 //!   gravity, reordering, neighbour method, embedded as `common` in each solver's parameters.
 //! - [`step`]: the plumbing the solvers share inside a step (state checks, the neighbour
 //!   search, reordering by cell, blow-up checks before the state is written, statistics).
+//! - [`initial`]: the density a fluid lattice starts at with the boundary's share, and
+//!   masses calibrated so that no particle starts above the rest density.
 //! - [`boundary`]: solid boundaries as values behind the [`Boundary`] trait, with two
 //!   models: [`CollisionBoundary`] (projection out of signed distance fields) and
 //!   `VolumeMapBoundary` (Bender, Kugelstadt, Weiler & Koschier 2019, "Volume Maps: An
@@ -20,6 +22,7 @@
 pub mod boundary;
 pub mod csr;
 mod error;
+pub mod initial;
 mod params;
 mod stats;
 pub mod step;

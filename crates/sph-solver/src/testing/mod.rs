@@ -1,7 +1,10 @@
 //! Scenes, independent oracle formulas and helpers shared by the solver crates' tests
 //! (feature `testing`; not part of the solvers' API).
 
+mod alloc;
 pub mod formulas;
+
+pub use alloc::{assert_warm_steps_do_not_allocate, CountingAllocator};
 
 use sph_core::{
     sampling::cubic_lattice, Aabb, BoxSdf, CoreError, Inverted, ParticleSet, Real, Vec3,
