@@ -26,7 +26,7 @@
 
 use anyhow::Result;
 use sph_core::Real;
-use sph_scene::{Precision, Scene};
+use sph_scene::Scene;
 
 use crate::helpers::{
     load_reference_csv, plot_xy, write_csv_rows, Legend, Marker, PlotSpec, Series, SeriesStyle,
@@ -177,10 +177,7 @@ impl Experiment for DamBreakFront {
         }
         let scene = shipped_scene("martin_moyce", ctx.mode)?;
         let run = |ctx: &Context, scene: &Scene| {
-            let r = match scene.precision {
-                Precision::F32 => simulate::<f32>(ctx, scene),
-                Precision::F64 => simulate::<f64>(ctx, scene),
-            }?;
+            let r = sph_sim::with_precision!(scene.precision, R => simulate::<R>(ctx, scene))?;
             anyhow::Ok((r.series, r.particles))
         };
         ctx.progress.set_length(3 * scene.frame_count() as u64);
