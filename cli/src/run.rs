@@ -22,9 +22,10 @@ pub struct RunArgs {
     /// Also render the frames (PNG in OUT/render) in process while the scene runs.
     #[arg(long)]
     render: bool,
-    /// Write an atomic checkpoint (OUT/checkpoint.sphck) every N frames and at the end.
-    #[arg(long, value_name = "N", value_parser = frame_count)]
-    checkpoint_every: Option<usize>,
+    /// Write an atomic checkpoint (OUT/checkpoint.sphck) every N frames and at the end
+    /// (0: none).
+    #[arg(long, value_name = "N", default_value_t = 25)]
+    checkpoint_every: usize,
     /// Continue from OUT's checkpoint: the frames and statistics come out bit-identical to
     /// an uninterrupted run's (but for the wall-clock columns).
     #[arg(long)]
@@ -55,7 +56,7 @@ pub fn run(a: &RunArgs) -> Result<()> {
             .unwrap_or_else(|| PathBuf::from("target").join("scenes").join(stem)),
         max_frames: a.frames,
         progress: true,
-        checkpoint_every: a.checkpoint_every,
+        checkpoint_every: (a.checkpoint_every > 0).then_some(a.checkpoint_every),
         resume: a.resume,
         render: a.render,
     };

@@ -393,7 +393,7 @@ impl<R: Real> SceneSim<R> {
         if !path.exists() {
             return Err(SimError::input(
                 path,
-                "no checkpoint to resume from (run with --checkpoint-every N first)",
+                "no checkpoint to resume from (a run writes one every --checkpoint-every frames, 25 by default)",
             ));
         }
         let c = read::<R>(path)?;

@@ -156,7 +156,7 @@ pub fn read_positions(path: &Path) -> Result<Vec<Vec3<f32>>, SimError> {
     }
     let vtk = Vtk::parse_legacy_be(bytes.as_slice()).map_err(|e| {
         corrupt(format!(
-            "the legacy VTK parser stopped ({e}); the file is truncated or was not written by this crate"
+            "the legacy VTK parser stopped before the end of the data: the file is truncated or was not written by this crate (vtkio: {e})"
         ))
     })?;
     let DataSet::PolyData { pieces, .. } = vtk.data else {
