@@ -31,6 +31,29 @@ pub trait Sdf<R: Real>: Send + Sync {
     fn bounds(&self) -> Option<Aabb<R>> {
         None
     }
+
+    /// Appends to `out` a stable, complete description of this solid (a type tag and every
+    /// parameter the distance depends on, as little-endian bytes) and returns `true`; two
+    /// solids with equal descriptions must have bit-identical distances and gradients. Caches
+    /// of data derived from a solid (the volume maps of `sph-solver`) key on it.
+    ///
+    /// The default appends nothing and returns `false`: "not cacheable" (a user solid that
+    /// does not describe itself is rebuilt every time rather than confused with another).
+    fn fingerprint(&self, out: &mut Vec<u8>) -> bool {
+        let _ = out;
+        false
+    }
+}
+
+/// Appends a type tag (length-prefixed) and the `f64` bit patterns of `values` (exact for
+/// `f32` and `f64` scalars) to a [`Sdf::fingerprint`] description.
+pub fn push_fingerprint<R: Real>(out: &mut Vec<u8>, tag: &str, values: &[R]) {
+    out.extend_from_slice(&(tag.len() as u64).to_le_bytes());
+    out.extend_from_slice(tag.as_bytes());
+    out.extend_from_slice(&(values.len() as u64).to_le_bytes());
+    for v in values {
+        out.extend_from_slice(&v.as_f64().to_bits().to_le_bytes());
+    }
 }
 
 fn check_positive<R: Real>(name: &'static str, value: R) -> Result<(), CoreError> {
@@ -88,6 +111,11 @@ impl<R: Real> Sdf<R> for Plane<R> {
     fn gradient(&self, _p: &Vec3<R>) -> Vec3<R> {
         self.normal
     }
+    fn fingerprint(&self, out: &mut Vec<u8>) -> bool {
+        let n = self.normal;
+        push_fingerprint(out, "plane", &[n.x, n.y, n.z, self.offset]);
+        true
+    }
 }
 
 /// Solid ball.
@@ -126,6 +154,11 @@ impl<R: Real> Sdf<R> for Sphere<R> {
             min: self.center - r,
             max: self.center + r,
         })
+    }
+    fn fingerprint(&self, out: &mut Vec<u8>) -> bool {
+        let c = self.center;
+        push_fingerprint(out, "sphere", &[c.x, c.y, c.z, self.radius]);
+        true
     }
 }
 
@@ -200,6 +233,11 @@ impl<R: Real> Sdf<R> for BoxSdf<R> {
     fn bounds(&self) -> Option<Aabb<R>> {
         Some(self.aabb())
     }
+    fn fingerprint(&self, out: &mut Vec<u8>) -> bool {
+        let (c, e) = (self.center, self.half_extents);
+        push_fingerprint(out, "box", &[c.x, c.y, c.z, e.x, e.y, e.z]);
+        true
+    }
 }
 
 /// Complement of a solid: what was inside becomes free space. A tank is `Inverted<BoxSdf>`:
@@ -216,6 +254,10 @@ impl<R: Real, S: Sdf<R>> Sdf<R> for Inverted<S> {
     }
     fn bounds(&self) -> Option<Aabb<R>> {
         self.0.bounds()
+    }
+    fn fingerprint(&self, out: &mut Vec<u8>) -> bool {
+        push_fingerprint::<R>(out, "inverted", &[]);
+        self.0.fingerprint(out)
     }
 }
 

@@ -85,11 +85,16 @@
 //!   `h`.
 
 mod boundary;
+mod file;
+mod key;
 mod quadrature;
 
 pub use boundary::VolumeMapBoundary;
+pub use file::{FORMAT_VERSION, MAGIC};
+pub use key::{VolumeMapCache, VolumeMapKey, BUILD_VERSION};
 pub use quadrature::{half_space_volume, half_space_volume_derivative};
 
+use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -126,7 +131,8 @@ pub struct VolumeMapOptions {
     pub azimuth_directions: usize,
     /// Samples of `φ` along each ray before the sign-change search (1..=256; default 8).
     pub ray_samples: usize,
-    /// Largest grid (nodes) a single solid may use (default 2²⁵ ≈ 3.4e7).
+    /// Largest grid (nodes) a single solid may use (8..=2²⁶, the limit of
+    /// [`SampledGrid::MAX_NODES`]; default 2²⁵ ≈ 3.4e7).
     pub max_nodes: usize,
     /// Interpolation scheme (default [`Interpolation::NodePlanes`]).
     pub interpolation: Interpolation,
@@ -176,7 +182,13 @@ impl VolumeMapOptions {
                 256,
                 "must be in 1..=256",
             ),
-            ("max_nodes", self.max_nodes, 8, usize::MAX, "must be >= 8"),
+            (
+                "max_nodes",
+                self.max_nodes,
+                8,
+                SampledGrid::<f64>::MAX_NODES,
+                "must be in 8..=2^26",
+            ),
         ];
         for (name, v, lo, hi, reason) in checks {
             if v < lo || v > hi {
@@ -209,8 +221,33 @@ pub struct VolumeMapStats {
     pub quadrature_nodes: usize,
     /// Nodes stored with a model (node-planes scheme: `|φ| < h + √3 cell`).
     pub stored_nodes: usize,
-    /// Wall-clock build time.
+    /// Wall-clock time of the cold build (for a map loaded from a cache: of the build that
+    /// wrote the file).
     pub build_time: Duration,
+    /// Wall-clock time of reading the map from a cache file (zero for a built map).
+    pub load_time: Duration,
+    /// How the map came about with respect to a [`VolumeMapCache`].
+    pub cache: CacheUse,
+}
+
+/// What a [`VolumeMapCache`] did for one map.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum CacheUse {
+    /// Built; no cache was given.
+    #[default]
+    NoCache,
+    /// Built; the solid does not describe itself ([`Sdf::fingerprint`]), so it is not cached.
+    Uncacheable,
+    /// Loaded from the cache.
+    Hit,
+    /// Built (no file yet) and written to the cache.
+    Stored,
+    /// A cache file existed but was refused (see
+    /// [`VolumeMapBoundary::cache_warnings`]); rebuilt and the file replaced.
+    Replaced,
+    /// Built; writing the cache file failed (see [`VolumeMapBoundary::cache_warnings`]).
+    WriteFailed,
 }
 
 /// One node's model (node-planes scheme), in `f32` (relative error 6e-8 of values ≤ 1 and
@@ -487,8 +524,50 @@ impl<R: Real> VolumeMap<R> {
                 quadrature_nodes: quad.into_inner(),
                 stored_nodes,
                 build_time: start.elapsed(),
+                ..VolumeMapStats::default()
             },
         })
+    }
+
+    /// Writes this map, built for `key`, to `path`, atomically (a temporary file beside
+    /// `path`, `fsync`, rename): a reader never sees a partial file.
+    ///
+    /// Errors: [`SolverError::MapFile`] with [`MapFileProblem::Io`](crate::MapFileProblem::Io).
+    pub fn write_file(&self, path: &Path, key: &VolumeMapKey) -> Result<(), SolverError> {
+        file::write_map(path, self, key)
+    }
+
+    /// Reads the map of `key` (whose solid must be the one passed to [`VolumeMap::sample`])
+    /// from `path`, written by [`VolumeMap::write_file`].
+    ///
+    /// File layout (integers little-endian): 8 bytes [`MAGIC`], 4 bytes [`FORMAT_VERSION`],
+    /// 8 bytes total file length, the key (8-byte length, bytes: [`VolumeMapKey::as_bytes`]),
+    /// the payload (8-byte length, bytes: grid, node models, statistics), and the SHA-256 of
+    /// all bytes before it. The reader checks, in this order, magic, version, length,
+    /// checksum, key and the payload's consistency, and refuses the file at the first
+    /// failure, loading nothing of it.
+    ///
+    /// Errors: [`SolverError::MapFile`] naming `path` and the
+    /// [`MapFileProblem`](crate::MapFileProblem): `Io`, `BadMagic`,
+    /// `UnsupportedVersion`, `Truncated`, `TrailingBytes`, `ChecksumMismatch`, `ForeignKey`
+    /// (a map of other inputs), `Malformed`; [`SolverError::Kernel`] for a key whose kernel
+    /// cannot be built.
+    pub fn read_file(path: &Path, key: &VolumeMapKey) -> Result<Self, SolverError> {
+        let kernel = key.kernel().build(key.support_radius())?;
+        let tables = Arc::new(KernelTables::new(&kernel));
+        Self::read_with_tables(path, key, tables)
+    }
+
+    pub(crate) fn read_with_tables(
+        path: &Path,
+        key: &VolumeMapKey,
+        tables: Arc<KernelTables>,
+    ) -> Result<Self, SolverError> {
+        let start = Instant::now();
+        let mut map = file::read_map(path, key, tables)?;
+        map.stats.load_time = start.elapsed();
+        map.stats.cache = CacheUse::Hit;
+        Ok(map)
     }
 
     /// Build statistics (node counts and build time).
