@@ -43,6 +43,15 @@ pub trait Sdf<R: Real>: Send + Sync {
         let _ = out;
         false
     }
+
+    /// A Lipschitz constant `L` of [`Sdf::signed_distance`] as evaluated
+    /// (`|φ(p) − φ(q)| ≤ L |p − q|` up to the rounding of the precision), when one is known:
+    /// `Some(1.0)` for exact Euclidean distances. Searches along rays (the volume maps'
+    /// quadrature) use it to skip stretches that cannot hold a surface crossing. The default,
+    /// `None`, makes no claim (interpolated fields such as [`GridSdf`](crate::GridSdf)).
+    fn lipschitz_bound(&self) -> Option<f64> {
+        None
+    }
 }
 
 /// Appends a type tag (length-prefixed) and the `f64` bit patterns of `values` (exact for
@@ -116,6 +125,9 @@ impl<R: Real> Sdf<R> for Plane<R> {
         push_fingerprint(out, "plane", &[n.x, n.y, n.z, self.offset]);
         true
     }
+    fn lipschitz_bound(&self) -> Option<f64> {
+        Some(1.0)
+    }
 }
 
 /// Solid ball.
@@ -159,6 +171,9 @@ impl<R: Real> Sdf<R> for Sphere<R> {
         let c = self.center;
         push_fingerprint(out, "sphere", &[c.x, c.y, c.z, self.radius]);
         true
+    }
+    fn lipschitz_bound(&self) -> Option<f64> {
+        Some(1.0)
     }
 }
 
@@ -238,6 +253,9 @@ impl<R: Real> Sdf<R> for BoxSdf<R> {
         push_fingerprint(out, "box", &[c.x, c.y, c.z, e.x, e.y, e.z]);
         true
     }
+    fn lipschitz_bound(&self) -> Option<f64> {
+        Some(1.0)
+    }
 }
 
 /// Complement of a solid: what was inside becomes free space. A tank is `Inverted<BoxSdf>`:
@@ -258,6 +276,9 @@ impl<R: Real, S: Sdf<R>> Sdf<R> for Inverted<S> {
     fn fingerprint(&self, out: &mut Vec<u8>) -> bool {
         push_fingerprint::<R>(out, "inverted", &[]);
         self.0.fingerprint(out)
+    }
+    fn lipschitz_bound(&self) -> Option<f64> {
+        self.0.lipschitz_bound()
     }
 }
 

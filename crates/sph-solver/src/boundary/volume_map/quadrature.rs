@@ -378,8 +378,9 @@ impl Directions {
 }
 
 /// Lipschitz bound assumed for the signed distance along a ray when looking for thin
-/// slivers between samples of equal sign (1 for exact distances; 2 leaves room for the
-/// trilinear `GridSdf`, whose gradient norm is at most `√3`).
+/// slivers between samples of equal sign, for solids that declare none
+/// ([`Sdf::lipschitz_bound`]; 2 leaves room for the trilinear `GridSdf`, whose gradient norm
+/// is at most `√3`).
 const LIPSCHITZ: f64 = 2.0;
 /// Slivers thinner than this (relative to `h`) are not looked for.
 const MIN_SLIVER: f64 = 1e-6;
@@ -392,6 +393,8 @@ struct Ray<'a, R: Real> {
     x: Vec3<f64>,
     dir: Vec3<f64>,
     h: f64,
+    /// Lipschitz bound of the sliver search.
+    lipschitz: f64,
 }
 
 impl<R: Real> Ray<'_, R> {
@@ -408,7 +411,7 @@ impl<R: Real> Ray<'_, R> {
             out.push(self.root(a, fa, b, fb));
             return;
         }
-        if fa.is_nan() || fb.is_nan() || fa.abs() + fb.abs() >= LIPSCHITZ * (b - a) {
+        if fa.is_nan() || fb.is_nan() || fa.abs() + fb.abs() >= self.lipschitz * (b - a) {
             return;
         }
         if b - a < MIN_SLIVER * self.h {
@@ -545,6 +548,21 @@ pub(crate) fn node_correction<R: Real>(
     let mut crossings = Vec::with_capacity(8);
     let (mut c, mut grad, mut hess) = (0.0, Vec3::zeros(), Matrix3::zeros());
     let s_step = h / dirs.ray_samples as f64;
+    let sample = |k: usize| {
+        if k == dirs.ray_samples {
+            h
+        } else {
+            k as f64 * s_step
+        }
+    };
+    let lipschitz = sdf.lipschitz_bound().unwrap_or(LIPSCHITZ);
+    // Rounding of the solid's distance at `x + t ω` (|x| + h bounds the coordinates), with a
+    // factor 64 of room; `reach` is `-∞` without a declared bound.
+    let margin = 64.0 * R::MACHINE_EPSILON.as_f64() * (x.amax() + h) + MIN_SLIVER * h;
+    let certified = |a: f64, fa: f64| match sdf.lipschitz_bound() {
+        Some(l) if fa.abs() > margin => a + (fa.abs() - margin) / l,
+        _ => f64::NEG_INFINITY,
+    };
     for &(lo, hi, count) in &pieces {
         if count == 0 || hi <= lo {
             continue;
@@ -556,18 +574,33 @@ pub(crate) fn node_correction<R: Real>(
             let fp = plane_sums(tables, phi0, mu);
             for &(ca, sa) in &dirs.azimuth {
                 let dir = n * mu + (t1 * ca + t2 * sa) * s;
-                let ray = Ray { sdf, x, dir, h };
+                let ray = Ray {
+                    sdf,
+                    x,
+                    dir,
+                    h,
+                    lipschitz,
+                };
                 crossings.clear();
                 let (mut a, mut fa) = (0.0, phi0);
+                // With a known Lipschitz bound `L`, `φ` keeps the sign of `φ(a)` on
+                // `[a, reach)`, `reach = a + (|φ(a)| − margin)/L`: samples there are skipped
+                // when the next sample is also within reach (neither adjacent interval can
+                // hold a crossing), and an interval ending within reach is not searched. The
+                // crossings, and the brackets they are refined from, are those of searching
+                // every interval.
+                let mut reach = certified(a, fa);
                 for k in 1..=dirs.ray_samples {
-                    let b = if k == dirs.ray_samples {
-                        h
-                    } else {
-                        k as f64 * s_step
-                    };
+                    let b = sample(k);
+                    if sample((k + 1).min(dirs.ray_samples)) < reach {
+                        continue;
+                    }
                     let fb = ray.phi(b);
-                    ray.scan(a, fa, b, fb, &mut crossings);
+                    if b >= reach {
+                        ray.scan(a, fa, b, fb, &mut crossings);
+                    }
                     (a, fa) = (b, fb);
+                    reach = certified(a, fa);
                 }
                 let fs = radial_sums(tables, phi0 < 0.0, &crossings);
                 let w = wi * hl * w_az;
