@@ -166,6 +166,32 @@ impl HermiteTable {
         }
     }
 
+    /// [`HermiteTable::eval`] of four tables on the same nodes at once (one index and one
+    /// set of basis weights; each result bit-identical to its table's `eval`).
+    #[inline]
+    fn eval4(nodes: &[[(f64, f64, f64); 4]], dx: f64, t: f64) -> [f64; 4] {
+        let n = nodes.len() - 1;
+        let u = t / dx;
+        if u.is_nan() || u <= 0.0 {
+            return nodes[0].map(|v| v.0);
+        }
+        if u >= n as f64 {
+            return nodes[n].map(|v| v.0);
+        }
+        let i = (u as usize).min(n - 1);
+        let s = u - i as f64;
+        let (a, b) = (&nodes[i], &nodes[i + 1]);
+        let s2 = s * s;
+        let h00 = (1.0 + 2.0 * s) * (1.0 - s) * (1.0 - s);
+        let h10 = s * (1.0 - s) * (1.0 - s);
+        let h01 = s2 * (3.0 - 2.0 * s);
+        let h11 = s2 * (s - 1.0);
+        std::array::from_fn(|k| {
+            let ((y0, _, m0), (y1, m1, _)) = (a[k], b[k]);
+            h00 * y0 + h10 * dx * m0 + h01 * y1 + h11 * dx * m1
+        })
+    }
+
     #[inline]
     pub(crate) fn eval(&self, t: f64) -> f64 {
         let n = self.nodes.len() - 1;
@@ -222,16 +248,15 @@ impl HermiteTable {
 pub(crate) const TABLE_INTERVALS: usize = 4096;
 
 /// The per-kernel tables of a volume map: `G(t) = ∫_0^t W r² dr`, `G₁(t) = ∫_0^t W'(r) r² dr`,
+/// `G₂(t) = ∫_0^t W''(r) r² dr`, `G₃(t) = ∫_0^t W'(r) r dr` (interleaved, [`KernelTables::radial`]),
 /// `Ψ_plane` and `dΨ_plane/dd` on `[0, h]`.
 #[derive(Debug, Clone)]
 pub(crate) struct KernelTables {
     pub(crate) h: f64,
-    g: HermiteTable,
-    g1: HermiteTable,
-    g2: HermiteTable,
-    g3: HermiteTable,
     plane: HermiteTable,
     plane_d: HermiteTable,
+    /// The nodes of `g`, `g1`, `g2`, `g3` interleaved, for [`KernelTables::radial`].
+    radial: Vec<[(f64, f64, f64); 4]>,
 }
 
 impl KernelTables {
@@ -263,12 +288,16 @@ impl KernelTables {
         let g2v = accumulate(&|r| ddw(r) * r * r);
         let g3v = accumulate(&|r| kernel.derivative(r) * r);
         let sq = |r: f64| at(r) * at(r);
+        let g = HermiteTable::new(h, n, |k, _| gv[k], |r| w(r) * sq(r));
+        let g1 = HermiteTable::new(h, n, |k, _| g1v[k], |r| dw(r) * sq(r));
+        let g2 = HermiteTable::new(h, n, |k, _| g2v[k], |r| ddw(r) * sq(r));
+        let g3 = HermiteTable::new(h, n, |k, _| g3v[k], |r| dw(r) * at(r));
+        let radial = (0..=n)
+            .map(|k| [g.nodes[k], g1.nodes[k], g2.nodes[k], g3.nodes[k]])
+            .collect();
         Self {
             h,
-            g: HermiteTable::new(h, n, |k, _| gv[k], |r| w(r) * sq(r)),
-            g1: HermiteTable::new(h, n, |k, _| g1v[k], |r| dw(r) * sq(r)),
-            g2: HermiteTable::new(h, n, |k, _| g2v[k], |r| ddw(r) * sq(r)),
-            g3: HermiteTable::new(h, n, |k, _| g3v[k], |r| dw(r) * at(r)),
+            radial,
             plane: HermiteTable::new(
                 h,
                 n,
@@ -284,28 +313,10 @@ impl KernelTables {
         }
     }
 
-    /// `G(t) = ∫_0^t W(r) r² dr`.
+    /// `[G(t), G₁(t), G₂(t), G₃(t)]` in one lookup.
     #[inline]
-    pub(crate) fn g(&self, t: f64) -> f64 {
-        self.g.eval(t)
-    }
-
-    /// `G₁(t) = ∫_0^t W'(r) r² dr`.
-    #[inline]
-    pub(crate) fn g1(&self, t: f64) -> f64 {
-        self.g1.eval(t)
-    }
-
-    /// `G₂(t) = ∫_0^t W''(r) r² dr`.
-    #[inline]
-    pub(crate) fn g2(&self, t: f64) -> f64 {
-        self.g2.eval(t)
-    }
-
-    /// `G₃(t) = ∫_0^t W'(r) r dr`.
-    #[inline]
-    pub(crate) fn g3(&self, t: f64) -> f64 {
-        self.g3.eval(t)
+    pub(crate) fn radial(&self, t: f64) -> [f64; 4] {
+        HermiteTable::eval4(&self.radial, self.plane.dx, t)
     }
 
     /// `Ψ_plane(d)` from the table.
@@ -480,12 +491,8 @@ fn radial_sums(tables: &KernelTables, inside0: bool, crossings: &[f64]) -> [f64;
 /// `[∫ W t², ∫ W' t², ∫ W'' t², ∫ W' t]` over `[a, b]`.
 #[inline]
 fn interval_sums(tables: &KernelTables, a: f64, b: f64) -> [f64; 4] {
-    [
-        tables.g(b) - tables.g(a),
-        tables.g1(b) - tables.g1(a),
-        tables.g2(b) - tables.g2(a),
-        tables.g3(b) - tables.g3(a),
-    ]
+    let (gb, ga) = (tables.radial(b), tables.radial(a));
+    [gb[0] - ga[0], gb[1] - ga[1], gb[2] - ga[2], gb[3] - ga[3]]
 }
 
 /// The same sums for the tangent half-space `{y : φ₀ + n·(y − x) < 0}` along a direction
@@ -697,10 +704,10 @@ mod tests {
             assert!((a - b).abs() * h < 1e-11, "{} d' {d}: {a} vs {b}", k.name());
         }
         // G(h) = ∫ W r² dr = 1/(4π) for a normalised 3D kernel: independent of the table.
-        assert!((t.g(h) * 4.0 * PI - 1.0).abs() < 1e-12);
+        assert!((t.radial(h)[0] * 4.0 * PI - 1.0).abs() < 1e-12);
         // G₁(h) = ∫ W' r² dr = −2 ∫ W r dr (by parts, W(h) = 0) = Ψ_plane'(0)/π.
         let ref_g1 = half_space_volume_derivative(&k, 0.0) / PI;
-        assert!((t.g1(h) - ref_g1).abs() * h < 1e-11, "{}", k.name());
+        assert!((t.radial(h)[1] - ref_g1).abs() * h < 1e-11, "{}", k.name());
     }
 
     #[test]
