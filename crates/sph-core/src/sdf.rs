@@ -319,6 +319,33 @@ mod tests {
     }
 
     proptest! {
+        /// Shapes that declare a Lipschitz bound keep it (exact distances: 1), which the
+        /// volume maps rely on to skip ray samples; and their fingerprints tell them apart.
+        #[test]
+        fn declared_lipschitz_bounds_hold(
+            p in prop::array::uniform3(-5.0..5.0f64),
+            q in prop::array::uniform3(-5.0..5.0f64),
+        ) {
+            let (p, q) = (Vec3::from(p), Vec3::from(q));
+            let shapes: Vec<Box<dyn Sdf<f64>>> = vec![
+                Box::new(unit_box()),
+                Box::new(Inverted(unit_box())),
+                Box::new(Sphere::new(Vec3::new(0.5, -0.5, 0.2), 1.5).unwrap()),
+                Box::new(Plane::new(Vec3::new(0.0, 1.0, 0.0), Vec3::new(1.0, 2.0, -0.5)).unwrap()),
+            ];
+            let mut prints = Vec::new();
+            for s in &shapes {
+                let l = s.lipschitz_bound().expect("exact distance");
+                let (a, b) = (s.signed_distance(&p), s.signed_distance(&q));
+                // Rounding of two f64 distances of magnitude < 20: 1e-13.
+                prop_assert!((a - b).abs() <= l * (p - q).norm() + 1e-13);
+                let mut f = Vec::new();
+                prop_assert!(s.fingerprint(&mut f));
+                prop_assert!(!prints.contains(&f));
+                prints.push(f);
+            }
+        }
+
         /// Analytic gradients agree with central differences of the distance away from
         /// the medial axis (where the gradient is discontinuous), and have unit length.
         #[test]

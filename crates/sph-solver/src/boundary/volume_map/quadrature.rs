@@ -710,6 +710,63 @@ mod tests {
         assert!((t.radial(h)[1] - ref_g1).abs() * h < 1e-11, "{}", k.name());
     }
 
+    /// The solid without its Lipschitz bound: the full ray search (the oracle of the skips).
+    struct NoBound<'a, R: Real>(&'a dyn Sdf<R>);
+
+    impl<R: Real> Sdf<R> for NoBound<'_, R> {
+        fn signed_distance(&self, p: &Vec3<R>) -> R {
+            self.0.signed_distance(p)
+        }
+        fn gradient(&self, p: &Vec3<R>) -> Vec3<R> {
+            self.0.gradient(p)
+        }
+    }
+
+    fn same_correction<R: Real>(solid: &dyn Sdf<R>, x: Vec3<f64>, tables: &KernelTables) {
+        assert_eq!(solid.lipschitz_bound(), Some(1.0));
+        let xr = Vec3::new(R::of_f64(x.x), R::of_f64(x.y), R::of_f64(x.z));
+        let phi0 = solid.signed_distance(&xr).as_f64();
+        let g = solid.gradient(&xr);
+        let n = Vec3::new(g.x.as_f64(), g.y.as_f64(), g.z.as_f64()).normalize();
+        let dirs = Directions::new(6, 12, 8);
+        let fast = node_correction(solid, x, phi0, n, tables, &dirs);
+        let full = node_correction(&NoBound(solid), x, phi0, n, tables, &dirs);
+        let bits = |c: &NodeCorrection| {
+            let mut v = vec![c.c.to_bits()];
+            v.extend(c.grad.iter().map(|x| x.to_bits()));
+            v.extend(c.hess.iter().map(|x| x.to_bits()));
+            v
+        };
+        assert_eq!(bits(&fast), bits(&full), "at {x:?}");
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig { cases: 64, ..Default::default() })]
+        /// Skipping ray samples and sliver searches by the Lipschitz bound gives the node
+        /// corrections of the full search bit for bit (tank corner in f32 and f64, sphere),
+        /// also at nodes on the surface and on grid-aligned walls.
+        #[test]
+        fn lipschitz_skips_are_bit_identical_to_the_full_search(
+            u in proptest::array::uniform3(-0.12..0.12f64),
+            snap in 0..4usize,
+        ) {
+            let h = 0.1;
+            let tables = KernelTables::new(&CubicSpline::new(h).unwrap());
+            // Tank corner at the origin; `snap` puts the node on a grid of h/4 (walls and
+            // edges through nodes, as in a tank whose walls lie on grid lines).
+            let u = if snap == 0 { u.map(|v| (v / (h / 4.0)).round() * (h / 4.0)) } else { u };
+            let x = Vec3::new(u[0], u[1], u[2]);
+            let b = sph_core::Aabb::new(Vec3::zeros(), Vec3::new(1.0, 0.8, 0.6)).unwrap();
+            let tank64 = sph_core::Inverted(sph_core::BoxSdf::new(b).unwrap());
+            same_correction::<f64>(&tank64, x, &tables);
+            let b32 = sph_core::Aabb::new(Vec3::zeros(), Vec3::new(1.0f32, 0.8, 0.6)).unwrap();
+            let tank32 = sph_core::Inverted(sph_core::BoxSdf::new(b32).unwrap());
+            same_correction::<f32>(&tank32, x, &tables);
+            let ball = sph_core::Sphere::new(Vec3::new(0.0, 0.0, 0.0), 0.15).unwrap();
+            same_correction::<f64>(&ball, x + Vec3::new(0.15, 0.0, 0.0), &tables);
+        }
+    }
+
     #[test]
     fn tables_agree_with_direct_quadrature() {
         tables_match(Poly6::new(0.7).unwrap());
