@@ -566,6 +566,7 @@ pub(crate) fn node_correction<R: Real>(
     // Rounding of the solid's distance at `x + t ω` (|x| + h bounds the coordinates), with a
     // factor 64 of room; `reach` is `-∞` without a declared bound.
     let margin = 64.0 * R::MACHINE_EPSILON.as_f64() * (x.amax() + h) + MIN_SLIVER * h;
+    let on_surface = sdf.lipschitz_bound().is_some() && phi0.abs() <= margin;
     let certified = |a: f64, fa: f64| match sdf.lipschitz_bound() {
         Some(l) if fa.abs() > margin => a + (fa.abs() - margin) / l,
         _ => f64::NEG_INFINITY,
@@ -603,7 +604,12 @@ pub(crate) fn node_correction<R: Real>(
                         continue;
                     }
                     let fb = ray.phi(b);
-                    if b >= reach {
+                    // A node on the surface (to rounding) of a solid with a declared bound:
+                    // the "sliver" touching the ray's start is the surface the node lies on,
+                    // so the first interval is only checked for a sign change (the sliver
+                    // search there would bisect towards `t = 0` down to `1e-6 h`).
+                    let skip_sliver = k == 1 && on_surface && (fa < 0.0) == (fb < 0.0);
+                    if b >= reach && !skip_sliver {
                         ray.scan(a, fa, b, fb, &mut crossings);
                     }
                     (a, fa) = (b, fb);
