@@ -46,7 +46,9 @@ pub enum MapFileProblem {
     ChecksumMismatch,
     /// The map in the file was built for other inputs (solid, kernel, support radius,
     /// domain, options or precision) than those asked for.
-    #[error("built for other inputs (solid, kernel, support radius, domain, options or precision)")]
+    #[error(
+        "built for other inputs (solid, kernel, support radius, domain, options or precision)"
+    )]
     ForeignKey,
     /// The contents pass the checksum but are inconsistent (a writer bug or a crafted file).
     #[error("malformed contents: {0}")]

@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use sph_core::{Aabb, BoxSdf, Inverted, Sdf, Sphere, Vec3};
 use sph_kernels::KernelKind;
 use sph_solver::boundary::{
-    Boundary, CacheUse, Interpolation, VolumeMap, VolumeMapBoundary, VolumeMapCache,
-    VolumeMapKey, VolumeMapOptions,
+    Boundary, CacheUse, Interpolation, VolumeMap, VolumeMapBoundary, VolumeMapCache, VolumeMapKey,
+    VolumeMapOptions,
 };
 use sph_solver::{MapFileProblem, SolverError};
 
@@ -17,10 +17,7 @@ struct TempDir(PathBuf);
 
 impl TempDir {
     fn new(name: &str) -> Self {
-        let d = std::env::temp_dir().join(format!(
-            "sph-solver-vmap-{}-{name}",
-            std::process::id()
-        ));
+        let d = std::env::temp_dir().join(format!("sph-solver-vmap-{}-{name}", std::process::id()));
         let _ = fs::remove_dir_all(&d);
         fs::create_dir_all(&d).unwrap();
         Self(d)
@@ -109,16 +106,37 @@ fn cache_hit_is_bit_identical_to_a_cold_build() {
     let hit = build(Some(&cache));
     assert_eq!(uses(&hit), [CacheUse::Hit; 2]);
     assert!(hit.cache_warnings().is_empty());
-    assert!(hit.maps()[0].stats().quadrature_nodes > 0, "the tank ran the quadrature");
+    assert!(
+        hit.maps()[0].stats().quadrature_nodes > 0,
+        "the tank ran the quadrature"
+    );
     let reference = samples(&cold);
     assert!(reference.iter().any(|s| f64::from_bits(s[0]) > 0.0));
-    assert!(samples(&stored) == reference, "a built map differs from a cold build");
-    assert!(samples(&hit) == reference, "a cache hit differs from a cold build");
+    assert!(
+        samples(&stored) == reference,
+        "a built map differs from a cold build"
+    );
+    assert!(
+        samples(&hit) == reference,
+        "a cache hit differs from a cold build"
+    );
     for (a, b) in cold.maps().iter().zip(hit.maps()) {
         let (a, b) = (a.stats(), b.stats());
         assert_eq!(
-            (a.dims, a.nodes, a.band_nodes, a.quadrature_nodes, a.stored_nodes),
-            (b.dims, b.nodes, b.band_nodes, b.quadrature_nodes, b.stored_nodes)
+            (
+                a.dims,
+                a.nodes,
+                a.band_nodes,
+                a.quadrature_nodes,
+                a.stored_nodes
+            ),
+            (
+                b.dims,
+                b.nodes,
+                b.band_nodes,
+                b.quadrature_nodes,
+                b.stored_nodes
+            )
         );
     }
 }
@@ -181,7 +199,13 @@ fn every_key_field_changes_the_key() {
         ),
         (
             "support radius",
-            key_with(&tank, KernelKind::CubicSpline, H * (1.0 + f64::EPSILON), domain(), o),
+            key_with(
+                &tank,
+                KernelKind::CubicSpline,
+                H * (1.0 + f64::EPSILON),
+                domain(),
+                o,
+            ),
         ),
         (
             "domain",
@@ -189,45 +213,81 @@ fn every_key_field_changes_the_key() {
         ),
         (
             "cells_per_support",
-            key_with(&tank, KernelKind::CubicSpline, H, domain(), VolumeMapOptions {
-                cells_per_support: 5,
-                ..o
-            }),
+            key_with(
+                &tank,
+                KernelKind::CubicSpline,
+                H,
+                domain(),
+                VolumeMapOptions {
+                    cells_per_support: 5,
+                    ..o
+                },
+            ),
         ),
         (
             "polar_directions",
-            key_with(&tank, KernelKind::CubicSpline, H, domain(), VolumeMapOptions {
-                polar_directions: 7,
-                ..o
-            }),
+            key_with(
+                &tank,
+                KernelKind::CubicSpline,
+                H,
+                domain(),
+                VolumeMapOptions {
+                    polar_directions: 7,
+                    ..o
+                },
+            ),
         ),
         (
             "azimuth_directions",
-            key_with(&tank, KernelKind::CubicSpline, H, domain(), VolumeMapOptions {
-                azimuth_directions: 13,
-                ..o
-            }),
+            key_with(
+                &tank,
+                KernelKind::CubicSpline,
+                H,
+                domain(),
+                VolumeMapOptions {
+                    azimuth_directions: 13,
+                    ..o
+                },
+            ),
         ),
         (
             "ray_samples",
-            key_with(&tank, KernelKind::CubicSpline, H, domain(), VolumeMapOptions {
-                ray_samples: 9,
-                ..o
-            }),
+            key_with(
+                &tank,
+                KernelKind::CubicSpline,
+                H,
+                domain(),
+                VolumeMapOptions {
+                    ray_samples: 9,
+                    ..o
+                },
+            ),
         ),
         (
             "max_nodes",
-            key_with(&tank, KernelKind::CubicSpline, H, domain(), VolumeMapOptions {
-                max_nodes: o.max_nodes - 1,
-                ..o
-            }),
+            key_with(
+                &tank,
+                KernelKind::CubicSpline,
+                H,
+                domain(),
+                VolumeMapOptions {
+                    max_nodes: o.max_nodes - 1,
+                    ..o
+                },
+            ),
         ),
         (
             "interpolation",
-            key_with(&tank, KernelKind::CubicSpline, H, domain(), VolumeMapOptions {
-                interpolation: Interpolation::TrilinearCorrection,
-                ..o
-            }),
+            key_with(
+                &tank,
+                KernelKind::CubicSpline,
+                H,
+                domain(),
+                VolumeMapOptions {
+                    interpolation: Interpolation::TrilinearCorrection,
+                    ..o
+                },
+            ),
         ),
     ];
     // Precision: the same tank in f32.
@@ -247,21 +307,38 @@ fn a_changed_input_misses_the_cache() {
     let dir = TempDir::new("miss");
     let cache = VolumeMapCache::new(&dir.0).unwrap();
     let sphere = || -> Vec<Box<dyn Sdf<f64>>> {
-        vec![Box::new(Sphere::new(Vec3::new(0.25, 0.2, 0.15), 0.08).unwrap())]
+        vec![Box::new(
+            Sphere::new(Vec3::new(0.25, 0.2, 0.15), 0.08).unwrap(),
+        )]
     };
     let make = |kernel, h: f64, opts| {
         VolumeMapBoundary::with_cache(sphere(), kernel, h, domain(), 0.0, opts, Some(&cache))
             .unwrap()
     };
-    assert_eq!(uses(&make(KernelKind::CubicSpline, H, options())), [CacheUse::Stored]);
-    assert_eq!(uses(&make(KernelKind::CubicSpline, H, options())), [CacheUse::Hit]);
-    assert_eq!(uses(&make(KernelKind::Poly6, H, options())), [CacheUse::Stored]);
-    assert_eq!(uses(&make(KernelKind::CubicSpline, 0.09, options())), [CacheUse::Stored]);
+    assert_eq!(
+        uses(&make(KernelKind::CubicSpline, H, options())),
+        [CacheUse::Stored]
+    );
+    assert_eq!(
+        uses(&make(KernelKind::CubicSpline, H, options())),
+        [CacheUse::Hit]
+    );
+    assert_eq!(
+        uses(&make(KernelKind::Poly6, H, options())),
+        [CacheUse::Stored]
+    );
+    assert_eq!(
+        uses(&make(KernelKind::CubicSpline, 0.09, options())),
+        [CacheUse::Stored]
+    );
     let finer = VolumeMapOptions {
         cells_per_support: 3,
         ..options()
     };
-    assert_eq!(uses(&make(KernelKind::CubicSpline, H, finer)), [CacheUse::Stored]);
+    assert_eq!(
+        uses(&make(KernelKind::CubicSpline, H, finer)),
+        [CacheUse::Stored]
+    );
     assert_eq!(fs::read_dir(&dir.0).unwrap().count(), 4);
 }
 
@@ -400,7 +477,10 @@ fn damaged_and_foreign_files_are_refused_with_named_errors() {
         matches!(
             &e,
             SolverError::MapFile {
-                problem: MapFileProblem::Io { operation: "read", .. },
+                problem: MapFileProblem::Io {
+                    operation: "read",
+                    ..
+                },
                 ..
             }
         ),
@@ -456,7 +536,9 @@ fn concurrent_builds_of_one_map_leave_a_valid_file() {
         .map(|e| e.unwrap().file_name().into_string().unwrap())
         .collect();
     assert_eq!(names.len(), 2, "{names:?}");
-    assert!(names.iter().all(|n| n.ends_with(".vmap") && !n.starts_with('.')));
+    assert!(names
+        .iter()
+        .all(|n| n.ends_with(".vmap") && !n.starts_with('.')));
     let hit = build(Some(&cache));
     assert_eq!(uses(&hit), [CacheUse::Hit; 2]);
     assert!(samples(&hit) == cold);

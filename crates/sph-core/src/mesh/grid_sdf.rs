@@ -167,7 +167,15 @@ impl<R: Real> Sdf<R> for GridSdf<R> {
         crate::sdf::push_fingerprint(
             out,
             "grid-sdf",
-            &[o.x, o.y, o.z, self.grid.cell_size(), d[0] as f64, d[1] as f64, d[2] as f64],
+            &[
+                o.x,
+                o.y,
+                o.z,
+                self.grid.cell_size(),
+                d[0] as f64,
+                d[1] as f64,
+                d[2] as f64,
+            ],
         );
         crate::sdf::push_fingerprint(
             out,

@@ -74,7 +74,7 @@ impl<R: Real> VolumeMapBoundary<R> {
     /// check (bit-identical to a cold build), and otherwise built and written. A refused
     /// cache file or a failed write is not an error: the map is built, and the refusal is
     /// kept in [`VolumeMapBoundary::cache_warnings`] for the caller to log.
-    /// [`VolumeMapStats::cache`] says what happened per map.
+    /// [`VolumeMapStats::cache`](super::VolumeMapStats::cache) says what happened per map.
     ///
     /// Errors: those of [`VolumeMapBoundary::new`].
     pub fn with_cache(
@@ -133,7 +133,8 @@ impl<R: Real> VolumeMapBoundary<R> {
                 maps.push(build()?);
                 continue;
             };
-            let Some(key) = VolumeMapKey::new(s.as_ref(), kernel, support_radius, &domain, &options)
+            let Some(key) =
+                VolumeMapKey::new(s.as_ref(), kernel, support_radius, &domain, &options)
             else {
                 let mut map = build()?;
                 map.stats.cache = CacheUse::Uncacheable;

@@ -99,10 +99,14 @@ impl<'a> In<'a> {
         Ok(self.take(1)?[0])
     }
     fn u32(&mut self) -> Result<u32, MapFileProblem> {
-        Ok(u32::from_le_bytes(self.take(4)?.try_into().expect("4 bytes")))
+        Ok(u32::from_le_bytes(
+            self.take(4)?.try_into().expect("4 bytes"),
+        ))
     }
     fn u64(&mut self) -> Result<u64, MapFileProblem> {
-        Ok(u64::from_le_bytes(self.take(8)?.try_into().expect("8 bytes")))
+        Ok(u64::from_le_bytes(
+            self.take(8)?.try_into().expect("8 bytes"),
+        ))
     }
     fn f64(&mut self) -> Result<f64, MapFileProblem> {
         Ok(f64::from_bits(self.u64()?))
@@ -179,7 +183,10 @@ fn encode<R: Real>(map: &VolumeMap<R>) -> Vec<u8> {
     o.0
 }
 
-fn decode<R: Real>(payload: &[u8], tables: Arc<KernelTables>) -> Result<VolumeMap<R>, MapFileProblem> {
+fn decode<R: Real>(
+    payload: &[u8],
+    tables: Arc<KernelTables>,
+) -> Result<VolumeMap<R>, MapFileProblem> {
     let mut r = In(payload);
     let origin = Vec3::new(r.f64()?, r.f64()?, r.f64()?);
     let cell = r.f64()?;
@@ -221,15 +228,20 @@ fn decode<R: Real>(payload: &[u8], tables: Arc<KernelTables>) -> Result<VolumeMa
             let n = r.len(8)?;
             let flat_cells: Vec<u64> = (0..n).map(|_| r.u64()).collect::<Result<_, _>>()?;
             if index.len() != nodes || dims.iter().any(|&d| d < 2) {
-                return Err(MapFileProblem::Malformed("node index does not match the grid"));
+                return Err(MapFileProblem::Malformed(
+                    "node index does not match the grid",
+                ));
             }
             let cells = (dims[0] - 1) * (dims[1] - 1) * (dims[2] - 1);
             if flat_cells.len() != cells.div_ceil(64) {
                 return Err(MapFileProblem::Malformed("cell bits do not match the grid"));
             }
-            let bad = |&v: &u32| v < super::DEEP && (v & !super::PLANE_BIT) as usize >= models.len();
+            let bad =
+                |&v: &u32| v < super::DEEP && (v & !super::PLANE_BIT) as usize >= models.len();
             if index.iter().any(bad) {
-                return Err(MapFileProblem::Malformed("node index points past the models"));
+                return Err(MapFileProblem::Malformed(
+                    "node index points past the models",
+                ));
             }
             Storage::NodePlanes {
                 index,
