@@ -33,7 +33,7 @@ pub use particles::{
     apply_permutation, validate_finite_positions, ParticleSet, PermutationScratch,
 };
 pub use real::Real;
-pub use sdf::{BoxSdf, Inverted, Plane, Sdf, Sphere};
+pub use sdf::{push_fingerprint, BoxSdf, Inverted, Plane, Sdf, Sphere};
 
 /// A 3D column vector of [`Real`] (nalgebra).
 pub type Vec3<R> = nalgebra::Vector3<R>;

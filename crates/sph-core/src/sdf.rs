@@ -31,6 +31,38 @@ pub trait Sdf<R: Real>: Send + Sync {
     fn bounds(&self) -> Option<Aabb<R>> {
         None
     }
+
+    /// Appends to `out` a stable, complete description of this solid (a type tag and every
+    /// parameter the distance depends on, as little-endian bytes) and returns `true`; two
+    /// solids with equal descriptions must have bit-identical distances and gradients. Caches
+    /// of data derived from a solid (the volume maps of `sph-solver`) key on it.
+    ///
+    /// The default appends nothing and returns `false`: "not cacheable" (a user solid that
+    /// does not describe itself is rebuilt every time rather than confused with another).
+    fn fingerprint(&self, out: &mut Vec<u8>) -> bool {
+        let _ = out;
+        false
+    }
+
+    /// A Lipschitz constant `L` of [`Sdf::signed_distance`] as evaluated
+    /// (`|φ(p) − φ(q)| ≤ L |p − q|` up to the rounding of the precision), when one is known:
+    /// `Some(1.0)` for exact Euclidean distances. Searches along rays (the volume maps'
+    /// quadrature) use it to skip stretches that cannot hold a surface crossing. The default,
+    /// `None`, makes no claim (interpolated fields such as [`GridSdf`](crate::GridSdf)).
+    fn lipschitz_bound(&self) -> Option<f64> {
+        None
+    }
+}
+
+/// Appends a type tag (length-prefixed) and the `f64` bit patterns of `values` (exact for
+/// `f32` and `f64` scalars) to a [`Sdf::fingerprint`] description.
+pub fn push_fingerprint<R: Real>(out: &mut Vec<u8>, tag: &str, values: &[R]) {
+    out.extend_from_slice(&(tag.len() as u64).to_le_bytes());
+    out.extend_from_slice(tag.as_bytes());
+    out.extend_from_slice(&(values.len() as u64).to_le_bytes());
+    for v in values {
+        out.extend_from_slice(&v.as_f64().to_bits().to_le_bytes());
+    }
 }
 
 fn check_positive<R: Real>(name: &'static str, value: R) -> Result<(), CoreError> {
@@ -88,6 +120,14 @@ impl<R: Real> Sdf<R> for Plane<R> {
     fn gradient(&self, _p: &Vec3<R>) -> Vec3<R> {
         self.normal
     }
+    fn fingerprint(&self, out: &mut Vec<u8>) -> bool {
+        let n = self.normal;
+        push_fingerprint(out, "plane", &[n.x, n.y, n.z, self.offset]);
+        true
+    }
+    fn lipschitz_bound(&self) -> Option<f64> {
+        Some(1.0)
+    }
 }
 
 /// Solid ball.
@@ -126,6 +166,14 @@ impl<R: Real> Sdf<R> for Sphere<R> {
             min: self.center - r,
             max: self.center + r,
         })
+    }
+    fn fingerprint(&self, out: &mut Vec<u8>) -> bool {
+        let c = self.center;
+        push_fingerprint(out, "sphere", &[c.x, c.y, c.z, self.radius]);
+        true
+    }
+    fn lipschitz_bound(&self) -> Option<f64> {
+        Some(1.0)
     }
 }
 
@@ -200,6 +248,14 @@ impl<R: Real> Sdf<R> for BoxSdf<R> {
     fn bounds(&self) -> Option<Aabb<R>> {
         Some(self.aabb())
     }
+    fn fingerprint(&self, out: &mut Vec<u8>) -> bool {
+        let (c, e) = (self.center, self.half_extents);
+        push_fingerprint(out, "box", &[c.x, c.y, c.z, e.x, e.y, e.z]);
+        true
+    }
+    fn lipschitz_bound(&self) -> Option<f64> {
+        Some(1.0)
+    }
 }
 
 /// Complement of a solid: what was inside becomes free space. A tank is `Inverted<BoxSdf>`:
@@ -216,6 +272,13 @@ impl<R: Real, S: Sdf<R>> Sdf<R> for Inverted<S> {
     }
     fn bounds(&self) -> Option<Aabb<R>> {
         self.0.bounds()
+    }
+    fn fingerprint(&self, out: &mut Vec<u8>) -> bool {
+        push_fingerprint::<R>(out, "inverted", &[]);
+        self.0.fingerprint(out)
+    }
+    fn lipschitz_bound(&self) -> Option<f64> {
+        self.0.lipschitz_bound()
     }
 }
 
@@ -256,6 +319,33 @@ mod tests {
     }
 
     proptest! {
+        /// Shapes that declare a Lipschitz bound keep it (exact distances: 1), which the
+        /// volume maps rely on to skip ray samples; and their fingerprints tell them apart.
+        #[test]
+        fn declared_lipschitz_bounds_hold(
+            p in prop::array::uniform3(-5.0..5.0f64),
+            q in prop::array::uniform3(-5.0..5.0f64),
+        ) {
+            let (p, q) = (Vec3::from(p), Vec3::from(q));
+            let shapes: Vec<Box<dyn Sdf<f64>>> = vec![
+                Box::new(unit_box()),
+                Box::new(Inverted(unit_box())),
+                Box::new(Sphere::new(Vec3::new(0.5, -0.5, 0.2), 1.5).unwrap()),
+                Box::new(Plane::new(Vec3::new(0.0, 1.0, 0.0), Vec3::new(1.0, 2.0, -0.5)).unwrap()),
+            ];
+            let mut prints = Vec::new();
+            for s in &shapes {
+                let l = s.lipschitz_bound().expect("exact distance");
+                let (a, b) = (s.signed_distance(&p), s.signed_distance(&q));
+                // Rounding of two f64 distances of magnitude < 20: 1e-13.
+                prop_assert!((a - b).abs() <= l * (p - q).norm() + 1e-13);
+                let mut f = Vec::new();
+                prop_assert!(s.fingerprint(&mut f));
+                prop_assert!(!prints.contains(&f));
+                prints.push(f);
+            }
+        }
+
         /// Analytic gradients agree with central differences of the distance away from
         /// the medial axis (where the gradient is discontinuous), and have unit length.
         #[test]

@@ -2,6 +2,59 @@ use neighbour_search::SearchError;
 use sph_core::CoreError;
 use sph_kernels::KernelError;
 
+/// Why a volume-map file was refused (in [`SolverError::MapFile`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum MapFileProblem {
+    /// The file could not be read, written or renamed.
+    #[error("{operation} failed: {message}")]
+    Io {
+        /// What was attempted (`"read"`, `"create"`, `"write"`, `"sync"`, `"rename"`).
+        operation: &'static str,
+        /// The operating system's message.
+        message: String,
+    },
+    /// The file does not start with the volume-map magic bytes.
+    #[error("not a volume map file (bad magic bytes)")]
+    BadMagic,
+    /// The file was written by another version of the format.
+    #[error("format version {found}, this build reads only version {supported}")]
+    UnsupportedVersion {
+        /// Version in the file.
+        found: u32,
+        /// Version this build reads and writes.
+        supported: u32,
+    },
+    /// The file is shorter than its header says (an interrupted copy).
+    #[error("truncated: {found} bytes, its header announces {expected}")]
+    Truncated {
+        /// Bytes the header announces.
+        expected: u64,
+        /// Bytes in the file.
+        found: u64,
+    },
+    /// The file is longer than its header says.
+    #[error("{found} bytes, its header announces {expected} (trailing data)")]
+    TrailingBytes {
+        /// Bytes the header announces.
+        expected: u64,
+        /// Bytes in the file.
+        found: u64,
+    },
+    /// The SHA-256 checksum of the contents does not match: the file is corrupt.
+    #[error("checksum mismatch: the contents are corrupt")]
+    ChecksumMismatch,
+    /// The map in the file was built for other inputs (solid, kernel, support radius,
+    /// domain, options or precision) than those asked for.
+    #[error(
+        "built for other inputs (solid, kernel, support radius, domain, options or precision)"
+    )]
+    ForeignKey,
+    /// The contents pass the checksum but are inconsistent (a writer bug or a crafted file).
+    #[error("malformed contents: {0}")]
+    Malformed(&'static str),
+}
+
 /// Errors of the particle solvers. Each names the offending solver parameter or particle.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
@@ -40,6 +93,15 @@ pub enum SolverError {
     /// A boundary could not be built (e.g. a volume map grid too large for the domain).
     #[error("boundary: {0}")]
     Boundary(String),
+    /// A volume-map file (see `boundary::volume_map::VolumeMapCache`) was refused: nothing
+    /// of it was loaded.
+    #[error("volume map file {}: {problem}", path.display())]
+    MapFile {
+        /// The file.
+        path: std::path::PathBuf,
+        /// Why it was refused.
+        problem: MapFileProblem,
+    },
     /// The simulation diverged during call number `step` (0-based count of
     /// [`crate::FluidSolver::step`] calls): a non-finite predicted or final position or
     /// velocity, or a particle that ended more than one support radius inside a solid. The

@@ -35,7 +35,7 @@ pub use boundary::{
     CollisionBoundary, Interpolation, VolumeMap, VolumeMapBoundary, VolumeMapOptions,
     VolumeMapStats,
 };
-pub use error::SolverError;
+pub use error::{MapFileProblem, SolverError};
 pub use params::{CommonParams, DEFAULT_SUPPORT_OVER_SPACING, MAX_SUBSTEPS};
 pub use state::{ArraySpec, SolverState};
 pub use stats::{PhaseTimes, StepStats, MAX_PHASES};

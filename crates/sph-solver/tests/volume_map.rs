@@ -525,6 +525,29 @@ fn invalid_arguments_are_named_errors() {
         }
         other => panic!("{other:?}"),
     }
+    // The limit itself is capped at the grid's 2^26 nodes (documented and enforced alike).
+    named(
+        build(
+            VolumeMapOptions {
+                max_nodes: (1 << 26) + 1,
+                ..d
+            },
+            0.1,
+            dom,
+            0.0,
+        ),
+        "max_nodes",
+    );
+    assert!(build(
+        VolumeMapOptions {
+            max_nodes: 1 << 26,
+            ..d
+        },
+        0.1,
+        dom,
+        0.0
+    )
+    .is_ok());
     // A huge unbounded domain: too many nodes, a named error (no panic, no allocation).
     let planes: Vec<Box<dyn Sdf<f64>>> =
         vec![Box::new(Plane::new(Vec3::zeros(), Vec3::z()).unwrap())];

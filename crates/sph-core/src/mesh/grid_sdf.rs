@@ -159,6 +159,32 @@ impl<R: Real> Sdf<R> for GridSdf<R> {
     fn bounds(&self) -> Option<Aabb<R>> {
         Some(self.surface_bounds)
     }
+
+    /// The grid geometry, surface bounds and every node value (the field is a pure function
+    /// of them).
+    fn fingerprint(&self, out: &mut Vec<u8>) -> bool {
+        let (o, d, b) = (self.grid.origin(), self.grid.dims(), self.surface_bounds);
+        crate::sdf::push_fingerprint(
+            out,
+            "grid-sdf",
+            &[
+                o.x,
+                o.y,
+                o.z,
+                self.grid.cell_size(),
+                d[0] as f64,
+                d[1] as f64,
+                d[2] as f64,
+            ],
+        );
+        crate::sdf::push_fingerprint(
+            out,
+            "bounds",
+            &[b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z],
+        );
+        crate::sdf::push_fingerprint(out, "values", self.grid.values());
+        true
+    }
 }
 
 /// The SDFGen construction on nodes `origin + (i, j, k) · dx`: returns the signed node values

@@ -7,7 +7,7 @@ use sph_core::{Aabb, Real, Sdf, Vec3};
 use sph_kernels::{Kernel, KernelKind};
 
 use super::quadrature::KernelTables;
-use super::{invalid, VolumeMap, VolumeMapOptions};
+use super::{invalid, CacheUse, VolumeMap, VolumeMapCache, VolumeMapKey, VolumeMapOptions};
 use crate::boundary::{project_out, Boundary, BoundarySample};
 use crate::SolverError;
 
@@ -22,6 +22,7 @@ pub struct VolumeMapBoundary<R: Real> {
     kernel: KernelKind,
     support_radius: R,
     contact_distance: R,
+    cache_warnings: Vec<SolverError>,
 }
 
 impl<R: Real> fmt::Debug for VolumeMapBoundary<R> {
@@ -57,6 +58,34 @@ impl<R: Real> VolumeMapBoundary<R> {
         contact_distance: R,
         options: VolumeMapOptions,
     ) -> Result<Self, SolverError> {
+        Self::with_cache(
+            solids,
+            kernel,
+            support_radius,
+            domain,
+            contact_distance,
+            options,
+            None,
+        )
+    }
+
+    /// As [`VolumeMapBoundary::new`], reusing maps from `cache` (see [`VolumeMapCache`]):
+    /// each solid's map is loaded from the cache when its file exists and passes every
+    /// check (bit-identical to a cold build), and otherwise built and written. A refused
+    /// cache file or a failed write is not an error: the map is built, and the refusal is
+    /// kept in [`VolumeMapBoundary::cache_warnings`] for the caller to log.
+    /// [`VolumeMapStats::cache`](super::VolumeMapStats::cache) says what happened per map.
+    ///
+    /// Errors: those of [`VolumeMapBoundary::new`].
+    pub fn with_cache(
+        solids: Vec<Box<dyn Sdf<R>>>,
+        kernel: KernelKind,
+        support_radius: R,
+        domain: Aabb<R>,
+        contact_distance: R,
+        options: VolumeMapOptions,
+        cache: Option<&VolumeMapCache>,
+    ) -> Result<Self, SolverError> {
         options.validate()?;
         if !(contact_distance.is_finite_value() && contact_distance >= R::zero()) {
             return Err(invalid(
@@ -90,17 +119,53 @@ impl<R: Real> VolumeMapBoundary<R> {
         // The kernel must also be representable in the solver's precision.
         kernel.build(support_radius)?;
         let tables = Arc::new(KernelTables::new(&k));
-        let maps = solids
-            .iter()
-            .enumerate()
-            .map(|(i, s)| {
+        let mut cache_warnings = Vec::new();
+        let mut maps = Vec::with_capacity(solids.len());
+        for (i, s) in solids.iter().enumerate() {
+            let build = || {
                 VolumeMap::build(s.as_ref(), tables.clone(), &domain, &options).map_err(|e| match e
                 {
                     SolverError::Boundary(m) => SolverError::Boundary(format!("solid {i}: {m}")),
                     e => e,
                 })
-            })
-            .collect::<Result<Vec<_>, _>>()?;
+            };
+            let Some(cache) = cache else {
+                maps.push(build()?);
+                continue;
+            };
+            let Some(key) =
+                VolumeMapKey::new(s.as_ref(), kernel, support_radius, &domain, &options)
+            else {
+                let mut map = build()?;
+                map.stats.cache = CacheUse::Uncacheable;
+                maps.push(map);
+                continue;
+            };
+            let path = cache.path(&key);
+            let mut refused = false;
+            if path.exists() {
+                match VolumeMap::read_with_tables(&path, &key, tables.clone()) {
+                    Ok(map) => {
+                        maps.push(map);
+                        continue;
+                    }
+                    Err(e) => {
+                        cache_warnings.push(e);
+                        refused = true;
+                    }
+                }
+            }
+            let mut map = build()?;
+            map.stats.cache = match map.write_file(&path, &key) {
+                Ok(()) if refused => CacheUse::Replaced,
+                Ok(()) => CacheUse::Stored,
+                Err(e) => {
+                    cache_warnings.push(e);
+                    CacheUse::WriteFailed
+                }
+            };
+            maps.push(map);
+        }
         debug_assert_eq!(k.name(), kernel.name());
         Ok(Self {
             solids,
@@ -108,7 +173,14 @@ impl<R: Real> VolumeMapBoundary<R> {
             kernel,
             support_radius,
             contact_distance,
+            cache_warnings,
         })
+    }
+
+    /// Cache files refused (and replaced) or not written during construction, as
+    /// [`SolverError::MapFile`] errors naming the file and the reason; empty without a cache.
+    pub fn cache_warnings(&self) -> &[SolverError] {
+        &self.cache_warnings
     }
 
     /// The maps, one per solid (in [`Boundary::solids`] order), with their build statistics.

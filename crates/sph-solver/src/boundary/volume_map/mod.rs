@@ -65,11 +65,48 @@
 //!
 //! With 16 × 32 directions the error is that of the direction quadrature at the nodes (the
 //! solid's ray integrals have kinks at grazing directions that the Gauss–Legendre rule in
-//! `cos θ` does not resolve); 64 × 128 reaches ~3e-4 on the sphere. Build times (release,
-//! 2 shared cores, cubic spline, default options): tank 1.6 × 1.0 × 0.6 m at `h = 0.05` m
-//! 11 s (6.9e5 nodes, 8.2e4 by quadrature), at `h = 0.025` m 32 s (4.7e6 nodes, 1.6e5 by
-//! quadrature, ~110 MB); sphere of radius 0.1 m at `h = 0.025` m 2.2 s (2.6e4 quadrature
-//! nodes). 32 × 64 directions cost 4× the quadrature time.
+//! `cos θ` does not resolve); 64 × 128 reaches ~3e-4 on the sphere.
+//!
+//! # Cost
+//!
+//! Every node costs one distance and one gradient; each band node 78 more distances (the
+//! planarity probes); each quadrature node (near edges, corners and curved surfaces)
+//! `polar × azimuth` rays. A ray samples `φ` at `ray_samples` points, refines each sign
+//! change by regula falsi and searches intervals whose end values leave room for a thin
+//! sliver of solid (bisection down to `1e-6 h`). For solids with a known Lipschitz bound
+//! ([`Sdf::lipschitz_bound`], 1 for exact distances) samples and searches that the bound
+//! rules out are skipped: the crossings, and the brackets they are refined from, are those of
+//! the full search, so the map is bit-identical (on the tank below: 9.4 distance evaluations
+//! per ray instead of 19.3). For such solids the sliver search is also skipped in the first
+//! interval of rays from nodes on the surface (`|φ| ≤` rounding): it would bisect towards
+//! the surface the node lies on, down to `1e-6 h`, and cost half of all evaluations on a
+//! tank whose walls lie on grid nodes. This changes a map only where a solid sliver lies
+//! within `h / ray_samples` of such a node; the tank's map is byte for byte that of the
+//! full search (and the property test `lipschitz_skips_are_bit_identical_to_the_full_search`
+//! checks nodes on walls, edges and corners). The quadrature dominates (90 % of the time on a tank: rays and distance
+//! evaluations); nodes are built in parallel by z-slab, each node on its own, so parallel
+//! and sequential builds are bit-identical. SPlisHSPlasH's dam-break tank (4 × 3 × 1.5 m,
+//! cubic spline, `h = 0.05` m, `f32`): 1.06e7 nodes, 2.3e6 in the band, 2.4e5 by
+//! quadrature, 2.9e6 stored (203 MB as a cache file); dated timings against SPlisHSPlasH in
+//! `docs/performance.md`. 32 × 64 directions cost 4× the quadrature time.
+//!
+//! # Cache
+//!
+//! A map depends only on its [`VolumeMapKey`]: the solid's [`Sdf::fingerprint`], kernel,
+//! support radius, domain, options, precision and the format and build versions
+//! ([`FORMAT_VERSION`], [`BUILD_VERSION`]). [`VolumeMapBoundary::with_cache`] looks each map
+//! up in a [`VolumeMapCache`] directory (file `<SHA-256 of the key>.vmap`), loads it when
+//! the file passes every check (bit-identical to a cold build), and otherwise builds it and
+//! writes the file atomically. [`VolumeMap::read_file`] documents the format and the
+//! refusals ([`SolverError::MapFile`]): a corrupt, truncated, foreign or other-version file
+//! is never half-loaded; the boundary then rebuilds, replaces the file and reports the
+//! refusal in [`VolumeMapBoundary::cache_warnings`] for the caller to log. Solids that do
+//! not describe themselves (the default of [`Sdf::fingerprint`]) are rebuilt every time.
+//!
+//! # Grid size
+//!
+//! A solid's grid may have at most [`VolumeMapOptions::max_nodes`] nodes (default 2²⁵), and
+//! that limit at most 2²⁶ ([`SampledGrid::MAX_NODES`]), checked before any work.
 //!
 //! # Other deviations and limits
 //!
@@ -78,18 +115,25 @@
 //! - Nodes equidistant to two surfaces (e.g. at `φ = h` from two tank walls) carry one of the
 //!   planes; beyond `φ ≥ h` their correction is not computed, so within a cell of such
 //!   nodes `Ψ` errs by up to `Ψ_plane(h − √3 cell)` (~1e-4 at `h/4` cells for Poly6).
-//! - Root finding along rays assumes the distance is 2-Lipschitz; solid slivers thinner than
-//!   `1e-6 h` between ray samples are ignored.
+//! - Root finding along rays assumes the distance is 2-Lipschitz (or the solid's
+//!   [`Sdf::lipschitz_bound`]); solid slivers thinner than `1e-6 h` between ray samples are
+//!   ignored, and for solids with a declared bound, slivers in the first `h / ray_samples`
+//!   of rays from nodes on the surface.
 //! - Outside the grid box `C = 0`: for bounded solids the box is the solid's bounds grown by
 //!   `h` (intersected with the domain grown by `h`), for unbounded solids the domain grown by
 //!   `h`.
 
 mod boundary;
+mod file;
+mod key;
 mod quadrature;
 
 pub use boundary::VolumeMapBoundary;
+pub use file::{FORMAT_VERSION, MAGIC};
+pub use key::{VolumeMapCache, VolumeMapKey, BUILD_VERSION};
 pub use quadrature::{half_space_volume, half_space_volume_derivative};
 
+use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -126,7 +170,8 @@ pub struct VolumeMapOptions {
     pub azimuth_directions: usize,
     /// Samples of `φ` along each ray before the sign-change search (1..=256; default 8).
     pub ray_samples: usize,
-    /// Largest grid (nodes) a single solid may use (default 2²⁵ ≈ 3.4e7).
+    /// Largest grid (nodes) a single solid may use (8..=2²⁶, the limit of
+    /// [`SampledGrid::MAX_NODES`]; default 2²⁵ ≈ 3.4e7).
     pub max_nodes: usize,
     /// Interpolation scheme (default [`Interpolation::NodePlanes`]).
     pub interpolation: Interpolation,
@@ -176,7 +221,13 @@ impl VolumeMapOptions {
                 256,
                 "must be in 1..=256",
             ),
-            ("max_nodes", self.max_nodes, 8, usize::MAX, "must be >= 8"),
+            (
+                "max_nodes",
+                self.max_nodes,
+                8,
+                SampledGrid::<f64>::MAX_NODES,
+                "must be in 8..=2^26",
+            ),
         ];
         for (name, v, lo, hi, reason) in checks {
             if v < lo || v > hi {
@@ -209,8 +260,33 @@ pub struct VolumeMapStats {
     pub quadrature_nodes: usize,
     /// Nodes stored with a model (node-planes scheme: `|φ| < h + √3 cell`).
     pub stored_nodes: usize,
-    /// Wall-clock build time.
+    /// Wall-clock time of the cold build (for a map loaded from a cache: of the build that
+    /// wrote the file).
     pub build_time: Duration,
+    /// Wall-clock time of reading the map from a cache file (zero for a built map).
+    pub load_time: Duration,
+    /// How the map came about with respect to a [`VolumeMapCache`].
+    pub cache: CacheUse,
+}
+
+/// What a [`VolumeMapCache`] did for one map.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum CacheUse {
+    /// Built; no cache was given.
+    #[default]
+    NoCache,
+    /// Built; the solid does not describe itself ([`Sdf::fingerprint`]), so it is not cached.
+    Uncacheable,
+    /// Loaded from the cache.
+    Hit,
+    /// Built (no file yet) and written to the cache.
+    Stored,
+    /// A cache file existed but was refused (see
+    /// [`VolumeMapBoundary::cache_warnings`]); rebuilt and the file replaced.
+    Replaced,
+    /// Built; writing the cache file failed (see [`VolumeMapBoundary::cache_warnings`]).
+    WriteFailed,
 }
 
 /// One node's model (node-planes scheme), in `f32` (relative error 6e-8 of values ≤ 1 and
@@ -487,8 +563,50 @@ impl<R: Real> VolumeMap<R> {
                 quadrature_nodes: quad.into_inner(),
                 stored_nodes,
                 build_time: start.elapsed(),
+                ..VolumeMapStats::default()
             },
         })
+    }
+
+    /// Writes this map, built for `key`, to `path`, atomically (a temporary file beside
+    /// `path`, `fsync`, rename): a reader never sees a partial file.
+    ///
+    /// Errors: [`SolverError::MapFile`] with [`MapFileProblem::Io`](crate::MapFileProblem::Io).
+    pub fn write_file(&self, path: &Path, key: &VolumeMapKey) -> Result<(), SolverError> {
+        file::write_map(path, self, key)
+    }
+
+    /// Reads the map of `key` (whose solid must be the one passed to [`VolumeMap::sample`])
+    /// from `path`, written by [`VolumeMap::write_file`].
+    ///
+    /// File layout (integers little-endian): 8 bytes [`MAGIC`], 4 bytes [`FORMAT_VERSION`],
+    /// 8 bytes total file length, the key (8-byte length, bytes: [`VolumeMapKey::as_bytes`]),
+    /// the payload (8-byte length, bytes: grid, node models, statistics), and the SHA-256 of
+    /// all bytes before it. The reader checks, in this order, magic, version, length,
+    /// checksum, key and the payload's consistency, and refuses the file at the first
+    /// failure, loading nothing of it.
+    ///
+    /// Errors: [`SolverError::MapFile`] naming `path` and the
+    /// [`MapFileProblem`](crate::MapFileProblem): `Io`, `BadMagic`,
+    /// `UnsupportedVersion`, `Truncated`, `TrailingBytes`, `ChecksumMismatch`, `ForeignKey`
+    /// (a map of other inputs), `Malformed`; [`SolverError::Kernel`] for a key whose kernel
+    /// cannot be built.
+    pub fn read_file(path: &Path, key: &VolumeMapKey) -> Result<Self, SolverError> {
+        let kernel = key.kernel().build(key.support_radius())?;
+        let tables = Arc::new(KernelTables::new(&kernel));
+        Self::read_with_tables(path, key, tables)
+    }
+
+    pub(crate) fn read_with_tables(
+        path: &Path,
+        key: &VolumeMapKey,
+        tables: Arc<KernelTables>,
+    ) -> Result<Self, SolverError> {
+        let start = Instant::now();
+        let mut map = file::read_map(path, key, tables)?;
+        map.stats.load_time = start.elapsed();
+        map.stats.cache = CacheUse::Hit;
+        Ok(map)
     }
 
     /// Build statistics (node counts and build time).
