@@ -224,12 +224,12 @@ mod scratch;
 mod solver;
 pub mod upscale;
 
+pub use kernels::IISPH_KERNEL;
 pub use params::{
     GranularParams, IisphParams, AIR_DENSITY, DEFAULT_DRAG_CONE_HALF_ANGLE_DEG,
     DEFAULT_FRICTION_MAX_ITERATIONS, DEFAULT_FRICTION_TOLERANCE, MAX_FRICTION_ITERATIONS,
     MAX_PRESSURE_ITERATIONS,
 };
-pub use kernels::IISPH_KERNEL;
 pub use solver::{Iisph, IisphScheme, IISPH_PHASES, IISPH_STATE_ARRAYS};
 
 pub use sph_core::{ParticleSet, Real, Vec3};

@@ -44,7 +44,6 @@ pub(crate) struct Scratch<R: Real> {
     pub density_new: Vec<R>,
     /// Partial sums of the density error per chunk of [`REDUCE_CHUNK`] particles.
     pub error_partials: Vec<f64>,
-    pub partials: Vec<[f64; 3]>,
     pub perm_scalar: Vec<R>,
 }
 

@@ -19,8 +19,8 @@ use crate::granular::Sym3;
 use crate::kernels::{Consts, IISPH_KERNEL};
 use crate::params::{IisphParams, NAME};
 use crate::passes::{
-    a_times_p, advection_pass, density_pass, forces_pass, predicted_density_pass,
-    pressure_accel, pressure_solve,
+    a_times_p, advection_pass, density_pass, forces_pass, predicted_density_pass, pressure_accel,
+    pressure_solve,
 };
 use crate::scratch::Scratch;
 use crate::upscale::Upscaler;
@@ -161,7 +161,10 @@ impl<R: Real> SubstepScheme<R> for IisphScheme<R> {
             arrays.push(("pressure".into(), s.pressure.clone()));
         }
         if !s.stress.is_empty() {
-            arrays.push(("stress".into(), s.stress.iter().flatten().copied().collect()));
+            arrays.push((
+                "stress".into(),
+                s.stress.iter().flatten().copied().collect(),
+            ));
         }
         if let Some(u) = self.upscaler.as_ref().filter(|u| u.seeded()) {
             let flat = |v: &[Vec3<R>]| v.iter().flat_map(|p| [p.x, p.y, p.z]).collect();
@@ -202,11 +205,15 @@ impl<R: Real> SubstepScheme<R> for IisphScheme<R> {
         }
         let found = match_arrays(self.name(), arrays, &accepted)?;
         let k = if granular { 2 } else { 1 };
-        let passive = (found.get(k).copied().flatten(), found.get(k + 1).copied().flatten());
+        let passive = (
+            found.get(k).copied().flatten(),
+            found.get(k + 1).copied().flatten(),
+        );
         if passive.0.is_some() != passive.1.is_some() {
             return Err(SolverError::InvalidSolverState {
                 solver: self.name().to_owned(),
-                reason: "the passive points need both `passive_positions` and `passive_velocities`".into(),
+                reason: "the passive points need both `passive_positions` and `passive_velocities`"
+                    .into(),
             });
         }
         let s = &mut self.scratch;
@@ -220,7 +227,11 @@ impl<R: Real> SubstepScheme<R> for IisphScheme<R> {
                 .extend(st.chunks_exact(6).map(|c| std::array::from_fn(|e| c[e])));
         }
         if let (Some(u), (Some(x), Some(v))) = (self.upscaler.as_mut(), passive) {
-            let vec3 = |f: &[R]| f.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect();
+            let vec3 = |f: &[R]| {
+                f.chunks_exact(3)
+                    .map(|c| Vec3::new(c[0], c[1], c[2]))
+                    .collect()
+            };
             u.restore(vec3(x), vec3(v));
         }
         Ok(())
@@ -247,8 +258,8 @@ impl<R: Real> IisphScheme<R> {
 
     /// Sets up the pressure system of one time step from `state` without advancing it:
     /// neighbours, densities, advection and the predicted density (Algorithm 1 lines 1–5),
-    /// with a cold start `p⁰ = 0`. Afterwards [`Iisph::system_diagonal`],
-    /// [`Iisph::system_source`], [`Iisph::apply_system`] and [`Iisph::solve_system`] inspect
+    /// with a cold start `p⁰ = 0`. Afterwards [`IisphScheme::system_diagonal`],
+    /// [`IisphScheme::system_source`], [`IisphScheme::apply_system`] and [`IisphScheme::solve_system`] inspect
     /// and solve it (for tests and studies of the solver; [`Iisph::step`] does the same
     /// internally). Errors as [`Iisph::step`].
     pub fn assemble_system(&mut self, state: &ParticleSet<R>) -> Result<(), SolverError> {
@@ -262,10 +273,15 @@ impl<R: Real> IisphScheme<R> {
             substep: 0,
         };
         let h = self.params.common.support_radius;
-        self.parts.neighbours
+        self.parts
+            .neighbours
             .find_in_step(&state.positions, h, at, "position")?;
         let nb = self.parts.neighbours.lists();
-        let volume = self.parts.boundary.has_volume().then_some(&*self.parts.boundary);
+        let volume = self
+            .parts
+            .boundary
+            .has_volume()
+            .then_some(&*self.parts.boundary);
         let (x, v, m) = (
             &state.positions[..],
             &state.velocities[..],
@@ -295,7 +311,7 @@ impl<R: Real> IisphScheme<R> {
     }
 
     /// `out = A p` for the last assembled system (`state` must be the one given to
-    /// [`Iisph::assemble_system`]): the density change `Σ_j m_j (Δt a^p_i − Δt a^p_j)·∇W_ij
+    /// [`IisphScheme::assemble_system`]): the density change `Σ_j m_j (Δt a^p_i − Δt a^p_j)·∇W_ij
     /// Δt + …` the pressures `p` cause (eqs. 20–22, `a_ii p_i + ψ_i`). Overwrites the
     /// solver's pressure scratch. Errors if the lengths differ from the system's.
     pub fn apply_system(
@@ -333,7 +349,7 @@ impl<R: Real> IisphScheme<R> {
 
     /// Runs the relaxed Jacobi solve (Algorithm 1 lines 6–13) on the last assembled system
     /// from `p = 0`; returns `(iterations, average compression, converged)`. The pressures
-    /// are then [`Iisph::pressure`].
+    /// are then [`IisphScheme::pressure`].
     pub fn solve_system(&mut self, state: &ParticleSet<R>) -> (usize, f64, bool) {
         let nb = self.parts.neighbours.lists();
         let s = &mut self.scratch;
@@ -359,13 +375,18 @@ impl<R: Real> IisphScheme<R> {
     ) -> Result<(), SolverError> {
         let h = self.params.common.support_radius;
         let search = self
+            .parts
             .neighbours
             .find_in_step(&state.positions, h, at, "position")?;
         stats.phases.add(CREATE_HASH_GRID, search.build_s());
         stats.phases.add(DETECT_NEIGHBOURS, search.detect_s());
         let nb = self.parts.neighbours.lists();
         let c = self.c;
-        let volume = self.parts.boundary.has_volume().then_some(&*self.parts.boundary);
+        let volume = self
+            .parts
+            .boundary
+            .has_volume()
+            .then_some(&*self.parts.boundary);
         let (x, v, m) = (
             &state.positions[..],
             &state.velocities[..],
@@ -460,4 +481,3 @@ impl<R: Real> IisphScheme<R> {
         Ok(())
     }
 }
-

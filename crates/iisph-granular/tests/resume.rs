@@ -6,8 +6,8 @@
 
 mod common;
 
-use iisph_granular::{FluidSolver, Iisph, IisphParams, SolverError, SolverState};
-use sph_solver::testing::{assert_resume_is_bit_identical, block_in_tank};
+use iisph_granular::{FluidSolver, IisphParams, IisphScheme, KernelKind, SolverError, SolverState};
+use sph_solver::testing::{assert_block_resumes, assert_resume_is_bit_identical};
 
 const BLOCK: [usize; 3] = [6, 6, 4];
 const TANK: [f64; 3] = [12.0, 10.0, 4.0];
@@ -29,27 +29,19 @@ fn granular() -> IisphParams<f64> {
 
 #[test]
 fn iisph_water_resumes_bit_for_bit() {
-    let p = water();
-    let (state, _, _) = block_in_tank(&p.common, BLOCK, TANK);
-    let make = || -> Box<dyn FluidSolver<f64>> {
-        let (_, solids, _) = block_in_tank(&p.common, BLOCK, TANK);
-        Box::new(Iisph::new(p.clone(), solids).unwrap())
-    };
-    let saved = assert_resume_is_bit_identical(&make, &state, 5);
+    let saved = assert_block_resumes::<f64, IisphScheme<f64>>(&water(), None);
     assert_eq!(saved.solver, "IISPH");
     let names: Vec<_> = saved.arrays.iter().map(|(n, _)| n.as_str()).collect();
     assert_eq!(names, ["pressure"]);
-    assert!(saved.arrays[0].1.iter().any(|&p| p > 0.0), "warm start carried");
+    assert!(
+        saved.arrays[0].1.iter().any(|&p| p > 0.0),
+        "warm start carried"
+    );
 }
 
 #[test]
 fn iisph_water_with_volume_maps_resumes_bit_for_bit() {
-    let p = water();
-    let (_, state) = common::block_solver(p.clone(), BLOCK, TANK);
-    let make = || -> Box<dyn FluidSolver<f64>> {
-        Box::new(common::block_solver(p.clone(), BLOCK, TANK).0)
-    };
-    assert_resume_is_bit_identical(&make, &state, 5);
+    assert_block_resumes::<f64, IisphScheme<f64>>(&water(), Some(KernelKind::CubicSpline));
 }
 
 #[test]
@@ -64,7 +56,12 @@ fn granular_with_upscaling_and_volume_maps_resumes_bit_for_bit() {
     let names: Vec<_> = saved.arrays.iter().map(|(n, _)| n.as_str()).collect();
     assert_eq!(
         names,
-        ["pressure", "stress", "passive_positions", "passive_velocities"]
+        [
+            "pressure",
+            "stress",
+            "passive_positions",
+            "passive_velocities"
+        ]
     );
     let n = state.len();
     assert_eq!(saved.array("stress").unwrap().len(), 6 * n);
@@ -106,4 +103,30 @@ fn iisph_refuses_states_that_do_not_fit() {
     fresh.restore_state(&saved, n).unwrap();
     assert_eq!(fresh.steps_done(), 1);
     assert_eq!(fresh.passive_points(), solver.passive_points());
+}
+
+/// Iteration counts beyond what can finish are refused, and the error states the bound
+/// (`min_iterations = 1e9` ran for ever before).
+#[test]
+fn counts_are_bounded() {
+    use iisph_granular::{MAX_FRICTION_ITERATIONS, MAX_PRESSURE_ITERATIONS};
+    let mut p = granular();
+    p.min_iterations = 1_000_000_000;
+    p.max_iterations = 1_000_000_000;
+    let e = p.validate().unwrap_err().to_string();
+    assert!(
+        e.contains("min_iterations") && e.contains(&MAX_PRESSURE_ITERATIONS.to_string()),
+        "{e}"
+    );
+    let mut p = granular();
+    p.max_iterations = MAX_PRESSURE_ITERATIONS + 1;
+    let e = p.validate().unwrap_err().to_string();
+    assert!(
+        e.contains("max_iterations") && e.contains(&MAX_PRESSURE_ITERATIONS.to_string()),
+        "{e}"
+    );
+    let mut p = granular();
+    p.granular.as_mut().unwrap().friction_max_iterations = MAX_FRICTION_ITERATIONS + 1;
+    let e = p.validate().unwrap_err().to_string();
+    assert!(e.contains(&MAX_FRICTION_ITERATIONS.to_string()), "{e}");
 }

@@ -55,7 +55,7 @@ impl<R: Real> PbfScratch<R> {
         &self.delta_p
     }
     /// Densities `ρ_i` (eq. 2 plus the boundary's `ρ0 Ψ`, kg/m³): after a step, at the final
-    /// positions; after [`Pbf::evaluate_constraints`], at the given positions.
+    /// positions; after [`PbfScheme::evaluate_constraints`], at the given positions.
     pub fn density(&self) -> &[R] {
         &self.density
     }

@@ -8,7 +8,9 @@ use rayon::prelude::*;
 use sph_core::{validate_finite_positions, CoreError, ParticleSet, Real, Vec3};
 use sph_kernels::{Kernel, KernelKind};
 use sph_solver::boundary::check_volume_kernel;
-use sph_solver::step::{check_divergence, check_masses, check_predicted, FramePhases, StepAt, MIN_LEN};
+use sph_solver::step::{
+    check_divergence, check_masses, check_predicted, FramePhases, StepAt, MIN_LEN,
+};
 use sph_solver::{
     Boundary, CommonParams, FrameSolver, SchemeParts, SolverError, StepStats, SubstepScheme,
 };
@@ -77,7 +79,7 @@ const REORDER: usize = 5;
 
 const NAME: &str = "PBF";
 
-/// What [`Pbf::evaluate_constraints`] computed, borrowed from the solver.
+/// What [`PbfScheme::evaluate_constraints`] computed, borrowed from the solver.
 #[derive(Debug, Clone, Copy)]
 pub struct ConstraintEval<'a, R: Real> {
     /// `ρ_i` (eq. 2 plus the boundary's `ρ0 Ψ`, kg/m³).
@@ -186,10 +188,15 @@ impl<R: Real> PbfScheme<R> {
         check_masses(masses)?;
         let n = positions.len();
         self.scratch.resize(n);
-        let volume = self.parts.boundary.has_volume().then_some(&*self.parts.boundary);
+        let volume = self
+            .parts
+            .boundary
+            .has_volume()
+            .then_some(&*self.parts.boundary);
         let s = &mut self.scratch;
         s.predicted.copy_from_slice(positions);
-        self.parts.neighbours
+        self.parts
+            .neighbours
             .find(&s.predicted, self.params.common.support_radius)?;
         if let Some(b) = volume {
             near_boundary(
@@ -236,7 +243,11 @@ impl<R: Real> PbfScheme<R> {
         at: StepAt,
         stats: &mut StepStats,
     ) -> Result<(), SolverError> {
-        let volume = self.parts.boundary.has_volume().then_some(&*self.parts.boundary);
+        let volume = self
+            .parts
+            .boundary
+            .has_volume()
+            .then_some(&*self.parts.boundary);
         let p = &self.params;
         let c = self.c;
         let dt = p.substep_dt();
@@ -263,7 +274,8 @@ impl<R: Real> PbfScheme<R> {
 
         // Lines 5–7: neighbours at the predicted positions, once per step.
         let search_stats =
-            self.parts.neighbours
+            self.parts
+                .neighbours
                 .find_in_step(&s.predicted, h, at, "predicted position")?;
         stats.phases.add(CREATE_HASH_GRID, search_stats.build_s());
         stats.phases.add(DETECT_NEIGHBOURS, search_stats.detect_s());

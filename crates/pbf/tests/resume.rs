@@ -2,12 +2,8 @@
 //! give bit for bit the particles of `2 k` frames straight (with reordering by cell inside
 //! both halves), with collision and with volume-map walls.
 
-use pbf::{FluidSolver, KernelKind, Pbf, PbfParams, SolverError, SolverState};
-use sph_solver::boundary::{VolumeMapBoundary, VolumeMapOptions};
-use sph_solver::testing::{assert_resume_is_bit_identical, block_in_tank};
-
-const BLOCK: [usize; 3] = [6, 6, 4];
-const TANK: [f64; 3] = [12.0, 10.0, 4.0];
+use pbf::{KernelKind, Pbf, PbfParams, PbfScheme, SolverError, SolverState};
+use sph_solver::testing::{assert_block_resumes, block_in_tank};
 
 fn params() -> PbfParams<f64> {
     let mut p = PbfParams::default();
@@ -17,35 +13,17 @@ fn params() -> PbfParams<f64> {
 
 #[test]
 fn pbf_resumes_bit_for_bit() {
-    let p = params();
-    let (state, _, _) = block_in_tank(&p.common, BLOCK, TANK);
-    let make = || -> Box<dyn FluidSolver<f64>> {
-        let (_, solids, _) = block_in_tank(&p.common, BLOCK, TANK);
-        Box::new(Pbf::new(p.clone(), solids).unwrap())
-    };
-    let saved = assert_resume_is_bit_identical(&make, &state, 5);
+    let saved = assert_block_resumes::<f64, PbfScheme<f64>>(&params(), None);
     assert_eq!(saved.solver, "PBF");
-    assert!(saved.arrays.is_empty(), "PBF carries nothing but the frame count");
+    assert!(
+        saved.arrays.is_empty(),
+        "PBF carries nothing but the frame count"
+    );
 }
 
 #[test]
 fn pbf_with_volume_maps_resumes_bit_for_bit() {
-    let p = params();
-    let (state, _, _) = block_in_tank(&p.common, BLOCK, TANK);
-    let make = || -> Box<dyn FluidSolver<f64>> {
-        let (_, solids, tank) = block_in_tank(&p.common, BLOCK, TANK);
-        let b = VolumeMapBoundary::new(
-            solids,
-            KernelKind::Poly6,
-            p.common.support_radius,
-            tank,
-            p.common.particle_radius() * 0.5,
-            VolumeMapOptions::default(),
-        )
-        .unwrap();
-        Box::new(Pbf::with_boundary(p.clone(), Box::new(b)).unwrap())
-    };
-    assert_resume_is_bit_identical(&make, &state, 5);
+    assert_block_resumes::<f64, PbfScheme<f64>>(&params(), Some(KernelKind::Poly6));
 }
 
 /// A state of another solver, or carrying an array PBF does not have, is refused by name
@@ -53,7 +31,7 @@ fn pbf_with_volume_maps_resumes_bit_for_bit() {
 #[test]
 fn pbf_refuses_foreign_states() {
     let p = params();
-    let (_, solids, _) = block_in_tank(&p.common, BLOCK, TANK);
+    let (_, solids, _) = block_in_tank(&p.common, [2, 2, 2], [4.0, 4.0, 4.0]);
     let mut solver = Pbf::new(p, solids).unwrap();
     let foreign = SolverState::<f64>::new("PCISPH", 3, vec![]);
     let e = solver.restore_state(&foreign, 10).unwrap_err();
@@ -69,4 +47,20 @@ fn pbf_refuses_foreign_states() {
         .restore_state(&SolverState::new("PBF", 7, vec![]), 10)
         .unwrap();
     assert_eq!(solver.steps_done(), 7);
+}
+
+/// Iteration and substep counts beyond what can finish are refused, and the error states
+/// the bound.
+#[test]
+fn counts_are_bounded() {
+    let mut p = params();
+    p.solver_iterations = pbf::MAX_SOLVER_ITERATIONS + 1;
+    let e = p.validate().unwrap_err().to_string();
+    assert!(e.contains(&pbf::MAX_SOLVER_ITERATIONS.to_string()), "{e}");
+    p.solver_iterations = 1_000_000_000;
+    assert!(p.validate().is_err());
+    let mut p = params();
+    p.common.substeps = 100_000;
+    let e = p.validate().unwrap_err().to_string();
+    assert!(e.contains(&sph_solver::MAX_SUBSTEPS.to_string()), "{e}");
 }

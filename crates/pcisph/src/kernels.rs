@@ -1,7 +1,7 @@
 //! The kernels and constants of the per-particle loops, built once from the parameters.
 
 use sph_core::Real;
-use sph_kernels::{Kernel, KernelKind, Poly6, Spiky};
+use sph_kernels::{KernelKind, Poly6, Spiky};
 use sph_solver::SolverError;
 
 use crate::params::PcisphParams;

@@ -6,7 +6,9 @@ use std::time::Instant;
 use rayon::prelude::*;
 use sph_core::{ParticleSet, Real, Vec3};
 use sph_kernels::{Kernel, KernelKind};
-use sph_solver::step::{check_divergence, check_predicted, density_at, FramePhases, StepAt, MIN_LEN};
+use sph_solver::step::{
+    check_divergence, check_predicted, density_at, FramePhases, StepAt, MIN_LEN,
+};
 use sph_solver::{CommonParams, FrameSolver, SchemeParts, SolverError, StepStats, SubstepScheme};
 
 use crate::kernels::{Consts, PCISPH_KERNEL};
@@ -121,7 +123,11 @@ impl<R: Real> PcisphScheme<R> {
         at: StepAt,
         stats: &mut StepStats,
     ) -> Result<(), SolverError> {
-        let volume = self.parts.boundary.has_volume().then_some(&*self.parts.boundary);
+        let volume = self
+            .parts
+            .boundary
+            .has_volume()
+            .then_some(&*self.parts.boundary);
         let boundary = &*self.parts.boundary;
         let p = &self.params;
         let c = self.c;

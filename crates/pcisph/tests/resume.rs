@@ -2,12 +2,8 @@
 //! give bit for bit the particles of `2 k` frames straight (with reordering by cell inside
 //! both halves), with collision and with volume-map walls.
 
-use pcisph::{FluidSolver, KernelKind, Pcisph, PcisphParams};
-use sph_solver::boundary::{VolumeMapBoundary, VolumeMapOptions};
-use sph_solver::testing::{assert_resume_is_bit_identical, block_in_tank};
-
-const BLOCK: [usize; 3] = [6, 6, 4];
-const TANK: [f64; 3] = [12.0, 10.0, 4.0];
+use pcisph::{KernelKind, PcisphParams, PcisphScheme};
+use sph_solver::testing::assert_block_resumes;
 
 fn params() -> PcisphParams<f64> {
     let mut p = PcisphParams::default();
@@ -17,33 +13,34 @@ fn params() -> PcisphParams<f64> {
 
 #[test]
 fn pcisph_resumes_bit_for_bit() {
-    let p = params();
-    let (state, _, _) = block_in_tank(&p.common, BLOCK, TANK);
-    let make = || -> Box<dyn FluidSolver<f64>> {
-        let (_, solids, _) = block_in_tank(&p.common, BLOCK, TANK);
-        Box::new(Pcisph::new(p.clone(), solids).unwrap())
-    };
-    let saved = assert_resume_is_bit_identical(&make, &state, 5);
+    let saved = assert_block_resumes::<f64, PcisphScheme<f64>>(&params(), None);
     assert_eq!(saved.solver, "PCISPH");
-    assert!(saved.arrays.is_empty(), "PCISPH starts each time step from p = 0");
+    assert!(
+        saved.arrays.is_empty(),
+        "PCISPH starts each time step from p = 0"
+    );
 }
 
 #[test]
 fn pcisph_with_volume_maps_resumes_bit_for_bit() {
-    let p = params();
-    let (state, _, _) = block_in_tank(&p.common, BLOCK, TANK);
-    let make = || -> Box<dyn FluidSolver<f64>> {
-        let (_, solids, tank) = block_in_tank(&p.common, BLOCK, TANK);
-        let b = VolumeMapBoundary::new(
-            solids,
-            KernelKind::Poly6,
-            p.common.support_radius,
-            tank,
-            p.common.particle_radius() * 0.5,
-            VolumeMapOptions::default(),
-        )
-        .unwrap();
-        Box::new(Pcisph::with_boundary(p.clone(), Box::new(b)).unwrap())
-    };
-    assert_resume_is_bit_identical(&make, &state, 5);
+    assert_block_resumes::<f64, PcisphScheme<f64>>(&params(), Some(KernelKind::Poly6));
+}
+
+/// Iteration counts beyond what can finish are refused, and the error states the bound.
+#[test]
+fn counts_are_bounded() {
+    let mut p = params();
+    p.pressure_iterations = pcisph::MAX_PRESSURE_ITERATIONS + 1;
+    let e = p.validate().unwrap_err().to_string();
+    assert!(
+        e.contains(&pcisph::MAX_PRESSURE_ITERATIONS.to_string()),
+        "{e}"
+    );
+    p.pressure_iterations = pcisph::MAX_PRESSURE_ITERATIONS;
+    p.common.substeps = 1000;
+    let e = p.validate().unwrap_err().to_string();
+    assert!(
+        e.contains(&sph_solver::MAX_ITERATIONS_PER_FRAME.to_string()),
+        "{e}"
+    );
 }

@@ -55,6 +55,9 @@ pub trait FluidSolver<R: Real>: Send {
     /// Refuses ([`SolverError::InvalidSolverState`], naming what) a state written by another
     /// solver, or with array names or lengths that do not fit `particles` particles, and
     /// then leaves the solver unchanged.
-    fn restore_state(&mut self, state: &SolverState<R>, particles: usize)
-        -> Result<(), SolverError>;
+    fn restore_state(
+        &mut self,
+        state: &SolverState<R>,
+        particles: usize,
+    ) -> Result<(), SolverError>;
 }

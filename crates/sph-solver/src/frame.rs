@@ -23,13 +23,13 @@ use sph_core::{ParticleSet, Real, Sdf, Vec3};
 use sph_kernels::KernelKind;
 
 use crate::boundary::check_volume_kernel;
-use crate::step::{begin_frame, end_frame, CellReorder, FramePhases, StepAt, StepNeighbours};
 use crate::boundary::{Boundary, CollisionBoundary};
 use crate::error::SolverError;
 use crate::fluid_solver::{FluidSolver, Solids};
 use crate::params::CommonParams;
 use crate::state::SolverState;
 use crate::stats::StepStats;
+use crate::step::{begin_frame, end_frame, CellReorder, FramePhases, StepAt, StepNeighbours};
 
 /// What every scheme works with besides its own buffers: the boundary and the neighbour
 /// search. A scheme owns its parts (so that its diagnostics can use them) and lends them to

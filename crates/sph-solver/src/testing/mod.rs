@@ -113,7 +113,11 @@ pub fn assert_resume_is_bit_identical<R: Real>(
             .collect::<Vec<_>>()
     };
     assert_eq!(vec_bits(&a.positions), vec_bits(&c.positions), "positions");
-    assert_eq!(vec_bits(&a.velocities), vec_bits(&c.velocities), "velocities");
+    assert_eq!(
+        vec_bits(&a.velocities),
+        vec_bits(&c.velocities),
+        "velocities"
+    );
     assert_eq!(bits_of(&a.densities), bits_of(&c.densities), "densities");
     assert_eq!(
         straight.passive_points().map(vec_bits),
@@ -129,4 +133,53 @@ pub fn assert_resume_is_bit_identical<R: Real>(
         assert_eq!(bits_of(v1), bits_of(v2), "carried array {n1}");
     }
     saved
+}
+
+/// The walls of a tank for [`block_in_tank`]: the collision model at the particle radius
+/// `s/2` (`kernel` `None`, what the solvers' `new` builds) or volume maps integrated with
+/// `kernel` and a contact distance of `s/4`.
+pub fn tank_walls<R: Real>(
+    common: &CommonParams<R>,
+    solids: Solids<R>,
+    tank: Aabb<R>,
+    kernel: Option<sph_kernels::KernelKind>,
+) -> Box<dyn crate::Boundary<R>> {
+    let r = common.particle_radius();
+    match kernel {
+        None => Box::new(crate::CollisionBoundary::new(solids, r).unwrap()),
+        Some(k) => Box::new(
+            crate::VolumeMapBoundary::new(
+                solids,
+                k,
+                common.support_radius,
+                tank,
+                r * R::of_f64(0.5),
+                crate::VolumeMapOptions::default(),
+            )
+            .unwrap(),
+        ),
+    }
+}
+
+/// [`assert_resume_is_bit_identical`] for solver `S` with `params` on a block of 6 × 6 × 4
+/// particles in a tank of 12 × 10 × 4 spacings with [`tank_walls`] of `kernel`, 5 + 5
+/// frames (set `common.reorder_every` so that both halves reorder).
+pub fn assert_block_resumes<R, S>(
+    params: &S::Params,
+    kernel: Option<sph_kernels::KernelKind>,
+) -> crate::SolverState<R>
+where
+    R: Real,
+    S: crate::SubstepScheme<R> + 'static,
+{
+    const BLOCK: [usize; 3] = [6, 6, 4];
+    const TANK: [f64; 3] = [12.0, 10.0, 4.0];
+    let common = S::common_of(params);
+    let (state, _, _) = block_in_tank(common, BLOCK, TANK);
+    let make = || -> Box<dyn FluidSolver<R>> {
+        let (_, solids, tank) = block_in_tank(common, BLOCK, TANK);
+        let walls = tank_walls(common, solids, tank, kernel);
+        Box::new(crate::FrameSolver::<R, S>::with_boundary(params.clone(), walls).unwrap())
+    };
+    assert_resume_is_bit_identical(&make, &state, 5)
 }
