@@ -5,7 +5,7 @@ use sph_core::{Real, Vec3};
 use crate::passes::PairCache;
 
 /// Per-particle working arrays of the solver (structure of arrays, one `Vec` per quantity),
-/// kept between steps so that a step does not allocate. After a [`Pbf::step`] they hold the
+/// kept between steps so that a step does not allocate. After a [`crate::Pbf::step`] they hold the
 /// values of its last substep, in the state's current particle order.
 #[derive(Debug, Clone, Default)]
 pub struct PbfScratch<R: Real> {
@@ -55,7 +55,7 @@ impl<R: Real> PbfScratch<R> {
         &self.delta_p
     }
     /// Densities `ρ_i` (eq. 2 plus the boundary's `ρ0 Ψ`, kg/m³): after a step, at the final
-    /// positions; after [`PbfScheme::evaluate_constraints`], at the given positions.
+    /// positions; after [`crate::PbfScheme::evaluate_constraints`], at the given positions.
     pub fn density(&self) -> &[R] {
         &self.density
     }
