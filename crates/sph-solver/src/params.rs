@@ -265,8 +265,10 @@ mod tests {
     /// The bounds are checked and their messages state the constants' values.
     #[test]
     fn counts_are_bounded_and_the_messages_state_the_bounds() {
-        let mut p = CommonParams::<f64>::default();
-        p.substeps = MAX_SUBSTEPS;
+        let mut p = CommonParams::<f64> {
+            substeps: MAX_SUBSTEPS,
+            ..Default::default()
+        };
         p.validate("test").unwrap();
         p.substeps = MAX_SUBSTEPS + 1;
         let r = reason(p.validate("test").unwrap_err());
