@@ -24,7 +24,9 @@ use sph_core::{Real, Vec3};
 use sph_solver::step::{par_update_sum, MIN_LEN};
 
 use crate::granular::{deviatoric, frobenius, strain_rate, sym_mul, yield_clamp, Sym3};
-use crate::solver::{grad, pressure_accel, Consts, Scratch};
+use crate::kernels::Consts;
+use crate::passes::{grad, pressure_accel};
+use crate::scratch::Scratch;
 
 /// How a friction solve ended.
 #[derive(Debug, Clone, Copy, PartialEq)]

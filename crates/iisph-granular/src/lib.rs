@@ -23,6 +23,23 @@
 //!
 //! Water is the same solver without [`GranularParams`] (no friction, no drag).
 //!
+//! # Shape of the crate
+//!
+//! Like every solver of the workspace (`sph_solver`'s "Adding a solver"), split by concern
+//! with no two files importing each other: `params.rs` ([`IisphParams`],
+//! [`GranularParams`], the maxima [`MAX_PRESSURE_ITERATIONS`] and
+//! [`MAX_FRICTION_ITERATIONS`]), `kernels.rs` (the cubic spline, [`IISPH_KERNEL`], and the
+//! constants of the loops), `scratch.rs` (the per-particle arrays), `passes.rs` (density,
+//! advection, predicted density, the pressure solve, forces), `friction.rs` (the
+//! friction-stress solve, on top of `passes.rs`), `granular.rs` (stress algebra, drag),
+//! `upscale.rs` (passive points) and `solver.rs` ([`IisphScheme`], the
+//! [`SubstepScheme`] of one time step, and what it carries between frames). [`Iisph`] is
+//! `FrameSolver<R, IisphScheme<R>>`: the workspace's one frame shell runs the frame and
+//! implements [`FluidSolver`]; [`IisphScheme::pressure`], [`IisphScheme::stress`] and the
+//! pressure-system diagnostics are methods of [`Iisph`] through `Deref`. Between frames it
+//! carries the warm-started pressures, the frictional stress and the passive points with
+//! their velocities ([`IISPH_STATE_ARRAYS`], [`FluidSolver::save_state`]).
+//!
 //! # One time step (Algorithm 1)
 //!
 //! `Δt = dt / substeps`; `∇W_ij = ∇_i W(x_i − x_j)` of the cubic spline (the kernel of the
@@ -199,46 +216,24 @@
 
 mod friction;
 pub mod granular;
+mod kernels;
 pub mod measure;
 mod params;
+mod passes;
+mod scratch;
 mod solver;
 pub mod upscale;
 
+pub use kernels::IISPH_KERNEL;
 pub use params::{
     GranularParams, IisphParams, AIR_DENSITY, DEFAULT_DRAG_CONE_HALF_ANGLE_DEG,
-    DEFAULT_FRICTION_MAX_ITERATIONS, DEFAULT_FRICTION_TOLERANCE,
+    DEFAULT_FRICTION_MAX_ITERATIONS, DEFAULT_FRICTION_TOLERANCE, MAX_FRICTION_ITERATIONS,
+    MAX_PRESSURE_ITERATIONS,
 };
-pub use solver::{Iisph, IISPH_KERNEL, IISPH_PHASES};
+pub use solver::{Iisph, IisphScheme, IISPH_PHASES, IISPH_STATE_ARRAYS};
 
 pub use sph_core::{ParticleSet, Real, Vec3};
 pub use sph_solver::{
-    Boundary, CollisionBoundary, CommonParams, FluidSolver, Solids, SolverError, StepStats,
+    Boundary, CollisionBoundary, CommonParams, FluidSolver, FrameSolver, KernelKind, Solids,
+    SolverError, SolverState, StepStats, SubstepScheme,
 };
-
-impl<R: Real> FluidSolver<R> for Iisph<R> {
-    fn step(&mut self, state: &mut ParticleSet<R>) -> Result<StepStats, SolverError> {
-        Iisph::step(self, state)
-    }
-    fn common(&self) -> &CommonParams<R> {
-        &self.params().common
-    }
-    fn boundary(&self) -> &dyn Boundary<R> {
-        Iisph::boundary(self)
-    }
-    fn last_permutation(&self) -> Option<&[u32]> {
-        Iisph::last_permutation(self)
-    }
-    fn name(&self) -> &'static str {
-        if self.params().granular.is_some() {
-            "IISPH-granular"
-        } else {
-            "IISPH"
-        }
-    }
-    fn phase_names(&self) -> &'static [&'static str] {
-        IISPH_PHASES
-    }
-    fn passive_points(&self) -> Option<&[Vec3<R>]> {
-        Iisph::passive_points(self)
-    }
-}

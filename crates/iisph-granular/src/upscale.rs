@@ -103,6 +103,21 @@ impl<R: Real> Upscaler<R> {
         &self.points
     }
 
+    /// The velocities of the passive points (m/s): the interpolated velocity of the last
+    /// step, or the last one advanced by gravity where no particle is within reach.
+    pub fn velocities(&self) -> &[Vec3<R>] {
+        &self.velocities
+    }
+
+    /// Puts back saved points and their velocities (of a checkpoint) and marks the points
+    /// seeded. `points` and `velocities` must have the same length.
+    pub fn restore(&mut self, points: Vec<Vec3<R>>, velocities: Vec<Vec3<R>>) {
+        debug_assert_eq!(points.len(), velocities.len());
+        self.points = points;
+        self.velocities = velocities;
+        self.seeded = true;
+    }
+
     /// Seeds `per_particle` points around each of `positions` (spacing `s`), at rest.
     pub fn seed(&mut self, positions: &[Vec3<R>], s: R) {
         let offsets = seed_offsets(self.per_particle);

@@ -47,6 +47,19 @@
 //! assert!(state.positions[k].y < s);
 //! ```
 //!
+//! # Shape of the crate
+//!
+//! Like every solver of the workspace (`sph_solver`'s "Adding a solver"): `params.rs`
+//! ([`PbfParams`], with [`MAX_SOLVER_ITERATIONS`]), `kernels.rs` (Poly6 and Spiky; the
+//! density kernel [`PBF_KERNEL`]), `scratch.rs` ([`PbfScratch`]), `passes.rs` (the two
+//! passes of a Jacobi iteration; `scorr.rs`, eq. 13) and `solver.rs` ([`PbfScheme`], the
+//! [`SubstepScheme`] of one time step). [`Pbf`] is `FrameSolver<R, PbfScheme<R>>`: the
+//! workspace's one frame shell runs the frame (checks, reordering, substeps, statistics)
+//! and implements [`FluidSolver`]; the scheme's own methods ([`PbfScheme::scratch`],
+//! [`PbfScheme::evaluate_constraints`], …) are methods of [`Pbf`] through `Deref`. PBF
+//! carries nothing from one frame to the next besides the particles and the frame count
+//! ([`FluidSolver::save_state`]).
+//!
 //! | paper | here |
 //! | --- | --- |
 //! | Algorithm 1 lines 1–4 (gravity, prediction) | [`Pbf::step`], phase `integrate` of [`StepStats`] ([`PBF_PHASES`]) |
@@ -170,38 +183,24 @@
 //! that bound: they are compute-bound (about 28 cycles per pair evaluation), the positions of
 //! the neighbours being L2 hits after the cell reorder.
 
+mod kernels;
 mod params;
 mod passes;
 mod scorr;
+mod scratch;
 mod solver;
 
-pub use params::{PbfParams, DEFAULT_RELATIVE_CFM, DEFAULT_SUPPORT_OVER_SPACING};
+pub use kernels::PBF_KERNEL;
+pub use params::{
+    PbfParams, DEFAULT_RELATIVE_CFM, DEFAULT_SUPPORT_OVER_SPACING, MAX_SOLVER_ITERATIONS,
+};
 pub use scorr::ArtificialPressure;
-pub use solver::{ConstraintEval, Pbf, PbfScratch, PBF_PHASES};
+pub use scratch::PbfScratch;
+pub use solver::{ConstraintEval, Pbf, PbfScheme, PBF_PHASES};
 
 pub use neighbour_search::Method;
 pub use sph_core::{ParticleSet, Real, Sdf, Vec3};
 pub use sph_solver::{
-    Boundary, CollisionBoundary, CommonParams, FluidSolver, Solids, SolverError, StepStats,
+    Boundary, CollisionBoundary, CommonParams, FluidSolver, FrameSolver, KernelKind, Solids,
+    SolverError, SolverState, StepStats, SubstepScheme,
 };
-
-impl<R: Real> FluidSolver<R> for Pbf<R> {
-    fn step(&mut self, state: &mut ParticleSet<R>) -> Result<StepStats, SolverError> {
-        Pbf::step(self, state)
-    }
-    fn common(&self) -> &CommonParams<R> {
-        &self.params().common
-    }
-    fn boundary(&self) -> &dyn Boundary<R> {
-        Pbf::boundary(self)
-    }
-    fn last_permutation(&self) -> Option<&[u32]> {
-        Pbf::last_permutation(self)
-    }
-    fn name(&self) -> &'static str {
-        "PBF"
-    }
-    fn phase_names(&self) -> &'static [&'static str] {
-        PBF_PHASES
-    }
-}

@@ -11,6 +11,12 @@ pub use sph_solver::DEFAULT_SUPPORT_OVER_SPACING;
 /// `ε` (eq. 11); see the crate documentation for why it is this large.
 pub const DEFAULT_RELATIVE_CFM: f64 = 1.0;
 
+/// Most Jacobi iterations per time step ([`PbfParams::solver_iterations`]) accepted,
+/// bounded by what can finish: the paper uses 2–10 (§8, Table 1), SPlisHSPlasH caps its
+/// tolerance-driven count at 100; an iteration is two neighbour passes, so beyond 1000 a
+/// frame takes minutes while the mean compression no longer changes.
+pub const MAX_SOLVER_ITERATIONS: usize = 1000;
+
 /// Parameters of [`crate::Pbf`]. Lengths are absolute, in metres; SI units throughout.
 ///
 /// Build them with [`PbfParams::for_spacing`] (or [`Default`], which is `for_spacing(0.025)`),
@@ -187,9 +193,13 @@ impl<R: Real> PbfParams<R> {
     /// Checks every field; the error names the first invalid one.
     pub fn validate(&self) -> Result<(), SolverError> {
         self.common.validate("PBF")?;
-        if self.solver_iterations == 0 {
-            return Err(invalid("solver_iterations", 0.0, "must be >= 1"));
-        }
+        self.common.check_iteration_count(
+            "PBF",
+            "solver_iterations",
+            self.solver_iterations,
+            MAX_SOLVER_ITERATIONS,
+            "must be at most 1000 per time step (MAX_SOLVER_ITERATIONS: a run must be able to finish)",
+        )?;
         if let Some(tol) = self.mean_compression_tolerance {
             if !(tol.is_finite_value() && tol > R::zero()) {
                 return Err(invalid(

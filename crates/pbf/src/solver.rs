@@ -1,30 +1,31 @@
-//! The solver: Algorithm 1 of Macklin & Müller (2013).
+//! The solver: Algorithm 1 of Macklin & Müller (2013), one time step per
+//! [`SubstepScheme::substep`] of the frame shell.
 
-use std::fmt;
 use std::time::Instant;
 
 use neighbour_search::NeighbourLists;
 use rayon::prelude::*;
-use sph_core::{validate_finite_positions, CoreError, ParticleSet, Real, Sdf, Vec3};
-use sph_kernels::Kernel;
+use sph_core::{validate_finite_positions, CoreError, ParticleSet, Real, Vec3};
+use sph_kernels::{Kernel, KernelKind};
 use sph_solver::boundary::check_volume_kernel;
 use sph_solver::step::{
-    begin_frame, check_divergence, check_masses, check_predicted, end_frame, CellReorder,
-    FramePhases, StepAt, StepNeighbours, MIN_LEN,
+    check_divergence, check_masses, check_predicted, FramePhases, StepAt, MIN_LEN,
 };
-use sph_solver::{Boundary, CollisionBoundary, Solids, SolverError, StepStats};
+use sph_solver::{
+    Boundary, CommonParams, FrameSolver, SchemeParts, SolverError, StepStats, SubstepScheme,
+};
 
-use crate::passes::{
-    delta_pass, lambda_pass, near_boundary, Consts, LambdaOut, PairCache, PassInput,
-};
-use crate::PbfParams;
+use crate::kernels::{Consts, PBF_KERNEL};
+use crate::params::PbfParams;
+use crate::passes::{delta_pass, lambda_pass, near_boundary, LambdaOut, PassInput};
+use crate::scratch::PbfScratch;
 
 /// The Position Based Fluids solver of
 ///
 /// > Miles Macklin and Matthias Müller, "Position Based Fluids", *ACM Transactions on
 /// > Graphics* 32(4), Article 104, 2013 (SIGGRAPH 2013),
 ///
-/// Algorithm 1, one call of [`Pbf::step`] advancing one whole frame of `substeps` steps of
+/// Algorithm 1, one call of [`FrameSolver::step`] advancing one whole frame of `substeps` steps of
 /// `Δt = dt / substeps`:
 ///
 /// 1. apply gravity and predict `x* = x + Δt (v + Δt g)` (lines 1–4);
@@ -46,14 +47,17 @@ use crate::PbfParams;
 ///
 /// See the crate documentation for the mass convention, the collision response, the blow-up
 /// checks and the deviations from the paper.
-pub struct Pbf<R: Real> {
+pub type Pbf<R> = FrameSolver<R, PbfScheme<R>>;
+
+/// The time step of [`Pbf`]: Algorithm 1 of Macklin & Müller (2013) as a [`SubstepScheme`]
+/// (its parameters, kernels, working arrays, boundary and neighbour search). PBF carries
+/// nothing from one frame to the next besides the particles.
+#[derive(Debug)]
+pub struct PbfScheme<R: Real> {
     params: PbfParams<R>,
     c: Consts<R>,
-    boundary: Box<dyn Boundary<R>>,
-    neighbours: StepNeighbours<R>,
+    parts: SchemeParts<R>,
     scratch: PbfScratch<R>,
-    reorder: CellReorder<R>,
-    steps: u64,
 }
 
 /// The phases [`Pbf::step`] times ([`StepStats::phases`]), named after the rows of the
@@ -72,94 +76,10 @@ const DETECT_NEIGHBOURS: usize = 2;
 const CONSTRAINT_SOLVE: usize = 3;
 const VELOCITY_UPDATE: usize = 4;
 const REORDER: usize = 5;
-const FRAME: FramePhases = FramePhases {
-    checks: INTEGRATE,
-    reorder: REORDER,
-    statistics: VELOCITY_UPDATE,
-};
 
 const NAME: &str = "PBF";
 
-impl<R: Real> fmt::Debug for Pbf<R> {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("Pbf")
-            .field("params", &self.params)
-            .field("boundary", &self.boundary.name())
-            .field("solids", &self.boundary.solids().len())
-            .field("particles", &self.scratch.predicted.len())
-            .field("steps", &self.steps)
-            .finish()
-    }
-}
-
-/// Per-particle working arrays of the solver (structure of arrays, one `Vec` per quantity),
-/// kept between steps so that a step does not allocate. After a [`Pbf::step`] they hold the
-/// values of its last substep, in the state's current particle order.
-#[derive(Debug, Clone, Default)]
-pub struct PbfScratch<R: Real> {
-    predicted: Vec<Vec3<R>>,
-    next: Vec<Vec3<R>>,
-    lambda: Vec<R>,
-    delta_p: Vec<Vec3<R>>,
-    density: Vec<R>,
-    boundary_grad: Vec<Vec3<R>>,
-    near_boundary: Vec<bool>,
-    velocity: Vec<Vec3<R>>,
-    velocity_new: Vec<Vec3<R>>,
-    vorticity: Vec<Vec3<R>>,
-    vorticity_norm: Vec<R>,
-    partials: Vec<[f64; 3]>,
-    pairs: PairCache<R>,
-}
-
-impl<R: Real> PbfScratch<R> {
-    fn resize(&mut self, n: usize) {
-        if self.predicted.len() == n {
-            return;
-        }
-        let z = Vec3::zeros();
-        self.predicted.resize(n, z);
-        self.next.resize(n, z);
-        self.lambda.resize(n, R::zero());
-        self.delta_p.resize(n, z);
-        self.density.resize(n, R::zero());
-        self.boundary_grad.resize(n, z);
-        self.near_boundary.resize(n, false);
-        self.velocity.resize(n, z);
-        self.velocity_new.resize(n, z);
-        self.vorticity.resize(n, z);
-        self.vorticity_norm.resize(n, R::zero());
-    }
-
-    /// Predicted positions `x*` (m): after a step, the final positions of its last substep.
-    pub fn predicted(&self) -> &[Vec3<R>] {
-        &self.predicted
-    }
-    /// `λ_i` of the last iteration (eq. 11; m², see the crate docs for units).
-    pub fn lambda(&self) -> &[R] {
-        &self.lambda
-    }
-    /// `Δp_i` of the last iteration (eq. 14, before the contact response; m).
-    pub fn delta_p(&self) -> &[Vec3<R>] {
-        &self.delta_p
-    }
-    /// Densities `ρ_i` (eq. 2 plus the boundary's `ρ0 Ψ`, kg/m³): after a step, at the final
-    /// positions; after [`Pbf::evaluate_constraints`], at the given positions.
-    pub fn density(&self) -> &[R] {
-        &self.density
-    }
-    /// Velocities `(x* − x)/Δt` of Algorithm 1 line 21 (m/s), before vorticity confinement
-    /// and XSPH.
-    pub fn velocity(&self) -> &[Vec3<R>] {
-        &self.velocity
-    }
-    /// Vorticity `ω_i` of eq. 15 (1/s); zero when vorticity confinement is off.
-    pub fn vorticity(&self) -> &[Vec3<R>] {
-        &self.vorticity
-    }
-}
-
-/// What [`Pbf::evaluate_constraints`] computed, borrowed from the solver.
+/// What [`PbfScheme::evaluate_constraints`] computed, borrowed from the solver.
 #[derive(Debug, Clone, Copy)]
 pub struct ConstraintEval<'a, R: Real> {
     /// `ρ_i` (eq. 2 plus the boundary's `ρ0 Ψ`, kg/m³).
@@ -172,81 +92,79 @@ pub struct ConstraintEval<'a, R: Real> {
     pub neighbours: &'a NeighbourLists,
 }
 
-impl<R: Real> Pbf<R> {
-    /// A solver with validated `params` and the given solids as a [`CollisionBoundary`]
-    /// with the particle radius `s / 2` as contact distance (the paper's collision handling).
-    pub fn new(params: PbfParams<R>, solids: Solids<R>) -> Result<Self, SolverError> {
-        let boundary = CollisionBoundary::new(solids, params.particle_radius())?;
-        Self::with_boundary(params, Box::new(boundary))
-    }
+impl<R: Real> SubstepScheme<R> for PbfScheme<R> {
+    type Params = PbfParams<R>;
+    const NAME: &'static str = NAME;
+    const PHASES: &'static [&'static str] = PBF_PHASES;
+    const FRAME_PHASES: FramePhases = FramePhases {
+        checks: INTEGRATE,
+        reorder: REORDER,
+        statistics: VELOCITY_UPDATE,
+    };
+    const DENSITY_KERNEL: KernelKind = PBF_KERNEL;
 
-    /// A solver with validated `params` and any boundary model. A boundary that takes part
-    /// in the density must have been integrated with this solver's density kernel (Poly6 of
-    /// support radius `h`), otherwise [`SolverError::InvalidParameter`].
-    pub fn with_boundary(
-        params: PbfParams<R>,
-        boundary: Box<dyn Boundary<R>>,
-    ) -> Result<Self, SolverError> {
-        params.validate()?;
-        check_volume_kernel(&*boundary, NAME, "poly6", params.common.support_radius)?;
-        let c = Consts::new(&params)?;
+    fn validate(params: &PbfParams<R>) -> Result<(), SolverError> {
+        params.validate()
+    }
+    fn common_of(params: &PbfParams<R>) -> &CommonParams<R> {
+        &params.common
+    }
+    fn new(params: PbfParams<R>, parts: SchemeParts<R>) -> Result<Self, SolverError> {
         Ok(Self {
-            neighbours: StepNeighbours::new(params.common.neighbour_method),
+            c: Consts::new(&params)?,
             params,
-            c,
-            boundary,
+            parts,
             scratch: PbfScratch::default(),
-            reorder: CellReorder::default(),
-            steps: 0,
         })
     }
-
-    /// The parameters.
-    pub fn params(&self) -> &PbfParams<R> {
+    fn params(&self) -> &PbfParams<R> {
         &self.params
     }
+    fn parts(&self) -> &SchemeParts<R> {
+        &self.parts
+    }
+    fn begin_frame(
+        &mut self,
+        state: &mut ParticleSet<R>,
+        _permutation: Option<&[u32]>,
+        _stats: &mut StepStats,
+    ) -> Result<(), SolverError> {
+        self.scratch.resize(state.len());
+        Ok(())
+    }
+    fn substep(
+        &mut self,
+        state: &mut ParticleSet<R>,
+        at: StepAt,
+        _last: bool,
+        stats: &mut StepStats,
+    ) -> Result<(), SolverError> {
+        self.time_step(state, at, stats)
+    }
+}
 
+impl<R: Real> PbfScheme<R> {
     /// Replaces the parameters (validated; the kernels are rebuilt, the buffers kept). The
     /// support radius must stay that of a volume boundary's kernel.
     pub fn set_params(&mut self, params: PbfParams<R>) -> Result<(), SolverError> {
         params.validate()?;
-        check_volume_kernel(&*self.boundary, NAME, "poly6", params.common.support_radius)?;
+        check_volume_kernel(
+            &*self.parts.boundary,
+            NAME,
+            PBF_KERNEL,
+            params.common.support_radius,
+        )?;
         self.c = Consts::new(&params)?;
-        self.neighbours.set_method(params.common.neighbour_method);
+        self.parts
+            .neighbours
+            .set_method(params.common.neighbour_method);
         self.params = params;
         Ok(())
-    }
-
-    /// The boundary.
-    pub fn boundary(&self) -> &dyn Boundary<R> {
-        &*self.boundary
-    }
-
-    /// The solids, in the order contacts are resolved.
-    pub fn solids(&self) -> &[Box<dyn Sdf<R>>] {
-        self.boundary.solids()
-    }
-
-    /// The neighbour lists of the last substep (or of [`Pbf::evaluate_constraints`]).
-    pub fn neighbours(&self) -> &NeighbourLists {
-        self.neighbours.lists()
     }
 
     /// The working arrays (values of the last substep).
     pub fn scratch(&self) -> &PbfScratch<R> {
         &self.scratch
-    }
-
-    /// Number of [`Pbf::step`] calls made (including failed ones).
-    pub fn steps_done(&self) -> u64 {
-        self.steps
-    }
-
-    /// The permutation applied to the particles at the start of the last [`Pbf::step`]
-    /// call (`new[k] = old[perm[k]]`), or `None` if that call did not reorder. Apply it to any
-    /// per-particle data kept beside the [`ParticleSet`] (`sph_core::apply_permutation`).
-    pub fn last_permutation(&self) -> Option<&[u32]> {
-        self.reorder.last_permutation()
     }
 
     /// Computes, at the given positions and without moving anything, the neighbours, the
@@ -270,10 +188,15 @@ impl<R: Real> Pbf<R> {
         check_masses(masses)?;
         let n = positions.len();
         self.scratch.resize(n);
-        let volume = self.boundary.has_volume().then_some(&*self.boundary);
+        let volume = self
+            .parts
+            .boundary
+            .has_volume()
+            .then_some(&*self.parts.boundary);
         let s = &mut self.scratch;
         s.predicted.copy_from_slice(positions);
-        self.neighbours
+        self.parts
+            .neighbours
             .find(&s.predicted, self.params.common.support_radius)?;
         if let Some(b) = volume {
             near_boundary(
@@ -288,7 +211,7 @@ impl<R: Real> Pbf<R> {
             c: &self.c,
             x: &s.predicted,
             m: masses,
-            nb: self.neighbours.lists(),
+            nb: self.parts.neighbours.lists(),
             volume,
         };
         let out = LambdaOut {
@@ -302,7 +225,7 @@ impl<R: Real> Pbf<R> {
             &s.lambda,
             &s.boundary_grad,
             &s.pairs,
-            &*self.boundary,
+            &*self.parts.boundary,
             &mut s.delta_p,
             &mut s.next,
         );
@@ -310,74 +233,28 @@ impl<R: Real> Pbf<R> {
             density: &s.density,
             lambda: &s.lambda,
             delta_p: &s.delta_p,
-            neighbours: self.neighbours.lists(),
+            neighbours: self.parts.neighbours.lists(),
         })
     }
 
-    /// Advances `state` by one whole frame, `common.dt` (16 ms by default), made of
-    /// `common.substeps` time steps of Algorithm 1 (see [`Pbf`]): one call is a frame, not
-    /// one solver step.
-    ///
-    /// **Particle order.** Every `common.reorder_every` calls (the first call included), the
-    /// call begins by reordering the particles of `state` by grid cell for memory locality:
-    /// afterwards [`Pbf::last_permutation`] returns `perm` with `new[k] = old[perm[k]]`
-    /// (`None` when the call did not reorder). To follow particles across a run, keep an
-    /// index map `ids` (initially `0..n`) and compose it after each call,
-    /// `ids = perm.iter().map(|&o| ids[o as usize]).collect()`, so `ids[k]` is the original
-    /// index of the particle now at `k`; apply the same permutation to any per-particle data
-    /// kept beside the state (`sph_core::apply_permutation`). `reorder_every = 0` keeps the
-    /// input order. The crate-level example shows it.
-    ///
-    /// Checks the state first (array lengths, finite positions and velocities, positive
-    /// masses: [`SolverError::InvalidState`], [`SolverError::InvalidMass`]), reorders it by
-    /// cell every `reorder_every` calls, and after each substep checks for divergence before
-    /// writing the substep's result into `state` ([`SolverError::BlowUp`]; `state` then holds
-    /// the last completed substep, never a non-finite value). Writes positions, velocities
-    /// and densities (at the final positions).
-    ///
-    /// Does not allocate once its buffers have grown to the particle count (and the neighbour
-    /// lists to the pair count).
-    pub fn step(&mut self, state: &mut ParticleSet<R>) -> Result<StepStats, SolverError> {
-        let step = self.steps;
-        self.steps += 1;
-        let mut stats = StepStats::new(PBF_PHASES);
-        let common = &self.params.common;
-        begin_frame(state, &mut self.reorder, common, step, FRAME, &mut stats)?;
-        self.scratch.resize(state.len());
-
-        for sub in 0..self.params.common.substeps {
-            let at = StepAt {
-                solver: NAME,
-                step,
-                substep: sub,
-            };
-            self.substep(state, at, &mut stats)?;
-        }
-
-        end_frame(
-            state,
-            self.params.common.rest_density,
-            &mut self.scratch.partials,
-            FRAME,
-            &mut stats,
-        );
-        Ok(stats)
-    }
-
-    fn substep(
+    fn time_step(
         &mut self,
         state: &mut ParticleSet<R>,
         at: StepAt,
         stats: &mut StepStats,
     ) -> Result<(), SolverError> {
-        let volume = self.boundary.has_volume().then_some(&*self.boundary);
+        let volume = self
+            .parts
+            .boundary
+            .has_volume()
+            .then_some(&*self.parts.boundary);
         let p = &self.params;
         let c = self.c;
         let dt = p.substep_dt();
         let g = p.common.gravity;
         let h = p.common.support_radius;
         let s = &mut self.scratch;
-        let boundary = &*self.boundary;
+        let boundary = &*self.parts.boundary;
 
         // Lines 1–4: apply forces, predict positions.
         let t = Instant::now();
@@ -397,11 +274,12 @@ impl<R: Real> Pbf<R> {
 
         // Lines 5–7: neighbours at the predicted positions, once per step.
         let search_stats =
-            self.neighbours
+            self.parts
+                .neighbours
                 .find_in_step(&s.predicted, h, at, "predicted position")?;
         stats.phases.add(CREATE_HASH_GRID, search_stats.build_s());
         stats.phases.add(DETECT_NEIGHBOURS, search_stats.detect_s());
-        let nb = self.neighbours.lists();
+        let nb = self.parts.neighbours.lists();
         let m = &state.masses[..];
 
         // Lines 8–19: Jacobi iterations with the contact response.

@@ -35,7 +35,17 @@
 //!    displacement of the response (`v += (x_collided − x_uncollided) / Δt`: PBF's line 21
 //!    for a projected particle, the unchanged velocity otherwise).
 //!
-//! **Scaling factor (eq. 8).** `δ = −1 / (β (−Σ_j ∇W_ij · Σ_j ∇W_ij − Σ_j ∇W_ij · ∇W_ij))`
+//! **Shape of the crate.** Like every solver of the workspace (`sph_solver`'s "Adding a
+//! solver"): `params.rs` ([`PcisphParams`], with [`MAX_PRESSURE_ITERATIONS`]), `kernels.rs`
+//! (Poly6, Spiky, `δ`; the density kernel [`PCISPH_KERNEL`]), `scratch.rs` and `solver.rs`
+//! ([`PcisphScheme`], the [`SubstepScheme`] of one time step, whose passes are short enough
+//! to stay in it). [`Pcisph`] is `FrameSolver<R, PcisphScheme<R>>`: the workspace's one
+//! frame shell runs the frame and implements [`FluidSolver`]; [`PcisphScheme::delta`] and
+//! [`PcisphScheme::pressure`] are methods of [`Pcisph`] through `Deref`. PCISPH starts every
+//! time step from `p = 0`, so it carries nothing between frames besides the particles and
+//! the frame count ([`FluidSolver::save_state`]).
+//!
+//! //! **Scaling factor (eq. 8).** `δ = −1 / (β (−Σ_j ∇W_ij · Σ_j ∇W_ij − Σ_j ∇W_ij · ∇W_ij))`
 //! with `β = Δt² m² 2/ρ0²`, evaluated once, in [`PcisphParams::scaling_factor`], for a
 //! prototype particle at the origin of a full simple cubic lattice of spacing
 //! `particle_spacing` (all lattice points within `h`) with the prototype mass
@@ -167,34 +177,17 @@
 //! chunks, so the results are bitwise identical for any number of threads; the particles are
 //! reordered by cell every `reorder_every` calls ([`Pcisph::last_permutation`]).
 
+mod kernels;
 mod params;
+mod scratch;
 mod solver;
 
-pub use params::{PcisphParams, DEFAULT_PCISPH_XSPH};
-pub use solver::{Pcisph, PCISPH_PHASES};
+pub use kernels::PCISPH_KERNEL;
+pub use params::{PcisphParams, DEFAULT_PCISPH_XSPH, MAX_PRESSURE_ITERATIONS};
+pub use solver::{Pcisph, PcisphScheme, PCISPH_PHASES};
 
 pub use sph_core::{ParticleSet, Real, Vec3};
 pub use sph_solver::{
-    Boundary, CollisionBoundary, CommonParams, FluidSolver, Solids, SolverError, StepStats,
+    Boundary, CollisionBoundary, CommonParams, FluidSolver, FrameSolver, KernelKind, Solids,
+    SolverError, SolverState, StepStats, SubstepScheme,
 };
-
-impl<R: Real> FluidSolver<R> for Pcisph<R> {
-    fn step(&mut self, state: &mut ParticleSet<R>) -> Result<StepStats, SolverError> {
-        Pcisph::step(self, state)
-    }
-    fn common(&self) -> &CommonParams<R> {
-        &self.params().common
-    }
-    fn boundary(&self) -> &dyn Boundary<R> {
-        Pcisph::boundary(self)
-    }
-    fn last_permutation(&self) -> Option<&[u32]> {
-        Pcisph::last_permutation(self)
-    }
-    fn name(&self) -> &'static str {
-        "PCISPH"
-    }
-    fn phase_names(&self) -> &'static [&'static str] {
-        PCISPH_PHASES
-    }
-}

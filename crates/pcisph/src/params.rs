@@ -3,6 +3,12 @@
 use sph_core::Real;
 use sph_solver::{CommonParams, SolverError};
 
+/// Most prediction-correction iterations per time step ([`PcisphParams::pressure_iterations`])
+/// accepted, bounded by what can finish: Macklin & Müller (2013, §8) run 4, SPlisHSPlasH
+/// caps its PCISPH at 100; an iteration is two neighbour passes, so beyond 1000 a frame takes
+/// minutes while the density error no longer changes.
+pub const MAX_PRESSURE_ITERATIONS: usize = 1000;
+
 /// Parameters of [`crate::Pcisph`]. Lengths are absolute, in metres; SI units throughout.
 ///
 /// Build them with [`PcisphParams::for_spacing`] (or [`Default`], `for_spacing(0.025)`),
@@ -135,9 +141,13 @@ impl<R: Real> PcisphParams<R> {
     /// invalid one.
     pub fn validate(&self) -> Result<(), SolverError> {
         self.common.validate("PCISPH")?;
-        if self.pressure_iterations == 0 {
-            return Err(invalid("pressure_iterations", 0.0, "must be >= 1"));
-        }
+        self.common.check_iteration_count(
+            "PCISPH",
+            "pressure_iterations",
+            self.pressure_iterations,
+            MAX_PRESSURE_ITERATIONS,
+            "must be at most 1000 per time step (MAX_PRESSURE_ITERATIONS: a run must be able to finish)",
+        )?;
         if let Some(t) = self.density_error_tolerance {
             if !(t.is_finite_value() && t > R::zero()) {
                 return Err(invalid(

@@ -1,20 +1,19 @@
-//! The PCISPH time step (see the crate documentation for the equations).
+//! The PCISPH time step (see the crate documentation for the equations), one per
+//! [`SubstepScheme::substep`] of the frame shell.
 
-use std::fmt;
 use std::time::Instant;
 
-use neighbour_search::NeighbourLists;
 use rayon::prelude::*;
-use sph_core::{ParticleSet, Real, Sdf, Vec3};
-use sph_kernels::{Kernel, Poly6, Spiky};
-use sph_solver::boundary::check_volume_kernel;
+use sph_core::{ParticleSet, Real, Vec3};
+use sph_kernels::{Kernel, KernelKind};
 use sph_solver::step::{
-    begin_frame, check_divergence, check_predicted, density_at, end_frame, CellReorder,
-    FramePhases, StepAt, StepNeighbours, MIN_LEN,
+    check_divergence, check_predicted, density_at, FramePhases, StepAt, MIN_LEN,
 };
-use sph_solver::{Boundary, CollisionBoundary, Solids, SolverError, StepStats};
+use sph_solver::{CommonParams, FrameSolver, SchemeParts, SolverError, StepStats, SubstepScheme};
 
-use crate::PcisphParams;
+use crate::kernels::{Consts, PCISPH_KERNEL};
+use crate::params::PcisphParams;
+use crate::scratch::Scratch;
 
 /// The phases [`Pcisph::step`] times ([`StepStats::phases`]).
 pub const PCISPH_PHASES: &[&str] = &[
@@ -31,99 +30,20 @@ const DETECT_NEIGHBOURS: usize = 2;
 const PRESSURE_SOLVE: usize = 3;
 const VELOCITY_UPDATE: usize = 4;
 const REORDER: usize = 5;
-const FRAME: FramePhases = FramePhases {
-    checks: INTEGRATE,
-    reorder: REORDER,
-    statistics: VELOCITY_UPDATE,
-};
-
 const NAME: &str = "PCISPH";
 
-/// Kernels and constants of the per-particle loops.
-#[derive(Debug, Clone, Copy)]
-struct Consts<R: Real> {
-    poly6: Poly6<R>,
-    spiky: Spiky<R>,
-    rho0: R,
-    inv_rho0: R,
-    /// `1/ρ0²` of the pressure force.
-    inv_rho0_sq: R,
-    delta: R,
-}
-
-impl<R: Real> Consts<R> {
-    fn new(p: &PcisphParams<R>) -> Result<Self, SolverError> {
-        let h = p.common.support_radius;
-        let poly6 = Poly6::new(h)?;
-        let rho0 = p.common.rest_density;
-        let inv_rho0 = R::one() / rho0;
-        Ok(Self {
-            poly6,
-            spiky: Spiky::new(h)?,
-            rho0,
-            inv_rho0,
-            inv_rho0_sq: inv_rho0 * inv_rho0,
-            delta: p.scaling_factor()?,
-        })
-    }
-}
-
-/// Per-particle working arrays (structure of arrays), kept between steps.
-#[derive(Debug, Clone, Default)]
-struct Scratch<R: Real> {
-    /// Velocity after the non-pressure velocity change (XSPH), `v_i` of the loop.
-    velocity: Vec<Vec3<R>>,
-    /// Predicted positions `x*` (after the contact response); at the end, the final
-    /// positions.
-    predicted: Vec<Vec3<R>>,
-    pressure: Vec<R>,
-    /// Pressure acceleration `F^p_i / m_i`.
-    accel: Vec<Vec3<R>>,
-    /// `∇Ψ` of a volume boundary at `x(t)` (zero otherwise).
-    boundary_grad: Vec<Vec3<R>>,
-    density: Vec<R>,
-    velocity_new: Vec<Vec3<R>>,
-    partials: Vec<[f64; 3]>,
-}
-
-impl<R: Real> Scratch<R> {
-    fn resize(&mut self, n: usize) {
-        if self.predicted.len() == n {
-            return;
-        }
-        let z = Vec3::zeros();
-        self.velocity.resize(n, z);
-        self.predicted.resize(n, z);
-        self.pressure.resize(n, R::zero());
-        self.accel.resize(n, z);
-        self.boundary_grad.resize(n, z);
-        self.density.resize(n, R::zero());
-        self.velocity_new.resize(n, z);
-    }
-}
-
 /// The PCISPH solver of Solenthaler & Pajarola (2009); see the crate documentation.
-pub struct Pcisph<R: Real> {
+pub type Pcisph<R> = FrameSolver<R, PcisphScheme<R>>;
+
+/// The time step of [`Pcisph`] as a [`SubstepScheme`] (its parameters, kernels and `δ`,
+/// working arrays, boundary and neighbour search). PCISPH starts every time step from
+/// `p = 0`, so it carries nothing from one frame to the next besides the particles.
+#[derive(Debug)]
+pub struct PcisphScheme<R: Real> {
     params: PcisphParams<R>,
     c: Consts<R>,
-    boundary: Box<dyn Boundary<R>>,
-    neighbours: StepNeighbours<R>,
+    parts: SchemeParts<R>,
     scratch: Scratch<R>,
-    reorder: CellReorder<R>,
-    steps: u64,
-}
-
-impl<R: Real> fmt::Debug for Pcisph<R> {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("Pcisph")
-            .field("params", &self.params)
-            .field("delta", &self.c.delta)
-            .field("boundary", &self.boundary.name())
-            .field("solids", &self.boundary.solids().len())
-            .field("particles", &self.scratch.predicted.len())
-            .field("steps", &self.steps)
-            .finish()
-    }
 }
 
 /// Symplectic Euler with total acceleration `a`: `v* = v + Δt a` and the position
@@ -134,59 +54,62 @@ fn advance<R: Real>(x: Vec3<R>, v: Vec3<R>, a: Vec3<R>, dt: R) -> (Vec3<R>, Vec3
     (v_star, x + v_star * dt)
 }
 
-impl<R: Real> Pcisph<R> {
-    /// A solver with validated `params` and the given solids as a [`CollisionBoundary`]
-    /// with the particle radius `s / 2` as contact distance. Computes `δ`.
-    pub fn new(params: PcisphParams<R>, solids: Solids<R>) -> Result<Self, SolverError> {
-        let boundary = CollisionBoundary::new(solids, params.particle_radius())?;
-        Self::with_boundary(params, Box::new(boundary))
-    }
+impl<R: Real> SubstepScheme<R> for PcisphScheme<R> {
+    type Params = PcisphParams<R>;
+    const NAME: &'static str = NAME;
+    const PHASES: &'static [&'static str] = PCISPH_PHASES;
+    const FRAME_PHASES: FramePhases = FramePhases {
+        checks: INTEGRATE,
+        reorder: REORDER,
+        statistics: VELOCITY_UPDATE,
+    };
+    const DENSITY_KERNEL: KernelKind = PCISPH_KERNEL;
 
-    /// A solver with validated `params` and any boundary model. A boundary that takes part
-    /// in the density must have been integrated with Poly6 of this solver's support radius,
-    /// otherwise [`SolverError::InvalidParameter`].
-    pub fn with_boundary(
-        params: PcisphParams<R>,
-        boundary: Box<dyn Boundary<R>>,
-    ) -> Result<Self, SolverError> {
-        params.validate()?;
-        check_volume_kernel(&*boundary, NAME, "poly6", params.common.support_radius)?;
-        let c = Consts::new(&params)?;
+    fn validate(params: &PcisphParams<R>) -> Result<(), SolverError> {
+        params.validate()
+    }
+    fn common_of(params: &PcisphParams<R>) -> &CommonParams<R> {
+        &params.common
+    }
+    fn new(params: PcisphParams<R>, parts: SchemeParts<R>) -> Result<Self, SolverError> {
         Ok(Self {
-            neighbours: StepNeighbours::new(params.common.neighbour_method),
+            c: Consts::new(&params)?,
             params,
-            c,
-            boundary,
+            parts,
             scratch: Scratch::default(),
-            reorder: CellReorder::default(),
-            steps: 0,
         })
     }
-
-    /// The parameters.
-    pub fn params(&self) -> &PcisphParams<R> {
+    fn params(&self) -> &PcisphParams<R> {
         &self.params
     }
+    fn parts(&self) -> &SchemeParts<R> {
+        &self.parts
+    }
+    fn begin_frame(
+        &mut self,
+        state: &mut ParticleSet<R>,
+        _permutation: Option<&[u32]>,
+        _stats: &mut StepStats,
+    ) -> Result<(), SolverError> {
+        self.scratch.resize(state.len());
+        Ok(())
+    }
+    fn substep(
+        &mut self,
+        state: &mut ParticleSet<R>,
+        at: StepAt,
+        _last: bool,
+        stats: &mut StepStats,
+    ) -> Result<(), SolverError> {
+        self.time_step(state, at, stats)
+    }
+}
 
+impl<R: Real> PcisphScheme<R> {
     /// The scaling factor `δ` of S&P09 eq. 8 (m²/s²), computed once by [`Pcisph::new`]
     /// ([`PcisphParams::scaling_factor`]).
     pub fn delta(&self) -> R {
         self.c.delta
-    }
-
-    /// The boundary.
-    pub fn boundary(&self) -> &dyn Boundary<R> {
-        &*self.boundary
-    }
-
-    /// The solids, in the order contacts are resolved.
-    pub fn solids(&self) -> &[Box<dyn Sdf<R>>] {
-        self.boundary.solids()
-    }
-
-    /// The neighbour lists of the last time step (found at its start positions).
-    pub fn neighbours(&self) -> &NeighbourLists {
-        self.neighbours.lists()
     }
 
     /// The pressures `p_i` (Pa) at the end of the last time step's iterations.
@@ -194,71 +117,18 @@ impl<R: Real> Pcisph<R> {
         &self.scratch.pressure
     }
 
-    /// Number of [`Pcisph::step`] calls made (including failed ones).
-    pub fn steps_done(&self) -> u64 {
-        self.steps
-    }
-
-    /// The permutation applied to the particles at the start of the last [`Pcisph::step`]
-    /// call (`new[k] = old[perm[k]]`), or `None` if that call did not reorder.
-    pub fn last_permutation(&self) -> Option<&[u32]> {
-        self.reorder.last_permutation()
-    }
-
-    /// Advances `state` by one whole frame, `common.dt` (16 ms by default), made of
-    /// `common.substeps` PCISPH time steps (see the crate documentation): one call is a
-    /// frame, not one time step.
-    ///
-    /// **Particle order.** Every `common.reorder_every` calls (the first call included), the
-    /// call begins by reordering the particles of `state` by grid cell: afterwards
-    /// [`Pcisph::last_permutation`] returns `perm` with `new[k] = old[perm[k]]` (`None` when
-    /// the call did not reorder). To follow particles, keep an index map `ids` (initially
-    /// `0..n`) and compose it after each call, `ids = perm.iter().map(|&o| ids[o as
-    /// usize]).collect()`, so `ids[k]` is the original index of the particle now at `k`
-    /// (the `pbf` and `sph-scene` crate examples show it); `reorder_every = 0` keeps the
-    /// input order.
-    ///
-    /// Checks the state first ([`SolverError::InvalidState`], [`SolverError::InvalidMass`]),
-    /// reorders it by cell every `reorder_every` calls, and after each time step checks for
-    /// divergence before writing its result into `state` ([`SolverError::BlowUp`]; `state`
-    /// then holds the last completed time step, never a non-finite value). Writes positions,
-    /// velocities and densities (at the final positions). Does not allocate once its buffers
-    /// have grown.
-    pub fn step(&mut self, state: &mut ParticleSet<R>) -> Result<StepStats, SolverError> {
-        let step = self.steps;
-        self.steps += 1;
-        let mut stats = StepStats::new(PCISPH_PHASES);
-        let common = &self.params.common;
-        begin_frame(state, &mut self.reorder, common, step, FRAME, &mut stats)?;
-        self.scratch.resize(state.len());
-
-        for sub in 0..self.params.common.substeps {
-            let at = StepAt {
-                solver: NAME,
-                step,
-                substep: sub,
-            };
-            self.substep(state, at, &mut stats)?;
-        }
-
-        end_frame(
-            state,
-            self.params.common.rest_density,
-            &mut self.scratch.partials,
-            FRAME,
-            &mut stats,
-        );
-        Ok(stats)
-    }
-
-    fn substep(
+    fn time_step(
         &mut self,
         state: &mut ParticleSet<R>,
         at: StepAt,
         stats: &mut StepStats,
     ) -> Result<(), SolverError> {
-        let volume = self.boundary.has_volume().then_some(&*self.boundary);
-        let boundary = &*self.boundary;
+        let volume = self
+            .parts
+            .boundary
+            .has_volume()
+            .then_some(&*self.parts.boundary);
+        let boundary = &*self.parts.boundary;
         let p = &self.params;
         let c = self.c;
         let dt = p.substep_dt();
@@ -274,10 +144,10 @@ impl<R: Real> Pcisph<R> {
         );
 
         // Step 1: neighbours once, at the current positions.
-        let search_stats = self.neighbours.find_in_step(x, h, at, "position")?;
+        let search_stats = self.parts.neighbours.find_in_step(x, h, at, "position")?;
         stats.phases.add(CREATE_HASH_GRID, search_stats.build_s());
         stats.phases.add(DETECT_NEIGHBOURS, search_stats.detect_s());
-        let nb = self.neighbours.lists();
+        let nb = self.parts.neighbours.lists();
 
         // Step 2: non-pressure forces (XSPH, gravity), p = 0, first prediction; the
         // boundary's ∇Ψ at x(t) for the pressure force.

@@ -112,7 +112,7 @@ impl<'a, R: Real> DensitySum<'a, R> {
     ) -> Result<Self, SolverError> {
         let h = common.support_radius;
         let built = kernel.build::<f64>(h.as_f64())?;
-        check_volume_kernel(boundary, "initial masses", built.name(), h)?;
+        check_volume_kernel(boundary, "initial masses", kernel, h)?;
         let mut neighbours = StepNeighbours::new(common.neighbour_method);
         neighbours.find(positions, h)?;
         let rest_density = common.rest_density.as_f64();

@@ -16,12 +16,40 @@
 //!   Implicit Boundary Representation for SPH", MIG '19), where the walls take part in the
 //!   density.
 //!
-//! Adding a solver means one crate that implements [`FluidSolver`] on top of this one; no
-//! solver depends on another.
+//! - [`FrameSolver`]: the one frame shell. A solver is a [`SubstepScheme`] (its name, phase
+//!   table, density kernel as a [`KernelKind`], parameters and one time step); the shell
+//!   checks and reorders the state, runs the substeps, times the phases, keeps the frame
+//!   counter and implements [`FluidSolver`] once for every solver.
+//! - [`SolverState`]: what a solver carries from one frame to the next besides the
+//!   particles ([`FluidSolver::save_state`], [`FluidSolver::restore_state`]), for runs that
+//!   resume bit for bit from a checkpoint.
+//!
+//! # Adding a solver
+//!
+//! A new solver (DFSPH, say) is one crate that depends on this one and on no other solver,
+//! shaped like `pbf`, `pcisph` and `iisph-granular`:
+//!
+//! - `params.rs`: its parameters with `common: CommonParams<R>` and a `validate` that bounds
+//!   every iteration count by a named public maximum;
+//! - `kernels.rs`: the kernels and constants of its loops, built once from the parameters;
+//! - `scratch.rs`: its per-particle buffers (structure of arrays), resized once per frame;
+//! - `passes.rs`: the per-particle loops (each writes one particle's values, so results do
+//!   not depend on the thread count);
+//! - `solver.rs`: `pub struct DfsphScheme<R>` implementing [`SubstepScheme`] (name,
+//!   `PHASES`, `FRAME_PHASES`, `DENSITY_KERNEL`, `validate`, `new`, `begin_frame`,
+//!   `substep`, and `save_arrays`/`restore_arrays` when it carries anything between frames,
+//!   e.g. warm-started pressures) and `pub type Dfsph<R> = FrameSolver<R, DfsphScheme<R>>`.
+//!
+//! `Dfsph::new(params, solids)` and `Dfsph::with_boundary(params, boundary)` then exist, and
+//! `Dfsph<R>` is a [`FluidSolver`]. Scene files reach it through one variant of
+//! `sph_scene::SolverSpec` and one arm of `sph_sim::factory::build_solver`
+//! (`Ok(Box::new(Dfsph::with_boundary(p, b).map_err(setup)?))`).
 
 pub mod boundary;
 pub mod csr;
 mod error;
+mod fluid_solver;
+pub mod frame;
 pub mod initial;
 mod params;
 pub mod state;
@@ -36,62 +64,14 @@ pub use boundary::{
     VolumeMapStats,
 };
 pub use error::{MapFileProblem, SolverError};
-pub use params::{CommonParams, DEFAULT_SUPPORT_OVER_SPACING, MAX_SUBSTEPS};
+pub use fluid_solver::{FluidSolver, Solids};
+pub use frame::{FrameSolver, SchemeParts, SubstepScheme};
+pub use params::{
+    CommonParams, DEFAULT_SUPPORT_OVER_SPACING, MAX_ITERATIONS_PER_FRAME, MAX_SUBSTEPS,
+};
 pub use state::{ArraySpec, SolverState};
 pub use stats::{PhaseTimes, StepStats, MAX_PHASES};
 
 pub use neighbour_search::{Method, NeighbourLists};
 pub use sph_core::{ParticleSet, Real, Sdf, Vec3};
-
-/// The solids of a scene: signed distance fields, negative inside the solid (a tank is
-/// `sph_core::Inverted<sph_core::BoxSdf>`).
-pub type Solids<R> = Vec<Box<dyn Sdf<R>>>;
-
-/// A particle solver advancing a [`ParticleSet`] by one frame per call: the object-safe
-/// common interface of the workspace's solvers.
-pub trait FluidSolver<R: Real>: Send {
-    /// Advances `state` by one whole frame ([`FluidSolver::frame_dt`]) of
-    /// `common().substeps` time steps. Errors leave `state` at the last completed substep,
-    /// never with a non-finite value.
-    fn step(&mut self, state: &mut ParticleSet<R>) -> Result<StepStats, SolverError>;
-    /// Time advanced by one [`FluidSolver::step`] call (s).
-    fn frame_dt(&self) -> R {
-        self.common().dt
-    }
-    /// The parameters every solver has.
-    fn common(&self) -> &CommonParams<R>;
-    /// The boundary (solids and their model).
-    fn boundary(&self) -> &dyn Boundary<R>;
-    /// The permutation applied to the particles by the last step (`new[k] = old[perm[k]]`),
-    /// or `None` if it did not reorder. Apply it to anything kept per particle beside the
-    /// state (`sph_core::apply_permutation`) to track particles across reordering.
-    fn last_permutation(&self) -> Option<&[u32]>;
-    /// Short name for reports, e.g. `"PBF"`.
-    fn name(&self) -> &'static str;
-    /// The names of the phases its [`StepStats::phases`] report, in order.
-    fn phase_names(&self) -> &'static [&'static str];
-    /// Passive points the solver advects beside the particles (e.g. the high-resolution
-    /// points of an upscaling), to be written with the output; `None` (the default) when it
-    /// has none.
-    fn passive_points(&self) -> Option<&[Vec3<R>]> {
-        None
-    }
-    /// Everything the solver carries from one frame to the next besides the
-    /// [`ParticleSet`] (TEMPORARY default until the frame shell lands).
-    fn save_state(&self) -> SolverState<R> {
-        SolverState::new(self.name(), 0, Vec::new())
-    }
-    /// Takes back a [`FluidSolver::save_state`] (TEMPORARY default until the frame shell
-    /// lands: refuses).
-    fn restore_state(
-        &mut self,
-        state: &SolverState<R>,
-        particles: usize,
-    ) -> Result<(), SolverError> {
-        let _ = (state, particles);
-        Err(SolverError::InvalidSolverState {
-            solver: self.name().into(),
-            reason: "not supported yet".into(),
-        })
-    }
-}
+pub use sph_kernels::KernelKind;

@@ -4,16 +4,27 @@ use neighbour_search::Method;
 use sph_core::{Real, Vec3};
 use sph_kernels::{Kernel, Spiky};
 
-use crate::SolverError;
+use crate::error::SolverError;
 
 /// Ratio `h / s` of the support radius to the particle spacing used by
 /// [`CommonParams::for_spacing`]: `h = 2 s` (26 neighbours on a simple cubic lattice; the
 /// value of SPlisHSPlasH's dam-break scene, `s = 0.025 m`, `h = 0.05 m`).
 pub const DEFAULT_SUPPORT_OVER_SPACING: f64 = 2.0;
 
-/// Most substeps per frame a solver accepts: beyond this a frame is a mistake (a frame of
-/// 16 ms in 100 000 substeps is a 0.16 µs step), not a simulation.
-pub const MAX_SUBSTEPS: usize = 100_000;
+/// Most substeps per frame a solver accepts, bounded by what can finish: 100 000 substeps
+/// took 40 minutes for 3 frames of a quick scene (2026-11), so 10 000 is at most a few
+/// minutes per quick frame; a frame of 16 ms in 10 000 substeps is a 1.6 µs step, far below
+/// any CFL limit of the workspace's scenes (they use 2–32). A shorter frame (`dt`) gives
+/// shorter steps.
+pub const MAX_SUBSTEPS: usize = 10_000;
+
+/// Most solver iterations per frame (`substeps` × the maximum iteration count per time
+/// step of any iterative solve) a solver accepts, bounded by what can finish: an iteration
+/// is one or two neighbour passes (≈ 1–2 ms for a quick scene of 10⁴ particles), so
+/// 200 000 is at most a few minutes per quick frame. The shipped scenes use at most
+/// 32 × 100; the IISPH direct-solve comparison (`iisph-granular/tests/pressure_system.rs`)
+/// caps one solve at 20 000 iterations with 8 substeps.
+pub const MAX_ITERATIONS_PER_FRAME: usize = 200_000;
 
 /// Parameters shared by the particle solvers (embedded as `common` in each solver's own
 /// parameters). Lengths absolute, in metres; SI units.
@@ -130,6 +141,38 @@ impl<R: Real> CommonParams<R> {
         (d.is_finite_value() && d > R::zero()).then_some(d)
     }
 
+    /// Checks an iteration count `count` of field `name` of `solver`: at least 1, at most
+    /// `max` per time step (the solver's named maximum; `max_reason` states it, e.g. "must be
+    /// at most 1000 per time step (MAX_SOLVER_ITERATIONS)") and at most
+    /// [`MAX_ITERATIONS_PER_FRAME`] over the frame's `substeps`.
+    pub fn check_iteration_count(
+        &self,
+        solver: &'static str,
+        name: &'static str,
+        count: usize,
+        max: usize,
+        max_reason: &'static str,
+    ) -> Result<(), SolverError> {
+        let invalid = |reason| SolverError::InvalidParameter {
+            solver,
+            name,
+            value: count as f64,
+            reason,
+        };
+        if count == 0 {
+            return Err(invalid("must be >= 1"));
+        }
+        if count > max {
+            return Err(invalid(max_reason));
+        }
+        if count.saturating_mul(self.substeps) > MAX_ITERATIONS_PER_FRAME {
+            return Err(invalid(
+                "times substeps must be at most 200000 iterations per frame (MAX_ITERATIONS_PER_FRAME: a run must be able to finish)",
+            ));
+        }
+        Ok(())
+    }
+
     /// Checks every field; the error names `solver` and the first invalid field.
     pub fn validate(&self, solver: &'static str) -> Result<(), SolverError> {
         let invalid = |name, value: f64, reason| SolverError::InvalidParameter {
@@ -170,7 +213,7 @@ impl<R: Real> CommonParams<R> {
             return Err(invalid(
                 "substeps",
                 self.substeps as f64,
-                "must be at most 100000 per frame",
+                "must be at most 10000 per frame (MAX_SUBSTEPS: a run must be able to finish)",
             ));
         }
         if let Some(a) = (0..3).find(|&a| !self.gravity[a].is_finite_value()) {
@@ -204,5 +247,48 @@ impl<R: Real> CommonParams<R> {
             ));
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{CommonParams, MAX_ITERATIONS_PER_FRAME, MAX_SUBSTEPS};
+    use crate::SolverError;
+
+    fn reason(e: SolverError) -> &'static str {
+        match e {
+            SolverError::InvalidParameter { reason, .. } => reason,
+            other => panic!("{other:?}"),
+        }
+    }
+
+    /// The bounds are checked and their messages state the constants' values.
+    #[test]
+    fn counts_are_bounded_and_the_messages_state_the_bounds() {
+        let mut p = CommonParams::<f64> {
+            substeps: MAX_SUBSTEPS,
+            ..Default::default()
+        };
+        p.validate("test").unwrap();
+        p.substeps = MAX_SUBSTEPS + 1;
+        let r = reason(p.validate("test").unwrap_err());
+        assert!(r.contains(&MAX_SUBSTEPS.to_string()), "{r}");
+        p.substeps = 10;
+        let max = MAX_ITERATIONS_PER_FRAME / 10;
+        p.check_iteration_count("test", "it", max, usize::MAX, "x")
+            .unwrap();
+        let r = reason(
+            p.check_iteration_count("test", "it", max + 1, usize::MAX, "x")
+                .unwrap_err(),
+        );
+        assert!(r.contains(&MAX_ITERATIONS_PER_FRAME.to_string()), "{r}");
+        assert_eq!(
+            reason(
+                p.check_iteration_count("test", "it", 11, 10, "cap")
+                    .unwrap_err()
+            ),
+            "cap"
+        );
+        assert!(p.check_iteration_count("test", "it", 0, 10, "cap").is_err());
     }
 }

@@ -3,7 +3,7 @@
 
 use sph_core::Real;
 
-use crate::SolverError;
+use crate::error::SolverError;
 
 /// Everything a solver carries from one frame to the next besides the `ParticleSet`:
 /// [`crate::FluidSolver::save_state`] writes it, [`crate::FluidSolver::restore_state`]

@@ -18,8 +18,9 @@ pub use volume_map::{
 };
 
 use sph_core::{Real, Sdf, Vec3};
+use sph_kernels::KernelKind;
 
-use crate::SolverError;
+use crate::error::SolverError;
 
 /// What the boundary contributes to a particle at one position.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -91,20 +92,19 @@ pub trait Boundary<R: Real>: Send + Sync {
 }
 
 /// A boundary that takes part in the density ([`Boundary::has_volume`]) must have been
-/// integrated with the solver's density kernel `kernel` (a `sph_kernels` name such as
-/// `"poly6"`) at the solver's support radius `h` (relative difference at most 1e-6);
+/// integrated with the solver's density kernel `kernel` at the solver's support radius `h` (relative difference at most 1e-6);
 /// otherwise [`SolverError::InvalidParameter`] naming `solver` and `boundary`.
 pub fn check_volume_kernel<R: Real>(
     boundary: &dyn Boundary<R>,
     solver: &'static str,
-    kernel: &'static str,
+    kernel: KernelKind,
     h: R,
 ) -> Result<(), SolverError> {
     if !boundary.has_volume() {
         return Ok(());
     }
     match boundary.volume_kernel() {
-        Some((name, hb)) if name == kernel && (hb - h).abs() <= h * R::of_f64(1e-6) => Ok(()),
+        Some((name, hb)) if name == kernel.name() && (hb - h).abs() <= h * R::of_f64(1e-6) => Ok(()),
         Some((_, hb)) => Err(SolverError::InvalidParameter {
             solver,
             name: "boundary",

@@ -1,0 +1,417 @@
+//! The per-particle passes of one IISPH time step (Algorithm 1 of Ihmsen et al. 2014 with
+//! the boundary terms of Neder 2024): densities and `a_ii`, advection, predicted density,
+//! the relaxed Jacobi pressure solve, forces and integration.
+
+use neighbour_search::NeighbourLists;
+use rayon::prelude::*;
+use sph_core::{Real, Vec3};
+use sph_kernels::Kernel;
+use sph_solver::csr::par_csr_blocks;
+use sph_solver::step::{par_update_sum, MIN_LEN};
+use sph_solver::Boundary;
+
+use crate::granular::{drag_force, occlusion};
+use crate::kernels::Consts;
+use crate::params::IisphParams;
+use crate::scratch::Scratch;
+
+/// `∇W_ij` from the cached `W'(r)/r` of the pair.
+#[inline(always)]
+pub(crate) fn grad<R: Real>(xi: &Vec3<R>, xj: &Vec3<R>, f: R) -> Vec3<R> {
+    (xi - xj) * f
+}
+
+/// Eq. 3 + eq. 29: `ρ_i`, `∇Ψ_i`, `W'(r)/r` of every pair, and the diagonal `a_ii` of
+/// eq. 24 (it needs only `x`, `m` and the particle's own density):
+/// `a_ii = Σ_j m_j (d_ii − d_ji)·∇W_ij + ρ0 d_ii·∇Ψ_i
+///       = −Δt²/ρ_i² (|Σ_j m_j ∇W_ij + ρ0 ∇Ψ_i|² + m_i Σ_j m_j |∇W_ij|²)`.
+#[allow(clippy::needless_range_loop)] // k addresses the CSR pair arrays (indices, scales)
+pub(crate) fn density_pass<R: Real>(
+    c: &Consts<R>,
+    x: &[Vec3<R>],
+    m: &[R],
+    nb: &NeighbourLists,
+    volume: Option<&dyn Boundary<R>>,
+    s: &mut Scratch<R>,
+) {
+    let offsets = nb.offsets();
+    let indices = nb.indices();
+    s.grad_scale.resize(indices.len(), R::zero());
+    let dt2 = c.dt * c.dt;
+    let outputs = (&mut s.density[..], &mut s.bgrad[..], &mut s.aii[..]);
+    par_csr_blocks(
+        offsets,
+        outputs,
+        &mut s.grad_scale[..],
+        &|first, (rho_b, bg_b, aii_b): (&mut [R], &mut [Vec3<R>], &mut [R]), gs: &mut [R]| {
+            let base = offsets[first];
+            let block = rho_b.iter_mut().zip(bg_b.iter_mut()).zip(aii_b.iter_mut());
+            for (l, ((rho, bg), aii)) in block.enumerate() {
+                let i = first + l;
+                let (xi, mi) = (x[i], m[i]);
+                let mut sum = mi * c.w0;
+                let mut sum_grad = Vec3::zeros();
+                let mut sum_grad_sq = R::zero();
+                for k in offsets[i]..offsets[i + 1] {
+                    let j = indices[k] as usize;
+                    let d = xi - x[j];
+                    let r = d.norm();
+                    sum += m[j] * c.kernel.value(r);
+                    let f = if r > R::zero() {
+                        c.kernel.derivative(r) / r
+                    } else {
+                        R::zero()
+                    };
+                    gs[k - base] = f;
+                    let gw = d * f;
+                    sum_grad += gw * m[j];
+                    sum_grad_sq += m[j] * gw.norm_squared();
+                }
+                if let Some(b) = volume {
+                    let smp = b.sample(&xi);
+                    sum += c.rho0 * smp.volume;
+                    *bg = smp.volume_gradient;
+                } else {
+                    *bg = Vec3::zeros();
+                }
+                *rho = sum;
+                let gi = sum_grad + *bg * c.rho0;
+                *aii = -dt2 / (sum * sum) * (gi.norm_squared() + mi * sum_grad_sq);
+            }
+            0.0
+        },
+    );
+}
+
+/// Eqs. 5–6 and 17–18: drag, viscosity, `v^adv`; the warm start `p⁰ = p(t − Δt) / 2` and
+/// its `p/ρ²`.
+pub(crate) fn advection_pass<R: Real>(
+    c: &Consts<R>,
+    g: Vec3<R>,
+    x: &[Vec3<R>],
+    v: &[Vec3<R>],
+    m: &[R],
+    nb: &NeighbourLists,
+    s: &mut Scratch<R>,
+) {
+    let offsets = nb.offsets();
+    let indices = nb.indices();
+    let (rho, gs) = (&s.density[..], &s.grad_scale[..]);
+    let half = R::of_f64(0.5);
+    let eps_h2 = R::of_f64(0.01) * c.h * c.h;
+    let neighbour_terms = c.drag || c.visc > R::zero();
+    // The body for particle i: writes v^adv, the warm start and p/ρ².
+    let body = |i: usize, va: &mut Vec3<R>, pr: &mut R, pi: &mut R| {
+        let (xi, vi, mi, rhoi) = (x[i], v[i], m[i], rho[i]);
+        *pr *= half;
+        *pi = *pr / (rhoi * rhoi);
+        if !neighbour_terms {
+            *va = vi + g * c.dt;
+            return;
+        }
+        let mut visc = Vec3::zeros();
+        let upstream = {
+            let rel = c.air_velocity - vi;
+            let len = rel.norm();
+            if c.drag && len > R::zero() {
+                -rel / len
+            } else {
+                Vec3::zeros()
+            }
+        };
+        let mut occ = R::zero();
+        for k in offsets[i]..offsets[i + 1] {
+            let j = indices[k] as usize;
+            let xj = x[j];
+            if c.visc > R::zero() {
+                let gw = grad(&xi, &xj, gs[k]);
+                let vol_j = m[j] / rho[j];
+                let xij = xi - xj;
+                visc += gw * (vol_j * (vi - v[j]).dot(&xij) / (xij.norm_squared() + eps_h2));
+            }
+            if c.drag {
+                occ = occ.max(occlusion(&upstream, &(xj - xi), c.cos_cone));
+            }
+        }
+        let mut acc = g + visc * c.visc;
+        if c.drag {
+            let f = drag_force(
+                c.air_velocity - vi,
+                c.air_density,
+                c.drag_coefficient,
+                c.area,
+                R::one() - occ,
+            );
+            acc += f / mi;
+        }
+        *va = vi + acc * c.dt;
+    };
+    s.v_adv
+        .par_iter_mut()
+        .zip(s.pressure.par_iter_mut())
+        .zip(s.p_over_rho2.par_iter_mut())
+        .enumerate()
+        .with_min_len(MIN_LEN)
+        .for_each(|(i, ((va, pr), pi))| body(i, va, pr, pi));
+}
+
+/// Eq. 19 (with the boundary term): the source `ρ0 − ρ_i^adv`; fused with the pressure
+/// accelerations of the warm start `p⁰` (the first half of the first Jacobi iteration,
+/// which reads the same neighbour data).
+pub(crate) fn predicted_density_pass<R: Real>(
+    c: &Consts<R>,
+    x: &[Vec3<R>],
+    m: &[R],
+    nb: &NeighbourLists,
+    s: &mut Scratch<R>,
+) {
+    let offsets = nb.offsets();
+    let indices = nb.indices();
+    let (rho, gs, bgrad, va, pi) = (
+        &s.density[..],
+        &s.grad_scale[..],
+        &s.bgrad[..],
+        &s.v_adv[..],
+        &s.p_over_rho2[..],
+    );
+    s.source
+        .par_iter_mut()
+        .zip(s.accel.par_iter_mut())
+        .enumerate()
+        .with_min_len(MIN_LEN)
+        .for_each(|(i, (src, acc))| {
+            let (xi, vai, p_i) = (x[i], va[i], pi[i]);
+            let mut div = R::zero();
+            let mut a = Vec3::zeros();
+            for k in offsets[i]..offsets[i + 1] {
+                let j = indices[k] as usize;
+                let gw = grad(&xi, &x[j], gs[k]);
+                div += m[j] * (vai - va[j]).dot(&gw);
+                a -= gw * (m[j] * (p_i + pi[j]));
+            }
+            div += c.rho0 * vai.dot(&bgrad[i]);
+            let rho_adv = rho[i] + c.dt * div;
+            *src = c.rho0 - rho_adv;
+            *acc = a - bgrad[i] * (c.rho0 * p_i);
+        });
+}
+
+/// The pressure acceleration `F^p_i/m_i = −Σ_j m_j (p_i/ρ_i² + p_j/ρ_j²) ∇W_ij − ρ0 (p_i/ρ_i²)
+/// ∇Ψ_i` (eqs. 25 and 31) from `p/ρ²`.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn pressure_accel<R: Real>(
+    c: &Consts<R>,
+    x: &[Vec3<R>],
+    m: &[R],
+    offsets: &[usize],
+    indices: &[u32],
+    gs: &[R],
+    pi: &[R],
+    bgrad: &[Vec3<R>],
+    i: usize,
+) -> Vec3<R> {
+    let (xi, p_i) = (x[i], pi[i]);
+    let mut a = Vec3::zeros();
+    for k in offsets[i]..offsets[i + 1] {
+        let j = indices[k] as usize;
+        a -= grad(&xi, &x[j], gs[k]) * (m[j] * (p_i + pi[j]));
+    }
+    a - bgrad[i] * (c.rho0 * p_i)
+}
+
+/// `(A p)_i = Δt² (Σ_j m_j (a_i − a_j)·∇W_ij + ρ0 a_i·∇Ψ_i)` from the pressure accelerations
+/// `a` of `p`: the predicted density change due to pressure, `ρ_i^{l} − ρ_i^adv`, i.e. the
+/// left side of Ihmsen et al.'s eq. 12 / Neder 2024 eqs. 20–23 (`a_ii p_i + ψ_i`).
+#[inline]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn a_times_p<R: Real>(
+    c: &Consts<R>,
+    x: &[Vec3<R>],
+    m: &[R],
+    offsets: &[usize],
+    indices: &[u32],
+    gs: &[R],
+    a: &[Vec3<R>],
+    bgrad: &[Vec3<R>],
+    i: usize,
+) -> R {
+    let (xi, ai) = (x[i], a[i]);
+    let mut sum = R::zero();
+    for k in offsets[i]..offsets[i + 1] {
+        let j = indices[k] as usize;
+        sum += m[j] * (ai - a[j]).dot(&grad(&xi, &x[j], gs[k]));
+    }
+    sum += c.rho0 * ai.dot(&bgrad[i]);
+    c.dt * c.dt * sum
+}
+
+/// Relaxed Jacobi (Ihmsen et al. 2014 eq. 14, Neder 2024 eq. 20) with the unilateral
+/// projection `p ≥ 0` (eq. 4): at least `min_iterations`, then until the average predicted
+/// compression is below `η`, at most `max_iterations`. Expects `accel` to hold the pressure
+/// accelerations of the starting pressures. Returns `(iterations, last average error,
+/// converged)`.
+pub(crate) fn pressure_solve<R: Real>(
+    c: &Consts<R>,
+    p: &IisphParams<R>,
+    x: &[Vec3<R>],
+    m: &[R],
+    nb: &NeighbourLists,
+    s: &mut Scratch<R>,
+) -> (usize, f64, bool) {
+    let n = x.len();
+    if n == 0 {
+        return (0, 0.0, true);
+    }
+    let offsets = nb.offsets();
+    let indices = nb.indices();
+    let omega = p.relaxation;
+    let eta = p.density_error_tolerance.as_f64();
+    let inv_rho0 = 1.0 / c.rho0.as_f64();
+    let mut error = 0.0;
+    for l in 0..p.max_iterations {
+        // Pressure accelerations of the iterate p^l (for l = 0 computed by
+        // `predicted_density_pass`).
+        if l > 0 {
+            let (gs, pi, bgrad) = (&s.grad_scale[..], &s.p_over_rho2[..], &s.bgrad[..]);
+            s.accel
+                .par_iter_mut()
+                .enumerate()
+                .with_min_len(MIN_LEN)
+                .for_each(|(i, a)| {
+                    *a = pressure_accel(c, x, m, offsets, indices, gs, pi, bgrad, i);
+                });
+        }
+        // A p^l, the density error of p^l, and the update p^{l+1}.
+        {
+            let (gs, acc, bgrad, src, aii, rho) = (
+                &s.grad_scale[..],
+                &s.accel[..],
+                &s.bgrad[..],
+                &s.source[..],
+                &s.aii[..],
+                &s.density[..],
+            );
+            let update = |i: usize, pr: &mut R, pi: &mut R| -> f64 {
+                let ap = a_times_p(c, x, m, offsets, indices, gs, acc, bgrad, i);
+                let a = aii[i];
+                let next = if a < R::zero() {
+                    let q = *pr + omega * (src[i] - ap) / a;
+                    if q > R::zero() {
+                        q
+                    } else {
+                        R::zero()
+                    }
+                } else {
+                    R::zero()
+                };
+                *pr = next;
+                *pi = next / (rho[i] * rho[i]);
+                // ρ_i^l − ρ0 = (A p)_i − (ρ0 − ρ_i^adv), counted where positive.
+                (ap - src[i]).as_f64().max(0.0)
+            };
+            let total = par_update_sum(
+                &mut s.pressure,
+                &mut s.p_over_rho2,
+                &mut s.error_partials,
+                update,
+            );
+            error = total / n as f64 * inv_rho0;
+        }
+        if l + 1 >= p.min_iterations && error <= eta {
+            return (l + 1, error, true);
+        }
+    }
+    (p.max_iterations, error, false)
+}
+
+/// Line 14 (pressure and friction forces, eqs. 25–26 and 30–31) and line 15 (symplectic
+/// Euler, eqs. 27–28), with the boundary's contact response on the new positions. A
+/// granular step takes the velocity the friction solve left in `v_trial` (which holds both
+/// forces); water adds the pressure acceleration to `v^adv`.
+pub(crate) fn forces_pass<R: Real>(
+    c: &Consts<R>,
+    x: &[Vec3<R>],
+    m: &[R],
+    nb: &NeighbourLists,
+    boundary: &dyn Boundary<R>,
+    s: &mut Scratch<R>,
+) {
+    let offsets = nb.offsets();
+    let indices = nb.indices();
+    let (gs, pi, bgrad, va, vt) = (
+        &s.grad_scale[..],
+        &s.p_over_rho2[..],
+        &s.bgrad[..],
+        &s.v_adv[..],
+        &s.v_trial[..],
+    );
+    let inv_dt = R::one() / c.dt;
+    s.x_new
+        .par_iter_mut()
+        .zip(s.v_new.par_iter_mut())
+        .enumerate()
+        .with_min_len(MIN_LEN)
+        .for_each(|(i, (xn, vn))| {
+            let v_new = if c.granular {
+                vt[i]
+            } else {
+                va[i] + pressure_accel(c, x, m, offsets, indices, gs, pi, bgrad, i) * c.dt
+            };
+            let y = x[i] + v_new * c.dt;
+            let projected = boundary.project(y);
+            let push = projected - y;
+            let mut v_out = v_new + push * inv_dt;
+            if c.granular {
+                v_out = coulomb_contact(v_out, push * inv_dt, c.wall_friction);
+            }
+            *vn = v_out;
+            *xn = projected;
+        });
+}
+
+/// Coulomb friction of the contact response (granular only): a particle the boundary pushed
+/// out with the velocity change `dv_n` (along the wall normal) loses up to `μ |dv_n|` of
+/// its tangential velocity, `μ = tan θ`. It acts only where the contact safety net acts
+/// (particles the volume map's pressure did not hold off the wall, which have no
+/// confining pressure and so no Drucker–Prager friction).
+#[inline]
+fn coulomb_contact<R: Real>(v: Vec3<R>, dv_n: Vec3<R>, mu: R) -> Vec3<R> {
+    let push = dv_n.norm();
+    if push <= R::zero() || mu <= R::zero() {
+        return v;
+    }
+    let n = dv_n / push;
+    let vn = n * v.dot(&n);
+    let vt = v - vn;
+    let speed_t = vt.norm();
+    let loss = mu * push;
+    if speed_t <= loss {
+        vn
+    } else {
+        vn + vt * ((speed_t - loss) / speed_t)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::coulomb_contact;
+    use sph_core::Vec3;
+
+    /// Coulomb's law at a contact: the tangential speed drops by `μ |Δv_n|` (to zero at
+    /// most), the normal velocity is kept, and without a push nothing changes.
+    #[test]
+    fn coulomb_contact_follows_coulombs_law() {
+        let v = Vec3::new(2.0, 0.5, 0.0);
+        let push = Vec3::new(0.0, 1.0, 0.0);
+        let out = coulomb_contact(v, push, 0.5);
+        assert!((out - Vec3::new(1.5, 0.5, 0.0)).norm() < 1e-12, "{out}");
+        let stopped = coulomb_contact(v, push * 10.0, 0.5);
+        assert!(
+            (stopped - Vec3::new(0.0, 0.5, 0.0)).norm() < 1e-12,
+            "{stopped}"
+        );
+        assert_eq!(coulomb_contact(v, Vec3::zeros(), 0.5), v);
+        assert_eq!(coulomb_contact(v, push, 0.0), v);
+    }
+}

@@ -1,0 +1,72 @@
+//! The per-particle working arrays of the solver.
+
+use sph_core::{Real, Vec3};
+use sph_solver::step::REDUCE_CHUNK;
+
+use crate::granular::Sym3;
+
+/// Per-particle working arrays (structure of arrays), kept between steps.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Scratch<R: Real> {
+    /// `W'(r)/r` per neighbour pair (CSR order of the neighbour lists): `∇W_ij = (x_i − x_j)
+    /// · grad_scale[k]`.
+    pub grad_scale: Vec<R>,
+    /// `ρ_i` at the step's start positions, boundary included (eq. 3 + eq. 29).
+    pub density: Vec<R>,
+    /// `∇Ψ(x_i)` of a volume boundary.
+    pub bgrad: Vec<Vec3<R>>,
+    /// `v_i^adv` (eq. 18).
+    pub v_adv: Vec<Vec3<R>>,
+    /// Source term `ρ0 − ρ_i^adv` (eq. 19) of the linear system.
+    pub source: Vec<R>,
+    /// Diagonal `a_ii` (eq. 24), Δt² included.
+    pub aii: Vec<R>,
+    /// Pressure `p_i` (Pa); kept between steps for the warm start.
+    pub pressure: Vec<R>,
+    /// `p_i / ρ_i²`.
+    pub p_over_rho2: Vec<R>,
+    /// Pressure acceleration `F^p_i / m_i` of the current iterate.
+    pub accel: Vec<Vec3<R>>,
+    /// Frictional stress `s_i` (Pa, deviatoric, inside the yield surface); kept between
+    /// steps (the friction solve's warm start).
+    pub stress: Vec<Sym3<R>>,
+    /// `s_i / ρ_i²`.
+    pub stress_over_rho2: Vec<Sym3<R>>,
+    /// Friction acceleration `F^f_i / m_i` of the current stress.
+    pub friction_accel: Vec<Vec3<R>>,
+    /// Velocity at the step's end without friction, `v^adv + Δt (a^p − a^f_prev)`.
+    pub v_base: Vec<Vec3<R>>,
+    /// Velocity at the step's end with the current stress iterate.
+    pub v_trial: Vec<Vec3<R>>,
+    pub perm_sym: Vec<Sym3<R>>,
+    pub x_new: Vec<Vec3<R>>,
+    pub v_new: Vec<Vec3<R>>,
+    pub density_new: Vec<R>,
+    /// Partial sums of the density error per chunk of [`REDUCE_CHUNK`] particles.
+    pub error_partials: Vec<f64>,
+    pub perm_scalar: Vec<R>,
+}
+
+impl<R: Real> Scratch<R> {
+    pub(crate) fn resize(&mut self, n: usize, granular: bool) {
+        let z = Vec3::zeros();
+        self.density.resize(n, R::zero());
+        self.bgrad.resize(n, z);
+        self.v_adv.resize(n, z);
+        self.source.resize(n, R::zero());
+        self.aii.resize(n, R::zero());
+        self.pressure.resize(n, R::zero());
+        self.p_over_rho2.resize(n, R::zero());
+        self.accel.resize(n, z);
+        let ng = if granular { n } else { 0 };
+        self.stress.resize(ng, [R::zero(); 6]);
+        self.stress_over_rho2.resize(ng, [R::zero(); 6]);
+        self.friction_accel.resize(ng, z);
+        self.v_base.resize(ng, z);
+        self.v_trial.resize(ng, z);
+        self.x_new.resize(n, z);
+        self.v_new.resize(n, z);
+        self.density_new.resize(n, R::zero());
+        self.error_partials.resize(n.div_ceil(REDUCE_CHUNK), 0.0);
+    }
+}
