@@ -11,9 +11,9 @@ use sph_core::{
 };
 
 use crate::error::Ctx;
-use crate::{
-    cast3, fmt3, v3, FluidSpec, Scene, SceneError, SolidSpec, AXES, MAX_PARTICLES, MAX_SDF_NODES,
-};
+use crate::geom::{cast3, fmt3, v3, AXES};
+use crate::limits::{MAX_PARTICLES, MAX_SDF_NODES};
+use crate::{FluidSpec, Scene, SceneError, SolidSpec};
 
 impl Scene {
     /// Initial fluid particle positions (m), fluid by fluid in file order (see the crate

@@ -232,43 +232,30 @@
 //! signed distance fields.
 
 mod build;
+mod check;
 mod error;
+mod geom;
+mod limits;
 mod mesh_io;
 mod obj;
+mod params;
 mod parse;
 mod raw;
+mod read;
+mod render;
+mod solver_spec;
 mod spec;
 
-use sph_core::{Real, Vec3};
-
 pub use error::SceneError;
-pub use spec::{
-    BoundaryModel, BoundarySpec, FluidSpec, GranularSpec, IisphSpec, InitialMasses, MeshPlacement,
-    MeshSpec, OutputSpec, PbfSpec, PcisphSpec, Precision, QuickSpec, Scene, SolidSpec, SolverKind,
+pub use limits::{
+    MAX_FRAMES, MAX_MESH_FILE_BYTES, MAX_PARTICLES, MAX_SCENE_FILE_BYTES, MAX_SDF_NODES,
+};
+pub use params::SolverParams;
+pub use solver_spec::{
+    GranularSpec, IisphSettings, IisphSpec, PbfSpec, PcisphSpec, SolverCommon, SolverKind,
     SolverSpec, DEFAULT_IISPH_MAX_ITERATIONS, DEFAULT_IISPH_MIN_ITERATIONS,
 };
-
-/// Largest total number of fluid particles a scene may produce (20 M).
-pub const MAX_PARTICLES: usize = 20_000_000;
-
-/// Most frames (`duration / frame_dt`) a scene may have: 10 million, 44 hours of 16 ms
-/// frames; beyond it the frame length or the duration is a typing mistake.
-pub const MAX_FRAMES: f64 = 1e7;
-
-/// Largest number of nodes of a signed distance grid built for a mesh (16 M).
-pub const MAX_SDF_NODES: usize = 16 << 20;
-
-/// Axis names, for messages.
-const AXES: [char; 3] = ['x', 'y', 'z'];
-
-fn v3(a: [f64; 3]) -> Vec3<f64> {
-    Vec3::new(a[0], a[1], a[2])
-}
-
-fn cast3<R: Real>(v: &Vec3<f64>) -> Vec3<R> {
-    Vec3::new(R::of_f64(v.x), R::of_f64(v.y), R::of_f64(v.z))
-}
-
-fn fmt3(v: &Vec3<f64>) -> String {
-    format!("({:.6}, {:.6}, {:.6})", v.x, v.y, v.z)
-}
+pub use spec::{
+    BoundaryModel, BoundarySpec, FluidSpec, InitialMasses, MeshPlacement, MeshSpec, OutputSpec,
+    Precision, QuickSpec, Scene, SolidSpec,
+};
