@@ -19,28 +19,26 @@ impl Scene {
     /// Initial fluid particle positions (m), fluid by fluid in file order (see the crate
     /// documentation for the sampling rules).
     pub fn fluid_positions<R: Real>(&self) -> Result<Vec<Vec3<R>>, SceneError> {
-        let ctx = Ctx::new(&self.source);
-        let mut out = Vec::new();
-        for i in 0..self.fluids.len() {
-            out.extend(self.sample_fluid(&ctx, i)?.iter().map(cast3::<R>));
-        }
-        Ok(out)
+        Ok(self.fluid_particles::<R>()?.0)
     }
 
     /// Initial velocities (m/s), one per particle of [`Scene::fluid_positions`] (same order).
     pub fn fluid_velocities<R: Real>(&self) -> Result<Vec<Vec3<R>>, SceneError> {
+        Ok(self.fluid_particles::<R>()?.1)
+    }
+
+    /// The initial fluid particles from one sampling: positions (m) and velocities (m/s),
+    /// fluid by fluid in file order.
+    pub fn fluid_particles<R: Real>(&self) -> Result<(Vec<Vec3<R>>, Vec<Vec3<R>>), SceneError> {
         let ctx = Ctx::new(&self.source);
-        let mut out = Vec::new();
+        let (mut positions, mut velocities) = (Vec::new(), Vec::new());
         for (i, f) in self.fluids.iter().enumerate() {
-            let v = match f {
-                FluidSpec::Block { velocity, .. } | FluidSpec::Mesh { velocity, .. } => {
-                    cast3::<R>(&v3(*velocity))
-                }
-            };
-            let n = self.sample_fluid(&ctx, i)?.len();
-            out.extend(std::iter::repeat_n(v, n));
+            let (FluidSpec::Block { velocity, .. } | FluidSpec::Mesh { velocity, .. }) = f;
+            let pts = self.sample_fluid(&ctx, i)?;
+            velocities.extend(std::iter::repeat_n(cast3::<R>(&v3(*velocity)), pts.len()));
+            positions.extend(pts.iter().map(cast3::<R>));
         }
-        Ok(out)
+        Ok((positions, velocities))
     }
 
     /// Upper bound of the particle count of fluid `i` (lattice points over its box).

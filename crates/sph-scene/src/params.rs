@@ -99,7 +99,10 @@ impl Scene {
             SolverError::InvalidParameter { name, .. } => self.field_of_parameter(name),
             _ => "solver".to_string(),
         };
-        ctx.invalid(field, format!("{e} (in {precision})"))
+        ctx.invalid(
+            field,
+            format!("{e} (in {precision}, the precision the solver runs in)"),
+        )
     }
 
     /// The scene field a solver parameter comes from: of the fields written in `[solver]`
