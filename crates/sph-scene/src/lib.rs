@@ -2,12 +2,16 @@
 //! granular solver): fluid blocks and meshes, the tank, solid obstacles, solver parameters,
 //! duration and output.
 //!
-//! [`Scene::load`] reads and validates a file; [`Scene::fluid_positions`] samples the initial
-//! particles and [`Scene::build_solids`] builds the boundary signed distance fields (the tank
-//! first, as `Inverted<BoxSdf>`, then the solids in file order, meshes as
-//! [`GridSdf`](sph_core::GridSdf), the PBF paper's "signed distance fields stored as volume
-//! textures" after Bridson et al. 2006 / SDFGen). [`Scene::quick`] applies the optional
-//! `[quick]` overrides used by `cargo xtask validate` and `run --quick`.
+//! [`Scene::load`] reads a file and checks it ([`Scene::check`], which a program that edits
+//! a scene's fields calls again); [`Scene::fluid_particles`] samples the initial particles
+//! (positions and velocities from one sampling) and [`Scene::build_solids`] builds the
+//! boundary signed distance fields (the tank first, as `Inverted<BoxSdf>`, then the solids
+//! in file order, meshes as [`GridSdf`](sph_core::GridSdf), the PBF paper's "signed distance
+//! fields stored as volume textures" after Bridson et al. 2006 / SDFGen).
+//! [`Scene::solver_params`] makes the solver's parameters ([`SolverParams`]);
+//! [`Scene::render_info`] and [`Scene::render_params`] are the renderer's view of the scene.
+//! [`Scene::quick`] applies the optional `[quick]` overrides used by `cargo xtask validate`
+//! and `run --quick`.
 //!
 //! # Example: a scene run with the PBF solver
 //!
@@ -179,8 +183,9 @@
 //! vtk = true                       # default true
 //!
 //! [render]                         # optional: camera, light, background of the
-//!                                  # screen-space renderer (`cargo xtask render`); kept as
-//!                                  # a raw table here and checked by the `ssfr-render` crate
+//!                                  # screen-space renderer (`cargo xtask render`): the
+//!                                  # fields of `ssfr_render::RenderConfig`, resolved
+//!                                  # against the scene when it is loaded
 //!
 //! [quick]                          # optional overrides for quick mode (all optional)
 //! particle_spacing = 0.05          # m
@@ -203,12 +208,23 @@
 //!   triangles; vertices of several objects welded by exact position) so that every problem
 //!   in a mesh file is reported with its line: a malformed number, a face index that does not
 //!   exist, a file cut short before its faces, and the face an open edge belongs to.
-//! * After parsing, every value is checked: spacing, durations, radii and cells finite and
+//! * Files are read with a stated size limit: the scene file at most
+//!   [`MAX_SCENE_FILE_BYTES`], a mesh file at most [`MAX_MESH_FILE_BYTES`], and only regular
+//!   files (a named pipe, a device such as `/dev/zero` or a directory is refused by name
+//!   before it is opened).
+//! * After parsing, every value is checked ([`Scene::check`]): spacing, durations, radii and cells finite and
 //!   positive, every number finite, `min < max`, substeps/iterations ≥ 1, fluids inside the tank
 //!   (block or mesh bounds inside the tank box, every particle strictly inside it), blocks at
 //!   least one spacing thick, no fluid particle inside (or on) a solid, at most
 //!   [`MAX_PARTICLES`] particles, mesh files that exist and are closed. The scene with its
 //!   `[quick]` overrides is validated too, so [`Scene::quick`] cannot fail.
+//! * The solver's own checks of the parameters made from the scene (`validate` of
+//!   `PbfParams`, `PcisphParams`, `IisphParams`) run in the scene's precision: a tolerance of
+//!   `1e-300` is `0` in `f32` and refused at its field. A parameter a solver refuses is
+//!   reported at the scene field it comes from (the longest field written in `[solver]` or
+//!   `[simulation]` whose words are all words of the parameter's name), with its line.
+//! * The `[render]` table is resolved against the scene (image size, camera, material), so
+//!   that a scene the renderer would refuse is refused when it is loaded.
 //! * Time stepping: at most [`sph_solver::MAX_SUBSTEPS`] substeps per frame and
 //!   [`MAX_FRAMES`] frames, and a solver step of `Δt = frame_dt / substeps` must not carry a
 //!   particle farther than the support radius `h`: `(|v0| + |g| Δt) Δt <= h` with `|v0|` the
@@ -225,11 +241,14 @@
 //!
 //! # Modules
 //!
-//! The public types are in `spec.rs` ([`Scene`], [`SolverSpec`], …) and `error.rs`
-//! ([`SceneError`]); `raw.rs` holds the serde input structs, `parse.rs` the validation from
-//! them to a [`Scene`] (one function per section; `parse/solver.rs` for `[solver]`),
-//! `mesh_io.rs` OBJ loading and mesh placement, `build.rs` particle sampling and the solids'
-//! signed distance fields.
+//! The public types are in `spec.rs` ([`Scene`], [`FluidSpec`], …), `solver_spec.rs`
+//! ([`SolverSpec`] and its settings) and `error.rs` ([`SceneError`]); `raw.rs` holds the
+//! serde input structs, `parse.rs` the reading from them to a [`Scene`] (`parse/solver.rs`
+//! for `[solver]`), `check.rs` the value checks (`check/solver.rs`, `check/time_step.rs`),
+//! `params.rs` the solver parameters, `render.rs` the renderer's view, `read.rs` the
+//! size-limited file reading, `mesh_io.rs` OBJ loading and mesh placement, `build.rs`
+//! particle sampling and the solids' signed distance fields, `limits.rs` the bounds. No two
+//! modules import each other.
 
 mod build;
 mod check;
@@ -246,6 +265,7 @@ mod render;
 mod solver_spec;
 mod spec;
 
+pub use build::FluidParticles;
 pub use error::SceneError;
 pub use limits::{
     MAX_FRAMES, MAX_MESH_FILE_BYTES, MAX_PARTICLES, MAX_SCENE_FILE_BYTES, MAX_SDF_NODES,

@@ -62,11 +62,14 @@ impl<R: Real> SceneSetup<R> {
             scene.solver_params::<R>()?
         };
         let common = params.common().clone();
-        let (positions, velocities) = scene.fluid_particles::<R>()?;
-        let boundary = build_boundary(scene, &common, &positions)?;
-        let mut state =
-            ParticleSet::from_positions(positions, common.particle_mass(), common.rest_density);
-        state.velocities = velocities;
+        let fluid = scene.fluid_particles::<R>()?;
+        let boundary = build_boundary(scene, &common, &fluid.positions)?;
+        let mut state = ParticleSet::from_positions(
+            fluid.positions,
+            common.particle_mass(),
+            common.rest_density,
+        );
+        state.velocities = fluid.velocities;
         let calibration = match scene.boundary.initial_masses {
             InitialMasses::Lattice => None,
             InitialMasses::Calibrated => Some(
