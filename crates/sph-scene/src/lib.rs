@@ -46,8 +46,8 @@
 //! "#;
 //! // Mesh paths would be relative to the file's directory; this scene has none.
 //! let scene = Scene::parse_str(text, Path::new("small_dam.toml")).unwrap();
-//! let positions = scene.fluid_positions::<f64>().unwrap();
-//! assert_eq!(positions.len(), 6 * 8 * 6);
+//! let fluid = scene.fluid_particles::<f64>().unwrap(); // sampled once
+//! assert_eq!(fluid.positions.len(), 6 * 8 * 6);
 //!
 //! let mut params = PbfParams::<f64>::for_spacing(scene.particle_spacing);
 //! params.common.dt = scene.frame_dt_s; // one `step` call = one frame ...
@@ -56,8 +56,8 @@
 //! params.common.reorder_every = 3;
 //! params.solver_iterations = scene.solver.iterations();
 //! let (m, rho0) = (params.particle_mass(), params.common.rest_density);
-//! let mut state = ParticleSet::from_positions(positions, m, rho0);
-//! state.velocities = scene.fluid_velocities().unwrap();
+//! let mut state = ParticleSet::from_positions(fluid.positions, m, rho0);
+//! state.velocities = fluid.velocities;
 //! let mut solver = Pbf::new(params, scene.build_solids::<f64>().unwrap()).unwrap();
 //!
 //! // `ids[k]`: the scene's index of the particle stored at `k` now.

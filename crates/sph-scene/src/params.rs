@@ -213,7 +213,7 @@ impl Scene {
         p
     }
 
-    /// Granular IISPH: [`Scene::iisph_params`], then friction, drag and upscaling.
+    /// Granular IISPH: `iisph_params`, then friction, drag and upscaling.
     fn granular_params<R: Real>(&self, s: &GranularSpec) -> IisphParams<R> {
         let mut p = self.iisph_params::<R>(&s.iisph);
         let mut g = GranularParams::with_friction_angle(r(s.friction_angle_deg));
@@ -232,5 +232,47 @@ impl Scene {
         p.granular = Some(g);
         p.upscaling_factor = s.upscaling_factor;
         p
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use crate::Scene;
+
+    const TEXT: &str = r#"
+name = "mapping"
+[simulation]
+particle_spacing = 0.05
+duration = 0.1
+frame_dt = 0.02
+[solver]
+kind = "pbf"
+substeps = 2
+iterations = 3
+mean_compression_tolerance = 0.01
+min_iterations = 2
+[[fluid]]
+kind = "block"
+min = [0.0, 0.0, 0.0]
+max = [0.2, 0.2, 0.2]
+"#;
+
+    /// A parameter a solver refuses is named by the scene field it comes from (generic: by
+    /// the words of its name, not a list of fields).
+    #[test]
+    fn solver_parameters_map_to_scene_fields() {
+        let scene = Scene::parse_str(TEXT, Path::new("mapping.toml")).unwrap();
+        for (param, field) in [
+            ("solver_iterations", "solver.iterations"),
+            ("pressure_iterations", "solver.iterations"),
+            ("min_solver_iterations", "solver.min_iterations"),
+            ("mean_compression_tolerance", "solver.mean_compression_tolerance"),
+            ("substeps", "solver.substeps"),
+            ("support_radius", "solver"),
+        ] {
+            assert_eq!(scene.field_of_parameter(param), field, "{param}");
+        }
     }
 }
