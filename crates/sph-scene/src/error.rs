@@ -240,8 +240,7 @@ pub(crate) fn line_col(text: &str, offset: usize) -> (usize, usize) {
 /// The message of a TOML error with its line and column in `text`.
 pub(crate) fn toml_reason(text: &str, e: &toml::de::Error) -> String {
     let mut s = e.message().trim().to_string();
-    // (Errors met in values serde buffered, e.g. flattened fields, have an empty span.)
-    if let Some(span) = e.span().filter(|s| !s.is_empty()) {
+    if let Some(span) = e.span() {
         let (l, c) = line_col(text, span.start);
         let _ = write!(s, " (line {l}, column {c})");
     }
