@@ -4,7 +4,7 @@
 use anyhow::Result;
 use sph_scene::Scene;
 
-pub use sph_sim::{pbf_params, pcisph_params, SceneSim};
+pub use sph_sim::SceneSim;
 
 use crate::{workspace_root, Mode};
 

@@ -11,36 +11,46 @@ use sph_core::{
 };
 
 use crate::error::Ctx;
-use crate::{
-    cast3, fmt3, v3, FluidSpec, Scene, SceneError, SolidSpec, AXES, MAX_PARTICLES, MAX_SDF_NODES,
-};
+use crate::geom::{cast3, fmt3, v3, AXES};
+use crate::limits::{MAX_PARTICLES, MAX_SDF_NODES};
+use crate::{FluidSpec, Scene, SceneError, SolidSpec};
+
+/// The initial fluid particles of a scene ([`Scene::fluid_particles`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FluidParticles<R: Real> {
+    /// Positions (m), fluid by fluid in file order.
+    pub positions: Vec<Vec3<R>>,
+    /// Velocities (m/s), one per position.
+    pub velocities: Vec<Vec3<R>>,
+}
 
 impl Scene {
     /// Initial fluid particle positions (m), fluid by fluid in file order (see the crate
     /// documentation for the sampling rules).
     pub fn fluid_positions<R: Real>(&self) -> Result<Vec<Vec3<R>>, SceneError> {
-        let ctx = Ctx::new(&self.source);
-        let mut out = Vec::new();
-        for i in 0..self.fluids.len() {
-            out.extend(self.sample_fluid(&ctx, i)?.iter().map(cast3::<R>));
-        }
-        Ok(out)
+        Ok(self.fluid_particles::<R>()?.positions)
     }
 
     /// Initial velocities (m/s), one per particle of [`Scene::fluid_positions`] (same order).
     pub fn fluid_velocities<R: Real>(&self) -> Result<Vec<Vec3<R>>, SceneError> {
+        Ok(self.fluid_particles::<R>()?.velocities)
+    }
+
+    /// The initial fluid particles from one sampling: positions (m) and velocities (m/s),
+    /// fluid by fluid in file order.
+    pub fn fluid_particles<R: Real>(&self) -> Result<FluidParticles<R>, SceneError> {
         let ctx = Ctx::new(&self.source);
-        let mut out = Vec::new();
+        let (mut positions, mut velocities) = (Vec::new(), Vec::new());
         for (i, f) in self.fluids.iter().enumerate() {
-            let v = match f {
-                FluidSpec::Block { velocity, .. } | FluidSpec::Mesh { velocity, .. } => {
-                    cast3::<R>(&v3(*velocity))
-                }
-            };
-            let n = self.sample_fluid(&ctx, i)?.len();
-            out.extend(std::iter::repeat_n(v, n));
+            let (FluidSpec::Block { velocity, .. } | FluidSpec::Mesh { velocity, .. }) = f;
+            let pts = self.sample_fluid(&ctx, i)?;
+            velocities.extend(std::iter::repeat_n(cast3::<R>(&v3(*velocity)), pts.len()));
+            positions.extend(pts.iter().map(cast3::<R>));
         }
-        Ok(out)
+        Ok(FluidParticles {
+            positions,
+            velocities,
+        })
     }
 
     /// Upper bound of the particle count of fluid `i` (lattice points over its box).

@@ -8,8 +8,7 @@ use std::path::{Path, PathBuf};
 
 use sph_core::Aabb;
 
-use crate::raw::RawBox;
-use crate::{v3, AXES};
+use crate::geom::{v3, AXES};
 
 /// Errors of scene loading and building. Every variant names the scene file, the field path
 /// and the reason.
@@ -129,21 +128,26 @@ impl<'a> Ctx<'a> {
     }
 
     /// A box with finite corners and `min < max` on every axis.
-    pub fn check_box(&self, field: &str, b: &RawBox) -> Result<Aabb<f64>, SceneError> {
-        self.finite3(&format!("{field}.min"), &b.min)?;
-        self.finite3(&format!("{field}.max"), &b.max)?;
-        if let Some(a) = (0..3).find(|&a| b.min[a] >= b.max[a]) {
+    pub fn check_box(
+        &self,
+        field: &str,
+        min: &[f64; 3],
+        max: &[f64; 3],
+    ) -> Result<Aabb<f64>, SceneError> {
+        self.finite3(&format!("{field}.min"), min)?;
+        self.finite3(&format!("{field}.max"), max)?;
+        if let Some(a) = (0..3).find(|&a| min[a] >= max[a]) {
             return Err(self.invalid(
                 format!("{field}.min"),
                 format!(
                     "min must be < max on every axis ({}: min {} >= max {})",
-                    AXES[a], b.min[a], b.max[a]
+                    AXES[a], min[a], max[a]
                 ),
             ));
         }
         Ok(Aabb {
-            min: v3(b.min),
-            max: v3(b.max),
+            min: v3(*min),
+            max: v3(*max),
         })
     }
 }
@@ -151,6 +155,7 @@ impl<'a> Ctx<'a> {
 /// The 1-based line of every field path of a TOML document (`simulation.frame_dt`,
 /// `fluid[1]`, `fluid[1].min`, ...): the line of its key, or for an element of an array of
 /// tables the line where the element starts.
+#[derive(Debug, Default)]
 pub(crate) struct FieldLines(HashMap<String, usize>);
 
 impl FieldLines {
@@ -159,6 +164,15 @@ impl FieldLines {
         let mut map = HashMap::new();
         collect_lines(text, doc, "", &mut map);
         FieldLines(map)
+    }
+
+    /// The field paths written in the file directly under `table` (e.g. `solver`).
+    pub fn fields_under<'s>(&'s self, table: &'s str) -> impl Iterator<Item = &'s str> + 's {
+        self.0.keys().filter_map(move |k| {
+            k.strip_prefix(table)
+                .and_then(|rest| rest.strip_prefix('.'))
+                .filter(|name| !name.contains(['.', '[']))
+        })
     }
 
     /// The line of `field`, else of its closest parent path that has one.

@@ -2,12 +2,16 @@
 //! granular solver): fluid blocks and meshes, the tank, solid obstacles, solver parameters,
 //! duration and output.
 //!
-//! [`Scene::load`] reads and validates a file; [`Scene::fluid_positions`] samples the initial
-//! particles and [`Scene::build_solids`] builds the boundary signed distance fields (the tank
-//! first, as `Inverted<BoxSdf>`, then the solids in file order, meshes as
-//! [`GridSdf`](sph_core::GridSdf), the PBF paper's "signed distance fields stored as volume
-//! textures" after Bridson et al. 2006 / SDFGen). [`Scene::quick`] applies the optional
-//! `[quick]` overrides used by `cargo xtask validate` and `run --quick`.
+//! [`Scene::load`] reads a file and checks it ([`Scene::check`], which a program that edits
+//! a scene's fields calls again); [`Scene::fluid_particles`] samples the initial particles
+//! (positions and velocities from one sampling) and [`Scene::build_solids`] builds the
+//! boundary signed distance fields (the tank first, as `Inverted<BoxSdf>`, then the solids
+//! in file order, meshes as [`GridSdf`](sph_core::GridSdf), the PBF paper's "signed distance
+//! fields stored as volume textures" after Bridson et al. 2006 / SDFGen).
+//! [`Scene::solver_params`] makes the solver's parameters ([`SolverParams`]);
+//! [`Scene::render_info`] and [`Scene::render_params`] are the renderer's view of the scene.
+//! [`Scene::quick`] applies the optional `[quick]` overrides used by `cargo xtask validate`
+//! and `run --quick`.
 //!
 //! # Example: a scene run with the PBF solver
 //!
@@ -42,8 +46,8 @@
 //! "#;
 //! // Mesh paths would be relative to the file's directory; this scene has none.
 //! let scene = Scene::parse_str(text, Path::new("small_dam.toml")).unwrap();
-//! let positions = scene.fluid_positions::<f64>().unwrap();
-//! assert_eq!(positions.len(), 6 * 8 * 6);
+//! let fluid = scene.fluid_particles::<f64>().unwrap(); // sampled once
+//! assert_eq!(fluid.positions.len(), 6 * 8 * 6);
 //!
 //! let mut params = PbfParams::<f64>::for_spacing(scene.particle_spacing);
 //! params.common.dt = scene.frame_dt_s; // one `step` call = one frame ...
@@ -52,8 +56,8 @@
 //! params.common.reorder_every = 3;
 //! params.solver_iterations = scene.solver.iterations();
 //! let (m, rho0) = (params.particle_mass(), params.common.rest_density);
-//! let mut state = ParticleSet::from_positions(positions, m, rho0);
-//! state.velocities = scene.fluid_velocities().unwrap();
+//! let mut state = ParticleSet::from_positions(fluid.positions, m, rho0);
+//! state.velocities = fluid.velocities;
 //! let mut solver = Pbf::new(params, scene.build_solids::<f64>().unwrap()).unwrap();
 //!
 //! // `ids[k]`: the scene's index of the particle stored at `k` now.
@@ -179,8 +183,9 @@
 //! vtk = true                       # default true
 //!
 //! [render]                         # optional: camera, light, background of the
-//!                                  # screen-space renderer (`cargo xtask render`); kept as
-//!                                  # a raw table here and checked by the `ssfr-render` crate
+//!                                  # screen-space renderer (`cargo xtask render`): the
+//!                                  # fields of `ssfr_render::RenderConfig`, resolved
+//!                                  # against the scene when it is loaded
 //!
 //! [quick]                          # optional overrides for quick mode (all optional)
 //! particle_spacing = 0.05          # m
@@ -203,12 +208,23 @@
 //!   triangles; vertices of several objects welded by exact position) so that every problem
 //!   in a mesh file is reported with its line: a malformed number, a face index that does not
 //!   exist, a file cut short before its faces, and the face an open edge belongs to.
-//! * After parsing, every value is checked: spacing, durations, radii and cells finite and
+//! * Files are read with a stated size limit: the scene file at most
+//!   [`MAX_SCENE_FILE_BYTES`], a mesh file at most [`MAX_MESH_FILE_BYTES`], and only regular
+//!   files (a named pipe, a device such as `/dev/zero` or a directory is refused by name
+//!   before it is opened).
+//! * After parsing, every value is checked ([`Scene::check`]): spacing, durations, radii and cells finite and
 //!   positive, every number finite, `min < max`, substeps/iterations ≥ 1, fluids inside the tank
 //!   (block or mesh bounds inside the tank box, every particle strictly inside it), blocks at
 //!   least one spacing thick, no fluid particle inside (or on) a solid, at most
 //!   [`MAX_PARTICLES`] particles, mesh files that exist and are closed. The scene with its
 //!   `[quick]` overrides is validated too, so [`Scene::quick`] cannot fail.
+//! * The solver's own checks of the parameters made from the scene (`validate` of
+//!   `PbfParams`, `PcisphParams`, `IisphParams`) run in the scene's precision: a tolerance of
+//!   `1e-300` is `0` in `f32` and refused at its field. A parameter a solver refuses is
+//!   reported at the scene field it comes from (the longest field written in `[solver]` or
+//!   `[simulation]` whose words are all words of the parameter's name), with its line.
+//! * The `[render]` table is resolved against the scene (image size, camera, material), so
+//!   that a scene the renderer would refuse is refused when it is loaded.
 //! * Time stepping: at most [`sph_solver::MAX_SUBSTEPS`] substeps per frame and
 //!   [`MAX_FRAMES`] frames, and a solver step of `Δt = frame_dt / substeps` must not carry a
 //!   particle farther than the support radius `h`: `(|v0| + |g| Δt) Δt <= h` with `|v0|` the
@@ -225,50 +241,41 @@
 //!
 //! # Modules
 //!
-//! The public types are in `spec.rs` ([`Scene`], [`SolverSpec`], …) and `error.rs`
-//! ([`SceneError`]); `raw.rs` holds the serde input structs, `parse.rs` the validation from
-//! them to a [`Scene`] (one function per section; `parse/solver.rs` for `[solver]`),
-//! `mesh_io.rs` OBJ loading and mesh placement, `build.rs` particle sampling and the solids'
-//! signed distance fields.
+//! The public types are in `spec.rs` ([`Scene`], [`FluidSpec`], …), `solver_spec.rs`
+//! ([`SolverSpec`] and its settings) and `error.rs` ([`SceneError`]); `raw.rs` holds the
+//! serde input structs, `parse.rs` the reading from them to a [`Scene`] (`parse/solver.rs`
+//! for `[solver]`), `check.rs` the value checks (`check/solver.rs`, `check/time_step.rs`),
+//! `params.rs` the solver parameters, `render.rs` the renderer's view, `read.rs` the
+//! size-limited file reading, `mesh_io.rs` OBJ loading and mesh placement, `build.rs`
+//! particle sampling and the solids' signed distance fields, `limits.rs` the bounds. No two
+//! modules import each other.
 
 mod build;
+mod check;
 mod error;
+mod geom;
+mod limits;
 mod mesh_io;
 mod obj;
+mod params;
 mod parse;
 mod raw;
+mod read;
+mod render;
+mod solver_spec;
 mod spec;
 
-use sph_core::{Real, Vec3};
-
+pub use build::FluidParticles;
 pub use error::SceneError;
-pub use spec::{
-    BoundaryModel, BoundarySpec, FluidSpec, GranularSpec, IisphSpec, InitialMasses, MeshPlacement,
-    MeshSpec, OutputSpec, PbfSpec, PcisphSpec, Precision, QuickSpec, Scene, SolidSpec, SolverKind,
+pub use limits::{
+    MAX_FRAMES, MAX_MESH_FILE_BYTES, MAX_PARTICLES, MAX_SCENE_FILE_BYTES, MAX_SDF_NODES,
+};
+pub use params::SolverParams;
+pub use solver_spec::{
+    GranularSpec, IisphSettings, IisphSpec, PbfSpec, PcisphSpec, SolverCommon, SolverKind,
     SolverSpec, DEFAULT_IISPH_MAX_ITERATIONS, DEFAULT_IISPH_MIN_ITERATIONS,
 };
-
-/// Largest total number of fluid particles a scene may produce (20 M).
-pub const MAX_PARTICLES: usize = 20_000_000;
-
-/// Most frames (`duration / frame_dt`) a scene may have: 10 million, 44 hours of 16 ms
-/// frames; beyond it the frame length or the duration is a typing mistake.
-pub const MAX_FRAMES: f64 = 1e7;
-
-/// Largest number of nodes of a signed distance grid built for a mesh (16 M).
-pub const MAX_SDF_NODES: usize = 16 << 20;
-
-/// Axis names, for messages.
-const AXES: [char; 3] = ['x', 'y', 'z'];
-
-fn v3(a: [f64; 3]) -> Vec3<f64> {
-    Vec3::new(a[0], a[1], a[2])
-}
-
-fn cast3<R: Real>(v: &Vec3<f64>) -> Vec3<R> {
-    Vec3::new(R::of_f64(v.x), R::of_f64(v.y), R::of_f64(v.z))
-}
-
-fn fmt3(v: &Vec3<f64>) -> String {
-    format!("({:.6}, {:.6}, {:.6})", v.x, v.y, v.z)
-}
+pub use spec::{
+    BoundaryModel, BoundarySpec, FluidSpec, InitialMasses, MeshPlacement, MeshSpec, OutputSpec,
+    Precision, QuickSpec, Scene, SolidSpec,
+};

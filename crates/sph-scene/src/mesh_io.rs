@@ -8,8 +8,11 @@ use std::sync::Arc;
 use sph_core::{TriangleMesh, Vec3};
 
 use crate::error::Ctx;
-use crate::raw::RawBox;
-use crate::{v3, MeshPlacement, MeshSpec, SceneError};
+use crate::geom::v3;
+use crate::limits::MAX_MESH_FILE_BYTES;
+use crate::raw::{RawBox, RawFluid, RawSolid};
+use crate::read::read_limited;
+use crate::{MeshPlacement, MeshSpec, SceneError};
 
 /// The mesh fields of a `[[fluid]]` or `[[solid]]` table of `kind = "mesh"`, as written.
 #[derive(Debug, Clone, Copy)]
@@ -22,6 +25,28 @@ pub(crate) struct MeshFields<'a> {
     pub translate: Option<[f64; 3]>,
     /// Box to fit the mesh into, instead of scale/translate.
     pub fit: Option<RawBox>,
+}
+
+impl<'a> MeshFields<'a> {
+    /// The mesh fields of a `[[fluid]]` table.
+    pub fn of_fluid(f: &'a RawFluid) -> Self {
+        MeshFields {
+            path: f.path.as_deref(),
+            scale: f.scale,
+            translate: f.translate,
+            fit: f.fit,
+        }
+    }
+
+    /// The mesh fields of a `[[solid]]` table.
+    pub fn of_solid(s: &'a RawSolid) -> Self {
+        MeshFields {
+            path: s.path.as_deref(),
+            scale: s.scale,
+            translate: s.translate,
+            fit: s.fit,
+        }
+    }
 }
 
 /// Loads the meshes of one scene, each file once.
@@ -117,7 +142,7 @@ fn fit_placement(
     mesh: &TriangleMesh<f64>,
     fit: &RawBox,
 ) -> Result<(MeshPlacement, f64, Vec3<f64>), SceneError> {
-    let b = ctx.check_box(&format!("{field}.fit"), fit)?;
+    let b = ctx.check_box(&format!("{field}.fit"), &fit.min, &fit.max)?;
     let mb = mesh.bounds();
     let (me, be) = (mb.extent(), b.extent());
     let mut s = f64::INFINITY;
@@ -148,16 +173,10 @@ pub(crate) fn placement_field(field: &str, m: &MeshSpec) -> String {
     }
 }
 
-/// Reads a closed triangle mesh from an OBJ file (see [`crate::obj`]; every error names the
-/// line).
+/// Reads a closed triangle mesh from an OBJ file of at most [`MAX_MESH_FILE_BYTES`] (see
+/// [`crate::obj`]; every error names the line).
 fn load_obj(path: &Path) -> Result<TriangleMesh<f64>, String> {
-    if !path.exists() {
-        return Err("file not found".into());
-    }
-    if !path.is_file() {
-        return Err("not a file".into());
-    }
-    let bytes = std::fs::read(path).map_err(|e| format!("cannot read: {e}"))?;
+    let bytes = read_limited(path, MAX_MESH_FILE_BYTES, "mesh file (MAX_MESH_FILE_BYTES)")?;
     let text = String::from_utf8(bytes).map_err(|e| {
         let at = e.utf8_error().valid_up_to();
         let line = e.as_bytes()[..at].iter().filter(|&&b| b == b'\n').count() + 1;

@@ -1,30 +1,23 @@
-//! From scene text to a validated [`Scene`]: serde reads the document into the `raw` types
-//! (the `[solver]` table in two steps, see [`solver`]), then one function per section checks
-//! the values, and the particle-level checks run on the result (and on its `[quick]`
-//! variant).
-
-// NaN-rejecting checks are written as `!(x > 0.0)` on purpose.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
+//! From scene text to a [`Scene`]: serde reads the document into the `raw` types (the
+//! `[solver]` table in two steps, see [`solver`]), the kinds of fluids and solids get their
+//! fields, the meshes are loaded and placed; then [`Scene::check`] checks every value.
 
 mod solver;
-mod time_step;
 
 use std::path::Path;
+use std::sync::Arc;
 
 use sph_core::Aabb;
 use toml::de::{DeTable, DeValue};
 use toml::Spanned;
 
 use crate::error::{document_error, serde_error, Ctx, FieldLines};
-use crate::mesh_io::{placement_field, MeshLoader};
-use crate::raw::{
-    RawBox, RawFluid, RawFluidKind, RawOutput, RawQuick, RawScene, RawSimulation, RawSolid,
-    RawSolidKind,
-};
-use crate::{
-    fmt3, v3, FluidSpec, OutputSpec, Precision, QuickSpec, Scene, SceneError, SolidSpec,
-    SolverSpec, AXES, DEFAULT_IISPH_MIN_ITERATIONS,
-};
+use crate::geom::v3;
+use crate::limits::MAX_SCENE_FILE_BYTES;
+use crate::mesh_io::{MeshFields, MeshLoader};
+use crate::raw::{RawBox, RawFluid, RawFluidKind, RawOutput, RawQuick, RawScene, RawSolid, RawSolidKind};
+use crate::read::read_limited;
+use crate::{FluidSpec, OutputSpec, Precision, QuickSpec, Scene, SceneError, SolidSpec, SolverSpec};
 
 /// The `[solver]` table as parsed (with spans), for [`solver::parse`].
 type SolverTable<'i> = Spanned<DeValue<'i>>;
@@ -33,18 +26,25 @@ type SolverTable<'i> = Spanned<DeValue<'i>>;
 const DEFAULT_GRAVITY: [f64; 3] = [0.0, -9.81, 0.0];
 
 impl Scene {
-    /// Reads, parses and validates the scene file at `path` (mesh paths are relative to its
-    /// directory).
+    /// Reads, parses and checks the scene file at `path` (mesh paths are relative to its
+    /// directory). Only a regular file of at most [`MAX_SCENE_FILE_BYTES`] is read.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|e| SceneError::Read {
+        let read_error = |reason: String| SceneError::Read {
             file: path.to_path_buf(),
-            reason: e.to_string(),
+            reason,
+        };
+        let bytes = read_limited(path, MAX_SCENE_FILE_BYTES, "scene file (MAX_SCENE_FILE_BYTES)")
+            .map_err(read_error)?;
+        let text = String::from_utf8(bytes).map_err(|e| {
+            let at = e.utf8_error().valid_up_to();
+            let line = e.as_bytes()[..at].iter().filter(|&&b| b == b'\n').count() + 1;
+            read_error(format!("line {line}: not UTF-8 text (is it a scene file?)"))
         })?;
         Self::parse_str(&text, path)
     }
 
-    /// Parses and validates scene text; `path` names the file in messages and is the base of
-    /// relative mesh paths (its directory).
+    /// Parses and checks scene text ([`Scene::check`]); `path` names the file in messages and
+    /// is the base of relative mesh paths (its directory).
     pub fn parse_str(text: &str, path: &Path) -> Result<Scene, SceneError> {
         let doc = DeTable::parse(text).map_err(|e| document_error(path, text, &e))?;
         let lines = FieldLines::new(text, doc.get_ref());
@@ -62,41 +62,29 @@ impl Scene {
         };
         let base = path.parent().unwrap_or(Path::new(""));
         let scene = from_raw(&ctx, raw, solver, base)?;
-        time_step::check(&ctx, &scene, None)?;
-        scene.validate_particles(&ctx)?;
-        if let Some(overrides) = &scene.quick_overrides {
-            let quick = scene.quick();
-            let quick_ctx = Ctx {
-                note: "with the [quick] overrides: ",
-                ..ctx
-            };
-            time_step::check(&quick_ctx, &quick, Some(overrides))?;
-            quick.validate_particles(&quick_ctx)?;
-        }
+        let scene = Scene {
+            lines: Arc::new(lines),
+            ..scene
+        };
+        scene.check()?;
         Ok(scene)
     }
 }
 
-/// Checks every section of `raw` but `[solver]` (already read and checked as `solver`), in
-/// file-documentation order.
+/// The typed scene of `raw` and `solver`: each fluid and solid with the fields of its kind,
+/// meshes loaded and placed. The values are checked later, by [`Scene::check`].
 fn from_raw(
     ctx: &Ctx,
     raw: RawScene,
     solver: SolverSpec,
     base: &Path,
 ) -> Result<Scene, SceneError> {
-    check_name(ctx, &raw.name)?;
-    let gravity = simulation(ctx, &raw.simulation)?;
-    let tank = match &raw.tank {
-        Some(t) => Some(ctx.check_box("tank", t)?),
-        None => None,
-    };
     let mut meshes = MeshLoader::new(base);
     let fluids = raw
         .fluid
         .iter()
         .enumerate()
-        .map(|(i, f)| fluid(ctx, &format!("fluid[{i}]"), f, tank.as_ref(), &mut meshes))
+        .map(|(i, f)| fluid(ctx, &format!("fluid[{i}]"), f, &mut meshes))
         .collect::<Result<Vec<_>, _>>()?;
     let solids = raw
         .solid
@@ -104,11 +92,6 @@ fn from_raw(
         .enumerate()
         .map(|(i, s)| solid(ctx, &format!("solid[{i}]"), s, &mut meshes))
         .collect::<Result<Vec<_>, _>>()?;
-    let output = output(ctx, raw.output.as_ref())?;
-    let quick_overrides = match &raw.quick {
-        Some(q) => Some(quick(ctx, q, &solver)?),
-        None => None,
-    };
     let sim = raw.simulation;
     Ok(Scene {
         name: raw.name,
@@ -117,44 +100,20 @@ fn from_raw(
         particle_spacing: sim.particle_spacing,
         duration_s: sim.duration,
         frame_dt_s: sim.frame_dt,
-        gravity,
-        tank,
+        gravity: sim.gravity.unwrap_or(DEFAULT_GRAVITY),
+        tank: raw.tank.map(|t| Aabb {
+            min: v3(t.min),
+            max: v3(t.max),
+        }),
         fluids,
         solids,
         solver,
         boundary: raw.boundary,
-        output,
-        quick_overrides,
+        output: output(raw.output.as_ref()),
+        quick_overrides: raw.quick.as_ref().map(quick),
         render: raw.render,
+        lines: Arc::default(),
     })
-}
-
-/// `name`: non-empty, `[A-Za-z0-9_.-]+`.
-fn check_name(ctx: &Ctx, name: &str) -> Result<(), SceneError> {
-    let ok = !name.is_empty()
-        && name
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || "_-.".contains(c));
-    if ok {
-        Ok(())
-    } else {
-        Err(ctx.invalid(
-            "name",
-            format!(
-                "{name:?}: must be non-empty and use only ASCII letters, digits, '_', '-' and '.'"
-            ),
-        ))
-    }
-}
-
-/// `[simulation]`; returns the gravity (default [`DEFAULT_GRAVITY`]).
-fn simulation(ctx: &Ctx, sim: &RawSimulation) -> Result<[f64; 3], SceneError> {
-    ctx.positive("simulation.particle_spacing", sim.particle_spacing)?;
-    ctx.positive("simulation.duration", sim.duration)?;
-    ctx.positive("simulation.frame_dt", sim.frame_dt)?;
-    let gravity = sim.gravity.unwrap_or(DEFAULT_GRAVITY);
-    ctx.finite3("simulation.gravity", &gravity)?;
-    Ok(gravity)
 }
 
 /// Rejects the first field of `present` (name, given?) that is given but not one of the
@@ -188,24 +147,20 @@ fn required_box(
     min: Option<[f64; 3]>,
     max: Option<[f64; 3]>,
 ) -> Result<RawBox, SceneError> {
-    let b = RawBox {
+    Ok(RawBox {
         min: require(ctx, &format!("{field}.min"), kind, min)?,
         max: require(ctx, &format!("{field}.max"), kind, max)?,
-    };
-    ctx.check_box(field, &b)?;
-    Ok(b)
+    })
 }
 
-/// One `[[fluid]]` table at `field`, checked to lie inside the tank (box level).
+/// One `[[fluid]]` table at `field`.
 fn fluid(
     ctx: &Ctx,
     field: &str,
     f: &RawFluid,
-    tank: Option<&Aabb<f64>>,
     meshes: &mut MeshLoader,
 ) -> Result<FluidSpec, SceneError> {
     let velocity = f.velocity.unwrap_or([0.0; 3]);
-    ctx.finite3(&format!("{field}.velocity"), &velocity)?;
     // The kind-specific fields given, in the order errors report them.
     let present = [
         ("min", f.min.is_some()),
@@ -215,7 +170,7 @@ fn fluid(
         ("translate", f.translate.is_some()),
         ("fit", f.fit.is_some()),
     ];
-    let spec = match f.kind {
+    Ok(match f.kind {
         RawFluidKind::Block => {
             forbid(ctx, field, "block", &present, &["min", "max"])?;
             let b = required_box(ctx, field, "block", f.min, f.max)?;
@@ -228,48 +183,10 @@ fn fluid(
         RawFluidKind::Mesh => {
             let own = ["path", "scale", "translate", "fit"];
             forbid(ctx, field, "mesh", &present, &own)?;
-            let mesh = meshes.mesh_spec(ctx, field, f.mesh_fields())?;
+            let mesh = meshes.mesh_spec(ctx, field, MeshFields::of_fluid(f))?;
             FluidSpec::Mesh { mesh, velocity }
         }
-    };
-    if let Some(t) = tank {
-        fluid_inside_tank(ctx, field, &spec, t)?;
-    }
-    Ok(spec)
-}
-
-/// The fluid's bounding box lies inside the tank (up to rounding).
-fn fluid_inside_tank(
-    ctx: &Ctx,
-    field: &str,
-    spec: &FluidSpec,
-    t: &Aabb<f64>,
-) -> Result<(), SceneError> {
-    let (b, bfield) = match spec {
-        FluidSpec::Block { min, max, .. } => (
-            Aabb {
-                min: v3(*min),
-                max: v3(*max),
-            },
-            format!("{field}.max"),
-        ),
-        FluidSpec::Mesh { mesh, .. } => (mesh.mesh.bounds(), placement_field(field, mesh)),
-    };
-    let tol = 1e-9 * (t.extent().norm() + 1.0);
-    match (0..3).find(|&a| b.min[a] < t.min[a] - tol || b.max[a] > t.max[a] + tol) {
-        Some(a) => Err(ctx.invalid(
-            bfield,
-            format!(
-                "the fluid's box {} – {} is not inside the tank {} – {} (axis {})",
-                fmt3(&b.min),
-                fmt3(&b.max),
-                fmt3(&t.min),
-                fmt3(&t.max),
-                AXES[a]
-            ),
-        )),
-        None => Ok(()),
-    }
+    })
 }
 
 /// One `[[solid]]` table at `field`.
@@ -294,16 +211,13 @@ fn solid(
         ("sdf_cell", s.sdf_cell.is_some()),
     ];
     let vector = |name: &str, kind: &str, v: Option<[f64; 3]>| {
-        let f = format!("{field}.{name}");
-        let v = require(ctx, &f, kind, v)?;
-        ctx.finite3(&f, &v).map(|()| v)
+        require(ctx, &format!("{field}.{name}"), kind, v)
     };
     Ok(match s.kind {
         RawSolidKind::Sphere => {
             forbid(ctx, field, "sphere", &present, &["center", "radius"])?;
             let center = vector("center", "sphere", s.center)?;
             let radius = require(ctx, &format!("{field}.radius"), "sphere", s.radius)?;
-            ctx.positive(&format!("{field}.radius"), radius)?;
             SolidSpec::Sphere { center, radius }
         }
         RawSolidKind::Box => {
@@ -318,22 +232,12 @@ fn solid(
             forbid(ctx, field, "plane", &present, &["point", "normal"])?;
             let point = vector("point", "plane", s.point)?;
             let normal = vector("normal", "plane", s.normal)?;
-            let n = v3(normal).norm();
-            if !(n.is_finite() && n > 0.0) {
-                return Err(ctx.invalid(
-                    format!("{field}.normal"),
-                    "must have a finite, non-zero length",
-                ));
-            }
             SolidSpec::Plane { point, normal }
         }
         RawSolidKind::Mesh => {
             let own = ["path", "scale", "translate", "fit", "sdf_cell"];
             forbid(ctx, field, "mesh", &present, &own)?;
-            if let Some(c) = s.sdf_cell {
-                ctx.positive(&format!("{field}.sdf_cell"), c)?;
-            }
-            let mesh = meshes.mesh_spec(ctx, field, s.mesh_fields())?;
+            let mesh = meshes.mesh_spec(ctx, field, MeshFields::of_solid(s))?;
             SolidSpec::Mesh {
                 mesh,
                 sdf_cell: s.sdf_cell,
@@ -343,57 +247,21 @@ fn solid(
 }
 
 /// `[output]` (optional, defaults: every frame, VTK on).
-fn output(ctx: &Ctx, o: Option<&RawOutput>) -> Result<OutputSpec, SceneError> {
-    let output = OutputSpec {
+fn output(o: Option<&RawOutput>) -> OutputSpec {
+    OutputSpec {
         every_frames: o.and_then(|o| o.every_frames).unwrap_or(1),
         vtk: o.and_then(|o| o.vtk).unwrap_or(true),
-    };
-    if output.every_frames == 0 {
-        return Err(ctx.invalid("output.every_frames", "must be >= 1, got 0"));
     }
-    Ok(output)
 }
 
-/// `[quick]`: each override in range and consistent with `solver`.
-fn quick(ctx: &Ctx, q: &RawQuick, solver: &SolverSpec) -> Result<QuickSpec, SceneError> {
-    for (name, v) in [
-        ("particle_spacing", q.particle_spacing),
-        ("duration", q.duration),
-        ("frame_dt", q.frame_dt),
-    ] {
-        if let Some(v) = v {
-            ctx.positive(&format!("quick.{name}"), v)?;
-        }
-    }
-    for (name, v) in [
-        ("substeps", q.substeps),
-        ("iterations", q.iterations),
-        ("every_frames", q.every_frames),
-    ] {
-        if v == Some(0) {
-            return Err(ctx.invalid(format!("quick.{name}"), "must be >= 1, got 0"));
-        }
-    }
-    let min_iterations = match solver {
-        SolverSpec::Pbf(p) => p.min_iterations,
-        SolverSpec::Pcisph(_) => None,
-        SolverSpec::Iisph(p) => Some(p.min_iterations.unwrap_or(DEFAULT_IISPH_MIN_ITERATIONS)),
-        SolverSpec::Granular(p) => Some(p.min_iterations.unwrap_or(DEFAULT_IISPH_MIN_ITERATIONS)),
-    };
-    if let Some(k) = q.iterations {
-        if let Some(min) = min_iterations.filter(|&min| k < min) {
-            return Err(ctx.invalid(
-                "quick.iterations",
-                format!("must be >= solver.min_iterations = {min}, got {k}"),
-            ));
-        }
-    }
-    Ok(QuickSpec {
+/// `[quick]`, as written.
+fn quick(q: &RawQuick) -> QuickSpec {
+    QuickSpec {
         particle_spacing: q.particle_spacing,
         duration_s: q.duration,
         frame_dt_s: q.frame_dt,
         substeps: q.substeps,
         iterations: q.iterations,
         every_frames: q.every_frames,
-    })
+    }
 }

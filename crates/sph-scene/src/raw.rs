@@ -2,7 +2,8 @@
 
 use serde::Deserialize;
 
-use crate::mesh_io::MeshFields;
+use ssfr_render::RenderConfig;
+
 use crate::{BoundarySpec, Precision, SolverKind};
 
 #[derive(Debug, Deserialize)]
@@ -21,8 +22,8 @@ pub(crate) struct RawScene {
     pub solid: Vec<RawSolid>,
     pub output: Option<RawOutput>,
     pub quick: Option<RawQuick>,
-    /// Read by the renderer (`ssfr-render`), kept as a raw table here.
-    pub render: Option<toml::Table>,
+    /// The renderer's settings (`ssfr-render`), checked against the scene by `Scene::check`.
+    pub render: Option<RenderConfig>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -38,7 +39,7 @@ pub(crate) struct RawSimulation {
 /// The tag of the `[solver]` table. Its other fields are ignored here and read by
 /// `parse::solver` from the same table as the variant struct of this kind (see there why).
 #[derive(Debug, Deserialize)]
-#[serde(expecting = "a table with kind = \"pbf\" or \"pcisph\"")]
+#[serde(expecting = "a table with a solver kind")]
 pub(crate) struct RawSolverTag {
     pub kind: SolverKind,
 }
@@ -79,17 +80,6 @@ pub(crate) enum RawSolidKind {
     Mesh,
 }
 
-impl RawFluid {
-    /// The mesh fields (`kind = "mesh"`).
-    pub fn mesh_fields(&self) -> MeshFields<'_> {
-        MeshFields {
-            path: self.path.as_deref(),
-            scale: self.scale,
-            translate: self.translate,
-            fit: self.fit,
-        }
-    }
-}
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -108,17 +98,6 @@ pub(crate) struct RawSolid {
     pub sdf_cell: Option<f64>,
 }
 
-impl RawSolid {
-    /// The mesh fields (`kind = "mesh"`).
-    pub fn mesh_fields(&self) -> MeshFields<'_> {
-        MeshFields {
-            path: self.path.as_deref(),
-            scale: self.scale,
-            translate: self.translate,
-            fit: self.fit,
-        }
-    }
-}
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]

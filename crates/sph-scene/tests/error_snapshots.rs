@@ -236,6 +236,66 @@ const SCENE_CASES: &[SceneCase] = &[
         name: "quick_frame_dt_too_long",
         edits: &[("duration = 0.5", "duration = 0.5\nframe_dt = 0.5")],
     },
+    SceneCase {
+        name: "iisph_tolerance_below_f32",
+        edits: &[
+            ("precision = \"f64\"", "precision = \"f32\""),
+            (
+                "kind = \"pbf\"\nsubsteps = 2\niterations = 3\nxsph_c = 0.01",
+                "kind = \"iisph\"\nsubsteps = 2\ndensity_error_tolerance = 1e-300",
+            ),
+        ],
+    },
+    SceneCase {
+        name: "friction_angle_out_of_range",
+        edits: &[(
+            "kind = \"pbf\"\nsubsteps = 2\niterations = 3\nxsph_c = 0.01",
+            "kind = \"granular\"\nsubsteps = 2\nfriction_angle_deg = 95.0",
+        )],
+    },
+    SceneCase {
+        name: "iisph_unknown_field",
+        edits: &[(
+            "kind = \"pbf\"\nsubsteps = 2\niterations = 3\nxsph_c = 0.01",
+            "kind = \"iisph\"\nsubsteps = 2\niterations = 3",
+        )],
+    },
+    SceneCase {
+        name: "wrong_type_in_iisph_settings",
+        edits: &[(
+            "kind = \"pbf\"\nsubsteps = 2\niterations = 3\nxsph_c = 0.01",
+            "kind = \"iisph\"\nsubsteps = 2\nrelaxation = \"half\"",
+        )],
+    },
+    SceneCase {
+        name: "render_zero_size",
+        edits: &[("vtk = false\n", "vtk = false\n\n[render]\nwidth = 0\nheight = 0\n")],
+    },
+    SceneCase {
+        name: "render_too_large",
+        edits: &[(
+            "vtk = false\n",
+            "vtk = false\n\n[render]\nwidth = 100000\nheight = 100000\n",
+        )],
+    },
+    SceneCase {
+        name: "render_unknown_field",
+        edits: &[("vtk = false\n", "vtk = false\n\n[render.camera]\nfov = 40.0\n")],
+    },
+    SceneCase {
+        name: "render_eye_at_target",
+        edits: &[(
+            "vtk = false\n",
+            "vtk = false\n\n[render.camera]\neye = [1.0, 0.5, 0.5]\ntarget = [1.0, 0.5, 0.5]\n",
+        )],
+    },
+    SceneCase {
+        name: "render_negative_radius",
+        edits: &[(
+            "vtk = false\n",
+            "vtk = false\n\n[render]\nparticle_radius = -1.0\n",
+        )],
+    },
 ];
 
 /// A mesh file that replaces `cube.obj` (used as fluid and as solid by the fixture).
@@ -345,4 +405,49 @@ fn unreadable_scene_file() {
     let dir = fixture_dir("snap-unreadable");
     let e = Scene::load(&dir.join("absent.toml")).unwrap_err();
     insta::assert_snapshot!("unreadable_scene_file", message(&e, &dir));
+}
+
+/// Files that are not scene files: refused by name before they are read (a FIFO would block,
+/// `/dev/zero` never ends, a sparse file claims gigabytes).
+#[cfg(unix)]
+#[test]
+fn scene_paths_that_are_not_scene_files() {
+    let dir = fixture_dir("snap-not-files");
+    let e = Scene::load(std::path::Path::new("/dev/zero")).unwrap_err();
+    insta::assert_snapshot!("scene_path_dev_zero", message(&e, &dir));
+    let fifo = dir.join("pipe.toml");
+    let _ = std::fs::remove_file(&fifo);
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    if made.is_ok_and(|s| s.success()) {
+        let e = Scene::load(&fifo).unwrap_err();
+        insta::assert_snapshot!("scene_path_fifo", message(&e, &dir));
+    }
+    let big = dir.join("big.toml");
+    let f = std::fs::File::create(&big).unwrap();
+    f.set_len(8 << 30).unwrap(); // sparse: no disk space used
+    let e = Scene::load(&big).unwrap_err();
+    insta::assert_snapshot!("scene_file_too_large", message(&e, &dir));
+    std::fs::remove_file(&big).unwrap();
+}
+
+/// Mesh files that cannot be meshes: a sparse 8 GB file and a named pipe.
+#[cfg(unix)]
+#[test]
+fn mesh_paths_that_are_not_mesh_files() {
+    let dir = fixture_dir("snap-not-meshes");
+    let big = dir.join("big.obj");
+    let f = std::fs::File::create(&big).unwrap();
+    f.set_len(8 << 30).unwrap(); // sparse: no disk space used
+    let text = VALID.replacen("path = \"cube.obj\"", "path = \"big.obj\"", 1);
+    let e = Scene::parse_str(&text, &dir.join("scene.toml")).unwrap_err();
+    insta::assert_snapshot!("mesh_file_too_large", message(&e, &dir));
+    std::fs::remove_file(&big).unwrap();
+    let fifo = dir.join("pipe.obj");
+    let _ = std::fs::remove_file(&fifo);
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    if made.is_ok_and(|s| s.success()) {
+        let text = VALID.replacen("path = \"cube.obj\"", "path = \"pipe.obj\"", 1);
+        let e = Scene::parse_str(&text, &dir.join("scene.toml")).unwrap_err();
+        insta::assert_snapshot!("mesh_path_fifo", message(&e, &dir));
+    }
 }

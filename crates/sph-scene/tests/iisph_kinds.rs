@@ -22,8 +22,8 @@ fn iisph_scene_reads_with_defaults() {
     let SolverSpec::Iisph(p) = &s.solver else {
         panic!("{:?}", s.solver)
     };
-    assert_eq!(p.substeps, 8);
-    assert_eq!(p.max_iterations, None);
+    assert_eq!(p.common.substeps, 8);
+    assert_eq!(p.iisph.max_iterations, None);
     assert_eq!(s.solver.iterations(), DEFAULT_IISPH_MAX_ITERATIONS);
 }
 
@@ -44,13 +44,13 @@ fn granular_scene_reads_every_field() {
     assert_eq!(p.drag_coefficient, Some(0.47));
     assert_eq!(p.air_velocity, Some([1.0, 0.0, 0.0]));
     assert_eq!(p.upscaling_factor, Some(8));
-    assert_eq!((p.max_iterations, p.min_iterations), (Some(50), Some(3)));
+    assert_eq!((p.iisph.max_iterations, p.iisph.min_iterations), (Some(50), Some(3)));
     // with_kind keeps the IISPH settings between the two IISPH kinds.
     let SolverSpec::Iisph(w) = s.solver.with_kind(SolverKind::Iisph) else {
         panic!()
     };
     assert_eq!(
-        (w.substeps, w.relaxation, w.viscosity),
+        (w.common.substeps, w.iisph.relaxation, w.iisph.viscosity),
         (4, Some(0.4), Some(1e-6))
     );
 }

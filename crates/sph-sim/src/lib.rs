@@ -1,9 +1,12 @@
 //! Scene running as a library.
 //!
-//! - [`build_solver`]: the one factory from a scene's `[solver]` and `[boundary]` sections
-//!   (`sph_scene::Scene`) to a `Box<dyn sph_solver::FluidSolver<R>>` — PBF (Macklin & Müller
-//!   2013) or PCISPH (Solenthaler & Pajarola 2009) — with its walls as SDF collisions or
-//!   volume maps (Bender, Kugelstadt, Weiler & Koschier 2019), see [`build_boundary`].
+//! - [`SceneSetup`]: a checked scene (`sph_scene::Scene`) built once — the solver's
+//!   parameters, the fluid particles sampled once (masses calibrated if asked) and the
+//!   boundary, with its walls as SDF collisions or volume maps (Bender, Kugelstadt, Weiler &
+//!   Koschier 2019), see [`build_boundary`].
+//! - [`build_solver`]: the one factory from those parameters and boundary to a
+//!   `Box<dyn sph_solver::FluidSolver<R>>` — PBF (Macklin & Müller 2013), PCISPH
+//!   (Solenthaler & Pajarola 2009) or IISPH (Ihmsen et al. 2014; granular, Neder 2024).
 //! - [`SceneSim`]: the particles, the solver and the ids that follow particles across the
 //!   solver's reordering, advanced frame by frame.
 //! - [`run_scene`]: the frame loop behind `cargo xtask run SCENE`, with a progress bar,
@@ -27,19 +30,18 @@ mod factory;
 pub mod render;
 pub mod run;
 pub mod run_dir;
+mod setup;
 mod sim;
 pub mod vtk;
 
 pub use error::SimError;
-pub use factory::{
-    build_boundary, build_boundary_with_kernel, build_solver, density_kernel, granular_params,
-    iisph_params, pbf_params, pcisph_params, VOLUME_MAP_CONTACT_FRACTION,
-};
+pub use factory::{build_boundary, build_solver, density_kernel, VOLUME_MAP_CONTACT_FRACTION};
 pub use run::{
     run_frames, run_scene, stats_header, stats_row, FrameObserver, RunPlan, SceneRunOptions,
     STATS_COLUMNS,
 };
 pub use run_dir::RunDir;
+pub use setup::SceneSetup;
 pub use sim::SceneSim;
 pub use sph_scene::Precision;
 

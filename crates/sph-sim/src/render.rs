@@ -1,89 +1,22 @@
-//! Scenes seen by the screen-space renderer (`ssfr-render`): the renderer's view of a scene
-//! (tank, liquid bounds, obstacles), its `[render]` table resolved against it, and a frame
-//! observer that renders each frame of a running scene in process.
+//! Scenes seen by the screen-space renderer (`ssfr-render`): rendered PNGs of a scene's
+//! particles, and a frame observer that renders each frame of a running scene in process
+//! (the renderer's view of a scene and its `[render]` table are `sph_scene::Scene`'s).
 
 use std::path::{Path, PathBuf};
 
 use sph_core::Real;
-use sph_scene::{FluidSpec, Scene, SolidSpec};
+use sph_scene::Scene;
 use sph_solver::StepStats;
-use ssfr_render::config::SceneInfo;
-use ssfr_render::{Obstacle, RenderConfig, RenderParams, Renderer};
+use ssfr_render::{RenderParams, Renderer};
 
 use crate::run::{FrameObserver, RunPlan};
 use crate::run_dir::RunDir;
 use crate::{SceneSim, SimError};
 
-fn f3(a: [f64; 3]) -> [f32; 3] {
-    [a[0] as f32, a[1] as f32, a[2] as f32]
-}
-
-/// What the renderer's defaults need from a scene: tank, liquid bounds, spacing, and the
-/// box and sphere solids as obstacles (mesh solids as their bounding box; planes are not
-/// drawn).
-pub fn scene_info(scene: &Scene) -> SceneInfo {
-    let mut liquid: Option<([f32; 3], [f32; 3])> = None;
-    let mut grow = |lo: [f32; 3], hi: [f32; 3]| {
-        liquid = Some(match liquid {
-            None => (lo, hi),
-            Some((a, b)) => (
-                [a[0].min(lo[0]), a[1].min(lo[1]), a[2].min(lo[2])],
-                [b[0].max(hi[0]), b[1].max(hi[1]), b[2].max(hi[2])],
-            ),
-        })
-    };
-    for f in &scene.fluids {
-        match f {
-            FluidSpec::Block { min, max, .. } => grow(f3(*min), f3(*max)),
-            FluidSpec::Mesh { mesh, .. } => {
-                let b = mesh.mesh.bounds();
-                grow(f3(b.min.into()), f3(b.max.into()))
-            }
-        }
-    }
-    let grey = [0.55, 0.45, 0.40];
-    let obstacles = scene
-        .solids
-        .iter()
-        .filter_map(|s| match s {
-            SolidSpec::Box { min, max } => Some(Obstacle::Box {
-                min: f3(*min),
-                max: f3(*max),
-                colour: grey,
-            }),
-            SolidSpec::Sphere { center, radius } => Some(Obstacle::Sphere {
-                center: f3(*center),
-                radius: *radius as f32,
-                colour: grey,
-            }),
-            SolidSpec::Mesh { mesh, .. } => {
-                let b = mesh.mesh.bounds();
-                Some(Obstacle::Box {
-                    min: f3(b.min.into()),
-                    max: f3(b.max.into()),
-                    colour: grey,
-                })
-            }
-            SolidSpec::Plane { .. } => None,
-        })
-        .collect();
-    SceneInfo {
-        tank: scene.tank.map(|t| (f3(t.min.into()), f3(t.max.into()))),
-        liquid,
-        particle_spacing: scene.particle_spacing as f32,
-        obstacles,
-    }
-}
-
 /// The render parameters of `scene`: its `[render]` table (defaults when absent) resolved
-/// against the scene. Errors name the scene file and the table.
+/// against the scene (`sph_scene::Scene::render_params`, checked when the scene was loaded).
 pub fn render_params(scene: &Scene) -> Result<RenderParams, SimError> {
-    let cfg = match &scene.render {
-        Some(t) => RenderConfig::from_table(t),
-        None => Ok(RenderConfig::default()),
-    };
-    cfg.and_then(|c| c.resolve(&scene_info(scene)))
-        .map_err(|e| SimError::Invalid(format!("{}: [render]: {e}", scene.source.display())))
+    Ok(scene.render_params()?)
 }
 
 /// Renders `positions` (a frame of `scene`) with the scene's `[render]` parameters to a PNG

@@ -4,12 +4,12 @@
 use std::path::Path;
 
 use sph_core::{apply_permutation, ParticleSet, Real};
-use sph_scene::{InitialMasses, Scene};
-use sph_solver::initial::{calibrate_masses, MassCalibration};
+use sph_scene::Scene;
+use sph_solver::initial::MassCalibration;
 use sph_solver::{FluidSolver, StepStats};
 
 use crate::vtk::{write_particle_frame, write_point_frame, ParticleFrame};
-use crate::{build_solver, density_kernel, SimError};
+use crate::{build_solver, SceneSetup, SimError};
 
 /// A scene being simulated in precision `R`.
 pub struct SceneSim<R: Real> {
@@ -43,40 +43,31 @@ impl<R: Real> std::fmt::Debug for SceneSim<R> {
 }
 
 impl<R: Real> SceneSim<R> {
-    /// Samples the scene's fluid (masses `ρ0 s³`, the scene's initial velocities) and builds
-    /// its solver and boundary ([`build_solver`]). With `[boundary] initial_masses =
-    /// "calibrated"` the masses of the particles that the lattice plus the boundary put above
-    /// `ρ0` are lowered until none is ([`calibrate_masses`] with the solver's density kernel,
-    /// [`density_kernel`]). Errors name the scene file.
+    /// Builds the scene once ([`SceneSetup::new`]: the fluid sampled, the solids' signed
+    /// distance fields and the boundary built, the masses calibrated if asked) and its
+    /// solver ([`SceneSim::from_setup`]). Errors name the scene file.
     pub fn new(scene: &Scene) -> Result<Self, SimError> {
-        let solver = build_solver::<R>(scene)?;
-        let common = solver.common();
-        let positions = scene.fluid_positions::<R>()?;
-        let mut state =
-            ParticleSet::from_positions(positions, common.particle_mass(), common.rest_density);
-        let calibration = match scene.boundary.initial_masses {
-            InitialMasses::Lattice => None,
-            InitialMasses::Calibrated => Some(
-                calibrate_masses(density_kernel(scene), common, solver.boundary(), &mut state)
-                    .map_err(|source| SimError::Setup {
-                        file: scene.source.display().to_string(),
-                        source,
-                    })?,
-            ),
-        };
-        let velocities = scene.fluid_velocities::<R>()?;
-        if velocities.len() != state.len() {
-            return Err(SimError::Invalid(format!(
-                "{}: {} initial velocities for {} particles",
-                scene.source.display(),
-                velocities.len(),
-                state.len()
-            )));
-        }
-        state.velocities = velocities;
+        Self::from_setup(SceneSetup::new(scene)?)
+    }
+
+    /// The simulation of a scene built once: its solver made from the set-up's parameters
+    /// and boundary ([`build_solver`]), its particles the set-up's. Nothing is sampled or
+    /// built again.
+    pub fn from_setup(setup: SceneSetup<R>) -> Result<Self, SimError> {
+        let SceneSetup {
+            scene,
+            params,
+            state,
+            boundary,
+            calibration,
+        } = setup;
+        let solver = build_solver(params, boundary).map_err(|source| SimError::Setup {
+            file: scene.source.display().to_string(),
+            source,
+        })?;
         let n = state.len() as u32;
         Ok(Self {
-            scene: scene.clone(),
+            scene,
             state,
             ids: (0..n).collect(),
             frame: 0,

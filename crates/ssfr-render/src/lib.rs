@@ -110,7 +110,7 @@ pub mod splat;
 
 pub use background::{ray_box, Background, Ground, Light, Obstacle, SceneBuffer, TankWalls};
 pub use camera::{Camera, CameraFrame};
-pub use config::RenderConfig;
+pub use config::{RenderConfig, SceneInfo};
 pub use error::SsfrError;
 pub use image::{image_difference, RgbImage};
 pub use march::DepthTiles;

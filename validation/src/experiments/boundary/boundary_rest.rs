@@ -60,7 +60,7 @@ fn scene_for(base: &Scene, kind: SolverKind, model: BoundaryModel, case: &str) -
     let mut scene = base.clone();
     scene.solver = scene.solver.with_kind(kind);
     if kind == SolverKind::Pcisph {
-        scene.solver.set_substeps(10);
+        scene.solver.common_mut().substeps = 10;
         scene.solver.set_iterations(4);
     }
     scene.boundary.model = model;

@@ -28,7 +28,7 @@ use anyhow::{bail, Result};
 use iisph_granular::measure::{normalised_runout, runout, RunoutOptions};
 use sph_scene::{FluidSpec, Scene};
 
-use super::scene_edit::SceneText;
+use super::scene_edit::{set_block_and_tank, shipped};
 use super::{run_scene, solver_error_check};
 use crate::helpers::{
     load_reference_csv, plot_xy, write_csv_rows, Legend, Marker, PlotSpec, Series, SeriesStyle,
@@ -78,7 +78,7 @@ fn band(laws: &[Regime; 2], a: f64) -> (f64, f64, &'static str) {
     }
 }
 
-fn column_scene(template: &SceneText, base: &Scene, a: f64, laws: &[Regime; 2]) -> Result<Scene> {
+fn column_scene(base: &Scene, a: f64, laws: &[Regime; 2]) -> Result<Scene> {
     let Some(FluidSpec::Block { min, max, .. }) = base.fluids.first() else {
         bail!("{TEMPLATE}: the template's first fluid must be a block");
     };
@@ -96,17 +96,18 @@ fn column_scene(template: &SceneText, base: &Scene, a: f64, laws: &[Regime; 2]) 
     let courant = (2.0 * g * h0_template).sqrt() * dt_template / s;
     let substeps = (base.frame_dt_s * (2.0 * g * h0).sqrt() / (courant * s)).ceil() as i64;
     let duration = 0.5 + 6.0 * (h0 / g).sqrt();
-    let mut text = template.clone();
-    text.set_block_and_tank(
+    let mut scene = base.clone();
+    set_block_and_tank(
+        &mut scene,
         [0.0, 0.0, 0.0],
         [l0, h0, depth],
         [0.0, 0.0, 0.0],
         [length, h0 + 4.0 * s, depth],
     );
-    text.set("solver.substeps", substeps.max(1))?;
-    text.set("simulation.duration", duration)?;
-    let mut scene = text.scene()?;
+    scene.solver.common_mut().substeps = substeps.max(1) as usize;
+    scene.duration_s = duration;
     scene.name = format!("{TEMPLATE}_a{a}");
+    scene.check()?;
     Ok(scene)
 }
 
@@ -139,11 +140,10 @@ impl Experiment for GranularColumnCollapse {
 
     fn run(&self, ctx: &mut Context) -> Result<Outcome> {
         let laws = load_laws(ctx)?;
-        let template = SceneText::shipped(TEMPLATE, ctx.mode)?;
-        let base = template.scene()?;
+        let base = shipped(TEMPLATE, ctx.mode)?;
         let scenes: Vec<(f64, Scene)> = ASPECT_RATIOS
             .iter()
-            .map(|&a| Ok((a, column_scene(&template, &base, a, &laws)?)))
+            .map(|&a| Ok((a, column_scene(&base, a, &laws)?)))
             .collect::<Result<_>>()?;
         ctx.progress
             .set_length(scenes.iter().map(|(_, s)| s.frame_count() as u64).sum());

@@ -23,7 +23,7 @@ use anyhow::{anyhow, Result};
 use sph_core::Real;
 use sph_scene::{Scene, SolverKind};
 
-use super::scene_edit::SceneText;
+use super::scene_edit::{set_block_and_tank, shipped};
 use super::solver_error_check;
 use crate::helpers::write_csv_rows;
 use crate::sim::SceneSim;
@@ -38,23 +38,21 @@ pub const WARM_UP_STEPS: usize = 3;
 const PARTICLES: usize = 100_000;
 
 fn pile_scene(mode: Mode, measured_steps: usize) -> Result<Scene> {
-    let mut text = SceneText::shipped("granular_repose_30", mode)?;
-    let s = 0.005;
-    text.set("simulation.particle_spacing", s)?;
-    text.set("simulation.frame_dt", 0.001)?;
-    text.set(
-        "simulation.duration",
-        0.001 * (WARM_UP_STEPS + measured_steps) as f64,
-    )?;
-    text.set("solver.substeps", 1)?;
-    text.set("output.vtk", false)?;
-    text.set_block_and_tank(
+    let mut scene = shipped("granular_repose_30", mode)?;
+    scene.particle_spacing = 0.005;
+    scene.frame_dt_s = 0.001;
+    scene.duration_s = 0.001 * (WARM_UP_STEPS + measured_steps) as f64;
+    scene.solver.common_mut().substeps = 1;
+    scene.output.vtk = false;
+    set_block_and_tank(
+        &mut scene,
         [0.4, 0.0, 0.0],
         [0.8, 0.25, 0.125],
         [0.0, 0.0, 0.0],
         [1.2, 0.3, 0.125],
     );
-    text.scene()
+    scene.check()?;
+    Ok(scene)
 }
 
 /// One timed run: per-phase seconds summed over the measured steps, the wall time of
@@ -129,10 +127,8 @@ impl Experiment for GranularPerformance {
         let scene = pile_scene(ctx.mode, measured)?;
         // The same pile as water (friction off, every other setting equal): the reference of
         // the granular step's cost.
-        let water = Scene {
-            solver: scene.solver.with_kind(SolverKind::Iisph),
-            ..scene.clone()
-        };
+        let mut water = scene.clone();
+        water.solver = scene.solver.with_kind(SolverKind::Iisph);
         let thread_counts: Vec<usize> = ctx.mode.pick(vec![2], vec![1, 2]);
         ctx.progress
             .set_length((2 * thread_counts.len() * scene.frame_count()) as u64);

@@ -29,10 +29,9 @@
 
 use anyhow::Result;
 use sph_core::{ParticleSet, Real};
-use sph_scene::Scene;
-use toml::Value;
+use sph_scene::{BoundaryModel, IisphSettings, Scene};
 
-use super::scene_edit::SceneText;
+use super::scene_edit::{iisph_solver, shipped};
 use crate::helpers::{plot_xy, write_csv_rows, Legend, PlotSpec, Series, SeriesStyle};
 use crate::sim::SceneSim;
 use crate::{Check, Context, Experiment, Mode, Outcome};
@@ -58,19 +57,26 @@ const QUICK_SPACING_M: f64 = 0.04;
 const ETA: f64 = 1e-3;
 
 /// The dam break with IISPH at step `dt_s`, one step per frame, `extra` solver settings.
-fn iisph_scene(mode: Mode, dt_s: f64, duration_s: f64, extra: &[(&str, Value)]) -> Result<Scene> {
-    let mut text = SceneText::shipped("dam_break", mode)?;
+fn iisph_scene(mode: Mode, dt_s: f64, duration_s: f64, iisph: IisphSettings) -> Result<Scene> {
+    let mut scene = shipped("dam_break", mode)?;
     if mode == Mode::Quick {
-        text.set("simulation.particle_spacing", QUICK_SPACING_M)?;
+        scene.particle_spacing = QUICK_SPACING_M;
     }
-    let mut fields = vec![("substeps", Value::Integer(1))];
-    fields.extend(extra.iter().cloned());
-    text.set_solver("iisph", &fields);
-    text.set("simulation.frame_dt", dt_s)?;
-    text.set("simulation.duration", duration_s)?;
-    text.set("boundary.model", "volume-map")?;
-    text.set("output.vtk", false)?;
-    text.scene()
+    scene.solver = iisph_solver(1, iisph);
+    scene.frame_dt_s = dt_s;
+    scene.duration_s = duration_s;
+    scene.boundary.model = BoundaryModel::VolumeMap;
+    scene.output.vtk = false;
+    scene.check()?;
+    Ok(scene)
+}
+
+/// The IISPH settings with stopping tolerance `eta`, the rest the solver's defaults.
+fn with_tolerance(eta: f64) -> IisphSettings {
+    IisphSettings {
+        density_error_tolerance: Some(eta),
+        ..IisphSettings::default()
+    }
 }
 
 /// Per-step statistics of a window: `(mean error after the solve, mean max ρ/ρ0 − 1, mean
@@ -113,8 +119,7 @@ struct Results {
 fn run_in<R: Real>(ctx: &Context) -> Result<Results> {
     let dt_ref_s = ctx.mode.pick(0.002, 0.001);
     let duration = ctx.mode.pick(0.8, 2.0);
-    let eta = [("density_error_tolerance", Value::Float(ETA))];
-    let reference_scene = iisph_scene(ctx.mode, dt_ref_s, duration, &eta)?;
+    let reference_scene = iisph_scene(ctx.mode, dt_ref_s, duration, with_tolerance(ETA))?;
     let steps = reference_scene.frame_count();
     ctx.progress
         .set_length((steps + STATE_TIMES_S.len() * (ITERATIONS.len() + TIME_STEPS_S.len())) as u64);
@@ -141,16 +146,15 @@ fn run_in<R: Real>(ctx: &Context) -> Result<Results> {
     }
     let mut by_iterations = Vec::new();
     for &k in &ITERATIONS {
-        let k_value = Value::Integer(k as i64);
         let scene = iisph_scene(
             ctx.mode,
             dt_ref_s,
             dt_ref_s * WINDOW_STEPS as f64,
-            &[
-                ("max_iterations", k_value.clone()),
-                ("min_iterations", k_value),
-                ("density_error_tolerance", Value::Float(1e-12)),
-            ],
+            IisphSettings {
+                max_iterations: Some(k),
+                min_iterations: Some(k),
+                ..with_tolerance(1e-12)
+            },
         )?;
         let (mut e, mut m) = (0.0, 0.0);
         let mut sim = SceneSim::<R>::new(&scene)?;
@@ -164,7 +168,7 @@ fn run_in<R: Real>(ctx: &Context) -> Result<Results> {
     }
     let mut by_dt = Vec::new();
     for &dt in &TIME_STEPS_S {
-        let scene = iisph_scene(ctx.mode, dt, WINDOW_S, &eta)?;
+        let scene = iisph_scene(ctx.mode, dt, WINDOW_S, with_tolerance(ETA))?;
         let (mut it, mut m) = (0.0, 0.0);
         let mut sim = SceneSim::<R>::new(&scene)?;
         for state in &states {
@@ -194,9 +198,7 @@ impl Experiment for IisphConvergence {
     }
 
     fn run(&self, ctx: &mut Context) -> Result<Outcome> {
-        let precision = SceneText::shipped("dam_break", ctx.mode)?
-            .scene()?
-            .precision;
+        let precision = shipped("dam_break", ctx.mode)?.precision;
         let r = sph_sim::with_precision!(precision, R => run_in::<R>(ctx)?);
         let mut out = Outcome::new();
         out.metric("particles", r.particles as f64);

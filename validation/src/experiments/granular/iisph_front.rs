@@ -13,10 +13,9 @@
 //! calibrated), and the front then led the measurements by up to 33 %.
 
 use anyhow::Result;
-use sph_scene::{Precision, Scene};
-use toml::Value;
+use sph_scene::{BoundaryModel, IisphSettings, InitialMasses, Precision, Scene};
 
-use super::scene_edit::SceneText;
+use super::scene_edit::{iisph_solver, shipped};
 use crate::experiments::pbf::front::{interpolate, simulate, FrontRun};
 use crate::{Context, Mode};
 
@@ -39,19 +38,18 @@ pub struct IisphFront {
 
 /// The Martin & Moyce scene with IISPH (see the module documentation).
 pub fn iisph_scene(ctx: &Context) -> Result<Scene> {
-    let mut text = SceneText::shipped("martin_moyce", ctx.mode)?;
-    let mut substeps = text.number("solver.substeps")?;
+    let mut scene = shipped("martin_moyce", ctx.mode)?;
+    let mut substeps = scene.solver.substeps() as f64;
     if ctx.mode == Mode::Quick {
         // same CFL number as the scene's steps at the coarser spacing
-        let s = text.number("simulation.particle_spacing")?;
-        substeps = (substeps * s / QUICK_SPACING_M).ceil();
-        text.set("simulation.particle_spacing", QUICK_SPACING_M)?;
+        substeps = (substeps * scene.particle_spacing / QUICK_SPACING_M).ceil();
+        scene.particle_spacing = QUICK_SPACING_M;
     }
-    let substeps = substeps as i64;
-    text.set_solver("iisph", &[("substeps", Value::Integer(substeps))]);
-    text.set("boundary.model", "volume-map")?;
-    text.set("boundary.initial_masses", "calibrated")?;
-    text.scene()
+    scene.solver = iisph_solver(substeps as usize, IisphSettings::default());
+    scene.boundary.model = BoundaryModel::VolumeMap;
+    scene.boundary.initial_masses = InitialMasses::Calibrated;
+    scene.check()?;
+    Ok(scene)
 }
 
 /// Runs the IISPH curve and compares it with the measured `(T, Z)`.

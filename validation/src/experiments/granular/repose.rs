@@ -28,9 +28,9 @@
 use anyhow::Result;
 use iisph_granular::measure::{angle_of_repose, surface_profile, PileShape, ReposeOptions};
 use sph_core::Vec3;
-use sph_scene::Scene;
+use sph_scene::{Scene, SolverSpec};
 
-use super::scene_edit::SceneText;
+use super::scene_edit::shipped;
 use super::{run_scene, solver_error_check, SceneRun};
 use crate::helpers::{plot_xy, write_csv_rows, Legend, Marker, PlotSpec, Series, SeriesStyle};
 use crate::{Check, Context, Experiment, Outcome};
@@ -59,9 +59,17 @@ struct Case {
 }
 
 fn scene_for(theta_deg: f64, name: &str, ctx: &Context) -> Result<Scene> {
-    let mut text = SceneText::shipped(name, ctx.mode)?;
-    text.set("solver.friction_angle_deg", theta_deg)?;
-    text.scene()
+    let mut scene = shipped(name, ctx.mode)?;
+    let SolverSpec::Granular(granular) = &mut scene.solver else {
+        anyhow::bail!(
+            "{}: the repose sweep needs kind = \"granular\", not \"{}\"",
+            scene.source.display(),
+            scene.solver.kind_name()
+        );
+    };
+    granular.friction_angle_deg = theta_deg;
+    scene.check()?;
+    Ok(scene)
 }
 
 impl Experiment for GranularRepose {

@@ -158,7 +158,7 @@ pub fn run_fluid(
 ) -> Result<FluidRun> {
     let mut scene = scene.clone();
     scene.solver = scene.solver.with_kind(kind);
-    scene.solver.set_substeps(substeps);
+    scene.solver.common_mut().substeps = substeps;
     scene.solver.set_iterations(iterations);
     let name = match kind {
         SolverKind::Pbf => "PBF",

@@ -24,10 +24,10 @@
 use anyhow::Result;
 use pbf::{ParticleSet, Pbf};
 use sph_core::Real;
-use sph_scene::{Scene, SolverSpec};
+use sph_scene::{Scene, SolverParams};
 
 use crate::helpers::{plot_xy, write_csv_rows, Legend, PlotSpec, Series, SeriesStyle};
-use crate::sim::{pbf_params, shipped_scene, SceneSim};
+use crate::sim::{shipped_scene, SceneSim};
 use crate::{Check, Context, Experiment, Outcome};
 
 /// The experiment.
@@ -127,14 +127,13 @@ fn sweep<R: Real>(ctx: &Context, scene: &Scene) -> Result<(Vec<Row>, usize)> {
         sim.advance()?;
         ctx.progress.inc(1);
     }
-    let SolverSpec::Pbf(spec) = &scene.solver else {
+    let SolverParams::Pbf(base) = scene.solver_params::<R>()? else {
         anyhow::bail!(
             "{}: the convergence sweep needs a PBF scene, not kind = \"{}\"",
             scene.source.display(),
             scene.solver.kind_name()
         );
     };
-    let base = pbf_params::<R>(scene, spec)?;
     let mut rows = Vec::new();
     {
         let mut p = base.clone();

@@ -24,7 +24,9 @@
 use sph_solver::{DEFAULT_SUPPORT_OVER_SPACING, MAX_SUBSTEPS};
 
 use crate::error::Ctx;
-use crate::{v3, FluidSpec, QuickSpec, Scene, SceneError, MAX_FRAMES};
+use crate::geom::v3;
+use crate::limits::MAX_FRAMES;
+use crate::{FluidSpec, QuickSpec, Scene, SceneError};
 
 /// Checks the time stepping of `scene`; `quick` are the overrides applied to it (the field
 /// names then point at `quick.*` for the values they set).
@@ -80,7 +82,8 @@ pub(super) fn check(ctx: &Ctx, scene: &Scene, quick: Option<&QuickSpec>) -> Resu
     let dt = scene.frame_dt_s / substeps as f64;
     let h = scene
         .solver
-        .support_over_spacing()
+        .common()
+        .support_over_spacing
         .unwrap_or(DEFAULT_SUPPORT_OVER_SPACING)
         * scene.particle_spacing;
     let g = v3(scene.gravity).norm();

@@ -1,0 +1,192 @@
+//! The value checks of a scene, on its typed fields ([`Scene::check`]): the same whether the
+//! scene was just read from a file or edited in code. One function per section, in the
+//! order of the file documentation, then the time stepping (`check/time_step.rs`), the
+//! particles (`build.rs`), the solver's own parameter checks in the scene's precision
+//! (`params.rs`) and the `[render]` table (`render.rs`); the scene with its `[quick]`
+//! overrides is checked too, so that [`Scene::quick`] gives a valid scene.
+
+// NaN-rejecting checks are written as `!(x > 0.0)` on purpose.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+mod solver;
+mod time_step;
+
+use sph_core::Aabb;
+
+use crate::error::Ctx;
+use crate::geom::{fmt3, v3, AXES};
+use crate::mesh_io::placement_field;
+use crate::{FluidSpec, QuickSpec, Scene, SceneError, SolidSpec, DEFAULT_IISPH_MIN_ITERATIONS};
+
+impl Scene {
+    /// Checks every value of the scene, as [`Scene::load`] does: after editing a loaded
+    /// scene's fields in code, this says whether the result is a scene a file could give
+    /// (errors name the field, with its line in the file the scene was read from when the
+    /// field is written there). Meshes are not read again: a [`crate::MeshSpec`] keeps the
+    /// mesh as loaded and placed.
+    pub fn check(&self) -> Result<(), SceneError> {
+        let ctx = Ctx {
+            lines: Some(&self.lines),
+            ..Ctx::new(&self.source)
+        };
+        solver::check(&ctx, &self.solver)?;
+        self.check_sections(&ctx)?;
+        time_step::check(&ctx, self, None)?;
+        self.validate_particles(&ctx)?;
+        self.check_solver_params(&ctx)?;
+        self.check_render(&ctx)?;
+        if let Some(overrides) = &self.quick_overrides {
+            let quick = self.quick();
+            let ctx = Ctx {
+                note: "with the [quick] overrides: ",
+                ..ctx
+            };
+            time_step::check(&ctx, &quick, Some(overrides))?;
+            quick.validate_particles(&ctx)?;
+            quick.check_solver_params(&ctx)?;
+            quick.check_render(&ctx)?;
+        }
+        Ok(())
+    }
+
+    /// The sections but `[solver]`, in file-documentation order.
+    fn check_sections(&self, ctx: &Ctx) -> Result<(), SceneError> {
+        check_name(ctx, &self.name)?;
+        ctx.positive("simulation.particle_spacing", self.particle_spacing)?;
+        ctx.positive("simulation.duration", self.duration_s)?;
+        ctx.positive("simulation.frame_dt", self.frame_dt_s)?;
+        ctx.finite3("simulation.gravity", &self.gravity)?;
+        if let Some(t) = &self.tank {
+            ctx.check_box("tank", &t.min.into(), &t.max.into())?;
+        }
+        for (i, f) in self.fluids.iter().enumerate() {
+            check_fluid(ctx, &format!("fluid[{i}]"), f, self.tank.as_ref())?;
+        }
+        for (j, s) in self.solids.iter().enumerate() {
+            check_solid(ctx, &format!("solid[{j}]"), s)?;
+        }
+        if self.output.every_frames == 0 {
+            return Err(ctx.invalid("output.every_frames", "must be >= 1, got 0"));
+        }
+        if let Some(q) = &self.quick_overrides {
+            self.check_quick(ctx, q)?;
+        }
+        Ok(())
+    }
+
+    /// `[quick]`: each override in range and consistent with the solver.
+    fn check_quick(&self, ctx: &Ctx, q: &QuickSpec) -> Result<(), SceneError> {
+        for (name, v) in [
+            ("particle_spacing", q.particle_spacing),
+            ("duration", q.duration_s),
+            ("frame_dt", q.frame_dt_s),
+        ] {
+            if let Some(v) = v {
+                ctx.positive(&format!("quick.{name}"), v)?;
+            }
+        }
+        for (name, v) in [
+            ("substeps", q.substeps),
+            ("iterations", q.iterations),
+            ("every_frames", q.every_frames),
+        ] {
+            if v == Some(0) {
+                return Err(ctx.invalid(format!("quick.{name}"), "must be >= 1, got 0"));
+            }
+        }
+        let min_iterations = match (&self.solver, self.solver.iisph()) {
+            (crate::SolverSpec::Pbf(p), _) => p.min_iterations,
+            (_, Some(i)) => Some(i.min_iterations.unwrap_or(DEFAULT_IISPH_MIN_ITERATIONS)),
+            _ => None,
+        };
+        if let Some(k) = q.iterations {
+            if let Some(min) = min_iterations.filter(|&min| k < min) {
+                return Err(ctx.invalid(
+                    "quick.iterations",
+                    format!("must be >= solver.min_iterations = {min}, got {k}"),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `name`: non-empty, `[A-Za-z0-9_.-]+`.
+fn check_name(ctx: &Ctx, name: &str) -> Result<(), SceneError> {
+    let ok = !name.is_empty()
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "_-.".contains(c));
+    if ok {
+        Ok(())
+    } else {
+        Err(ctx.invalid(
+            "name",
+            format!(
+                "{name:?}: must be non-empty and use only ASCII letters, digits, '_', '-' and '.'"
+            ),
+        ))
+    }
+}
+
+/// One fluid at `field`: finite velocity, a proper block, inside the tank (box level).
+fn check_fluid(
+    ctx: &Ctx,
+    field: &str,
+    f: &FluidSpec,
+    tank: Option<&Aabb<f64>>,
+) -> Result<(), SceneError> {
+    let (FluidSpec::Block { velocity, .. } | FluidSpec::Mesh { velocity, .. }) = f;
+    ctx.finite3(&format!("{field}.velocity"), velocity)?;
+    let (b, bfield) = match f {
+        FluidSpec::Block { min, max, .. } => {
+            (ctx.check_box(field, min, max)?, format!("{field}.max"))
+        }
+        FluidSpec::Mesh { mesh, .. } => (mesh.mesh.bounds(), placement_field(field, mesh)),
+    };
+    let Some(t) = tank else {
+        return Ok(());
+    };
+    let tol = 1e-9 * (t.extent().norm() + 1.0);
+    match (0..3).find(|&a| b.min[a] < t.min[a] - tol || b.max[a] > t.max[a] + tol) {
+        Some(a) => Err(ctx.invalid(
+            bfield,
+            format!(
+                "the fluid's box {} – {} is not inside the tank {} – {} (axis {})",
+                fmt3(&b.min),
+                fmt3(&b.max),
+                fmt3(&t.min),
+                fmt3(&t.max),
+                AXES[a]
+            ),
+        )),
+        None => Ok(()),
+    }
+}
+
+/// One solid at `field`.
+fn check_solid(ctx: &Ctx, field: &str, s: &SolidSpec) -> Result<(), SceneError> {
+    match s {
+        SolidSpec::Sphere { center, radius } => {
+            ctx.finite3(&format!("{field}.center"), center)?;
+            ctx.positive(&format!("{field}.radius"), *radius)
+        }
+        SolidSpec::Box { min, max } => ctx.check_box(field, min, max).map(|_| ()),
+        SolidSpec::Plane { point, normal } => {
+            ctx.finite3(&format!("{field}.point"), point)?;
+            ctx.finite3(&format!("{field}.normal"), normal)?;
+            let n = v3(*normal).norm();
+            if !(n.is_finite() && n > 0.0) {
+                return Err(ctx.invalid(
+                    format!("{field}.normal"),
+                    "must have a finite, non-zero length",
+                ));
+            }
+            Ok(())
+        }
+        SolidSpec::Mesh { sdf_cell, .. } => match sdf_cell {
+            Some(c) => ctx.positive(&format!("{field}.sdf_cell"), *c),
+            None => Ok(()),
+        },
+    }
+}

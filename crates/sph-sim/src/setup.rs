@@ -1,0 +1,91 @@
+//! A scene built once: [`SceneSetup`] holds everything a run starts from — the solver's
+//! parameters, the particles (positions, velocities, masses, calibrated if asked) and the
+//! boundary — each made once from a checked [`Scene`], so that [`crate::SceneSim`] and any
+//! other consumer (an experiment reading the initial state, a renderer) share one build.
+
+use sph_core::{ParticleSet, Real};
+use sph_scene::{InitialMasses, Precision, Scene, SolverParams};
+use sph_solver::initial::{calibrate_masses, MassCalibration};
+use sph_solver::Boundary;
+
+use crate::factory::{build_boundary, density_kernel};
+use crate::SimError;
+
+/// A scene built once in precision `R`: the parameters, the initial particles and the
+/// boundary. [`crate::SceneSim::from_setup`] builds the solver from it without sampling,
+/// building a signed distance field or range-checking again.
+pub struct SceneSetup<R: Real> {
+    /// The scene it was built from.
+    pub scene: Scene,
+    /// The solver's parameters (checked: by [`Scene::check`] when `R` is the scene's
+    /// precision, else here, in `R`).
+    pub params: SolverParams<R>,
+    /// The initial particles: the fluid sampled once, masses `ρ0 s³` (calibrated with
+    /// `[boundary] initial_masses = "calibrated"`), the scene's initial velocities.
+    pub state: ParticleSet<R>,
+    /// The tank and solids as the solver's boundary (`[boundary] model`).
+    pub boundary: Box<dyn Boundary<R>>,
+    /// What the mass calibration did, `None` for lattice masses.
+    pub calibration: Option<MassCalibration>,
+}
+
+impl<R: Real> std::fmt::Debug for SceneSetup<R> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SceneSetup")
+            .field("scene", &self.scene.name)
+            .field("particles", &self.state.len())
+            .field("boundary", &self.boundary.name())
+            .field("calibration", &self.calibration)
+            .finish()
+    }
+}
+
+/// `R` is the scene's precision (its parameters were checked in it by [`Scene::check`]).
+fn is_scene_precision<R: Real>(scene: &Scene) -> bool {
+    let name = match scene.precision {
+        Precision::F32 => f32::NAME,
+        Precision::F64 => f64::NAME,
+    };
+    R::NAME == name
+}
+
+impl<R: Real> SceneSetup<R> {
+    /// Builds `scene` (checked, e.g. by [`Scene::load`] or [`Scene::check`]): samples the
+    /// fluid once (positions and velocities together), builds the solids' signed distance
+    /// fields and the boundary once, and calibrates the masses if the scene asks for it
+    /// ([`calibrate_masses`] with the solver's density kernel, [`density_kernel`]). Errors
+    /// name the scene file.
+    pub fn new(scene: &Scene) -> Result<Self, SimError> {
+        let params = if is_scene_precision::<R>(scene) {
+            scene.solver_params_unchecked::<R>()
+        } else {
+            scene.solver_params::<R>()?
+        };
+        let common = params.common().clone();
+        let fluid = scene.fluid_particles::<R>()?;
+        let boundary = build_boundary(scene, &common, &fluid.positions)?;
+        let mut state = ParticleSet::from_positions(
+            fluid.positions,
+            common.particle_mass(),
+            common.rest_density,
+        );
+        state.velocities = fluid.velocities;
+        let calibration = match scene.boundary.initial_masses {
+            InitialMasses::Lattice => None,
+            InitialMasses::Calibrated => Some(
+                calibrate_masses(density_kernel(scene), &common, &*boundary, &mut state)
+                    .map_err(|source| SimError::Setup {
+                        file: scene.source.display().to_string(),
+                        source,
+                    })?,
+            ),
+        };
+        Ok(Self {
+            scene: scene.clone(),
+            params,
+            state,
+            boundary,
+            calibration,
+        })
+    }
+}
