@@ -26,6 +26,13 @@ pub struct RunArgs {
     /// (0: none).
     #[arg(long, value_name = "N", default_value_t = 25)]
     checkpoint_every: usize,
+    /// Directory of cached volume maps, reused by later runs
+    /// [default: target/cache/volume-maps under the current directory].
+    #[arg(long, value_name = "DIR", value_parser = crate::directory)]
+    cache: Option<PathBuf>,
+    /// Build volume maps afresh and keep none.
+    #[arg(long, conflicts_with = "cache")]
+    no_cache: bool,
     /// Continue from OUT's checkpoint: the frames and statistics come out bit-identical to
     /// an uninterrupted run's (but for the wall-clock columns).
     #[arg(long)]
@@ -59,6 +66,11 @@ pub fn run(a: &RunArgs) -> Result<()> {
         checkpoint_every: (a.checkpoint_every > 0).then_some(a.checkpoint_every),
         resume: a.resume,
         render: a.render,
+        volume_map_cache: (!a.no_cache).then(|| {
+            a.cache
+                .clone()
+                .unwrap_or_else(|| PathBuf::from("target").join("cache").join("volume-maps"))
+        }),
     };
     Ok(run_scene(&a.scene, &opts)?)
 }

@@ -65,7 +65,8 @@ impl Scene {
             lines: Some(&self.lines),
             ..Ctx::new(&self.source)
         };
-        p.validate().map_err(|e| self.param_error(&ctx, R::NAME, e))?;
+        p.validate()
+            .map_err(|e| self.param_error(&ctx, R::NAME, e))?;
         Ok(p)
     }
 
@@ -268,7 +269,10 @@ max = [0.2, 0.2, 0.2]
             ("solver_iterations", "solver.iterations"),
             ("pressure_iterations", "solver.iterations"),
             ("min_solver_iterations", "solver.min_iterations"),
-            ("mean_compression_tolerance", "solver.mean_compression_tolerance"),
+            (
+                "mean_compression_tolerance",
+                "solver.mean_compression_tolerance",
+            ),
             ("substeps", "solver.substeps"),
             ("support_radius", "solver"),
         ] {

@@ -15,9 +15,13 @@ use crate::error::{document_error, serde_error, Ctx, FieldLines};
 use crate::geom::v3;
 use crate::limits::MAX_SCENE_FILE_BYTES;
 use crate::mesh_io::{MeshFields, MeshLoader};
-use crate::raw::{RawBox, RawFluid, RawFluidKind, RawOutput, RawQuick, RawScene, RawSolid, RawSolidKind};
+use crate::raw::{
+    RawBox, RawFluid, RawFluidKind, RawOutput, RawQuick, RawScene, RawSolid, RawSolidKind,
+};
 use crate::read::read_limited;
-use crate::{FluidSpec, OutputSpec, Precision, QuickSpec, Scene, SceneError, SolidSpec, SolverSpec};
+use crate::{
+    FluidSpec, OutputSpec, Precision, QuickSpec, Scene, SceneError, SolidSpec, SolverSpec,
+};
 
 /// The `[solver]` table as parsed (with spans), for [`solver::parse`].
 type SolverTable<'i> = Spanned<DeValue<'i>>;
@@ -33,8 +37,12 @@ impl Scene {
             file: path.to_path_buf(),
             reason,
         };
-        let bytes = read_limited(path, MAX_SCENE_FILE_BYTES, "scene file (MAX_SCENE_FILE_BYTES)")
-            .map_err(read_error)?;
+        let bytes = read_limited(
+            path,
+            MAX_SCENE_FILE_BYTES,
+            "scene file (MAX_SCENE_FILE_BYTES)",
+        )
+        .map_err(read_error)?;
         let text = String::from_utf8(bytes).map_err(|e| {
             let at = e.utf8_error().valid_up_to();
             let line = e.as_bytes()[..at].iter().filter(|&&b| b == b'\n').count() + 1;

@@ -80,7 +80,6 @@ pub(crate) enum RawSolidKind {
     Mesh,
 }
 
-
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct RawSolid {
@@ -97,7 +96,6 @@ pub(crate) struct RawSolid {
     pub fit: Option<RawBox>,
     pub sdf_cell: Option<f64>,
 }
-
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]

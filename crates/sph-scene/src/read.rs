@@ -46,7 +46,10 @@ pub(crate) fn read_limited(path: &Path, limit: u64, what: &str) -> Result<Vec<u8
         return Err(format!("is {kind}, not a regular file"));
     }
     let too_large = |n: u64| {
-        format!("{n} bytes, more than the {limit} bytes a {what} may have ({})", human(limit))
+        format!(
+            "{n} bytes, more than the {limit} bytes a {what} may have ({})",
+            human(limit)
+        )
     };
     if meta.len() > limit {
         return Err(too_large(meta.len()));

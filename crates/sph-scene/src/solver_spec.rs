@@ -237,9 +237,9 @@ impl SolverSpec {
             SolverSpec::Pbf(s) => s.iterations,
             SolverSpec::Pcisph(s) => s.iterations,
             SolverSpec::Iisph(IisphSpec { iisph, .. })
-            | SolverSpec::Granular(GranularSpec { iisph, .. }) => iisph
-                .max_iterations
-                .unwrap_or(DEFAULT_IISPH_MAX_ITERATIONS),
+            | SolverSpec::Granular(GranularSpec { iisph, .. }) => {
+                iisph.max_iterations.unwrap_or(DEFAULT_IISPH_MAX_ITERATIONS)
+            }
         }
     }
 

@@ -269,7 +269,10 @@ const SCENE_CASES: &[SceneCase] = &[
     },
     SceneCase {
         name: "render_zero_size",
-        edits: &[("vtk = false\n", "vtk = false\n\n[render]\nwidth = 0\nheight = 0\n")],
+        edits: &[(
+            "vtk = false\n",
+            "vtk = false\n\n[render]\nwidth = 0\nheight = 0\n",
+        )],
     },
     SceneCase {
         name: "render_too_large",
@@ -280,7 +283,10 @@ const SCENE_CASES: &[SceneCase] = &[
     },
     SceneCase {
         name: "render_unknown_field",
-        edits: &[("vtk = false\n", "vtk = false\n\n[render.camera]\nfov = 40.0\n")],
+        edits: &[(
+            "vtk = false\n",
+            "vtk = false\n\n[render.camera]\nfov = 40.0\n",
+        )],
     },
     SceneCase {
         name: "render_eye_at_target",

@@ -44,7 +44,10 @@ fn granular_scene_reads_every_field() {
     assert_eq!(p.drag_coefficient, Some(0.47));
     assert_eq!(p.air_velocity, Some([1.0, 0.0, 0.0]));
     assert_eq!(p.upscaling_factor, Some(8));
-    assert_eq!((p.iisph.max_iterations, p.iisph.min_iterations), (Some(50), Some(3)));
+    assert_eq!(
+        (p.iisph.max_iterations, p.iisph.min_iterations),
+        (Some(50), Some(3))
+    );
     // with_kind keeps the IISPH settings between the two IISPH kinds.
     let SolverSpec::Iisph(w) = s.solver.with_kind(SolverKind::Iisph) else {
         panic!()

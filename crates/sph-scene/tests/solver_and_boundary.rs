@@ -30,7 +30,10 @@ fn pbf_fixture_reads_into_the_pbf_variant() {
     let SolverSpec::Pbf(p) = &s.solver else {
         panic!("{:?}", s.solver)
     };
-    assert_eq!((p.common.substeps, p.iterations, p.xsph_c), (2, 3, Some(0.01)));
+    assert_eq!(
+        (p.common.substeps, p.iterations, p.xsph_c),
+        (2, 3, Some(0.01))
+    );
     assert_eq!(p.scorr_k, None);
 }
 
@@ -162,7 +165,10 @@ fn solver_spec_deserializes_as_an_internally_tagged_table() {
     let SolverSpec::Pcisph(p) = &s else {
         panic!("{s:?}")
     };
-    assert_eq!((p.common.substeps, p.iterations, p.xsph_c), (1, 2, Some(0.5)));
+    assert_eq!(
+        (p.common.substeps, p.iterations, p.xsph_c),
+        (1, 2, Some(0.5))
+    );
     let e = toml::from_str::<SolverSpec>(
         "kind = \"pcisph\"\nsubsteps = 1\niterations = 2\nscorr_k = 0.1",
     )
@@ -196,7 +202,10 @@ fn with_kind_keeps_the_shared_settings() {
         panic!("{back:?}")
     };
     // PBF's own option did not survive the round trip through PCISPH.
-    assert_eq!((b.vorticity_epsilon, b.common.rest_density), (None, Some(990.0)));
+    assert_eq!(
+        (b.vorticity_epsilon, b.common.rest_density),
+        (None, Some(990.0))
+    );
 }
 
 #[test]

@@ -11,7 +11,7 @@ use pcisph::Pcisph;
 use sph_core::{Aabb, Real, Vec3};
 use sph_kernels::KernelKind;
 use sph_scene::{BoundaryModel, Scene, SolverParams, SolverSpec};
-use sph_solver::boundary::{VolumeMapBoundary, VolumeMapOptions};
+use sph_solver::boundary::{VolumeMapBoundary, VolumeMapCache, VolumeMapOptions};
 use sph_solver::{Boundary, CollisionBoundary, CommonParams, FluidSolver, SolverError};
 
 use crate::SimError;
@@ -80,10 +80,14 @@ fn domain<R: Real>(scene: &Scene, positions: &[Vec3<R>]) -> Result<Aabb<R>, SimE
 /// solids ([`Scene::build_solids`], built once here) as a [`CollisionBoundary`] at the
 /// particle radius, or as a [`VolumeMapBoundary`] of the kernel at the support radius with
 /// contact distance [`VOLUME_MAP_CONTACT_FRACTION`] of the particle radius.
+///
+/// With `cache`, volume maps are loaded from (or built into) that cache
+/// ([`VolumeMapCache`]); a refused cache file is rebuilt and reported on stderr.
 pub fn build_boundary<R: Real>(
     scene: &Scene,
     c: &CommonParams<R>,
     positions: &[Vec3<R>],
+    cache: Option<&VolumeMapCache>,
 ) -> Result<Box<dyn Boundary<R>>, SimError> {
     let solids = scene.build_solids::<R>()?;
     let setup = |source| setup_error(scene, source);
@@ -92,15 +96,19 @@ pub fn build_boundary<R: Real>(
             CollisionBoundary::new(solids, c.particle_radius()).map_err(setup)?,
         )),
         BoundaryModel::VolumeMap => {
-            let b = VolumeMapBoundary::new(
+            let b = VolumeMapBoundary::with_cache(
                 solids,
                 density_kernel(scene),
                 c.support_radius,
                 domain(scene, positions)?,
                 c.particle_radius() * R::of_f64(VOLUME_MAP_CONTACT_FRACTION),
                 VolumeMapOptions::default(),
+                cache,
             )
             .map_err(setup)?;
+            for w in b.cache_warnings() {
+                eprintln!("warning: {w} (the map was rebuilt)");
+            }
             Ok(Box::new(b))
         }
     }

@@ -304,6 +304,8 @@ pub struct SceneRunOptions {
     pub resume: bool,
     /// Render the frames (PNG in `OUT/render`) in process as the run writes them.
     pub render: bool,
+    /// A directory of volume maps to load from and add to (`None`: build them, keep none).
+    pub volume_map_cache: Option<PathBuf>,
 }
 
 /// The frame a run of `scene` stops at with `max_frames`.
@@ -347,7 +349,13 @@ fn run_scene_in<R: Real>(
     mut render: Option<RenderObserver>,
 ) -> Result<(), SimError> {
     let t0 = Instant::now();
-    let mut sim = SceneSim::<R>::new(scene)?;
+    let cache = match &opts.volume_map_cache {
+        Some(dir) => Some(
+            sph_solver::boundary::VolumeMapCache::new(dir).map_err(|e| SimError::output(dir, e))?,
+        ),
+        None => None,
+    };
+    let mut sim = SceneSim::<R>::with_cache(scene, cache.as_ref())?;
     let resumed = opts.resume;
     if resumed {
         sim.resume_from(&run.checkpoint())?;

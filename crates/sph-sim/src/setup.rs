@@ -5,6 +5,7 @@
 
 use sph_core::{ParticleSet, Real};
 use sph_scene::{InitialMasses, Precision, Scene, SolverParams};
+use sph_solver::boundary::VolumeMapCache;
 use sph_solver::initial::{calibrate_masses, MassCalibration};
 use sph_solver::Boundary;
 
@@ -50,12 +51,20 @@ fn is_scene_precision<R: Real>(scene: &Scene) -> bool {
 }
 
 impl<R: Real> SceneSetup<R> {
+    /// [`SceneSetup::with_cache`] without a volume-map cache.
+    pub fn new(scene: &Scene) -> Result<Self, SimError> {
+        Self::with_cache(scene, None)
+    }
+
     /// Builds `scene` (checked, e.g. by [`Scene::load`] or [`Scene::check`]): samples the
     /// fluid once (positions and velocities together), builds the solids' signed distance
     /// fields and the boundary once, and calibrates the masses if the scene asks for it
     /// ([`calibrate_masses`] with the solver's density kernel, [`density_kernel`]). Errors
     /// name the scene file.
-    pub fn new(scene: &Scene) -> Result<Self, SimError> {
+    ///
+    /// With `cache`, the volume maps come from (or go into) that cache
+    /// ([`sph_solver::boundary::VolumeMapCache`]).
+    pub fn with_cache(scene: &Scene, cache: Option<&VolumeMapCache>) -> Result<Self, SimError> {
         let params = if is_scene_precision::<R>(scene) {
             scene.solver_params_unchecked::<R>()
         } else {
@@ -63,7 +72,7 @@ impl<R: Real> SceneSetup<R> {
         };
         let common = params.common().clone();
         let fluid = scene.fluid_particles::<R>()?;
-        let boundary = build_boundary(scene, &common, &fluid.positions)?;
+        let boundary = build_boundary(scene, &common, &fluid.positions, cache)?;
         let mut state = ParticleSet::from_positions(
             fluid.positions,
             common.particle_mass(),
@@ -73,11 +82,12 @@ impl<R: Real> SceneSetup<R> {
         let calibration = match scene.boundary.initial_masses {
             InitialMasses::Lattice => None,
             InitialMasses::Calibrated => Some(
-                calibrate_masses(density_kernel(scene), &common, &*boundary, &mut state)
-                    .map_err(|source| SimError::Setup {
+                calibrate_masses(density_kernel(scene), &common, &*boundary, &mut state).map_err(
+                    |source| SimError::Setup {
                         file: scene.source.display().to_string(),
                         source,
-                    })?,
+                    },
+                )?,
             ),
         };
         Ok(Self {

@@ -50,6 +50,14 @@ impl<R: Real> SceneSim<R> {
         Self::from_setup(SceneSetup::new(scene)?)
     }
 
+    /// [`SceneSim::new`] with the volume maps from (or into) `cache`.
+    pub fn with_cache(
+        scene: &Scene,
+        cache: Option<&sph_solver::boundary::VolumeMapCache>,
+    ) -> Result<Self, SimError> {
+        Self::from_setup(SceneSetup::with_cache(scene, cache)?)
+    }
+
     /// The simulation of a scene built once: its solver made from the set-up's parameters
     /// and boundary ([`build_solver`]), its particles the set-up's. Nothing is sampled or
     /// built again.

@@ -60,6 +60,7 @@ fn runs_a_scene_and_writes_frames_and_statistics() {
                 checkpoint_every: None,
                 resume: false,
                 render: false,
+                volume_map_cache: None,
             },
         )
         .unwrap();
@@ -124,6 +125,7 @@ fn runs_iisph_and_granular_scenes_with_passive_points() {
                 checkpoint_every: None,
                 resume: false,
                 render: false,
+                volume_map_cache: None,
             },
         )
         .unwrap();
@@ -172,6 +174,7 @@ fn malformed_scene_names_file_and_field() {
             checkpoint_every: None,
             resume: false,
             render: false,
+            volume_map_cache: None,
         },
     )
     .unwrap_err();
@@ -194,6 +197,7 @@ fn zero_frames_and_a_file_as_output_are_refused() {
         checkpoint_every: None,
         resume: false,
         render: false,
+        volume_map_cache: None,
     };
     let err = run_scene(&scene, &opts(dir.join("out"), Some(0))).unwrap_err();
     assert!(err.to_string().contains("--frames 0"), "{err}");

@@ -43,10 +43,9 @@ fn check_common(ctx: &Ctx, c: &SolverCommon) -> Result<(), SceneError> {
 /// XSPH `c` in [0, 1] (PBF and PCISPH).
 fn xsph(ctx: &Ctx, xsph_c: Option<f64>) -> Result<(), SceneError> {
     match xsph_c {
-        Some(v) if !(v.is_finite() && (0.0..=1.0).contains(&v)) => Err(ctx.invalid(
-            "solver.xsph_c",
-            format!("must be in [0, 1], got {v}"),
-        )),
+        Some(v) if !(v.is_finite() && (0.0..=1.0).contains(&v)) => {
+            Err(ctx.invalid("solver.xsph_c", format!("must be in [0, 1], got {v}")))
+        }
         _ => Ok(()),
     }
 }
@@ -114,10 +113,7 @@ fn check_iisph(ctx: &Ctx, s: &IisphSettings) -> Result<(), SceneError> {
     positive(ctx, "density_error_tolerance", s.density_error_tolerance)?;
     if let Some(w) = s.relaxation {
         if !(w.is_finite() && w > 0.0 && w <= 1.0) {
-            return Err(ctx.invalid(
-                "solver.relaxation",
-                format!("must be in (0, 1], got {w}"),
-            ));
+            return Err(ctx.invalid("solver.relaxation", format!("must be in (0, 1], got {w}")));
         }
     }
     if let Some(v) = s.viscosity {

@@ -13,7 +13,7 @@ use sph_core::{ParticleSet, Real, Vec3};
 use sph_scene::{BoundaryModel, Scene, SolidSpec, SolverKind};
 
 use crate::helpers::{plot_xy, write_csv_rows, Legend, PlotSpec, Series, SeriesStyle};
-use crate::sim::{shipped_scene, SceneSim};
+use crate::sim::{scene_sim, shipped_scene};
 use crate::{Check, Context, Experiment, Outcome};
 
 /// The experiment.
@@ -80,7 +80,7 @@ fn scene_for(base: &Scene, kind: SolverKind, model: BoundaryModel, case: &str) -
 }
 
 fn run<R: Real>(ctx: &Context, scene: &Scene, label: String) -> Result<RestRun> {
-    let mut sim = SceneSim::<R>::new(scene)?;
+    let mut sim = scene_sim::<R>(scene)?;
     let s = scene.particle_spacing;
     let h = sim.solver().common().support_radius.as_f64();
     // Remove the lattice points inside (or within s/2 of) the solids: the sphere.

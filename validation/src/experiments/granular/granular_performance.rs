@@ -26,7 +26,7 @@ use sph_scene::{Scene, SolverKind};
 use super::scene_edit::{set_block_and_tank, shipped};
 use super::solver_error_check;
 use crate::helpers::write_csv_rows;
-use crate::sim::SceneSim;
+use crate::sim::scene_sim;
 use crate::{Check, Context, Experiment, Mode, Outcome};
 
 /// The experiment.
@@ -75,7 +75,7 @@ fn time_in<R: Real>(ctx: &Context, scene: &Scene, threads: usize) -> Result<Time
         .build()
         .map_err(|e| anyhow!("thread pool of {threads}: {e}"))?;
     pool.install(|| -> Result<Timed> {
-        let mut sim = SceneSim::<R>::new(scene)?;
+        let mut sim = scene_sim::<R>(scene)?;
         let steps = scene.frame_count();
         let mut t = Timed {
             threads,

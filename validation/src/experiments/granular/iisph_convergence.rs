@@ -33,7 +33,7 @@ use sph_scene::{BoundaryModel, IisphSettings, Scene};
 
 use super::scene_edit::{iisph_solver, shipped};
 use crate::helpers::{plot_xy, write_csv_rows, Legend, PlotSpec, Series, SeriesStyle};
-use crate::sim::SceneSim;
+use crate::sim::{scene_sim, SceneSim};
 use crate::{Check, Context, Experiment, Mode, Outcome};
 
 /// The experiment.
@@ -123,7 +123,7 @@ fn run_in<R: Real>(ctx: &Context) -> Result<Results> {
     let steps = reference_scene.frame_count();
     ctx.progress
         .set_length((steps + STATE_TIMES_S.len() * (ITERATIONS.len() + TIME_STEPS_S.len())) as u64);
-    let mut sim = SceneSim::<R>::new(&reference_scene)?;
+    let mut sim = scene_sim::<R>(&reference_scene)?;
     let state_steps: Vec<usize> = STATE_TIMES_S
         .iter()
         .map(|t| (t / dt_ref_s).round() as usize)
@@ -157,7 +157,7 @@ fn run_in<R: Real>(ctx: &Context) -> Result<Results> {
             },
         )?;
         let (mut e, mut m) = (0.0, 0.0);
-        let mut sim = SceneSim::<R>::new(&scene)?;
+        let mut sim = scene_sim::<R>(&scene)?;
         for state in &states {
             let (err, max, _) = window(ctx, &mut sim, state)?;
             e += err;
@@ -170,7 +170,7 @@ fn run_in<R: Real>(ctx: &Context) -> Result<Results> {
     for &dt in &TIME_STEPS_S {
         let scene = iisph_scene(ctx.mode, dt, WINDOW_S, with_tolerance(ETA))?;
         let (mut it, mut m) = (0.0, 0.0);
-        let mut sim = SceneSim::<R>::new(&scene)?;
+        let mut sim = scene_sim::<R>(&scene)?;
         for state in &states {
             let (_, max, iters) = window(ctx, &mut sim, state)?;
             it += iters;

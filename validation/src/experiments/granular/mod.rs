@@ -15,7 +15,7 @@ use anyhow::Result;
 use sph_core::{Real, Vec3};
 use sph_scene::Scene;
 
-use crate::sim::SceneSim;
+use crate::sim::scene_sim;
 use crate::{Check, Context};
 
 /// One frame of a run.
@@ -63,7 +63,7 @@ fn to_f64<R: Real>(p: &[Vec3<R>]) -> Vec<Vec3<f64>> {
 }
 
 fn run_in<R: Real>(ctx: &Context, scene: &Scene, snapshot_frames: &[usize]) -> Result<SceneRun> {
-    let mut sim = SceneSim::<R>::new(scene)?;
+    let mut sim = scene_sim::<R>(scene)?;
     let frames = scene.frame_count();
     let initial_potential_energy_j = crate::experiments::fluid_runs::potential_energy_j(&sim);
     let mut run = SceneRun {

@@ -11,7 +11,7 @@ use sph_core::Real;
 use sph_scene::{Scene, SolverKind};
 use sph_solver::SolverError;
 
-use crate::sim::SceneSim;
+use crate::sim::{scene_sim, SceneSim};
 use crate::Context;
 
 /// `max ρ/ρ0` above which a run counts as diverged (twice the rest density: 100 %
@@ -106,7 +106,7 @@ pub fn potential_energy_j<R: Real>(sim: &SceneSim<R>) -> f64 {
 }
 
 fn run_in<R: Real>(ctx: &Context, scene: &Scene, label: String) -> Result<FluidRun> {
-    let mut sim = SceneSim::<R>::new(scene)?;
+    let mut sim = scene_sim::<R>(scene)?;
     let frames = scene.frame_count();
     let initial_potential_energy_j = potential_energy_j(&sim);
     let mut run = FluidRun {

@@ -5,7 +5,7 @@ use anyhow::Result;
 use sph_core::Real;
 use sph_scene::Scene;
 
-use crate::sim::SceneSim;
+use crate::sim::scene_sim;
 use crate::Context;
 
 /// Column width `a` of the scene (m).
@@ -69,7 +69,7 @@ pub(crate) struct FrontRun {
 }
 
 pub(crate) fn simulate<R: Real>(ctx: &Context, scene: &Scene) -> Result<FrontRun> {
-    let mut sim = SceneSim::<R>::new(scene)?;
+    let mut sim = scene_sim::<R>(scene)?;
     let frames = scene.frame_count();
     let radius = 0.5 * scene.particle_spacing;
     let g = (scene.gravity[0].powi(2) + scene.gravity[1].powi(2) + scene.gravity[2].powi(2)).sqrt();

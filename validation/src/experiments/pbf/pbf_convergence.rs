@@ -27,7 +27,7 @@ use sph_core::Real;
 use sph_scene::{Scene, SolverParams};
 
 use crate::helpers::{plot_xy, write_csv_rows, Legend, PlotSpec, Series, SeriesStyle};
-use crate::sim::{shipped_scene, SceneSim};
+use crate::sim::{scene_sim, shipped_scene};
 use crate::{Check, Context, Experiment, Outcome};
 
 /// The experiment.
@@ -117,7 +117,7 @@ fn advected<R: Real>(
 }
 
 fn sweep<R: Real>(ctx: &Context, scene: &Scene) -> Result<(Vec<Row>, usize)> {
-    let mut sim = SceneSim::<R>::new(scene)?;
+    let mut sim = scene_sim::<R>(scene)?;
     let frames = (T_FIGURE_S / scene.frame_dt_s).round() as usize;
     ctx.progress
         .set_length((frames + 2 * ITERATIONS.len()) as u64);

@@ -23,7 +23,7 @@ use sph_core::Real;
 use sph_scene::Scene;
 
 use crate::helpers::{load_reference_csv, write_csv_rows};
-use crate::sim::{shipped_scene, SceneSim};
+use crate::sim::{scene_sim, shipped_scene};
 use crate::{fmt_num, Check, Context, Experiment, Outcome};
 
 /// The experiment.
@@ -65,7 +65,7 @@ struct Timing {
 }
 
 fn time_scene<R: Real>(ctx: &Context, scene: &Scene) -> Result<Timing> {
-    let mut sim = SceneSim::<R>::new(scene)?;
+    let mut sim = scene_sim::<R>(scene)?;
     for _ in 0..WARM_UP_FRAMES {
         sim.advance()?;
         ctx.progress.inc(1);

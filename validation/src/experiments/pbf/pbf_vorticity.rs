@@ -24,7 +24,7 @@ use sph_scene::{Scene, SolverSpec};
 use crate::helpers::{
     plot_xy, side_view_png, write_csv_rows, Legend, PlotSpec, Series, SeriesStyle,
 };
-use crate::sim::{shipped_scene, SceneSim};
+use crate::sim::{scene_sim, shipped_scene};
 use crate::{Check, Context, Experiment, Outcome};
 
 /// The experiment.
@@ -119,7 +119,7 @@ struct Run {
 }
 
 fn simulate<R: Real>(ctx: &Context, scene: &Scene, perturb_seed: Option<u64>) -> Result<Run> {
-    let mut sim = SceneSim::<R>::new(scene)?;
+    let mut sim = scene_sim::<R>(scene)?;
     if let Some(seed) = perturb_seed {
         let mut rng = crate::helpers::SplitMix64::new(seed);
         for p in sim.state.positions.iter_mut() {

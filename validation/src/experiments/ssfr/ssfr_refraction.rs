@@ -27,7 +27,7 @@ use ssfr_render::{
 
 use super::shapes::Shape;
 use crate::helpers::{plot_xy, write_csv_rows, Legend, PlotSpec, Series};
-use crate::sim::{shipped_scene, SceneSim};
+use crate::sim::{scene_sim, shipped_scene};
 use crate::{Check, Context, Experiment, Outcome};
 use sph_sim::render::render_params;
 
@@ -174,7 +174,7 @@ fn dam_break_frames(
         scene.precision == Precision::F32 || scene.precision == Precision::F64,
         "unknown precision"
     );
-    let mut sim = SceneSim::<f32>::new(&scene)?;
+    let mut sim = scene_sim::<f32>(&scene)?;
     let mut out = Vec::new();
     let last = frames.iter().copied().max().unwrap_or(0);
     for f in 0..=last {
