@@ -1,6 +1,6 @@
 //! The messages of the `validation` command line for arguments a user can get wrong
-//! (`validation scene ...`, `validation run ...`, what `cargo xtask run` and `cargo xtask
-//! validate` pass on), as reviewed snapshots (`tests/snapshots/cli_errors__<case>.snap`).
+//! (`validation run ...`, what `cargo xtask validate` passes on; the scene commands are
+//! `particles`', tested in `cli/tests/cli_errors.rs`), as reviewed snapshots (`tests/snapshots/cli_errors__<case>.snap`).
 //! Each case runs the binary in a fresh directory holding a valid scene (`good.toml` with
 //! `cube.obj`), a malformed one (`bad.toml`) and a plain file (`notes.txt`); every case must
 //! fail before simulating anything, with exit code 1 or 2 and the message on stderr (the
@@ -64,27 +64,6 @@ fn run(dir: &Path, args: &[&str]) -> (i32, String) {
 #[test]
 fn command_line_error_messages() {
     let cases: &[(&str, &[&str])] = &[
-        ("scene_without_path", &["scene"]),
-        (
-            "scene_frames_zero",
-            &["scene", "good.toml", "--frames", "0"],
-        ),
-        (
-            "scene_frames_negative",
-            &["scene", "good.toml", "--frames", "-3"],
-        ),
-        (
-            "scene_frames_not_a_number",
-            &["scene", "good.toml", "--frames", "many"],
-        ),
-        (
-            "scene_out_is_a_file",
-            &["scene", "good.toml", "--quick", "--out", "notes.txt"],
-        ),
-        ("scene_missing_file", &["scene", "absent.toml"]),
-        ("scene_path_is_a_directory", &["scene", "."]),
-        ("scene_malformed", &["scene", "bad.toml"]),
-        ("scene_not_toml", &["scene", "notes.txt"]),
         ("run_out_is_a_file", &["run", "--out", "notes.txt"]),
         ("run_only_without_id", &["run", "--only"]),
         ("run_unknown_flag", &["run", "--fast"]),

@@ -2,7 +2,7 @@
 //! the value checks shared by the parser and the mesh placement, and the translation of
 //! TOML/serde errors into a field path and a reason with line and column.
 
-use std::collections::HashMap;
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -156,12 +156,12 @@ impl<'a> Ctx<'a> {
 /// `fluid[1]`, `fluid[1].min`, ...): the line of its key, or for an element of an array of
 /// tables the line where the element starts.
 #[derive(Debug, Default)]
-pub(crate) struct FieldLines(HashMap<String, usize>);
+pub(crate) struct FieldLines(BTreeMap<String, usize>);
 
 impl FieldLines {
     /// The lines of the fields of the parsed document `doc` of `text`.
     pub fn new(text: &str, doc: &toml::de::DeTable<'_>) -> Self {
-        let mut map = HashMap::new();
+        let mut map = BTreeMap::new();
         collect_lines(text, doc, "", &mut map);
         FieldLines(map)
     }
@@ -192,7 +192,7 @@ fn collect_lines(
     text: &str,
     table: &toml::de::DeTable<'_>,
     prefix: &str,
-    out: &mut HashMap<String, usize>,
+    out: &mut BTreeMap<String, usize>,
 ) {
     use toml::de::DeValue;
     for (key, value) in table {
