@@ -91,4 +91,3 @@ pub(crate) fn simulate<R: Real>(ctx: &Context, scene: &Scene) -> Result<FrontRun
         calibration: sim.calibration,
     })
 }
-
