@@ -34,7 +34,7 @@ use sph_kernels::{
 
 use crate::helpers::{
     load_reference_csv, plot_xy, write_csv_columns, write_csv_rows, Legend, Marker, PlotSpec,
-    Series,
+    ReferenceTable, Series,
 };
 use crate::{fmt_num, Check, Context, Experiment, Mode, Outcome};
 
@@ -65,138 +65,14 @@ impl Experiment for Kernels {
         let settings = Settings::for_mode(ctx.mode);
         let reference =
             load_reference_csv(ctx, REFERENCE, &["kernel", "dim", "quantity", "sigma"])?;
-        let gl = gauss_legendre(GL_POINTS);
-
-        type Case = Box<dyn Fn(&Settings, &[(f64, f64)]) -> Result<Analysis>>;
-        macro_rules! both {
-            ($($ty:ident),*) => {
-                vec![$(
-                    Box::new(|s: &Settings, gl: &[(f64, f64)]| analyse(<$ty<f64>>::new, s, gl)) as Case,
-                    Box::new(|s: &Settings, gl: &[(f64, f64)]| analyse(<$ty<f32>>::new, s, gl)) as Case,
-                )*]
-            };
-        }
-        let cases = both!(
-            Poly6,
-            Spiky,
-            ViscosityKernel,
-            CubicSpline,
-            WendlandC2,
-            CubicSpline2D,
-            WendlandC2Planar
-        );
-        ctx.progress.set_length(cases.len() as u64);
-        let mut analyses = Vec::new();
-        for case in &cases {
-            let a = case(&settings, &gl)?;
-            ctx.progress
-                .set_message(format!("kernel cases (last: {} {})", a.name, a.precision));
-            ctx.progress.inc(1);
-            analyses.push(a);
-        }
+        let analyses = analyse_all(ctx, &settings)?;
 
         let mut out = Outcome::new();
         out.metric("h_values", settings.h.len() as f64);
         out.metric("fd_samples", settings.samples as f64);
         for a in &analyses {
-            let key = format!("{}/{}", a.name, a.precision);
-            let eps = a.eps;
-            out.metric(format!("normalisation_error/{key}"), a.norm_err);
-            out.check(Check::less_than(
-                format!("normalisation/{key}"),
-                a.norm_err,
-                NORMALISATION_BOUND,
-                "a normalised kernel has ∫W dV = 1 (definition); 1e-4 is above the radial quadrature's error and f32 round-off, and far below any wrong constant (a factor error in the normalisation)",
-            ));
-            let fd_bound = 50.0 * eps.powf(2.0 / 3.0);
-            let fd_origin = format!(
-                "central-difference error analysis: δ = ε^(1/3)·d, d = min(r, h−r, |r−h/2|), truncation + rounding = O(ε^(2/3)); bound 50·ε^(2/3), ε = {}",
-                fmt_num(eps)
-            );
-            out.metric(format!("gradient_fd_error/{key}"), a.grad_err);
-            out.metric(format!("gradient_fd_error_at_q/{key}"), a.grad_err_q);
-            out.check(Check::less_than(
-                format!("gradient-fd/{key}"),
-                a.grad_err,
-                fd_bound,
-                fd_origin.clone(),
-            ));
-            if let Some((e, q)) = a.lap_err {
-                out.metric(format!("laplacian_fd_error/{key}"), e);
-                out.metric(format!("laplacian_fd_error_at_q/{key}"), q);
-                out.check(Check::less_than(
-                    format!("laplacian-fd/{key}"),
-                    e,
-                    fd_bound,
-                    fd_origin,
-                ));
-            }
-            out.metric(format!("api_consistency_error/{key}"), a.api_err);
-            out.check(Check::less_than(
-                format!("vector-api/{key}"),
-                a.api_err,
-                32.0 * eps,
-                format!(
-                    "same formula up to a few roundings: 32ε, ε = {}",
-                    fmt_num(eps)
-                ),
-            ));
-
-            // (c) closed-form constants.
-            let rows = reference.find_all(&[("kernel", a.name), ("dim", &a.dim.to_string())])?;
-            if rows.is_empty() {
-                out.check(Check::less_than(
-                    format!("constant/{key}"),
-                    f64::NAN,
-                    64.0 * eps,
-                    format!("no row for this kernel in reference-data/{REFERENCE}"),
-                ));
-            }
-            for row in rows {
-                let quantity = reference.text(row, "quantity")?;
-                let sigma = reference.number(row, "sigma")?;
-                let measured: Vec<f64> = a
-                    .constants
-                    .iter()
-                    .map(|c| match quantity {
-                        "W0" => Ok(c.w0),
-                        "dW0" => Ok(c.dw0),
-                        "lap0" => c.lap0.with_context(|| format!("{key}: laplacian(0) is None")),
-                        other => anyhow::bail!(
-                            "reference file {}, line {}: unknown quantity {other:?} (expected W0, dW0 or lap0)",
-                            reference.path.display(),
-                            reference.rows[row].line
-                        ),
-                    })
-                    .collect::<Result<_>>()?;
-                let rel = measured.iter().map(|m| ((m - sigma) / sigma).abs()).fold(
-                    0.0,
-                    |acc: f64, e| {
-                        if e.is_nan() || acc.is_nan() {
-                            f64::NAN
-                        } else {
-                            acc.max(e)
-                        }
-                    },
-                );
-                out.metric(format!("{quantity}_scaled/{key}"), measured[0]);
-                out.metric(format!("{quantity}_relative_error/{key}"), rel);
-                let source = reference
-                    .text(row, "source")
-                    .unwrap_or("reference")
-                    .to_string();
-                out.check(Check::less_than(
-                    format!("constant-{quantity}/{key}"),
-                    rel,
-                    64.0 * eps,
-                    format!(
-                        "{} = {} ({source}, reference-data/{REFERENCE} line {}); rounding bound 64ε",
-                        quantity_label(quantity, a.dim),
-                        fmt_num(sigma),
-                        reference.rows[row].line
-                    ),
-                ));
-            }
+            check_derivatives(&mut out, a);
+            check_constants(&mut out, a, &reference)?;
         }
 
         write_outputs(ctx, &analyses, &reference)?;
@@ -219,6 +95,158 @@ impl Experiment for Kernels {
         );
         Ok(out)
     }
+}
+
+/// Analyses every kernel, f64 and f32.
+fn analyse_all(ctx: &Context, settings: &Settings) -> Result<Vec<Analysis>> {
+    let gl = gauss_legendre(GL_POINTS);
+    type Case = Box<dyn Fn(&Settings, &[(f64, f64)]) -> Result<Analysis>>;
+    macro_rules! both {
+        ($($ty:ident),*) => {
+            vec![$(
+                Box::new(|s: &Settings, gl: &[(f64, f64)]| analyse(<$ty<f64>>::new, s, gl)) as Case,
+                Box::new(|s: &Settings, gl: &[(f64, f64)]| analyse(<$ty<f32>>::new, s, gl)) as Case,
+            )*]
+        };
+    }
+    let cases = both!(
+        Poly6,
+        Spiky,
+        ViscosityKernel,
+        CubicSpline,
+        WendlandC2,
+        CubicSpline2D,
+        WendlandC2Planar
+    );
+    ctx.progress.set_length(cases.len() as u64);
+    let mut analyses = Vec::new();
+    for case in &cases {
+        let a = case(settings, &gl)?;
+        ctx.progress
+            .set_message(format!("kernel cases (last: {} {})", a.name, a.precision));
+        ctx.progress.inc(1);
+        analyses.push(a);
+    }
+    Ok(analyses)
+}
+
+/// (a) normalisation, (b) the derivatives against finite differences and the vector API.
+fn check_derivatives(out: &mut Outcome, a: &Analysis) {
+    let key = format!("{}/{}", a.name, a.precision);
+    let eps = a.eps;
+    out.metric(format!("normalisation_error/{key}"), a.norm_err);
+    out.check(Check::less_than(
+        format!("normalisation/{key}"),
+        a.norm_err,
+        NORMALISATION_BOUND,
+        "a normalised kernel has ∫W dV = 1 (definition); 1e-4 is above the radial quadrature's error and f32 round-off, and far below any wrong constant (a factor error in the normalisation)",
+    ));
+    let fd_bound = 50.0 * eps.powf(2.0 / 3.0);
+    let fd_origin = format!(
+        "central-difference error analysis: δ = ε^(1/3)·d, d = min(r, h−r, |r−h/2|), truncation + rounding = O(ε^(2/3)); bound 50·ε^(2/3), ε = {}",
+        fmt_num(eps)
+    );
+    out.metric(format!("gradient_fd_error/{key}"), a.grad_err);
+    out.metric(format!("gradient_fd_error_at_q/{key}"), a.grad_err_q);
+    out.check(Check::less_than(
+        format!("gradient-fd/{key}"),
+        a.grad_err,
+        fd_bound,
+        fd_origin.clone(),
+    ));
+    if let Some((e, q)) = a.lap_err {
+        out.metric(format!("laplacian_fd_error/{key}"), e);
+        out.metric(format!("laplacian_fd_error_at_q/{key}"), q);
+        out.check(Check::less_than(
+            format!("laplacian-fd/{key}"),
+            e,
+            fd_bound,
+            fd_origin,
+        ));
+    }
+    out.metric(format!("api_consistency_error/{key}"), a.api_err);
+    out.check(Check::less_than(
+        format!("vector-api/{key}"),
+        a.api_err,
+        32.0 * eps,
+        format!(
+            "same formula up to a few roundings: 32ε, ε = {}",
+            fmt_num(eps)
+        ),
+    ));
+}
+
+/// (c) closed-form constants against the reference table.
+fn check_constants(out: &mut Outcome, a: &Analysis, reference: &ReferenceTable) -> Result<()> {
+    let key = format!("{}/{}", a.name, a.precision);
+    let eps = a.eps;
+    let rows = reference.find_all(&[("kernel", a.name), ("dim", &a.dim.to_string())])?;
+    if rows.is_empty() {
+        out.check(Check::less_than(
+            format!("constant/{key}"),
+            f64::NAN,
+            64.0 * eps,
+            format!("no row for this kernel in reference-data/{REFERENCE}"),
+        ));
+    }
+    for row in rows {
+        let quantity = reference.text(row, "quantity")?;
+        let sigma = reference.number(row, "sigma")?;
+        let measured = measured_constant(a, &key, quantity, reference, row)?;
+        let rel = measured
+            .iter()
+            .map(|m| ((m - sigma) / sigma).abs())
+            .fold(0.0, |acc: f64, e| {
+                if e.is_nan() || acc.is_nan() {
+                    f64::NAN
+                } else {
+                    acc.max(e)
+                }
+            });
+        out.metric(format!("{quantity}_scaled/{key}"), measured[0]);
+        out.metric(format!("{quantity}_relative_error/{key}"), rel);
+        let source = reference
+            .text(row, "source")
+            .unwrap_or("reference")
+            .to_string();
+        out.check(Check::less_than(
+            format!("constant-{quantity}/{key}"),
+            rel,
+            64.0 * eps,
+            format!(
+                "{} = {} ({source}, reference-data/{REFERENCE} line {}); rounding bound 64ε",
+                quantity_label(quantity, a.dim),
+                fmt_num(sigma),
+                reference.rows[row].line
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The measured `quantity` (W0, dW0 or lap0) at each support radius.
+fn measured_constant(
+    a: &Analysis,
+    key: &str,
+    quantity: &str,
+    reference: &ReferenceTable,
+    row: usize,
+) -> Result<Vec<f64>> {
+    a.constants
+        .iter()
+        .map(|c| match quantity {
+            "W0" => Ok(c.w0),
+            "dW0" => Ok(c.dw0),
+            "lap0" => c
+                .lap0
+                .with_context(|| format!("{key}: laplacian(0) is None")),
+            other => anyhow::bail!(
+                "reference file {}, line {}: unknown quantity {other:?} (expected W0, dW0 or lap0)",
+                reference.path.display(),
+                reference.rows[row].line
+            ),
+        })
+        .collect()
 }
 
 fn quantity_label(q: &str, dim: usize) -> String {
