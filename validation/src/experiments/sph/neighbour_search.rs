@@ -766,41 +766,9 @@ fn plot_timings(
     );
     us_plot.log_x = true;
     us_plot.legend = Legend::UpperRight;
-    let markers = [Marker::Circle, Marker::Triangle, Marker::Cross];
-    for (mi, method) in Method::FAST.iter().enumerate() {
-        for &threads in thread_settings {
-            let sel: Vec<&Timing> = timings
-                .iter()
-                .filter(|t| t.method == *method && t.threads == threads)
-                .collect();
-            // The legend draws a short stroke that cannot show the dash: the 1-thread series
-            // get open rings (colour = method), the pool's series the method's filled marker.
-            let style = if threads == 1 && thread_settings.len() > 1 {
-                SeriesStyle::DashedMarkers(Marker::Ring)
-            } else {
-                SeriesStyle::LineMarkers(markers[mi % markers.len()])
-            };
-            let name = format!(
-                "{} ({threads} thread{})",
-                method.name(),
-                if threads == 1 { "" } else { "s" }
-            );
-            time_plot.series.push(Series::styled(
-                name.clone(),
-                sel.iter().map(|t| (t.n as f64, t.median_s * 1e3)).collect(),
-                style,
-                mi,
-            ));
-            us_plot.series.push(Series::styled(
-                name,
-                sel.iter()
-                    .map(|t| (t.n as f64, t.us_per_particle()))
-                    .collect(),
-                style,
-                mi,
-            ));
-        }
-    }
+    let (time_series, us_series) = timing_series(timings, thread_settings);
+    time_plot.series = time_series;
+    us_plot.series = us_series;
     us_plot.series.push(Series::styled(
         format!(
             "CompactNSearch, {anchor_threads} thread (maintainers' measurement): {anchor_us} µs"
@@ -826,4 +794,45 @@ fn plot_timings(
          (reference-data/neighbour-search/compactnsearch_anchor.csv), 1 thread",
     );
     Ok(())
+}
+
+/// Per method and thread count: the time per search (ms) and per particle (µs) against N.
+fn timing_series(timings: &[Timing], thread_settings: &[usize]) -> (Vec<Series>, Vec<Series>) {
+    let (mut time_series, mut us_series) = (Vec::new(), Vec::new());
+    let markers = [Marker::Circle, Marker::Triangle, Marker::Cross];
+    for (mi, method) in Method::FAST.iter().enumerate() {
+        for &threads in thread_settings {
+            let sel: Vec<&Timing> = timings
+                .iter()
+                .filter(|t| t.method == *method && t.threads == threads)
+                .collect();
+            // The legend draws a short stroke that cannot show the dash: the 1-thread series
+            // get open rings (colour = method), the pool's series the method's filled marker.
+            let style = if threads == 1 && thread_settings.len() > 1 {
+                SeriesStyle::DashedMarkers(Marker::Ring)
+            } else {
+                SeriesStyle::LineMarkers(markers[mi % markers.len()])
+            };
+            let name = format!(
+                "{} ({threads} thread{})",
+                method.name(),
+                if threads == 1 { "" } else { "s" }
+            );
+            time_series.push(Series::styled(
+                name.clone(),
+                sel.iter().map(|t| (t.n as f64, t.median_s * 1e3)).collect(),
+                style,
+                mi,
+            ));
+            us_series.push(Series::styled(
+                name,
+                sel.iter()
+                    .map(|t| (t.n as f64, t.us_per_particle()))
+                    .collect(),
+                style,
+                mi,
+            ));
+        }
+    }
+    (time_series, us_series)
 }
