@@ -13,7 +13,7 @@ use sph_core::{ParticleSet, Real, Vec3};
 use sph_scene::{BoundaryModel, Scene, SolidSpec, SolverKind};
 
 use crate::helpers::{plot_xy, write_csv_rows, Legend, PlotSpec, Series, SeriesStyle};
-use crate::sim::{scene_sim, shipped_scene};
+use crate::sim::{scene_sim, shipped_scene, SceneSim};
 use crate::{Check, Context, Experiment, Outcome};
 
 /// The experiment.
@@ -79,11 +79,9 @@ fn scene_for(base: &Scene, kind: SolverKind, model: BoundaryModel, case: &str) -
     scene
 }
 
-fn run<R: Real>(ctx: &Context, scene: &Scene, label: String) -> Result<RestRun> {
-    let mut sim = scene_sim::<R>(scene)?;
+/// Removes the lattice points inside (or within s/2 of) the solids: the sphere.
+fn remove_inside_solids<R: Real>(sim: &mut SceneSim<R>, scene: &Scene) -> Result<()> {
     let s = scene.particle_spacing;
-    let h = sim.solver().common().support_radius.as_f64();
-    // Remove the lattice points inside (or within s/2 of) the solids: the sphere.
     let solids = scene.build_solids::<f64>()?;
     let keep: Vec<bool> = sim
         .state
@@ -112,6 +110,13 @@ fn run<R: Real>(ctx: &Context, scene: &Scene, label: String) -> Result<RestRun> 
     }
     sim.state = state;
     sim.ids = ids;
+    Ok(())
+}
+
+/// The run's record before it starts, with the hydrostatic surface height; returns it and
+/// the energy unit `N m g H` (J).
+fn new_rest_run<R: Real>(sim: &SceneSim<R>, scene: &Scene, label: String) -> (RestRun, f64) {
+    let s = scene.particle_spacing;
     let n = sim.state.len();
     let tank = scene.tank.expect("boundary_rest has a tank");
     let height = sim
@@ -134,11 +139,10 @@ fn run<R: Real>(ctx: &Context, scene: &Scene, label: String) -> Result<RestRun> 
             _ => 0.0,
         })
         .sum();
-    let (solver, model) = (sim.solver().name(), scene.boundary.model);
-    let mut out = RestRun {
+    let run = RestRun {
         label,
-        solver,
-        model,
+        solver: sim.solver().name(),
+        model: scene.boundary.model,
         case: if sphere_volume > 0.0 {
             "sphere"
         } else {
@@ -152,6 +156,13 @@ fn run<R: Real>(ctx: &Context, scene: &Scene, label: String) -> Result<RestRun> 
         expected_surface_m: tank.min.y + (n as f64 * s.powi(3) + sphere_volume) / footprint,
         blow_up: None,
     };
+    (run, unit)
+}
+
+fn run<R: Real>(ctx: &Context, scene: &Scene, label: String) -> Result<RestRun> {
+    let mut sim = scene_sim::<R>(scene)?;
+    remove_inside_solids(&mut sim, scene)?;
+    let (mut out, unit) = new_rest_run(&sim, scene, label);
     for _ in 0..scene.frame_count() {
         match sim.advance() {
             Ok(st) => out.energy.push((sim.time_s, st.kinetic_energy / unit)),
@@ -162,6 +173,14 @@ fn run<R: Real>(ctx: &Context, scene: &Scene, label: String) -> Result<RestRun> 
         }
         ctx.progress.inc(1);
     }
+    measure_rest(&sim, scene.particle_spacing, &mut out);
+    Ok(out)
+}
+
+/// The end state: per particle height, `ρ/ρ0` and wall distance; the free surface; the
+/// near-wall and bulk mean densities.
+fn measure_rest<R: Real>(sim: &SceneSim<R>, s: f64, out: &mut RestRun) {
+    let h = sim.solver().common().support_radius.as_f64();
     let rho0 = sim.solver().common().rest_density.as_f64();
     let boundary = sim.solver().boundary();
     for (p, rho) in sim.state.positions.iter().zip(&sim.state.densities) {
@@ -198,7 +217,6 @@ fn run<R: Real>(ctx: &Context, scene: &Scene, label: String) -> Result<RestRun> 
             .map(|q| q.1)
             .collect(),
     );
-    Ok(out)
 }
 
 /// Means of `value` over bins of `key` of width `dx` from `x0`: `(bin centre, mean)`.
@@ -277,161 +295,185 @@ impl Experiment for BoundaryRest {
 impl BoundaryRest {
     fn report(&self, ctx: &mut Context, base: &Scene, runs: &[RestRun]) -> Result<Outcome> {
         let mut out = Outcome::new();
-        let mut rows = Vec::new();
-        for r in runs {
-            let key = r.label.to_lowercase().replace(' ', "_");
-            let ke_end = r.energy.last().map_or(f64::NAN, |e| e.1);
-            out.metric(format!("{key}/kinetic_energy_per_mgh_at_end"), ke_end);
-            out.metric(format!("{key}/near_wall_density_ratio"), r.near_wall);
-            out.metric(format!("{key}/bulk_density_ratio"), r.bulk);
-            out.metric(format!("{key}/surface_height_m"), r.surface_m);
-            out.metric(
-                format!("{key}/hydrostatic_surface_height_m"),
-                r.expected_surface_m,
-            );
-            if let Some(e) = &r.blow_up {
-                out.note(format!("{} blew up: {e}", r.label));
-            }
-            rows.push(vec![
-                r.solver.to_string(),
-                model_name(r.model).to_string(),
-                r.case.to_string(),
-                format!("{ke_end:.4e}"),
-                format!("{:.5}", r.near_wall),
-                format!("{:.5}", r.bulk),
-                format!("{:.5}", r.surface_m),
-                format!("{:.5}", r.expected_surface_m),
-            ]);
-            let origin =
-                "at rest: kinetic energy per particle below 1e-3 m g H, i.e. an r.m.s. speed below 4.5 % of the free-fall speed sqrt(2 g H) from the column height (3-5e-5 is seen with volume maps)";
-            let ke_check = Check::less_than(
-                format!(
-                    "{}: kinetic energy per particle / (m g H) at t = 2 s",
-                    r.label
-                ),
-                ke_end,
-                REST_KE,
-                origin,
-            );
-            if r.model == BoundaryModel::VolumeMap {
-                out.check(ke_check);
-                out.check(Check::at_most(
-                    format!("{}: |near-wall / bulk mean rho/rho0 - 1|", r.label),
-                    (r.near_wall / r.bulk - 1.0).abs(),
-                    NEAR_WALL_TOLERANCE,
-                    "volume maps give wall particles full neighbourhoods (Bender et al. 2019); 1 % = the density error target of Solenthaler & Pajarola 2009 and Macklin & Muller 2013",
-                ));
-            } else {
-                out.note(format!(
-                    "{} (collision walls, not checked): KE/(m g H) {ke_end:.2e}, near-wall/bulk - 1 = {:+.4}",
-                    r.label,
-                    r.near_wall / r.bulk - 1.0
-                ));
-            }
-        }
-        write_csv_rows(
-            &ctx.path("summary.csv"),
-            &[
-                "solver",
-                "boundary",
-                "case",
-                "kinetic_energy_per_mgh_at_end",
-                "near_wall_density_ratio",
-                "bulk_density_ratio",
-                "surface_height_m",
-                "hydrostatic_surface_height_m",
-            ],
-            rows,
-        )?;
-        ctx.add_file(
-            "summary.csv",
-            "per run: kinetic energy at the end, near-wall and bulk density, surface height",
-        );
+        let rows = runs.iter().map(|r| check_run(&mut out, r)).collect();
+        write_summary(ctx, rows)?;
         self.plots(ctx, base, runs)?;
         Ok(out)
     }
 
     fn plots(&self, ctx: &mut Context, base: &Scene, runs: &[RestRun]) -> Result<()> {
-        let s = base.particle_spacing;
-        let style = |r: &RestRun| match r.model {
-            BoundaryModel::VolumeMap => SeriesStyle::Line,
-            BoundaryModel::Collision => SeriesStyle::Dashed,
-        };
-        let color = |r: &RestRun| match (r.solver, r.model) {
-            ("PBF", BoundaryModel::VolumeMap) => 2,
-            ("PBF", _) => 4,
-            (_, BoundaryModel::VolumeMap) => 3,
-            _ => 5,
-        };
         for case in ["column", "sphere"] {
             let sel: Vec<&RestRun> = runs.iter().filter(|r| r.case == case).collect();
-            let mut energy = vec![Series::styled(
-                "rest bound 1e-3",
-                vec![(0.0, REST_KE)],
-                SeriesStyle::HorizontalLine,
-                0,
-            )];
-            let mut height = vec![Series::styled(
-                "rest density",
-                vec![(0.0, 1.0)],
-                SeriesStyle::HorizontalLine,
-                0,
-            )];
-            let mut wall = height.clone();
-            for r in &sel {
-                let e: Vec<(f64, f64)> = r.energy.iter().map(|&(t, k)| (t, k.max(1e-9))).collect();
-                energy.push(Series::styled(r.label.clone(), e, style(r), color(r)));
-                height.push(Series::styled(
-                    r.label.clone(),
-                    binned(r.particles.iter().map(|q| (q.0, q.1)), 0.0, s),
-                    style(r),
-                    color(r),
-                ));
-                wall.push(Series::styled(
-                    r.label.clone(),
-                    binned(r.particles.iter().map(|q| (q.2, q.1)), 0.0, 0.25 * s),
-                    style(r),
-                    color(r),
-                ));
-            }
-            let mut spec = PlotSpec::new(
-                format!("Water {case} at rest: kinetic energy"),
-                "t (s)",
-                "kinetic energy per particle / (m g H)",
-            );
-            spec.log_y = true;
-            spec.series = energy;
-            spec.legend = Legend::UpperRight;
-            let f = format!("energy_{case}.png");
-            plot_xy(&ctx.path(&f), &spec)?;
-            ctx.add_plot(&f, format!("{case}: kinetic energy per particle over time, each solver and boundary model, with the rest bound"));
-            let mut spec = PlotSpec::new(
-                format!("Water {case} at rest: density against height at t = 2 s"),
-                "height y (m)",
-                "mean rho / rho0 in layers of one spacing",
-            );
-            spec.series = height;
-            spec.legend = Legend::LowerLeft;
-            let f = format!("density_height_{case}.png");
-            plot_xy(&ctx.path(&f), &spec)?;
-            ctx.add_plot(
-                &f,
-                format!("{case}: rho/rho0 against height at the end (layer means)"),
-            );
-            let mut spec = PlotSpec::new(
-                format!("Water {case} at rest: density against distance to the nearest wall"),
-                "distance to the nearest solid (m)",
-                "mean rho / rho0 in bins of s/4",
-            );
-            spec.series = wall;
-            spec.legend = Legend::LowerRight;
-            let f = format!("density_wall_{case}.png");
-            plot_xy(&ctx.path(&f), &spec)?;
-            ctx.add_plot(
-                &f,
-                format!("{case}: rho/rho0 against the distance to the nearest wall at the end"),
-            );
+            plot_case(ctx, case, &sel, base.particle_spacing)?;
         }
         Ok(())
     }
+}
+
+/// One run's metrics, and its checks (volume maps) or note (collision walls); returns its
+/// row of `summary.csv`.
+fn check_run(out: &mut Outcome, r: &RestRun) -> Vec<String> {
+    let key = r.label.to_lowercase().replace(' ', "_");
+    let ke_end = r.energy.last().map_or(f64::NAN, |e| e.1);
+    out.metric(format!("{key}/kinetic_energy_per_mgh_at_end"), ke_end);
+    out.metric(format!("{key}/near_wall_density_ratio"), r.near_wall);
+    out.metric(format!("{key}/bulk_density_ratio"), r.bulk);
+    out.metric(format!("{key}/surface_height_m"), r.surface_m);
+    out.metric(
+        format!("{key}/hydrostatic_surface_height_m"),
+        r.expected_surface_m,
+    );
+    if let Some(e) = &r.blow_up {
+        out.note(format!("{} blew up: {e}", r.label));
+    }
+    let origin =
+        "at rest: kinetic energy per particle below 1e-3 m g H, i.e. an r.m.s. speed below 4.5 % of the free-fall speed sqrt(2 g H) from the column height (3-5e-5 is seen with volume maps)";
+    if r.model == BoundaryModel::VolumeMap {
+        out.check(Check::less_than(
+            format!(
+                "{}: kinetic energy per particle / (m g H) at t = 2 s",
+                r.label
+            ),
+            ke_end,
+            REST_KE,
+            origin,
+        ));
+        out.check(Check::at_most(
+            format!("{}: |near-wall / bulk mean rho/rho0 - 1|", r.label),
+            (r.near_wall / r.bulk - 1.0).abs(),
+            NEAR_WALL_TOLERANCE,
+            "volume maps give wall particles full neighbourhoods (Bender et al. 2019); 1 % = the density error target of Solenthaler & Pajarola 2009 and Macklin & Muller 2013",
+        ));
+    } else {
+        out.note(format!(
+            "{} (collision walls, not checked): KE/(m g H) {ke_end:.2e}, near-wall/bulk - 1 = {:+.4}",
+            r.label,
+            r.near_wall / r.bulk - 1.0
+        ));
+    }
+    vec![
+        r.solver.to_string(),
+        model_name(r.model).to_string(),
+        r.case.to_string(),
+        format!("{ke_end:.4e}"),
+        format!("{:.5}", r.near_wall),
+        format!("{:.5}", r.bulk),
+        format!("{:.5}", r.surface_m),
+        format!("{:.5}", r.expected_surface_m),
+    ]
+}
+
+fn write_summary(ctx: &mut Context, rows: Vec<Vec<String>>) -> Result<()> {
+    write_csv_rows(
+        &ctx.path("summary.csv"),
+        &[
+            "solver",
+            "boundary",
+            "case",
+            "kinetic_energy_per_mgh_at_end",
+            "near_wall_density_ratio",
+            "bulk_density_ratio",
+            "surface_height_m",
+            "hydrostatic_surface_height_m",
+        ],
+        rows,
+    )?;
+    ctx.add_file(
+        "summary.csv",
+        "per run: kinetic energy at the end, near-wall and bulk density, surface height",
+    );
+    Ok(())
+}
+
+/// Line style and colour of a run: solid for volume maps, dashed for collision walls.
+fn run_style(r: &RestRun) -> (SeriesStyle, usize) {
+    let style = match r.model {
+        BoundaryModel::VolumeMap => SeriesStyle::Line,
+        BoundaryModel::Collision => SeriesStyle::Dashed,
+    };
+    let color = match (r.solver, r.model) {
+        ("PBF", BoundaryModel::VolumeMap) => 2,
+        ("PBF", _) => 4,
+        (_, BoundaryModel::VolumeMap) => 3,
+        _ => 5,
+    };
+    (style, color)
+}
+
+/// The series of one case: kinetic energy, density against height, density against the
+/// wall distance (each with its reference line first).
+fn case_series(sel: &[&RestRun], s: f64) -> [Vec<Series>; 3] {
+    let mut energy = vec![Series::styled(
+        "rest bound 1e-3",
+        vec![(0.0, REST_KE)],
+        SeriesStyle::HorizontalLine,
+        0,
+    )];
+    let mut height = vec![Series::styled(
+        "rest density",
+        vec![(0.0, 1.0)],
+        SeriesStyle::HorizontalLine,
+        0,
+    )];
+    let mut wall = height.clone();
+    for r in sel {
+        let (style, color) = run_style(r);
+        let e: Vec<(f64, f64)> = r.energy.iter().map(|&(t, k)| (t, k.max(1e-9))).collect();
+        energy.push(Series::styled(r.label.clone(), e, style, color));
+        height.push(Series::styled(
+            r.label.clone(),
+            binned(r.particles.iter().map(|q| (q.0, q.1)), 0.0, s),
+            style,
+            color,
+        ));
+        wall.push(Series::styled(
+            r.label.clone(),
+            binned(r.particles.iter().map(|q| (q.2, q.1)), 0.0, 0.25 * s),
+            style,
+            color,
+        ));
+    }
+    [energy, height, wall]
+}
+
+fn plot_case(ctx: &mut Context, case: &str, sel: &[&RestRun], s: f64) -> Result<()> {
+    let [energy, height, wall] = case_series(sel, s);
+    let mut spec = PlotSpec::new(
+        format!("Water {case} at rest: kinetic energy"),
+        "t (s)",
+        "kinetic energy per particle / (m g H)",
+    );
+    spec.log_y = true;
+    spec.series = energy;
+    spec.legend = Legend::UpperRight;
+    let f = format!("energy_{case}.png");
+    plot_xy(&ctx.path(&f), &spec)?;
+    ctx.add_plot(&f, format!("{case}: kinetic energy per particle over time, each solver and boundary model, with the rest bound"));
+    let mut spec = PlotSpec::new(
+        format!("Water {case} at rest: density against height at t = 2 s"),
+        "height y (m)",
+        "mean rho / rho0 in layers of one spacing",
+    );
+    spec.series = height;
+    spec.legend = Legend::LowerLeft;
+    let f = format!("density_height_{case}.png");
+    plot_xy(&ctx.path(&f), &spec)?;
+    ctx.add_plot(
+        &f,
+        format!("{case}: rho/rho0 against height at the end (layer means)"),
+    );
+    let mut spec = PlotSpec::new(
+        format!("Water {case} at rest: density against distance to the nearest wall"),
+        "distance to the nearest solid (m)",
+        "mean rho / rho0 in bins of s/4",
+    );
+    spec.series = wall;
+    spec.legend = Legend::LowerRight;
+    let f = format!("density_wall_{case}.png");
+    plot_xy(&ctx.path(&f), &spec)?;
+    ctx.add_plot(
+        &f,
+        format!("{case}: rho/rho0 against the distance to the nearest wall at the end"),
+    );
+    Ok(())
 }

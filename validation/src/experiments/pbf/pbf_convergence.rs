@@ -163,6 +163,146 @@ fn sweep<R: Real>(ctx: &Context, scene: &Scene) -> Result<(Vec<Row>, usize)> {
     Ok((rows, sim.state.len()))
 }
 
+fn write_convergence(ctx: &mut Context, rows: &[Row]) -> Result<()> {
+    write_csv_rows(
+        &ctx.path("convergence.csv"),
+        &[
+            "iterations",
+            "max_compression",
+            "average_compression",
+            "unilateral_max_compression",
+            "unilateral_average_compression",
+            "no_scorr_max_compression",
+            "no_scorr_average_compression",
+        ],
+        rows.iter().map(|&(k, c, m, cu, mu, cn, mn)| {
+            vec![
+                k.to_string(),
+                format!("{c:.6e}"),
+                format!("{m:.6e}"),
+                format!("{cu:.6e}"),
+                format!("{mu:.6e}"),
+                format!("{cn:.6e}"),
+                format!("{mn:.6e}"),
+            ]
+        }),
+    )?;
+    ctx.add_file(
+        "convergence.csv",
+        "density error after one step against the iteration count, at t = 1.0 s",
+    );
+    Ok(())
+}
+
+/// The errors per iteration count (metrics) and the note comparing the two forms.
+fn convergence_metrics(out: &mut Outcome, rows: &[Row]) {
+    for &(k, c, m, cu, mu, cn, mn) in &rows[1..] {
+        out.metric(format!("no_scorr_max_compression_{k}_iterations"), cn);
+        out.metric(format!("no_scorr_average_compression_{k}_iterations"), mn);
+        out.metric(format!("max_compression_{k}_iterations"), c);
+        out.metric(format!("average_compression_{k}_iterations"), m);
+        out.metric(format!("unilateral_max_compression_{k}_iterations"), cu);
+        out.metric(format!("unilateral_average_compression_{k}_iterations"), mu);
+    }
+    if let (Some(first), Some(last)) = (rows.get(1), rows.last()) {
+        out.note(format!(
+            "Average compression after {} → {} iterations: paper's form {:.3e} → {:.3e}; \
+             SPlisHSPlasH's form (unilateral C, ε = 1e-6 m⁻², no s_corr; no check) \
+             {:.3e} → {:.3e}.",
+            first.0, last.0, first.2, last.2, first.4, last.4
+        ));
+    }
+}
+
+/// Monotone convergence, the first iteration's effect, 1 → 40 reduction, the 1 % target.
+fn check_convergence(out: &mut Outcome, rows: &[Row]) {
+    // Fig. 6 shows the error falling with every added iteration (from the first on).
+    let increases = rows[1..]
+        .windows(2)
+        .filter(|w| w[1].2 > w[0].2 * (1.0 + 1e-3))
+        .count();
+    out.check(Check::equals(
+        "average compression non-increasing with iterations (count of increases)",
+        increases as f64,
+        0.0,
+        "Fig. 6 of the paper: monotone convergence (0.1 % slack for single-precision round-off)",
+    ));
+    let at = |k: usize| rows.iter().find(|r| r.0 == k).copied();
+    if let (Some(r0), Some(r1), Some(r40)) = (at(0), at(1), at(40)) {
+        for (what, e0, e1, e40) in [
+            ("average", r0.2, r1.2, r40.2),
+            ("largest", r0.1, r1.1, r40.1),
+        ] {
+            out.metric(format!("{what}_compression_0_iterations"), e0);
+            out.check(Check::less_than(
+                format!("{what} compression: 1 iteration over the advection baseline"),
+                e1 / e0,
+                1.0,
+                "Algorithm 1: each Jacobi iteration moves the particles towards C_i = 0, so the first one lowers the error the advection left (a sign error or a dropped lambda would not)",
+            ));
+            out.check(Check::at_most(
+                format!("{what} compression: 40 iterations over 1 iteration"),
+                e40 / e1,
+                REDUCTION_1_TO_40,
+                "Fig. 6 of the paper: the error keeps falling with the iterations, about tenfold from 1 to 40; at least half (a solve that stalls after one iteration, e.g. a halved lambda, stays above)",
+            ));
+        }
+    }
+    let last = rows.last().map_or(f64::NAN, |r| r.2);
+    out.check(Check::less_than(
+        "average compression after 40 iterations",
+        last,
+        TARGET_COMPRESSION,
+        "PCISPH's 1 % density-error target (Solenthaler & Pajarola 2009), which §8 of the PBF paper says PBF matches",
+    ));
+}
+
+fn plot_convergence(ctx: &mut Context, rows: &[Row], particles: usize) -> Result<()> {
+    let spec = PlotSpec {
+        legend: Legend::LowerLeft,
+        log_y: true,
+        series: vec![
+            Series::styled(
+                "largest compression max ρ/ρ0 − 1",
+                rows.iter().map(|&(k, c, ..)| (k as f64, c)).collect(),
+                SeriesStyle::LineMarkers(crate::helpers::Marker::Circle),
+                0,
+            ),
+            Series::styled(
+                "average compression mean max(ρ/ρ0 − 1, 0)",
+                rows.iter().map(|&(k, _, m, ..)| (k as f64, m)).collect(),
+                SeriesStyle::LineMarkers(crate::helpers::Marker::Triangle),
+                1,
+            ),
+            Series::styled(
+                "average compression, SPlisHSPlasH's unilateral form",
+                rows.iter()
+                    .map(|&(k, _, _, _, mu, ..)| (k as f64, mu))
+                    .collect(),
+                SeriesStyle::LineMarkers(crate::helpers::Marker::Cross),
+                2,
+            ),
+            Series::styled(
+                "1 % (PCISPH target)",
+                vec![(0.0, TARGET_COMPRESSION), (41.0, TARGET_COMPRESSION)],
+                SeriesStyle::Dashed,
+                7,
+            ),
+        ],
+        ..PlotSpec::new(
+            format!("PBF convergence at t = 1.0 s, dam break ({particles} particles)"),
+            "Jacobi iterations in the step (0 = advection only)",
+            "density error",
+        )
+    };
+    plot_xy(&ctx.path("convergence.png"), &spec)?;
+    ctx.add_plot(
+        "convergence.png",
+        "density error after one step against the number of iterations (Fig. 6)",
+    );
+    Ok(())
+}
+
 impl Experiment for PbfConvergence {
     fn id(&self) -> &'static str {
         "pbf-convergence"
@@ -176,132 +316,12 @@ impl Experiment for PbfConvergence {
         let scene = shipped_scene("dam_break", ctx.mode)?;
         let (rows, particles) =
             sph_sim::with_precision!(scene.precision, R => sweep::<R>(ctx, &scene)?);
-        write_csv_rows(
-            &ctx.path("convergence.csv"),
-            &[
-                "iterations",
-                "max_compression",
-                "average_compression",
-                "unilateral_max_compression",
-                "unilateral_average_compression",
-                "no_scorr_max_compression",
-                "no_scorr_average_compression",
-            ],
-            rows.iter().map(|&(k, c, m, cu, mu, cn, mn)| {
-                vec![
-                    k.to_string(),
-                    format!("{c:.6e}"),
-                    format!("{m:.6e}"),
-                    format!("{cu:.6e}"),
-                    format!("{mu:.6e}"),
-                    format!("{cn:.6e}"),
-                    format!("{mn:.6e}"),
-                ]
-            }),
-        )?;
-        ctx.add_file(
-            "convergence.csv",
-            "density error after one step against the iteration count, at t = 1.0 s",
-        );
+        write_convergence(ctx, &rows)?;
         let mut out = Outcome::new();
         out.metric("particles", particles as f64);
-        for &(k, c, m, cu, mu, cn, mn) in &rows[1..] {
-            out.metric(format!("no_scorr_max_compression_{k}_iterations"), cn);
-            out.metric(format!("no_scorr_average_compression_{k}_iterations"), mn);
-            out.metric(format!("max_compression_{k}_iterations"), c);
-            out.metric(format!("average_compression_{k}_iterations"), m);
-            out.metric(format!("unilateral_max_compression_{k}_iterations"), cu);
-            out.metric(format!("unilateral_average_compression_{k}_iterations"), mu);
-        }
-        if let (Some(first), Some(last)) = (rows.get(1), rows.last()) {
-            out.note(format!(
-                "Average compression after {} → {} iterations: paper's form {:.3e} → {:.3e}; \
-                 SPlisHSPlasH's form (unilateral C, ε = 1e-6 m⁻², no s_corr; no check) \
-                 {:.3e} → {:.3e}.",
-                first.0, last.0, first.2, last.2, first.4, last.4
-            ));
-        }
-        // Fig. 6 shows the error falling with every added iteration (from the first on).
-        let increases = rows[1..]
-            .windows(2)
-            .filter(|w| w[1].2 > w[0].2 * (1.0 + 1e-3))
-            .count();
-        out.check(Check::equals(
-            "average compression non-increasing with iterations (count of increases)",
-            increases as f64,
-            0.0,
-            "Fig. 6 of the paper: monotone convergence (0.1 % slack for single-precision round-off)",
-        ));
-        let at = |k: usize| rows.iter().find(|r| r.0 == k).copied();
-        if let (Some(r0), Some(r1), Some(r40)) = (at(0), at(1), at(40)) {
-            for (what, e0, e1, e40) in [
-                ("average", r0.2, r1.2, r40.2),
-                ("largest", r0.1, r1.1, r40.1),
-            ] {
-                out.metric(format!("{what}_compression_0_iterations"), e0);
-                out.check(Check::less_than(
-                    format!("{what} compression: 1 iteration over the advection baseline"),
-                    e1 / e0,
-                    1.0,
-                    "Algorithm 1: each Jacobi iteration moves the particles towards C_i = 0, so the first one lowers the error the advection left (a sign error or a dropped lambda would not)",
-                ));
-                out.check(Check::at_most(
-                    format!("{what} compression: 40 iterations over 1 iteration"),
-                    e40 / e1,
-                    REDUCTION_1_TO_40,
-                    "Fig. 6 of the paper: the error keeps falling with the iterations, about tenfold from 1 to 40; at least half (a solve that stalls after one iteration, e.g. a halved lambda, stays above)",
-                ));
-            }
-        }
-        let last = rows.last().map_or(f64::NAN, |r| r.2);
-        out.check(Check::less_than(
-            "average compression after 40 iterations",
-            last,
-            TARGET_COMPRESSION,
-            "PCISPH's 1 % density-error target (Solenthaler & Pajarola 2009), which §8 of the PBF paper says PBF matches",
-        ));
-        let spec = PlotSpec {
-            legend: Legend::LowerLeft,
-            log_y: true,
-            series: vec![
-                Series::styled(
-                    "largest compression max ρ/ρ0 − 1",
-                    rows.iter().map(|&(k, c, ..)| (k as f64, c)).collect(),
-                    SeriesStyle::LineMarkers(crate::helpers::Marker::Circle),
-                    0,
-                ),
-                Series::styled(
-                    "average compression mean max(ρ/ρ0 − 1, 0)",
-                    rows.iter().map(|&(k, _, m, ..)| (k as f64, m)).collect(),
-                    SeriesStyle::LineMarkers(crate::helpers::Marker::Triangle),
-                    1,
-                ),
-                Series::styled(
-                    "average compression, SPlisHSPlasH's unilateral form",
-                    rows.iter()
-                        .map(|&(k, _, _, _, mu, ..)| (k as f64, mu))
-                        .collect(),
-                    SeriesStyle::LineMarkers(crate::helpers::Marker::Cross),
-                    2,
-                ),
-                Series::styled(
-                    "1 % (PCISPH target)",
-                    vec![(0.0, TARGET_COMPRESSION), (41.0, TARGET_COMPRESSION)],
-                    SeriesStyle::Dashed,
-                    7,
-                ),
-            ],
-            ..PlotSpec::new(
-                format!("PBF convergence at t = 1.0 s, dam break ({particles} particles)"),
-                "Jacobi iterations in the step (0 = advection only)",
-                "density error",
-            )
-        };
-        plot_xy(&ctx.path("convergence.png"), &spec)?;
-        ctx.add_plot(
-            "convergence.png",
-            "density error after one step against the number of iterations (Fig. 6)",
-        );
+        convergence_metrics(&mut out, &rows);
+        check_convergence(&mut out, &rows);
+        plot_convergence(ctx, &rows, particles)?;
         Ok(out)
     }
 }

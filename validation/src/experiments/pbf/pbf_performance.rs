@@ -22,7 +22,7 @@ use anyhow::Result;
 use sph_core::Real;
 use sph_scene::Scene;
 
-use crate::helpers::{load_reference_csv, write_csv_rows};
+use crate::helpers::{load_reference_csv, write_csv_rows, ReferenceTable};
 use crate::sim::{scene_sim, shipped_scene};
 use crate::{fmt_num, Check, Context, Experiment, Outcome};
 
@@ -104,6 +104,153 @@ fn time_scene<R: Real>(ctx: &Context, scene: &Scene) -> Result<Timing> {
     })
 }
 
+/// Table 1 of the paper (particles, steps, iterations, time per step, phase percentages).
+fn load_paper(ctx: &Context) -> Result<ReferenceTable> {
+    load_reference_csv(
+        ctx,
+        "pbf/macklin_muller_2013_performance.csv",
+        &[
+            "scene",
+            "particles",
+            "steps_per_frame",
+            "iterations_per_step",
+            "time_per_step_ms",
+        ],
+    )
+}
+
+/// CompactNSearch's time per particle per step (µs, one thread).
+fn load_anchor_us(ctx: &Context) -> Result<f64> {
+    let anchor = load_reference_csv(
+        ctx,
+        "neighbour-search/compactnsearch_anchor.csv",
+        &["method", "us_per_particle", "threads"],
+    )?;
+    let anchor_row = anchor.find(&[("method", "compactnsearch")])?;
+    anchor.number(anchor_row, "us_per_particle")
+}
+
+/// One scene's metrics; for the dam break, the neighbour search against the anchor.
+fn scene_metrics(out: &mut Outcome, name: &str, t: &Timing, anchor_us: f64) {
+    out.metric(format!("{name}/particles"), t.particles as f64);
+    out.metric(format!("{name}/ms_per_step"), t.ms_per_step);
+    out.metric(
+        format!("{name}/us_per_particle_step"),
+        1e3 * t.ms_per_step / t.particles as f64,
+    );
+    for (p, v) in PHASES.iter().zip(t.percent) {
+        out.metric(format!("{name}/{p}_percent"), v);
+    }
+    // Table 2: the constraint solve is the largest phase in both scenes (a record).
+    let largest = t.percent.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+    out.metric(
+        format!("{name}/constraint_solve_is_largest_phase"),
+        (t.percent[3] == largest) as u8 as f64,
+    );
+    out.metric(
+        format!("{name}/solve_us_per_particle_iteration"),
+        t.solve_us_per_particle_iteration,
+    );
+    out.metric(
+        format!("{name}/search_us_per_particle_step"),
+        t.search_us_per_particle,
+    );
+    if name == "dam_break" {
+        let thread_us = t.search_us_per_particle * t.threads as f64;
+        out.metric("dam_break/search_thread_us_per_particle_step", thread_us);
+        out.check(Check::at_most(
+            "dam_break/neighbour search, thread-µs per particle-step, over the CompactNSearch anchor",
+            thread_us / anchor_us,
+            1.0,
+            "SPlisHSPlasH's CompactNSearch on the same dam-break spacing and support, one thread of this machine: 0.25 µs per particle per step (reference-data/neighbour-search/compactnsearch_anchor.csv); the cell-start grid (Green 2008) is meant to be no slower",
+        ));
+    }
+}
+
+/// One scene's row of `performance.md`, the paper's figures in parentheses.
+fn markdown_row(name: &str, t: &Timing, paper: &ReferenceTable) -> Result<String> {
+    let row = paper.find(&[("scene", name)])?;
+    let paper_ms = paper.number(row, "time_per_step_ms")?;
+    let paper_n = paper.number(row, "particles")?;
+    let paper_pct: Vec<String> = PHASES
+        .iter()
+        .map(|p| {
+            paper
+                .number(row, &format!("{p}_percent"))
+                .map_or("–".to_string(), fmt_num)
+        })
+        .collect();
+    Ok(format!(
+        "| {name} | {} ({}) | {} | {} | {} ({}) | {} | {} |\n",
+        t.particles,
+        fmt_num(paper_n),
+        t.steps,
+        t.iterations,
+        fmt_num(t.ms_per_step),
+        fmt_num(paper_ms),
+        fmt_num(1e3 * t.ms_per_step / t.particles as f64),
+        t.percent
+            .iter()
+            .zip(&paper_pct)
+            .map(|(v, p)| format!("{:.1} ({p})", v))
+            .collect::<Vec<_>>()
+            .join(" | "),
+    ))
+}
+
+/// One scene's row of `performance.csv`.
+fn csv_row(name: &str, t: &Timing) -> Vec<String> {
+    let mut r = vec![
+        name.to_string(),
+        t.particles.to_string(),
+        t.steps.to_string(),
+        t.iterations.to_string(),
+        format!("{:.4}", t.ms_per_step),
+        t.threads.to_string(),
+    ];
+    r.extend(t.percent.iter().map(|v| format!("{v:.2}")));
+    r
+}
+
+fn write_performance_csv(ctx: &mut Context, rows: Vec<Vec<String>>) -> Result<()> {
+    let mut header = vec![
+        "scene",
+        "particles",
+        "steps_per_frame",
+        "iterations_per_step",
+        "ms_per_step",
+        "threads",
+    ];
+    header.extend(PHASES.iter().map(|p| match *p {
+        "integrate" => "integrate_percent",
+        "create_hash_grid" => "create_hash_grid_percent",
+        "detect_neighbours" => "detect_neighbours_percent",
+        "constraint_solve" => "constraint_solve_percent",
+        _ => "velocity_update_percent",
+    }));
+    write_csv_rows(&ctx.path("performance.csv"), &header, rows)?;
+    ctx.add_file(
+        "performance.csv",
+        "time per step and phase percentages of each scene (this machine)",
+    );
+    Ok(())
+}
+
+/// The constraint solve's cost per particle-iteration is the same in every scene.
+fn check_solve_spread(out: &mut Outcome, solve_costs: &[f64]) {
+    let (lo, hi) = solve_costs
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), &c| {
+            (lo.min(c), hi.max(c))
+        });
+    out.check(Check::at_most(
+        "constraint solve time per particle-iteration, slowest scene over fastest",
+        hi / lo,
+        SOLVE_COST_SPREAD,
+        "the solve costs O(N x iterations x neighbours) with the same kernel, support and spacing ratio in the three scenes; 1.5 allows for free-surface share and cache effects (1.1-1.2 seen), a twofold scene-dependent slowdown misses it",
+    ));
+}
+
 impl Experiment for PbfPerformance {
     fn id(&self) -> &'static str {
         "pbf-performance"
@@ -114,27 +261,11 @@ impl Experiment for PbfPerformance {
     }
 
     fn run(&self, ctx: &mut Context) -> Result<Outcome> {
-        let paper = load_reference_csv(
-            ctx,
-            "pbf/macklin_muller_2013_performance.csv",
-            &[
-                "scene",
-                "particles",
-                "steps_per_frame",
-                "iterations_per_step",
-                "time_per_step_ms",
-            ],
-        )?;
+        let paper = load_paper(ctx)?;
         ctx.progress
             .set_length((SCENES.len() * (WARM_UP_FRAMES + MEASURED_FRAMES)) as u64);
         ctx.progress.set_message("frames of 3 scenes");
-        let anchor = load_reference_csv(
-            ctx,
-            "neighbour-search/compactnsearch_anchor.csv",
-            &["method", "us_per_particle", "threads"],
-        )?;
-        let anchor_row = anchor.find(&[("method", "compactnsearch")])?;
-        let anchor_us = anchor.number(anchor_row, "us_per_particle")?;
+        let anchor_us = load_anchor_us(ctx)?;
         let mut out = Outcome::new();
         let mut rows = Vec::new();
         let mut solve_costs = Vec::new();
@@ -144,107 +275,13 @@ impl Experiment for PbfPerformance {
         for name in SCENES {
             let scene = shipped_scene(name, ctx.mode)?;
             let t = sph_sim::with_precision!(scene.precision, R => time_scene::<R>(ctx, &scene)?);
-            let row = paper.find(&[("scene", name)])?;
-            let paper_ms = paper.number(row, "time_per_step_ms")?;
-            let paper_n = paper.number(row, "particles")?;
-            let paper_pct: Vec<String> = PHASES
-                .iter()
-                .map(|p| {
-                    paper
-                        .number(row, &format!("{p}_percent"))
-                        .map_or("–".to_string(), fmt_num)
-                })
-                .collect();
-            let us_per_particle_step = 1e3 * t.ms_per_step / t.particles as f64;
-            out.metric(format!("{name}/particles"), t.particles as f64);
-            out.metric(format!("{name}/ms_per_step"), t.ms_per_step);
-            out.metric(format!("{name}/us_per_particle_step"), us_per_particle_step);
-            for (p, v) in PHASES.iter().zip(t.percent) {
-                out.metric(format!("{name}/{p}_percent"), v);
-            }
-            // Table 2: the constraint solve is the largest phase in both scenes (a record).
-            let largest = t.percent.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
-            out.metric(
-                format!("{name}/constraint_solve_is_largest_phase"),
-                (t.percent[3] == largest) as u8 as f64,
-            );
-            out.metric(
-                format!("{name}/solve_us_per_particle_iteration"),
-                t.solve_us_per_particle_iteration,
-            );
-            out.metric(
-                format!("{name}/search_us_per_particle_step"),
-                t.search_us_per_particle,
-            );
+            scene_metrics(&mut out, name, &t, anchor_us);
             solve_costs.push(t.solve_us_per_particle_iteration);
-            if name == "dam_break" {
-                let thread_us = t.search_us_per_particle * t.threads as f64;
-                out.metric("dam_break/search_thread_us_per_particle_step", thread_us);
-                out.check(Check::at_most(
-                    "dam_break/neighbour search, thread-µs per particle-step, over the CompactNSearch anchor",
-                    thread_us / anchor_us,
-                    1.0,
-                    "SPlisHSPlasH's CompactNSearch on the same dam-break spacing and support, one thread of this machine: 0.25 µs per particle per step (reference-data/neighbour-search/compactnsearch_anchor.csv); the cell-start grid (Green 2008) is meant to be no slower",
-                ));
-            }
-            md.push_str(&format!(
-                "| {name} | {} ({}) | {} | {} | {} ({}) | {} | {} |\n",
-                t.particles,
-                fmt_num(paper_n),
-                t.steps,
-                t.iterations,
-                fmt_num(t.ms_per_step),
-                fmt_num(paper_ms),
-                fmt_num(us_per_particle_step),
-                t.percent
-                    .iter()
-                    .zip(&paper_pct)
-                    .map(|(v, p)| format!("{:.1} ({p})", v))
-                    .collect::<Vec<_>>()
-                    .join(" | "),
-            ));
-            let mut r = vec![
-                name.to_string(),
-                t.particles.to_string(),
-                t.steps.to_string(),
-                t.iterations.to_string(),
-                format!("{:.4}", t.ms_per_step),
-                t.threads.to_string(),
-            ];
-            r.extend(t.percent.iter().map(|v| format!("{v:.2}")));
-            rows.push(r);
+            md.push_str(&markdown_row(name, &t, &paper)?);
+            rows.push(csv_row(name, &t));
         }
-        let mut header = vec![
-            "scene",
-            "particles",
-            "steps_per_frame",
-            "iterations_per_step",
-            "ms_per_step",
-            "threads",
-        ];
-        header.extend(PHASES.iter().map(|p| match *p {
-            "integrate" => "integrate_percent",
-            "create_hash_grid" => "create_hash_grid_percent",
-            "detect_neighbours" => "detect_neighbours_percent",
-            "constraint_solve" => "constraint_solve_percent",
-            _ => "velocity_update_percent",
-        }));
-        let (lo, hi) = solve_costs
-            .iter()
-            .fold((f64::INFINITY, 0.0f64), |(lo, hi), &c| {
-                (lo.min(c), hi.max(c))
-            });
-        out.check(Check::at_most(
-            "constraint solve time per particle-iteration, slowest scene over fastest",
-            hi / lo,
-            SOLVE_COST_SPREAD,
-            "the solve costs O(N x iterations x neighbours) with the same kernel, support and spacing ratio in the three scenes; 1.5 allows for free-surface share and cache effects (1.1-1.2 seen), a twofold scene-dependent slowdown misses it",
-        ));
-        write_csv_rows(&ctx.path("performance.csv"), &header, rows)?;
-        ctx.add_file(
-            "performance.csv",
-            "time per step and phase percentages of each scene (this machine)",
-        );
+        check_solve_spread(&mut out, &solve_costs);
+        write_performance_csv(ctx, rows)?;
         md.push_str(&format!(
             "\nThis machine, {} rayon threads, CPU; in parentheses the paper's GTX 680 figures (Tables 1 and 2). Reorder time is counted in Velocity Update.\n",
             rayon::current_num_threads()

@@ -57,6 +57,151 @@ fn stable(run: &FluidRun) -> bool {
     run.bounded() && compression(run) <= STABLE_COMPRESSION
 }
 
+/// PBF at one step per frame with each iteration count, then PCISPH with each sub-step
+/// count, negative pressures clamped, then unclamped.
+fn simulate_runs(ctx: &Context, scene: &sph_scene::Scene) -> Result<Vec<FluidRun>> {
+    let mut runs = Vec::new();
+    for it in PBF_ITERATIONS {
+        runs.push(run_fluid(ctx, scene, SolverKind::Pbf, 1, it)?);
+    }
+    let clamped = with_pressure_clamp(scene, true);
+    let unclamped = with_pressure_clamp(scene, false);
+    for k in PCISPH_SUBSTEPS {
+        runs.push(run_fluid(ctx, &clamped, SolverKind::Pcisph, k, 4)?);
+    }
+    for k in PCISPH_SUBSTEPS {
+        let mut run = run_fluid(ctx, &unclamped, SolverKind::Pcisph, k, 4)?;
+        run.label = run.label.replacen("PCISPH", "PCISPH unclamped", 1);
+        runs.push(run);
+    }
+    Ok(runs)
+}
+
+/// One run's metrics and note; returns its row of `stability.csv`.
+fn run_summary(out: &mut Outcome, run: &FluidRun) -> Vec<String> {
+    let c = compression(run);
+    let frames_done = run.frames.len();
+    out.metric(
+        format!("{}/frames_completed", run.label),
+        frames_done as f64,
+    );
+    out.metric(format!("{}/mean_compression_after_impact", run.label), c);
+    out.metric(
+        format!("{}/peak_density_ratio", run.label),
+        run.peak_density_ratio(),
+    );
+    let what = match &run.blow_up {
+        Some(e) => format!("blew up after {frames_done} frames: {e}"),
+        None => format!(
+            "completed; mean compression after impact {}, peak kinetic energy {} J (initial potential energy {} J)",
+            fmt_num(c),
+            fmt_num(run.peak_kinetic_energy()),
+            fmt_num(run.initial_potential_energy_j)
+        ),
+    };
+    out.note(format!("{}: {what}", run.label));
+    vec![
+        run.label.clone(),
+        frames_done.to_string(),
+        run.blow_up.is_some().to_string(),
+        format!("{:.6e}", run.peak_kinetic_energy()),
+        format!("{:.6e}", run.initial_potential_energy_j),
+        run.bounded().to_string(),
+        format!("{c:.6}"),
+        format!("{:.6}", run.peak_density_ratio()),
+        stable(run).to_string(),
+    ]
+}
+
+fn write_stability(ctx: &mut Context, rows: Vec<Vec<String>>) -> Result<()> {
+    write_csv_rows(
+        &ctx.path("stability.csv"),
+        &[
+            "run",
+            "frames_completed",
+            "blew_up",
+            "peak_kinetic_energy_j",
+            "initial_potential_energy_j",
+            "bounded",
+            "mean_compression_after_impact",
+            "peak_density_ratio",
+            "stable",
+        ],
+        rows,
+    )?;
+    ctx.add_file(
+        "stability.csv",
+        "one row per run: frames completed, blow-up, compression, verdict",
+    );
+    Ok(())
+}
+
+/// PBF stable at one step per frame; clamped PCISPH stable from 10 sub-steps on.
+fn check_stability(out: &mut Outcome, runs: &[FluidRun]) {
+    let origin = "Macklin & Müller 2013, §8: PBF \"is stable with a single step (Δt = 0.016 s)\", PCISPH \"is not stable with less than 10 sub-steps per frame\"; stable = bounded (no blow-up, kinetic energy <= initial potential energy) and time-averaged max compression after impact <= 10 % (ten times Solenthaler & Pajarola's 1 % target)";
+    out.check(Check::equals(
+        format!("{} stable", runs[0].label),
+        stable(&runs[0]) as u8 as f64,
+        1.0,
+        origin,
+    ));
+    let pcisph_clamped = &runs[PBF_ITERATIONS.len()..PBF_ITERATIONS.len() + PCISPH_SUBSTEPS.len()];
+    for (run, k) in pcisph_clamped.iter().zip(PCISPH_SUBSTEPS) {
+        out.check(Check::equals(
+            format!("{} stable", run.label),
+            stable(run) as u8 as f64,
+            (k >= 10) as u8 as f64,
+            origin,
+        ));
+    }
+    for run in runs {
+        out.metric(format!("{}/stable", run.label), stable(run) as u8 as f64);
+    }
+}
+
+/// Max compression per frame of `runs`, with the stable bound, in `file`.
+fn plot_panel(
+    ctx: &mut Context,
+    runs: &[FluidRun],
+    t_end: f64,
+    file: &str,
+    what: &str,
+) -> Result<()> {
+    let mut series = vec![Series::styled(
+        "stable bound (10 % compression)",
+        vec![(0.0, STABLE_COMPRESSION), (t_end, STABLE_COMPRESSION)],
+        SeriesStyle::Dashed,
+        7,
+    )];
+    for (i, run) in runs.iter().enumerate() {
+        series.push(Series::line(
+            run.label.clone(),
+            run.frames
+                .iter()
+                .map(|s| (s.t_s, (s.max_density_ratio - 1.0).max(1e-4)))
+                .collect(),
+            if i >= 7 { i + 1 } else { i },
+        ));
+    }
+    let spec = PlotSpec {
+        legend: Legend::UpperRight,
+        log_y: true,
+        y_range: Some((1e-4, 2.0)),
+        series,
+        ..PlotSpec::new(
+            format!("Bunny drop: max compression per frame, {what}"),
+            "t (s)",
+            "max compression max(rho)/rho0 - 1 (log; floor 1e-4)",
+        )
+    };
+    plot_xy(&ctx.path(file), &spec)?;
+    ctx.add_plot(
+        file,
+        format!("max compression per frame, {what}; the dashed line is the stable bound (a curve that stops blew up)"),
+    );
+    Ok(())
+}
+
 impl Experiment for PbfStability {
     fn id(&self) -> &'static str {
         "pbf-stability"
@@ -72,143 +217,28 @@ impl Experiment for PbfStability {
         ctx.progress
             .set_length((n_runs * scene.frame_count()) as u64);
         ctx.progress.set_message(format!("frames of {n_runs} runs"));
-        let mut runs = Vec::new();
-        for it in PBF_ITERATIONS {
-            runs.push(run_fluid(ctx, &scene, SolverKind::Pbf, 1, it)?);
-        }
-        let clamped = with_pressure_clamp(&scene, true);
-        let unclamped = with_pressure_clamp(&scene, false);
-        for k in PCISPH_SUBSTEPS {
-            runs.push(run_fluid(ctx, &clamped, SolverKind::Pcisph, k, 4)?);
-        }
-        for k in PCISPH_SUBSTEPS {
-            let mut run = run_fluid(ctx, &unclamped, SolverKind::Pcisph, k, 4)?;
-            run.label = run.label.replacen("PCISPH", "PCISPH unclamped", 1);
-            runs.push(run);
-        }
+        let runs = simulate_runs(ctx, &scene)?;
         let mut out = Outcome::new();
         out.metric("particles", runs[0].particles as f64);
-        let mut rows = Vec::new();
-        for run in &runs {
-            let c = compression(run);
-            let frames_done = run.frames.len();
-            out.metric(
-                format!("{}/frames_completed", run.label),
-                frames_done as f64,
-            );
-            out.metric(format!("{}/mean_compression_after_impact", run.label), c);
-            out.metric(
-                format!("{}/peak_density_ratio", run.label),
-                run.peak_density_ratio(),
-            );
-            let what = match &run.blow_up {
-                Some(e) => format!("blew up after {frames_done} frames: {e}"),
-                None => format!(
-                    "completed; mean compression after impact {}, peak kinetic energy {} J (initial potential energy {} J)",
-                    fmt_num(c),
-                    fmt_num(run.peak_kinetic_energy()),
-                    fmt_num(run.initial_potential_energy_j)
-                ),
-            };
-            out.note(format!("{}: {what}", run.label));
-            rows.push(vec![
-                run.label.clone(),
-                frames_done.to_string(),
-                run.blow_up.is_some().to_string(),
-                format!("{:.6e}", run.peak_kinetic_energy()),
-                format!("{:.6e}", run.initial_potential_energy_j),
-                run.bounded().to_string(),
-                format!("{c:.6}"),
-                format!("{:.6}", run.peak_density_ratio()),
-                stable(run).to_string(),
-            ]);
-        }
-        write_csv_rows(
-            &ctx.path("stability.csv"),
-            &[
-                "run",
-                "frames_completed",
-                "blew_up",
-                "peak_kinetic_energy_j",
-                "initial_potential_energy_j",
-                "bounded",
-                "mean_compression_after_impact",
-                "peak_density_ratio",
-                "stable",
-            ],
-            rows,
-        )?;
-        ctx.add_file(
-            "stability.csv",
-            "one row per run: frames completed, blow-up, compression, verdict",
-        );
-        let origin = "Macklin & Müller 2013, §8: PBF \"is stable with a single step (Δt = 0.016 s)\", PCISPH \"is not stable with less than 10 sub-steps per frame\"; stable = bounded (no blow-up, kinetic energy <= initial potential energy) and time-averaged max compression after impact <= 10 % (ten times Solenthaler & Pajarola's 1 % target)";
-        out.check(Check::equals(
-            format!("{} stable", runs[0].label),
-            stable(&runs[0]) as u8 as f64,
-            1.0,
-            origin,
-        ));
-        let pcisph_clamped =
-            &runs[PBF_ITERATIONS.len()..PBF_ITERATIONS.len() + PCISPH_SUBSTEPS.len()];
-        for (run, k) in pcisph_clamped.iter().zip(PCISPH_SUBSTEPS) {
-            out.check(Check::equals(
-                format!("{} stable", run.label),
-                stable(run) as u8 as f64,
-                (k >= 10) as u8 as f64,
-                origin,
-            ));
-        }
-        for run in &runs {
-            out.metric(format!("{}/stable", run.label), stable(run) as u8 as f64);
-        }
+        let rows = runs.iter().map(|run| run_summary(&mut out, run)).collect();
+        write_stability(ctx, rows)?;
+        check_stability(&mut out, &runs);
         let t_end = runs[0].frames.last().map_or(1.5, |f| f.t_s);
-        let panels = [
-            (
-                "stability.png",
-                "PBF at one step per frame and PCISPH (negative pressures clamped)",
-                0..PBF_ITERATIONS.len() + PCISPH_SUBSTEPS.len(),
-            ),
-            (
-                "stability_unclamped.png",
-                "PCISPH without the negative-pressure clamp",
-                PBF_ITERATIONS.len() + PCISPH_SUBSTEPS.len()..runs.len(),
-            ),
-        ];
-        for (file, what, range) in panels {
-            let mut series = vec![Series::styled(
-                "stable bound (10 % compression)",
-                vec![(0.0, STABLE_COMPRESSION), (t_end, STABLE_COMPRESSION)],
-                SeriesStyle::Dashed,
-                7,
-            )];
-            for (i, run) in runs[range].iter().enumerate() {
-                series.push(Series::line(
-                    run.label.clone(),
-                    run.frames
-                        .iter()
-                        .map(|s| (s.t_s, (s.max_density_ratio - 1.0).max(1e-4)))
-                        .collect(),
-                    if i >= 7 { i + 1 } else { i },
-                ));
-            }
-            let spec = PlotSpec {
-                legend: Legend::UpperRight,
-                log_y: true,
-                y_range: Some((1e-4, 2.0)),
-                series,
-                ..PlotSpec::new(
-                    format!("Bunny drop: max compression per frame, {what}"),
-                    "t (s)",
-                    "max compression max(rho)/rho0 - 1 (log; floor 1e-4)",
-                )
-            };
-            plot_xy(&ctx.path(file), &spec)?;
-            ctx.add_plot(
-                file,
-                format!("max compression per frame, {what}; the dashed line is the stable bound (a curve that stops blew up)"),
-            );
-        }
+        let clamped_end = PBF_ITERATIONS.len() + PCISPH_SUBSTEPS.len();
+        plot_panel(
+            ctx,
+            &runs[..clamped_end],
+            t_end,
+            "stability.png",
+            "PBF at one step per frame and PCISPH (negative pressures clamped)",
+        )?;
+        plot_panel(
+            ctx,
+            &runs[clamped_end..],
+            t_end,
+            "stability_unclamped.png",
+            "PCISPH without the negative-pressure clamp",
+        )?;
         Ok(out)
     }
 }

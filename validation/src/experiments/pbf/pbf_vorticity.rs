@@ -187,6 +187,253 @@ fn mean(values: impl Iterator<Item = f64>) -> f64 {
     s / n as f64
 }
 
+/// The runs of the experiment: confinement off, on, reversed, and the perturbed "off" runs
+/// that measure the noise floor.
+struct Runs {
+    off: Run,
+    on: Run,
+    negative: Run,
+    noise: Vec<Run>,
+}
+
+impl Runs {
+    fn simulate(ctx: &Context, scene: &Scene) -> Result<Self> {
+        Ok(Self {
+            off: run_with(ctx, scene, 0.0, None)?,
+            on: run_with(ctx, scene, VORTICITY_EPSILON, None)?,
+            negative: run_with(ctx, scene, -VORTICITY_EPSILON, None)?,
+            noise: NOISE_SEEDS
+                .iter()
+                .map(|&seed| run_with(ctx, scene, 0.0, Some(seed)))
+                .collect::<Result<Vec<_>>>()?,
+        })
+    }
+}
+
+fn write_series(ctx: &mut Context, runs: &Runs) -> Result<()> {
+    let Runs {
+        off, on, negative, ..
+    } = runs;
+    let rows = (0..off.series.len()).map(|k| {
+        let mut row = vec![format!("{:.4}", off.series[k].0)];
+        for run in [off, on, negative] {
+            let r = run.series[k];
+            row.push(format!("{:.5}", r.1));
+            row.push(format!("{:.6e}", r.2));
+            row.push(format!("{:.6e}", r.3));
+        }
+        row
+    });
+    write_csv_rows(
+        &ctx.path("vorticity.csv"),
+        &[
+            "t_s",
+            "splash_height_off_m",
+            "kinetic_energy_off_j",
+            "enstrophy_off_m3_per_s2",
+            "splash_height_on_m",
+            "kinetic_energy_on_j",
+            "enstrophy_on_m3_per_s2",
+            "splash_height_negative_m",
+            "kinetic_energy_negative_j",
+            "enstrophy_negative_m3_per_s2",
+        ],
+        rows,
+    )?;
+    ctx.add_file(
+        "vorticity.csv",
+        "splash height, kinetic energy and enstrophy per frame: confinement off, on, and reversed (negative control); enstrophy over the second half only",
+    );
+    Ok(())
+}
+
+/// A compared quantity: (name, metric key, column, max (else mean), origin of the check).
+type Quantity = (&'static str, &'static str, Column, bool, &'static str);
+
+const QUANTITIES: [Quantity; 3] = [
+    (
+        "kinetic energy",
+        "mean_kinetic_energy_second_half",
+        |r| r.2,
+        false,
+        "§5 of the paper: confinement is used \"to replace lost energy\"",
+    ),
+    (
+        "max splash height",
+        "max_splash_height_second_half",
+        |r| r.1,
+        true,
+        "Fig. 5 of the paper: \"note the visibly higher splash\" with confinement",
+    ),
+    (
+        "enstrophy",
+        "mean_enstrophy_second_half",
+        |r| r.3,
+        false,
+        "§5, eqs. 15–16: the confinement force adds rotational energy where numerical damping removed it, i.e. restores vorticity",
+    ),
+];
+
+/// Maximum or mean of a column over the second half of a run: after the first impact on
+/// the far wall.
+fn second_half(run: &Run, col: Column, max: bool) -> f64 {
+    let half = run.series.len() / 2;
+    let v = run.series[half..].iter().map(col);
+    if max {
+        v.fold(f64::NEG_INFINITY, f64::max)
+    } else {
+        mean(v)
+    }
+}
+
+/// On/off and negative/off ratios of `q` against the noise floor.
+fn check_quantity(out: &mut Outcome, runs: &Runs, q: Quantity) {
+    let (what, key, col, max, origin) = q;
+    let second = |run: &Run| second_half(run, col, max);
+    let base = second(&runs.off);
+    let ratio_on = second(&runs.on) / base;
+    let ratio_neg = second(&runs.negative) / base;
+    let noise = runs
+        .noise
+        .iter()
+        .map(|r| (second(r) / base - 1.0).abs())
+        .fold(0.0, f64::max);
+    out.metric(format!("{key}_off"), base);
+    out.metric(format!("{key}_on"), second(&runs.on));
+    out.metric(format!("{key}_negative"), second(&runs.negative));
+    out.metric(format!("{what} ratio on/off"), ratio_on);
+    out.metric(format!("{what} ratio negative/off"), ratio_neg);
+    out.metric(format!("{what} noise floor |perturbed/off - 1|"), noise);
+    out.check(Check::greater_than(
+        format!("{what}: (ratio on/off - 1) over the noise floor"),
+        (ratio_on - 1.0) / noise,
+        NOISE_MULTIPLE,
+        format!("{origin}; the gap must exceed {NOISE_MULTIPLE} times the spread of two runs with eps = 0 started {PERTURBATION_M} m apart (a dam break is chaotic)"),
+    ));
+    out.check(Check::less_than(
+        format!("{what}: ratio negative/off (negative control)"),
+        ratio_neg,
+        1.0,
+        "the reversed confinement force (eps < 0) takes rotational energy out: if the on/off gap comes from eq. 16 and not from noise, the reversed force lowers the quantity",
+    ));
+}
+
+/// A time-series plot of one column, every run.
+fn series_spec(runs: &Runs, title: &str, col: Column, y: &str) -> PlotSpec {
+    let pts = |run: &Run| {
+        run.series
+            .iter()
+            .map(|r| (r.0, col(r)))
+            .filter(|p| p.1.is_finite())
+            .collect::<Vec<_>>()
+    };
+    let mut series = vec![
+        Series::line("confinement off", pts(&runs.off), 0),
+        Series::line(
+            format!("confinement on (ε = {VORTICITY_EPSILON} m/s)"),
+            pts(&runs.on),
+            3,
+        ),
+        Series::styled(
+            format!("reversed (ε = −{VORTICITY_EPSILON} m/s)"),
+            pts(&runs.negative),
+            SeriesStyle::Dashed,
+            2,
+        ),
+    ];
+    for (k, r) in runs.noise.iter().enumerate() {
+        series.push(Series::styled(
+            format!(
+                "off, start perturbed by {PERTURBATION_M} m (seed {})",
+                NOISE_SEEDS[k]
+            ),
+            pts(r),
+            SeriesStyle::Line,
+            7 + k,
+        ));
+    }
+    PlotSpec {
+        legend: Legend::UpperRight,
+        series,
+        ..PlotSpec::new(title, "t (s)", y)
+    }
+}
+
+fn plot_series(ctx: &mut Context, runs: &Runs) -> Result<()> {
+    plot_xy(
+        &ctx.path("splash_height.png"),
+        &series_spec(
+            runs,
+            "Dam break: splash height",
+            |r| r.1,
+            "99.9 % quantile of y (m)",
+        ),
+    )?;
+    ctx.add_plot(
+        "splash_height.png",
+        "splash height with and without vorticity confinement",
+    );
+    plot_xy(
+        &ctx.path("kinetic_energy.png"),
+        &series_spec(
+            runs,
+            "Dam break: kinetic energy",
+            |r| r.2,
+            "kinetic energy (J)",
+        ),
+    )?;
+    ctx.add_plot(
+        "kinetic_energy.png",
+        "kinetic energy with and without vorticity confinement",
+    );
+    plot_xy(
+        &ctx.path("enstrophy.png"),
+        &series_spec(
+            runs,
+            "Dam break: enstrophy (second half)",
+            |r| r.3,
+            "enstrophy 1/2 sum (m/rho0) |omega|^2 (m^3/s^2)",
+        ),
+    )?;
+    ctx.add_plot(
+        "enstrophy.png",
+        "enstrophy over the second half with and without vorticity confinement",
+    );
+    Ok(())
+}
+
+/// The final frames of the off and on runs: side views and renders.
+fn plot_frames(ctx: &mut Context, scene: &Scene, runs: &Runs) -> Result<()> {
+    let (off, on) = (&runs.off, &runs.on);
+    let tank = scene.tank.map_or(((0.0, 1.0), (0.0, 1.0)), |t| {
+        ((t.min.x, t.max.x), (t.min.y, t.max.y))
+    });
+    let t_end = off.series.last().map_or(0.0, |r| r.0);
+    for (name, run, label) in [("frame_off.png", off, "off"), ("frame_on.png", on, "on")] {
+        side_view_png(
+            &ctx.path(name),
+            &format!("Dam break at t = {t_end:.2} s, vorticity confinement {label}"),
+            &run.last_frame,
+            tank.0,
+            tank.1,
+            3.0,
+            1000,
+        )?;
+        ctx.add_plot(
+            name,
+            format!("final frame, confinement {label} (side view, colour = speed up to 3 m/s)"),
+        );
+    }
+    for (name, run, label) in [("render_off.png", off, "off"), ("render_on.png", on, "on")] {
+        sph_sim::render::render_particles_png(scene, &run.last_positions, 1000, &ctx.path(name))?;
+        ctx.add_plot(
+            name,
+            format!("final frame, confinement {label}, rendered (screen-space fluid rendering)"),
+        );
+    }
+    Ok(())
+}
+
 impl Experiment for PbfVorticity {
     fn id(&self) -> &'static str {
         "pbf-vorticity"
@@ -202,225 +449,26 @@ impl Experiment for PbfVorticity {
         let n_runs = 3 + NOISE_SEEDS.len();
         ctx.progress.set_length(n_runs as u64 * frames);
         ctx.progress.set_message(format!("frames of {n_runs} runs"));
-        let off = run_with(ctx, &scene, 0.0, None)?;
-        let on = run_with(ctx, &scene, VORTICITY_EPSILON, None)?;
-        let negative = run_with(ctx, &scene, -VORTICITY_EPSILON, None)?;
-        let noise_runs = NOISE_SEEDS
-            .iter()
-            .map(|&seed| run_with(ctx, &scene, 0.0, Some(seed)))
-            .collect::<Result<Vec<_>>>()?;
+        let runs = Runs::simulate(ctx, &scene)?;
+        write_series(ctx, &runs)?;
 
-        let rows = (0..off.series.len()).map(|k| {
-            let mut row = vec![format!("{:.4}", off.series[k].0)];
-            for run in [&off, &on, &negative] {
-                let r = run.series[k];
-                row.push(format!("{:.5}", r.1));
-                row.push(format!("{:.6e}", r.2));
-                row.push(format!("{:.6e}", r.3));
-            }
-            row
-        });
-        write_csv_rows(
-            &ctx.path("vorticity.csv"),
-            &[
-                "t_s",
-                "splash_height_off_m",
-                "kinetic_energy_off_j",
-                "enstrophy_off_m3_per_s2",
-                "splash_height_on_m",
-                "kinetic_energy_on_j",
-                "enstrophy_on_m3_per_s2",
-                "splash_height_negative_m",
-                "kinetic_energy_negative_j",
-                "enstrophy_negative_m3_per_s2",
-            ],
-            rows,
-        )?;
-        ctx.add_file(
-            "vorticity.csv",
-            "splash height, kinetic energy and enstrophy per frame: confinement off, on, and reversed (negative control); enstrophy over the second half only",
-        );
-
-        // The second half of the run: after the first impact on the far wall.
-        let half = off.series.len() / 2;
-        let second = |run: &Run, col: Column, max: bool| {
-            let v = run.series[half..].iter().map(col);
-            if max {
-                v.fold(f64::NEG_INFINITY, f64::max)
-            } else {
-                mean(v)
-            }
-        };
-        let quantities: [(&str, &str, Column, bool, &str); 3] = [
-            (
-                "kinetic energy",
-                "mean_kinetic_energy_second_half",
-                |r| r.2,
-                false,
-                "§5 of the paper: confinement is used \"to replace lost energy\"",
-            ),
-            (
-                "max splash height",
-                "max_splash_height_second_half",
-                |r| r.1,
-                true,
-                "Fig. 5 of the paper: \"note the visibly higher splash\" with confinement",
-            ),
-            (
-                "enstrophy",
-                "mean_enstrophy_second_half",
-                |r| r.3,
-                false,
-                "§5, eqs. 15–16: the confinement force adds rotational energy where numerical damping removed it, i.e. restores vorticity",
-            ),
-        ];
         let mut out = Outcome::new();
-        out.metric("particles", off.particles as f64);
+        out.metric("particles", runs.off.particles as f64);
         out.metric("vorticity_epsilon_m_per_s", VORTICITY_EPSILON);
         out.metric("perturbation_m", PERTURBATION_M);
-        for (what, key, col, max, origin) in quantities {
-            let base = second(&off, col, max);
-            let ratio_on = second(&on, col, max) / base;
-            let ratio_neg = second(&negative, col, max) / base;
-            let noise = noise_runs
-                .iter()
-                .map(|r| (second(r, col, max) / base - 1.0).abs())
-                .fold(0.0, f64::max);
-            out.metric(format!("{key}_off"), base);
-            out.metric(format!("{key}_on"), second(&on, col, max));
-            out.metric(format!("{key}_negative"), second(&negative, col, max));
-            out.metric(format!("{what} ratio on/off"), ratio_on);
-            out.metric(format!("{what} ratio negative/off"), ratio_neg);
-            out.metric(format!("{what} noise floor |perturbed/off - 1|"), noise);
-            out.check(Check::greater_than(
-                format!("{what}: (ratio on/off - 1) over the noise floor"),
-                (ratio_on - 1.0) / noise,
-                NOISE_MULTIPLE,
-                format!("{origin}; the gap must exceed {NOISE_MULTIPLE} times the spread of two runs with eps = 0 started {PERTURBATION_M} m apart (a dam break is chaotic)"),
-            ));
-            out.check(Check::less_than(
-                format!("{what}: ratio negative/off (negative control)"),
-                ratio_neg,
-                1.0,
-                "the reversed confinement force (eps < 0) takes rotational energy out: if the on/off gap comes from eq. 16 and not from noise, the reversed force lowers the quantity",
-            ));
+        for q in QUANTITIES {
+            check_quantity(&mut out, &runs, q);
         }
         out.metric(
             "final_splash_height_off_m",
-            off.series.last().map_or(f64::NAN, |r| r.1),
+            runs.off.series.last().map_or(f64::NAN, |r| r.1),
         );
         out.metric(
             "final_splash_height_on_m",
-            on.series.last().map_or(f64::NAN, |r| r.1),
+            runs.on.series.last().map_or(f64::NAN, |r| r.1),
         );
-
-        let spec = |title: &str, col: Column, y: &str| {
-            let pts = |run: &Run| {
-                run.series
-                    .iter()
-                    .map(|r| (r.0, col(r)))
-                    .filter(|p| p.1.is_finite())
-                    .collect::<Vec<_>>()
-            };
-            let mut series = vec![
-                Series::line("confinement off", pts(&off), 0),
-                Series::line(
-                    format!("confinement on (ε = {VORTICITY_EPSILON} m/s)"),
-                    pts(&on),
-                    3,
-                ),
-                Series::styled(
-                    format!("reversed (ε = −{VORTICITY_EPSILON} m/s)"),
-                    pts(&negative),
-                    SeriesStyle::Dashed,
-                    2,
-                ),
-            ];
-            for (k, r) in noise_runs.iter().enumerate() {
-                series.push(Series::styled(
-                    format!(
-                        "off, start perturbed by {PERTURBATION_M} m (seed {})",
-                        NOISE_SEEDS[k]
-                    ),
-                    pts(r),
-                    SeriesStyle::Line,
-                    7 + k,
-                ));
-            }
-            PlotSpec {
-                legend: Legend::UpperRight,
-                series,
-                ..PlotSpec::new(title, "t (s)", y)
-            }
-        };
-        plot_xy(
-            &ctx.path("splash_height.png"),
-            &spec(
-                "Dam break: splash height",
-                |r| r.1,
-                "99.9 % quantile of y (m)",
-            ),
-        )?;
-        ctx.add_plot(
-            "splash_height.png",
-            "splash height with and without vorticity confinement",
-        );
-        plot_xy(
-            &ctx.path("kinetic_energy.png"),
-            &spec("Dam break: kinetic energy", |r| r.2, "kinetic energy (J)"),
-        )?;
-        ctx.add_plot(
-            "kinetic_energy.png",
-            "kinetic energy with and without vorticity confinement",
-        );
-        plot_xy(
-            &ctx.path("enstrophy.png"),
-            &spec(
-                "Dam break: enstrophy (second half)",
-                |r| r.3,
-                "enstrophy 1/2 sum (m/rho0) |omega|^2 (m^3/s^2)",
-            ),
-        )?;
-        ctx.add_plot(
-            "enstrophy.png",
-            "enstrophy over the second half with and without vorticity confinement",
-        );
-        let tank = scene.tank.map_or(((0.0, 1.0), (0.0, 1.0)), |t| {
-            ((t.min.x, t.max.x), (t.min.y, t.max.y))
-        });
-        let t_end = off.series.last().map_or(0.0, |r| r.0);
-        for (name, run, label) in [("frame_off.png", &off, "off"), ("frame_on.png", &on, "on")] {
-            side_view_png(
-                &ctx.path(name),
-                &format!("Dam break at t = {t_end:.2} s, vorticity confinement {label}"),
-                &run.last_frame,
-                tank.0,
-                tank.1,
-                3.0,
-                1000,
-            )?;
-            ctx.add_plot(
-                name,
-                format!("final frame, confinement {label} (side view, colour = speed up to 3 m/s)"),
-            );
-        }
-        for (name, run, label) in [
-            ("render_off.png", &off, "off"),
-            ("render_on.png", &on, "on"),
-        ] {
-            sph_sim::render::render_particles_png(
-                &scene,
-                &run.last_positions,
-                1000,
-                &ctx.path(name),
-            )?;
-            ctx.add_plot(
-                name,
-                format!(
-                    "final frame, confinement {label}, rendered (screen-space fluid rendering)"
-                ),
-            );
-        }
+        plot_series(ctx, &runs)?;
+        plot_frames(ctx, &scene, &runs)?;
         Ok(out)
     }
 }

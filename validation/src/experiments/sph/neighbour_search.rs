@@ -53,17 +53,7 @@ impl Experiment for NeighbourSearchExperiment {
     }
 
     fn run(&self, ctx: &mut Context) -> Result<Outcome> {
-        let claims = load_reference_csv(ctx, CLAIMS, &["claim", "low", "high", "unit"])?;
-        let claim_row = claims.find(&[("claim", "speedup_vs_cell_start")])?;
-        let (claim_lo, claim_hi) = (
-            claims.number(claim_row, "low")?,
-            claims.number(claim_row, "high")?,
-        );
-        let anchor = load_reference_csv(ctx, ANCHOR, &["method", "us_per_particle", "threads"])?;
-        let anchor_row = anchor.find(&[("method", "compactnsearch")])?;
-        let anchor_us = anchor.number(anchor_row, "us_per_particle")?;
-        let anchor_threads = anchor.number(anchor_row, "threads")?;
-
+        let refs = References::load(ctx)?;
         let mode = ctx.mode;
         let clouds = clouds(mode);
         let sizes: Vec<usize> = mode.pick(vec![22, 31, 46], vec![22, 31, 46, 67, 100]);
@@ -82,253 +72,22 @@ impl Experiment for NeighbourSearchExperiment {
         out.metric("rayon_threads", pool_threads as f64);
 
         // (a) correctness.
-        let mut rows: Vec<CorrectnessRow> = Vec::new();
-        for cloud in &clouds {
-            ctx.progress
-                .set_message(format!("correctness: {} f64", cloud.name));
-            rows.extend(correctness::<f64>(cloud)?);
-            ctx.progress.inc(1);
-            ctx.progress
-                .set_message(format!("correctness: {} f32", cloud.name));
-            rows.extend(correctness::<f32>(cloud)?);
-            ctx.progress.inc(1);
-        }
-        for method in Method::FAST {
-            for precision in ["f32", "f64"] {
-                let sel = || {
-                    rows.iter()
-                        .filter(|r| r.method == method.name() && r.precision == precision)
-                };
-                let mismatches: usize = sel().map(|r| r.mismatches).sum();
-                let refused = sel().filter(|r| r.status == "refused").count();
-                for r in sel() {
-                    out.metric(
-                        format!("mismatches/{}/{}/{}", r.method, r.precision, r.cloud),
-                        r.mismatches as f64,
-                    );
-                }
-                out.metric(
-                    format!("refused/{}/{precision}", method.name()),
-                    refused as f64,
-                );
-                out.check(Check::equals(
-                    format!("mismatches/{}/{precision}", method.name()),
-                    mismatches as f64,
-                    0.0,
-                    "exact algorithm: same criterion |xi − xj|² < h² as the O(N²) oracle (BruteForce); \
-                     particles with a differing neighbour set, summed over the 5 clouds",
-                ));
-            }
-        }
-        for r in rows.iter().filter(|r| r.method == Method::FAST[0].name()) {
-            out.metric(
-                format!("mean_neighbours/{}/{}", r.cloud, r.precision),
-                r.pairs as f64 / r.n as f64,
-            );
-        }
-        for r in rows.iter().filter(|r| r.status == "refused") {
-            out.note(format!(
-                "{} ({}) refused the cloud {:?} ({} particles): {} — counted as refused, not as a mismatch.",
-                r.method, r.precision, r.cloud, r.n, r.error
-            ));
-        }
-        for r in rows.iter().filter(|r| r.status == "error") {
-            out.note(format!(
-                "{} ({}) FAILED on the cloud {:?}: {} — all {} particles counted as mismatching.",
-                r.method, r.precision, r.cloud, r.error, r.n
-            ));
-        }
-        write_csv_rows(
-            &ctx.path("correctness.csv"),
-            &[
-                "cloud",
-                "precision",
-                "method",
-                "particles",
-                "radius",
-                "oracle_pairs",
-                "method_pairs",
-                "mismatching_particles",
-                "status",
-                "error",
-            ],
-            rows.iter().map(|r| {
-                vec![
-                    r.cloud.to_string(),
-                    r.precision.to_string(),
-                    r.method.to_string(),
-                    r.n.to_string(),
-                    format!("{}", r.radius),
-                    r.pairs.to_string(),
-                    r.method_pairs.to_string(),
-                    r.mismatches.to_string(),
-                    r.status.to_string(),
-                    r.error.clone(),
-                ]
-            }),
-        )?;
-        ctx.add_file("correctness.csv", "per cloud, precision and method: oracle pairs, method pairs, mismatching particles, status");
-
-        // Thread-count determinism on the random cloud.
-        ctx.progress.set_message("determinism (1 thread vs pool)");
-        let random = clouds
-            .iter()
-            .find(|c| c.name == "random")
-            .expect("random cloud");
-        let pos = to_real::<f64>(&random.points);
-        let single = rayon::ThreadPoolBuilder::new()
-            .num_threads(1)
-            .build()
-            .context("building a 1-thread rayon pool")?;
-        for method in Method::FAST {
-            let mut a = NeighbourLists::new();
-            let mut b = NeighbourLists::new();
-            method.build::<f64>().search(&pos, random.radius, &mut a)?;
-            single.install(|| method.build::<f64>().search(&pos, random.radius, &mut b))?;
-            let differing = (0..a.particle_count().max(b.particle_count()))
-                .filter(|&i| {
-                    i >= a.particle_count()
-                        || i >= b.particle_count()
-                        || a.neighbours(i) != b.neighbours(i)
-                })
-                .count();
-            out.check(Check::equals(
-                format!("thread-determinism/{}", method.name()),
-                differing as f64,
-                0.0,
-                format!(
-                    "neighbour-search crate docs: output independent of the thread count (1 vs {pool_threads} threads, random cloud, raw lists)"
-                ),
-            ));
-        }
-        ctx.progress.inc(1);
+        let rows = measure_correctness(ctx, &clouds)?;
+        check_correctness(&mut out, &rows);
+        write_correctness(ctx, &rows)?;
+        check_determinism(ctx, &mut out, &clouds, pool_threads)?;
 
         // (b) timing.
-        let mut timings: Vec<Timing> = Vec::new();
-        let mut pair_disagreements = 0usize;
-        for &n_side in &sizes {
-            let pos = timing_block(n_side)?;
-            let n = pos.len();
-            let reps = match (mode, n) {
-                (Mode::Quick, _) => 5,
-                (Mode::Full, n) if n > 500_000 => 5,
-                (Mode::Full, _) => 9,
-            };
-            let mut pairs_here = Vec::new();
-            for &threads in &thread_settings {
-                for method in Method::FAST {
-                    ctx.progress.set_message(format!(
-                        "timing: {} N={n} {threads} thread(s)",
-                        method.name()
-                    ));
-                    let t = if threads == pool_threads {
-                        time_search(method, &pos, reps)?
-                    } else {
-                        let pool = rayon::ThreadPoolBuilder::new()
-                            .num_threads(threads)
-                            .build()
-                            .context("building a rayon pool")?;
-                        pool.install(|| time_search(method, &pos, reps))?
-                    };
-                    pairs_here.push(t.pairs);
-                    timings.push(Timing {
-                        method,
-                        threads,
-                        n,
-                        ..t
-                    });
-                    ctx.progress.inc(1);
-                }
-            }
-            if pairs_here.iter().any(|&p| p != pairs_here[0]) {
-                pair_disagreements += 1;
-            }
-        }
+        let (timings, pair_disagreements) =
+            measure_timings(ctx, &sizes, &thread_settings, pool_threads)?;
         out.check(Check::equals(
             "timing-runs/pair-count-agreement",
             pair_disagreements as f64,
             0.0,
             "exact algorithm: every method and thread count finds the same number of pairs (number of N with disagreement)",
         ));
-        let n_max = timings.iter().map(|t| t.n).max().unwrap_or(0);
-        for t in &timings {
-            out.metric(
-                format!(
-                    "us_per_particle/{}/{}t/N={}",
-                    t.method.name(),
-                    t.threads,
-                    t.n
-                ),
-                t.us_per_particle(),
-            );
-        }
-        if let Some(t) = timings.iter().find(|t| t.n == n_max) {
-            out.metric("timing_mean_neighbours/N_max", t.pairs as f64 / t.n as f64);
-        }
-        out.metric("timing_N_max", n_max as f64);
-        let find = |m: Method, threads: usize| {
-            timings
-                .iter()
-                .find(|t| t.method == m && t.threads == threads && t.n == n_max)
-        };
-        for &threads in &thread_settings {
-            let (Some(rt), Some(csg)) = (
-                find(Method::RelationTable, threads),
-                find(Method::CellStartGrid, threads),
-            ) else {
-                continue;
-            };
-            let ratio = csg.median_s / rt.median_s;
-            out.metric(
-                format!("ratio_cell_start_over_relation_table/{threads}t"),
-                ratio,
-            );
-            if let Some(hg) = find(Method::HashedGrid, threads) {
-                out.metric(
-                    format!("ratio_hashed_grid_over_relation_table/{threads}t"),
-                    hg.median_s / rt.median_s,
-                );
-            }
-            let holds = (claim_lo..=claim_hi).contains(&ratio);
-            out.metric(
-                format!("im_chan_claim_holds/{threads}t"),
-                if holds { 1.0 } else { 0.0 },
-            );
-            out.note(claim_note(ratio, claim_lo, claim_hi, threads, n_max));
-        }
-        // The fastest method on one thread against the same anchor.
-        let fastest = Method::FAST
-            .iter()
-            .filter_map(|&m| find(m, anchor_threads as usize))
-            .min_by(|a, b| a.median_s.total_cmp(&b.median_s));
-        if let Some(f) = fastest {
-            out.metric(
-                "fastest_over_compactnsearch_anchor/1t",
-                f.us_per_particle() / anchor_us,
-            );
-            out.note(format!(
-                "Fastest method on {} thread(s), N = {n_max}: {} at {} µs/particle, {}× the CompactNSearch anchor of {} µs/particle (this block has about {} neighbours per particle; the anchor scene of the benchmarks has about 23).",
-                anchor_threads,
-                f.method.name(),
-                fmt_num(f.us_per_particle()),
-                fmt_num(f.us_per_particle() / anchor_us),
-                fmt_num(anchor_us),
-                fmt_num(f.pairs as f64 / f.n as f64),
-            ));
-        }
-        if let Some(rt1) = find(Method::RelationTable, anchor_threads as usize) {
-            out.metric(
-                "relation_table_over_compactnsearch_anchor/1t",
-                rt1.us_per_particle() / anchor_us,
-            );
-            out.note(format!(
-                "Relation table, {} thread(s), N = {n_max}: {} µs/particle; CompactNSearch anchor (measured by the maintainers, 1 thread): {} µs/particle (ratio {}).",
-                anchor_threads,
-                fmt_num(rt1.us_per_particle()),
-                fmt_num(anchor_us),
-                fmt_num(rt1.us_per_particle() / anchor_us)
-            ));
-        }
+        let n_max = timing_metrics(&mut out, &timings, &thread_settings, &refs);
+        anchor_notes(&mut out, &timings, n_max, &refs);
         out.note(format!(
             "Timing setup: jittered block (one particle uniformly random in each cube of edge {SPACING}), h = {RADIUS}, \
              f64, particles pre-sorted by CellSorter (lexicographic cell order of h, as a simulation keeps them), median of \
@@ -341,38 +100,368 @@ impl Experiment for NeighbourSearchExperiment {
              and Goswami et al. 2010); here only the neighbour searches are compared, on the CPU, so the ratio is a \
              metric and a note, not a check.",
         );
-        write_csv_rows(
-            &ctx.path("timing.csv"),
-            &[
-                "method",
-                "threads",
-                "particles",
-                "repetitions",
-                "median_s",
-                "min_s",
-                "us_per_particle",
-                "pairs",
-            ],
-            timings.iter().map(|t| {
-                vec![
-                    t.method.name().to_string(),
-                    t.threads.to_string(),
-                    t.n.to_string(),
-                    t.reps.to_string(),
-                    format!("{:e}", t.median_s),
-                    format!("{:e}", t.min_s),
-                    format!("{}", t.us_per_particle()),
-                    t.pairs.to_string(),
-                ]
-            }),
+        write_timing(ctx, &timings)?;
+        plot_timings(
+            ctx,
+            &timings,
+            &thread_settings,
+            refs.anchor_us,
+            refs.anchor_threads,
         )?;
-        ctx.add_file(
-            "timing.csv",
-            "median and minimum wall time of one search per method, thread count and N",
-        );
-        plot_timings(ctx, &timings, &thread_settings, anchor_us, anchor_threads)?;
         Ok(out)
     }
+}
+
+/// The reference figures: Im & Chan's claimed speed-up and the CompactNSearch anchor.
+struct References {
+    claim_lo: f64,
+    claim_hi: f64,
+    anchor_us: f64,
+    anchor_threads: f64,
+}
+
+impl References {
+    fn load(ctx: &Context) -> Result<Self> {
+        let claims = load_reference_csv(ctx, CLAIMS, &["claim", "low", "high", "unit"])?;
+        let claim_row = claims.find(&[("claim", "speedup_vs_cell_start")])?;
+        let anchor = load_reference_csv(ctx, ANCHOR, &["method", "us_per_particle", "threads"])?;
+        let anchor_row = anchor.find(&[("method", "compactnsearch")])?;
+        Ok(Self {
+            claim_lo: claims.number(claim_row, "low")?,
+            claim_hi: claims.number(claim_row, "high")?,
+            anchor_us: anchor.number(anchor_row, "us_per_particle")?,
+            anchor_threads: anchor.number(anchor_row, "threads")?,
+        })
+    }
+}
+
+/// Every method against the oracle on every cloud, f64 and f32.
+fn measure_correctness(ctx: &Context, clouds: &[Cloud]) -> Result<Vec<CorrectnessRow>> {
+    let mut rows: Vec<CorrectnessRow> = Vec::new();
+    for cloud in clouds {
+        ctx.progress
+            .set_message(format!("correctness: {} f64", cloud.name));
+        rows.extend(correctness::<f64>(cloud)?);
+        ctx.progress.inc(1);
+        ctx.progress
+            .set_message(format!("correctness: {} f32", cloud.name));
+        rows.extend(correctness::<f32>(cloud)?);
+        ctx.progress.inc(1);
+    }
+    Ok(rows)
+}
+
+/// Mismatches per method and precision (checked `== 0`), refusals and failures (noted).
+fn check_correctness(out: &mut Outcome, rows: &[CorrectnessRow]) {
+    for method in Method::FAST {
+        for precision in ["f32", "f64"] {
+            let sel = || {
+                rows.iter()
+                    .filter(|r| r.method == method.name() && r.precision == precision)
+            };
+            let mismatches: usize = sel().map(|r| r.mismatches).sum();
+            let refused = sel().filter(|r| r.status == "refused").count();
+            for r in sel() {
+                out.metric(
+                    format!("mismatches/{}/{}/{}", r.method, r.precision, r.cloud),
+                    r.mismatches as f64,
+                );
+            }
+            out.metric(
+                format!("refused/{}/{precision}", method.name()),
+                refused as f64,
+            );
+            out.check(Check::equals(
+                format!("mismatches/{}/{precision}", method.name()),
+                mismatches as f64,
+                0.0,
+                "exact algorithm: same criterion |xi − xj|² < h² as the O(N²) oracle (BruteForce); \
+                 particles with a differing neighbour set, summed over the 5 clouds",
+            ));
+        }
+    }
+    for r in rows.iter().filter(|r| r.method == Method::FAST[0].name()) {
+        out.metric(
+            format!("mean_neighbours/{}/{}", r.cloud, r.precision),
+            r.pairs as f64 / r.n as f64,
+        );
+    }
+    for r in rows.iter().filter(|r| r.status == "refused") {
+        out.note(format!(
+            "{} ({}) refused the cloud {:?} ({} particles): {} — counted as refused, not as a mismatch.",
+            r.method, r.precision, r.cloud, r.n, r.error
+        ));
+    }
+    for r in rows.iter().filter(|r| r.status == "error") {
+        out.note(format!(
+            "{} ({}) FAILED on the cloud {:?}: {} — all {} particles counted as mismatching.",
+            r.method, r.precision, r.cloud, r.error, r.n
+        ));
+    }
+}
+
+fn write_correctness(ctx: &mut Context, rows: &[CorrectnessRow]) -> Result<()> {
+    write_csv_rows(
+        &ctx.path("correctness.csv"),
+        &[
+            "cloud",
+            "precision",
+            "method",
+            "particles",
+            "radius",
+            "oracle_pairs",
+            "method_pairs",
+            "mismatching_particles",
+            "status",
+            "error",
+        ],
+        rows.iter().map(|r| {
+            vec![
+                r.cloud.to_string(),
+                r.precision.to_string(),
+                r.method.to_string(),
+                r.n.to_string(),
+                format!("{}", r.radius),
+                r.pairs.to_string(),
+                r.method_pairs.to_string(),
+                r.mismatches.to_string(),
+                r.status.to_string(),
+                r.error.clone(),
+            ]
+        }),
+    )?;
+    ctx.add_file("correctness.csv", "per cloud, precision and method: oracle pairs, method pairs, mismatching particles, status");
+    Ok(())
+}
+
+/// Thread-count determinism on the random cloud: raw lists with 1 thread and with the pool.
+fn check_determinism(
+    ctx: &Context,
+    out: &mut Outcome,
+    clouds: &[Cloud],
+    pool_threads: usize,
+) -> Result<()> {
+    ctx.progress.set_message("determinism (1 thread vs pool)");
+    let random = clouds
+        .iter()
+        .find(|c| c.name == "random")
+        .expect("random cloud");
+    let pos = to_real::<f64>(&random.points);
+    let single = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .context("building a 1-thread rayon pool")?;
+    for method in Method::FAST {
+        let mut a = NeighbourLists::new();
+        let mut b = NeighbourLists::new();
+        method.build::<f64>().search(&pos, random.radius, &mut a)?;
+        single.install(|| method.build::<f64>().search(&pos, random.radius, &mut b))?;
+        let differing = (0..a.particle_count().max(b.particle_count()))
+            .filter(|&i| {
+                i >= a.particle_count()
+                    || i >= b.particle_count()
+                    || a.neighbours(i) != b.neighbours(i)
+            })
+            .count();
+        out.check(Check::equals(
+            format!("thread-determinism/{}", method.name()),
+            differing as f64,
+            0.0,
+            format!(
+                "neighbour-search crate docs: output independent of the thread count (1 vs {pool_threads} threads, random cloud, raw lists)"
+            ),
+        ));
+    }
+    ctx.progress.inc(1);
+    Ok(())
+}
+
+/// Times every method at every N and thread count; returns the timings and the number of N
+/// at which the methods' pair counts disagree.
+fn measure_timings(
+    ctx: &Context,
+    sizes: &[usize],
+    thread_settings: &[usize],
+    pool_threads: usize,
+) -> Result<(Vec<Timing>, usize)> {
+    let mut timings: Vec<Timing> = Vec::new();
+    let mut pair_disagreements = 0usize;
+    for &n_side in sizes {
+        let pos = timing_block(n_side)?;
+        let n = pos.len();
+        let reps = match (ctx.mode, n) {
+            (Mode::Quick, _) => 5,
+            (Mode::Full, n) if n > 500_000 => 5,
+            (Mode::Full, _) => 9,
+        };
+        let mut pairs_here = Vec::new();
+        for &threads in thread_settings {
+            for method in Method::FAST {
+                ctx.progress.set_message(format!(
+                    "timing: {} N={n} {threads} thread(s)",
+                    method.name()
+                ));
+                let t = if threads == pool_threads {
+                    time_search(method, &pos, reps)?
+                } else {
+                    let pool = rayon::ThreadPoolBuilder::new()
+                        .num_threads(threads)
+                        .build()
+                        .context("building a rayon pool")?;
+                    pool.install(|| time_search(method, &pos, reps))?
+                };
+                pairs_here.push(t.pairs);
+                timings.push(Timing {
+                    method,
+                    threads,
+                    n,
+                    ..t
+                });
+                ctx.progress.inc(1);
+            }
+        }
+        if pairs_here.iter().any(|&p| p != pairs_here[0]) {
+            pair_disagreements += 1;
+        }
+    }
+    Ok((timings, pair_disagreements))
+}
+
+/// The timing of `m` on `threads` threads at `n`, if measured.
+fn find_timing(timings: &[Timing], m: Method, threads: usize, n: usize) -> Option<&Timing> {
+    timings
+        .iter()
+        .find(|t| t.method == m && t.threads == threads && t.n == n)
+}
+
+/// Per-particle times, and the ratios against the relation table at the largest N, with
+/// Im & Chan's claim; returns the largest N.
+fn timing_metrics(
+    out: &mut Outcome,
+    timings: &[Timing],
+    thread_settings: &[usize],
+    refs: &References,
+) -> usize {
+    let n_max = timings.iter().map(|t| t.n).max().unwrap_or(0);
+    for t in timings {
+        out.metric(
+            format!(
+                "us_per_particle/{}/{}t/N={}",
+                t.method.name(),
+                t.threads,
+                t.n
+            ),
+            t.us_per_particle(),
+        );
+    }
+    if let Some(t) = timings.iter().find(|t| t.n == n_max) {
+        out.metric("timing_mean_neighbours/N_max", t.pairs as f64 / t.n as f64);
+    }
+    out.metric("timing_N_max", n_max as f64);
+    let find = |m: Method, threads: usize| find_timing(timings, m, threads, n_max);
+    for &threads in thread_settings {
+        let (Some(rt), Some(csg)) = (
+            find(Method::RelationTable, threads),
+            find(Method::CellStartGrid, threads),
+        ) else {
+            continue;
+        };
+        let ratio = csg.median_s / rt.median_s;
+        out.metric(
+            format!("ratio_cell_start_over_relation_table/{threads}t"),
+            ratio,
+        );
+        if let Some(hg) = find(Method::HashedGrid, threads) {
+            out.metric(
+                format!("ratio_hashed_grid_over_relation_table/{threads}t"),
+                hg.median_s / rt.median_s,
+            );
+        }
+        let holds = (refs.claim_lo..=refs.claim_hi).contains(&ratio);
+        out.metric(
+            format!("im_chan_claim_holds/{threads}t"),
+            if holds { 1.0 } else { 0.0 },
+        );
+        out.note(claim_note(
+            ratio,
+            refs.claim_lo,
+            refs.claim_hi,
+            threads,
+            n_max,
+        ));
+    }
+    n_max
+}
+
+/// The fastest method and the relation table on one thread against the CompactNSearch anchor.
+fn anchor_notes(out: &mut Outcome, timings: &[Timing], n_max: usize, refs: &References) {
+    let (anchor_us, anchor_threads) = (refs.anchor_us, refs.anchor_threads);
+    let find = |m: Method| find_timing(timings, m, anchor_threads as usize, n_max);
+    let fastest = Method::FAST
+        .iter()
+        .filter_map(|&m| find(m))
+        .min_by(|a, b| a.median_s.total_cmp(&b.median_s));
+    if let Some(f) = fastest {
+        out.metric(
+            "fastest_over_compactnsearch_anchor/1t",
+            f.us_per_particle() / anchor_us,
+        );
+        out.note(format!(
+            "Fastest method on {} thread(s), N = {n_max}: {} at {} µs/particle, {}× the CompactNSearch anchor of {} µs/particle (this block has about {} neighbours per particle; the anchor scene of the benchmarks has about 23).",
+            anchor_threads,
+            f.method.name(),
+            fmt_num(f.us_per_particle()),
+            fmt_num(f.us_per_particle() / anchor_us),
+            fmt_num(anchor_us),
+            fmt_num(f.pairs as f64 / f.n as f64),
+        ));
+    }
+    if let Some(rt1) = find(Method::RelationTable) {
+        out.metric(
+            "relation_table_over_compactnsearch_anchor/1t",
+            rt1.us_per_particle() / anchor_us,
+        );
+        out.note(format!(
+            "Relation table, {} thread(s), N = {n_max}: {} µs/particle; CompactNSearch anchor (measured by the maintainers, 1 thread): {} µs/particle (ratio {}).",
+            anchor_threads,
+            fmt_num(rt1.us_per_particle()),
+            fmt_num(anchor_us),
+            fmt_num(rt1.us_per_particle() / anchor_us)
+        ));
+    }
+}
+
+fn write_timing(ctx: &mut Context, timings: &[Timing]) -> Result<()> {
+    write_csv_rows(
+        &ctx.path("timing.csv"),
+        &[
+            "method",
+            "threads",
+            "particles",
+            "repetitions",
+            "median_s",
+            "min_s",
+            "us_per_particle",
+            "pairs",
+        ],
+        timings.iter().map(|t| {
+            vec![
+                t.method.name().to_string(),
+                t.threads.to_string(),
+                t.n.to_string(),
+                t.reps.to_string(),
+                format!("{:e}", t.median_s),
+                format!("{:e}", t.min_s),
+                format!("{}", t.us_per_particle()),
+                t.pairs.to_string(),
+            ]
+        }),
+    )?;
+    ctx.add_file(
+        "timing.csv",
+        "median and minimum wall time of one search per method, thread count and N",
+    );
+    Ok(())
 }
 
 /// A fraction as a percentage with one decimal ("12.3").
@@ -420,9 +509,23 @@ struct Cloud {
 fn clouds(mode: Mode) -> Vec<Cloud> {
     let n = mode.pick(3000usize, 12000);
     let mut rng = SplitMix64::new(0x5eed_2016);
-    let mut v = Vec::new();
+    // The generators draw from one stream, in this order.
+    vec![
+        uniform_block(n),
+        random_cloud(&mut rng, n),
+        two_clusters(&mut rng, n),
+        negative_coordinates(&mut rng, n),
+        cell_faces(&mut rng, n),
+    ]
+}
 
-    // Uniform block: lattice at spacing s, h = 2s (pairs at exactly h: ties decided identically).
+/// Search radius giving ~30 neighbours for `n` particles spread uniformly over `volume`.
+fn radius_for(volume: f64, n: usize) -> f64 {
+    (30.0 * volume * 3.0 / (4.0 * std::f64::consts::PI * n as f64)).cbrt()
+}
+
+/// Uniform block: lattice at spacing s, h = 2s (pairs at exactly h: ties decided identically).
+fn uniform_block(n: usize) -> Cloud {
     let side = (n as f64).cbrt().round() as usize;
     let s = SPACING;
     let mut block = Vec::with_capacity(side * side * side);
@@ -433,41 +536,42 @@ fn clouds(mode: Mode) -> Vec<Cloud> {
             }
         }
     }
-    v.push(Cloud {
+    Cloud {
         name: "uniform-block",
         points: block,
         radius: 2.0 * s,
-    });
+    }
+}
 
-    // Random cloud in the unit cube, ~30 neighbours.
-    // radius giving ~30 neighbours for n particles spread uniformly over `volume`
-    let radius_for =
-        |volume: f64| (30.0 * volume * 3.0 / (4.0 * std::f64::consts::PI * n as f64)).cbrt();
-    let h = radius_for(1.0);
+/// Random cloud in the unit cube, ~30 neighbours.
+fn random_cloud(rng: &mut SplitMix64, n: usize) -> Cloud {
     let points = (0..n)
         .map(|_| [rng.unit(), rng.unit(), rng.unit()])
         .collect();
-    v.push(Cloud {
+    Cloud {
         name: "random",
         points,
-        radius: h,
-    });
+        radius: radius_for(1.0, n),
+    }
+}
 
-    // Two clusters 1e6 apart along x (f32 quantises the far one to a 0.0625 lattice).
+/// Two clusters 1e6 apart along x (f32 quantises the far one to a 0.0625 lattice).
+fn two_clusters(rng: &mut SplitMix64, n: usize) -> Cloud {
     let points = (0..n)
         .map(|i| {
             let off = if i % 2 == 0 { 0.0 } else { 1.0e6 };
             [off + 0.5 * rng.unit(), 0.5 * rng.unit(), 0.5 * rng.unit()]
         })
         .collect();
-    v.push(Cloud {
+    Cloud {
         name: "two-clusters-1e6-apart",
         points,
         radius: 0.1,
-    });
+    }
+}
 
-    // Negative coordinates (and straddling zero, where floor ≠ truncation).
-    let h = radius_for(1.5f64.powi(3));
+/// Negative coordinates (and straddling zero, where floor ≠ truncation).
+fn negative_coordinates(rng: &mut SplitMix64, n: usize) -> Cloud {
     let points = (0..n)
         .map(|_| {
             [
@@ -477,14 +581,16 @@ fn clouds(mode: Mode) -> Vec<Cloud> {
             ]
         })
         .collect();
-    v.push(Cloud {
+    Cloud {
         name: "negative-coordinates",
         points,
-        radius: h,
-    });
+        radius: radius_for(1.5f64.powi(3), n),
+    }
+}
 
-    // On cell faces: coordinates on the cell boundaries k·h(1 + CELL_MARGIN), on multiples of h
-    // (pairs at exactly h), or random, in [−4h, 4h].
+/// On cell faces: coordinates on the cell boundaries k·h(1 + CELL_MARGIN), on multiples of h
+/// (pairs at exactly h), or random, in [−4h, 4h].
+fn cell_faces(rng: &mut SplitMix64, n: usize) -> Cloud {
     let h = 0.1;
     let face = h * (1.0 + CELL_MARGIN);
     let coord = |rng: &mut SplitMix64| {
@@ -496,14 +602,13 @@ fn clouds(mode: Mode) -> Vec<Cloud> {
         }
     };
     let points = (0..n)
-        .map(|_| [coord(&mut rng), coord(&mut rng), coord(&mut rng)])
+        .map(|_| [coord(rng), coord(rng), coord(rng)])
         .collect();
-    v.push(Cloud {
+    Cloud {
         name: "cell-faces",
         points,
         radius: h,
-    });
-    v
+    }
 }
 
 fn to_real<R: Real>(points: &[[f64; 3]]) -> Vec<Vec3<R>> {
@@ -661,41 +766,9 @@ fn plot_timings(
     );
     us_plot.log_x = true;
     us_plot.legend = Legend::UpperRight;
-    let markers = [Marker::Circle, Marker::Triangle, Marker::Cross];
-    for (mi, method) in Method::FAST.iter().enumerate() {
-        for &threads in thread_settings {
-            let sel: Vec<&Timing> = timings
-                .iter()
-                .filter(|t| t.method == *method && t.threads == threads)
-                .collect();
-            // The legend draws a short stroke that cannot show the dash: the 1-thread series
-            // get open rings (colour = method), the pool's series the method's filled marker.
-            let style = if threads == 1 && thread_settings.len() > 1 {
-                SeriesStyle::DashedMarkers(Marker::Ring)
-            } else {
-                SeriesStyle::LineMarkers(markers[mi % markers.len()])
-            };
-            let name = format!(
-                "{} ({threads} thread{})",
-                method.name(),
-                if threads == 1 { "" } else { "s" }
-            );
-            time_plot.series.push(Series::styled(
-                name.clone(),
-                sel.iter().map(|t| (t.n as f64, t.median_s * 1e3)).collect(),
-                style,
-                mi,
-            ));
-            us_plot.series.push(Series::styled(
-                name,
-                sel.iter()
-                    .map(|t| (t.n as f64, t.us_per_particle()))
-                    .collect(),
-                style,
-                mi,
-            ));
-        }
-    }
+    let (time_series, us_series) = timing_series(timings, thread_settings);
+    time_plot.series = time_series;
+    us_plot.series = us_series;
     us_plot.series.push(Series::styled(
         format!(
             "CompactNSearch, {anchor_threads} thread (maintainers' measurement): {anchor_us} µs"
@@ -721,4 +794,45 @@ fn plot_timings(
          (reference-data/neighbour-search/compactnsearch_anchor.csv), 1 thread",
     );
     Ok(())
+}
+
+/// Per method and thread count: the time per search (ms) and per particle (µs) against N.
+fn timing_series(timings: &[Timing], thread_settings: &[usize]) -> (Vec<Series>, Vec<Series>) {
+    let (mut time_series, mut us_series) = (Vec::new(), Vec::new());
+    let markers = [Marker::Circle, Marker::Triangle, Marker::Cross];
+    for (mi, method) in Method::FAST.iter().enumerate() {
+        for &threads in thread_settings {
+            let sel: Vec<&Timing> = timings
+                .iter()
+                .filter(|t| t.method == *method && t.threads == threads)
+                .collect();
+            // The legend draws a short stroke that cannot show the dash: the 1-thread series
+            // get open rings (colour = method), the pool's series the method's filled marker.
+            let style = if threads == 1 && thread_settings.len() > 1 {
+                SeriesStyle::DashedMarkers(Marker::Ring)
+            } else {
+                SeriesStyle::LineMarkers(markers[mi % markers.len()])
+            };
+            let name = format!(
+                "{} ({threads} thread{})",
+                method.name(),
+                if threads == 1 { "" } else { "s" }
+            );
+            time_series.push(Series::styled(
+                name.clone(),
+                sel.iter().map(|t| (t.n as f64, t.median_s * 1e3)).collect(),
+                style,
+                mi,
+            ));
+            us_series.push(Series::styled(
+                name,
+                sel.iter()
+                    .map(|t| (t.n as f64, t.us_per_particle()))
+                    .collect(),
+                style,
+                mi,
+            ));
+        }
+    }
+    (time_series, us_series)
 }

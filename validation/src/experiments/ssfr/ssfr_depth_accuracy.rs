@@ -116,6 +116,222 @@ fn measure(renderer: &Renderer, truth: &[Option<(f32, ssfr_render::V3)>], radius
     e
 }
 
+/// The analytic shapes: a sphere, a box and a slab of liquid.
+fn shapes() -> [(&'static str, Shape); 3] {
+    [
+        (
+            "sphere",
+            Shape::Sphere {
+                centre: [0.0, 0.3, 0.0],
+                radius: 0.24,
+            },
+        ),
+        (
+            "box",
+            Shape::Box {
+                min: [-0.2, 0.0, -0.2],
+                max: [0.2, 0.32, 0.2],
+            },
+        ),
+        (
+            "slab",
+            Shape::Box {
+                min: [-0.5, 0.0, -0.5],
+                max: [0.5, 0.08, 0.5],
+            },
+        ),
+    ]
+}
+
+/// The smoothing methods compared, for spheres of radius `r` (m).
+fn smoothing_methods(r: f32) -> [(&'static str, Smoothing); 3] {
+    [
+        ("raw", Smoothing::None),
+        (
+            "bilateral",
+            Smoothing::Bilateral(BilateralParams {
+                radius_m: 3.0 * r,
+                max_radius_px: 24,
+                depth_falloff_m: 2.0 * r,
+            }),
+        ),
+        (
+            "curvature-flow",
+            Smoothing::CurvatureFlow {
+                iterations: 60,
+                depth_falloff_m: 2.0 * r,
+            },
+        ),
+    ]
+}
+
+/// One method's result on one shape: its label, errors and [`STATS`].
+type MethodResult = (&'static str, Errors, [f64; 6]);
+
+/// The [`STATS`] of one method's errors.
+fn stats_of(e: &Errors) -> [f64; 6] {
+    let bias = mean(&e.signed_r);
+    let roughness = (e.signed_r.iter().map(|x| (x - bias).powi(2)).sum::<f64>()
+        / e.signed_r.len() as f64)
+        .sqrt();
+    [
+        mean(&e.depth_r),
+        percentile(&e.depth_r, 0.95),
+        mean(&e.angle_deg),
+        percentile(&e.angle_deg, 0.95),
+        bias,
+        roughness,
+    ]
+}
+
+/// Renders `shape` with every method, records the statistics (metrics and CSV rows) and
+/// writes the side-by-side image.
+fn measure_shape(
+    ctx: &mut Context,
+    out: &mut Outcome,
+    (name, shape): (&str, &Shape),
+    (camera, s): (Camera, f32),
+    rows: &mut Vec<Vec<String>>,
+) -> Result<Vec<MethodResult>> {
+    let r = ssfr_render::RADIUS_OVER_SPACING * s;
+    let positions = shape.particles(s);
+    let truth = mask(shape, &camera.frame()?);
+    out.metric(format!("{name}/particles"), positions.len() as f64);
+    let mut per_method = Vec::new();
+    let mut images = Vec::new();
+    for (label, smoothing) in smoothing_methods(r) {
+        let mut params = RenderParams::new(camera, Background::ground_only(-0.001, 0.1), r);
+        params.smoothing = smoothing;
+        let mut renderer = Renderer::default();
+        renderer.render(&params, &ParticleView::spheres(&positions, r))?;
+        images.push(renderer.image());
+        let e = measure(&renderer, &truth, r);
+        let stats = stats_of(&e);
+        for (k, key) in STATS.iter().enumerate() {
+            out.metric(format!("{name}/{label}/{key}"), stats[k]);
+        }
+        out.metric(format!("{name}/{label}/pixels"), e.depth_r.len() as f64);
+        rows.push(vec![
+            name.to_string(),
+            label.to_string(),
+            e.depth_r.len().to_string(),
+            format!("{:.4}", stats[0]),
+            format!("{:.4}", stats[1]),
+            format!("{:.3}", stats[2]),
+            format!("{:.3}", stats[3]),
+            format!("{:.4}", stats[4]),
+            format!("{:.4}", stats[5]),
+        ]);
+        per_method.push((label, e, stats));
+        ctx.progress.inc(1);
+    }
+    let refs: Vec<&ssfr_render::RgbImage> = images.iter().collect();
+    let file = format!("{name}_raw_bilateral_curvature.png");
+    ssfr_render::RgbImage::side_by_side(&refs, 8)?.write_png(&ctx.path(&file))?;
+    ctx.add_plot(
+        &file,
+        format!("{name} of liquid: raw splats | bilateral filter | curvature flow"),
+    );
+    Ok(per_method)
+}
+
+/// Cumulative distribution of sorted values (at most about 400 points).
+fn cdf(v: &[f64]) -> Vec<(f64, f64)> {
+    let n = v.len() as f64;
+    v.iter()
+        .enumerate()
+        .step_by((v.len() / 400).max(1))
+        .map(|(k, &x)| (x, (k + 1) as f64 / n))
+        .collect()
+}
+
+/// The depth and normal error distributions of every method on one shape.
+fn plot_cdfs(ctx: &mut Context, name: &str, per_method: &[MethodResult]) -> Result<()> {
+    let out_dir = ctx.out_dir.clone();
+    let plot = |file: &str, title: &str, x: &str, pick: fn(&Errors) -> &Vec<f64>| {
+        plot_xy(
+            &out_dir.join(file),
+            &PlotSpec {
+                legend: Legend::LowerRight,
+                y_range: Some((0.0, 1.0)),
+                series: per_method
+                    .iter()
+                    .enumerate()
+                    .map(|(c, (label, e, _))| Series::line(*label, cdf(pick(e)), c))
+                    .collect(),
+                ..PlotSpec::new(title, x, "fraction of measured pixels")
+            },
+        )
+    };
+    let f1 = format!("{name}_depth_error_cdf.png");
+    plot(
+        &f1,
+        &format!("{name}: depth error against the analytic surface"),
+        "|z − z_exact| (particle radii)",
+        |e| &e.depth_r,
+    )?;
+    ctx.add_plot(
+        &f1,
+        format!("{name}: cumulative distribution of the depth error"),
+    );
+    let f2 = format!("{name}_normal_error_cdf.png");
+    plot(
+        &f2,
+        &format!("{name}: normal error against the analytic surface"),
+        "angle between rendered and exact normal (degrees)",
+        |e| &e.angle_deg,
+    )?;
+    ctx.add_plot(
+        &f2,
+        format!("{name}: cumulative distribution of the normal error"),
+    );
+    Ok(())
+}
+
+/// The smoothed surfaces against the raw spheres and the absolute bounds, on one shape.
+fn check_shape(out: &mut Outcome, name: &str, per_method: &[MethodResult]) {
+    let [raw, bil, cf] = [&per_method[0].2, &per_method[1].2, &per_method[2].2];
+    let claim = "the purpose of the smoothing step (Im & Chan 2016 §IV.A step 3; van der Laan et al. 2009 §3.2): the filtered surface is closer to the liquid's surface than the raw spheres";
+    out.check(Check::less_than(
+        format!("{name}/bilateral mean depth error / raw"),
+        bil[0] / raw[0],
+        0.9,
+        format!("{claim}; 'measurably': at least 10 % lower"),
+    ));
+    out.check(Check::less_than(
+        format!("{name}/bilateral mean normal error / raw"),
+        bil[2] / raw[2],
+        0.9,
+        format!("{claim}; 'measurably': at least 10 % lower"),
+    ));
+    out.check(Check::less_than(
+        format!("{name}/curvature-flow mean normal error / raw"),
+        cf[2] / raw[2],
+        0.9,
+        "van der Laan et al. 2009 §3.2: curvature flow smooths the surface the spheres make",
+    ));
+    out.check(Check::less_than(
+        format!("{name}/bilateral depth roughness / raw"),
+        bil[5] / raw[5],
+        0.9,
+        format!("{claim}; roughness = RMS of the signed error about its mean (the bias a filter cannot remove is reported as mean_signed_depth_error_r)"),
+    ));
+    if name != "sphere" {
+        out.check(Check::less_than(
+            format!("{name}/bilateral p95 depth error (particle radii)"),
+            bil[1],
+            1.0,
+            "geometry of a flat lattice face: the spheres (radius 0.75 s, centres 0.5 s inside) reach 0.25 s = r/3 beyond the face and stay 0.25 s short of it between four centres, so a surface smoothed between them lies within one radius",
+        ));
+    }
+    out.check(Check::less_than(
+        format!("{name}/bilateral mean normal error (degrees)"),
+        bil[2],
+        15.0,
+        "this project's bound for a usable shading normal (a 15° tilt moves a specular highlight visibly); the raw spheres' normals are reported beside it",
+    ));
+}
+
 impl Experiment for SsfrDepthAccuracy {
     fn id(&self) -> &'static str {
         "ssfr-depth-accuracy"
@@ -129,29 +345,7 @@ impl Experiment for SsfrDepthAccuracy {
         let s: f32 = ctx.mode.pick(0.02, 0.01);
         let r = ssfr_render::RADIUS_OVER_SPACING * s;
         let (w, h) = ctx.mode.pick((480, 360), (1280, 720));
-        let shapes = [
-            (
-                "sphere",
-                Shape::Sphere {
-                    centre: [0.0, 0.3, 0.0],
-                    radius: 0.24,
-                },
-            ),
-            (
-                "box",
-                Shape::Box {
-                    min: [-0.2, 0.0, -0.2],
-                    max: [0.2, 0.32, 0.2],
-                },
-            ),
-            (
-                "slab",
-                Shape::Box {
-                    min: [-0.5, 0.0, -0.5],
-                    max: [0.5, 0.08, 0.5],
-                },
-            ),
-        ];
+        let shapes = shapes();
         let camera = Camera {
             eye: [0.55, 0.75, 1.05],
             target: [0.0, 0.15, 0.0],
@@ -160,166 +354,14 @@ impl Experiment for SsfrDepthAccuracy {
             width: w,
             height: h,
         };
-        let methods = [
-            ("raw", Smoothing::None),
-            (
-                "bilateral",
-                Smoothing::Bilateral(BilateralParams {
-                    radius_m: 3.0 * r,
-                    max_radius_px: 24,
-                    depth_falloff_m: 2.0 * r,
-                }),
-            ),
-            (
-                "curvature-flow",
-                Smoothing::CurvatureFlow {
-                    iterations: 60,
-                    depth_falloff_m: 2.0 * r,
-                },
-            ),
-        ];
         ctx.progress
-            .set_length((shapes.len() * methods.len()) as u64);
+            .set_length((shapes.len() * smoothing_methods(r).len()) as u64);
         let mut out = Outcome::new();
         let mut rows = Vec::new();
-        let cam = camera.frame()?;
-        for (name, shape) in shapes {
-            let positions = shape.particles(s);
-            let truth = mask(&shape, &cam);
-            out.metric(format!("{name}/particles"), positions.len() as f64);
-            let mut per_method = Vec::new();
-            let mut images = Vec::new();
-            for (label, smoothing) in methods {
-                let mut params = RenderParams::new(camera, Background::ground_only(-0.001, 0.1), r);
-                params.smoothing = smoothing;
-                let mut renderer = Renderer::default();
-                renderer.render(&params, &ParticleView::spheres(&positions, r))?;
-                images.push(renderer.image());
-                let e = measure(&renderer, &truth, r);
-                let bias = mean(&e.signed_r);
-                let roughness = (e.signed_r.iter().map(|x| (x - bias).powi(2)).sum::<f64>()
-                    / e.signed_r.len() as f64)
-                    .sqrt();
-                let stats = [
-                    mean(&e.depth_r),
-                    percentile(&e.depth_r, 0.95),
-                    mean(&e.angle_deg),
-                    percentile(&e.angle_deg, 0.95),
-                    bias,
-                    roughness,
-                ];
-                for (k, key) in STATS.iter().enumerate() {
-                    out.metric(format!("{name}/{label}/{key}"), stats[k]);
-                }
-                out.metric(format!("{name}/{label}/pixels"), e.depth_r.len() as f64);
-                rows.push(vec![
-                    name.to_string(),
-                    label.to_string(),
-                    e.depth_r.len().to_string(),
-                    format!("{:.4}", stats[0]),
-                    format!("{:.4}", stats[1]),
-                    format!("{:.3}", stats[2]),
-                    format!("{:.3}", stats[3]),
-                    format!("{:.4}", stats[4]),
-                    format!("{:.4}", stats[5]),
-                ]);
-                per_method.push((label, e, stats));
-                ctx.progress.inc(1);
-            }
-            let refs: Vec<&ssfr_render::RgbImage> = images.iter().collect();
-            let file = format!("{name}_raw_bilateral_curvature.png");
-            ssfr_render::RgbImage::side_by_side(&refs, 8)?.write_png(&ctx.path(&file))?;
-            ctx.add_plot(
-                &file,
-                format!("{name} of liquid: raw splats | bilateral filter | curvature flow"),
-            );
-            let cdf = |v: &[f64]| -> Vec<(f64, f64)> {
-                let n = v.len() as f64;
-                v.iter()
-                    .enumerate()
-                    .step_by((v.len() / 400).max(1))
-                    .map(|(k, &x)| (x, (k + 1) as f64 / n))
-                    .collect()
-            };
-            let out_dir = ctx.out_dir.clone();
-            let plot = |file: &str, title: &str, x: &str, pick: fn(&Errors) -> &Vec<f64>| {
-                plot_xy(
-                    &out_dir.join(file),
-                    &PlotSpec {
-                        legend: Legend::LowerRight,
-                        y_range: Some((0.0, 1.0)),
-                        series: per_method
-                            .iter()
-                            .enumerate()
-                            .map(|(c, (label, e, _))| Series::line(*label, cdf(pick(e)), c))
-                            .collect(),
-                        ..PlotSpec::new(title, x, "fraction of measured pixels")
-                    },
-                )
-            };
-            let f1 = format!("{name}_depth_error_cdf.png");
-            plot(
-                &f1,
-                &format!("{name}: depth error against the analytic surface"),
-                "|z − z_exact| (particle radii)",
-                |e| &e.depth_r,
-            )?;
-            ctx.add_plot(
-                &f1,
-                format!("{name}: cumulative distribution of the depth error"),
-            );
-            let f2 = format!("{name}_normal_error_cdf.png");
-            plot(
-                &f2,
-                &format!("{name}: normal error against the analytic surface"),
-                "angle between rendered and exact normal (degrees)",
-                |e| &e.angle_deg,
-            )?;
-            ctx.add_plot(
-                &f2,
-                format!("{name}: cumulative distribution of the normal error"),
-            );
-
-            let [raw, bil, cf] = [&per_method[0].2, &per_method[1].2, &per_method[2].2];
-            let claim = "the purpose of the smoothing step (Im & Chan 2016 §IV.A step 3; van der Laan et al. 2009 §3.2): the filtered surface is closer to the liquid's surface than the raw spheres";
-            out.check(Check::less_than(
-                format!("{name}/bilateral mean depth error / raw"),
-                bil[0] / raw[0],
-                0.9,
-                format!("{claim}; 'measurably': at least 10 % lower"),
-            ));
-            out.check(Check::less_than(
-                format!("{name}/bilateral mean normal error / raw"),
-                bil[2] / raw[2],
-                0.9,
-                format!("{claim}; 'measurably': at least 10 % lower"),
-            ));
-            out.check(Check::less_than(
-                format!("{name}/curvature-flow mean normal error / raw"),
-                cf[2] / raw[2],
-                0.9,
-                "van der Laan et al. 2009 §3.2: curvature flow smooths the surface the spheres make",
-            ));
-            out.check(Check::less_than(
-                format!("{name}/bilateral depth roughness / raw"),
-                bil[5] / raw[5],
-                0.9,
-                format!("{claim}; roughness = RMS of the signed error about its mean (the bias a filter cannot remove is reported as mean_signed_depth_error_r)"),
-            ));
-            if name != "sphere" {
-                out.check(Check::less_than(
-                    format!("{name}/bilateral p95 depth error (particle radii)"),
-                    bil[1],
-                    1.0,
-                    "geometry of a flat lattice face: the spheres (radius 0.75 s, centres 0.5 s inside) reach 0.25 s = r/3 beyond the face and stay 0.25 s short of it between four centres, so a surface smoothed between them lies within one radius",
-                ));
-            }
-            out.check(Check::less_than(
-                format!("{name}/bilateral mean normal error (degrees)"),
-                bil[2],
-                15.0,
-                "this project's bound for a usable shading normal (a 15° tilt moves a specular highlight visibly); the raw spheres' normals are reported beside it",
-            ));
+        for (name, shape) in &shapes {
+            let per_method = measure_shape(ctx, &mut out, (name, shape), (camera, s), &mut rows)?;
+            plot_cdfs(ctx, name, &per_method)?;
+            check_shape(&mut out, name, &per_method);
         }
         write_csv_rows(
             &ctx.path("depth_accuracy.csv"),

@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use anyhow::Result;
 use sph_core::{sampling::cubic_lattice, Aabb, Vec3};
-use ssfr_render::{ParticleView, Renderer};
+use ssfr_render::{FrameStats, ParticleView, Renderer};
 
 use crate::helpers::write_csv_rows;
 use crate::sim::shipped_scene;
@@ -36,6 +36,82 @@ pub fn column_particles(n: usize) -> Result<(Vec<Vec3<f32>>, f32)> {
     Ok((cubic_lattice(&column, s, 4 * n)?, s))
 }
 
+/// Renders `positions` `REPEATS` times at 1280x720; returns the renderer (holding the last
+/// frame) and the wall time and statistics of each frame.
+fn time_frames(
+    ctx: &Context,
+    scene: &sph_scene::Scene,
+    positions: &[Vec3<f32>],
+    s: f32,
+) -> Result<(Renderer, Vec<(f64, FrameStats)>)> {
+    let mut params = render_params(scene)?;
+    params.camera.width = 1280;
+    params.camera.height = 720;
+    let r = ssfr_render::RADIUS_OVER_SPACING * s;
+    params = ssfr_render::RenderParams {
+        particle_radius_m: r,
+        ..ssfr_render::RenderParams::new(params.camera, params.background, r)
+    };
+    let mut renderer = Renderer::default();
+    let mut runs = Vec::new();
+    for _ in 0..REPEATS {
+        let t = Instant::now();
+        let stats = renderer.render(&params, &ParticleView::spheres(positions, r))?;
+        runs.push((t.elapsed().as_secs_f64(), stats));
+        ctx.progress.inc(1);
+    }
+    Ok((renderer, runs))
+}
+
+/// Median frame and stage times (metrics; rows of `stages.csv`) and the framing check.
+fn record_frames(
+    out: &mut Outcome,
+    label: &str,
+    particles: usize,
+    runs: &[(f64, FrameStats)],
+    rows: &mut Vec<Vec<String>>,
+) {
+    // The first frame also renders the background; time the others.
+    let timed = &runs[1..];
+    let (median, spread) = median_spread(&mut timed.iter().map(|x| x.0).collect::<Vec<_>>());
+    out.metric(format!("{label}/frame_median_s"), median);
+    out.metric(format!("{label}/frame_spread_s"), spread);
+    let last = runs[runs.len() - 1].1;
+    let background_s = runs[0].1.times.background_s;
+    out.metric(format!("{label}/background_s"), background_s);
+    for (k, (stage, _)) in last.times.stages().into_iter().enumerate() {
+        let secs = if stage == "background" {
+            background_s
+        } else {
+            let (m, spread) = median_spread(
+                &mut timed
+                    .iter()
+                    .map(|x| x.1.times.stages()[k].1)
+                    .collect::<Vec<_>>(),
+            );
+            out.metric(format!("{label}/{stage}_s"), m);
+            out.metric(format!("{label}/{stage}_spread_s"), spread);
+            m
+        };
+        rows.push(vec![
+            particles.to_string(),
+            stage.to_string(),
+            format!("{secs:.6}"),
+        ]);
+    }
+    out.metric(
+        format!("{label}/splat_pixel_tests"),
+        last.splat_pixel_tests as f64,
+    );
+    out.metric(format!("{label}/liquid_pixels"), last.liquid_pixels as f64);
+    out.check(Check::equals(
+        format!("{label}: particles drawn"),
+        last.particles_drawn as f64,
+        particles as f64,
+        "the default camera frames the whole tank (definition of the framing)",
+    ));
+}
+
 impl Experiment for SsfrPerformance {
     fn id(&self) -> &'static str {
         "ssfr-performance"
@@ -54,63 +130,9 @@ impl Experiment for SsfrPerformance {
         out.metric("threads", rayon::current_num_threads() as f64);
         for &n in &sizes {
             let (positions, s) = column_particles(n)?;
-            let mut params = render_params(&scene)?;
-            params.camera.width = 1280;
-            params.camera.height = 720;
-            let r = ssfr_render::RADIUS_OVER_SPACING * s;
-            params = ssfr_render::RenderParams {
-                particle_radius_m: r,
-                ..ssfr_render::RenderParams::new(params.camera, params.background, r)
-            };
-            let mut renderer = Renderer::default();
-            let mut runs = Vec::new();
-            for _ in 0..REPEATS {
-                let t = Instant::now();
-                let stats = renderer.render(&params, &ParticleView::spheres(&positions, r))?;
-                runs.push((t.elapsed().as_secs_f64(), stats));
-                ctx.progress.inc(1);
-            }
-            // The first frame also renders the background; time the others.
-            let timed = &runs[1..];
-            let (median, spread) =
-                median_spread(&mut timed.iter().map(|x| x.0).collect::<Vec<_>>());
+            let (renderer, runs) = time_frames(ctx, &scene, &positions, s)?;
             let label = format!("{}k", positions.len() / 1000);
-            out.metric(format!("{label}/frame_median_s"), median);
-            out.metric(format!("{label}/frame_spread_s"), spread);
-            let last = runs[runs.len() - 1].1;
-            let background_s = runs[0].1.times.background_s;
-            out.metric(format!("{label}/background_s"), background_s);
-            for (k, (stage, _)) in last.times.stages().into_iter().enumerate() {
-                let secs = if stage == "background" {
-                    background_s
-                } else {
-                    let (m, spread) = median_spread(
-                        &mut timed
-                            .iter()
-                            .map(|x| x.1.times.stages()[k].1)
-                            .collect::<Vec<_>>(),
-                    );
-                    out.metric(format!("{label}/{stage}_s"), m);
-                    out.metric(format!("{label}/{stage}_spread_s"), spread);
-                    m
-                };
-                rows.push(vec![
-                    positions.len().to_string(),
-                    stage.to_string(),
-                    format!("{secs:.6}"),
-                ]);
-            }
-            out.metric(
-                format!("{label}/splat_pixel_tests"),
-                last.splat_pixel_tests as f64,
-            );
-            out.metric(format!("{label}/liquid_pixels"), last.liquid_pixels as f64);
-            out.check(Check::equals(
-                format!("{label}: particles drawn"),
-                last.particles_drawn as f64,
-                positions.len() as f64,
-                "the default camera frames the whole tank (definition of the framing)",
-            ));
+            record_frames(&mut out, &label, positions.len(), &runs, &mut rows);
             renderer
                 .image()
                 .write_png(&ctx.path(&format!("frame_{label}.png")))?;
