@@ -111,7 +111,9 @@ pub mod kepler;
 mod maps;
 mod particles;
 mod planets;
+mod population;
 mod run;
+pub mod samples;
 pub mod solar_system;
 mod work;
 
@@ -123,6 +125,9 @@ pub use particles::{
     PARTICLE_S6_STAGES,
 };
 pub use planets::Planets;
+pub use population::{
+    Population, PopulationMember, PopulationProgress, RemovalRules, DEFAULT_WINDOW_STEPS,
+};
 pub use run::{
     load_checkpoint, save_checkpoint, CometRun, Limits, ParticleStatus, TrackedParticle,
 };
@@ -206,6 +211,15 @@ pub enum SymplecticError {
         path: String,
         /// Why.
         reason: String,
+    },
+    /// A read-only ephemeris ([`Ephemeris::interpolate`]) was asked for a time after its
+    /// newest grid state.
+    #[error("time {time} is after the newest planet state ({newest}) of a read-only ephemeris")]
+    BeyondEphemeris {
+        /// Requested time.
+        time: f64,
+        /// Newest grid time.
+        newest: f64,
     },
     /// The integration blew up: a non-finite value appeared at this step.
     #[error("blow-up at step {step}: body {body} has a non-finite state")]
