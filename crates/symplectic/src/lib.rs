@@ -107,6 +107,8 @@
 //! these steps.
 
 pub mod ephemeris;
+#[cfg(feature = "io")]
+pub mod io;
 pub mod kepler;
 mod maps;
 mod particles;
@@ -220,6 +222,48 @@ pub enum SymplecticError {
         time: f64,
         /// Newest grid time.
         newest: f64,
+    },
+    /// A population specification (TOML) is malformed or out of range.
+    #[error("{path}: field `{field}`: {reason}")]
+    Spec {
+        /// File.
+        path: String,
+        /// Field path (`span.years`), empty for the document.
+        field: String,
+        /// Why, with the line and column for syntax errors.
+        reason: String,
+    },
+    /// A particle file (CSV) has a bad row; nothing was built.
+    #[error("{path}: line {line}, column `{column}`: {reason}")]
+    ParticleFile {
+        /// File.
+        path: String,
+        /// Line (1-based; the header is line 1).
+        line: u64,
+        /// Column name (empty if the whole row).
+        column: String,
+        /// Why.
+        reason: String,
+    },
+    /// A population would not fit in memory; refused before allocating.
+    #[error(
+        "{particles} particles need about {needed_bytes} bytes, more than the {available_bytes} bytes available"
+    )]
+    OutOfMemory {
+        /// Particles requested.
+        particles: usize,
+        /// Bytes needed.
+        needed_bytes: u128,
+        /// Bytes available.
+        available_bytes: u64,
+    },
+    /// An output table could not be written.
+    #[error("output {path}: {reason}")]
+    Output {
+        /// File.
+        path: String,
+        /// Why.
+        reason: String,
     },
     /// The integration blew up: a non-finite value appeared at this step.
     #[error("blow-up at step {step}: body {body} has a non-finite state")]

@@ -319,6 +319,18 @@ impl Population {
         )
     }
 
+    /// The extended-Hamiltonian error `(H + p₄)/|H|` of member `i` at its own time, or
+    /// `None` if the ephemeris no longer holds that time (a particle removed long ago).
+    pub fn relative_error(&self, i: usize) -> Option<f64> {
+        let m = self.members.get(i)?;
+        let mut bodies = BodyStates::default();
+        self.ephemeris
+            .interpolate(m.particle.time, &mut bodies, true)
+            .ok()?;
+        let h = self.integrator.hamiltonian(&m.particle, &bodies);
+        Some((h + m.particle.p4) / h.abs())
+    }
+
     /// Advances every active particle until its own time reaches `t_end` (its last step
     /// overshoots: the steps are variable), in windows; `on_sync` sees the population's
     /// progress after each window. Removed particles stop; they never stop the others. Errors
