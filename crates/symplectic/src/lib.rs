@@ -116,6 +116,8 @@ mod planets;
 mod population;
 mod run;
 pub mod samples;
+#[cfg(feature = "io")]
+pub mod study;
 pub mod solar_system;
 mod work;
 
