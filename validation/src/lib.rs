@@ -19,8 +19,6 @@ use serde::{Deserialize, Serialize};
 pub mod deviations;
 pub mod experiments;
 pub mod helpers;
-pub mod render;
-pub mod repose_cmd;
 pub mod runner;
 pub mod sim;
 

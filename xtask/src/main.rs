@@ -4,17 +4,13 @@
 //!   crate in release and runs the experiments (`validation run ...`); exit code 1 when any
 //!   check fails or an experiment errors.
 //! - `cargo xtask list` — the experiments and the paper figure each reproduces.
-//! - `cargo xtask run SCENE [--quick] [--frames N] [--out DIR]` — builds `validation` in release
-//!   and runs a scene file (`validation scene ...`): ParaView frames and per-frame statistics.
-//!   With `--render`, the frames are also rendered (PNG in `OUT/render`) while it runs.
-//! - `cargo xtask render OUTPUT_DIR [--scene SCENE] [--quick] [--out DIR]` — renders a scene
-//!   run's VTK frames to PNG images with the screen-space renderer (`validation render ...`).
-//! - `cargo xtask repose OUTPUT_DIR [--frame FILE] [--shape planar|conical]` — the angle of
-//!   repose of a granular scene run's last frame (`validation repose ...`).
+//! - `cargo xtask run SCENE [--quick] [--frames N] [--out DIR] [--render]
+//!   [--checkpoint-every N] [--resume]`, `cargo xtask render DIR …`, `cargo xtask repose DIR …`
+//!   — build the command-line crate `particles-cli` in release and run `particles run|render|
+//!   repose ARGS...` from the directory the command was typed in (see `particles --help`).
 //! - `cargo xtask bench [ARGS...]` — `cargo bench -p benches -- ARGS...` (criterion).
 //!
-//! Deliberately light: clap + anyhow + std. Cargo is the one running this (`$CARGO`), and
-//! every command runs from the workspace root.
+//! Deliberately light: clap + anyhow + std. Cargo is the one running this (`$CARGO`).
 
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
@@ -49,49 +45,40 @@ enum Task {
     },
     /// List the experiments and the figure or claim each reproduces.
     List,
-    /// Run a scene file (e.g. `scenes/dam_break.toml`): VTK frames for ParaView and a CSV of
-    /// per-frame statistics in `--out` [default: `target/scenes/SCENE_NAME`].
+    /// Run a scene file (`particles run`): VTK frames, `stats.csv`, checkpoints
+    /// (`--checkpoint-every N`, `--resume`), rendered frames (`--render`). See
+    /// `cargo xtask run --help`.
+    #[command(disable_help_flag = true)]
     Run {
-        /// The scene file (TOML).
-        scene: PathBuf,
-        /// Apply the scene's `[quick]` overrides (fewer particles, shorter).
-        #[arg(long)]
-        quick: bool,
-        /// Stop after this many frames.
-        #[arg(long, value_name = "N")]
-        frames: Option<usize>,
-        /// Output directory.
-        #[arg(long, value_name = "DIR")]
-        out: Option<PathBuf>,
-        /// Also render the frames (PNG in OUT/render) while the scene runs.
-        #[arg(long)]
-        render: bool,
+        /// Arguments of `particles run` (paths relative to where you typed the command).
+        #[arg(
+            trailing_var_arg = true,
+            allow_hyphen_values = true,
+            value_name = "ARGS"
+        )]
+        args: Vec<OsString>,
     },
-    /// Render a scene run's VTK frames (`frame_*.vtk` in OUTPUT_DIR) to PNG images, with the
-    /// camera, light and background of the scene's `[render]` table.
+    /// Render an earlier run's VTK frames to PNG (`particles render`).
+    #[command(disable_help_flag = true)]
     Render {
-        /// The run's output directory (as given to `run --out`).
-        dir: PathBuf,
-        /// The scene file [default: the one recorded in OUTPUT_DIR by `run`].
-        #[arg(long, value_name = "SCENE")]
-        scene: Option<PathBuf>,
-        /// With --scene: apply its `[quick]` overrides.
-        #[arg(long)]
-        quick: bool,
-        /// Output directory for the PNGs [default: OUTPUT_DIR/render].
-        #[arg(long, value_name = "DIR")]
-        out: Option<PathBuf>,
+        /// Arguments of `particles render`.
+        #[arg(
+            trailing_var_arg = true,
+            allow_hyphen_values = true,
+            value_name = "ARGS"
+        )]
+        args: Vec<OsString>,
     },
-    /// Measure the angle of repose of a granular scene run's last frame (or `--frame FILE`).
+    /// The angle of repose of a granular run's last frame (`particles repose`).
+    #[command(disable_help_flag = true)]
     Repose {
-        /// The run's output directory (as given to `run --out`).
-        dir: PathBuf,
-        /// The frame to measure [default: the last `frame_*.vtk` in OUTPUT_DIR].
-        #[arg(long, value_name = "FILE")]
-        frame: Option<PathBuf>,
-        /// `planar` (a 2.5D heap, profile along x) or `conical`.
-        #[arg(long, default_value = "planar")]
-        shape: String,
+        /// Arguments of `particles repose`.
+        #[arg(
+            trailing_var_arg = true,
+            allow_hyphen_values = true,
+            value_name = "ARGS"
+        )]
+        args: Vec<OsString>,
     },
     /// Run the criterion benchmarks: `cargo bench -p benches -- ARGS...`.
     Bench {
@@ -121,11 +108,11 @@ fn cargo() -> OsString {
 }
 
 /// Runs `cargo <args>` from the workspace root; returns its exit code.
-fn run_cargo(args: &[OsString]) -> Result<u8> {
-    let root = workspace_root();
+fn run_cargo(args: &[OsString], in_dir: &Path) -> Result<u8> {
+    let root = in_dir;
     let status = Command::new(cargo())
         .args(args)
-        .current_dir(&root)
+        .current_dir(root)
         .status()
         .with_context(|| format!("running cargo {args:?} in {}", root.display()))?;
     Ok(match status.code() {
@@ -135,10 +122,16 @@ fn run_cargo(args: &[OsString]) -> Result<u8> {
     })
 }
 
-/// `path` made absolute against the directory the user typed the command in (cargo runs
-/// the commands from the workspace root).
-fn abs(path: PathBuf) -> OsString {
-    std::path::absolute(&path).unwrap_or(path).into_os_string()
+/// `cargo run --release -p particles-cli -- COMMAND ARGS...`, run from the directory the
+/// user typed the command in (so relative paths mean what they typed), with the default
+/// output under the workspace's `target/`.
+fn particles(command: &str, args: Vec<OsString>) -> Vec<OsString> {
+    let manifest = workspace_root().join("Cargo.toml");
+    let mut a = os(&["run", "--release", "--quiet", "--manifest-path"]);
+    a.push(manifest.into_os_string());
+    a.extend(os(&["-p", "particles-cli", "--", command]));
+    a.extend(args);
+    a
 }
 
 fn os(args: &[&str]) -> Vec<OsString> {
@@ -147,6 +140,14 @@ fn os(args: &[&str]) -> Vec<OsString> {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // The scene commands run where the user typed them (their relative paths); the others
+    // from the workspace root.
+    let dir = match &cli.command {
+        Task::Run { .. } | Task::Render { .. } | Task::Repose { .. } => {
+            std::env::current_dir().unwrap_or_else(|_| workspace_root())
+        }
+        _ => workspace_root(),
+    };
     let args = match cli.command {
         Task::Validate { full, only, out } => {
             let mut a = os(&["run", "--release", "-p", "validation", "--", "run"]);
@@ -165,63 +166,9 @@ fn main() -> ExitCode {
             }
             a
         }
-        Task::Run {
-            scene,
-            quick,
-            frames,
-            out,
-            render,
-        } => {
-            let mut a = os(&["run", "--release", "-p", "validation", "--", "scene"]);
-            if render {
-                a.push("--render".into());
-            }
-            // Paths relative to where the user typed the command, not the workspace root.
-            a.push(
-                std::path::absolute(&scene)
-                    .unwrap_or(scene)
-                    .into_os_string(),
-            );
-            if quick {
-                a.push("--quick".into());
-            }
-            if let Some(n) = frames {
-                a.push("--frames".into());
-                a.push(n.to_string().into());
-            }
-            if let Some(out) = out {
-                a.push("--out".into());
-                a.push(std::path::absolute(&out).unwrap_or(out).into_os_string());
-            }
-            a
-        }
-        Task::Render {
-            dir,
-            scene,
-            quick,
-            out,
-        } => {
-            let mut a = os(&["run", "--release", "-p", "validation", "--", "render"]);
-            a.push(abs(dir));
-            for (flag, path) in [("--scene", scene), ("--out", out)] {
-                if let Some(p) = path {
-                    a.extend([flag.into(), abs(p)]);
-                }
-            }
-            if quick {
-                a.push("--quick".into());
-            }
-            a
-        }
-        Task::Repose { dir, frame, shape } => {
-            let mut a = os(&["run", "--release", "-p", "validation", "--", "repose"]);
-            a.push(abs(dir));
-            if let Some(f) = frame {
-                a.extend(["--frame".into(), abs(f)]);
-            }
-            a.extend(["--shape".into(), shape.into()]);
-            a
-        }
+        Task::Run { args } => particles("run", args),
+        Task::Render { args } => particles("render", args),
+        Task::Repose { args } => particles("repose", args),
         Task::List => os(&["run", "--release", "-p", "validation", "--", "list"]),
         Task::Bench { args } => {
             let mut a = os(&["bench", "-p", "benches", "--"]);
@@ -229,7 +176,7 @@ fn main() -> ExitCode {
             a
         }
     };
-    match run_cargo(&args) {
+    match run_cargo(&args, &dir) {
         Ok(code) => ExitCode::from(code),
         Err(e) => {
             eprintln!("xtask: {e:#}");

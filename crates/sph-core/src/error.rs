@@ -50,6 +50,14 @@ pub enum CoreError {
         /// The offending entry.
         value: u32,
     },
+    /// An input file was refused (missing, not a regular file, too large, not text).
+    #[error("{path}: {reason}")]
+    Input {
+        /// The file.
+        path: std::path::PathBuf,
+        /// Why it was refused.
+        reason: String,
+    },
     /// A [`SampledGrid`](crate::SampledGrid) would have more nodes than allowed (counts
     /// that do not fit a `usize` are reported as `usize::MAX`).
     #[error("sampled grid of {nx} x {ny} x {nz} nodes exceeds the maximum of {max} nodes (cell size too small for the box)")]

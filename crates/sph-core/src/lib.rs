@@ -18,6 +18,7 @@
 mod aabb;
 mod error;
 pub mod grid;
+pub mod input;
 pub mod mesh;
 mod particles;
 mod real;

@@ -16,7 +16,7 @@
 
 use std::path::PathBuf;
 
-use sph_scene::{BoundaryModel, InitialMasses, Precision, Scene};
+use sph_scene::{BoundaryModel, InitialMasses, Scene};
 use sph_sim::{density_kernel, SceneSim};
 use sph_solver::initial::density_ratios;
 
@@ -52,10 +52,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Some(other) => return Err(format!("unknown initial masses {other}").into()),
         None => {}
     }
-    match scene.precision {
-        Precision::F32 => report::<f32>(&scene, frames),
-        Precision::F64 => report::<f64>(&scene, frames),
-    }
+    sph_sim::with_precision!(scene.precision, R => report::<R>(&scene, frames))
 }
 
 fn report<R: sph_core::Real>(

@@ -33,6 +33,15 @@ pub enum SimError {
     /// A request that cannot be run (e.g. zero frames), with the reason.
     #[error("{0}")]
     Invalid(String),
+    /// An input file (a VTK frame, a checkpoint, a run directory) is missing, unreadable,
+    /// corrupt or foreign.
+    #[error("{path}: {reason}")]
+    Input {
+        /// The path.
+        path: PathBuf,
+        /// What is wrong with it.
+        reason: String,
+    },
     /// An output path could not be created or written.
     #[error("{path}: {reason}")]
     Output {
@@ -51,11 +60,29 @@ impl SimError {
         }
     }
 
+    pub(crate) fn input(path: impl Into<PathBuf>, reason: impl ToString) -> Self {
+        SimError::Input {
+            path: path.into(),
+            reason: reason.to_string(),
+        }
+    }
+
     /// The solver error behind a [`SimError::Frame`] or [`SimError::Setup`], if any.
     pub fn solver_error(&self) -> Option<&SolverError> {
         match self {
             SimError::Frame { source, .. } | SimError::Setup { source, .. } => Some(source),
             _ => None,
+        }
+    }
+}
+
+impl From<sph_core::CoreError> for SimError {
+    /// An input file refused by `sph_core::input` becomes [`SimError::Input`] with its path;
+    /// any other core error is [`SimError::Invalid`].
+    fn from(e: sph_core::CoreError) -> Self {
+        match e {
+            sph_core::CoreError::Input { path, reason } => SimError::Input { path, reason },
+            other => SimError::Invalid(other.to_string()),
         }
     }
 }

@@ -21,9 +21,12 @@
 //! }
 //! ```
 
+pub mod checkpoint;
 mod error;
 mod factory;
-mod run;
+pub mod render;
+pub mod run;
+pub mod run_dir;
 mod sim;
 pub mod vtk;
 
@@ -33,6 +36,33 @@ pub use factory::{
     iisph_params, pbf_params, pcisph_params, VOLUME_MAP_CONTACT_FRACTION,
 };
 pub use run::{
-    create_output_dir, run_scene, stats_header, stats_row, SceneRunOptions, STATS_COLUMNS,
+    run_frames, run_scene, stats_header, stats_row, FrameObserver, RunPlan, SceneRunOptions,
+    STATS_COLUMNS,
 };
+pub use run_dir::RunDir;
 pub use sim::SceneSim;
+pub use sph_scene::Precision;
+
+/// Runs `$body` with the type `$R` bound to the real type of precision `$p` (an
+/// `sph_scene::Precision`): the workspace's one precision dispatch.
+///
+/// ```
+/// use sph_sim::{with_precision, Precision};
+/// fn bytes<R>() -> usize { std::mem::size_of::<R>() }
+/// assert_eq!(with_precision!(Precision::F64, R => bytes::<R>()), 8);
+/// ```
+#[macro_export]
+macro_rules! with_precision {
+    ($p:expr, $R:ident => $body:expr) => {
+        match $p {
+            $crate::Precision::F32 => {
+                type $R = f32;
+                $body
+            }
+            $crate::Precision::F64 => {
+                type $R = f64;
+                $body
+            }
+        }
+    };
+}

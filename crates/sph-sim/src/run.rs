@@ -1,27 +1,119 @@
-//! `cargo xtask run SCENE`: a scene file run frame by frame with a progress bar, ParaView
-//! frames and a CSV of per-frame statistics.
+//! The one frame loop of a scene run ([`run_frames`]) with its observers: VTK frames,
+//! `stats.csv`, a progress bar, checkpoints (and, in [`crate::render`], rendered frames);
+//! and [`run_scene`], the run of `particles run SCENE` / `cargo xtask run SCENE`.
 
+use std::fs::File;
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use sph_core::Real;
-use sph_scene::{Precision, Scene};
+use sph_scene::Scene;
 use sph_solver::StepStats;
 
-use crate::{SceneSim, SimError};
+use crate::checkpoint::CheckpointObserver;
+use crate::render::RenderObserver;
+use crate::run_dir::RunDir;
+use crate::{with_precision, SceneSim, SimError};
 
-/// Options of [`run_scene`].
-#[derive(Debug, Clone)]
-pub struct SceneRunOptions {
-    /// Apply the scene's `[quick]` overrides.
-    pub quick: bool,
-    /// Output directory (frames and statistics); created if missing.
-    pub out_dir: PathBuf,
-    /// Stop after this many frames (default: the scene's duration); must be ≥ 1.
-    pub max_frames: Option<usize>,
-    /// Show a progress bar on stderr.
-    pub progress: bool,
+/// What a run will do, given to the observers when it starts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RunPlan {
+    /// The frame the run starts from (0, or the checkpoint's frame when resumed).
+    pub first_frame: usize,
+    /// The frame the run stops at (exclusive of nothing: the last frame advanced to).
+    pub last_frame: usize,
+    /// Whether the run continues from a checkpoint.
+    pub resumed: bool,
+}
+
+impl RunPlan {
+    /// Frames this run advances.
+    pub fn frames(&self) -> usize {
+        self.last_frame.saturating_sub(self.first_frame)
+    }
+}
+
+/// Something that follows a run frame by frame: writes files, shows progress, renders.
+/// Observers are called in the order given to [`run_frames`]; an observer's error stops
+/// the run (the observers after it are not called for that frame).
+pub trait FrameObserver<R: Real> {
+    /// Once, before the first frame, with the simulation at `plan.first_frame`.
+    fn start(&mut self, sim: &SceneSim<R>, plan: &RunPlan) -> Result<(), SimError> {
+        let _ = (sim, plan);
+        Ok(())
+    }
+    /// After each frame, with the frame's statistics (`sim.frame` is the frame just done).
+    fn frame(&mut self, sim: &SceneSim<R>, stats: &StepStats) -> Result<(), SimError>;
+    /// Once at the end, also when the run stopped on an error (`completed` is then false).
+    fn finish(&mut self, sim: &SceneSim<R>, completed: bool) -> Result<(), SimError> {
+        let _ = (sim, completed);
+        Ok(())
+    }
+}
+
+/// Advances `sim` to `plan.last_frame`, calling every observer after each frame. The first
+/// error (a blow-up names the frame, step and particle; an observer's error names its
+/// file) stops the run; every observer's `finish` is still called.
+pub fn run_frames<R: Real>(
+    sim: &mut SceneSim<R>,
+    plan: &RunPlan,
+    observers: &mut [&mut dyn FrameObserver<R>],
+) -> Result<(), SimError> {
+    let mut result = observers.iter_mut().try_for_each(|o| o.start(sim, plan));
+    while result.is_ok() && sim.frame < plan.last_frame {
+        result = sim
+            .advance()
+            .and_then(|stats| observers.iter_mut().try_for_each(|o| o.frame(sim, &stats)));
+    }
+    let completed = result.is_ok();
+    for o in observers.iter_mut() {
+        let finished = o.finish(sim, completed);
+        if result.is_ok() {
+            result = finished;
+        }
+    }
+    result
+}
+
+/// Writes `frame_NNNNN.vtk` (and `passive_NNNNN.vtk` when the solver advects passive
+/// points) every `output.every_frames` frames, frame 0 included.
+#[derive(Debug)]
+pub struct VtkObserver {
+    run: RunDir,
+    every: usize,
+}
+
+impl VtkObserver {
+    /// Frames of `scene`'s output cadence into `run`.
+    pub fn new(scene: &Scene, run: &RunDir) -> Self {
+        Self {
+            run: run.clone(),
+            every: scene.output.every_frames.max(1),
+        }
+    }
+
+    fn write<R: Real>(&self, sim: &SceneSim<R>) -> Result<(), SimError> {
+        sim.write_vtk(&self.run.frame_vtk(sim.frame))?;
+        sim.write_passive_vtk(&self.run.passive_vtk(sim.frame))?;
+        Ok(())
+    }
+}
+
+impl<R: Real> FrameObserver<R> for VtkObserver {
+    fn start(&mut self, sim: &SceneSim<R>, plan: &RunPlan) -> Result<(), SimError> {
+        if plan.resumed {
+            return Ok(());
+        }
+        self.write(sim)
+    }
+    fn frame(&mut self, sim: &SceneSim<R>, _: &StepStats) -> Result<(), SimError> {
+        if sim.frame.is_multiple_of(self.every) {
+            self.write(sim)?;
+        }
+        Ok(())
+    }
 }
 
 /// The columns of the statistics CSV before the solver's phase times.
@@ -38,7 +130,7 @@ pub const STATS_COLUMNS: [&str; 9] = [
 ];
 
 /// The header of the statistics CSV for a solver with phases `phases`: [`STATS_COLUMNS`],
-/// then `<phase>_s` for each phase, then `total_s`.
+/// then `<phase>_s` for each phase, then `total_s` (the wall-clock columns).
 pub fn stats_header(phases: &[&str]) -> Vec<String> {
     STATS_COLUMNS
         .iter()
@@ -66,53 +158,253 @@ pub fn stats_row(frame: usize, time_s: f64, particles: usize, s: &StepStats) -> 
     row
 }
 
-/// Creates `dir` (and its parents) or names why it cannot be an output directory.
-pub fn create_output_dir(dir: &Path) -> Result<(), SimError> {
-    if dir.exists() && !dir.is_dir() {
-        return Err(SimError::output(
-            dir,
-            "exists and is not a directory (give a directory for the output)",
-        ));
-    }
-    std::fs::create_dir_all(dir).map_err(|e| SimError::output(dir, e))
+/// Writes `stats.csv`, one row per frame, flushed as each frame ends (so a killed run keeps
+/// the rows of the frames it finished). Resumed at frame `k`, it keeps the header and the
+/// rows of frames `1..=k` and appends after them.
+#[derive(Debug)]
+pub struct StatsObserver {
+    path: PathBuf,
+    writer: Option<csv::Writer<File>>,
 }
 
-/// Loads the scene at `path` and runs it: a progress bar, `frame_NNNNN.vtk` every
-/// `output.every_frames` frames (when `output.vtk`; with `passive_NNNNN.vtk` beside it when
-/// the solver advects passive points, e.g. a granular scene's upscaling), and `stats.csv` (one row per frame,
-/// [`stats_header`]) in `opts.out_dir`. A blow-up stops the run with an error naming the
-/// frame, step and particle; the statistics up to it are kept.
+impl StatsObserver {
+    /// The statistics file of `run`.
+    pub fn new(run: &RunDir) -> Self {
+        Self {
+            path: run.stats_csv(),
+            writer: None,
+        }
+    }
+
+    fn err(&self, e: impl ToString) -> SimError {
+        SimError::output(&self.path, e)
+    }
+}
+
+/// The lines of an earlier `stats.csv` to keep when resuming at `frame`: the header and the
+/// complete rows of frames `1..=frame` (a partial last line, left by a kill, is dropped).
+fn kept_stats_lines(text: &str, frame: usize) -> String {
+    let mut kept = String::new();
+    for (k, line) in text.split_inclusive('\n').enumerate() {
+        let complete = line.ends_with('\n');
+        let row_frame = line.split(',').next().and_then(|f| f.parse::<usize>().ok());
+        let keep = complete && (k == 0 || row_frame.is_some_and(|f| f <= frame));
+        if keep {
+            kept.push_str(line);
+        }
+    }
+    kept
+}
+
+impl<R: Real> FrameObserver<R> for StatsObserver {
+    fn start(&mut self, sim: &SceneSim<R>, plan: &RunPlan) -> Result<(), SimError> {
+        let header = stats_header(sim.solver().phase_names());
+        let kept = if plan.resumed && self.path.is_file() {
+            let text = sph_core::input::read_text_limited(&self.path, 1 << 30, "statistics file")?;
+            let kept = kept_stats_lines(&text, sim.frame);
+            let expected = header.join(",");
+            if kept.lines().next() != Some(expected.as_str()) {
+                return Err(SimError::input(
+                    &self.path,
+                    "its header is not this solver's: the run directory holds another run's statistics",
+                ));
+            }
+            Some(kept)
+        } else {
+            None
+        };
+        let mut file = File::create(&self.path).map_err(|e| self.err(e))?;
+        let mut writer = match kept {
+            Some(kept) => {
+                file.write_all(kept.as_bytes()).map_err(|e| self.err(e))?;
+                csv::Writer::from_writer(file)
+            }
+            None => {
+                let mut w = csv::Writer::from_writer(file);
+                w.write_record(&header).map_err(|e| self.err(e))?;
+                w
+            }
+        };
+        writer.flush().map_err(|e| self.err(e))?;
+        self.writer = Some(writer);
+        Ok(())
+    }
+
+    fn frame(&mut self, sim: &SceneSim<R>, stats: &StepStats) -> Result<(), SimError> {
+        let row = stats_row(sim.frame, sim.time_s, sim.state.len(), stats);
+        let Some(w) = self.writer.as_mut() else {
+            return Err(self.err("statistics written before the run started"));
+        };
+        let r = w.write_record(&row).and_then(|()| Ok(w.flush()?));
+        r.map_err(|e| self.err(e))
+    }
+}
+
+/// A progress bar on stderr: frames done, ETA, the last frame's largest density ratio and
+/// time per frame.
+#[derive(Debug)]
+pub struct ProgressObserver {
+    bar: ProgressBar,
+}
+
+impl ProgressObserver {
+    /// A visible bar (`visible = false`: hidden, for tests and scripts).
+    pub fn new(visible: bool) -> Self {
+        let bar = if visible {
+            ProgressBar::new(0)
+        } else {
+            ProgressBar::hidden()
+        };
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} frames ETA {eta} {msg}",
+            )
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        Self { bar }
+    }
+}
+
+impl<R: Real> FrameObserver<R> for ProgressObserver {
+    fn start(&mut self, _: &SceneSim<R>, plan: &RunPlan) -> Result<(), SimError> {
+        self.bar.set_length(plan.last_frame as u64);
+        self.bar.set_position(plan.first_frame as u64);
+        self.bar.reset_eta();
+        Ok(())
+    }
+    fn frame(&mut self, _: &SceneSim<R>, stats: &StepStats) -> Result<(), SimError> {
+        self.bar.set_message(format!(
+            "rho_max/rho0 {:.4}, {:.1} ms/frame",
+            stats.max_density_ratio,
+            stats.total_s() * 1e3
+        ));
+        self.bar.inc(1);
+        Ok(())
+    }
+    fn finish(&mut self, _: &SceneSim<R>, _: bool) -> Result<(), SimError> {
+        self.bar.finish();
+        Ok(())
+    }
+}
+
+/// Options of [`run_scene`].
+#[derive(Debug, Clone)]
+pub struct SceneRunOptions {
+    /// Apply the scene's `[quick]` overrides.
+    pub quick: bool,
+    /// Output directory (frames, statistics, checkpoint); created if missing.
+    pub out_dir: PathBuf,
+    /// Stop at this frame (default: the scene's duration); must be ≥ 1.
+    pub max_frames: Option<usize>,
+    /// Show a progress bar on stderr.
+    pub progress: bool,
+    /// Write a checkpoint every this many frames (and at the end); `None`: none.
+    pub checkpoint_every: Option<usize>,
+    /// Continue from the run directory's checkpoint instead of starting afresh.
+    pub resume: bool,
+    /// Render the frames (PNG in `OUT/render`) in process as the run writes them.
+    pub render: bool,
+}
+
+/// The frame a run of `scene` stops at with `max_frames`.
+pub fn last_frame(scene: &Scene, max_frames: Option<usize>) -> Result<usize, SimError> {
+    match max_frames {
+        Some(0) => Err(SimError::Invalid(
+            "--frames 0: nothing to run (give at least 1 frame)".into(),
+        )),
+        Some(m) => Ok(m.min(scene.frame_count())),
+        None => Ok(scene.frame_count()),
+    }
+}
+
+/// Loads the scene at `path` and runs it into `opts.out_dir` ([`crate::run_dir`]): a
+/// progress bar, VTK frames, `stats.csv`, checkpoints, and with `opts.render` the frames
+/// rendered in process ([`crate::render::RenderObserver`]). A fresh run first removes what
+/// an earlier run left in the directory; `opts.resume` continues from its checkpoint
+/// (refused by name if it is another scene's, another version's, or damaged). A blow-up
+/// stops the run with an error naming the frame, step and particle; the files up to it are
+/// kept.
 pub fn run_scene(path: &Path, opts: &SceneRunOptions) -> Result<(), SimError> {
     let scene = Scene::load(path)?;
     let scene = if opts.quick { scene.quick() } else { scene };
-    match scene.precision {
-        Precision::F32 => run_scene_in::<f32>(&scene, opts),
-        Precision::F64 => run_scene_in::<f64>(&scene, opts),
-    }
+    let last = last_frame(&scene, opts.max_frames)?;
+    let run = RunDir::new(&opts.out_dir);
+    run.create()?;
+    // Checked before any work, so that a bad [render] table costs nothing.
+    let render = match opts.render {
+        true => Some(RenderObserver::new(&scene, &run)?),
+        false => None,
+    };
+    with_precision!(scene.precision, R => run_scene_in::<R>(path, &scene, &run, last, opts, render))
 }
 
-fn run_scene_in<R: Real>(scene: &Scene, opts: &SceneRunOptions) -> Result<(), SimError> {
-    if opts.max_frames == Some(0) {
-        return Err(SimError::Invalid(
-            "--frames 0: nothing to run (give at least 1 frame)".into(),
-        ));
-    }
-    create_output_dir(&opts.out_dir)?;
+fn run_scene_in<R: Real>(
+    path: &Path,
+    scene: &Scene,
+    run: &RunDir,
+    last: usize,
+    opts: &SceneRunOptions,
+    mut render: Option<RenderObserver>,
+) -> Result<(), SimError> {
     let t0 = Instant::now();
     let mut sim = SceneSim::<R>::new(scene)?;
-    let frames = opts
-        .max_frames
-        .map_or(scene.frame_count(), |m| m.min(scene.frame_count()));
+    let resumed = opts.resume;
+    if resumed {
+        sim.resume_from(&run.checkpoint())?;
+        run.remove_outputs(Some(sim.frame))?;
+    } else {
+        run.remove_outputs(None)?;
+        run.write_source(path, opts.quick)?;
+    }
+    let plan = RunPlan {
+        first_frame: sim.frame,
+        last_frame: last.max(sim.frame),
+        resumed,
+    };
+    announce(&sim, scene, &plan, run, t0);
+    let mut vtk = VtkObserver::new(scene, run);
+    let mut stats = StatsObserver::new(run);
+    let mut bar = ProgressObserver::new(opts.progress);
+    let mut checkpoints = CheckpointObserver::new(run, opts.checkpoint_every);
+    let mut observers: Vec<&mut dyn FrameObserver<R>> = vec![&mut stats, &mut vtk];
+    if let Some(r) = render.as_mut() {
+        observers.push(r);
+    }
+    observers.push(&mut checkpoints);
+    observers.push(&mut bar);
+    let result = run_frames(&mut sim, &plan, &mut observers);
     eprintln!(
-        "{}: {} particles, solver {}, boundary {}, {} frames of {} s, set-up {:.2} s -> {}",
+        "{}: at frame {} after {:.1} s{}; statistics in {}",
+        scene.name,
+        sim.frame,
+        t0.elapsed().as_secs_f64(),
+        render.map_or(String::new(), |r| format!(
+            ", {} frames rendered to {}",
+            r.rendered,
+            run.render_dir().display()
+        )),
+        run.stats_csv().display()
+    );
+    result
+}
+
+/// Prints what the run will do, and its cost in substeps, before it starts.
+fn announce<R: Real>(sim: &SceneSim<R>, scene: &Scene, plan: &RunPlan, run: &RunDir, t0: Instant) {
+    let substeps = sim.solver().common().substeps;
+    eprintln!(
+        "{}: {} particles, solver {}, boundary {}, frames {}..{} of {} s ({} substeps each, {} particle-substeps), set-up {:.2} s{} -> {}",
         scene.name,
         sim.state.len(),
         sim.solver().name(),
         sim.solver().boundary().name(),
-        frames,
+        plan.first_frame,
+        plan.last_frame,
         scene.frame_dt_s,
+        substeps,
+        plan.frames() as u128 * substeps as u128 * sim.state.len() as u128,
         t0.elapsed().as_secs_f64(),
-        opts.out_dir.display()
+        if plan.resumed { ", resumed from the checkpoint" } else { "" },
+        run.path().display()
     );
     if let Some(c) = &sim.calibration {
         eprintln!(
@@ -125,60 +417,17 @@ fn run_scene_in<R: Real>(scene: &Scene, opts: &SceneRunOptions) -> Result<(), Si
             c.total_mass_ratio
         );
     }
-    let stats_path = opts.out_dir.join("stats.csv");
-    let csv_err = |e: csv::Error| SimError::output(&stats_path, e);
-    let mut csv = csv::Writer::from_path(&stats_path).map_err(csv_err)?;
-    csv.write_record(stats_header(sim.solver().phase_names()))
-        .map_err(csv_err)?;
-    let every = scene.output.every_frames.max(1);
-    let vtk_path = |f: usize| opts.out_dir.join(format!("frame_{f:05}.vtk"));
-    let passive_path = |f: usize| opts.out_dir.join(format!("passive_{f:05}.vtk"));
-    if scene.output.vtk {
-        sim.write_vtk(&vtk_path(0))?;
-        sim.write_passive_vtk(&passive_path(0))?;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::kept_stats_lines;
+
+    #[test]
+    fn resumed_statistics_keep_the_header_and_the_finished_rows() {
+        let text = "frame,x\n1,a\n2,b\n3,c\n4,d";
+        assert_eq!(kept_stats_lines(text, 2), "frame,x\n1,a\n2,b\n");
+        assert_eq!(kept_stats_lines(text, 9), "frame,x\n1,a\n2,b\n3,c\n");
+        assert_eq!(kept_stats_lines("frame,x\n", 0), "frame,x\n");
     }
-    let bar = if opts.progress {
-        ProgressBar::new(frames as u64)
-    } else {
-        ProgressBar::hidden()
-    };
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} frames ETA {eta} {msg}",
-        )
-        .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    let mut result = Ok(());
-    for _ in 0..frames {
-        match sim.advance() {
-            Ok(stats) => {
-                csv.write_record(stats_row(sim.frame, sim.time_s, sim.state.len(), &stats))
-                    .map_err(csv_err)?;
-                bar.set_message(format!(
-                    "rho_max/rho0 {:.4}, {:.1} ms/frame",
-                    stats.max_density_ratio,
-                    stats.total_s() * 1e3
-                ));
-                if scene.output.vtk && sim.frame % every == 0 {
-                    sim.write_vtk(&vtk_path(sim.frame))?;
-                    sim.write_passive_vtk(&passive_path(sim.frame))?;
-                }
-                bar.inc(1);
-            }
-            Err(e) => {
-                result = Err(e);
-                break;
-            }
-        }
-    }
-    bar.finish();
-    csv.flush().map_err(|e| SimError::output(&stats_path, e))?;
-    eprintln!(
-        "{}: {} frames in {:.1} s; statistics in {}",
-        scene.name,
-        sim.frame,
-        t0.elapsed().as_secs_f64(),
-        stats_path.display()
-    );
-    result
 }

@@ -92,6 +92,10 @@ impl<R: Real> SceneSim<R> {
         &*self.solver
     }
 
+    pub(crate) fn solver_mut(&mut self) -> &mut dyn FluidSolver<R> {
+        &mut *self.solver
+    }
+
     /// Advances one frame (`frame_dt`); keeps [`SceneSim::ids`] in step with the solver's
     /// reordering. A blow-up is a [`SimError::Frame`] naming the frame and the solver's step
     /// and particle; the state then holds the last completed substep.

@@ -136,6 +136,63 @@ fn write_points<R: Real>(
         .map_err(|e| SimError::output(path, format!("writing VTK frame: {e}")))
 }
 
+/// Largest particle frame [`read_positions`] reads (bytes): 4 GiB, 25 times the
+/// 10⁶-particle frame this crate writes (about 40 bytes per particle).
+pub const MAX_FRAME_BYTES: u64 = 4 << 30;
+
+/// Reads the particle positions (m) of one frame written by [`write_particle_frame`] or
+/// [`write_point_frame`]. A missing file, a file that is not a regular file or is larger
+/// than [`MAX_FRAME_BYTES`], or anything that is not such a frame is a
+/// [`SimError::Input`] naming the file and what is wrong.
+pub fn read_positions(path: &Path) -> Result<Vec<Vec3<f32>>, SimError> {
+    let bytes = sph_core::input::read_bytes_limited(path, MAX_FRAME_BYTES, "VTK frame")
+        .map_err(SimError::from)?;
+    let corrupt = |reason: String| SimError::input(path, format!("not a particle frame: {reason}"));
+    if !bytes.starts_with(b"# vtk DataFile Version") {
+        return Err(corrupt(
+            "no legacy VTK header (the first line must start with \"# vtk DataFile Version\")"
+                .into(),
+        ));
+    }
+    let vtk = Vtk::parse_legacy_be(bytes.as_slice()).map_err(|e| {
+        corrupt(format!(
+            "the legacy VTK parser stopped ({e}); the file is truncated or was not written by this crate"
+        ))
+    })?;
+    let DataSet::PolyData { pieces, .. } = vtk.data else {
+        return Err(corrupt("not POLYDATA".into()));
+    };
+    let mut out = Vec::new();
+    for piece in pieces {
+        let vtkio::model::Piece::Inline(p) = piece else {
+            return Err(corrupt("a piece is not inline".into()));
+        };
+        let pts: Vec<f32> = p
+            .points
+            .clone()
+            .cast_into()
+            .ok_or_else(|| corrupt("the points are not numbers".into()))?;
+        if !pts.len().is_multiple_of(3) {
+            return Err(corrupt(format!(
+                "{} coordinates, not a multiple of 3",
+                pts.len()
+            )));
+        }
+        out.extend(pts.chunks(3).map(|c| Vec3::new(c[0], c[1], c[2])));
+    }
+    if let Some((i, p)) = out
+        .iter()
+        .enumerate()
+        .find(|(_, p)| !p.iter().all(|x| x.is_finite()))
+    {
+        return Err(corrupt(format!(
+            "particle {i} at {:?} is not finite",
+            p.as_slice()
+        )));
+    }
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -57,6 +57,9 @@ fn runs_a_scene_and_writes_frames_and_statistics() {
                 out_dir: out.clone(),
                 max_frames: None,
                 progress: false,
+                checkpoint_every: None,
+                resume: false,
+                render: false,
             },
         )
         .unwrap();
@@ -118,6 +121,9 @@ fn runs_iisph_and_granular_scenes_with_passive_points() {
                 out_dir: out.clone(),
                 max_frames: None,
                 progress: false,
+                checkpoint_every: None,
+                resume: false,
+                render: false,
             },
         )
         .unwrap();
@@ -163,6 +169,9 @@ fn malformed_scene_names_file_and_field() {
             out_dir: dir.join("out"),
             max_frames: None,
             progress: false,
+            checkpoint_every: None,
+            resume: false,
+            render: false,
         },
     )
     .unwrap_err();
@@ -182,6 +191,9 @@ fn zero_frames_and_a_file_as_output_are_refused() {
         out_dir,
         max_frames,
         progress: false,
+        checkpoint_every: None,
+        resume: false,
+        render: false,
     };
     let err = run_scene(&scene, &opts(dir.join("out"), Some(0))).unwrap_err();
     assert!(err.to_string().contains("--frames 0"), "{err}");

@@ -56,4 +56,13 @@ pub enum SolverError {
         /// What was detected (substep, quantity and value).
         reason: String,
     },
+    /// A saved [`crate::SolverState`] does not fit the solver it is restored into (another
+    /// solver, or arrays whose names or lengths do not fit the particle count).
+    #[error("cannot restore the state into {solver}: {reason}")]
+    InvalidSolverState {
+        /// The solver restoring the state ([`crate::FluidSolver::name`]).
+        solver: String,
+        /// What does not fit.
+        reason: String,
+    },
 }

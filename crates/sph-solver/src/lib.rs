@@ -24,6 +24,7 @@ pub mod csr;
 mod error;
 pub mod initial;
 mod params;
+pub mod state;
 mod stats;
 pub mod step;
 #[cfg(feature = "testing")]
@@ -36,6 +37,7 @@ pub use boundary::{
 };
 pub use error::SolverError;
 pub use params::{CommonParams, DEFAULT_SUPPORT_OVER_SPACING, MAX_SUBSTEPS};
+pub use state::{ArraySpec, SolverState};
 pub use stats::{PhaseTimes, StepStats, MAX_PHASES};
 
 pub use neighbour_search::{Method, NeighbourLists};
@@ -73,5 +75,23 @@ pub trait FluidSolver<R: Real>: Send {
     /// has none.
     fn passive_points(&self) -> Option<&[Vec3<R>]> {
         None
+    }
+    /// Everything the solver carries from one frame to the next besides the
+    /// [`ParticleSet`] (TEMPORARY default until the frame shell lands).
+    fn save_state(&self) -> SolverState<R> {
+        SolverState::new(self.name(), 0, Vec::new())
+    }
+    /// Takes back a [`FluidSolver::save_state`] (TEMPORARY default until the frame shell
+    /// lands: refuses).
+    fn restore_state(
+        &mut self,
+        state: &SolverState<R>,
+        particles: usize,
+    ) -> Result<(), SolverError> {
+        let _ = (state, particles);
+        Err(SolverError::InvalidSolverState {
+            solver: self.name().into(),
+            reason: "not supported yet".into(),
+        })
     }
 }

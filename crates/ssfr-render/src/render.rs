@@ -3,7 +3,7 @@
 
 use std::time::Instant;
 
-use sph_core::Real;
+use sph_core::{Real, Vec3};
 
 use crate::background::{Background, Light, SceneBuffer};
 use crate::camera::{Camera, CameraFrame};
@@ -308,6 +308,29 @@ impl Renderer {
             splat_pixel_tests: self.splatter.pixel_tests,
             liquid_pixels: self.splats.depth.iter().filter(|z| z.is_finite()).count(),
         })
+    }
+
+    /// Renders particle centres `positions` with the radius of `params`: as spheres, or as
+    /// Yu & Turk ellipsoids ([`crate::anisotropy::anisotropic_ellipsoids`]) when
+    /// `params.anisotropy` asks for them. The one call a frame of a simulation needs.
+    pub fn render_points<R: Real>(
+        &mut self,
+        params: &RenderParams,
+        positions: &[Vec3<R>],
+    ) -> Result<FrameStats, SsfrError> {
+        let radius = params.particle_radius_m;
+        match &params.anisotropy {
+            None => self.render(params, &ParticleView::spheres(positions, radius)),
+            Some(a) => {
+                let (centres, ellipsoids) =
+                    crate::anisotropy::anisotropic_ellipsoids(positions, a)?;
+                let view = ParticleView {
+                    ellipsoids: Some(&ellipsoids),
+                    ..ParticleView::spheres(&centres, radius)
+                };
+                self.render(params, &view)
+            }
+        }
     }
 
     /// The last frame as an 8-bit sRGB image.

@@ -10,7 +10,7 @@
 
 use anyhow::Result;
 use sph_core::{ParticleSet, Real, Vec3};
-use sph_scene::{BoundaryModel, Precision, Scene, SolidSpec, SolverKind};
+use sph_scene::{BoundaryModel, Scene, SolidSpec, SolverKind};
 
 use crate::helpers::{plot_xy, write_csv_rows, Legend, PlotSpec, Series, SeriesStyle};
 use crate::sim::{shipped_scene, SceneSim};
@@ -258,10 +258,7 @@ impl Experiment for BoundaryRest {
                 kind.name().to_uppercase(),
                 model_name(model)
             );
-            let r = match scene.precision {
-                Precision::F32 => run::<f32>(ctx, &scene, label)?,
-                Precision::F64 => run::<f64>(ctx, &scene, label)?,
-            };
+            let r = sph_sim::with_precision!(scene.precision, R => run::<R>(ctx, &scene, label)?);
             ctx.println(format!(
                 "{}: KE/(N m g H) at the end {:.2e}, near-wall rho/rho0 {:.4}, bulk {:.4}, surface {:.4} m (hydrostatic {:.4} m)",
                 r.label,

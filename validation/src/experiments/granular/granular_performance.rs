@@ -21,7 +21,7 @@ use std::time::Instant;
 
 use anyhow::{anyhow, Result};
 use sph_core::Real;
-use sph_scene::{Precision, Scene, SolverKind};
+use sph_scene::{Scene, SolverKind};
 
 use super::scene_edit::SceneText;
 use super::solver_error_check;
@@ -139,20 +139,16 @@ impl Experiment for GranularPerformance {
         let mut out = Outcome::new();
         let mut rows = Vec::new();
         for &threads in &thread_counts {
-            let water_ms = match water.precision {
-                Precision::F32 => time_in::<f32>(ctx, &water, threads),
-                Precision::F64 => time_in::<f64>(ctx, &water, threads),
-            }
-            .map(|w| {
-                (
-                    1e3 * w.wall_s / w.steps.max(1) as f64,
-                    w.iterations as f64 / w.steps.max(1) as f64,
-                )
-            });
-            let t = match scene.precision {
-                Precision::F32 => time_in::<f32>(ctx, &scene, threads),
-                Precision::F64 => time_in::<f64>(ctx, &scene, threads),
-            };
+            let water_ms =
+                sph_sim::with_precision!(water.precision, R => time_in::<R>(ctx, &water, threads))
+                    .map(|w| {
+                        (
+                            1e3 * w.wall_s / w.steps.max(1) as f64,
+                            w.iterations as f64 / w.steps.max(1) as f64,
+                        )
+                    });
+            let t =
+                sph_sim::with_precision!(scene.precision, R => time_in::<R>(ctx, &scene, threads));
             let t = match t {
                 Ok(t) => t,
                 Err(e) => {

@@ -29,7 +29,7 @@
 
 use anyhow::Result;
 use sph_core::{ParticleSet, Real};
-use sph_scene::{Precision, Scene};
+use sph_scene::Scene;
 use toml::Value;
 
 use super::scene_edit::SceneText;
@@ -197,10 +197,7 @@ impl Experiment for IisphConvergence {
         let precision = SceneText::shipped("dam_break", ctx.mode)?
             .scene()?
             .precision;
-        let r = match precision {
-            Precision::F32 => run_in::<f32>(ctx)?,
-            Precision::F64 => run_in::<f64>(ctx)?,
-        };
+        let r = sph_sim::with_precision!(precision, R => run_in::<R>(ctx)?);
         let mut out = Outcome::new();
         out.metric("particles", r.particles as f64);
         out.metric("reference_dt_s", r.dt_ref_s);

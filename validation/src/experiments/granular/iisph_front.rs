@@ -17,7 +17,7 @@ use sph_scene::{Precision, Scene};
 use toml::Value;
 
 use super::scene_edit::SceneText;
-use crate::experiments::pbf::dam_break_front::{interpolate, simulate, FrontRun};
+use crate::experiments::pbf::front::{interpolate, simulate, FrontRun};
 use crate::{Context, Mode};
 
 /// Spacing of the IISPH curve in quick mode (m): `a/16`, 16 × 32 × 8 = 4,096 particles (the

@@ -13,7 +13,7 @@ pub mod scene_edit;
 
 use anyhow::Result;
 use sph_core::{Real, Vec3};
-use sph_scene::{Precision, Scene};
+use sph_scene::Scene;
 
 use crate::sim::SceneSim;
 use crate::{Check, Context};
@@ -108,10 +108,7 @@ fn run_in<R: Real>(ctx: &Context, scene: &Scene, snapshot_frames: &[usize]) -> R
 /// solver error during a frame ends the run and is kept in [`SceneRun::blow_up`]; set-up
 /// errors (the scene, the solver factory) are returned.
 pub fn run_scene(ctx: &Context, scene: &Scene, snapshot_frames: &[usize]) -> Result<SceneRun> {
-    match scene.precision {
-        Precision::F32 => run_in::<f32>(ctx, scene, snapshot_frames),
-        Precision::F64 => run_in::<f64>(ctx, scene, snapshot_frames),
-    }
+    sph_sim::with_precision!(scene.precision, R => run_in::<R>(ctx, scene, snapshot_frames))
 }
 
 /// The failing check of a run that a solver error (a blow-up) ended early: a blow-up is an

@@ -25,22 +25,19 @@
 //! `front/IISPH …`.
 
 use anyhow::Result;
-use sph_core::Real;
-use sph_scene::{Precision, Scene};
 
 use crate::helpers::{
     load_reference_csv, plot_xy, write_csv_rows, Legend, Marker, PlotSpec, Series, SeriesStyle,
 };
-use crate::sim::{shipped_scene, SceneSim};
+use sph_scene::Scene;
+
+use super::front::{fitted_slope, interpolate, simulate, COLUMN_WIDTH_M, FRONT_QUANTILE};
+use crate::sim::shipped_scene;
 use crate::{Check, Context, Experiment, Outcome};
 
 /// The experiment.
 pub struct DamBreakFront;
 
-/// Column width `a` of the scene (m).
-const COLUMN_WIDTH_M: f64 = 0.2;
-/// Fraction of the particles allowed ahead of the measured front (droplets).
-const FRONT_QUANTILE: f64 = 1e-3;
 /// A-priori band on `|Z_sim − Z_exp| / Z_exp` at every measured `T`; see [`DamBreakFront`].
 const Z_BAND: f64 = 0.15;
 
@@ -53,86 +50,6 @@ const LATE_SLOPE_BAND: f64 = 0.10;
 /// Ritter's (1892) inviscid dam-break front speed `2 √(g H)` in `dZ/dT` units for a column of
 /// height `H = 2a`: `2 √(2 g a) / √(2 g a) = 2`.
 const RITTER_DZ_DT: f64 = 2.0;
-
-/// Least-squares slope and rms residual of `(x, y)` points with `x` in `span`.
-pub fn fitted_slope(points: &[(f64, f64)], span: (f64, f64)) -> (f64, f64) {
-    let pts: Vec<(f64, f64)> = points
-        .iter()
-        .copied()
-        .filter(|p| p.0 >= span.0 && p.0 <= span.1 && p.1.is_finite())
-        .collect();
-    let n = pts.len() as f64;
-    if pts.len() < 2 {
-        return (f64::NAN, f64::NAN);
-    }
-    let (mx, my) = (
-        pts.iter().map(|p| p.0).sum::<f64>() / n,
-        pts.iter().map(|p| p.1).sum::<f64>() / n,
-    );
-    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
-    let slope = sxy / sxx;
-    let rms = (pts
-        .iter()
-        .map(|p| (p.1 - (my + slope * (p.0 - mx))).powi(2))
-        .sum::<f64>()
-        / n)
-        .sqrt();
-    (slope, rms)
-}
-
-/// `x` of the leading free surface: the `k`-th largest particle `x` (k = `FRONT_QUANTILE`
-/// of the particles, at least 1) plus `radius`.
-pub fn front_x<R: Real>(positions: &[sph_core::Vec3<R>], radius: f64) -> f64 {
-    let mut xs: Vec<f64> = positions.iter().map(|p| p.x.as_f64()).collect();
-    if xs.is_empty() {
-        return f64::NAN;
-    }
-    let k = ((xs.len() as f64 * FRONT_QUANTILE) as usize).max(1);
-    let idx = xs.len() - k;
-    let (_, x, _) = xs.select_nth_unstable_by(idx, f64::total_cmp);
-    *x + radius
-}
-
-/// Linear interpolation of `y(x)` in points sorted by `x`; `None` outside their span.
-pub(crate) fn interpolate(points: &[(f64, f64)], x: f64) -> Option<f64> {
-    points.windows(2).find_map(|w| {
-        let ((x0, y0), (x1, y1)) = (w[0], w[1]);
-        (x0 <= x && x <= x1 && x1 > x0).then(|| y0 + (y1 - y0) * (x - x0) / (x1 - x0))
-    })
-}
-
-/// One run of the surge front: `(T, Z)` per frame, the particle count, and what the mass
-/// calibration did (`[boundary] initial_masses = "calibrated"`).
-pub(crate) struct FrontRun {
-    pub series: Vec<(f64, f64)>,
-    pub particles: usize,
-    pub calibration: Option<sph_solver::initial::MassCalibration>,
-}
-
-pub(crate) fn simulate<R: Real>(ctx: &Context, scene: &Scene) -> Result<FrontRun> {
-    let mut sim = SceneSim::<R>::new(scene)?;
-    let frames = scene.frame_count();
-    let radius = 0.5 * scene.particle_spacing;
-    let g = (scene.gravity[0].powi(2) + scene.gravity[1].powi(2) + scene.gravity[2].powi(2)).sqrt();
-    let t_scale = (2.0 * g / COLUMN_WIDTH_M).sqrt();
-    let x_wall = scene.tank.map_or(0.0, |t| t.min.x);
-    let mut series = vec![(
-        0.0,
-        (front_x(&sim.state.positions, radius) - x_wall) / COLUMN_WIDTH_M,
-    )];
-    for _ in 0..frames {
-        sim.advance()?;
-        let z = (front_x(&sim.state.positions, radius) - x_wall) / COLUMN_WIDTH_M;
-        series.push((sim.time_s * t_scale, z));
-        ctx.progress.inc(1);
-    }
-    Ok(FrontRun {
-        series,
-        particles: sim.state.len(),
-        calibration: sim.calibration,
-    })
-}
 
 /// The three checks of a front (`prefix` names the solver, empty for PBF): the pointwise
 /// band, the late speed against the measured slope, and Ritter's limit.
@@ -177,10 +94,7 @@ impl Experiment for DamBreakFront {
         }
         let scene = shipped_scene("martin_moyce", ctx.mode)?;
         let run = |ctx: &Context, scene: &Scene| {
-            let r = match scene.precision {
-                Precision::F32 => simulate::<f32>(ctx, scene),
-                Precision::F64 => simulate::<f64>(ctx, scene),
-            }?;
+            let r = sph_sim::with_precision!(scene.precision, R => simulate::<R>(ctx, scene))?;
             anyhow::Ok((r.series, r.particles))
         };
         ctx.progress.set_length(3 * scene.frame_count() as u64);

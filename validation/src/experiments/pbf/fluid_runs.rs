@@ -8,7 +8,7 @@
 
 use anyhow::Result;
 use sph_core::Real;
-use sph_scene::{Precision, Scene, SolverKind};
+use sph_scene::{Scene, SolverKind};
 use sph_solver::SolverError;
 
 use crate::sim::SceneSim;
@@ -171,8 +171,5 @@ pub fn run_fluid(
         sph_scene::BoundaryModel::Collision => "collision walls",
     };
     let label = format!("{name} {substeps}×{iterations}, {walls}");
-    match scene.precision {
-        Precision::F32 => run_in::<f32>(ctx, &scene, label),
-        Precision::F64 => run_in::<f64>(ctx, &scene, label),
-    }
+    sph_sim::with_precision!(scene.precision, R => run_in::<R>(ctx, &scene, label))
 }

@@ -3,6 +3,7 @@
 
 pub mod dam_break_front;
 pub mod fluid_runs;
+pub mod front;
 pub mod pbf_bunny_density;
 pub mod pbf_convergence;
 pub mod pbf_performance;

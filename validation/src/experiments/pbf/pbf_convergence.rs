@@ -24,7 +24,7 @@
 use anyhow::Result;
 use pbf::{ParticleSet, Pbf};
 use sph_core::Real;
-use sph_scene::{Precision, Scene, SolverSpec};
+use sph_scene::{Scene, SolverSpec};
 
 use crate::helpers::{plot_xy, write_csv_rows, Legend, PlotSpec, Series, SeriesStyle};
 use crate::sim::{pbf_params, shipped_scene, SceneSim};
@@ -175,10 +175,8 @@ impl Experiment for PbfConvergence {
 
     fn run(&self, ctx: &mut Context) -> Result<Outcome> {
         let scene = shipped_scene("dam_break", ctx.mode)?;
-        let (rows, particles) = match scene.precision {
-            Precision::F32 => sweep::<f32>(ctx, &scene)?,
-            Precision::F64 => sweep::<f64>(ctx, &scene)?,
-        };
+        let (rows, particles) =
+            sph_sim::with_precision!(scene.precision, R => sweep::<R>(ctx, &scene)?);
         write_csv_rows(
             &ctx.path("convergence.csv"),
             &[

@@ -20,7 +20,7 @@
 
 use anyhow::Result;
 use sph_core::Real;
-use sph_scene::{Precision, Scene};
+use sph_scene::Scene;
 
 use crate::helpers::{load_reference_csv, write_csv_rows};
 use crate::sim::{shipped_scene, SceneSim};
@@ -143,10 +143,7 @@ impl Experiment for PbfPerformance {
         );
         for name in SCENES {
             let scene = shipped_scene(name, ctx.mode)?;
-            let t = match scene.precision {
-                Precision::F32 => time_scene::<f32>(ctx, &scene)?,
-                Precision::F64 => time_scene::<f64>(ctx, &scene)?,
-            };
+            let t = sph_sim::with_precision!(scene.precision, R => time_scene::<R>(ctx, &scene)?);
             let row = paper.find(&[("scene", name)])?;
             let paper_ms = paper.number(row, "time_per_step_ms")?;
             let paper_n = paper.number(row, "particles")?;

@@ -19,7 +19,7 @@
 
 use anyhow::Result;
 use sph_core::Real;
-use sph_scene::{Precision, Scene, SolverSpec};
+use sph_scene::{Scene, SolverSpec};
 
 use crate::helpers::{
     plot_xy, side_view_png, write_csv_rows, Legend, PlotSpec, Series, SeriesStyle,
@@ -179,10 +179,7 @@ fn run_with(ctx: &Context, scene: &Scene, epsilon: f64, perturb_seed: Option<u64
         );
     };
     pbf.vorticity_epsilon = Some(epsilon);
-    match scene.precision {
-        Precision::F32 => simulate::<f32>(ctx, &scene, perturb_seed),
-        Precision::F64 => simulate::<f64>(ctx, &scene, perturb_seed),
-    }
+    sph_sim::with_precision!(scene.precision, R => simulate::<R>(ctx, &scene, perturb_seed))
 }
 
 fn mean(values: impl Iterator<Item = f64>) -> f64 {
@@ -411,7 +408,7 @@ impl Experiment for PbfVorticity {
             ("render_off.png", &off, "off"),
             ("render_on.png", &on, "on"),
         ] {
-            crate::render::render_particles_png(
+            sph_sim::render::render_particles_png(
                 &scene,
                 &run.last_positions,
                 1000,

@@ -12,9 +12,9 @@ use sph_core::{sampling::cubic_lattice, Aabb, Vec3};
 use ssfr_render::{ParticleView, Renderer};
 
 use crate::helpers::write_csv_rows;
-use crate::render::render_params;
 use crate::sim::shipped_scene;
 use crate::{Check, Context, Experiment, Outcome};
+use sph_sim::render::render_params;
 
 /// The experiment.
 pub struct SsfrPerformance;

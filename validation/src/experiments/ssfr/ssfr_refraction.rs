@@ -27,9 +27,9 @@ use ssfr_render::{
 
 use super::shapes::Shape;
 use crate::helpers::{plot_xy, write_csv_rows, Legend, PlotSpec, Series};
-use crate::render::render_params;
 use crate::sim::{shipped_scene, SceneSim};
 use crate::{Check, Context, Experiment, Outcome};
+use sph_sim::render::render_params;
 
 /// The experiment.
 pub struct SsfrRefraction;

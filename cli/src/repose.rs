@@ -1,15 +1,16 @@
-//! `validation repose DIR`: the angle of repose of the last (or a given) frame of a scene
+//! `particles repose DIR`: the angle of repose of the last (or a given) frame of a scene
 //! run, measured with [`iisph_granular::measure::angle_of_repose`], so that any granular
 //! scene's output can be measured, not only the experiment's.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use iisph_granular::measure::{angle_of_repose, ReposeOptions};
+use sph_sim::RunDir;
 
-use crate::render::{frame_files, read_frame_positions, run_scene_of};
+use crate::render::scene_of_run;
 
-/// The shape argument of the command.
+/// The shape of the heap.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Shape {
     /// A planar (2.5D) heap, its profile taken along x.
@@ -18,27 +19,42 @@ pub enum Shape {
     Conical,
 }
 
-/// Measures frame `frame` (default: the last `frame_*.vtk`) of the run in `dir` and prints
-/// the angle, the flanks and the resolution. The floor is the scene tank's bottom (or
-/// y = 0 without a tank); the bins are one particle spacing wide.
-pub fn measure_run(
-    dir: &Path,
+/// Arguments of `particles repose`.
+#[derive(Debug, clap::Args)]
+pub struct ReposeArgs {
+    /// The run's output directory.
+    dir: PathBuf,
+    /// The frame to measure [default: the last `frame_*.vtk` in DIR].
+    #[arg(long, value_name = "FILE")]
     frame: Option<PathBuf>,
+    /// Planar heap (profile along x) or conical pile.
+    #[arg(long, value_enum, default_value = "planar")]
     shape: Shape,
-    scene: Option<&Path>,
+    /// The scene file [default: the one recorded by `run` in DIR].
+    #[arg(long, value_name = "PATH")]
+    scene: Option<PathBuf>,
+    /// With --scene: apply its `[quick]` overrides.
+    #[arg(long)]
     quick: bool,
-) -> Result<()> {
-    let scene = run_scene_of(dir, scene, quick)?;
-    let file = match frame {
-        Some(f) => f,
-        None => frame_files(dir)?
+}
+
+/// Measures the frame and prints the angle, the flanks and the resolution. The floor is the
+/// scene tank's bottom (or y = 0 without a tank); the bins are one particle spacing wide.
+pub fn run(a: &ReposeArgs) -> Result<()> {
+    let run = RunDir::new(&a.dir);
+    let scene = scene_of_run(&run, a.scene.as_deref(), a.quick)?;
+    let file = match &a.frame {
+        Some(f) => f.clone(),
+        None => run
+            .frames()?
             .pop()
-            .with_context(|| format!("{}: no frame_*.vtk to measure", dir.display()))?,
+            .map(|(_, p)| p)
+            .with_context(|| format!("{}: no frame_*.vtk to measure", a.dir.display()))?,
     };
-    let positions = read_frame_positions(&file)?;
+    let positions = sph_sim::vtk::read_positions(&file)?;
     let s = scene.particle_spacing;
     let floor = scene.tank.map_or(0.0, |t| t.min.y);
-    let opts = match shape {
+    let opts = match a.shape {
         Shape::Planar => ReposeOptions::planar(floor, s),
         Shape::Conical => ReposeOptions::conical(floor, s),
     }

@@ -1,0 +1,65 @@
+//! `particles`: the workspace's command line (`cargo xtask run|render|repose …` forward to
+//! it).
+//!
+//! - `particles run SCENE [--quick] [--frames N] [--out DIR] [--render]
+//!   [--checkpoint-every N] [--resume]`: runs a scene file: VTK frames, `stats.csv`, rendered
+//!   frames, checkpoints ([`sph_sim::run_scene`]);
+//! - `particles render DIR [--scene SCENE] [--quick] [--out DIR]`: renders an earlier run's
+//!   VTK frames to PNG;
+//! - `particles repose DIR [--frame FILE] [--shape planar|conical]`: the angle of repose of a
+//!   granular run's last frame.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+mod render;
+mod repose;
+mod run;
+
+#[derive(Parser)]
+#[command(
+    name = "particles",
+    version,
+    about = "Particle simulation from four papers: run scenes, render and measure them"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a scene file: VTK frames, per-frame statistics, checkpoints, rendered frames.
+    Run(run::RunArgs),
+    /// Render the VTK frames of an earlier run (`frame_*.vtk` in DIR) to PNG images.
+    Render(render::RenderArgs),
+    /// Measure the angle of repose of a granular run's last frame (or `--frame FILE`).
+    Repose(repose::ReposeArgs),
+}
+
+/// `--out DIR` and run directories: refuses a path that exists and is not a directory.
+pub(crate) fn directory(s: &str) -> Result<PathBuf, String> {
+    let p = PathBuf::from(s);
+    if p.exists() && !p.is_dir() {
+        return Err("exists and is not a directory (give a directory for the output)".into());
+    }
+    Ok(p)
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Run(a) => run::run(&a),
+        Command::Render(a) => render::run(&a),
+        Command::Repose(a) => repose::run(&a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}
