@@ -478,7 +478,7 @@ pub fn available_memory() -> Option<u64> {
 pub fn population_table(population: &Population) -> Result<RecordBatch, SymplecticError> {
     let members = population.members();
     let n = members.len();
-    let mut cols: Vec<Vec<f64>> = vec![Vec::with_capacity(n); 12];
+    let mut cols: Vec<Vec<f64>> = (0..12).map(|_| Vec::with_capacity(n)).collect();
     let mut status = Vec::with_capacity(n);
     for (i, m) in members.iter().enumerate() {
         let el = population.elements(i)?;

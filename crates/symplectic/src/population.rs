@@ -349,10 +349,7 @@ impl Population {
         }
         let window = f64::from(self.window_steps) * self.ephemeris.grid_step();
         let mut needed = f64::NEG_INFINITY;
-        loop {
-            let Some(oldest) = self.oldest_active_time() else {
-                break;
-            };
+        while let Some(oldest) = self.oldest_active_time() {
             if oldest >= t_end {
                 break;
             }
