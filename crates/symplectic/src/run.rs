@@ -31,9 +31,10 @@ pub enum ParticleStatus {
         /// Distance from the barycentre then.
         distance: f64,
     },
-    /// Entered `hill_factor` Hill radii of a planet ([`RemovalRules::hill_factor`]
-    /// (crate::RemovalRules::hill_factor); a [`Population`](crate::Population) rule: the method
-    /// does not resolve planetary encounters).
+    /// Entered `hill_factor` Hill radii of a planet
+    /// ([`RemovalRules::hill_factor`](crate::RemovalRules::hill_factor); a
+    /// [`Population`](crate::Population) rule: the method does not resolve planetary
+    /// encounters).
     HillSphereEntry {
         /// Time when detected (end of the step).
         time: f64,
