@@ -6,6 +6,8 @@
 //!   frames, checkpoints ([`sph_sim::run_scene`]);
 //! - `particles render DIR [--scene SCENE] [--quick] [--out DIR]`: renders an earlier run's
 //!   VTK frames to PNG;
+//! - `particles comets POPULATION.toml [--out DIR]`: a population study of test particles
+//!   among the planets: Parquet snapshots and final table, checkpoints, resume;
 //! - `particles repose DIR [--frame FILE] [--shape planar|conical]`: the angle of repose of a
 //!   granular run's last frame.
 
@@ -14,6 +16,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+mod comets;
 mod render;
 mod repose;
 mod run;
@@ -37,6 +40,9 @@ enum Command {
     Render(render::RenderArgs),
     /// Measure the angle of repose of a granular run's last frame (or `--frame FILE`).
     Repose(repose::ReposeArgs),
+    /// Integrate a population of comets among the planets (TOML specification): Parquet
+    /// snapshots and final table, checkpoints; rerun the same command to resume.
+    Comets(comets::CometsArgs),
 }
 
 /// `--out DIR` and run directories: refuses a path that exists and is not a directory.
@@ -54,6 +60,7 @@ fn main() -> ExitCode {
         Command::Run(a) => run::run(&a),
         Command::Render(a) => render::run(&a),
         Command::Repose(a) => repose::run(&a),
+        Command::Comets(a) => comets::run(&a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

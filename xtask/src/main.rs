@@ -5,7 +5,8 @@
 //!   check fails or an experiment errors.
 //! - `cargo xtask list` — the experiments and the paper figure each reproduces.
 //! - `cargo xtask run SCENE [--quick] [--frames N] [--out DIR] [--render]
-//!   [--checkpoint-every N] [--resume]`, `cargo xtask render DIR …`, `cargo xtask repose DIR …`
+//!   [--checkpoint-every N] [--resume]`, `cargo xtask render DIR …`, `cargo xtask repose DIR …`,
+//!   `cargo xtask comets POPULATION.toml [--out DIR]`
 //!   — build the command-line crate `particles-cli` in release and run `particles run|render|
 //!   repose ARGS...` from the directory the command was typed in (see `particles --help`).
 //! - `cargo xtask bench [ARGS...]` — `cargo bench -p benches -- ARGS...` (criterion).
@@ -62,6 +63,18 @@ enum Task {
     #[command(disable_help_flag = true)]
     Render {
         /// Arguments of `particles render`.
+        #[arg(
+            trailing_var_arg = true,
+            allow_hyphen_values = true,
+            value_name = "ARGS"
+        )]
+        args: Vec<OsString>,
+    },
+    /// A population study of comets among the planets (`particles comets POPULATION.toml
+    /// [--out DIR]`): Parquet snapshots and final table, checkpoints; rerun to resume.
+    #[command(disable_help_flag = true)]
+    Comets {
+        /// Arguments of `particles comets`.
         #[arg(
             trailing_var_arg = true,
             allow_hyphen_values = true,
@@ -143,7 +156,7 @@ fn main() -> ExitCode {
     // The scene commands run where the user typed them (their relative paths); the others
     // from the workspace root.
     let dir = match &cli.command {
-        Task::Run { .. } | Task::Render { .. } | Task::Repose { .. } => {
+        Task::Run { .. } | Task::Render { .. } | Task::Repose { .. } | Task::Comets { .. } => {
             std::env::current_dir().unwrap_or_else(|_| workspace_root())
         }
         _ => workspace_root(),
@@ -169,6 +182,7 @@ fn main() -> ExitCode {
         Task::Run { args } => particles("run", args),
         Task::Render { args } => particles("render", args),
         Task::Repose { args } => particles("repose", args),
+        Task::Comets { args } => particles("comets", args),
         Task::List => os(&["run", "--release", "-p", "validation", "--", "list"]),
         Task::Bench { args } => {
             let mut a = os(&["bench", "-p", "benches", "--"]);

@@ -232,10 +232,60 @@ impl Ephemeris {
             });
         }
         self.extend_to(t)?;
-        let tau = self.grid_step();
-        let rel = (t - self.start_time) / tau;
-        let first = self.first_index as f64;
-        if rel < first {
+        self.check_retained(t)?;
+        self.work.interpolations += 1;
+        self.interpolate_unchecked(t, out, true);
+        Ok(())
+    }
+
+    /// Fills `out` with the bodies' barycentric states at time `t` without integrating the
+    /// planets: the read-only form of [`Ephemeris::bodies_at`], which many threads can call
+    /// at once on one shared ephemeris. The values are bit for bit those of
+    /// [`Ephemeris::bodies_at`] (the same grid, the same interpolant). With
+    /// `accelerations = false` the accelerations are left as they were (the barycentric
+    /// variant does not use them). Errors with [`SymplecticError::BeyondEphemeris`] if `t`
+    /// lies after the newest grid time, and names `t` if it precedes the retained window.
+    /// Does not count the interpolation (the caller does).
+    pub fn interpolate(
+        &self,
+        t: f64,
+        out: &mut BodyStates,
+        accelerations: bool,
+    ) -> Result<(), SymplecticError> {
+        let newest = self.grid_time(self.planet_steps());
+        if t > newest {
+            return Err(SymplecticError::BeyondEphemeris { time: t, newest });
+        }
+        if !t.is_finite() {
+            return Err(SymplecticError::InvalidParameter {
+                name: "ephemeris time",
+                value: t,
+                reason: "must be finite",
+            });
+        }
+        self.check_retained(t)?;
+        self.interpolate_unchecked(t, out, accelerations);
+        Ok(())
+    }
+
+    /// Time of the oldest retained grid state.
+    pub fn oldest_time(&self) -> f64 {
+        self.grid_time(self.first_index)
+    }
+
+    /// Time of the newest grid state.
+    pub fn newest_time(&self) -> f64 {
+        self.grid_time(self.planet_steps())
+    }
+
+    /// Number of grid states retained (each `9 (n+1)` values of 8 bytes).
+    pub fn retained_states(&self) -> usize {
+        (self.grid.len() - self.offset) / self.stride()
+    }
+
+    fn check_retained(&self, t: f64) -> Result<(), SymplecticError> {
+        let rel = (t - self.start_time) / self.grid_step();
+        if rel < self.first_index as f64 {
             return Err(SymplecticError::InvalidParameter {
                 name: "ephemeris time",
                 value: t,
@@ -243,13 +293,24 @@ impl Ephemeris {
                     "precedes the retained window of planet states (discarded or before the start)",
             });
         }
-        self.work.interpolations += 1;
+        Ok(())
+    }
+
+    /// The interpolation proper; `t` must lie in the retained window.
+    fn interpolate_unchecked(&self, t: f64, out: &mut BodyStates, accelerations: bool) {
+        let tau = self.grid_step();
+        let rel = (t - self.start_time) / tau;
         let last = self.planet_steps();
-        // Interval [k, k+1] containing t (the last interval if t is on the last grid point).
-        let k = (rel.floor() as u64).clamp(
-            self.first_index,
-            last.saturating_sub(1).max(self.first_index),
-        );
+        // The grid point at or before t (rounding of `rel` corrected against the grid times),
+        // so that the result depends on t and the grid only, not on how far the grid reaches:
+        // a time on a grid point takes that state, anything else the interval after it.
+        let mut k = (rel.floor().max(0.0) as u64).clamp(self.first_index, last);
+        if k > self.first_index && t < self.grid_time(k) {
+            k -= 1;
+        }
+        if k < last && self.grid_time(k + 1) <= t {
+            k += 1;
+        }
         let n1 = self.planets.len() + 1;
         out.resize(n1);
         out.time = t;
@@ -259,15 +320,15 @@ impl Ephemeris {
         }
         let stride = self.stride();
         let base = self.offset + (k - self.first_index) as usize * stride;
-        if k == last {
-            // Only one grid state (t is the start time): no interpolation.
+        if t == self.grid_time(k) || k == last {
+            // On a grid point: the stored state itself.
             for j in 0..n1 {
                 let o = base + 9 * j;
                 out.positions[j] = self.vec_at(o);
                 out.velocities[j] = self.vec_at(o + 3);
                 out.accelerations[j] = self.vec_at(o + 6);
             }
-            return Ok(());
+            return;
         }
         let x = (t - self.grid_time(k)) / tau;
         let w = QuinticHermite::at(x);
@@ -289,9 +350,10 @@ impl Ephemeris {
             };
             out.positions[j] = combine(&w.value);
             out.velocities[j] = combine(&w.first) / tau;
-            out.accelerations[j] = combine(&w.second) / (tau * tau);
+            if accelerations {
+                out.accelerations[j] = combine(&w.second) / (tau * tau);
+            }
         }
-        Ok(())
     }
 
     fn vec_at(&self, o: usize) -> Vec3 {

@@ -293,3 +293,91 @@ pub fn elements(r: &Vec3, v: &Vec3, mu: f64) -> Result<Elements, SymplecticError
         perihelion: h.norm_squared() / mu / (1.0 + e),
     })
 }
+
+/// The six classical elements of an elliptic or hyperbolic orbit, angles in radians.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ConicElements {
+    /// Perihelion distance `q > 0`.
+    pub perihelion: f64,
+    /// Eccentricity `e ≥ 0`, `e ≠ 1`.
+    pub eccentricity: f64,
+    /// Inclination `i`.
+    pub inclination: f64,
+    /// Longitude of the ascending node `Ω`.
+    pub node: f64,
+    /// Argument of perihelion `ω`.
+    pub argument_of_perihelion: f64,
+    /// Mean anomaly `M` (`E − e sin E` for `e < 1`, `e sinh H − H` for `e > 1`).
+    pub mean_anomaly: f64,
+}
+
+/// Position and velocity of `el` about a centre of gravitational parameter `mu`: Kepler's
+/// equation solved by Newton's method from `E = M + e sin M` (ellipse) or
+/// `H = asinh(M/e)` (hyperbola) to round-off, then the perifocal state rotated by
+/// `R_z(Ω) R_x(i) R_z(ω)`. Errors name the element out of range (a parabola `e = 1` has no
+/// mean anomaly of this form).
+pub fn state_from_elements(el: &ConicElements, mu: f64) -> Result<(Vec3, Vec3), SymplecticError> {
+    let bad = |name: &'static str, value: f64, reason: &'static str| {
+        Err(SymplecticError::InvalidParameter { name, value, reason })
+    };
+    let e = el.eccentricity;
+    let q = el.perihelion;
+    if !(mu.is_finite() && mu > 0.0) {
+        return bad("mu", mu, "must be finite and > 0");
+    }
+    if !(q.is_finite() && q > 0.0) {
+        return bad("perihelion", q, "must be finite and > 0");
+    }
+    if !(e.is_finite() && e >= 0.0) || e == 1.0 {
+        return bad("eccentricity", e, "must be finite, >= 0 and != 1");
+    }
+    for (name, v) in [
+        ("inclination", el.inclination),
+        ("node", el.node),
+        ("argument_of_perihelion", el.argument_of_perihelion),
+        ("mean_anomaly", el.mean_anomaly),
+    ] {
+        if !v.is_finite() {
+            return bad(name, v, "must be finite");
+        }
+    }
+    let a = q / (1.0 - e); // negative for a hyperbola
+    let (x, y, vx, vy);
+    if e < 1.0 {
+        let m = el.mean_anomaly.rem_euclid(std::f64::consts::TAU);
+        let mut ea = if e < 0.8 { m + e * m.sin() } else { std::f64::consts::PI };
+        for _ in 0..60 {
+            let d = (ea - e * ea.sin() - m) / (1.0 - e * ea.cos());
+            ea -= d;
+            if d.abs() < 1e-15 {
+                break;
+            }
+        }
+        let (s, c) = ea.sin_cos();
+        let b = a * (1.0 - e * e).sqrt();
+        let n = (mu / (a * a * a)).sqrt();
+        let edot = n / (1.0 - e * c);
+        (x, y) = (a * (c - e), b * s);
+        (vx, vy) = (-a * s * edot, b * c * edot);
+    } else {
+        let m = el.mean_anomaly;
+        let mut h = (m / e).asinh();
+        for _ in 0..100 {
+            let d = (e * h.sinh() - h - m) / (e * h.cosh() - 1.0);
+            h -= d;
+            if d.abs() < 1e-15 * (1.0 + h.abs()) {
+                break;
+            }
+        }
+        let (sh, ch) = (h.sinh(), h.cosh());
+        let b = -a * (e * e - 1.0).sqrt();
+        let n = (mu / (-a * a * a)).sqrt();
+        let hdot = n / (e * ch - 1.0);
+        (x, y) = (a * (ch - e), b * sh);
+        (vx, vy) = (a * sh * hdot, b * ch * hdot);
+    }
+    let rot = nalgebra::Rotation3::from_axis_angle(&Vec3::z_axis(), el.node)
+        * nalgebra::Rotation3::from_axis_angle(&Vec3::x_axis(), el.inclination)
+        * nalgebra::Rotation3::from_axis_angle(&Vec3::z_axis(), el.argument_of_perihelion);
+    Ok((rot * Vec3::new(x, y, 0.0), rot * Vec3::new(vx, vy, 0.0)))
+}

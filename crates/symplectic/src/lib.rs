@@ -49,6 +49,23 @@
 //!   atomic checkpoints ([`save_checkpoint`], [`load_checkpoint`]: temporary file, `fsync`,
 //!   rename) that resume bit for bit.
 //!
+//! Populations of test particles (10 to 10⁶ comets sharing one planet integration, the
+//! reason the paper integrates particles separately from the planets):
+//!
+//! - [`Population`]: every particle on its own clock with the same maps, advanced in parallel
+//!   (rayon) through synchronisation windows against one shared, read-only ephemeris window
+//!   ([`Ephemeris::interpolate`]), extended once per window; removal per particle with its
+//!   reason, time and state ([`RemovalRules`]: Hill-sphere entry, perihelion below a limit,
+//!   ejection; regularisation lost; [`ParticleStatus`]); shards ([`Population::shard`],
+//!   [`Population::merge`]) and versioned atomic checkpoints ([`Population::save`]). The
+//!   result is a deterministic function of the input: bit-identical on any number of
+//!   threads, across shards, after a resume, and equal bit for bit to each particle
+//!   integrated alone with [`ParticleIntegrator::step`];
+//! - [`samples`]: seeded sample populations (SplitMix64) shared with the peer scripts;
+//! - with the feature `io`: `io` (the population TOML, the particle CSV with line/column
+//!   errors, Parquet tables readable by pandas and polars) and `study` (a whole study with
+//!   snapshots, final table and checkpoints, resumed byte for byte).
+//!
 //! Every integration counts its work ([`WorkCounters`]: Kepler solves, their iterations,
 //! pairwise force evaluations, ephemeris interpolations): a cost measure that does not
 //! depend on the machine.
@@ -105,13 +122,40 @@
 //! REBOUND's WHFast are in the workspace's `docs/performance.md`. The Kepler drift uses Halley's
 //! iteration from a third-order series start, which converges in two Stumpff evaluations for
 //! these steps.
+//!
+//! ## What bounds a population's step
+//!
+//! One particle step of [`Population`] (barycentric variant, S2, Sun and four giants) is one
+//! ephemeris interpolation at the particle's new time (the one at its old time is reused from
+//! the previous step: 5 bodies × positions and velocities, ≈ 450 flops with the Hermite
+//! weights), two perturbation kicks `E₁(h/2)` (5 body terms each: ≈ 150 flops, 5 square
+//! roots and 10 divisions), one universal-variable Kepler drift (≈ 150 flops, two Stumpff
+//! evaluations) and the removal checks (Hill spheres: 8 square roots; perihelion and
+//! ejection from energy and angular momentum: ≈ 40 flops, 1 square root): about 1000 flops
+//! and 30 square roots or divisions, all on data in L1. S6 has 3 drifts, 4 kicks and 3
+//! interpolations. Each particle is one [`PopulationMember`] of
+//! [`Population::bytes_per_particle`] bytes (184 on x86-64), stepped many times per window
+//! while it sits in L1, so memory traffic is 2 × 184 bytes per particle per window, not per
+//! step. The ephemeris window (360 bytes per planet step for five bodies, ≈ 2 ×
+//! [`DEFAULT_WINDOW_STEPS`] steps, ≈ 180 KB) is shared read-only by all threads and stays in
+//! L2; extending it costs one planet step per grid point, once for the whole population
+//! (it matters only for N ≲ 10). Nothing in a window is O(N) per particle step, so the cost
+//! per particle step does not depend on N; `cargo run --release -p benches --example
+//! comet_throughput -- N YEARS [s2|s6]` measures it, and `docs/performance.md` compares it
+//! with REBOUND's WHFast from one script.
 
 pub mod ephemeris;
+#[cfg(feature = "io")]
+pub mod io;
 pub mod kepler;
 mod maps;
 mod particles;
 mod planets;
+mod population;
 mod run;
+pub mod samples;
+#[cfg(feature = "io")]
+pub mod study;
 pub mod solar_system;
 mod work;
 
@@ -123,6 +167,9 @@ pub use particles::{
     PARTICLE_S6_STAGES,
 };
 pub use planets::Planets;
+pub use population::{
+    Population, PopulationMember, PopulationProgress, RemovalRules, DEFAULT_WINDOW_STEPS,
+};
 pub use run::{
     load_checkpoint, save_checkpoint, CometRun, Limits, ParticleStatus, TrackedParticle,
 };
@@ -202,6 +249,57 @@ pub enum SymplecticError {
     /// A checkpoint could not be written or read.
     #[error("checkpoint {path}: {reason}")]
     Checkpoint {
+        /// File.
+        path: String,
+        /// Why.
+        reason: String,
+    },
+    /// A read-only ephemeris ([`Ephemeris::interpolate`]) was asked for a time after its
+    /// newest grid state.
+    #[error("time {time} is after the newest planet state ({newest}) of a read-only ephemeris")]
+    BeyondEphemeris {
+        /// Requested time.
+        time: f64,
+        /// Newest grid time.
+        newest: f64,
+    },
+    /// A population specification (TOML) is malformed or out of range.
+    #[error("{path}: field `{field}`: {reason}")]
+    Spec {
+        /// File.
+        path: String,
+        /// Field path (`span.years`), empty for the document.
+        field: String,
+        /// Why, with the line and column for syntax errors.
+        reason: String,
+    },
+    /// A particle file (CSV) has a bad row; nothing was built.
+    #[error("{path}: line {line}, column `{column}`: {reason}")]
+    ParticleFile {
+        /// File.
+        path: String,
+        /// Line (1-based; the header is line 1).
+        line: u64,
+        /// Column name (empty if the whole row).
+        column: String,
+        /// Why.
+        reason: String,
+    },
+    /// A population would not fit in memory; refused before allocating.
+    #[error(
+        "{particles} particles need about {needed_bytes} bytes, more than the {available_bytes} bytes available"
+    )]
+    OutOfMemory {
+        /// Particles requested.
+        particles: usize,
+        /// Bytes needed.
+        needed_bytes: u128,
+        /// Bytes available.
+        available_bytes: u64,
+    },
+    /// An output table could not be written.
+    #[error("output {path}: {reason}")]
+    Output {
         /// File.
         path: String,
         /// Why.

@@ -250,27 +250,33 @@ impl ParticleIntegrator {
         ephemeris: &mut Ephemeris,
         scratch: &mut ParticleScratch,
     ) -> Result<TestParticle, SymplecticError> {
-        if !position
-            .iter()
-            .chain(velocity.iter())
-            .all(|x| x.is_finite())
-            || position.norm() == 0.0
-        {
-            return Err(SymplecticError::InvalidState {
-                what: "test particle",
-                reason: format!("position {position:?} and velocity {velocity:?} must be finite, position non-zero"),
-            });
-        }
-        if !(initial_dt.is_finite() && initial_dt > 0.0) {
-            return Err(SymplecticError::InvalidParameter {
-                name: "initial particle step",
-                value: initial_dt,
-                reason: "must be finite and > 0",
-            });
-        }
+        check_initial(&position, &velocity, initial_dt)?;
         ephemeris.bodies_at(time, &mut scratch.bodies)?;
+        self.particle_from_bodies(
+            position,
+            velocity,
+            time,
+            initial_dt,
+            &scratch.bodies,
+            ephemeris.planets(),
+        )
+    }
+
+    /// [`ParticleIntegrator::particle`] with the bodies already at `time` (`bodies`) and the
+    /// planets for the mixed variant's domain check: the read-only form used by
+    /// [`Population`](crate::Population) to build particles in parallel.
+    pub(crate) fn particle_from_bodies(
+        &self,
+        position: Vec3,
+        velocity: Vec3,
+        time: f64,
+        initial_dt: f64,
+        bodies: &BodyStates,
+        planets: &crate::Planets,
+    ) -> Result<TestParticle, SymplecticError> {
+        check_initial(&position, &velocity, initial_dt)?;
         if self.variant == Variant::Mixed {
-            self.check_mixed_domain(&position, &velocity, ephemeris.planets())?;
+            self.check_mixed_domain(&position, &velocity, planets)?;
         }
         let mut p = TestParticle {
             position,
@@ -281,8 +287,8 @@ impl ParticleIntegrator {
             steps: 0,
             work: WorkCounters::default(),
         };
-        p.p4 = -self.hamiltonian(&p, &scratch.bodies);
-        let f0 = self.f0(&p, &scratch.bodies)?;
+        p.p4 = -self.hamiltonian(&p, bodies);
+        let f0 = self.f0(&p, bodies)?;
         p.step = initial_dt * f0;
         Ok(p)
     }
@@ -530,24 +536,46 @@ impl ParticleIntegrator {
         scratch: &mut ParticleScratch,
     ) -> Result<ParticleStepInfo, SymplecticError> {
         let t_start = p.time;
+        self.advance(
+            p,
+            &mut scratch.bodies,
+            f64::NAN,
+            &mut |t: f64, out: &mut BodyStates| ephemeris.bodies_at(t, out),
+        )?;
+        let hamiltonian = self.hamiltonian(p, &scratch.bodies);
+        Ok(ParticleStepInfo {
+            dt: p.time - t_start,
+            relative_error: (hamiltonian + p.p4) / hamiltonian.abs(),
+        })
+    }
+
+    /// The map proper, shared by [`ParticleIntegrator::step`] and
+    /// [`Population`](crate::Population): the stages of the scheme, fetching the bodies with
+    /// `fetch` whenever the particle's time differs from `bodies_time` (the time `bodies`
+    /// holds, `NaN` if none), and once more at the end, so that `bodies` ends at the particle's
+    /// new time. Returns that time.
+    pub(crate) fn advance(
+        &self,
+        p: &mut TestParticle,
+        bodies: &mut BodyStates,
+        mut bodies_time: f64,
+        fetch: &mut impl FnMut(f64, &mut BodyStates) -> Result<(), SymplecticError>,
+    ) -> Result<f64, SymplecticError> {
         let h = p.step;
-        let mut bodies_time = f64::NAN;
         for s in self.stages() {
             if bodies_time != p.time {
-                ephemeris.bodies_at(p.time, &mut scratch.bodies)?;
+                fetch(p.time, bodies)?;
                 bodies_time = p.time;
             }
             match s.piece {
                 ParticlePiece::KeplerDrift => {
-                    self.kepler_drift(p, s.coefficient * h, &scratch.bodies)?;
+                    self.kepler_drift(p, s.coefficient * h, bodies)?;
                 }
-                ParticlePiece::Perturbation => {
-                    self.perturbation(p, s.coefficient * h, &scratch.bodies)?
-                }
+                ParticlePiece::Perturbation => self.perturbation(p, s.coefficient * h, bodies)?,
             }
         }
         if bodies_time != p.time {
-            ephemeris.bodies_at(p.time, &mut scratch.bodies)?;
+            fetch(p.time, bodies)?;
         }
         p.steps += 1;
         if !(p
@@ -562,11 +590,7 @@ impl ParticleIntegrator {
                 reason: format!("non-finite state at t = {} after step {}", p.time, p.steps),
             });
         }
-        let hamiltonian = self.hamiltonian(p, &scratch.bodies);
-        Ok(ParticleStepInfo {
-            dt: p.time - t_start,
-            relative_error: (hamiltonian + p.p4) / hamiltonian.abs(),
-        })
+        Ok(p.time)
     }
 
     /// The extended-Hamiltonian error `(H + p₄)/|H|` of `p` now.
@@ -593,6 +617,28 @@ fn planets_momentum_over_m0(bodies: &BodyStates) -> (Vec3, Vec3) {
         s_dot += bodies.accelerations[j] * bodies.gm[j];
     }
     (s / m0, s_dot / m0)
+}
+
+fn check_initial(position: &Vec3, velocity: &Vec3, initial_dt: f64) -> Result<(), SymplecticError> {
+        if !position
+            .iter()
+            .chain(velocity.iter())
+            .all(|x| x.is_finite())
+            || position.norm() == 0.0
+        {
+            return Err(SymplecticError::InvalidState {
+                what: "test particle",
+                reason: format!("position {position:?} and velocity {velocity:?} must be finite, position non-zero"),
+            });
+        }
+        if !(initial_dt.is_finite() && initial_dt > 0.0) {
+            return Err(SymplecticError::InvalidParameter {
+                name: "initial particle step",
+                value: initial_dt,
+                reason: "must be finite and > 0",
+            });
+        }
+    Ok(())
 }
 
 fn check_positive(quantity: &'static str, value: f64, time: f64) -> Result<f64, SymplecticError> {

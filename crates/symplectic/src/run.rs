@@ -31,6 +31,29 @@ pub enum ParticleStatus {
         /// Distance from the barycentre then.
         distance: f64,
     },
+    /// Entered `hill_factor` Hill radii of a planet
+    /// ([`RemovalRules::hill_factor`](crate::RemovalRules::hill_factor); a
+    /// [`Population`](crate::Population) rule: the method does not resolve planetary
+    /// encounters).
+    HillSphereEntry {
+        /// Time when detected (end of the step).
+        time: f64,
+        /// The planet (1-based, in the order of [`Planets`](crate::Planets)).
+        planet: usize,
+        /// Distance to the planet then.
+        distance: f64,
+        /// The planet's Hill radius then, `|Q_j| (m_j / 3m₀)^{1/3}`.
+        hill_radius: f64,
+    },
+    /// The step failed for another reason (non-finite state, Kepler solver); the particle is
+    /// kept at its state before the step (a [`Population`](crate::Population) goes on with the
+    /// others).
+    IntegrationFailed {
+        /// The particle's time before the failed step.
+        time: f64,
+        /// The error.
+        reason: String,
+    },
     /// `K₀/r` or `K₁/r` stopped being positive.
     RegularisationLost {
         /// Time.

@@ -18,6 +18,7 @@ pub fn registry() -> Vec<Box<dyn Experiment>> {
         Box::new(sph::neighbour_search::NeighbourSearchExperiment),
         Box::new(symplectic::symplectic_100myr::Symplectic100Myr),
         Box::new(symplectic::symplectic_order::SymplecticOrder),
+        Box::new(symplectic::comet_population::CometPopulation),
         Box::new(boundary::boundary_rest::BoundaryRest),
         Box::new(pbf::pbf_bunny_density::PbfBunnyDensity),
         Box::new(pbf::pbf_stability::PbfStability),

@@ -1,0 +1,167 @@
+//! Throughput of `symplectic::Population` with a fixed interface, for comparison with other
+//! codes:
+//!
+//! `cargo run --release -p benches --example comet_throughput -- N YEARS [s2|s6] [DT0_DAYS]`
+//!
+//! builds the issue-21 population (the four giant planets of `outer_solar_system`, ecliptic
+//! J2000, planets at τ = 365.25 d by the same map as the particles (S2 or S6); `N` comets with barycentric perihelia 32–40 AU,
+//! semi-major axes 40–100 AU, inclinations 0–30°, random angles, seed 2026 through
+//! `symplectic::samples`; barycentric variant, `B₀ = 0`, `B₁ = 0.21·10⁻⁶`, first step
+//! `DT0_DAYS`, default 365.25 d; removal at Hill-sphere entry, perihelion below 26 AU or
+//! ejection beyond 1000 AU), advances it `YEARS` years on `RAYON_NUM_THREADS` threads and prints as its last
+//! line
+//!
+//! `particles=N particle_years_per_s=X particle_steps_per_s=Y threads=T ...`
+//!
+//! followed by the wall time, the steps per particle-year and the median and largest
+//! extended-Hamiltonian error `|H + p₄|/|H|` of the surviving particles. The clock covers
+//! `advance_to` only (not building the particles).
+//!
+//! For side-by-side runs with other codes, `COMET_THROUGHPUT_INITIAL=FILE` writes the
+//! initial barycentric states of the planets and particles (CSV: `kind,id,gm,x,y,z,vx,vy,vz`,
+//! AU, AU/day, `G m` in AU³/day²) and `COMET_THROUGHPUT_FINAL=FILE` the particles at the end
+//! (`id,status,time,x,y,z,vx,vy,vz`, each at its own time).
+use std::time::Instant;
+
+use symplectic::kepler::state_from_elements;
+use symplectic::samples::{sample_elements, SCATTERED_DISK};
+use symplectic::{
+    outer_solar_system, Ephemeris, Frame, Integrator, ParticleIntegrator, Population,
+    RemovalRules, Scheme, Variant,
+};
+
+const DAYS_PER_YEAR: f64 = 365.25;
+const SEED: u64 = 2026;
+
+fn main() {
+    if let Err(e) = run() {
+        eprintln!("comet_throughput: {e}");
+        std::process::exit(2);
+    }
+}
+
+fn run() -> Result<(), String> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let usage = "usage: comet_throughput N YEARS [s2|s6]";
+    let n: usize = args.first().and_then(|s| s.parse().ok()).ok_or(usage)?;
+    let years: f64 = args.get(1).and_then(|s| s.parse().ok()).ok_or(usage)?;
+    let scheme = match args.get(2).map(String::as_str) {
+        None | Some("s2") => Scheme::S2,
+        Some("s6") => Scheme::S6,
+        Some(other) => return Err(format!("unknown scheme {other:?}; {usage}")),
+    };
+    let dt0: f64 = match args.get(3) {
+        None => DAYS_PER_YEAR,
+        Some(s) => s.parse().map_err(|_| usage)?,
+    };
+    let planets = outer_solar_system(Frame::EclipticJ2000);
+    let g = planets.g();
+    let mu = g * (planets.sun_mass() + planets.masses().iter().sum::<f64>());
+    let states = sample_elements(&SCATTERED_DISK, n, SEED)
+        .iter()
+        .map(|el| state_from_elements(el, mu))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| e.to_string())?;
+    let ids: Vec<u64> = (0..n as u64).collect();
+    if let Ok(path) = std::env::var("COMET_THROUGHPUT_INITIAL") {
+        write_initial(&path, &planets, &states).map_err(|e| format!("{path}: {e}"))?;
+    }
+    // The planets by the same composition as the particles (`s6`: both pseudo-sixth order).
+    let planet_map = match scheme {
+        Scheme::S2 => Integrator::S2 { step: DAYS_PER_YEAR },
+        Scheme::S6 => Integrator::S6 { step: DAYS_PER_YEAR },
+    };
+    let ephemeris = Ephemeris::new(planets, planet_map)
+        .map_err(|e| e.to_string())?;
+    let integrator = ParticleIntegrator::new(Variant::Barycentric, scheme, 0.0, 0.21e-6)
+        .map_err(|e| e.to_string())?;
+    let rules = RemovalRules {
+        hill_factor: Some(1.0),
+        min_perihelion: Some(26.0),
+        ejection_distance: Some(1000.0),
+    };
+    let mut population = Population::new(
+        ephemeris,
+        integrator,
+        rules,
+        0.0,
+        dt0,
+        &states,
+        &ids,
+    )
+    .map_err(|e| e.to_string())?;
+    let start = Instant::now();
+    let progress = population
+        .advance_to(years * DAYS_PER_YEAR, |_| {})
+        .map_err(|e| e.to_string())?;
+    let seconds = start.elapsed().as_secs_f64();
+    if let Ok(path) = std::env::var("COMET_THROUGHPUT_FINAL") {
+        write_final(&path, &population).map_err(|e| format!("{path}: {e}"))?;
+    }
+    let particle_years: f64 = population
+        .members()
+        .iter()
+        .map(|m| m.particle.time / DAYS_PER_YEAR)
+        .sum();
+    let mut errors: Vec<f64> = (0..n)
+        .filter(|&i| population.members()[i].status == symplectic::ParticleStatus::Active)
+        .filter_map(|i| population.relative_error(i))
+        .map(f64::abs)
+        .collect();
+    errors.sort_by(f64::total_cmp);
+    let median = errors.get(errors.len() / 2).copied().unwrap_or(f64::NAN);
+    let largest = errors.last().copied().unwrap_or(f64::NAN);
+    println!(
+        "particles={n} particle_years_per_s={:.4e} particle_steps_per_s={:.4e} threads={} \
+         seconds={seconds:.3} steps_per_particle_year={:.4} removed={} \
+         median_rel_energy_error={median:.3e} max_rel_energy_error={largest:.3e} \
+         bytes_per_particle={}",
+        particle_years / seconds,
+        progress.particle_steps as f64 / seconds,
+        rayon::current_num_threads(),
+        progress.particle_steps as f64 / particle_years,
+        progress.removed,
+        Population::bytes_per_particle(),
+    );
+    Ok(())
+}
+
+fn write_initial(
+    path: &str,
+    planets: &symplectic::Planets,
+    states: &[(symplectic::Vec3, symplectic::Vec3)],
+) -> std::io::Result<()> {
+    use std::fmt::Write as _;
+    let mut out = String::from("kind,id,gm,x,y,z,vx,vy,vz\n");
+    let g = planets.g();
+    let (sun_q, sun_v) = planets.sun_barycentric_state();
+    let row = |out: &mut String, kind: &str, id: usize, gm: f64, q: &symplectic::Vec3, v: &symplectic::Vec3| {
+        writeln!(out, "{kind},{id},{gm:e},{:e},{:e},{:e},{:e},{:e},{:e}", q.x, q.y, q.z, v.x, v.y, v.z).ok();
+    };
+    row(&mut out, "body", 0, g * planets.sun_mass(), &sun_q, &sun_v);
+    let velocities = planets.barycentric_velocities();
+    for (i, (m, q)) in planets.masses().iter().zip(planets.positions()).enumerate() {
+        row(&mut out, "body", i + 1, g * m, &(q + sun_q), &velocities[i]);
+    }
+    for (i, (q, v)) in states.iter().enumerate() {
+        row(&mut out, "particle", i, 0.0, q, v);
+    }
+    std::fs::write(path, out)
+}
+
+fn write_final(path: &str, population: &Population) -> std::io::Result<()> {
+    use std::fmt::Write as _;
+    let mut out = String::from("id,status,time,x,y,z,vx,vy,vz\n");
+    for (i, m) in population.members().iter().enumerate() {
+        let q = population.barycentric_position(i);
+        let v = m.particle.velocity;
+        let status = if m.status == symplectic::ParticleStatus::Active { "active" } else { "removed" };
+        writeln!(
+            out,
+            "{},{status},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
+            m.id, m.particle.time, q.x, q.y, q.z, v.x, v.y, v.z
+        )
+        .ok();
+    }
+    std::fs::write(path, out)
+}

@@ -1,0 +1,574 @@
+//! Population files (feature `io`): the population specification (TOML), the particle file
+//! (CSV) and the output tables (Apache Parquet), reusable from any front end (the
+//! `particles comets` command, the Python package).
+//!
+//! Units: AU, days, degrees for angles in files, years for spans in the specification.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use arrow_array::{ArrayRef, Float64Array, RecordBatch, StringArray, UInt64Array};
+use arrow_schema::{DataType, Field, Schema};
+use serde::Deserialize;
+
+use crate::kepler::{state_from_elements, ConicElements};
+use crate::{
+    outer_solar_system, Ephemeris, Frame, Integrator, ParticleIntegrator, ParticleStatus,
+    Population, RemovalRules, Scheme, SymplecticError, Variant, Vec3,
+};
+
+/// Days per Julian year, the unit of spans in the specification.
+pub const DAYS_PER_YEAR: f64 = 365.25;
+
+/// A population study as written in a TOML file (every table and field is checked; an
+/// unknown field is an error naming it).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PopulationSpec {
+    /// The planets and their integrator.
+    pub planets: PlanetsSpec,
+    /// The particles' integrator.
+    pub integrator: IntegratorSpec,
+    /// The particle file.
+    pub particles: ParticlesSpec,
+    /// How long, how often to write.
+    pub span: SpanSpec,
+    /// When particles are removed (all rules off if the table is absent).
+    #[serde(default)]
+    pub removal: RemovalRules,
+}
+
+/// The planetary system.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlanetSystem {
+    /// The Sun (with the inner planets' masses) and the four giant planets of
+    /// [`outer_solar_system`], epoch 1994-09-05 0h at `t = 0`.
+    OuterSolarSystem,
+}
+
+/// A reference frame of the planet table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FrameSpec {
+    /// [`Frame::EclipticJ2000`].
+    EclipticJ2000,
+    /// [`Frame::Equatorial`].
+    Equatorial,
+}
+
+/// A composition of the planets' or the particles' map.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SchemeSpec {
+    /// Second order.
+    S2,
+    /// Pseudo-sixth order (Laskar & Robutel).
+    S6,
+}
+
+/// `[planets]`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlanetsSpec {
+    /// Which planets.
+    pub system: PlanetSystem,
+    /// Frame of positions and velocities (particles are read in the same frame).
+    pub frame: FrameSpec,
+    /// The planets' map.
+    pub scheme: SchemeSpec,
+    /// The planets' fixed step (days), the ephemeris grid spacing.
+    pub step_days: f64,
+}
+
+/// `[integrator]`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IntegratorSpec {
+    /// `"barycentric"` or `"mixed"`.
+    pub variant: VariantSpec,
+    /// `"s2"` or `"s6"`.
+    pub scheme: SchemeSpec,
+    /// `B₀` (AU²/day²).
+    #[serde(default)]
+    pub b0: f64,
+    /// `B₁` (AU³/day²).
+    pub b1: f64,
+    /// First physical step of every particle (days).
+    pub initial_step_days: f64,
+    /// Planet steps per synchronisation window (default
+    /// [`DEFAULT_WINDOW_STEPS`](crate::DEFAULT_WINDOW_STEPS)).
+    pub window_steps: Option<u32>,
+}
+
+/// Coordinates of the particle map.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum VariantSpec {
+    /// [`Variant::Barycentric`].
+    Barycentric,
+    /// [`Variant::Mixed`].
+    Mixed,
+}
+
+/// What the particle file's rows are.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ParticleKind {
+    /// Columns `id,x,y,z,vx,vy,vz` (AU, AU/day), barycentric.
+    BarycentricState,
+    /// Columns `id,x,y,z,vx,vy,vz`, heliocentric (velocity relative to the Sun).
+    HeliocentricState,
+    /// Columns `id,a,e,i,node,peri,mean_anomaly` (AU, degrees): barycentric osculating
+    /// elements about `G M` (the total mass); `a < 0` with `e > 1` for a hyperbola.
+    BarycentricElements,
+    /// The same columns, heliocentric osculating elements about `G m₀`.
+    HeliocentricElements,
+}
+
+/// `[particles]`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ParticlesSpec {
+    /// CSV file, relative to the specification's directory.
+    pub file: PathBuf,
+    /// What its rows are.
+    pub kind: ParticleKind,
+    /// Epoch of the rows (days after the planets' epoch, `>= 0`).
+    #[serde(default)]
+    pub epoch_days: f64,
+}
+
+/// `[span]`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpanSpec {
+    /// Integration span after the epoch (years).
+    pub years: f64,
+    /// Snapshot cadence (years).
+    pub snapshot_every_years: f64,
+    /// Checkpoint cadence (years; default: at every snapshot).
+    pub checkpoint_every_years: Option<f64>,
+}
+
+impl PopulationSpec {
+    /// Reads and checks a specification; errors name the file, the field and, for syntax,
+    /// the line and column.
+    pub fn from_file(path: &Path) -> Result<Self, SymplecticError> {
+        let text = std::fs::read_to_string(path).map_err(|e| spec_error(path, "", e.to_string()))?;
+        Self::parse(&text, path)
+    }
+
+    /// Parses and checks specification text; `path` names it in messages.
+    pub fn parse(text: &str, path: &Path) -> Result<Self, SymplecticError> {
+        let de = toml::de::Deserializer::parse(text)
+            .map_err(|e| spec_error(path, "", e.to_string().trim().to_string()))?;
+        let spec: Self = serde_path_to_error::deserialize(de).map_err(|e| {
+            let field = e.path().to_string();
+            spec_error(path, &field, e.inner().to_string().trim().to_string())
+        })?;
+        spec.check(path)?;
+        Ok(spec)
+    }
+
+    fn check(&self, path: &Path) -> Result<(), SymplecticError> {
+        let positive = [
+            ("planets.step_days", self.planets.step_days),
+            ("integrator.initial_step_days", self.integrator.initial_step_days),
+            ("span.years", self.span.years),
+            ("span.snapshot_every_years", self.span.snapshot_every_years),
+        ];
+        for (field, v) in positive
+            .into_iter()
+            .chain(self.span.checkpoint_every_years.map(|v| ("span.checkpoint_every_years", v)))
+        {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(spec_error(path, field, format!("{v} must be finite and > 0")));
+            }
+        }
+        if !(self.particles.epoch_days.is_finite() && self.particles.epoch_days >= 0.0) {
+            return Err(spec_error(
+                path,
+                "particles.epoch_days",
+                format!(
+                    "{} is outside the ephemeris (it starts at the planets' epoch, 0, and runs forward)",
+                    self.particles.epoch_days
+                ),
+            ));
+        }
+        if self.integrator.window_steps == Some(0) {
+            return Err(spec_error(path, "integrator.window_steps", "must be >= 1".into()));
+        }
+        Ok(())
+    }
+
+    /// The planets' ephemeris.
+    pub fn ephemeris(&self) -> Result<Ephemeris, SymplecticError> {
+        let frame = match self.planets.frame {
+            FrameSpec::EclipticJ2000 => Frame::EclipticJ2000,
+            FrameSpec::Equatorial => Frame::Equatorial,
+        };
+        let planets = match self.planets.system {
+            PlanetSystem::OuterSolarSystem => outer_solar_system(frame),
+        };
+        let step = self.planets.step_days;
+        let integrator = match self.planets.scheme {
+            SchemeSpec::S2 => Integrator::S2 { step },
+            SchemeSpec::S6 => Integrator::S6 { step },
+        };
+        Ephemeris::new(planets, integrator)
+    }
+
+    /// The particles' integrator.
+    pub fn particle_integrator(&self) -> Result<ParticleIntegrator, SymplecticError> {
+        let variant = match self.integrator.variant {
+            VariantSpec::Barycentric => Variant::Barycentric,
+            VariantSpec::Mixed => Variant::Mixed,
+        };
+        let scheme = match self.integrator.scheme {
+            SchemeSpec::S2 => Scheme::S2,
+            SchemeSpec::S6 => Scheme::S6,
+        };
+        ParticleIntegrator::new(variant, scheme, self.integrator.b0, self.integrator.b1)
+    }
+
+    /// The particle file's path (relative paths from the specification's directory).
+    pub fn particle_file(&self, spec_path: &Path) -> PathBuf {
+        spec_path
+            .parent()
+            .unwrap_or(Path::new(""))
+            .join(&self.particles.file)
+    }
+
+    /// Reads the particle file and builds the population at the epoch (nothing is written).
+    pub fn population(&self, spec_path: &Path) -> Result<Population, SymplecticError> {
+        let mut ephemeris = self.ephemeris()?;
+        let integrator = self.particle_integrator()?;
+        let file = self.particle_file(spec_path);
+        let rows = read_particle_rows(&file, self.particles.kind)?;
+        check_memory(rows.len(), available_memory())?;
+        let epoch = self.particles.epoch_days;
+        let mut bodies = crate::BodyStates::default();
+        ephemeris.bodies_at(epoch, &mut bodies)?;
+        let states = rows
+            .iter()
+            .map(|row| {
+                to_integrator_state(row, self.particles.kind, integrator.variant, &bodies)
+                    .map_err(|reason| particle_error(&file, row.line, "", reason))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let ids: Vec<u64> = rows.iter().map(|r| r.id).collect();
+        let mut population = Population::new(
+            ephemeris,
+            integrator,
+            self.removal,
+            epoch,
+            self.integrator.initial_step_days,
+            &states,
+            &ids,
+        )?;
+        if let Some(w) = self.integrator.window_steps {
+            population.set_window_steps(w)?;
+        }
+        Ok(population)
+    }
+}
+
+fn spec_error(path: &Path, field: &str, reason: String) -> SymplecticError {
+    SymplecticError::Spec {
+        path: path.display().to_string(),
+        field: field.to_string(),
+        reason,
+    }
+}
+
+fn particle_error(path: &Path, line: u64, column: &str, reason: String) -> SymplecticError {
+    SymplecticError::ParticleFile {
+        path: path.display().to_string(),
+        line,
+        column: column.to_string(),
+        reason,
+    }
+}
+
+/// One row of a particle file: the identifier and six numbers in the kind's column order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParticleRow {
+    /// Line in the file (1-based, the header is line 1).
+    pub line: u64,
+    /// Identifier.
+    pub id: u64,
+    /// `x,y,z,vx,vy,vz` or `a,e,i,node,peri,mean_anomaly`.
+    pub values: [f64; 6],
+}
+
+/// Column names of a particle file of `kind`, after `id`.
+pub fn particle_columns(kind: ParticleKind) -> [&'static str; 6] {
+    match kind {
+        ParticleKind::BarycentricState | ParticleKind::HeliocentricState => {
+            ["x", "y", "z", "vx", "vy", "vz"]
+        }
+        ParticleKind::BarycentricElements | ParticleKind::HeliocentricElements => {
+            ["a", "e", "i", "node", "peri", "mean_anomaly"]
+        }
+    }
+}
+
+/// Reads a particle CSV: a header naming `id` and the kind's six columns (any order, no
+/// others), then one particle per row. Errors name the line and column: a missing column, a
+/// value that is not a finite number, a state at the origin, elements out of range or whose
+/// sign of `a` contradicts `e` (bound/unbound mismatch), a repeated identifier.
+pub fn read_particle_rows(path: &Path, kind: ParticleKind) -> Result<Vec<ParticleRow>, SymplecticError> {
+    let mut reader = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .comment(Some(b'#'))
+        .from_path(path)
+        .map_err(|e| particle_error(path, 0, "", e.to_string()))?;
+    let header = reader
+        .headers()
+        .map_err(|e| particle_error(path, 1, "", e.to_string()))?
+        .clone();
+    let names = particle_columns(kind);
+    let index_of = |name: &str| header.iter().position(|h| h == name);
+    let id_col = index_of("id").ok_or_else(|| particle_error(path, 1, "id", "missing column".into()))?;
+    let mut cols = [0usize; 6];
+    for (c, name) in cols.iter_mut().zip(names) {
+        *c = index_of(name).ok_or_else(|| {
+            particle_error(path, 1, name, format!("missing column (a {kind:?} file has id,{})", names.join(",")))
+        })?;
+    }
+    if let Some(extra) = header.iter().find(|h| *h != "id" && !names.contains(h)) {
+        return Err(particle_error(path, 1, extra, format!("unknown column (a {kind:?} file has id,{})", names.join(","))));
+    }
+    let mut rows = Vec::new();
+    let mut seen = std::collections::HashSet::new();
+    for record in reader.records() {
+        let record = record.map_err(|e| {
+            let line = e.position().map_or(0, |p| p.line());
+            particle_error(path, line, "", e.to_string())
+        })?;
+        let line = record.position().map_or(0, |p| p.line());
+        let field = |c: usize, name: &str| {
+            record
+                .get(c)
+                .ok_or_else(|| particle_error(path, line, name, "missing value".into()))
+        };
+        let id_text = field(id_col, "id")?;
+        let id: u64 = id_text
+            .parse()
+            .map_err(|_| particle_error(path, line, "id", format!("{id_text:?} is not a non-negative integer")))?;
+        if !seen.insert(id) {
+            return Err(particle_error(path, line, "id", format!("identifier {id} appears twice")));
+        }
+        let mut values = [0.0; 6];
+        for ((v, &c), name) in values.iter_mut().zip(&cols).zip(names) {
+            let text = field(c, name)?;
+            *v = text
+                .parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| particle_error(path, line, name, format!("{text:?} is not a finite number")))?;
+        }
+        check_row(&values, kind).map_err(|(name, reason)| particle_error(path, line, name, reason))?;
+        rows.push(ParticleRow { line, id, values });
+    }
+    Ok(rows)
+}
+
+fn check_row(v: &[f64; 6], kind: ParticleKind) -> Result<(), (&'static str, String)> {
+    match kind {
+        ParticleKind::BarycentricState | ParticleKind::HeliocentricState => {
+            let r = Vec3::new(v[0], v[1], v[2]).norm();
+            if r <= 0.0 {
+                return Err(("x", format!("distance {r} must be > 0")));
+            }
+        }
+        ParticleKind::BarycentricElements | ParticleKind::HeliocentricElements => {
+            let (a, e) = (v[0], v[1]);
+            if e < 0.0 {
+                return Err(("e", format!("eccentricity {e} must be >= 0")));
+            }
+            if e == 1.0 || a == 0.0 {
+                return Err(("a", format!("a = {a}, e = {e}: a parabola has no semi-major axis; give a hyperbola (a < 0, e > 1) or an ellipse")));
+            }
+            if (a > 0.0) != (e < 1.0) {
+                return Err((
+                    "a",
+                    format!(
+                        "a = {a} with e = {e}: {} (bound orbits have a > 0 and e < 1, unbound a < 0 and e > 1)",
+                        if a > 0.0 { "a bound a with an unbound e" } else { "an unbound a with a bound e" }
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The state in the integrator's coordinates (barycentric or heliocentric position,
+/// barycentric velocity) of a row, with the bodies at the epoch.
+fn to_integrator_state(
+    row: &ParticleRow,
+    kind: ParticleKind,
+    variant: Variant,
+    bodies: &crate::BodyStates,
+) -> Result<(Vec3, Vec3), String> {
+    let v = &row.values;
+    let (sun_q, sun_v) = (bodies.positions[0], bodies.velocities[0]);
+    let deg = std::f64::consts::PI / 180.0;
+    let elements = || ConicElements {
+        perihelion: v[0] * (1.0 - v[1]),
+        eccentricity: v[1],
+        inclination: v[2] * deg,
+        node: v[3] * deg,
+        argument_of_perihelion: v[4] * deg,
+        mean_anomaly: v[5] * deg,
+    };
+    // Barycentric position and velocity.
+    let (q, w) = match kind {
+        ParticleKind::BarycentricState => (Vec3::new(v[0], v[1], v[2]), Vec3::new(v[3], v[4], v[5])),
+        ParticleKind::HeliocentricState => (
+            Vec3::new(v[0], v[1], v[2]) + sun_q,
+            Vec3::new(v[3], v[4], v[5]) + sun_v,
+        ),
+        ParticleKind::BarycentricElements => {
+            state_from_elements(&elements(), bodies.total_gm()).map_err(|e| e.to_string())?
+        }
+        ParticleKind::HeliocentricElements => {
+            let (q, w) = state_from_elements(&elements(), bodies.gm[0]).map_err(|e| e.to_string())?;
+            (q + sun_q, w + sun_v)
+        }
+    };
+    Ok(match variant {
+        Variant::Barycentric => (q, w),
+        Variant::Mixed => (q - sun_q, w),
+    })
+}
+
+/// Bytes a population of `particles` needs (the members and a copy for the output tables).
+pub fn population_bytes(particles: usize) -> u128 {
+    particles as u128 * (Population::bytes_per_particle() as u128 + 200)
+}
+
+/// Refuses a population that does not fit in `available` bytes, before allocating it.
+pub fn check_memory(particles: usize, available: Option<u64>) -> Result<(), SymplecticError> {
+    let needed = population_bytes(particles);
+    match available {
+        Some(avail) if needed > u128::from(avail) => Err(SymplecticError::OutOfMemory {
+            particles,
+            needed_bytes: needed,
+            available_bytes: avail,
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// `MemAvailable` of `/proc/meminfo` in bytes, where there is one.
+pub fn available_memory() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// The table of every particle now: `id`, `status`, `time_days` (the particle's own time:
+/// the steps are variable, so each particle is at the first step end at or after the
+/// snapshot time), `removal_time_days` (NaN if active), barycentric osculating `a_au`, `e`,
+/// `i_deg`, `q_au`, and the barycentric state `x_au … vz_au_per_day`.
+pub fn population_table(population: &Population) -> Result<RecordBatch, SymplecticError> {
+    let members = population.members();
+    let n = members.len();
+    let mut cols: Vec<Vec<f64>> = (0..12).map(|_| Vec::with_capacity(n)).collect();
+    let mut status = Vec::with_capacity(n);
+    for (i, m) in members.iter().enumerate() {
+        let el = population.elements(i)?;
+        let q = population.barycentric_position(i);
+        let v = m.particle.velocity;
+        let (label, removal_time) = status_label(&m.status);
+        status.push(label);
+        let row = [
+            m.particle.time,
+            removal_time,
+            el.semi_major_axis,
+            el.eccentricity,
+            el.inclination.to_degrees(),
+            el.perihelion,
+            q.x,
+            q.y,
+            q.z,
+            v.x,
+            v.y,
+            v.z,
+        ];
+        for (c, x) in cols.iter_mut().zip(row) {
+            c.push(x);
+        }
+    }
+    let names = [
+        "time_days",
+        "removal_time_days",
+        "a_au",
+        "e",
+        "i_deg",
+        "q_au",
+        "x_au",
+        "y_au",
+        "z_au",
+        "vx_au_per_day",
+        "vy_au_per_day",
+        "vz_au_per_day",
+    ];
+    let mut fields = vec![
+        Field::new("id", DataType::UInt64, false),
+        Field::new("status", DataType::Utf8, false),
+    ];
+    let mut arrays: Vec<ArrayRef> = vec![
+        Arc::new(UInt64Array::from_iter_values(members.iter().map(|m| m.id))),
+        Arc::new(StringArray::from(status)),
+    ];
+    for (name, c) in names.iter().zip(cols) {
+        fields.push(Field::new(*name, DataType::Float64, false));
+        arrays.push(Arc::new(Float64Array::from(c)));
+    }
+    RecordBatch::try_new(Arc::new(Schema::new(fields)), arrays)
+        .map_err(|e| SymplecticError::Output { path: String::new(), reason: e.to_string() })
+}
+
+/// A short label of a status (`active`, `hill_sphere_<planet>`, `perihelion`, `ejected`,
+/// `regularisation_lost`, `failed`) and the removal time (NaN if active).
+pub fn status_label(s: &ParticleStatus) -> (String, f64) {
+    match s {
+        ParticleStatus::Active => ("active".into(), f64::NAN),
+        ParticleStatus::HillSphereEntry { time, planet, .. } => (format!("hill_sphere_{planet}"), *time),
+        ParticleStatus::PerihelionBelowLimit { time, .. } => ("perihelion".into(), *time),
+        ParticleStatus::Ejected { time, .. } => ("ejected".into(), *time),
+        ParticleStatus::RegularisationLost { time, .. } => ("regularisation_lost".into(), *time),
+        ParticleStatus::IntegrationFailed { time, .. } => ("failed".into(), *time),
+    }
+}
+
+/// Writes `batch` to `path` as Parquet (Snappy pages), atomically: a temporary file, `fsync`,
+/// rename.
+pub fn write_parquet(path: &Path, batch: &RecordBatch) -> Result<(), SymplecticError> {
+    let err = |e: String| SymplecticError::Output { path: path.display().to_string(), reason: e };
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(".tmp");
+    let tmp = PathBuf::from(tmp);
+    {
+        let file = std::fs::File::create(&tmp).map_err(|e| err(e.to_string()))?;
+        let props = parquet::file::properties::WriterProperties::builder()
+            .set_compression(parquet::basic::Compression::SNAPPY)
+            .build();
+        let mut writer = parquet::arrow::ArrowWriter::try_new(
+            file.try_clone().map_err(|e| err(e.to_string()))?,
+            batch.schema(),
+            Some(props),
+        )
+        .map_err(|e| err(e.to_string()))?;
+        writer.write(batch).map_err(|e| err(e.to_string()))?;
+        writer.close().map_err(|e| err(e.to_string()))?;
+        file.sync_all().map_err(|e| err(e.to_string()))?;
+    }
+    std::fs::rename(&tmp, path).map_err(|e| err(e.to_string()))?;
+    Ok(())
+}

@@ -1,0 +1,635 @@
+//! A population of test particles advanced in parallel against one shared planet ephemeris.
+
+use std::ops::Range;
+use std::path::Path;
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::ephemeris::{BodyStates, Ephemeris};
+use crate::kepler::Elements;
+use crate::particles::{ParticleIntegrator, TestParticle};
+use crate::run::ParticleStatus;
+use crate::{SymplecticError, Variant, Vec3, WorkCounters};
+
+/// When a particle of a [`Population`] is removed, checked at the end of each of its steps.
+/// A rule left out (`None`) is not applied.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RemovalRules {
+    /// Remove a particle inside `hill_factor` Hill radii of a planet: the Hill radius of
+    /// planet `j` is `|Q_j| (m_j/3m₀)^{1/3}` with `Q_j` its heliocentric position at the
+    /// particle's time. The method does not resolve planetary encounters; removal at Hill
+    /// sphere entry is the standard treatment (Holman & Wisdom 1993, AJ 105, 1987). Checked
+    /// at step ends: an encounter shorter than a step can be missed, as in any fixed-step
+    /// integrator with this rule.
+    pub hill_factor: Option<f64>,
+    /// Remove a particle whose barycentric osculating perihelion is below this distance
+    /// (outside the validity domain of `B₀, B₁`, condition 35 of Chegodaeva 2004).
+    pub min_perihelion: Option<f64>,
+    /// Remove an unbound particle (barycentric osculating energy `≥ 0`) beyond this distance
+    /// from the barycentre.
+    pub ejection_distance: Option<f64>,
+}
+
+impl RemovalRules {
+    fn validate(&self) -> Result<(), SymplecticError> {
+        for (name, value) in [
+            ("hill_factor", self.hill_factor),
+            ("min_perihelion", self.min_perihelion),
+            ("ejection_distance", self.ejection_distance),
+        ] {
+            if let Some(v) = value {
+                if !(v.is_finite() && v >= 0.0) {
+                    return Err(SymplecticError::InvalidParameter {
+                        name,
+                        value: v,
+                        reason: "removal rule must be finite and >= 0",
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// One particle of a [`Population`]: its identifier (kept through shards and merges), its
+/// state and its status. A removed particle keeps its state at removal (the end of the step
+/// that triggered the rule, or the start of a step that failed).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PopulationMember {
+    /// Identifier given by the caller (row of the particle file, say).
+    pub id: u64,
+    /// The particle.
+    pub particle: TestParticle,
+    /// Active or removed, with the reason.
+    pub status: ParticleStatus,
+    /// Barycentric position of the Sun at the particle's time (to turn the mixed variant's
+    /// heliocentric position into a barycentric one without the ephemeris).
+    pub sun_position: Vec3,
+}
+
+/// Where a [`Population`] stands after a synchronisation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PopulationProgress {
+    /// The synchronisation time reached: every active particle is at or after it.
+    pub time: f64,
+    /// Particle steps taken so far (all particles, all calls).
+    pub particle_steps: u64,
+    /// Particles still active.
+    pub active: usize,
+    /// Particles removed.
+    pub removed: usize,
+}
+
+/// Default length of a synchronisation window, in planet steps.
+pub const DEFAULT_WINDOW_STEPS: u32 = 256;
+
+/// `N` test particles, each on its own clock with Emel'yanenko's variable step
+/// ([`ParticleIntegrator`], either [`Variant`] and either [`Scheme`](crate::Scheme)), advanced
+/// in parallel (rayon) between synchronisation times against one shared, read-only planet
+/// ephemeris.
+///
+/// Chegodaeva (2004) integrates the particles separately from the planets so that many can
+/// share one planet integration; this is that sharing. [`Population::advance_to`] cuts the
+/// span into windows of [`Population::window_steps`] planet steps: the ephemeris is extended
+/// once per window (sequentially, one planet step per grid point) to cover the window and
+/// one more, then every active particle steps while its own time is before the window's
+/// end, reading the ephemeris through [`Ephemeris::interpolate`]. A step that would need
+/// planets beyond the covered span is undone and redone in the next window. Nothing is
+/// scanned per particle step: the cost of a particle step does not depend on `N`.
+///
+/// **Determinism.** A particle's trajectory depends only on its own initial state and on the
+/// planet grid (the interpolant at a time depends on that time and the grid only, not on how
+/// far the grid reaches), never on the windows, the other particles or the threads. So the
+/// result is bit-identical on any number of threads, equal bit for bit to integrating the
+/// particle alone with [`ParticleIntegrator::step`] and a mutable [`Ephemeris`], and a
+/// population split into shards ([`Population::shard`]) run separately and merged
+/// ([`Population::merge`]) equals the whole run.
+///
+/// **Memory:** [`Population::bytes_per_particle`] per particle (one [`PopulationMember`]), plus
+/// the ephemeris window (`72 (n+1)` bytes per retained planet step: 360 bytes for the Sun and
+/// four giants, at most about `2 ×` [`Population::window_steps`] steps).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Population {
+    ephemeris: Ephemeris,
+    integrator: ParticleIntegrator,
+    rules: RemovalRules,
+    members: Vec<PopulationMember>,
+    /// Synchronisation time reached.
+    time: f64,
+    /// Planet steps per window.
+    window_steps: u32,
+    /// Particle steps taken so far.
+    particle_steps: u64,
+}
+
+/// Per-thread scratch of [`Population::advance_to`].
+struct Worker {
+    bodies: BodyStates,
+    /// Time `bodies` holds (`NaN` if none).
+    bodies_time: f64,
+}
+
+/// The read-only context of a window.
+struct WindowContext<'a> {
+    ephemeris: &'a Ephemeris,
+    integrator: ParticleIntegrator,
+    rules: RemovalRules,
+    /// `(m_j/3m₀)^{1/3}` per planet.
+    hill_coefficients: Vec<f64>,
+    total_gm: f64,
+    end: f64,
+}
+
+impl Population {
+    /// A population at the epoch `time` from initial positions and barycentric velocities
+    /// (`states[i] = (position, velocity)` in the integrator's variant: barycentric position
+    /// for [`Variant::Barycentric`], heliocentric for [`Variant::Mixed`]), each particle's
+    /// first physical step `initial_dt` (see [`ParticleIntegrator::particle`]), identifiers
+    /// `ids` (one per state, distinct). The ephemeris is extended to `time` if needed; the
+    /// particles are built in parallel. Errors name the offending particle by its identifier.
+    pub fn new(
+        mut ephemeris: Ephemeris,
+        integrator: ParticleIntegrator,
+        rules: RemovalRules,
+        time: f64,
+        initial_dt: f64,
+        states: &[(Vec3, Vec3)],
+        ids: &[u64],
+    ) -> Result<Self, SymplecticError> {
+        rules.validate()?;
+        if ids.len() != states.len() {
+            return Err(SymplecticError::InvalidParameter {
+                name: "ids",
+                value: ids.len() as f64,
+                reason: "need one identifier per particle state",
+            });
+        }
+        let mut bodies = BodyStates::default();
+        ephemeris.bodies_at(time, &mut bodies)?;
+        let planets = ephemeris.planets().clone();
+        let members = states
+            .par_iter()
+            .zip(ids)
+            .map(|(&(position, velocity), &id)| {
+                let particle = integrator
+                    .particle_from_bodies(position, velocity, time, initial_dt, &bodies, &planets)
+                    .map_err(|e| SymplecticError::InvalidState {
+                        what: "population particle",
+                        reason: format!("particle {id}: {e}"),
+                    })?;
+                Ok(PopulationMember {
+                    id,
+                    particle,
+                    status: ParticleStatus::Active,
+                    sun_position: bodies.positions[0],
+                })
+            })
+            .collect::<Result<Vec<_>, SymplecticError>>()?;
+        let mut population = Self {
+            ephemeris,
+            integrator,
+            rules,
+            members,
+            time,
+            window_steps: DEFAULT_WINDOW_STEPS,
+            particle_steps: 0,
+        };
+        population.check_ids()?;
+        Ok(population)
+    }
+
+    fn check_ids(&mut self) -> Result<(), SymplecticError> {
+        let mut ids: Vec<u64> = self.members.iter().map(|m| m.id).collect();
+        ids.sort_unstable();
+        if let Some(w) = ids.windows(2).find(|w| w[0] == w[1]) {
+            return Err(SymplecticError::InvalidParameter {
+                name: "particle id",
+                value: w[0] as f64,
+                reason: "appears twice in the population",
+            });
+        }
+        Ok(())
+    }
+
+    /// Bytes of one particle in memory (one [`PopulationMember`], without the heap text of a
+    /// failure message).
+    pub const fn bytes_per_particle() -> usize {
+        std::mem::size_of::<PopulationMember>()
+    }
+
+    /// Sets the synchronisation window, in planet steps (`>= 1`). Changes when the
+    /// population synchronises, never the particles' trajectories.
+    pub fn set_window_steps(&mut self, steps: u32) -> Result<(), SymplecticError> {
+        if steps == 0 {
+            return Err(SymplecticError::InvalidParameter {
+                name: "window_steps",
+                value: 0.0,
+                reason: "must be >= 1",
+            });
+        }
+        self.window_steps = steps;
+        Ok(())
+    }
+
+    /// Planet steps per synchronisation window.
+    pub fn window_steps(&self) -> u32 {
+        self.window_steps
+    }
+
+    /// The particles, in identifier order after a merge, in the caller's order otherwise.
+    pub fn members(&self) -> &[PopulationMember] {
+        &self.members
+    }
+
+    /// The particle map.
+    pub fn integrator(&self) -> ParticleIntegrator {
+        self.integrator
+    }
+
+    /// The removal rules.
+    pub fn rules(&self) -> RemovalRules {
+        self.rules
+    }
+
+    /// The planets' ephemeris.
+    pub fn ephemeris(&self) -> &Ephemeris {
+        &self.ephemeris
+    }
+
+    /// The synchronisation time reached.
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// Where the population stands.
+    pub fn progress(&self) -> PopulationProgress {
+        let active = self
+            .members
+            .iter()
+            .filter(|m| m.status == ParticleStatus::Active)
+            .count();
+        PopulationProgress {
+            time: self.time,
+            particle_steps: self.particle_steps,
+            active,
+            removed: self.members.len() - active,
+        }
+    }
+
+    /// Work of the planets, the ephemeris and every particle (a particle of a population
+    /// counts its own ephemeris interpolations).
+    pub fn work(&self) -> WorkCounters {
+        self.ephemeris.work() + self.members.iter().map(|m| m.particle.work).sum()
+    }
+
+    /// `G M`, the sum of `G m_j` over the Sun and the planets (the `μ` of barycentric
+    /// elements), summed as [`BodyStates::total_gm`] does.
+    pub fn total_gm(&self) -> f64 {
+        let planets = self.ephemeris.planets();
+        let g = planets.g();
+        std::iter::once(g * planets.sun_mass())
+            .chain(planets.masses().iter().map(|m| g * m))
+            .sum()
+    }
+
+    /// Barycentric position of member `i` at its own time.
+    pub fn barycentric_position(&self, i: usize) -> Vec3 {
+        let m = &self.members[i];
+        match self.integrator.variant {
+            Variant::Barycentric => m.particle.position,
+            Variant::Mixed => m.particle.position + m.sun_position,
+        }
+    }
+
+    /// Barycentric osculating elements of member `i` at its own time (`μ = G M`).
+    pub fn elements(&self, i: usize) -> Result<Elements, SymplecticError> {
+        let Some(m) = self.members.get(i) else {
+            return Err(SymplecticError::InvalidParameter {
+                name: "particle index",
+                value: i as f64,
+                reason: "no such particle in the population",
+            });
+        };
+        crate::kepler::elements(
+            &self.barycentric_position(i),
+            &m.particle.velocity,
+            self.total_gm(),
+        )
+    }
+
+    /// The extended-Hamiltonian error `(H + p₄)/|H|` of member `i` at its own time, or
+    /// `None` if the ephemeris no longer holds that time (a particle removed long ago).
+    pub fn relative_error(&self, i: usize) -> Option<f64> {
+        let m = self.members.get(i)?;
+        let mut bodies = BodyStates::default();
+        self.ephemeris
+            .interpolate(m.particle.time, &mut bodies, true)
+            .ok()?;
+        let h = self.integrator.hamiltonian(&m.particle, &bodies);
+        Some((h + m.particle.p4) / h.abs())
+    }
+
+    /// Advances every active particle until its own time reaches `t_end` (its last step
+    /// overshoots: the steps are variable), in windows; `on_sync` sees the population's
+    /// progress after each window. Removed particles stop; they never stop the others. Errors
+    /// only for a bad `t_end` or a planet integration that fails.
+    pub fn advance_to(
+        &mut self,
+        t_end: f64,
+        mut on_sync: impl FnMut(&PopulationProgress),
+    ) -> Result<PopulationProgress, SymplecticError> {
+        if !t_end.is_finite() {
+            return Err(SymplecticError::InvalidParameter {
+                name: "end time",
+                value: t_end,
+                reason: "must be finite",
+            });
+        }
+        let window = f64::from(self.window_steps) * self.ephemeris.grid_step();
+        let mut needed = f64::NEG_INFINITY;
+        while let Some(oldest) = self.oldest_active_time() {
+            if oldest >= t_end {
+                break;
+            }
+            let end = (self.time.max(oldest) + window).min(t_end);
+            self.ephemeris.discard_before(oldest);
+            self.ephemeris.extend_to((end + window).max(needed))?;
+            let (steps, beyond) = self.run_window(end);
+            self.particle_steps += steps;
+            needed = beyond;
+            self.time = self.time.max(end);
+            on_sync(&self.progress());
+        }
+        self.time = self.time.max(t_end);
+        Ok(self.progress())
+    }
+
+    /// One window: every active particle steps while its time is before `end`. Returns the
+    /// steps taken and the latest time a step needed beyond the ephemeris.
+    fn run_window(&mut self, end: f64) -> (u64, f64) {
+        let planets = self.ephemeris.planets();
+        let m0 = planets.sun_mass();
+        let ctx = WindowContext {
+            ephemeris: &self.ephemeris,
+            integrator: self.integrator,
+            rules: self.rules,
+            hill_coefficients: planets
+                .masses()
+                .iter()
+                .map(|m| (m / (3.0 * m0)).cbrt())
+                .collect(),
+            total_gm: self.total_gm(),
+            end,
+        };
+        self.members
+            .par_iter_mut()
+            .with_min_len(8)
+            .map_init(
+                || Worker {
+                    bodies: BodyStates::default(),
+                    bodies_time: f64::NAN,
+                },
+                |w, m| ctx.advance_member(m, w),
+            )
+            .reduce(
+                || (0, f64::NEG_INFINITY),
+                |a, b| (a.0 + b.0, a.1.max(b.1)),
+            )
+    }
+
+    fn oldest_active_time(&self) -> Option<f64> {
+        self.members
+            .iter()
+            .filter(|m| m.status == ParticleStatus::Active)
+            .map(|m| m.particle.time)
+            .reduce(f64::min)
+    }
+
+    /// The members in `range` as a population of their own, with a copy of the ephemeris:
+    /// run it anywhere and [`Population::merge`] the results.
+    pub fn shard(&self, range: Range<usize>) -> Result<Self, SymplecticError> {
+        let Some(members) = self.members.get(range.clone()) else {
+            return Err(SymplecticError::InvalidParameter {
+                name: "shard end",
+                value: range.end as f64,
+                reason: "beyond the population's particles",
+            });
+        };
+        Ok(Self {
+            members: members.to_vec(),
+            particle_steps: 0,
+            ..self.clone_without_members()
+        })
+    }
+
+    fn clone_without_members(&self) -> Self {
+        Self {
+            ephemeris: self.ephemeris.clone(),
+            integrator: self.integrator,
+            rules: self.rules,
+            members: Vec::new(),
+            time: self.time,
+            window_steps: self.window_steps,
+            particle_steps: self.particle_steps,
+        }
+    }
+
+    /// Joins shards of one population advanced to the same time ([`Population::shard`]): the
+    /// members in identifier order, the ephemeris covering all of them. Errors if the shards
+    /// differ in integrator, rules, planets' step or time, or share an identifier.
+    pub fn merge(shards: Vec<Self>) -> Result<Self, SymplecticError> {
+        let Some(first) = shards.first() else {
+            return Err(SymplecticError::InvalidParameter {
+                name: "shards",
+                value: 0.0,
+                reason: "nothing to merge",
+            });
+        };
+        for s in &shards[1..] {
+            let same = s.integrator == first.integrator
+                && s.rules == first.rules
+                && s.time.to_bits() == first.time.to_bits()
+                && s.ephemeris.integrator() == first.ephemeris.integrator()
+                && s.ephemeris.grid_time(0).to_bits() == first.ephemeris.grid_time(0).to_bits();
+            if !same {
+                return Err(SymplecticError::InvalidParameter {
+                    name: "shards",
+                    value: s.time,
+                    reason: "differ in integrator, rules, planets or time: not shards of one population",
+                });
+            }
+        }
+        // The ephemeris retaining the oldest state, extended to the newest of all.
+        let newest = shards
+            .iter()
+            .map(|s| s.ephemeris.newest_time())
+            .fold(f64::NEG_INFINITY, f64::max);
+        let oldest = shards
+            .iter()
+            .enumerate()
+            .min_by(|a, b| {
+                a.1.ephemeris
+                    .oldest_time()
+                    .total_cmp(&b.1.ephemeris.oldest_time())
+            })
+            .map_or(0, |(i, _)| i);
+        let mut merged = shards[oldest].clone_without_members();
+        merged.ephemeris.extend_to(newest)?;
+        merged.particle_steps = shards.iter().map(|s| s.particle_steps).sum();
+        merged.members = shards.into_iter().flat_map(|s| s.members).collect();
+        merged.members.sort_by_key(|m| m.id);
+        merged.check_ids()?;
+        Ok(merged)
+    }
+
+    /// Writes the whole population atomically to `path` (temporary file, `fsync`, rename;
+    /// see [`save_checkpoint`](crate::save_checkpoint)), in a versioned envelope.
+    pub fn save(&self, path: &Path) -> Result<(), SymplecticError> {
+        crate::save_checkpoint(
+            path,
+            &Envelope {
+                format: POPULATION_FORMAT.into(),
+                version: POPULATION_VERSION,
+                population: self.clone(),
+            },
+        )
+    }
+
+    /// Reads a population written by [`Population::save`]; refuses a foreign, truncated or
+    /// other-version file by name. A resumed population continues bit for bit.
+    pub fn load(path: &Path) -> Result<Self, SymplecticError> {
+        let e: Envelope = crate::load_checkpoint(path)?;
+        if e.format != POPULATION_FORMAT || e.version != POPULATION_VERSION {
+            return Err(SymplecticError::Checkpoint {
+                path: path.display().to_string(),
+                reason: format!(
+                    "format {:?} version {}, expected {POPULATION_FORMAT:?} version {POPULATION_VERSION}",
+                    e.format, e.version
+                ),
+            });
+        }
+        Ok(e.population)
+    }
+}
+
+const POPULATION_FORMAT: &str = "symplectic-population";
+const POPULATION_VERSION: u32 = 1;
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Envelope {
+    format: String,
+    version: u32,
+    population: Population,
+}
+
+impl WindowContext<'_> {
+    /// Steps one member through the window; returns its steps and the time it needed beyond
+    /// the ephemeris (`-∞` if none).
+    fn advance_member(&self, m: &mut PopulationMember, w: &mut Worker) -> (u64, f64) {
+        let mut steps = 0;
+        let accelerations = self.integrator.variant == Variant::Mixed;
+        while m.status == ParticleStatus::Active && m.particle.time < self.end {
+            let saved = m.particle.clone();
+            let bodies_time = w.bodies_time;
+            w.bodies_time = f64::NAN;
+            let result = self.integrator.advance(
+                &mut m.particle,
+                &mut w.bodies,
+                bodies_time,
+                &mut |t: f64, out: &mut BodyStates| {
+                    self.ephemeris.interpolate(t, out, accelerations)
+                },
+            );
+            match result {
+                Ok(t) => {
+                    w.bodies_time = t;
+                    steps += 1;
+                    m.sun_position = w.bodies.positions[0];
+                    if let Some(status) = self.removal(&m.particle, &w.bodies) {
+                        m.status = status;
+                    }
+                }
+                Err(SymplecticError::BeyondEphemeris { time, .. }) => {
+                    m.particle = saved;
+                    return (steps, time);
+                }
+                Err(SymplecticError::RegularisationLost {
+                    quantity,
+                    value,
+                    time,
+                }) => {
+                    m.particle = saved;
+                    m.status = ParticleStatus::RegularisationLost {
+                        time,
+                        quantity: quantity.to_string(),
+                        value,
+                    };
+                }
+                Err(e) => {
+                    m.particle = saved;
+                    m.status = ParticleStatus::IntegrationFailed {
+                        time: m.particle.time,
+                        reason: e.to_string(),
+                    };
+                }
+            }
+        }
+        (steps, f64::NEG_INFINITY)
+    }
+
+    /// The first removal rule the particle meets, with the bodies at its time.
+    fn removal(&self, p: &TestParticle, bodies: &BodyStates) -> Option<ParticleStatus> {
+        let q = match self.integrator.variant {
+            Variant::Barycentric => p.position,
+            Variant::Mixed => p.position + bodies.positions[0],
+        };
+        let rules = &self.rules;
+        if let Some(factor) = rules.hill_factor {
+            let sun = bodies.positions[0];
+            for (j, c) in self.hill_coefficients.iter().enumerate() {
+                let planet = bodies.positions[j + 1];
+                let distance = (q - planet).norm();
+                let hill_radius = (planet - sun).norm() * c;
+                if distance < factor * hill_radius {
+                    return Some(ParticleStatus::HillSphereEntry {
+                        time: p.time,
+                        planet: j + 1,
+                        distance,
+                        hill_radius,
+                    });
+                }
+            }
+        }
+        if rules.min_perihelion.is_none() && rules.ejection_distance.is_none() {
+            return None;
+        }
+        // Barycentric osculating energy and perihelion from the energy and angular momentum
+        // (no angles): e² = 1 + 2E h²/μ², q = h²/(μ (1 + e)).
+        let mu = self.total_gm;
+        let r = q.norm();
+        let energy = 0.5 * p.velocity.norm_squared() - mu / r;
+        if let Some(limit) = rules.ejection_distance {
+            if energy >= 0.0 && r > limit {
+                return Some(ParticleStatus::Ejected {
+                    time: p.time,
+                    distance: r,
+                });
+            }
+        }
+        if let Some(limit) = rules.min_perihelion {
+            let h2 = q.cross(&p.velocity).norm_squared();
+            let e = (1.0 + 2.0 * energy * h2 / (mu * mu)).max(0.0).sqrt();
+            let perihelion = h2 / (mu * (1.0 + e));
+            if perihelion < limit {
+                return Some(ParticleStatus::PerihelionBelowLimit {
+                    time: p.time,
+                    perihelion,
+                });
+            }
+        }
+        None
+    }
+}

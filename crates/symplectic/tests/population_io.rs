@@ -1,0 +1,181 @@
+//! Population files (feature `io`): bad input gets a named error with line and column and
+//! nothing is written; a study resumes bit for bit.
+#![cfg(feature = "io")]
+
+use std::path::{Path, PathBuf};
+
+use symplectic::io::{check_memory, read_particle_rows, ParticleKind};
+use symplectic::study::run_study;
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("population-io-{name}-{}", std::process::id()));
+    std::fs::remove_dir_all(&d).ok();
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+const SPEC: &str = r#"
+[planets]
+system = "outer_solar_system"
+frame = "ecliptic_j2000"
+scheme = "s2"
+step_days = 365.25
+
+[integrator]
+variant = "barycentric"
+scheme = "s2"
+b1 = 0.21e-6
+initial_step_days = 365.25
+window_steps = 7
+
+[particles]
+file = "p.csv"
+kind = "barycentric_elements"
+
+[span]
+years = 120.0
+snapshot_every_years = 50.0
+checkpoint_every_years = 20.0
+
+[removal]
+hill_factor = 1.0
+min_perihelion = 26.0
+"#;
+
+const GOOD_ROWS: &str = "id,a,e,i,node,peri,mean_anomaly\n\
+    0,60.0,0.4,10.0,20.0,30.0,40.0\n\
+    1,80.0,0.5,5.0,120.0,230.0,300.0\n\
+    2,-200.0,1.2,3.0,10.0,10.0,1.0\n";
+
+/// Writes the specification and particle file into a fresh directory.
+fn study(name: &str, spec: &str, rows: &str) -> (PathBuf, PathBuf) {
+    let dir = temp_dir(name);
+    std::fs::write(dir.join("study.toml"), spec).unwrap();
+    std::fs::write(dir.join("p.csv"), rows).unwrap();
+    (dir.join("study.toml"), dir.join("out"))
+}
+
+/// The error of a bad study, with the temporary directory replaced; checks nothing was
+/// written.
+fn bad_study(name: &str, spec: &str, rows: &str) -> String {
+    let (spec_path, out) = study(name, spec, rows);
+    let err = run_study(&spec_path, &out, |_| {}).unwrap_err().to_string();
+    assert!(!out.exists(), "{name}: output written despite {err}");
+    let dir = spec_path.parent().unwrap().display().to_string();
+    err.replace(&dir, "DIR")
+}
+
+#[test]
+fn bad_particle_files_name_line_and_column() {
+    let header = "id,a,e,i,node,peri,mean_anomaly\n0,60.0,0.4,10.0,20.0,30.0,40.0\n";
+    insta::assert_snapshot!("nan", bad_study("nan", SPEC, &format!("{header}1,NaN,0.4,1,2,3,4\n")));
+    insta::assert_snapshot!(
+        "bound_unbound",
+        bad_study("bound", SPEC, &format!("{header}1,60.0,1.4,1,2,3,4\n"))
+    );
+    insta::assert_snapshot!(
+        "missing_column",
+        bad_study("missing", SPEC, "id,a,e,i,node,peri\n0,60,0.4,1,2,3\n")
+    );
+    insta::assert_snapshot!(
+        "duplicate_id",
+        bad_study("dup", SPEC, &format!("{header}0,70.0,0.4,1,2,3,4\n"))
+    );
+    let states = SPEC.replace("barycentric_elements", "barycentric_state");
+    insta::assert_snapshot!(
+        "zero_distance",
+        bad_study("zero", &states, "id,x,y,z,vx,vy,vz\n0,0,0,0,0.001,0,0\n")
+    );
+}
+
+#[test]
+fn bad_specifications_name_the_field() {
+    insta::assert_snapshot!(
+        "epoch_outside",
+        bad_study("epoch", &SPEC.replace("kind = \"barycentric_elements\"", "kind = \"barycentric_elements\"\nepoch_days = -10.0"), GOOD_ROWS)
+    );
+    insta::assert_snapshot!(
+        "unknown_field",
+        bad_study("unknown", &SPEC.replace("b1 = 0.21e-6", "b1 = 0.21e-6\nb2 = 1.0"), GOOD_ROWS)
+    );
+    insta::assert_snapshot!(
+        "bad_variant",
+        bad_study("variant", &SPEC.replace("\"barycentric\"", "\"heliocentric\""), GOOD_ROWS)
+    );
+    insta::assert_snapshot!(
+        "negative_span",
+        bad_study("span", &SPEC.replace("years = 120.0", "years = -1.0"), GOOD_ROWS)
+    );
+}
+
+#[test]
+fn a_population_too_large_is_refused_with_the_figure() {
+    insta::assert_snapshot!(
+        "out_of_memory",
+        check_memory(1_000_000_000, Some(8 << 30)).unwrap_err().to_string()
+    );
+    assert!(check_memory(1000, Some(8 << 30)).is_ok());
+}
+
+#[test]
+fn elements_and_states_read_back() {
+    let dir = temp_dir("rows");
+    let p = dir.join("p.csv");
+    std::fs::write(&p, GOOD_ROWS).unwrap();
+    let rows = read_particle_rows(&p, ParticleKind::BarycentricElements).unwrap();
+    assert_eq!(rows.len(), 3);
+    assert_eq!(rows[2].line, 4);
+    assert_eq!(rows[2].values[0], -200.0);
+}
+
+fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut out = Vec::new();
+    for e in walk(dir) {
+        out.push((e.strip_prefix(dir).unwrap().display().to_string(), std::fs::read(&e).unwrap()));
+    }
+    out.sort();
+    out
+}
+
+fn walk(dir: &Path) -> Vec<PathBuf> {
+    let mut v = Vec::new();
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            v.extend(walk(&p));
+        } else {
+            v.push(p);
+        }
+    }
+    v
+}
+
+/// A study interrupted after any checkpoint and rerun writes the same files, byte for byte.
+#[test]
+fn a_resumed_study_writes_identical_files() {
+    let (spec, out) = study("resume", SPEC, GOOD_ROWS);
+    let summary = run_study(&spec, &out, |_| {}).unwrap();
+    assert!(!summary.resumed);
+    assert_eq!(summary.snapshots_written, 4); // 0, 50, 100, 120 years
+    let straight = files(&out);
+    // Interrupt after k synchronisation windows (a panic in the callback stands for kill -9:
+    // the files are those written so far), rerun, compare.
+    for k in [1, 3, 6, 11] {
+        let (spec2, out2) = study(&format!("resume{k}"), SPEC, GOOD_ROWS);
+        let mut calls = 0;
+        let interrupted = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            run_study(&spec2, &out2, |_| {
+                calls += 1;
+                assert!(calls < k, "interrupted");
+            })
+        }));
+        assert!(interrupted.is_err(), "k = {k}: not interrupted");
+        let resumed = run_study(&spec2, &out2, |_| {}).unwrap();
+        assert_eq!(resumed.resumed, out2.join("checkpoint.json").exists());
+        assert_eq!(files(&out2), straight, "k = {k}: resumed files differ");
+    }
+    // Rerun over a finished directory: resumes, rewrites the same files.
+    let again = run_study(&spec, &out, |_| {}).unwrap();
+    assert!(again.resumed);
+    assert_eq!(files(&out), straight);
+}
