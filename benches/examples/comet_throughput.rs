@@ -26,8 +26,8 @@ use std::time::Instant;
 use symplectic::kepler::state_from_elements;
 use symplectic::samples::{sample_elements, SCATTERED_DISK};
 use symplectic::{
-    outer_solar_system, Ephemeris, Frame, Integrator, ParticleIntegrator, Population,
-    RemovalRules, Scheme, Variant,
+    outer_solar_system, Ephemeris, Frame, Integrator, ParticleIntegrator, Population, RemovalRules,
+    Scheme, Variant,
 };
 
 const DAYS_PER_YEAR: f64 = 365.25;
@@ -68,11 +68,14 @@ fn run() -> Result<(), String> {
     }
     // The planets by the same composition as the particles (`s6`: both pseudo-sixth order).
     let planet_map = match scheme {
-        Scheme::S2 => Integrator::S2 { step: DAYS_PER_YEAR },
-        Scheme::S6 => Integrator::S6 { step: DAYS_PER_YEAR },
+        Scheme::S2 => Integrator::S2 {
+            step: DAYS_PER_YEAR,
+        },
+        Scheme::S6 => Integrator::S6 {
+            step: DAYS_PER_YEAR,
+        },
     };
-    let ephemeris = Ephemeris::new(planets, planet_map)
-        .map_err(|e| e.to_string())?;
+    let ephemeris = Ephemeris::new(planets, planet_map).map_err(|e| e.to_string())?;
     let integrator = ParticleIntegrator::new(Variant::Barycentric, scheme, 0.0, 0.21e-6)
         .map_err(|e| e.to_string())?;
     let rules = RemovalRules {
@@ -80,16 +83,8 @@ fn run() -> Result<(), String> {
         min_perihelion: Some(26.0),
         ejection_distance: Some(1000.0),
     };
-    let mut population = Population::new(
-        ephemeris,
-        integrator,
-        rules,
-        0.0,
-        dt0,
-        &states,
-        &ids,
-    )
-    .map_err(|e| e.to_string())?;
+    let mut population = Population::new(ephemeris, integrator, rules, 0.0, dt0, &states, &ids)
+        .map_err(|e| e.to_string())?;
     let start = Instant::now();
     let progress = population
         .advance_to(years * DAYS_PER_YEAR, |_| {})
@@ -135,8 +130,18 @@ fn write_initial(
     let mut out = String::from("kind,id,gm,x,y,z,vx,vy,vz\n");
     let g = planets.g();
     let (sun_q, sun_v) = planets.sun_barycentric_state();
-    let row = |out: &mut String, kind: &str, id: usize, gm: f64, q: &symplectic::Vec3, v: &symplectic::Vec3| {
-        writeln!(out, "{kind},{id},{gm:e},{:e},{:e},{:e},{:e},{:e},{:e}", q.x, q.y, q.z, v.x, v.y, v.z).ok();
+    let row = |out: &mut String,
+               kind: &str,
+               id: usize,
+               gm: f64,
+               q: &symplectic::Vec3,
+               v: &symplectic::Vec3| {
+        writeln!(
+            out,
+            "{kind},{id},{gm:e},{:e},{:e},{:e},{:e},{:e},{:e}",
+            q.x, q.y, q.z, v.x, v.y, v.z
+        )
+        .ok();
     };
     row(&mut out, "body", 0, g * planets.sun_mass(), &sun_q, &sun_v);
     let velocities = planets.barycentric_velocities();
@@ -155,7 +160,11 @@ fn write_final(path: &str, population: &Population) -> std::io::Result<()> {
     for (i, m) in population.members().iter().enumerate() {
         let q = population.barycentric_position(i);
         let v = m.particle.velocity;
-        let status = if m.status == symplectic::ParticleStatus::Active { "active" } else { "removed" };
+        let status = if m.status == symplectic::ParticleStatus::Active {
+            "active"
+        } else {
+            "removed"
+        };
         writeln!(
             out,
             "{},{status},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",

@@ -37,11 +37,9 @@ pub fn run(args: &CometsArgs) -> Result<()> {
     };
     let bar = ProgressBar::new(spec.span.years.ceil() as u64);
     bar.set_style(
-        ProgressStyle::with_template(
-            "{elapsed_precise} [{bar:40}] {pos}/{len} yr, {msg}",
-        )
-        .context("progress bar template")?
-        .progress_chars("=> "),
+        ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} yr, {msg}")
+            .context("progress bar template")?
+            .progress_chars("=> "),
     );
     let epoch = spec.particles.epoch_days;
     let start = Instant::now();

@@ -64,10 +64,7 @@ fn run(dir: &Path, args: &[&str]) -> (i32, String) {
 fn command_line_error_messages() {
     let cases: &[(&str, &[&str])] = &[
         ("scene_without_path", &["run"]),
-        (
-            "scene_frames_zero",
-            &["run", "good.toml", "--frames", "0"],
-        ),
+        ("scene_frames_zero", &["run", "good.toml", "--frames", "0"]),
         (
             "scene_frames_negative",
             &["run", "good.toml", "--frames", "-3"],

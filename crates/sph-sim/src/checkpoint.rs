@@ -40,9 +40,10 @@ use sph_core::{Real, Vec3};
 use sph_scene::Scene;
 use sph_solver::{SolverState, StepStats};
 
-use crate::run::{FrameObserver, RunPlan};
+use crate::error::SimError;
+use crate::frame_loop::{FrameObserver, RunPlan};
 use crate::run_dir::RunDir;
-use crate::{SceneSim, SimError};
+use crate::sim::SceneSim;
 
 /// The magic bytes opening a checkpoint.
 pub const MAGIC: &[u8; 8] = b"SPHSIMCK";

@@ -14,7 +14,7 @@ use sph_scene::{BoundaryModel, Scene, SolverParams, SolverSpec};
 use sph_solver::boundary::{VolumeMapBoundary, VolumeMapCache, VolumeMapOptions};
 use sph_solver::{Boundary, CollisionBoundary, CommonParams, FluidSolver, SolverError};
 
-use crate::SimError;
+use crate::error::SimError;
 
 /// Contact distance of the volume-map model, as a fraction of the particle radius `s/2`:
 /// particles are projected out of a solid only when closer than `s/4` to it (a safety net

@@ -27,6 +27,7 @@
 pub mod checkpoint;
 mod error;
 mod factory;
+pub mod frame_loop;
 pub mod render;
 pub mod run;
 pub mod run_dir;
@@ -36,10 +37,8 @@ pub mod vtk;
 
 pub use error::SimError;
 pub use factory::{build_boundary, build_solver, density_kernel, VOLUME_MAP_CONTACT_FRACTION};
-pub use run::{
-    run_frames, run_scene, stats_header, stats_row, FrameObserver, RunPlan, SceneRunOptions,
-    STATS_COLUMNS,
-};
+pub use frame_loop::{run_frames, FrameObserver, RunPlan};
+pub use run::{run_scene, stats_header, stats_row, SceneRunOptions, STATS_COLUMNS};
 pub use run_dir::RunDir;
 pub use setup::SceneSetup;
 pub use sim::SceneSim;

@@ -9,9 +9,10 @@ use sph_scene::Scene;
 use sph_solver::StepStats;
 use ssfr_render::{RenderParams, Renderer};
 
-use crate::run::{FrameObserver, RunPlan};
+use crate::error::SimError;
+use crate::frame_loop::{FrameObserver, RunPlan};
 use crate::run_dir::RunDir;
-use crate::{SceneSim, SimError};
+use crate::sim::SceneSim;
 
 /// The render parameters of `scene`: its `[render]` table (defaults when absent) resolved
 /// against the scene (`sph_scene::Scene::render_params`, checked when the scene was loaded).

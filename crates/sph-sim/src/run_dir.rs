@@ -14,7 +14,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::SimError;
+use crate::error::SimError;
 
 /// The file naming the scene and mode of a run, so that `render OUT` and `repose OUT` find
 /// the scene: two lines, the absolute scene path and `quick` or `full`.

@@ -9,8 +9,8 @@ use sph_solver::boundary::VolumeMapCache;
 use sph_solver::initial::{calibrate_masses, MassCalibration};
 use sph_solver::Boundary;
 
+use crate::error::SimError;
 use crate::factory::{build_boundary, density_kernel};
-use crate::SimError;
 
 /// A scene built once in precision `R`: the parameters, the initial particles and the
 /// boundary. [`crate::SceneSim::from_setup`] builds the solver from it without sampling,

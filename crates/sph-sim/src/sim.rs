@@ -8,8 +8,10 @@ use sph_scene::Scene;
 use sph_solver::initial::MassCalibration;
 use sph_solver::{FluidSolver, StepStats};
 
+use crate::error::SimError;
+use crate::factory::build_solver;
+use crate::setup::SceneSetup;
 use crate::vtk::{write_particle_frame, write_point_frame, ParticleFrame};
-use crate::{build_solver, SceneSetup, SimError};
 
 /// A scene being simulated in precision `R`.
 pub struct SceneSim<R: Real> {

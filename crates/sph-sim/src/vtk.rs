@@ -5,7 +5,7 @@ use std::path::Path;
 
 use sph_core::{Real, Vec3};
 
-use crate::SimError;
+use crate::error::SimError;
 use vtkio::model::{
     Attribute, Attributes, ByteOrder, DataSet, PolyDataPiece, Version, VertexNumbers, Vtk,
 };

@@ -155,7 +155,8 @@ impl PopulationSpec {
     /// Reads and checks a specification; errors name the file, the field and, for syntax,
     /// the line and column.
     pub fn from_file(path: &Path) -> Result<Self, SymplecticError> {
-        let text = std::fs::read_to_string(path).map_err(|e| spec_error(path, "", e.to_string()))?;
+        let text =
+            std::fs::read_to_string(path).map_err(|e| spec_error(path, "", e.to_string()))?;
         Self::parse(&text, path)
     }
 
@@ -174,16 +175,24 @@ impl PopulationSpec {
     fn check(&self, path: &Path) -> Result<(), SymplecticError> {
         let positive = [
             ("planets.step_days", self.planets.step_days),
-            ("integrator.initial_step_days", self.integrator.initial_step_days),
+            (
+                "integrator.initial_step_days",
+                self.integrator.initial_step_days,
+            ),
             ("span.years", self.span.years),
             ("span.snapshot_every_years", self.span.snapshot_every_years),
         ];
-        for (field, v) in positive
-            .into_iter()
-            .chain(self.span.checkpoint_every_years.map(|v| ("span.checkpoint_every_years", v)))
-        {
+        for (field, v) in positive.into_iter().chain(
+            self.span
+                .checkpoint_every_years
+                .map(|v| ("span.checkpoint_every_years", v)),
+        ) {
             if !(v.is_finite() && v > 0.0) {
-                return Err(spec_error(path, field, format!("{v} must be finite and > 0")));
+                return Err(spec_error(
+                    path,
+                    field,
+                    format!("{v} must be finite and > 0"),
+                ));
             }
         }
         if !(self.particles.epoch_days.is_finite() && self.particles.epoch_days >= 0.0) {
@@ -197,7 +206,11 @@ impl PopulationSpec {
             ));
         }
         if self.integrator.window_steps == Some(0) {
-            return Err(spec_error(path, "integrator.window_steps", "must be >= 1".into()));
+            return Err(spec_error(
+                path,
+                "integrator.window_steps",
+                "must be >= 1".into(),
+            ));
         }
         Ok(())
     }
@@ -318,7 +331,10 @@ pub fn particle_columns(kind: ParticleKind) -> [&'static str; 6] {
 /// others), then one particle per row. Errors name the line and column: a missing column, a
 /// value that is not a finite number, a state at the origin, elements out of range or whose
 /// sign of `a` contradicts `e` (bound/unbound mismatch), a repeated identifier.
-pub fn read_particle_rows(path: &Path, kind: ParticleKind) -> Result<Vec<ParticleRow>, SymplecticError> {
+pub fn read_particle_rows(
+    path: &Path,
+    kind: ParticleKind,
+) -> Result<Vec<ParticleRow>, SymplecticError> {
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .comment(Some(b'#'))
@@ -330,15 +346,32 @@ pub fn read_particle_rows(path: &Path, kind: ParticleKind) -> Result<Vec<Particl
         .clone();
     let names = particle_columns(kind);
     let index_of = |name: &str| header.iter().position(|h| h == name);
-    let id_col = index_of("id").ok_or_else(|| particle_error(path, 1, "id", "missing column".into()))?;
+    let id_col =
+        index_of("id").ok_or_else(|| particle_error(path, 1, "id", "missing column".into()))?;
     let mut cols = [0usize; 6];
     for (c, name) in cols.iter_mut().zip(names) {
         *c = index_of(name).ok_or_else(|| {
-            particle_error(path, 1, name, format!("missing column (a {kind:?} file has id,{})", names.join(",")))
+            particle_error(
+                path,
+                1,
+                name,
+                format!(
+                    "missing column (a {kind:?} file has id,{})",
+                    names.join(",")
+                ),
+            )
         })?;
     }
     if let Some(extra) = header.iter().find(|h| *h != "id" && !names.contains(h)) {
-        return Err(particle_error(path, 1, extra, format!("unknown column (a {kind:?} file has id,{})", names.join(","))));
+        return Err(particle_error(
+            path,
+            1,
+            extra,
+            format!(
+                "unknown column (a {kind:?} file has id,{})",
+                names.join(",")
+            ),
+        ));
     }
     let mut rows = Vec::new();
     let mut seen = std::collections::HashSet::new();
@@ -354,11 +387,21 @@ pub fn read_particle_rows(path: &Path, kind: ParticleKind) -> Result<Vec<Particl
                 .ok_or_else(|| particle_error(path, line, name, "missing value".into()))
         };
         let id_text = field(id_col, "id")?;
-        let id: u64 = id_text
-            .parse()
-            .map_err(|_| particle_error(path, line, "id", format!("{id_text:?} is not a non-negative integer")))?;
+        let id: u64 = id_text.parse().map_err(|_| {
+            particle_error(
+                path,
+                line,
+                "id",
+                format!("{id_text:?} is not a non-negative integer"),
+            )
+        })?;
         if !seen.insert(id) {
-            return Err(particle_error(path, line, "id", format!("identifier {id} appears twice")));
+            return Err(particle_error(
+                path,
+                line,
+                "id",
+                format!("identifier {id} appears twice"),
+            ));
         }
         let mut values = [0.0; 6];
         for ((v, &c), name) in values.iter_mut().zip(&cols).zip(names) {
@@ -367,9 +410,12 @@ pub fn read_particle_rows(path: &Path, kind: ParticleKind) -> Result<Vec<Particl
                 .parse::<f64>()
                 .ok()
                 .filter(|x| x.is_finite())
-                .ok_or_else(|| particle_error(path, line, name, format!("{text:?} is not a finite number")))?;
+                .ok_or_else(|| {
+                    particle_error(path, line, name, format!("{text:?} is not a finite number"))
+                })?;
         }
-        check_row(&values, kind).map_err(|(name, reason)| particle_error(path, line, name, reason))?;
+        check_row(&values, kind)
+            .map_err(|(name, reason)| particle_error(path, line, name, reason))?;
         rows.push(ParticleRow { line, id, values });
     }
     Ok(rows)
@@ -426,7 +472,9 @@ fn to_integrator_state(
     };
     // Barycentric position and velocity.
     let (q, w) = match kind {
-        ParticleKind::BarycentricState => (Vec3::new(v[0], v[1], v[2]), Vec3::new(v[3], v[4], v[5])),
+        ParticleKind::BarycentricState => {
+            (Vec3::new(v[0], v[1], v[2]), Vec3::new(v[3], v[4], v[5]))
+        }
         ParticleKind::HeliocentricState => (
             Vec3::new(v[0], v[1], v[2]) + sun_q,
             Vec3::new(v[3], v[4], v[5]) + sun_v,
@@ -435,7 +483,8 @@ fn to_integrator_state(
             state_from_elements(&elements(), bodies.total_gm()).map_err(|e| e.to_string())?
         }
         ParticleKind::HeliocentricElements => {
-            let (q, w) = state_from_elements(&elements(), bodies.gm[0]).map_err(|e| e.to_string())?;
+            let (q, w) =
+                state_from_elements(&elements(), bodies.gm[0]).map_err(|e| e.to_string())?;
             (q + sun_q, w + sun_v)
         }
     };
@@ -530,8 +579,12 @@ pub fn population_table(population: &Population) -> Result<RecordBatch, Symplect
         fields.push(Field::new(*name, DataType::Float64, false));
         arrays.push(Arc::new(Float64Array::from(c)));
     }
-    RecordBatch::try_new(Arc::new(Schema::new(fields)), arrays)
-        .map_err(|e| SymplecticError::Output { path: String::new(), reason: e.to_string() })
+    RecordBatch::try_new(Arc::new(Schema::new(fields)), arrays).map_err(|e| {
+        SymplecticError::Output {
+            path: String::new(),
+            reason: e.to_string(),
+        }
+    })
 }
 
 /// A short label of a status (`active`, `hill_sphere_<planet>`, `perihelion`, `ejected`,
@@ -539,7 +592,9 @@ pub fn population_table(population: &Population) -> Result<RecordBatch, Symplect
 pub fn status_label(s: &ParticleStatus) -> (String, f64) {
     match s {
         ParticleStatus::Active => ("active".into(), f64::NAN),
-        ParticleStatus::HillSphereEntry { time, planet, .. } => (format!("hill_sphere_{planet}"), *time),
+        ParticleStatus::HillSphereEntry { time, planet, .. } => {
+            (format!("hill_sphere_{planet}"), *time)
+        }
         ParticleStatus::PerihelionBelowLimit { time, .. } => ("perihelion".into(), *time),
         ParticleStatus::Ejected { time, .. } => ("ejected".into(), *time),
         ParticleStatus::RegularisationLost { time, .. } => ("regularisation_lost".into(), *time),
@@ -550,7 +605,10 @@ pub fn status_label(s: &ParticleStatus) -> (String, f64) {
 /// Writes `batch` to `path` as Parquet (Snappy pages), atomically: a temporary file, `fsync`,
 /// rename.
 pub fn write_parquet(path: &Path, batch: &RecordBatch) -> Result<(), SymplecticError> {
-    let err = |e: String| SymplecticError::Output { path: path.display().to_string(), reason: e };
+    let err = |e: String| SymplecticError::Output {
+        path: path.display().to_string(),
+        reason: e,
+    };
     let mut tmp = path.as_os_str().to_owned();
     tmp.push(".tmp");
     let tmp = PathBuf::from(tmp);

@@ -318,7 +318,11 @@ pub struct ConicElements {
 /// mean anomaly of this form).
 pub fn state_from_elements(el: &ConicElements, mu: f64) -> Result<(Vec3, Vec3), SymplecticError> {
     let bad = |name: &'static str, value: f64, reason: &'static str| {
-        Err(SymplecticError::InvalidParameter { name, value, reason })
+        Err(SymplecticError::InvalidParameter {
+            name,
+            value,
+            reason,
+        })
     };
     let e = el.eccentricity;
     let q = el.perihelion;
@@ -345,7 +349,11 @@ pub fn state_from_elements(el: &ConicElements, mu: f64) -> Result<(Vec3, Vec3), 
     let (x, y, vx, vy);
     if e < 1.0 {
         let m = el.mean_anomaly.rem_euclid(std::f64::consts::TAU);
-        let mut ea = if e < 0.8 { m + e * m.sin() } else { std::f64::consts::PI };
+        let mut ea = if e < 0.8 {
+            m + e * m.sin()
+        } else {
+            std::f64::consts::PI
+        };
         for _ in 0..60 {
             let d = (ea - e * ea.sin() - m) / (1.0 - e * ea.cos());
             ea -= d;

@@ -154,9 +154,9 @@ mod planets;
 mod population;
 mod run;
 pub mod samples;
+pub mod solar_system;
 #[cfg(feature = "io")]
 pub mod study;
-pub mod solar_system;
 mod work;
 
 pub use ephemeris::{BodyStates, Ephemeris};

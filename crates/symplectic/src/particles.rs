@@ -620,24 +620,26 @@ fn planets_momentum_over_m0(bodies: &BodyStates) -> (Vec3, Vec3) {
 }
 
 fn check_initial(position: &Vec3, velocity: &Vec3, initial_dt: f64) -> Result<(), SymplecticError> {
-        if !position
-            .iter()
-            .chain(velocity.iter())
-            .all(|x| x.is_finite())
-            || position.norm() == 0.0
-        {
-            return Err(SymplecticError::InvalidState {
-                what: "test particle",
-                reason: format!("position {position:?} and velocity {velocity:?} must be finite, position non-zero"),
-            });
-        }
-        if !(initial_dt.is_finite() && initial_dt > 0.0) {
-            return Err(SymplecticError::InvalidParameter {
-                name: "initial particle step",
-                value: initial_dt,
-                reason: "must be finite and > 0",
-            });
-        }
+    if !position
+        .iter()
+        .chain(velocity.iter())
+        .all(|x| x.is_finite())
+        || position.norm() == 0.0
+    {
+        return Err(SymplecticError::InvalidState {
+            what: "test particle",
+            reason: format!(
+                "position {position:?} and velocity {velocity:?} must be finite, position non-zero"
+            ),
+        });
+    }
+    if !(initial_dt.is_finite() && initial_dt > 0.0) {
+        return Err(SymplecticError::InvalidParameter {
+            name: "initial particle step",
+            value: initial_dt,
+            reason: "must be finite and > 0",
+        });
+    }
     Ok(())
 }
 

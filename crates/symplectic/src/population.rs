@@ -393,10 +393,7 @@ impl Population {
                 },
                 |w, m| ctx.advance_member(m, w),
             )
-            .reduce(
-                || (0, f64::NEG_INFINITY),
-                |a, b| (a.0 + b.0, a.1.max(b.1)),
-            )
+            .reduce(|| (0, f64::NEG_INFINITY), |a, b| (a.0 + b.0, a.1.max(b.1)))
     }
 
     fn oldest_active_time(&self) -> Option<f64> {
@@ -457,7 +454,8 @@ impl Population {
                 return Err(SymplecticError::InvalidParameter {
                     name: "shards",
                     value: s.time,
-                    reason: "differ in integrator, rules, planets or time: not shards of one population",
+                    reason:
+                        "differ in integrator, rules, planets or time: not shards of one population",
                 });
             }
         }

@@ -67,7 +67,10 @@ pub fn run_study(
         if c.format != STUDY_FORMAT || c.version != STUDY_VERSION {
             return Err(SymplecticError::Checkpoint {
                 path: checkpoint_path.display().to_string(),
-                reason: format!("format {:?} version {}, expected {STUDY_FORMAT:?} version {STUDY_VERSION}", c.format, c.version),
+                reason: format!(
+                    "format {:?} version {}, expected {STUDY_FORMAT:?} version {STUDY_VERSION}",
+                    c.format, c.version
+                ),
             });
         }
         if c.spec != spec_text {

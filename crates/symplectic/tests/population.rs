@@ -211,7 +211,10 @@ fn removal_is_per_particle_with_reason_and_time() {
     let mut pop = population(integ, rules, &st);
     let end = 3000.0 * DAYS_PER_YEAR;
     let progress = pop.advance_to(end, |_| {}).unwrap();
-    assert!(progress.removed > 0, "Neptune-crossing orbits for 3 kyr: some must be removed");
+    assert!(
+        progress.removed > 0,
+        "Neptune-crossing orbits for 3 kyr: some must be removed"
+    );
     assert!(progress.active > 0);
     let planets = outer_solar_system(Frame::EclipticJ2000);
     for m in pop.members() {
@@ -230,7 +233,10 @@ fn removal_is_per_particle_with_reason_and_time() {
                 let m_ratio = planets.masses()[planet - 1] / (3.0 * planets.sun_mass());
                 let a_j = [5.2, 9.55, 19.2, 30.1][planet - 1];
                 let expected = a_j * m_ratio.cbrt();
-                assert!((hill_radius / expected - 1.0).abs() < 0.1, "{hill_radius} vs {expected}");
+                assert!(
+                    (hill_radius / expected - 1.0).abs() < 0.1,
+                    "{hill_radius} vs {expected}"
+                );
             }
             other => assert!(m.particle.time < end, "{other:?}"),
         }
@@ -239,5 +245,9 @@ fn removal_is_per_particle_with_reason_and_time() {
 
 #[test]
 fn bytes_per_particle_is_stated() {
-    assert!(Population::bytes_per_particle() <= 256, "{}", Population::bytes_per_particle());
+    assert!(
+        Population::bytes_per_particle() <= 256,
+        "{}",
+        Population::bytes_per_particle()
+    );
 }

@@ -68,7 +68,10 @@ fn bad_study(name: &str, spec: &str, rows: &str) -> String {
 #[test]
 fn bad_particle_files_name_line_and_column() {
     let header = "id,a,e,i,node,peri,mean_anomaly\n0,60.0,0.4,10.0,20.0,30.0,40.0\n";
-    insta::assert_snapshot!("nan", bad_study("nan", SPEC, &format!("{header}1,NaN,0.4,1,2,3,4\n")));
+    insta::assert_snapshot!(
+        "nan",
+        bad_study("nan", SPEC, &format!("{header}1,NaN,0.4,1,2,3,4\n"))
+    );
     insta::assert_snapshot!(
         "bound_unbound",
         bad_study("bound", SPEC, &format!("{header}1,60.0,1.4,1,2,3,4\n"))
@@ -92,19 +95,38 @@ fn bad_particle_files_name_line_and_column() {
 fn bad_specifications_name_the_field() {
     insta::assert_snapshot!(
         "epoch_outside",
-        bad_study("epoch", &SPEC.replace("kind = \"barycentric_elements\"", "kind = \"barycentric_elements\"\nepoch_days = -10.0"), GOOD_ROWS)
+        bad_study(
+            "epoch",
+            &SPEC.replace(
+                "kind = \"barycentric_elements\"",
+                "kind = \"barycentric_elements\"\nepoch_days = -10.0"
+            ),
+            GOOD_ROWS
+        )
     );
     insta::assert_snapshot!(
         "unknown_field",
-        bad_study("unknown", &SPEC.replace("b1 = 0.21e-6", "b1 = 0.21e-6\nb2 = 1.0"), GOOD_ROWS)
+        bad_study(
+            "unknown",
+            &SPEC.replace("b1 = 0.21e-6", "b1 = 0.21e-6\nb2 = 1.0"),
+            GOOD_ROWS
+        )
     );
     insta::assert_snapshot!(
         "bad_variant",
-        bad_study("variant", &SPEC.replace("\"barycentric\"", "\"heliocentric\""), GOOD_ROWS)
+        bad_study(
+            "variant",
+            &SPEC.replace("\"barycentric\"", "\"heliocentric\""),
+            GOOD_ROWS
+        )
     );
     insta::assert_snapshot!(
         "negative_span",
-        bad_study("span", &SPEC.replace("years = 120.0", "years = -1.0"), GOOD_ROWS)
+        bad_study(
+            "span",
+            &SPEC.replace("years = 120.0", "years = -1.0"),
+            GOOD_ROWS
+        )
     );
 }
 
@@ -112,7 +134,9 @@ fn bad_specifications_name_the_field() {
 fn a_population_too_large_is_refused_with_the_figure() {
     insta::assert_snapshot!(
         "out_of_memory",
-        check_memory(1_000_000_000, Some(8 << 30)).unwrap_err().to_string()
+        check_memory(1_000_000_000, Some(8 << 30))
+            .unwrap_err()
+            .to_string()
     );
     assert!(check_memory(1000, Some(8 << 30)).is_ok());
 }
@@ -131,7 +155,10 @@ fn elements_and_states_read_back() {
 fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
     let mut out = Vec::new();
     for e in walk(dir) {
-        out.push((e.strip_prefix(dir).unwrap().display().to_string(), std::fs::read(&e).unwrap()));
+        out.push((
+            e.strip_prefix(dir).unwrap().display().to_string(),
+            std::fs::read(&e).unwrap(),
+        ));
     }
     out.sort();
     out

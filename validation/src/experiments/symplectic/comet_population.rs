@@ -164,7 +164,8 @@ fn plot_fractions(ctx: &mut Context, ours: &Removals, reference: &Removals) -> R
                 .collect()
         };
         let label = format!("{}–{} AU", BIN_EDGES[b], BIN_EDGES[b + 1]);
-        spec.series.push(Series::line(format!("{label} ours"), curve(ours), b));
+        spec.series
+            .push(Series::line(format!("{label} ours"), curve(ours), b));
         spec.series.push(Series::styled(
             format!("{label} REBOUND"),
             curve(reference),
@@ -252,7 +253,11 @@ impl Experiment for CometPopulation {
                     format!("{z:.3}"),
                 ]);
                 out.check(Check::less_than(
-                    format!("|z| surviving fraction, a0 {}–{} AU, {t} yr", BIN_EDGES[b], BIN_EDGES[b + 1]),
+                    format!(
+                        "|z| surviving fraction, a0 {}–{} AU, {t} yr",
+                        BIN_EDGES[b],
+                        BIN_EDGES[b + 1]
+                    ),
                     z.abs(),
                     Z_MAX,
                     "two-proportion z-test against REBOUND WHFast, binomial errors (module docs)",
@@ -261,13 +266,35 @@ impl Experiment for CometPopulation {
         }
         write_csv_rows(
             &ctx.path("surviving_fraction.csv"),
-            &["a0_min_au", "a0_max_au", "time_years", "ours_surviving", "ours_total", "rebound_surviving", "rebound_total", "z"],
+            &[
+                "a0_min_au",
+                "a0_max_au",
+                "time_years",
+                "ours_surviving",
+                "ours_total",
+                "rebound_surviving",
+                "rebound_total",
+                "z",
+            ],
             rows,
         )?;
-        ctx.add_file("surviving_fraction.csv", "surviving fractions per bin and time, both codes, z statistic");
+        ctx.add_file(
+            "surviving_fraction.csv",
+            "surviving fractions per bin and time, both codes, z statistic",
+        );
         out.metric("largest |z|", worst);
         out.metric("particles", n as f64);
-        let names = ["active", "Jupiter Hill", "Saturn Hill", "Uranus Hill", "Neptune Hill", "ejected", "regularisation lost", "failed", "perihelion"];
+        let names = [
+            "active",
+            "Jupiter Hill",
+            "Saturn Hill",
+            "Uranus Hill",
+            "Neptune Hill",
+            "ejected",
+            "regularisation lost",
+            "failed",
+            "perihelion",
+        ];
         for (code, count) in reasons {
             out.metric(format!("final: {}", names[code.min(8)]), count as f64);
         }
