@@ -293,11 +293,11 @@ fn run_scene_in<R: Real>(
     mut render: Option<RenderObserver>,
 ) -> Result<(), SimError> {
     let t0 = Instant::now();
-    let cache = match &opts.volume_map_cache {
-        Some(dir) => Some(
+    let cache = match (&opts.volume_map_cache, scene.boundary.model) {
+        (Some(dir), sph_scene::BoundaryModel::VolumeMap) => Some(
             sph_solver::boundary::VolumeMapCache::new(dir).map_err(|e| SimError::output(dir, e))?,
         ),
-        None => None,
+        _ => None,
     };
     let mut sim = SceneSim::<R>::with_cache(scene, cache.as_ref())?;
     let resumed = opts.resume;
