@@ -16,7 +16,7 @@ pub struct CometsArgs {
     /// The population specification (TOML: `[planets]`, `[integrator]`, `[particles]`,
     /// `[span]`, `[removal]`; see `populations/scattered-disk.toml`).
     pub population: PathBuf,
-    /// Output directory [default: `comets-<name of the TOML>` in the current directory]. If
+    /// Output directory [default: comets-STEM in the current directory, STEM the TOML file name without .toml]. If
     /// it holds a checkpoint of the same specification, the study resumes from it.
     #[arg(long, value_name = "DIR", value_parser = crate::directory)]
     pub out: Option<PathBuf>,

@@ -16,7 +16,7 @@ pub struct RunArgs {
     /// Stop at this frame (>= 1) [default: the scene's duration].
     #[arg(long, value_name = "N", value_parser = frame_count, allow_hyphen_values = true)]
     frames: Option<usize>,
-    /// Output directory [default: target/scenes/<scene file stem> under the current directory].
+    /// Output directory [default: target/scenes/STEM under the current directory, STEM the scene file name without .toml].
     #[arg(long, value_name = "DIR", value_parser = crate::directory)]
     out: Option<PathBuf>,
     /// Also render the frames (PNG in OUT/render) in process while the scene runs.
