@@ -52,6 +52,38 @@ pub trait Sdf<R: Real>: Send + Sync {
     fn lipschitz_bound(&self) -> Option<f64> {
         None
     }
+
+    /// The parts of the segment `x + t ω`, `0 ≤ t ≤ t_max`, inside the solid (`φ < 0`), in
+    /// closed form: appends them to `out` as disjoint intervals `(t_in, t_out)` in increasing
+    /// order (`0 ≤ t_in < t_out ≤ t_max`) and returns `true`. Computed in `f64` from the
+    /// shape's parameters (the surface of the stored shape, exactly up to `f64` rounding).
+    /// `ω` need not be unit. Integrals along rays (the volume maps' quadrature) use it instead
+    /// of searching the distance for sign changes.
+    ///
+    /// The default appends nothing and returns `false`: no closed form (meshes, user solids);
+    /// callers then sample [`Sdf::signed_distance`].
+    fn ray_inside_intervals(
+        &self,
+        x: &Vec3<f64>,
+        dir: &Vec3<f64>,
+        t_max: f64,
+        out: &mut Vec<(f64, f64)>,
+    ) -> bool {
+        let _ = (x, dir, t_max, out);
+        false
+    }
+}
+
+/// Appends `(a, b) ∩ [0, t_max]` to `out` when it is not empty.
+fn push_clipped(a: f64, b: f64, t_max: f64, out: &mut Vec<(f64, f64)>) {
+    let (a, b) = (a.max(0.0), b.min(t_max));
+    if a < b {
+        out.push((a, b));
+    }
+}
+
+fn v64<R: Real>(v: &Vec3<R>) -> Vec3<f64> {
+    Vec3::new(v.x.as_f64(), v.y.as_f64(), v.z.as_f64())
 }
 
 /// Appends a type tag (length-prefixed) and the `f64` bit patterns of `values` (exact for
@@ -128,6 +160,30 @@ impl<R: Real> Sdf<R> for Plane<R> {
     fn lipschitz_bound(&self) -> Option<f64> {
         Some(1.0)
     }
+    /// `φ(t) = n·x − offset + t n·ω < 0`.
+    fn ray_inside_intervals(
+        &self,
+        x: &Vec3<f64>,
+        dir: &Vec3<f64>,
+        t_max: f64,
+        out: &mut Vec<(f64, f64)>,
+    ) -> bool {
+        let n = v64(&self.normal);
+        let (phi0, slope) = (n.dot(x) - self.offset.as_f64(), n.dot(dir));
+        if slope == 0.0 {
+            if phi0 < 0.0 {
+                push_clipped(0.0, t_max, t_max, out);
+            }
+        } else {
+            let root = -phi0 / slope;
+            if slope > 0.0 {
+                push_clipped(f64::NEG_INFINITY, root, t_max, out);
+            } else {
+                push_clipped(root, f64::INFINITY, t_max, out);
+            }
+        }
+        true
+    }
 }
 
 /// Solid ball.
@@ -174,6 +230,26 @@ impl<R: Real> Sdf<R> for Sphere<R> {
     }
     fn lipschitz_bound(&self) -> Option<f64> {
         Some(1.0)
+    }
+    /// `|x + t ω − c|² < r²`: between the roots of the quadratic (the stable form that
+    /// avoids cancelling `b` against the discriminant).
+    fn ray_inside_intervals(
+        &self,
+        x: &Vec3<f64>,
+        dir: &Vec3<f64>,
+        t_max: f64,
+        out: &mut Vec<(f64, f64)>,
+    ) -> bool {
+        let d = x - v64(&self.center);
+        let r = self.radius.as_f64();
+        let (a, b, c) = (dir.norm_squared(), d.dot(dir), d.norm_squared() - r * r);
+        let disc = b * b - a * c;
+        if a > 0.0 && disc > 0.0 {
+            let q = -(b + b.signum() * disc.sqrt());
+            let (t1, t2) = (q / a, c / q);
+            push_clipped(t1.min(t2), t1.max(t2), t_max, out);
+        }
+        true
     }
 }
 
@@ -256,6 +332,31 @@ impl<R: Real> Sdf<R> for BoxSdf<R> {
     fn lipschitz_bound(&self) -> Option<f64> {
         Some(1.0)
     }
+    /// The slab test: the open box is the intersection of three open slabs.
+    fn ray_inside_intervals(
+        &self,
+        x: &Vec3<f64>,
+        dir: &Vec3<f64>,
+        t_max: f64,
+        out: &mut Vec<(f64, f64)>,
+    ) -> bool {
+        let b = self.aabb();
+        let (lo, hi) = (v64(&b.min), v64(&b.max));
+        let (mut t_in, mut t_out) = (f64::NEG_INFINITY, f64::INFINITY);
+        for a in 0..3 {
+            if dir[a] == 0.0 {
+                if !(x[a] > lo[a] && x[a] < hi[a]) {
+                    return true;
+                }
+            } else {
+                let (p, q) = ((lo[a] - x[a]) / dir[a], (hi[a] - x[a]) / dir[a]);
+                t_in = t_in.max(p.min(q));
+                t_out = t_out.min(p.max(q));
+            }
+        }
+        push_clipped(t_in, t_out, t_max, out);
+        true
+    }
 }
 
 /// Complement of a solid: what was inside becomes free space. A tank is `Inverted<BoxSdf>`:
@@ -279,6 +380,35 @@ impl<R: Real, S: Sdf<R>> Sdf<R> for Inverted<S> {
     }
     fn lipschitz_bound(&self) -> Option<f64> {
         self.0.lipschitz_bound()
+    }
+    /// The gaps of the inner solid's intervals in `[0, t_max]`.
+    fn ray_inside_intervals(
+        &self,
+        x: &Vec3<f64>,
+        dir: &Vec3<f64>,
+        t_max: f64,
+        out: &mut Vec<(f64, f64)>,
+    ) -> bool {
+        let start = out.len();
+        if !self.0.ray_inside_intervals(x, dir, t_max, out) {
+            out.truncate(start);
+            return false;
+        }
+        // The gaps overwrite the inner intervals in place: the gap before interval `k` is
+        // written at or before `k`, after `k` is read; the last gap is pushed.
+        let end = out.len();
+        let (mut from, mut written) = (0.0, start);
+        for k in start..end {
+            let (a, b) = out[k];
+            if from < a.min(t_max) {
+                out[written] = (from, a.min(t_max));
+                written += 1;
+            }
+            from = b;
+        }
+        out.truncate(written);
+        push_clipped(from, t_max, t_max, out);
+        true
     }
 }
 
@@ -343,6 +473,58 @@ mod tests {
                 prop_assert!(s.fingerprint(&mut f));
                 prop_assert!(!prints.contains(&f));
                 prints.push(f);
+            }
+        }
+
+        /// Closed-form ray intervals against the sampled distance (the naive oracle): the
+        /// distance is negative at every interval's midpoint and non-negative at every
+        /// gap's, and vanishes at every interior end point.
+        #[test]
+        fn ray_intervals_match_the_distance(
+            x in prop::array::uniform3(-4.0..4.0f64),
+            dir in prop::array::uniform3(-1.0..1.0f64),
+            t_max in 0.1..8.0f64,
+        ) {
+            let (x, dir) = (Vec3::from(x), Vec3::from(dir));
+            prop_assume!(dir.norm() > 1e-3);
+            let shapes: Vec<Box<dyn Sdf<f64>>> = vec![
+                Box::new(unit_box()),
+                Box::new(Inverted(unit_box())),
+                Box::new(Sphere::new(Vec3::new(0.5, -0.5, 0.2), 1.5).unwrap()),
+                Box::new(Inverted(Sphere::new(Vec3::new(0.5, -0.5, 0.2), 1.5).unwrap())),
+                Box::new(Plane::new(Vec3::new(0.0, 1.0, 0.0), Vec3::new(1.0, 2.0, -0.5)).unwrap()),
+                Box::new(Inverted(Inverted(unit_box()))),
+            ];
+            for (k, s) in shapes.iter().enumerate() {
+                let mut iv = vec![(-1.0, -1.0)]; // appended after what is there
+                prop_assert!(s.ray_inside_intervals(&x, &dir, t_max, &mut iv));
+                prop_assert_eq!(iv[0], (-1.0, -1.0));
+                let iv = &iv[1..];
+                let phi = |t: f64| s.signed_distance(&(x + dir * t));
+                // Rounding of f64 distances and roots of magnitude < 20: 1e-12 (m).
+                let tol = 1e-12 * (1.0 + t_max) * (1.0 + dir.norm());
+                let mut from = 0.0;
+                for &(a, b) in iv {
+                    prop_assert!(0.0 <= a && a < b && b <= t_max && a >= from, "shape {}: {:?}", k, iv);
+                    for t in [a, b] {
+                        if t > 0.0 && t < t_max {
+                            prop_assert!(phi(t).abs() < 1e-9, "shape {}: end {} phi {}", k, t, phi(t));
+                        }
+                    }
+                    from = b;
+                }
+                // The sign of the distance at 401 points along the segment: negative exactly
+                // where an interval says inside.
+                for i in 0..=400 {
+                    let t = if i == 400 { t_max } else { t_max * i as f64 / 400.0 };
+                    let inside = iv.iter().any(|&(a, b)| t >= a && t <= b);
+                    let (f, near_end) = (phi(t), iv.iter().any(|&(a, b)| (t - a).abs().min((t - b).abs()) < 1e-9));
+                    if !near_end {
+                        prop_assert_eq!(f < 0.0, inside, "shape {}: t {} phi {} in {:?}", k, t, f, iv);
+                    }
+                    let consistent = if inside { f < tol } else { f > -tol };
+                    prop_assert!(consistent, "shape {}: t {} phi {}", k, t, f);
+                }
             }
         }
 

@@ -16,8 +16,9 @@ use crate::SolverError;
 
 /// Version of the map construction: bump it whenever a change of the build moves any stored
 /// value (a quadrature, a tolerance, the node models), so that no cache serves maps of the
-/// old construction.
-pub const BUILD_VERSION: u32 = 1;
+/// old construction. 2: closed-form ray intervals for analytic solids
+/// ([`Sdf::ray_inside_intervals`](sph_core::Sdf::ray_inside_intervals)).
+pub const BUILD_VERSION: u32 = 2;
 
 /// Everything a [`VolumeMap`](super::VolumeMap) depends on, as bytes: the file format and
 /// build versions, the precision `R`, the kernel and its support radius, the domain, every

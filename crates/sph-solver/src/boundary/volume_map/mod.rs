@@ -71,24 +71,27 @@
 //!
 //! Every node costs one distance and one gradient; each band node 78 more distances (the
 //! planarity probes); each quadrature node (near edges, corners and curved surfaces)
-//! `polar × azimuth` rays. A ray samples `φ` at `ray_samples` points, refines each sign
-//! change by regula falsi and searches intervals whose end values leave room for a thin
-//! sliver of solid (bisection down to `1e-6 h`). For solids with a known Lipschitz bound
-//! ([`Sdf::lipschitz_bound`], 1 for exact distances) samples and searches that the bound
-//! rules out are skipped: the crossings, and the brackets they are refined from, are those of
-//! the full search, so the map is bit-identical (on the tank below: 9.4 distance evaluations
-//! per ray instead of 19.3). For such solids the sliver search is also skipped in the first
-//! interval of rays from nodes on the surface (`|φ| ≤` rounding): it would bisect towards
-//! the surface the node lies on, down to `1e-6 h`, and cost half of all evaluations on a
-//! tank whose walls lie on grid nodes. This changes a map only where a solid sliver lies
-//! within `h / ray_samples` of such a node; the tank's map is byte for byte that of the
-//! full search (and the property test `lipschitz_skips_are_bit_identical_to_the_full_search`
-//! checks nodes on walls, edges and corners). The quadrature dominates (90 % of the time on a tank: rays and distance
-//! evaluations); nodes are built in parallel by z-slab, each node on its own, so parallel
-//! and sequential builds are bit-identical. SPlisHSPlasH's dam-break tank (4 × 3 × 1.5 m,
-//! cubic spline, `h = 0.05` m, `f32`): 1.06e7 nodes, 2.3e6 in the band, 2.4e5 by
-//! quadrature, 2.9e6 stored (203 MB as a cache file); dated timings against SPlisHSPlasH in
-//! `docs/performance.md`. 32 × 64 directions cost 4× the quadrature time.
+//! `polar × azimuth` rays. Along a ray, solids with closed-form ray intervals
+//! ([`Sdf::ray_inside_intervals`]: planes, spheres, boxes and their complements) give the
+//! inside stretches directly (exact up to `f64` rounding of the stored shape). Other solids
+//! (meshes, user solids) are searched: a ray samples `φ` at `ray_samples` points, refines
+//! each sign change by regula falsi to `|φ| ≤ 1e-10 h` and searches intervals whose end
+//! values leave room for a thin sliver of solid (bisection down to `1e-6 h`). For solids with
+//! a known Lipschitz bound ([`Sdf::lipschitz_bound`], 1 for exact distances) samples and
+//! searches that the bound rules out are skipped: the crossings, and the brackets they are
+//! refined from, are those of the full search, so the map is bit-identical (on the tank
+//! below: 9.4 distance evaluations per ray instead of 19.3). For such solids the sliver
+//! search is also skipped in the first interval of rays from nodes on the surface
+//! (`|φ| ≤` rounding): it would bisect towards the surface the node lies on, down to
+//! `1e-6 h`. This changes a map only where a solid sliver lies within `h / ray_samples` of
+//! such a node (the property test `lipschitz_skips_are_bit_identical_to_the_full_search`
+//! checks nodes on walls, edges and corners); closed-form intervals agree with the search to
+//! its root tolerance (`closed_form_intervals_agree_with_the_search`). Nodes are built in
+//! parallel by rows, each node on its own, so parallel and sequential builds are
+//! bit-identical. SPlisHSPlasH's dam-break tank (4 × 3 × 1.5 m, cubic spline, `h = 0.05` m,
+//! `f32`): 1.06e7 nodes, 2.3e6 in the band, 2.4e5 by quadrature, 2.9e6 stored (203 MB as a
+//! cache file); dated timings against SPlisHSPlasH in `docs/performance.md`. 32 × 64
+//! directions cost 4× the quadrature time.
 //!
 //! # Cache
 //!
@@ -477,48 +480,46 @@ impl<R: Real> VolumeMap<R> {
             ),
             Interpolation::NodePlanes => {
                 let [nx, ny, nz] = dims;
-                let slabs: Vec<(Vec<u32>, Vec<NodeModel>)> = (0..nz)
+                // Rows of nodes in parallel (fine enough that the quadrature nodes, which
+                // gather near edges, spread over the threads), each node on its own.
+                let slabs: Vec<(Vec<u32>, Vec<NodeModel>)> = (0..nz * ny)
                     .into_par_iter()
-                    .map(|k| {
-                        let mut index = Vec::with_capacity(nx * ny);
+                    .map(|row| {
+                        let (j, k) = (row % ny, row / ny);
+                        let mut index = Vec::with_capacity(nx);
                         let mut models = Vec::new();
-                        for j in 0..ny {
-                            for i in 0..nx {
-                                let p = origin + Vec3::new(i as f64, j as f64, k as f64) * cell;
-                                let (
-                                    phi,
-                                    n,
-                                    NodeCorrection {
-                                        c,
-                                        grad: g,
-                                        hess: hs,
-                                    },
-                                ) = node(p);
-                                if phi >= reach {
-                                    index.push(FAR);
-                                } else if phi <= -reach {
-                                    index.push(DEEP);
-                                } else {
-                                    let pure =
-                                        c == 0.0 && g == Vec3::zeros() && hs == Matrix3::zeros();
-                                    index.push(
-                                        models.len() as u32 | if pure { PLANE_BIT } else { 0 },
-                                    );
-                                    models.push(NodeModel {
-                                        phi: phi as f32,
-                                        n: [n.x as f32, n.y as f32, n.z as f32],
-                                        c: c as f32,
-                                        g: [g.x as f32, g.y as f32, g.z as f32],
-                                        hess: [
-                                            hs[(0, 0)] as f32,
-                                            hs[(1, 1)] as f32,
-                                            hs[(2, 2)] as f32,
-                                            hs[(0, 1)] as f32,
-                                            hs[(0, 2)] as f32,
-                                            hs[(1, 2)] as f32,
-                                        ],
-                                    });
-                                }
+                        for i in 0..nx {
+                            let p = origin + Vec3::new(i as f64, j as f64, k as f64) * cell;
+                            let (
+                                phi,
+                                n,
+                                NodeCorrection {
+                                    c,
+                                    grad: g,
+                                    hess: hs,
+                                },
+                            ) = node(p);
+                            if phi >= reach {
+                                index.push(FAR);
+                            } else if phi <= -reach {
+                                index.push(DEEP);
+                            } else {
+                                let pure = c == 0.0 && g == Vec3::zeros() && hs == Matrix3::zeros();
+                                index.push(models.len() as u32 | if pure { PLANE_BIT } else { 0 });
+                                models.push(NodeModel {
+                                    phi: phi as f32,
+                                    n: [n.x as f32, n.y as f32, n.z as f32],
+                                    c: c as f32,
+                                    g: [g.x as f32, g.y as f32, g.z as f32],
+                                    hess: [
+                                        hs[(0, 0)] as f32,
+                                        hs[(1, 1)] as f32,
+                                        hs[(2, 2)] as f32,
+                                        hs[(0, 1)] as f32,
+                                        hs[(0, 2)] as f32,
+                                        hs[(1, 2)] as f32,
+                                    ],
+                                });
                             }
                         }
                         (index, models)
