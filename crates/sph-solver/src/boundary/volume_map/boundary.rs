@@ -6,8 +6,10 @@ use std::sync::Arc;
 use sph_core::{Aabb, Real, Sdf, Vec3};
 use sph_kernels::{Kernel, KernelKind};
 
+use super::key::{VolumeMapCache, VolumeMapKey};
+use super::map::{CacheUse, VolumeMap};
+use super::options::{invalid, VolumeMapOptions};
 use super::quadrature::KernelTables;
-use super::{invalid, CacheUse, VolumeMap, VolumeMapCache, VolumeMapKey, VolumeMapOptions};
 use crate::boundary::{project_out, Boundary, BoundarySample};
 use crate::SolverError;
 

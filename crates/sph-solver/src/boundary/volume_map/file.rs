@@ -23,21 +23,19 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use sha2::{Digest, Sha256};
 use sph_core::{Real, SampledGrid, Vec3};
 
-use super::key::VolumeMapKey;
+use super::key::{VolumeMapKey, FORMAT_VERSION};
+use super::map::{CacheUse, NodeModel, Storage, VolumeMap, VolumeMapStats, DEEP, PLANE_BIT};
 use super::quadrature::KernelTables;
-use super::{NodeModel, Storage, VolumeMap, VolumeMapStats};
 use crate::error::MapFileProblem;
 use crate::SolverError;
 
 /// The magic bytes that open every volume-map file.
 pub const MAGIC: [u8; 8] = *b"SPHVMAP\x1a";
-/// The version of the file layout this build reads and writes.
-pub const FORMAT_VERSION: u32 = 1;
 /// Magic, version and total length.
 const HEADER: usize = 8 + 4 + 8;
 const CHECKSUM: usize = 32;
@@ -236,8 +234,7 @@ fn decode<R: Real>(
             if flat_cells.len() != cells.div_ceil(64) {
                 return Err(MapFileProblem::Malformed("cell bits do not match the grid"));
             }
-            let bad =
-                |&v: &u32| v < super::DEEP && (v & !super::PLANE_BIT) as usize >= models.len();
+            let bad = |&v: &u32| v < DEEP && (v & !PLANE_BIT) as usize >= models.len();
             if index.iter().any(bad) {
                 return Err(MapFileProblem::Malformed(
                     "node index points past the models",
@@ -416,6 +413,49 @@ pub(crate) fn write_map<R: Real>(
         }
     }
     Ok(())
+}
+
+impl<R: Real> VolumeMap<R> {
+    /// Writes this map, built for `key`, to `path`, atomically (a temporary file beside
+    /// `path`, `fsync`, rename): a reader never sees a partial file.
+    ///
+    /// Errors: [`SolverError::MapFile`] with [`MapFileProblem::Io`](crate::MapFileProblem::Io).
+    pub fn write_file(&self, path: &Path, key: &VolumeMapKey) -> Result<(), SolverError> {
+        write_map(path, self, key)
+    }
+
+    /// Reads the map of `key` (whose solid must be the one passed to [`VolumeMap::sample`])
+    /// from `path`, written by [`VolumeMap::write_file`].
+    ///
+    /// File layout (integers little-endian): 8 bytes [`MAGIC`], 4 bytes [`FORMAT_VERSION`],
+    /// 8 bytes total file length, the key (8-byte length, bytes: [`VolumeMapKey::as_bytes`]),
+    /// the payload (8-byte length, bytes: grid, node models, statistics), and the SHA-256 of
+    /// all bytes before it. The reader checks, in this order, magic, version, length,
+    /// checksum, key and the payload's consistency, and refuses the file at the first
+    /// failure, loading nothing of it.
+    ///
+    /// Errors: [`SolverError::MapFile`] naming `path` and the
+    /// [`MapFileProblem`](crate::MapFileProblem): `Io`, `BadMagic`,
+    /// `UnsupportedVersion`, `Truncated`, `TrailingBytes`, `ChecksumMismatch`, `ForeignKey`
+    /// (a map of other inputs), `Malformed`; [`SolverError::Kernel`] for a key whose kernel
+    /// cannot be built.
+    pub fn read_file(path: &Path, key: &VolumeMapKey) -> Result<Self, SolverError> {
+        let kernel = key.kernel().build(key.support_radius())?;
+        let tables = Arc::new(KernelTables::new(&kernel));
+        Self::read_with_tables(path, key, tables)
+    }
+
+    pub(crate) fn read_with_tables(
+        path: &Path,
+        key: &VolumeMapKey,
+        tables: Arc<KernelTables>,
+    ) -> Result<Self, SolverError> {
+        let start = Instant::now();
+        let mut map = read_map(path, key, tables)?;
+        map.stats.load_time = start.elapsed();
+        map.stats.cache = CacheUse::Hit;
+        Ok(map)
+    }
 }
 
 #[cfg(test)]

@@ -8,11 +8,14 @@ use sha2::{Digest, Sha256};
 use sph_core::{push_fingerprint, Aabb, Real, Sdf};
 use sph_kernels::KernelKind;
 
-use super::file::FORMAT_VERSION;
+use super::options::{Interpolation, VolumeMapOptions};
 use super::quadrature::TABLE_INTERVALS;
-use super::{Interpolation, VolumeMapOptions};
 use crate::error::MapFileProblem;
 use crate::SolverError;
+
+/// The version of the volume-map file layout this build reads and writes (see
+/// [`VolumeMap::read_file`](super::VolumeMap::read_file)).
+pub const FORMAT_VERSION: u32 = 1;
 
 /// Version of the map construction: bump it whenever a change of the build moves any stored
 /// value (a quadrature, a tolerance, the node models), so that no cache serves maps of the
