@@ -5,6 +5,8 @@
 // NaN-rejecting checks are written as `!(x > 0.0)` on purpose.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+use std::sync::Arc;
+
 use sph_core::{
     sampling::cubic_lattice, Aabb, BoxSdf, GridSdf, Inverted, Plane, Real, Sdf, Sphere,
     TriangleMesh, Vec3,
@@ -13,6 +15,7 @@ use sph_core::{
 use crate::error::Ctx;
 use crate::geom::{cast3, fmt3, v3, AXES};
 use crate::limits::{MAX_PARTICLES, MAX_SDF_NODES};
+use crate::sample_cache::{FluidKey, FluidSample, SampleKey};
 use crate::{FluidSpec, Scene, SceneError, SolidSpec};
 
 /// The initial fluid particles of a scene ([`Scene::fluid_particles`]).
@@ -40,10 +43,10 @@ impl Scene {
     /// fluid by fluid in file order.
     pub fn fluid_particles<R: Real>(&self) -> Result<FluidParticles<R>, SceneError> {
         let ctx = Ctx::new(&self.source);
+        let samples = self.fluid_samples(&ctx)?;
         let (mut positions, mut velocities) = (Vec::new(), Vec::new());
-        for (i, f) in self.fluids.iter().enumerate() {
+        for (f, pts) in self.fluids.iter().zip(samples.iter()) {
             let (FluidSpec::Block { velocity, .. } | FluidSpec::Mesh { velocity, .. }) = f;
-            let pts = self.sample_fluid(&ctx, i)?;
             velocities.extend(std::iter::repeat_n(cast3::<R>(&v3(*velocity)), pts.len()));
             positions.extend(pts.iter().map(cast3::<R>));
         }
@@ -67,6 +70,30 @@ impl Scene {
         (0..3)
             .map(|a| ((e[a] / s) + 1e-9).floor().max(1.0))
             .product()
+    }
+
+    /// Every fluid's sample (f64, file order), from the scene's cache when the particle
+    /// checks already sampled this spacing and these fluids.
+    fn fluid_samples(&self, ctx: &Ctx) -> Result<FluidSample, SceneError> {
+        let key = SampleKey {
+            spacing: self.particle_spacing,
+            fluids: self
+                .fluids
+                .iter()
+                .map(|f| match f {
+                    FluidSpec::Block { min, max, .. } => FluidKey::Block {
+                        min: *min,
+                        max: *max,
+                    },
+                    FluidSpec::Mesh { mesh, .. } => FluidKey::Mesh(Arc::clone(&mesh.mesh)),
+                })
+                .collect(),
+        };
+        self.fluid_samples.get_or_sample(key, || {
+            (0..self.fluids.len())
+                .map(|i| self.sample_fluid(ctx, i))
+                .collect()
+        })
     }
 
     fn sample_fluid(&self, ctx: &Ctx, i: usize) -> Result<Vec<Vec3<f64>>, SceneError> {
@@ -185,7 +212,10 @@ impl Scene {
                     ));
                 }
             }
-            let pts = self.sample_fluid(ctx, i)?;
+        }
+        let samples = self.fluid_samples(ctx)?;
+        for (i, pts) in samples.iter().enumerate() {
+            let field = format!("fluid[{i}]");
             if pts.is_empty() {
                 return Err(ctx.invalid(
                     field,

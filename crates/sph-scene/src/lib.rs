@@ -262,6 +262,7 @@ mod parse;
 mod raw;
 mod read;
 mod render;
+mod sample_cache;
 mod solver_spec;
 mod spec;
 

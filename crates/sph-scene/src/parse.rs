@@ -19,6 +19,7 @@ use crate::raw::{
     RawBox, RawFluid, RawFluidKind, RawOutput, RawQuick, RawScene, RawSolid, RawSolidKind,
 };
 use crate::read::read_limited;
+use crate::sample_cache::FluidSampleCache;
 use crate::{
     FluidSpec, OutputSpec, Precision, QuickSpec, Scene, SceneError, SolidSpec, SolverSpec,
 };
@@ -121,6 +122,7 @@ fn from_raw(
         quick_overrides: raw.quick.as_ref().map(quick),
         render: raw.render,
         lines: Arc::default(),
+        fluid_samples: FluidSampleCache::default(),
     })
 }
 

@@ -10,6 +10,7 @@ use sph_core::{Aabb, TriangleMesh};
 use ssfr_render::RenderConfig;
 
 use crate::error::FieldLines;
+use crate::sample_cache::FluidSampleCache;
 use crate::SolverSpec;
 
 /// Floating-point precision the solver should run in.
@@ -222,6 +223,8 @@ pub struct Scene {
     pub render: Option<RenderConfig>,
     /// The line of each field path in the scene file, for the messages of [`Scene::check`].
     pub(crate) lines: Arc<FieldLines>,
+    /// The fluid sample of the last particle check, for the set-up that follows.
+    pub(crate) fluid_samples: FluidSampleCache,
 }
 
 impl Scene {

@@ -41,3 +41,27 @@ fn new_is_setup_then_from_setup() {
     }
     assert_eq!(a.state.positions, b.state.positions);
 }
+
+/// The fluid sample that the load-time checks took is reused by the set-up only for the
+/// scene it was taken from: after a typed edit of a fluid the set-up samples the edited
+/// block (as many particles as the lattice of the edited block, sampled here directly).
+#[test]
+fn an_edited_scene_is_sampled_again() {
+    let mut scene = dam_break();
+    let before = SceneSetup::<f32>::new(&scene).unwrap().state.len();
+    let sph_scene::FluidSpec::Block { min, max, .. } = &mut scene.fluids[0] else {
+        panic!("the dam-break fluid is a block")
+    };
+    max[1] = min[1] + 0.5 * (max[1] - min[1]);
+    let block = sph_core::Aabb {
+        min: sph_core::Vec3::from(*min),
+        max: sph_core::Vec3::from(*max),
+    };
+    scene.check().unwrap();
+    let edited = SceneSetup::<f32>::new(&scene).unwrap().state.len();
+    let lattice =
+        sph_core::sampling::cubic_lattice(&block, scene.particle_spacing, usize::MAX).unwrap();
+    assert_eq!(scene.fluids.len(), 1);
+    assert_eq!(edited, lattice.len());
+    assert!(edited < before, "{edited} vs {before}");
+}

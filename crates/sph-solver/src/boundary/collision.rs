@@ -3,6 +3,7 @@
 use std::fmt;
 
 use sph_core::{Real, Sdf, Vec3};
+use sph_kernels::KernelKind;
 
 use super::{project_out, Boundary, BoundarySample};
 use crate::SolverError;
@@ -55,7 +56,7 @@ impl<R: Real> Boundary<R> for CollisionBoundary<R> {
     fn has_volume(&self) -> bool {
         false
     }
-    fn volume_kernel(&self) -> Option<(&'static str, R)> {
+    fn volume_kernel(&self) -> Option<(KernelKind, R)> {
         None
     }
     fn sample(&self, _x: &Vec3<R>) -> BoundarySample<R> {

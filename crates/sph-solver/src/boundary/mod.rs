@@ -67,10 +67,10 @@ pub trait Boundary<R: Real>: Send + Sync {
     fn solids(&self) -> &[Box<dyn Sdf<R>>];
     /// Whether [`Boundary::sample`] can be non-zero (the boundary takes part in the density).
     fn has_volume(&self) -> bool;
-    /// The kernel the boundary volumes were integrated with, as `(name, support radius)`
-    /// (`None` when [`Boundary::has_volume`] is false). Solvers refuse a boundary whose
-    /// kernel differs from their density kernel.
-    fn volume_kernel(&self) -> Option<(&'static str, R)>;
+    /// The kernel the boundary volumes were integrated with and its support radius (`None`
+    /// when [`Boundary::has_volume`] is false). Solvers refuse a boundary whose kernel
+    /// differs from their density kernel.
+    fn volume_kernel(&self) -> Option<(KernelKind, R)>;
     /// `Ψ` and `∇Ψ` at `x` (zero when the boundary has no volume).
     fn sample(&self, x: &Vec3<R>) -> BoundarySample<R>;
     /// The contact response: `x` moved out of each solid in turn, along the solid's SDF
@@ -104,7 +104,7 @@ pub fn check_volume_kernel<R: Real>(
         return Ok(());
     }
     match boundary.volume_kernel() {
-        Some((name, hb)) if name == kernel.name() && (hb - h).abs() <= h * R::of_f64(1e-6) => Ok(()),
+        Some((kind, hb)) if kind == kernel && (hb - h).abs() <= h * R::of_f64(1e-6) => Ok(()),
         Some((_, hb)) => Err(SolverError::InvalidParameter {
             solver,
             name: "boundary",

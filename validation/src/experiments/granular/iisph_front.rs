@@ -13,7 +13,7 @@
 //! calibrated), and the front then led the measurements by up to 33 %.
 
 use anyhow::Result;
-use sph_scene::{BoundaryModel, IisphSettings, InitialMasses, Precision, Scene};
+use sph_scene::{BoundaryModel, IisphSettings, InitialMasses, Scene};
 
 use super::scene_edit::{iisph_solver, shipped};
 use crate::experiments::pbf::front::{interpolate, simulate, FrontRun};
@@ -59,10 +59,7 @@ pub fn run(ctx: &Context, measured: &[(f64, f64)]) -> Result<IisphFront> {
         series,
         particles,
         calibration,
-    } = match scene.precision {
-        Precision::F32 => simulate::<f32>(ctx, &scene)?,
-        Precision::F64 => simulate::<f64>(ctx, &scene)?,
-    };
+    } = sph_sim::with_precision!(scene.precision, R => simulate::<R>(ctx, &scene)?);
     let worst_relative_error = measured
         .iter()
         .map(|&(t, z)| (interpolate(&series, t).unwrap_or(f64::NAN) - z) / z)

@@ -201,8 +201,8 @@ impl<R: Real> Boundary<R> for VolumeMapBoundary<R> {
     fn has_volume(&self) -> bool {
         true
     }
-    fn volume_kernel(&self) -> Option<(&'static str, R)> {
-        Some((self.kernel.name(), self.support_radius))
+    fn volume_kernel(&self) -> Option<(KernelKind, R)> {
+        Some((self.kernel, self.support_radius))
     }
     fn sample(&self, x: &Vec3<R>) -> BoundarySample<R> {
         let mut out = BoundarySample::default();
