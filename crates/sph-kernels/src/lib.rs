@@ -1,3 +1,7 @@
+#![doc = include_str!("../README.md")]
+//!
+//! ## In detail
+//!
 //! SPH smoothing kernels as values.
 //!
 //! Every kernel is a small `Copy` value built from its **support radius** `h` (absolute

@@ -1,3 +1,7 @@
+#![doc = include_str!("../README.md")]
+//!
+//! ## In detail
+//!
 //! Scene files (TOML) shared by the workspace's particle solvers (PBF, PCISPH; later an IISPH
 //! granular solver): fluid blocks and meshes, the tank, solid obstacles, solver parameters,
 //! duration and output.

@@ -1,3 +1,7 @@
+#![doc = include_str!("../README.md")]
+//!
+//! ## In detail
+//!
 //! Symplectic integrators for the planets and small bodies of the Solar System.
 //!
 //! Implements
