@@ -107,7 +107,7 @@
 //! [`AnyKernel`], which implements [`Kernel`] with `DIM = 3` by dispatching on a `match`.
 
 use nalgebra::SVector;
-pub use sph_core::Real;
+pub use sph_core::{Real, Vec3};
 
 mod any;
 mod cubic;
