@@ -3,14 +3,14 @@
 //! 1. `cargo package --no-verify` writes the tarball of every crate that is published (all
 //!    but the `publish = false` ones, read from `cargo metadata`) to `target/package/`.
 //! 2. The tarballs are unpacked into `target/package-check/crates/`, beside a user project
-//!    `target/package-check/user/` with one program per crate: the example of the crate's
-//!    packaged README (its front door). The unpacked crates and the user project form a
+//!    `target/package-check/user/`, one program that runs the example of every crate's
+//!    packaged README (its front door) in turn. The unpacked crates and the user project form a
 //!    scratch workspace outside this one, whose `[patch.crates-io]` points every published
 //!    name at its unpacked crate, so the crates resolve one another by version as they would
 //!    from crates.io; this workspace's `Cargo.lock` pins the other dependencies.
 //! 3. The user project is built in release against the unpacked crates, sharing this
 //!    workspace's `target/` (dependencies compiled by `cargo test --release` are reused), and
-//!    every program is run. A missing file, re-export or dependency version fails here.
+//!    program is run. A missing file, re-export or dependency version fails here.
 //!
 //! With `--tests`, the unpacked crates' own tests (unit, integration, doc) run as well
 //! (`cargo test --release --workspace` in the scratch workspace): the packaged tests build
@@ -81,7 +81,7 @@ fn lib_name(manifest: &str, package: &str) -> String {
     package.replace('-', "_")
 }
 
-/// The first ```rust block of a README as the body of a `main` returning
+/// The first ```rust block of a README as a module whose `run` returns
 /// `Result<(), Box<dyn Error>>`: doc-test hidden lines (`# …`) are kept as code, the closing
 /// `Ok::<(), E>(())` becomes `Ok(())`.
 fn readme_program(readme: &str, package: &str) -> Result<String> {
@@ -103,14 +103,15 @@ fn readme_program(readme: &str, package: &str) -> Result<String> {
     }
     Ok(format!(
         "//! The README example of `{package}`, built against its packaged crate.\n\
-         fn main() -> Result<(), Box<dyn std::error::Error>> {{\n{body}    Ok(())\n}}\n"
+         pub fn run() -> Result<(), Box<dyn std::error::Error>> {{\n{body}    Ok(())\n}}\n"
     ))
 }
 
 /// Writes the scratch workspace (manifest, lock file, user project) for `crates`.
 fn write_scratch(root: &Path, scratch: &Path, crates: &[Unpacked]) -> Result<()> {
     let user = scratch.join("user");
-    std::fs::create_dir_all(user.join("src/bin"))?;
+    std::fs::create_dir_all(user.join("src"))?;
+    let (mut mods, mut calls) = (String::new(), String::new());
     let mut ws = String::from(
         "# Written by `cargo xtask package-check`: the packaged crates and a user of them.\n\
          [workspace]\nresolver = \"2\"\nmembers = [\"user\"",
@@ -132,11 +133,25 @@ fn write_scratch(root: &Path, scratch: &Path, crates: &[Unpacked]) -> Result<()>
         let readme = std::fs::read_to_string(c.dir.join("README.md"))
             .with_context(|| format!("{}: the package has no README.md", c.package))?;
         let program = readme_program(&readme, &c.package)?;
-        std::fs::write(
-            user.join(format!("src/bin/front-door-{}.rs", c.lib)),
-            program,
+        std::fs::write(user.join(format!("src/front_door_{}.rs", c.lib)), program)?;
+        writeln!(mods, "mod front_door_{};", c.lib)?;
+        writeln!(
+            calls,
+            "    (\"{} {}\", front_door_{}::run),",
+            c.package, c.version, c.lib
         )?;
     }
+    let main = format!(
+        "//! Runs the README example of every packaged crate.\n{mods}\n\
+         type Example = fn() -> Result<(), Box<dyn std::error::Error>>;\n\n\
+         const EXAMPLES: [(&str, Example); {n}] = [\n{calls}];\n\n\
+         fn main() {{\n    for (name, run) in EXAMPLES {{\n        if let Err(e) = run() {{\n            \
+         eprintln!(\"package-check: the README example of {{name}} failed: {{e}}\");\n            \
+         std::process::exit(1);\n        }}\n        \
+         println!(\"package-check: {{name}}: README example ran\");\n    }}\n}}\n",
+        n = crates.len()
+    );
+    std::fs::write(user.join("src/main.rs"), main)?;
     ws.push_str("]\n");
     ws.push_str(&patch);
     ws.push_str("\n[profile.release]\ndebug = 1\n");
@@ -257,21 +272,15 @@ pub fn run(tests: bool) -> Result<()> {
     let env = [("CARGO_TARGET_DIR", target.as_path())];
     cargo_in(
         &scratch,
-        &["build", "--release", "--quiet", "-p", USER, "--bins"],
+        &["build", "--release", "--quiet", "-p", USER],
         &env,
     )?;
-    for c in &crates {
-        let bin = target.join(format!("release/front-door-{}", c.lib));
-        let status = Command::new(&bin)
-            .status()
-            .with_context(|| format!("running {}", bin.display()))?;
-        if !status.success() {
-            bail!("the README example of {} failed ({status})", c.package);
-        }
-        println!(
-            "package-check: {} {}: README example ran",
-            c.package, c.version
-        );
+    let bin = target.join(format!("release/{USER}"));
+    let status = Command::new(&bin)
+        .status()
+        .with_context(|| format!("running {}", bin.display()))?;
+    if !status.success() {
+        bail!("a README example failed ({status})");
     }
     if tests {
         cargo_in(
