@@ -10,12 +10,17 @@
 //!   — build the command-line crate `particles-cli` in release and run `particles run|render|
 //!   repose ARGS...` from the directory the command was typed in (see `particles --help`).
 //! - `cargo xtask bench [ARGS...]` — `cargo bench -p benches -- ARGS...` (criterion).
+//! - `cargo xtask package-check [--tests]` — packages every published crate, unpacks the
+//!   tarballs and builds and runs each crate's README example against them as a user's
+//!   project would ([`package_check`]); `--tests` also runs the packaged crates' tests.
 //!
 //! Deliberately light: clap + anyhow + std. Cargo is the one running this (`$CARGO`).
 
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
+
+mod package_check;
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
@@ -93,6 +98,14 @@ enum Task {
         )]
         args: Vec<OsString>,
     },
+    /// Package the published crates and build and run each README example against the
+    /// tarballs, as a user's project outside the workspace (`--tests`: also the packaged
+    /// crates' own tests).
+    PackageCheck {
+        /// Also run the unpacked crates' tests (many minutes).
+        #[arg(long)]
+        tests: bool,
+    },
     /// Run the criterion benchmarks: `cargo bench -p benches -- ARGS...`.
     Bench {
         /// Arguments passed to criterion (e.g. a filter, `--save-baseline main`).
@@ -161,6 +174,15 @@ fn main() -> ExitCode {
         }
         _ => workspace_root(),
     };
+    if let Task::PackageCheck { tests } = cli.command {
+        return match package_check::run(tests) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(e) => {
+                eprintln!("xtask package-check: {e:#}");
+                ExitCode::from(1)
+            }
+        };
+    }
     let args = match cli.command {
         Task::Validate { full, only, out } => {
             let mut a = os(&["run", "--release", "-p", "validation", "--", "run"]);
@@ -184,6 +206,7 @@ fn main() -> ExitCode {
         Task::Repose { args } => particles("repose", args),
         Task::Comets { args } => particles("comets", args),
         Task::List => os(&["run", "--release", "-p", "validation", "--", "list"]),
+        Task::PackageCheck { .. } => unreachable!("handled above"),
         Task::Bench { args } => {
             let mut a = os(&["bench", "-p", "benches", "--"]);
             a.extend(args);

@@ -1,3 +1,7 @@
+#![doc = include_str!("../README.md")]
+//!
+//! ## In detail
+//!
 //! Implicit incompressible SPH for water and granular matter ([`Iisph`]), implementing
 //!
 //! > André Neder, *Real-time Simulation of Granular Matter using Smoothed Particle
@@ -223,6 +227,7 @@ mod passes;
 mod scratch;
 mod solver;
 pub mod upscale;
+mod walls;
 
 pub use kernels::IISPH_KERNEL;
 pub use params::{
@@ -231,9 +236,14 @@ pub use params::{
     MAX_PRESSURE_ITERATIONS,
 };
 pub use solver::{Iisph, IisphScheme, IISPH_PHASES, IISPH_STATE_ARRAYS};
+pub use walls::volume_map_walls;
 
-pub use sph_core::{ParticleSet, Real, Vec3};
+pub use sph_core::{
+    sampling::cubic_lattice, Aabb, BoxSdf, Inverted, ParticleSet, Plane, Real, Sdf, Sphere, Vec3,
+};
+pub use sph_solver::boundary::{VolumeMapBoundary, VolumeMapCache, VolumeMapOptions};
+pub use sph_solver::initial::{calibrate_masses, density_ratios, MassCalibration};
 pub use sph_solver::{
     Boundary, CollisionBoundary, CommonParams, FluidSolver, FrameSolver, KernelKind, Solids,
-    SolverError, SolverState, StepStats, SubstepScheme,
+    SolverError, SolverState, StepStats, SubstepScheme, VOLUME_MAP_CONTACT_FRACTION,
 };

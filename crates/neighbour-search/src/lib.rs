@@ -1,3 +1,7 @@
+#![doc = include_str!("../README.md")]
+//!
+//! ## In detail
+//!
 //! Fixed-radius neighbour search for particle simulations.
 //!
 //! Given positions `x_i` and a radius `h`, find for every particle all `j ≠ i` with

@@ -1,3 +1,7 @@
+#![doc = include_str!("../README.md")]
+//!
+//! ## In detail
+//!
 //! Position Based Fluids: the solver core of
 //!
 //! > Miles Macklin and Matthias Müller, "Position Based Fluids", *ACM Transactions on
@@ -199,7 +203,11 @@ pub use scratch::PbfScratch;
 pub use solver::{ConstraintEval, Pbf, PbfScheme, PBF_PHASES};
 
 pub use neighbour_search::Method;
+pub use sph_core::{sampling::cubic_lattice, Aabb, BoxSdf, Inverted, Plane, Sphere};
 pub use sph_core::{ParticleSet, Real, Sdf, Vec3};
+pub use sph_solver::boundary::{VolumeMapBoundary, VolumeMapCache, VolumeMapOptions};
+pub use sph_solver::initial::{calibrate_masses, density_ratios, MassCalibration};
+pub use sph_solver::VOLUME_MAP_CONTACT_FRACTION;
 pub use sph_solver::{
     Boundary, CollisionBoundary, CommonParams, FluidSolver, FrameSolver, KernelKind, Solids,
     SolverError, SolverState, StepStats, SubstepScheme,

@@ -1,3 +1,7 @@
+#![doc = include_str!("../README.md")]
+//!
+//! ## In detail
+//!
 //! The PCISPH solver ([`Pcisph`]), the baseline of
 //!
 //! > Barbara Solenthaler and Renato Pajarola, "Predictive-Corrective Incompressible SPH",
@@ -186,7 +190,11 @@ pub use kernels::PCISPH_KERNEL;
 pub use params::{PcisphParams, DEFAULT_PCISPH_XSPH, MAX_PRESSURE_ITERATIONS};
 pub use solver::{Pcisph, PcisphScheme, PCISPH_PHASES};
 
+pub use sph_core::{sampling::cubic_lattice, Aabb, BoxSdf, Inverted, Plane, Sphere};
 pub use sph_core::{ParticleSet, Real, Vec3};
+pub use sph_solver::boundary::{VolumeMapBoundary, VolumeMapCache, VolumeMapOptions};
+pub use sph_solver::initial::{calibrate_masses, density_ratios, MassCalibration};
+pub use sph_solver::VOLUME_MAP_CONTACT_FRACTION;
 pub use sph_solver::{
     Boundary, CollisionBoundary, CommonParams, FluidSolver, FrameSolver, KernelKind, Solids,
     SolverError, SolverState, StepStats, SubstepScheme,

@@ -1,3 +1,7 @@
+#![doc = include_str!("../README.md")]
+//!
+//! ## In detail
+//!
 //! Shared foundation of the particle-simulation workspace.
 //!
 //! Everything numeric in the workspace is generic over [`Real`] (implemented for `f32` and

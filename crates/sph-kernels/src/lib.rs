@@ -1,3 +1,7 @@
+#![doc = include_str!("../README.md")]
+//!
+//! ## In detail
+//!
 //! SPH smoothing kernels as values.
 //!
 //! Every kernel is a small `Copy` value built from its **support radius** `h` (absolute
@@ -103,7 +107,7 @@
 //! [`AnyKernel`], which implements [`Kernel`] with `DIM = 3` by dispatching on a `match`.
 
 use nalgebra::SVector;
-pub use sph_core::Real;
+pub use sph_core::{Real, Vec3};
 
 mod any;
 mod cubic;

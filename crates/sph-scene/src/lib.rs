@@ -1,6 +1,10 @@
-//! Scene files (TOML) shared by the workspace's particle solvers (PBF, PCISPH; later an IISPH
-//! granular solver): fluid blocks and meshes, the tank, solid obstacles, solver parameters,
-//! duration and output.
+#![doc = include_str!("../README.md")]
+//!
+//! ## In detail
+//!
+//! Scene files (TOML) shared by the workspace's particle solvers (PBF, PCISPH, and IISPH for
+//! water and granular matter): fluid blocks and meshes, the tank, solid obstacles, solver
+//! and boundary parameters, duration, output and rendering.
 //!
 //! [`Scene::load`] reads a file and checks it ([`Scene::check`], which a program that edits
 //! a scene's fields calls again); [`Scene::fluid_particles`] samples the initial particles

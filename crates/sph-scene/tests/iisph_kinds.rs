@@ -184,14 +184,3 @@ fn quick_iterations_below_the_minimum_refused() {
         Scene::parse_str(&text, &fixture_dir("iisph_quick").join("iisph_quick.toml")).unwrap_err();
     assert_names(&e, "iisph_quick", "quick.iterations", "min_iterations = 2");
 }
-
-/// The shipped IISPH dam break reads as an IISPH scene with volume-map walls.
-#[test]
-fn shipped_dam_break_iisph() {
-    let path =
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/dam_break_iisph.toml");
-    let s = Scene::load(&path).unwrap();
-    assert_eq!(s.solver.kind(), SolverKind::Iisph);
-    assert_eq!(s.boundary.model, sph_scene::BoundaryModel::VolumeMap);
-    assert_eq!(s.solver.substeps(), 8);
-}

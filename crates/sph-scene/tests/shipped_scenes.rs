@@ -1,5 +1,7 @@
 //! The scenes shipped in `scenes/` parse, produce the particle counts stated in their
-//! comments (within ±15 % of the paper's targets), and build their solids.
+//! comments (within ±15 % of the paper's targets), and build their solids. They read the
+//! workspace's `scenes/`, so this file stays out of the published package (`exclude` in
+//! `Cargo.toml`).
 
 use std::path::{Path, PathBuf};
 
@@ -178,4 +180,14 @@ fn meshes_are_cached_and_grids_match_exact_distance() {
     }
     println!("dragon grid: max |grid - exact| at 50 points = {worst:.3} cells");
     assert!(worst < 0.97);
+}
+
+/// The shipped IISPH dam break reads as an IISPH scene with volume-map walls.
+#[test]
+fn shipped_dam_break_iisph() {
+    let path = scene_path("dam_break_iisph.toml");
+    let s = Scene::load(&path).unwrap();
+    assert_eq!(s.solver.kind(), sph_scene::SolverKind::Iisph);
+    assert_eq!(s.boundary.model, BoundaryModel::VolumeMap);
+    assert_eq!(s.solver.substeps(), 8);
 }

@@ -16,10 +16,9 @@ use sph_solver::{Boundary, CollisionBoundary, CommonParams, FluidSolver, SolverE
 
 use crate::error::SimError;
 
-/// Contact distance of the volume-map model, as a fraction of the particle radius `s/2`:
-/// particles are projected out of a solid only when closer than `s/4` to it (a safety net
-/// against tunnelling in fast impacts); at rest the boundary density keeps them near `s/2`.
-pub const VOLUME_MAP_CONTACT_FRACTION: f64 = 0.5;
+/// The contact distance of volume-map walls, as a fraction of the particle radius (defined
+/// in `sph-solver`, where every solver crate reaches it).
+pub use sph_solver::VOLUME_MAP_CONTACT_FRACTION;
 
 /// A solver or boundary refusing `scene`'s parameters.
 fn setup_error(scene: &Scene, source: SolverError) -> SimError {
@@ -101,7 +100,7 @@ pub fn build_boundary<R: Real>(
                 density_kernel(scene),
                 c.support_radius,
                 domain(scene, positions)?,
-                c.particle_radius() * R::of_f64(VOLUME_MAP_CONTACT_FRACTION),
+                c.volume_map_contact_distance(),
                 VolumeMapOptions::default(),
                 cache,
             )

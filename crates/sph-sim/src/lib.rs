@@ -1,3 +1,7 @@
+#![doc = include_str!("../README.md")]
+//!
+//! ## In detail
+//!
 //! Scene running as a library.
 //!
 //! - [`SceneSetup`]: a checked scene (`sph_scene::Scene`) built once — the solver's
@@ -42,7 +46,7 @@ pub use run::{run_scene, stats_header, stats_row, SceneRunOptions, STATS_COLUMNS
 pub use run_dir::RunDir;
 pub use setup::SceneSetup;
 pub use sim::SceneSim;
-pub use sph_scene::Precision;
+pub use sph_scene::{Precision, Scene};
 
 /// Runs `$body` with the type `$R` bound to the real type of precision `$p` (an
 /// `sph_scene::Precision`): the workspace's one precision dispatch.

@@ -8,7 +8,7 @@ use sph_scene::Scene;
 use sph_sim::{SceneSetup, SceneSim};
 
 fn dam_break() -> Scene {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/dam_break.toml");
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/dam_break.toml");
     Scene::load(&path).unwrap().quick()
 }
 

@@ -1,3 +1,7 @@
+#![doc = include_str!("../README.md")]
+//!
+//! ## In detail
+//!
 //! The shared layer of the workspace's particle solvers.
 //!
 //! - [`FluidSolver`]: the object-safe interface of every solver (PBF, PCISPH, …), so a scene
@@ -68,6 +72,7 @@ pub use fluid_solver::{FluidSolver, Solids};
 pub use frame::{FrameSolver, SchemeParts, SubstepScheme};
 pub use params::{
     CommonParams, DEFAULT_SUPPORT_OVER_SPACING, MAX_ITERATIONS_PER_FRAME, MAX_SUBSTEPS,
+    VOLUME_MAP_CONTACT_FRACTION,
 };
 pub use state::{ArraySpec, SolverState};
 pub use stats::{PhaseTimes, StepStats, MAX_PHASES};

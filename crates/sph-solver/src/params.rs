@@ -11,6 +11,12 @@ use crate::error::SolverError;
 /// value of SPlisHSPlasH's dam-break scene, `s = 0.025 m`, `h = 0.05 m`).
 pub const DEFAULT_SUPPORT_OVER_SPACING: f64 = 2.0;
 
+/// Contact distance of volume-map walls as a fraction of the particle radius `s/2`
+/// ([`CommonParams::volume_map_contact_distance`]): particles are projected out of a solid
+/// only when closer than `s/4` to it (a safety net against tunnelling in fast impacts); at
+/// rest the boundary density keeps them near `s/2`. The shipped scenes use it.
+pub const VOLUME_MAP_CONTACT_FRACTION: f64 = 0.5;
+
 /// Most substeps per frame a solver accepts, bounded by what can finish: 100 000 substeps
 /// took 40 minutes for 3 frames of a quick scene (2026-11), so 10 000 is at most a few
 /// minutes per quick frame; a frame of 16 ms in 10 000 substeps is a 1.6 µs step, far below
@@ -93,6 +99,13 @@ impl<R: Real> CommonParams<R> {
     /// Particle radius `s / 2` (m).
     pub fn particle_radius(&self) -> R {
         self.particle_spacing * R::of_f64(0.5)
+    }
+
+    /// The recommended contact distance of volume-map walls (m):
+    /// [`VOLUME_MAP_CONTACT_FRACTION`] of the particle radius, the `contact_distance` of
+    /// [`VolumeMapBoundary::new`](crate::VolumeMapBoundary::new) in the shipped scenes.
+    pub fn volume_map_contact_distance(&self) -> R {
+        self.particle_radius() * R::of_f64(VOLUME_MAP_CONTACT_FRACTION)
     }
 
     /// Length of one time step, `Δt = dt / substeps` (s).

@@ -240,16 +240,8 @@ pub struct SceneInfo {
 }
 
 impl RenderConfig {
-    /// Parses a `[render]` table; errors name the field path.
-    pub fn from_table(table: &toml::Table) -> Result<RenderConfig, SsfrError> {
-        let text = toml::to_string(table).map_err(|e| SsfrError::Config {
-            field: String::new(),
-            reason: e.to_string(),
-        })?;
-        Self::from_toml_str(&text)
-    }
-
-    /// Parses the contents of a `[render]` table given as TOML text.
+    /// Parses the contents of a `[render]` table given as TOML text; errors name the field
+    /// path. (A `RenderConfig` is also `serde::Deserialize`, for any other format.)
     pub fn from_toml_str(text: &str) -> Result<RenderConfig, SsfrError> {
         let de = toml::de::Deserializer::parse(text).map_err(|e| SsfrError::Config {
             field: String::new(),
@@ -453,18 +445,17 @@ mod tests {
                 }
             }
         }
-        let t: toml::Table = toml::from_str("width = 0").unwrap();
-        let e = RenderConfig::from_table(&t)
+        let e = RenderConfig::from_toml_str("width = 0")
             .unwrap()
             .resolve(&info)
             .unwrap_err();
         assert!(matches!(e, SsfrError::ImageSize { .. }));
-        let t: toml::Table =
-            toml::from_str("[smoothing]\nmethod = \"curvature-flow\"\niterations = 10").unwrap();
-        let p = RenderConfig::from_table(&t)
-            .unwrap()
-            .resolve(&info)
-            .unwrap();
+        let p = RenderConfig::from_toml_str(
+            "[smoothing]\nmethod = \"curvature-flow\"\niterations = 10",
+        )
+        .unwrap()
+        .resolve(&info)
+        .unwrap();
         assert!(matches!(
             p.smoothing,
             Smoothing::CurvatureFlow { iterations: 10, .. }

@@ -1,3 +1,7 @@
+#![doc = include_str!("../README.md")]
+//!
+//! ## In detail
+//!
 //! Screen-space fluid rendering on the CPU.
 //!
 //! Implements section IV ("Fluid surface rendering") of
@@ -117,6 +121,7 @@ pub use march::DepthTiles;
 pub use render::{FrameStats, RenderParams, Renderer, Smoothing, StageTimes};
 pub use shade::{Material, RefractDistance, Refraction};
 pub use smooth::{BilateralParams, NoiseParams};
+pub use sph_core::Vec3;
 pub use splat::{ParticleView, SplatBuffers, Splatter};
 
 /// Default sphere radius over the particle spacing `s`: 0.75. Spheres of radius `s/2` on a

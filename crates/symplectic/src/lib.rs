@@ -1,3 +1,7 @@
+#![doc = include_str!("../README.md")]
+//!
+//! ## In detail
+//!
 //! Symplectic integrators for the planets and small bodies of the Solar System.
 //!
 //! Implements
@@ -90,7 +94,8 @@
 //! // Ω = ω = 0 on the outbound branch), moved to the barycentre for the barycentric variant.
 //! let position = Vec3::new(-90.2133300970874, 11.477121391583594, 3.291011600830304);
 //! let velocity = Vec3::new(-3.3558225919028486e-4, -1.1900915840439576e-3, -3.4125327035499536e-4);
-//! let integrator = ParticleIntegrator::new(Variant::Barycentric, Scheme::S2, 0.0, 0.21e-6)?;
+//! // The paper's regularisation B0 = 0, B1 = 0.21e-6 AU³/day² (`PAPER_B0`, `PAPER_B1`).
+//! let integrator = ParticleIntegrator::paper(Variant::Barycentric, Scheme::S2);
 //! let mut scratch = ParticleScratch::default();
 //! let comet = integrator.particle(
 //!     position + sun_position,
@@ -163,8 +168,8 @@ pub use ephemeris::{BodyStates, Ephemeris};
 pub use maps::{Integrator, Piece, Stage, S2_STAGES, S6_C1, S6_C2, S6_D1, S6_D2, S6_STAGES};
 pub use particles::{
     MixedDomain, ParticleIntegrator, ParticlePiece, ParticleScratch, ParticleStage,
-    ParticleStepInfo, Scheme, TestParticle, Variant, MIXED_DOMAIN_MIN_RATIO, PARTICLE_S2_STAGES,
-    PARTICLE_S6_STAGES,
+    ParticleStepInfo, Scheme, TestParticle, Variant, MIXED_DOMAIN_MIN_RATIO, PAPER_B0, PAPER_B1,
+    PARTICLE_S2_STAGES, PARTICLE_S6_STAGES,
 };
 pub use planets::Planets;
 pub use population::{

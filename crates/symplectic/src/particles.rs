@@ -185,6 +185,16 @@ pub struct MixedDomain {
 /// (`cargo run --release -p symplectic --example mixed_domain_scan`).
 pub const MIXED_DOMAIN_MIN_RATIO: f64 = 2.0;
 
+/// Chegodaeva's (2004) `B₀` for her numerical experiments: 0 (energy units, AU²/day²).
+/// With [`PAPER_B1`], the barycentric variant's regularisation; valid for perihelia beyond
+/// ≈ 26 AU (condition 35).
+pub const PAPER_B0: f64 = 0.0;
+
+/// Chegodaeva's (2004) `B₁` for her numerical experiments: 0.21·10⁻⁶ AU³/day² (energy ×
+/// length), chosen for the barycentric variant; the mixed variant needs more
+/// ([`ParticleIntegrator::mixed_domain`]).
+pub const PAPER_B1: f64 = 0.21e-6;
+
 const GAUSS4_NODES: [f64; 4] = [
     0.069_431_844_202_973_71,
     0.330_009_478_207_571_87,
@@ -228,6 +238,17 @@ impl ParticleIntegrator {
             b0,
             b1,
         })
+    }
+
+    /// The integrator with the paper's regularisation constants [`PAPER_B0`] and
+    /// [`PAPER_B1`] (chosen for [`Variant::Barycentric`]).
+    pub fn paper(variant: Variant, scheme: Scheme) -> Self {
+        Self {
+            variant,
+            scheme,
+            b0: PAPER_B0,
+            b1: PAPER_B1,
+        }
     }
 
     /// The stages of the map.

@@ -9,7 +9,7 @@ pub const G: f64 = 2.959_122_082_86e-4;
 /// (masses incl. the Sun first, heliocentric positions, heliocentric velocities), from
 /// `reference-data/symplectic/outer_solar_system.csv`.
 pub fn outer_solar_system_table() -> (Vec<f64>, Vec<Vec3>, Vec<Vec3>) {
-    let text = include_str!("../../../../reference-data/symplectic/outer_solar_system.csv");
+    let text = include_str!("../data/outer_solar_system.csv");
     let (mut m, mut q, mut v) = (vec![], vec![], vec![]);
     for line in text.lines().filter(|l| !l.starts_with('#')).skip(1) {
         let f: Vec<f64> = line
@@ -126,7 +126,7 @@ pub struct ParticleRow {
 }
 
 pub fn particle_rows() -> Vec<ParticleRow> {
-    let text = include_str!("../../../../reference-data/symplectic/particles.csv");
+    let text = include_str!("../data/particles.csv");
     text.lines()
         .filter(|l| !l.starts_with('#'))
         .skip(1)
