@@ -10,8 +10,10 @@ Run from the workspace root, after `cargo build --release -p benches --example c
 throughput: particle-years per second for N = 10 … 10^6 (span chosen per N, printed), ours on
 1 and 2 threads (RAYON_NUM_THREADS), REBOUND on 1 thread (OMP_NUM_THREADS=1).
 accuracy: N = 200 comets for 10 kyr; the median over particles of the distance to a converged
-reference (REBOUND IAS15, evaluated at each particle's own final time), ours (S2 and S6 at
-several first steps) against REBOUND WHFast at tau = 365.25 d.
+reference (REBOUND IAS15, evaluated at each particle's own final time), ours (particles S2 or
+S6 at several first steps, planets S2 or S6) against REBOUND WHFast at tau = 365.25 d.
+`accuracy K` runs only the first K configurations (the first is the default: S2 particles,
+S6 planets at 365.25 d).
 """
 import csv
 import os
@@ -27,13 +29,13 @@ EXAMPLE = "target/release/examples/comet_throughput"
 YEAR = 365.25
 
 
-def run_ours(n, years, scheme="s2", dt0=YEAR, threads=1, initial=None, final=None):
+def run_ours(n, years, scheme="s2", dt0=YEAR, threads=1, initial=None, final=None, planets="s6", planet_step=YEAR):
     env = dict(os.environ, RAYON_NUM_THREADS=str(threads))
     if initial:
         env["COMET_THROUGHPUT_INITIAL"] = initial
     if final:
         env["COMET_THROUGHPUT_FINAL"] = final
-    out = subprocess.run([EXAMPLE, str(n), str(years), scheme, repr(dt0)], env=env,
+    out = subprocess.run([EXAMPLE, str(n), str(years), scheme, repr(dt0), planets, repr(planet_step)], env=env,
                          check=True, capture_output=True, text=True).stdout
     last = out.strip().splitlines()[-1]
     return dict(kv.split("=") for kv in last.split())
@@ -98,11 +100,18 @@ def accuracy(n=200, years=10_000.0):
     wh_pos = np.array([[wh.particles[nb + i].x, wh.particles[nb + i].y, wh.particles[nb + i].z] for i in range(n)])
     # Ours, several configurations, each particle at its own final time.
     runs = {}
-    for scheme, dt0 in [("s2", 365.25), ("s2", 182.625), ("s2", 91.3125), ("s6", 365.25), ("s6", 730.5)]:
-        line = run_ours(n, years, scheme=scheme, dt0=dt0, final=fin)
+    # (particle scheme, first particle step, planet map, planet step): the default (S2 particles,
+    # S6 planets at 365.25 d) first, then the planets by S2, then S6 throughout.
+    configs = [("s2", 365.25, "s6", 365.25), ("s2", 182.625, "s6", 365.25), ("s2", 365.25, "s2", 365.25),
+               ("s2", 365.25, "s2", 182.625), ("s6", 365.25, "s6", 365.25), ("s6", 730.5, "s6", 730.5)]
+    if len(sys.argv) > 2:
+        configs = configs[:int(sys.argv[2])]
+    for scheme, dt0, planets, planet_step in configs:
+        key = (scheme, dt0, planets, planet_step)
+        line = run_ours(n, years, scheme=scheme, dt0=dt0, final=fin, planets=planets, planet_step=planet_step)
         with open(fin) as f:
             rows = list(csv.DictReader(f))
-        runs[(scheme, dt0)] = (line, rows)
+        runs[key] = (line, rows)
     # Reference: IAS15, stopped at every time needed (sorted), recording the particle asked for.
     ref = rebound_sim(bodies, particles, integrator="ias15")
     wanted = [(wh_t, -1)]
@@ -125,7 +134,7 @@ def accuracy(n=200, years=10_000.0):
     for key, (line, rows) in runs.items():
         errs = np.array([np.linalg.norm(np.array([float(r[c]) for c in "xyz"]) - ref_at[(key, int(r["id"]))])
                          for r in rows if r["status"] == "active"])
-        print(f"ours {key[0]} dt0={key[1]} steps_per_particle_year={float(line['steps_per_particle_year']):.4f} "
+        print(f"ours {key[0]} dt0={key[1]} planets={key[2]} planet_step={key[3]} steps_per_particle_year={float(line['steps_per_particle_year']):.4f} "
               f"median_error_au={np.median(errs):.4e} p90_error_au={np.percentile(errs, 90):.4e} active={len(errs)}")
 
 

@@ -332,26 +332,30 @@ impl Ephemeris {
         }
         let x = (t - self.grid_time(k)) / tau;
         let w = QuinticHermite::at(x);
-        for j in 0..n1 {
-            let a = base + 9 * j;
-            let b = a + stride;
-            let (p0, v0, a0) = (
-                self.vec_at(a),
-                self.vec_at(a + 3) * tau,
-                self.vec_at(a + 6) * (tau * tau),
-            );
-            let (p1, v1, a1) = (
-                self.vec_at(b),
-                self.vec_at(b + 3) * tau,
-                self.vec_at(b + 6) * (tau * tau),
-            );
-            let combine = |c: &[f64; 6]| {
-                p0 * c[0] + v0 * c[1] + a0 * c[2] + p1 * c[3] + v1 * c[4] + a1 * c[5]
-            };
-            out.positions[j] = combine(&w.value);
-            out.velocities[j] = combine(&w.first) / tau;
+        // The weights with the scaling to the unit interval folded in (the stored velocities
+        // and accelerations are per day): one multiply-add per datum and component.
+        let (tau2, inv_tau) = (tau * tau, 1.0 / tau);
+        let fold = |c: &[f64; 6], s: f64| {
+            [
+                c[0] * s,
+                c[1] * (tau * s),
+                c[2] * (tau2 * s),
+                c[3] * s,
+                c[4] * (tau * s),
+                c[5] * (tau2 * s),
+            ]
+        };
+        let value = fold(&w.value, 1.0);
+        let first = fold(&w.first, inv_tau);
+        let second = fold(&w.second, inv_tau * inv_tau);
+        let grid = &self.grid[base..base + 2 * stride];
+        let (before, after) = grid.split_at(stride);
+        let (before, after) = (before.as_chunks::<9>().0, after.as_chunks::<9>().0);
+        for (j, (a, b)) in before.iter().zip(after).enumerate().take(n1) {
+            out.positions[j] = combine(a, b, &value);
+            out.velocities[j] = combine(a, b, &first);
             if accelerations {
-                out.accelerations[j] = combine(&w.second) / (tau * tau);
+                out.accelerations[j] = combine(a, b, &second);
             }
         }
     }
@@ -359,6 +363,18 @@ impl Ephemeris {
     fn vec_at(&self, o: usize) -> Vec3 {
         Vec3::from_column_slice(&self.grid[o..o + 3])
     }
+}
+
+/// `Σ_k c_k d_k` over the six data `d = (p₀, v₀, a₀, p₁, v₁, a₁)` of one body (`a` and `b` its
+/// nine stored values at the two grid points).
+#[inline(always)]
+fn combine(a: &[f64; 9], b: &[f64; 9], c: &[f64; 6]) -> Vec3 {
+    let mut out = [0.0; 3];
+    for (i, o) in out.iter_mut().enumerate() {
+        *o = a[i] * c[0] + a[3 + i] * c[1] + a[6 + i] * c[2] + b[i] * c[3] + b[3 + i] * c[4]
+            + b[6 + i] * c[5];
+    }
+    Vec3::new(out[0], out[1], out[2])
 }
 
 /// Weights of the quintic Hermite interpolant on `[0, 1]` for the data

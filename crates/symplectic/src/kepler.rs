@@ -36,20 +36,29 @@ pub fn stumpff(z: f64) -> [f64; 4] {
         x *= 0.25;
         n += 1;
     }
-    // Series (Horner form) for c2 and c3 at small x, then c1 = 1 − x c3, c0 = 1 − x c2.
+    // Series (Horner form) for c2 and c3 at small x, then c1 = 1 − x c3, c0 = 1 − x c2. The
+    // divisors are multiplied as reciprocals (constant-folded): a division costs several
+    // times a multiplication, and twelve of them made up most of a call.
     let c3 = (1.0
-        - x / 20.0
+        - x * (1.0 / 20.0)
             * (1.0
-                - x / 42.0
+                - x * (1.0 / 42.0)
                     * (1.0
-                        - x / 72.0 * (1.0 - x / 110.0 * (1.0 - x / 156.0 * (1.0 - x / 210.0))))))
-        / 6.0;
+                        - x * (1.0 / 72.0)
+                            * (1.0
+                                - x * (1.0 / 110.0)
+                                    * (1.0 - x * (1.0 / 156.0) * (1.0 - x * (1.0 / 210.0)))))))
+        * (1.0 / 6.0);
     let c2 = (1.0
-        - x / 12.0
+        - x * (1.0 / 12.0)
             * (1.0
-                - x / 30.0
-                    * (1.0 - x / 56.0 * (1.0 - x / 90.0 * (1.0 - x / 132.0 * (1.0 - x / 182.0))))))
-        / 2.0;
+                - x * (1.0 / 30.0)
+                    * (1.0
+                        - x * (1.0 / 56.0)
+                            * (1.0
+                                - x * (1.0 / 90.0)
+                                    * (1.0 - x * (1.0 / 132.0) * (1.0 - x * (1.0 / 182.0)))))))
+        * 0.5;
     let mut c = [1.0 - x * c2, 1.0 - x * c3, c2, c3];
     for _ in 0..n {
         let [c0, c1, c2, c3] = c;

@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::ephemeris::{BodyStates, Ephemeris};
 use crate::kepler::Elements;
-use crate::particles::{ParticleIntegrator, TestParticle};
+use crate::particles::{KickTerms, ParticleIntegrator, TestParticle};
 use crate::run::ParticleStatus;
 use crate::{SymplecticError, Variant, Vec3, WorkCounters};
 
@@ -129,6 +129,8 @@ struct Worker {
     bodies: BodyStates,
     /// Time `bodies` holds (`NaN` if none).
     bodies_time: f64,
+    /// The last barycentric kick's terms.
+    kick: KickTerms,
 }
 
 /// The read-only context of a window.
@@ -390,6 +392,7 @@ impl Population {
                 || Worker {
                     bodies: BodyStates::default(),
                     bodies_time: f64::NAN,
+                    kick: KickTerms::default(),
                 },
                 |w, m| ctx.advance_member(m, w),
             )
@@ -537,6 +540,7 @@ impl WindowContext<'_> {
                 &mut m.particle,
                 &mut w.bodies,
                 bodies_time,
+                &mut w.kick,
                 &mut |t: f64, out: &mut BodyStates| {
                     self.ephemeris.interpolate(t, out, accelerations)
                 },
