@@ -137,52 +137,21 @@ impl Ephemeris {
         self.first_index + ((self.grid.len() - self.offset) / self.stride()) as u64 - 1
     }
 
-    /// Appends the barycentric positions, velocities and accelerations of every body at the
-    /// planets' current state (written straight into the grid: no allocation per step once
-    /// the grid has its capacity).
+    /// Appends the barycentric state of every body at the planets' current state.
     fn push_state(&mut self) {
-        let n = self.planets.len();
-        let g = self.planets.g();
-        let m0 = self.planets.sun_mass();
-        let (sun_pos, sun_vel) = self.planets.sun_barycentric_state();
-        let base = self.grid.len();
-        self.grid.resize(base + 9 * (n + 1), 0.0);
-        let body = |j: usize| base + 9 * j;
-        self.grid[body(0)..body(0) + 3].copy_from_slice(sun_pos.as_slice());
-        self.grid[body(0) + 3..body(0) + 6].copy_from_slice(sun_vel.as_slice());
-        for i in 0..n {
-            let m = self.planets.masses()[i];
-            let o = body(i + 1);
-            let q = self.planets.positions()[i] + sun_pos;
-            let v = self.planets.momenta()[i] / m;
-            self.grid[o..o + 3].copy_from_slice(q.as_slice());
-            self.grid[o + 3..o + 6].copy_from_slice(v.as_slice());
-        }
-        let mass = |j: usize| {
-            if j == 0 {
-                m0
-            } else {
-                self.planets.masses()[j - 1]
-            }
-        };
-        self.work.force_evaluations += (n * (n + 1) / 2) as u64;
-        for j in 0..=n {
-            for k in j + 1..=n {
-                let d = self.vec_at(body(k)) - self.vec_at(body(j));
-                let r2 = d.norm_squared();
-                let f = d * (g / (r2 * r2.sqrt()));
-                let (aj, ak) = (
-                    self.vec_at(body(j) + 6) + f * mass(k),
-                    self.vec_at(body(k) + 6) - f * mass(j),
-                );
-                self.grid[body(j) + 6..body(j) + 9].copy_from_slice(aj.as_slice());
-                self.grid[body(k) + 6..body(k) + 9].copy_from_slice(ak.as_slice());
-            }
-        }
+        push_state(&self.planets, &mut self.grid, &mut self.work);
     }
 
     /// Integrates the planets until the grid covers time `t`.
     pub fn extend_to(&mut self, t: f64) -> Result<(), SymplecticError> {
+        let extension = self.extension(t)?;
+        self.append(extension)
+    }
+
+    /// The grid states from the newest one until `t` is covered, computed from a copy of the
+    /// planets without changing the ephemeris (so that the particles can read it meanwhile):
+    /// [`Ephemeris::append`] adds them. Exactly the states [`Ephemeris::extend_to`] computes.
+    pub(crate) fn extension(&self, t: f64) -> Result<Extension, SymplecticError> {
         // Grid times are start + k·τ with an integer k: exact only below 2⁵³ steps, and a
         // request that far out would run for ages. Refuse it by name instead.
         let steps_needed = (t - self.start_time) / self.grid_step();
@@ -193,17 +162,49 @@ impl Ephemeris {
                 reason: "beyond 2^52 planet steps from the start (or not finite): grid times would lose exactness",
             });
         }
-        while self.grid_time(self.planet_steps()) < t {
-            let step = self.planet_steps();
-            self.integrator.step(&mut self.planets)?;
-            if let Some(body) = self.planets.first_non_finite() {
-                return Err(SymplecticError::BlowUp { step, body });
+        let mut planets = self.planets.clone();
+        let mut states = Vec::new();
+        let mut work = WorkCounters::default();
+        let mut step = self.planet_steps();
+        while self.grid_time(step) < t {
+            if let Err(e) = self.integrator.step(&mut planets) {
+                return Ok(Extension {
+                    planets,
+                    states,
+                    work,
+                    error: Some(e),
+                });
+            }
+            if let Some(body) = planets.first_non_finite() {
+                let error = Some(SymplecticError::BlowUp { step, body });
+                return Ok(Extension {
+                    planets,
+                    states,
+                    work,
+                    error,
+                });
             }
             // Keep the planets' clock on the grid (no accumulation of rounding).
-            self.planets.set_time(self.grid_time(step + 1));
-            self.push_state();
+            planets.set_time(self.grid_time(step + 1));
+            push_state(&planets, &mut states, &mut work);
+            step += 1;
         }
-        Ok(())
+        Ok(Extension {
+            planets,
+            states,
+            work,
+            error: None,
+        })
+    }
+
+    /// Appends the states of an [`Ephemeris::extension`] computed from this ephemeris's newest
+    /// state (and the planets where they stopped); returns the planets' error if the
+    /// extension stopped on one.
+    pub(crate) fn append(&mut self, extension: Extension) -> Result<(), SymplecticError> {
+        self.planets = extension.planets;
+        self.grid.extend_from_slice(&extension.states);
+        self.work += extension.work;
+        extension.error.map_or(Ok(()), Err)
     }
 
     /// Drops the grid states no longer needed for times `>= t`.
@@ -362,6 +363,53 @@ impl Ephemeris {
 
     fn vec_at(&self, o: usize) -> Vec3 {
         Vec3::from_column_slice(&self.grid[o..o + 3])
+    }
+}
+
+/// Grid states computed ahead by [`Ephemeris::extension`].
+pub(crate) struct Extension {
+    planets: Planets,
+    states: Vec<f64>,
+    work: WorkCounters,
+    error: Option<SymplecticError>,
+}
+
+/// Appends to `grid` the barycentric positions, velocities and accelerations of every body at
+/// the state of `planets` (`9 (n+1)` values; no allocation once `grid` has its capacity),
+/// counting the `n(n+1)/2` pair forces in `work`.
+fn push_state(planets: &Planets, grid: &mut Vec<f64>, work: &mut WorkCounters) {
+    let n = planets.len();
+    let g = planets.g();
+    let m0 = planets.sun_mass();
+    let (sun_pos, sun_vel) = planets.sun_barycentric_state();
+    let base = grid.len();
+    grid.resize(base + 9 * (n + 1), 0.0);
+    let body = |j: usize| base + 9 * j;
+    let vec_at = |grid: &[f64], o: usize| Vec3::from_column_slice(&grid[o..o + 3]);
+    grid[body(0)..body(0) + 3].copy_from_slice(sun_pos.as_slice());
+    grid[body(0) + 3..body(0) + 6].copy_from_slice(sun_vel.as_slice());
+    for i in 0..n {
+        let m = planets.masses()[i];
+        let o = body(i + 1);
+        let q = planets.positions()[i] + sun_pos;
+        let v = planets.momenta()[i] / m;
+        grid[o..o + 3].copy_from_slice(q.as_slice());
+        grid[o + 3..o + 6].copy_from_slice(v.as_slice());
+    }
+    let mass = |j: usize| if j == 0 { m0 } else { planets.masses()[j - 1] };
+    work.force_evaluations += (n * (n + 1) / 2) as u64;
+    for j in 0..=n {
+        for k in j + 1..=n {
+            let d = vec_at(grid, body(k)) - vec_at(grid, body(j));
+            let r2 = d.norm_squared();
+            let f = d * (g / (r2 * r2.sqrt()));
+            let (aj, ak) = (
+                vec_at(grid, body(j) + 6) + f * mass(k),
+                vec_at(grid, body(k) + 6) - f * mass(j),
+            );
+            grid[body(j) + 6..body(j) + 9].copy_from_slice(aj.as_slice());
+            grid[body(k) + 6..body(k) + 9].copy_from_slice(ak.as_slice());
+        }
     }
 }
 

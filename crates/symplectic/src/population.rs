@@ -289,11 +289,7 @@ impl Population {
     /// `G M`, the sum of `G m_j` over the Sun and the planets (the `μ` of barycentric
     /// elements), summed as [`BodyStates::total_gm`] does.
     pub fn total_gm(&self) -> f64 {
-        let planets = self.ephemeris.planets();
-        let g = planets.g();
-        std::iter::once(g * planets.sun_mass())
-            .chain(planets.masses().iter().map(|m| g * m))
-            .sum()
+        total_gm(self.ephemeris.planets())
     }
 
     /// Barycentric position of member `i` at its own time.
@@ -357,8 +353,19 @@ impl Population {
             }
             let end = (self.time.max(oldest) + window).min(t_end);
             self.ephemeris.discard_before(oldest);
+            // Covered already by the previous window's extension, except at the start.
             self.ephemeris.extend_to((end + window).max(needed))?;
-            let (steps, beyond) = self.run_window(end);
+            // The planets of the next window are integrated while the particles step through
+            // this one (the same states, in the same order, as extending in turn).
+            let ahead = (end + window).min(t_end) + window;
+            let ephemeris = &self.ephemeris;
+            let members = &mut self.members;
+            let (integrator, rules) = (self.integrator, self.rules);
+            let (extension, (steps, beyond)) = rayon::join(
+                || ephemeris.extension(ahead),
+                || run_window(ephemeris, integrator, rules, members, end),
+            );
+            self.ephemeris.append(extension?)?;
             self.particle_steps += steps;
             needed = beyond;
             self.time = self.time.max(end);
@@ -366,37 +373,6 @@ impl Population {
         }
         self.time = self.time.max(t_end);
         Ok(self.progress())
-    }
-
-    /// One window: every active particle steps while its time is before `end`. Returns the
-    /// steps taken and the latest time a step needed beyond the ephemeris.
-    fn run_window(&mut self, end: f64) -> (u64, f64) {
-        let planets = self.ephemeris.planets();
-        let m0 = planets.sun_mass();
-        let ctx = WindowContext {
-            ephemeris: &self.ephemeris,
-            integrator: self.integrator,
-            rules: self.rules,
-            hill_coefficients: planets
-                .masses()
-                .iter()
-                .map(|m| (m / (3.0 * m0)).cbrt())
-                .collect(),
-            total_gm: self.total_gm(),
-            end,
-        };
-        self.members
-            .par_iter_mut()
-            .with_min_len(8)
-            .map_init(
-                || Worker {
-                    bodies: BodyStates::default(),
-                    bodies_time: f64::NAN,
-                    kick: KickTerms::default(),
-                },
-                |w, m| ctx.advance_member(m, w),
-            )
-            .reduce(|| (0, f64::NEG_INFINITY), |a, b| (a.0 + b.0, a.1.max(b.1)))
     }
 
     fn oldest_active_time(&self) -> Option<f64> {
@@ -515,6 +491,49 @@ impl Population {
     }
 }
 
+/// One window: every active member steps while its time is before `end`, reading `ephemeris`.
+/// Returns the steps taken and the latest time a step needed beyond the ephemeris.
+fn run_window(
+    ephemeris: &Ephemeris,
+    integrator: ParticleIntegrator,
+    rules: RemovalRules,
+    members: &mut [PopulationMember],
+    end: f64,
+) -> (u64, f64) {
+    let planets = ephemeris.planets();
+    let m0 = planets.sun_mass();
+    let ctx = WindowContext {
+        ephemeris,
+        integrator,
+        rules,
+        hill_coefficients: planets
+            .masses()
+            .iter()
+            .map(|m| (m / (3.0 * m0)).cbrt())
+            .collect(),
+        total_gm: total_gm(planets),
+        end,
+    };
+    members
+        .par_iter_mut()
+        .map_init(
+            || Worker {
+                bodies: BodyStates::default(),
+                bodies_time: f64::NAN,
+                kick: KickTerms::default(),
+            },
+            |w, m| ctx.advance_member(m, w),
+        )
+        .reduce(|| (0, f64::NEG_INFINITY), |a, b| (a.0 + b.0, a.1.max(b.1)))
+}
+
+fn total_gm(planets: &crate::Planets) -> f64 {
+    let g = planets.g();
+    std::iter::once(g * planets.sun_mass())
+        .chain(planets.masses().iter().map(|m| g * m))
+        .sum()
+}
+
 const POPULATION_FORMAT: &str = "symplectic-population";
 const POPULATION_VERSION: u32 = 1;
 
@@ -590,17 +609,19 @@ impl WindowContext<'_> {
         };
         let rules = &self.rules;
         if let Some(factor) = rules.hill_factor {
+            // Compared squared (no square root per planet and step); the distances are taken
+            // only for the report.
             let sun = bodies.positions[0];
             for (j, c) in self.hill_coefficients.iter().enumerate() {
                 let planet = bodies.positions[j + 1];
-                let distance = (q - planet).norm();
-                let hill_radius = (planet - sun).norm() * c;
-                if distance < factor * hill_radius {
+                let distance2 = (q - planet).norm_squared();
+                let hill2 = (planet - sun).norm_squared() * (c * c);
+                if distance2 < factor * factor * hill2 {
                     return Some(ParticleStatus::HillSphereEntry {
                         time: p.time,
                         planet: j + 1,
-                        distance,
-                        hill_radius,
+                        distance: distance2.sqrt(),
+                        hill_radius: (planet - sun).norm() * c,
                     });
                 }
             }
@@ -623,9 +644,12 @@ impl WindowContext<'_> {
         }
         if let Some(limit) = rules.min_perihelion {
             let h2 = q.cross(&p.velocity).norm_squared();
-            let e = (1.0 + 2.0 * energy * h2 / (mu * mu)).max(0.0).sqrt();
-            let perihelion = h2 / (mu * (1.0 + e));
-            if perihelion < limit {
+            let e2 = (1.0 + 2.0 * energy * h2 / (mu * mu)).max(0.0);
+            // q < L ⟺ h² − Lμ < Lμ e: true when the left side is negative, otherwise compared
+            // squared (no square root or division per step); q itself only for the report.
+            let (u, w) = (h2 - limit * mu, limit * mu);
+            if u < 0.0 || u * u < w * w * e2 {
+                let perihelion = h2 / (mu * (1.0 + e2.sqrt()));
                 return Some(ParticleStatus::PerihelionBelowLimit {
                     time: p.time,
                     perihelion,
