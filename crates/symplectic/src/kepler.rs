@@ -131,9 +131,11 @@ pub fn drift(r: &mut Vec3, v: &mut Vec3, mu: f64, dt: f64) -> Result<DriftInfo, 
     // dt = r0 s + η0 s²/2 + (μ − β r0) s³/6 + O(s⁴), when it is a small correction to dt/r0
     // (the usual case of a step much shorter than the orbit); otherwise from dt/r0, a
     // first-order guess valid for any conic.
-    let x = dt_eff / r0;
-    let a2 = eta / (2.0 * r0);
-    let a3 = (mu - beta * r0) / (6.0 * r0);
+    // One division for the three quotients by r0 (a division costs several multiplications).
+    let inv_r0 = 1.0 / r0;
+    let x = dt_eff * inv_r0;
+    let a2 = eta * (0.5 * inv_r0);
+    let a3 = (mu - beta * r0) * (inv_r0 * (1.0 / 6.0));
     let correction = -a2 * x * x + (2.0 * a2 * a2 - a3) * x * x * x;
     let mut s = if correction.abs() < 0.1 * x.abs() {
         x + correction
@@ -193,10 +195,11 @@ pub fn drift(r: &mut Vec3, v: &mut Vec3, mu: f64, dt: f64) -> Result<DriftInfo, 
         }
     };
     let rr = r0 * g0 + eta * g1 + mu * g2;
-    let f = 1.0 - mu * g2 / r0;
+    let inv_rr = 1.0 / rr;
+    let f = 1.0 - mu * g2 * inv_r0;
     let g = r0 * g1 + eta * g2;
-    let fdot = -mu * g1 / (rr * r0);
-    let gdot = 1.0 - mu * g2 / rr;
+    let fdot = -mu * g1 * (inv_rr * inv_r0);
+    let gdot = 1.0 - mu * g2 * inv_rr;
     let (r_old, v_old) = (*r, *v);
     *r = r_old * f + v_old * g;
     *v = r_old * fdot + v_old * gdot;
