@@ -6,10 +6,11 @@
 //! builds the issue-21 population (the four giant planets of `outer_solar_system`, ecliptic
 //! J2000, planets by `PLANETS` (`s2` or `s6`, default `s6`: the planets are shared by every
 //! particle, so their accuracy costs little per particle) at `PLANET_STEP_DAYS`, default
-//! τ = 365.25 d; particles by the first scheme, default S2; `N` comets with barycentric perihelia 32–40 AU,
+//! 730.5 d; particles by the first scheme, default S2; `N` comets with barycentric perihelia 32–40 AU,
 //! semi-major axes 40–100 AU, inclinations 0–30°, random angles, seed 2026 through
 //! `symplectic::samples`; barycentric variant, `B₀ = 0`, `B₁ = 0.21·10⁻⁶`, first step
-//! `DT0_DAYS`, default 365.25 d; removal at Hill-sphere entry, perihelion below 26 AU or
+//! `DT0_DAYS`, default 547.875 d (the defaults are the configuration whose median position
+//! error at 10 kyr is below REBOUND WHFast's at τ = 365.25 d: `docs/performance.md`); removal at Hill-sphere entry, perihelion below 26 AU or
 //! ejection beyond 1000 AU), advances it `YEARS` years on `RAYON_NUM_THREADS` threads and prints as its last
 //! line
 //!
@@ -53,11 +54,11 @@ fn run() -> Result<(), String> {
         Some(other) => return Err(format!("unknown scheme {other:?}; {usage}")),
     };
     let dt0: f64 = match args.get(3) {
-        None => DAYS_PER_YEAR,
+        None => 1.5 * DAYS_PER_YEAR,
         Some(s) => s.parse().map_err(|_| usage)?,
     };
     let planet_step: f64 = match args.get(5) {
-        None => DAYS_PER_YEAR,
+        None => 2.0 * DAYS_PER_YEAR,
         Some(s) => s.parse().map_err(|_| usage)?,
     };
     let planet_map = match args.get(4).map(String::as_str) {
