@@ -348,7 +348,11 @@ impl Ephemeris {
         };
         let value = fold(&w.value, 1.0);
         let first = fold(&w.first, inv_tau);
-        let second = fold(&w.second, inv_tau * inv_tau);
+        let second = if accelerations {
+            fold(&w.second, inv_tau * inv_tau)
+        } else {
+            [0.0; 6]
+        };
         let grid = &self.grid[base..base + 2 * stride];
         let (before, after) = grid.split_at(stride);
         let (before, after) = (before.as_chunks::<9>().0, after.as_chunks::<9>().0);

@@ -86,6 +86,18 @@ pub struct DriftInfo {
 /// Errors when `mu <= 0`, the state is not finite, `r = 0`, or the solver fails (it cannot
 /// for finite input, but a non-finite intermediate is reported rather than returned).
 pub fn drift(r: &mut Vec3, v: &mut Vec3, mu: f64, dt: f64) -> Result<DriftInfo, SymplecticError> {
+    let r0 = r.norm();
+    drift_from_distance(r, v, r0, mu, dt)
+}
+
+/// [`drift`] with `r0 = |r|` already computed by the caller (bit for bit `r.norm()`).
+pub(crate) fn drift_from_distance(
+    r: &mut Vec3,
+    v: &mut Vec3,
+    r0: f64,
+    mu: f64,
+    dt: f64,
+) -> Result<DriftInfo, SymplecticError> {
     if !(mu.is_finite() && mu > 0.0) {
         return Err(SymplecticError::InvalidParameter {
             name: "mu",
@@ -93,7 +105,6 @@ pub fn drift(r: &mut Vec3, v: &mut Vec3, mu: f64, dt: f64) -> Result<DriftInfo, 
             reason: "must be finite and > 0",
         });
     }
-    let r0 = r.norm();
     if !(r0.is_finite() && r0 > 0.0 && v.iter().all(|x| x.is_finite()) && dt.is_finite()) {
         return Err(SymplecticError::InvalidState {
             what: "Kepler drift",
@@ -131,11 +142,9 @@ pub fn drift(r: &mut Vec3, v: &mut Vec3, mu: f64, dt: f64) -> Result<DriftInfo, 
     // dt = r0 s + η0 s²/2 + (μ − β r0) s³/6 + O(s⁴), when it is a small correction to dt/r0
     // (the usual case of a step much shorter than the orbit); otherwise from dt/r0, a
     // first-order guess valid for any conic.
-    // One division for the three quotients by r0 (a division costs several multiplications).
-    let inv_r0 = 1.0 / r0;
-    let x = dt_eff * inv_r0;
-    let a2 = eta * (0.5 * inv_r0);
-    let a3 = (mu - beta * r0) * (inv_r0 * (1.0 / 6.0));
+    let x = dt_eff / r0;
+    let a2 = eta / (2.0 * r0);
+    let a3 = (mu - beta * r0) / (6.0 * r0);
     let correction = -a2 * x * x + (2.0 * a2 * a2 - a3) * x * x * x;
     let mut s = if correction.abs() < 0.1 * x.abs() {
         x + correction
@@ -160,10 +169,14 @@ pub fn drift(r: &mut Vec3, v: &mut Vec3, mu: f64, dt: f64) -> Result<DriftInfo, 
         let f = r0 * g1 + eta * g2 + mu * g3 - dt_eff;
         let fp = r0 * g0 + eta * g1 + mu * g2;
         let fpp = eta * g0 + (mu - beta * r0) * g1;
-        // Halley, ds = f/(f' − f f''/2f'), written with one division; Newton where the
-        // Halley denominator is not safely positive (f' = r > 0).
+        // Halley, ds = f/(f' − f f''/2f'), written with one division, where it is a modest
+        // change of Newton's step (|f f''| < f'², so |ds| is 2/3 to 2 Newton steps); Newton
+        // otherwise (f' = r > 0). Without the upper bound a large −f f'' (far from the root,
+        // near a pericentre passage) made the Halley step tiny though f was not, and the
+        // test below accepted a wrong anomaly: e = 0.99, a third of an orbit from
+        // pericentre, gave positions off by several AU in one drift of eight.
         let denominator = 2.0 * fp * fp - f * fpp;
-        let ds = if denominator > fp * fp {
+        let ds = if denominator > fp * fp && denominator < 3.0 * fp * fp {
             2.0 * f * fp / denominator
         } else {
             f / fp
@@ -195,7 +208,8 @@ pub fn drift(r: &mut Vec3, v: &mut Vec3, mu: f64, dt: f64) -> Result<DriftInfo, 
         }
     };
     let rr = r0 * g0 + eta * g1 + mu * g2;
-    let inv_rr = 1.0 / rr;
+    // Two divisions for the four quotients.
+    let (inv_r0, inv_rr) = (1.0 / r0, 1.0 / rr);
     let f = 1.0 - mu * g2 * inv_r0;
     let g = r0 * g1 + eta * g2;
     let fdot = -mu * g1 * (inv_rr * inv_r0);

@@ -440,7 +440,16 @@ impl ParticleIntegrator {
 
     /// `F₀ = K₀/r`.
     fn f0(&self, p: &TestParticle, bodies: &BodyStates) -> Result<f64, SymplecticError> {
-        let r = p.position.norm();
+        self.f0_at_distance(p, p.position.norm(), bodies)
+    }
+
+    /// `F₀` with `r = |q|` given.
+    fn f0_at_distance(
+        &self,
+        p: &TestParticle,
+        r: f64,
+        bodies: &BodyStates,
+    ) -> Result<f64, SymplecticError> {
         let mu = self.kepler_mu(bodies);
         let f0 = 0.5 * p.velocity.norm_squared() - mu / r + p.p4 + self.b0;
         check_positive("K0/r", f0, p.time)
@@ -461,7 +470,8 @@ impl ParticleIntegrator {
         h: f64,
         bodies: &BodyStates,
     ) -> Result<f64, SymplecticError> {
-        let f0 = self.f0(p, bodies)?;
+        let r = p.position.norm();
+        let f0 = self.f0_at_distance(p, r, bodies)?;
         let dt = h / f0;
         let mu = self.kepler_mu(bodies);
         if mu.is_nan() || mu <= 0.0 {
@@ -471,7 +481,8 @@ impl ParticleIntegrator {
                 reason: "B1 must be smaller than G M (the Kepler part needs a positive μ)",
             });
         }
-        let info = crate::kepler::drift(&mut p.position, &mut p.velocity, mu, dt)?;
+        let info =
+            crate::kepler::drift_from_distance(&mut p.position, &mut p.velocity, r, mu, dt)?;
         p.work.kepler_solves += 1;
         p.work.kepler_iterations += u64::from(info.iterations);
         p.time += dt;
