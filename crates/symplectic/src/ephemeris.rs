@@ -253,20 +253,22 @@ impl Ephemeris {
         out: &mut BodyStates,
         accelerations: bool,
     ) -> Result<(), SymplecticError> {
-        let newest = self.grid_time(self.planet_steps());
-        if t > newest {
-            return Err(SymplecticError::BeyondEphemeris { time: t, newest });
+        self.view().interpolate(t, out, accelerations)
+    }
+
+    /// The grid as the interpolation reads it, with what it needs per call (the newest index
+    /// and time, `1/τ`) computed once: for many interpolations between two extensions.
+    pub(crate) fn view(&self) -> GridView<'_> {
+        let tau = self.grid_step();
+        let last = self.planet_steps();
+        GridView {
+            ephemeris: self,
+            tau,
+            inv_tau: 1.0 / tau,
+            last,
+            newest: self.grid_time(last),
+            oldest: self.grid_time(self.first_index),
         }
-        if !t.is_finite() {
-            return Err(SymplecticError::InvalidParameter {
-                name: "ephemeris time",
-                value: t,
-                reason: "must be finite",
-            });
-        }
-        self.check_retained(t)?;
-        self.interpolate_unchecked(t, out, accelerations);
-        Ok(())
     }
 
     /// Time of the oldest retained grid state.
@@ -299,43 +301,99 @@ impl Ephemeris {
 
     /// The interpolation proper; `t` must lie in the retained window.
     fn interpolate_unchecked(&self, t: f64, out: &mut BodyStates, accelerations: bool) {
-        let tau = self.grid_step();
-        let rel = (t - self.start_time) / tau;
-        let last = self.planet_steps();
+        self.view().interpolate_unchecked(t, out, accelerations);
+    }
+
+    fn vec_at(&self, o: usize) -> Vec3 {
+        Vec3::from_column_slice(&self.grid[o..o + 3])
+    }
+}
+
+/// [`Ephemeris::view`]: the retained grid with the per-call constants of the interpolation.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct GridView<'a> {
+    ephemeris: &'a Ephemeris,
+    tau: f64,
+    inv_tau: f64,
+    /// Index of the newest grid state, and its time.
+    last: u64,
+    newest: f64,
+    /// Time of the oldest retained grid state.
+    oldest: f64,
+}
+
+impl GridView<'_> {
+    /// [`Ephemeris::interpolate`].
+    pub(crate) fn interpolate(
+        &self,
+        t: f64,
+        out: &mut BodyStates,
+        accelerations: bool,
+    ) -> Result<(), SymplecticError> {
+        if t > self.newest {
+            return Err(SymplecticError::BeyondEphemeris {
+                time: t,
+                newest: self.newest,
+            });
+        }
+        if !t.is_finite() {
+            return Err(SymplecticError::InvalidParameter {
+                name: "ephemeris time",
+                value: t,
+                reason: "must be finite",
+            });
+        }
+        if t < self.oldest {
+            return Err(SymplecticError::InvalidParameter {
+                name: "ephemeris time",
+                value: t,
+                reason:
+                    "precedes the retained window of planet states (discarded or before the start)",
+            });
+        }
+        self.interpolate_unchecked(t, out, accelerations);
+        Ok(())
+    }
+
+    /// The interpolation proper; `t` must lie in the retained window.
+    fn interpolate_unchecked(&self, t: f64, out: &mut BodyStates, accelerations: bool) {
+        let (e, tau, last) = (self.ephemeris, self.tau, self.last);
+        let rel = (t - e.start_time) * self.inv_tau;
         // The grid point at or before t (rounding of `rel` corrected against the grid times),
         // so that the result depends on t and the grid only, not on how far the grid reaches:
         // a time on a grid point takes that state, anything else the interval after it.
-        let mut k = (rel.floor().max(0.0) as u64).clamp(self.first_index, last);
-        if k > self.first_index && t < self.grid_time(k) {
+        // (`as u64` truncates: the floor of a non-negative `rel`, without a libm call.)
+        let mut k = (rel.max(0.0) as u64).clamp(e.first_index, last);
+        if k > e.first_index && t < e.grid_time(k) {
             k -= 1;
         }
-        if k < last && self.grid_time(k + 1) <= t {
+        if k < last && e.grid_time(k + 1) <= t {
             k += 1;
         }
-        let n1 = self.planets.len() + 1;
+        let n1 = e.planets.len() + 1;
         out.resize(n1);
         out.time = t;
-        out.gm[0] = self.planets.g() * self.planets.sun_mass();
-        for (i, &m) in self.planets.masses().iter().enumerate() {
-            out.gm[i + 1] = self.planets.g() * m;
+        out.gm[0] = e.planets.g() * e.planets.sun_mass();
+        for (i, &m) in e.planets.masses().iter().enumerate() {
+            out.gm[i + 1] = e.planets.g() * m;
         }
-        let stride = self.stride();
-        let base = self.offset + (k - self.first_index) as usize * stride;
-        if t == self.grid_time(k) || k == last {
+        let stride = e.stride();
+        let base = e.offset + (k - e.first_index) as usize * stride;
+        if t == e.grid_time(k) || k == last {
             // On a grid point: the stored state itself.
             for j in 0..n1 {
                 let o = base + 9 * j;
-                out.positions[j] = self.vec_at(o);
-                out.velocities[j] = self.vec_at(o + 3);
-                out.accelerations[j] = self.vec_at(o + 6);
+                out.positions[j] = e.vec_at(o);
+                out.velocities[j] = e.vec_at(o + 3);
+                out.accelerations[j] = e.vec_at(o + 6);
             }
             return;
         }
-        let x = (t - self.grid_time(k)) / tau;
+        let x = (t - e.grid_time(k)) * self.inv_tau;
         let w = QuinticHermite::at(x);
         // The weights with the scaling to the unit interval folded in (the stored velocities
         // and accelerations are per day): one multiply-add per datum and component.
-        let (tau2, inv_tau) = (tau * tau, 1.0 / tau);
+        let (tau2, inv_tau) = (tau * tau, self.inv_tau);
         let fold = |c: &[f64; 6], s: f64| {
             [
                 c[0] * s,
@@ -353,7 +411,7 @@ impl Ephemeris {
         } else {
             [0.0; 6]
         };
-        let grid = &self.grid[base..base + 2 * stride];
+        let grid = &e.grid[base..base + 2 * stride];
         let (before, after) = grid.split_at(stride);
         let (before, after) = (before.as_chunks::<9>().0, after.as_chunks::<9>().0);
         for (j, (a, b)) in before.iter().zip(after).enumerate().take(n1) {
@@ -365,9 +423,6 @@ impl Ephemeris {
         }
     }
 
-    fn vec_at(&self, o: usize) -> Vec3 {
-        Vec3::from_column_slice(&self.grid[o..o + 3])
-    }
 }
 
 /// Grid states computed ahead by [`Ephemeris::extension`].

@@ -6,7 +6,7 @@ use std::path::Path;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::ephemeris::{BodyStates, Ephemeris};
+use crate::ephemeris::{BodyStates, Ephemeris, GridView};
 use crate::kepler::Elements;
 use crate::particles::{KickTerms, ParticleIntegrator, TestParticle};
 use crate::run::ParticleStatus;
@@ -167,7 +167,8 @@ struct Worker {
 
 /// The read-only context of a window.
 struct WindowContext<'a> {
-    ephemeris: &'a Ephemeris,
+    /// The planets, read through one view of the grid for the whole window.
+    grid: GridView<'a>,
     integrator: ParticleIntegrator,
     rules: RemovalRules,
     /// `(m_j/3m₀)^{1/3}` per planet.
@@ -535,7 +536,7 @@ fn run_window(
     let planets = ephemeris.planets();
     let m0 = planets.sun_mass();
     let ctx = WindowContext {
-        ephemeris,
+        grid: ephemeris.view(),
         integrator,
         rules,
         hill_coefficients: planets
@@ -593,7 +594,7 @@ impl WindowContext<'_> {
                 bodies_time,
                 &mut w.kick,
                 &mut |t: f64, out: &mut BodyStates| {
-                    self.ephemeris.interpolate(t, out, accelerations)
+                    self.grid.interpolate(t, out, accelerations)
                 },
             );
             match result {
