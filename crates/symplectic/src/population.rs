@@ -663,12 +663,13 @@ impl WindowContext<'_> {
             return None;
         }
         // Barycentric osculating energy and perihelion from the energy and angular momentum
-        // (no angles): e² = 1 + 2E h²/μ², q = h²/(μ (1 + e)).
+        // (no angles): e² = 1 + 2E h²/μ², q = h²/(μ (1 + e)). Multiplied through by r (and
+        // μ²) so that no division is needed per step: 2E r = v² r − 2μ.
         let mu = self.total_gm;
         let r = q.norm();
-        let energy = 0.5 * p.velocity.norm_squared() - mu / r;
+        let v2r = p.velocity.norm_squared() * r;
         if let Some(limit) = rules.ejection_distance {
-            if energy >= 0.0 && r > limit {
+            if v2r >= 2.0 * mu && r > limit {
                 return Some(ParticleStatus::Ejected {
                     time: p.time,
                     distance: r,
@@ -677,12 +678,14 @@ impl WindowContext<'_> {
         }
         if let Some(limit) = rules.min_perihelion {
             let h2 = q.cross(&p.velocity).norm_squared();
-            let e2 = (1.0 + 2.0 * energy * h2 / (mu * mu)).max(0.0);
+            // r μ² e² = r μ² + (v² r − 2μ) h².
+            let r_mu2_e2 = (r * mu * mu + (v2r - 2.0 * mu) * h2).max(0.0);
             // q < L ⟺ h² − Lμ < Lμ e: true when the left side is negative, otherwise compared
-            // squared (no square root or division per step); q itself only for the report.
+            // squared; q itself only for the report.
             let (u, w) = (h2 - limit * mu, limit * mu);
-            if u < 0.0 || u * u < w * w * e2 {
-                let perihelion = h2 / (mu * (1.0 + e2.sqrt()));
+            if u < 0.0 || u * u * (r * mu * mu) < w * w * r_mu2_e2 {
+                let e = (r_mu2_e2 / r).sqrt() / mu;
+                let perihelion = h2 / (mu * (1.0 + e));
                 return Some(ParticleStatus::PerihelionBelowLimit {
                     time: p.time,
                     perihelion,
