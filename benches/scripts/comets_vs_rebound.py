@@ -77,9 +77,12 @@ def rebound_sim(bodies, particles, integrator="whfast", dt=YEAR):
 
 
 def throughput():
-    print("# N years ours_1t ours_2t rebound_1t (particle-years per second) ratio_1t ratio_2t_over_1t")
+    print(f"# ours: particles {DEFAULT[0]}, first step {DEFAULT[1]} d, planets {DEFAULT[2]} at {DEFAULT[3]} d; "
+          "REBOUND WHFast tau = 365.25 d; load = 1-minute load average before the row")
+    print("# N years ours_1t ours_2t rebound_1t (particle-years per second) ratio_1t ratio_2t_over_1t load")
     tmp = tempfile.mkdtemp()
     for n in [10, 100, 1000, 10_000, 100_000, 1_000_000]:
+        load = os.getloadavg()[0]
         years = max(2.0, min(20_000.0, 2.0e6 / n))
         init = os.path.join(tmp, "init.csv")
         one = run_ours(n, years, threads=1, initial=init)
@@ -91,7 +94,7 @@ def throughput():
         seconds = time.perf_counter() - t0
         rb = n * sim.t / YEAR / seconds
         o1, o2 = float(one["particle_years_per_s"]), float(two["particle_years_per_s"])
-        print(f"{n} {years:g} {o1:.4g} {o2:.4g} {rb:.4g} {o1 / rb:.3f} {o2 / o1:.3f}", flush=True)
+        print(f"{n} {years:g} {o1:.4g} {o2:.4g} {rb:.4g} {o1 / rb:.3f} {o2 / o1:.3f} {load:.2f}", flush=True)
 
 
 def accuracy(n=200, years=10_000.0):
