@@ -13,7 +13,8 @@ on 1 thread (OMP_NUM_THREADS=1).
 accuracy: N = 200 comets for 10 kyr; the median over particles of the distance to a converged
 reference (REBOUND IAS15, evaluated at each particle's own final time), ours (particles S2 or
 S6 at several first steps, planets S2 or S6) against REBOUND WHFast at tau = 365.25 d.
-`accuracy K` runs only the first K configurations (the first is the default: S2 particles,
+`throughput SCHEME DT0 PLANETS PLANET_STEP` measures another configuration of ours (e.g.
+`throughput s2 730.5 s6 730.5`). `accuracy K` runs only the first K configurations (the first is the default: S2 particles,
 first step 547.875 d, S6 planets at 730.5 d).
 """
 import csv
@@ -76,8 +77,9 @@ def rebound_sim(bodies, particles, integrator="whfast", dt=YEAR):
     return sim
 
 
-def throughput():
-    print(f"# ours: particles {DEFAULT[0]}, first step {DEFAULT[1]} d, planets {DEFAULT[2]} at {DEFAULT[3]} d; "
+def throughput(config=DEFAULT):
+    scheme, dt0, planets, planet_step = config
+    print(f"# ours: particles {scheme}, first step {dt0} d, planets {planets} at {planet_step} d; "
           "REBOUND WHFast tau = 365.25 d; load = 1-minute load average before the row")
     print("# N years ours_1t ours_2t rebound_1t (particle-years per second) ratio_1t ratio_2t_over_1t load")
     tmp = tempfile.mkdtemp()
@@ -85,8 +87,8 @@ def throughput():
         load = os.getloadavg()[0]
         years = max(2.0, min(20_000.0, 2.0e6 / n))
         init = os.path.join(tmp, "init.csv")
-        one = run_ours(n, years, threads=1, initial=init)
-        two = run_ours(n, years, threads=2)
+        one = run_ours(n, years, scheme, dt0, threads=1, initial=init, planets=planets, planet_step=planet_step)
+        two = run_ours(n, years, scheme, dt0, threads=2, planets=planets, planet_step=planet_step)
         bodies, particles = read_initial(init)
         sim = rebound_sim(bodies, particles)
         t0 = time.perf_counter()
@@ -152,4 +154,8 @@ def accuracy(n=200, years=10_000.0):
 
 
 if __name__ == "__main__":
-    {"throughput": throughput, "accuracy": accuracy}[sys.argv[1]]()
+    if sys.argv[1] == "throughput" and len(sys.argv) == 6:
+        # throughput SCHEME DT0 PLANETS PLANET_STEP: another configuration of ours.
+        throughput((sys.argv[2], float(sys.argv[3]), sys.argv[4], float(sys.argv[5])))
+    else:
+        {"throughput": throughput, "accuracy": accuracy}[sys.argv[1]]()
