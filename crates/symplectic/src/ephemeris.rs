@@ -422,7 +422,6 @@ impl GridView<'_> {
             }
         }
     }
-
 }
 
 /// Grid states computed ahead by [`Ephemeris::extension`].
@@ -478,7 +477,11 @@ fn push_state(planets: &Planets, grid: &mut Vec<f64>, work: &mut WorkCounters) {
 fn combine(a: &[f64; 9], b: &[f64; 9], c: &[f64; 6]) -> Vec3 {
     let mut out = [0.0; 3];
     for (i, o) in out.iter_mut().enumerate() {
-        *o = a[i] * c[0] + a[3 + i] * c[1] + a[6 + i] * c[2] + b[i] * c[3] + b[3 + i] * c[4]
+        *o = a[i] * c[0]
+            + a[3 + i] * c[1]
+            + a[6 + i] * c[2]
+            + b[i] * c[3]
+            + b[3 + i] * c[4]
             + b[6 + i] * c[5];
     }
     Vec3::new(out[0], out[1], out[2])

@@ -481,8 +481,7 @@ impl ParticleIntegrator {
                 reason: "B1 must be smaller than G M (the Kepler part needs a positive μ)",
             });
         }
-        let info =
-            crate::kepler::drift_from_distance(&mut p.position, &mut p.velocity, r, mu, dt)?;
+        let info = crate::kepler::drift_from_distance(&mut p.position, &mut p.velocity, r, mu, dt)?;
         p.work.kepler_solves += 1;
         p.work.kepler_iterations += u64::from(info.iterations);
         p.time += dt;

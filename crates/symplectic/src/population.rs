@@ -594,9 +594,7 @@ impl WindowContext<'_> {
                 &mut w.bodies,
                 bodies_time,
                 &mut w.kick,
-                &mut |t: f64, out: &mut BodyStates| {
-                    self.grid.interpolate(t, out, accelerations)
-                },
+                &mut |t: f64, out: &mut BodyStates| self.grid.interpolate(t, out, accelerations),
             );
             match result {
                 Ok(t) => {
