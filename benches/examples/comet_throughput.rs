@@ -3,22 +3,24 @@
 //!
 //! `cargo run --release -p benches --example comet_throughput -- N YEARS [s2|s6] [DT0_DAYS] [PLANETS] [PLANET_STEP_DAYS]`
 //!
-//! builds the issue-21 population (the four giant planets of `outer_solar_system`, ecliptic
-//! J2000, planets by `PLANETS` (`s2` or `s6`, default `s6`: the planets are shared by every
-//! particle, so their accuracy costs little per particle) at `PLANET_STEP_DAYS`, default
-//! 730.5 d; particles by the first scheme, default S2; `N` comets with barycentric perihelia 32–40 AU,
-//! semi-major axes 40–100 AU, inclinations 0–30°, random angles, seed 2026 through
-//! `symplectic::samples`; barycentric variant, `B₀ = 0`, `B₁ = 0.21·10⁻⁶`, first step
-//! `DT0_DAYS`, default 547.875 d (the defaults are the configuration whose median position
-//! error at 10 kyr is below REBOUND WHFast's at τ = 365.25 d: `docs/performance.md`); removal at Hill-sphere entry, perihelion below 26 AU or
-//! ejection beyond 1000 AU), advances it `YEARS` years on `RAYON_NUM_THREADS` threads and prints as its last
-//! line
+//! builds the issue-21 population: the four giant planets of `outer_solar_system` (ecliptic
+//! J2000) integrated by `PLANETS` (`s2` or `s6`, default `s6`: the planets are shared by every
+//! particle, so their accuracy costs little per particle) at `PLANET_STEP_DAYS` (default
+//! 730.5 d); `N` comets with barycentric perihelia 32–40 AU, semi-major axes 40–100 AU,
+//! inclinations 0–30°, random angles, seed 2026 through `symplectic::samples`, integrated by
+//! the first scheme (default S2), barycentric variant, `B₀ = 0`, `B₁ = 0.21·10⁻⁶`, first step
+//! `DT0_DAYS` (default 547.875 d). The defaults are the configuration whose median position
+//! error at 10 kyr is below REBOUND WHFast's at τ = 365.25 d (`docs/performance.md`).
+//! Removal at Hill-sphere entry, perihelion below 26 AU or ejection beyond 1000 AU. It
+//! advances the population `YEARS` years on `RAYON_NUM_THREADS` threads and prints as its
+//! last line
 //!
 //! `particles=N particle_years_per_s=X particle_steps_per_s=Y threads=T ...`
 //!
-//! followed by the wall time, the steps per particle-year and the median and largest
-//! extended-Hamiltonian error `|H + p₄|/|H|` of the surviving particles. The clock covers
-//! `advance_to` only (not building the particles).
+//! followed by the wall time, the steps per particle-year, the median and largest
+//! extended-Hamiltonian error `|H + p₄|/|H|` of the surviving particles, the bytes per
+//! particle and the Kepler iterations per solve. The clock covers `advance_to` only (not
+//! building the particles).
 //!
 //! For side-by-side runs with other codes, `COMET_THROUGHPUT_INITIAL=FILE` writes the
 //! initial barycentric states of the planets and particles (CSV: `kind,id,gm,x,y,z,vx,vy,vz`,
