@@ -138,7 +138,7 @@ pub const DEFAULT_WINDOW_STEPS: u32 = 256;
 /// dependent chains (a step is latency-bound, not bandwidth-bound: a particle's 184 bytes
 /// stay in registers and L1 through the window). Measured share of the time (`perf`, 10³
 /// comets, 2026-11-25): drift 44 %, kicks 23 %, interpolation 20 %, removal and bookkeeping
-/// 13 %; about 0.17 µs per step on this project's 2-core machine (`docs/performance.md`).
+/// 13 %; about 0.18 µs per step on this project's 2-core machine (`docs/performance.md`).
 /// **The ephemeris:** one planet step per grid interval, shared by all `N` particles: with the
 /// default S6 at 730.5 d (12 Kepler solves and 24 pair forces per step, plus 10 pair forces
 /// for the stored accelerations) about 1.4 µs per planet step, i.e. `0.7/N` µs per
