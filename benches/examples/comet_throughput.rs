@@ -1,21 +1,26 @@
 //! Throughput of `symplectic::Population` with a fixed interface, for comparison with other
 //! codes:
 //!
-//! `cargo run --release -p benches --example comet_throughput -- N YEARS [s2|s6] [DT0_DAYS]`
+//! `cargo run --release -p benches --example comet_throughput -- N YEARS [s2|s6] [DT0_DAYS] [PLANETS] [PLANET_STEP_DAYS]`
 //!
-//! builds the issue-21 population (the four giant planets of `outer_solar_system`, ecliptic
-//! J2000, planets at τ = 365.25 d by the same map as the particles (S2 or S6); `N` comets with barycentric perihelia 32–40 AU,
-//! semi-major axes 40–100 AU, inclinations 0–30°, random angles, seed 2026 through
-//! `symplectic::samples`; barycentric variant, `B₀ = 0`, `B₁ = 0.21·10⁻⁶`, first step
-//! `DT0_DAYS`, default 365.25 d; removal at Hill-sphere entry, perihelion below 26 AU or
-//! ejection beyond 1000 AU), advances it `YEARS` years on `RAYON_NUM_THREADS` threads and prints as its last
-//! line
+//! builds the issue-21 population: the four giant planets of `outer_solar_system` (ecliptic
+//! J2000) integrated by `PLANETS` (`s2` or `s6`, default `s6`: the planets are shared by every
+//! particle, so their accuracy costs little per particle) at `PLANET_STEP_DAYS` (default
+//! 730.5 d); `N` comets with barycentric perihelia 32–40 AU, semi-major axes 40–100 AU,
+//! inclinations 0–30°, random angles, seed 2026 through `symplectic::samples`, integrated by
+//! the first scheme (default S2), barycentric variant, `B₀ = 0`, `B₁ = 0.21·10⁻⁶`, first step
+//! `DT0_DAYS` (default 547.875 d). The defaults are the configuration whose median position
+//! error at 10 kyr is below REBOUND WHFast's at τ = 365.25 d (`docs/performance.md`).
+//! Removal at Hill-sphere entry, perihelion below 26 AU or ejection beyond 1000 AU. It
+//! advances the population `YEARS` years on `RAYON_NUM_THREADS` threads and prints as its
+//! last line
 //!
 //! `particles=N particle_years_per_s=X particle_steps_per_s=Y threads=T ...`
 //!
-//! followed by the wall time, the steps per particle-year and the median and largest
-//! extended-Hamiltonian error `|H + p₄|/|H|` of the surviving particles. The clock covers
-//! `advance_to` only (not building the particles).
+//! followed by the wall time, the steps per particle-year, the median and largest
+//! extended-Hamiltonian error `|H + p₄|/|H|` of the surviving particles, the bytes per
+//! particle and the Kepler iterations per solve. The clock covers `advance_to` only (not
+//! building the particles).
 //!
 //! For side-by-side runs with other codes, `COMET_THROUGHPUT_INITIAL=FILE` writes the
 //! initial barycentric states of the planets and particles (CSV: `kind,id,gm,x,y,z,vx,vy,vz`,
@@ -42,7 +47,7 @@ fn main() {
 
 fn run() -> Result<(), String> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let usage = "usage: comet_throughput N YEARS [s2|s6]";
+    let usage = "usage: comet_throughput N YEARS [s2|s6] [DT0_DAYS] [s2|s6] [PLANET_STEP_DAYS]";
     let n: usize = args.first().and_then(|s| s.parse().ok()).ok_or(usage)?;
     let years: f64 = args.get(1).and_then(|s| s.parse().ok()).ok_or(usage)?;
     let scheme = match args.get(2).map(String::as_str) {
@@ -51,8 +56,17 @@ fn run() -> Result<(), String> {
         Some(other) => return Err(format!("unknown scheme {other:?}; {usage}")),
     };
     let dt0: f64 = match args.get(3) {
-        None => DAYS_PER_YEAR,
+        None => 1.5 * DAYS_PER_YEAR,
         Some(s) => s.parse().map_err(|_| usage)?,
+    };
+    let planet_step: f64 = match args.get(5) {
+        None => 2.0 * DAYS_PER_YEAR,
+        Some(s) => s.parse().map_err(|_| usage)?,
+    };
+    let planet_map = match args.get(4).map(String::as_str) {
+        None | Some("s6") => Integrator::S6 { step: planet_step },
+        Some("s2") => Integrator::S2 { step: planet_step },
+        Some(other) => return Err(format!("unknown planet map {other:?}; {usage}")),
     };
     let planets = outer_solar_system(Frame::EclipticJ2000);
     let g = planets.g();
@@ -66,15 +80,6 @@ fn run() -> Result<(), String> {
     if let Ok(path) = std::env::var("COMET_THROUGHPUT_INITIAL") {
         write_initial(&path, &planets, &states).map_err(|e| format!("{path}: {e}"))?;
     }
-    // The planets by the same composition as the particles (`s6`: both pseudo-sixth order).
-    let planet_map = match scheme {
-        Scheme::S2 => Integrator::S2 {
-            step: DAYS_PER_YEAR,
-        },
-        Scheme::S6 => Integrator::S6 {
-            step: DAYS_PER_YEAR,
-        },
-    };
     let ephemeris = Ephemeris::new(planets, planet_map).map_err(|e| e.to_string())?;
     let integrator = ParticleIntegrator::new(Variant::Barycentric, scheme, 0.0, 0.21e-6)
         .map_err(|e| e.to_string())?;
@@ -110,13 +115,17 @@ fn run() -> Result<(), String> {
         "particles={n} particle_years_per_s={:.4e} particle_steps_per_s={:.4e} threads={} \
          seconds={seconds:.3} steps_per_particle_year={:.4} removed={} \
          median_rel_energy_error={median:.3e} max_rel_energy_error={largest:.3e} \
-         bytes_per_particle={}",
+         bytes_per_particle={} kepler_iterations_per_solve={:.3}",
         particle_years / seconds,
         progress.particle_steps as f64 / seconds,
         rayon::current_num_threads(),
         progress.particle_steps as f64 / particle_years,
         progress.removed,
         Population::bytes_per_particle(),
+        {
+            let w = population.work();
+            w.kepler_iterations as f64 / w.kepler_solves as f64
+        },
     );
     Ok(())
 }

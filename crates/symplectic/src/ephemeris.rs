@@ -137,52 +137,21 @@ impl Ephemeris {
         self.first_index + ((self.grid.len() - self.offset) / self.stride()) as u64 - 1
     }
 
-    /// Appends the barycentric positions, velocities and accelerations of every body at the
-    /// planets' current state (written straight into the grid: no allocation per step once
-    /// the grid has its capacity).
+    /// Appends the barycentric state of every body at the planets' current state.
     fn push_state(&mut self) {
-        let n = self.planets.len();
-        let g = self.planets.g();
-        let m0 = self.planets.sun_mass();
-        let (sun_pos, sun_vel) = self.planets.sun_barycentric_state();
-        let base = self.grid.len();
-        self.grid.resize(base + 9 * (n + 1), 0.0);
-        let body = |j: usize| base + 9 * j;
-        self.grid[body(0)..body(0) + 3].copy_from_slice(sun_pos.as_slice());
-        self.grid[body(0) + 3..body(0) + 6].copy_from_slice(sun_vel.as_slice());
-        for i in 0..n {
-            let m = self.planets.masses()[i];
-            let o = body(i + 1);
-            let q = self.planets.positions()[i] + sun_pos;
-            let v = self.planets.momenta()[i] / m;
-            self.grid[o..o + 3].copy_from_slice(q.as_slice());
-            self.grid[o + 3..o + 6].copy_from_slice(v.as_slice());
-        }
-        let mass = |j: usize| {
-            if j == 0 {
-                m0
-            } else {
-                self.planets.masses()[j - 1]
-            }
-        };
-        self.work.force_evaluations += (n * (n + 1) / 2) as u64;
-        for j in 0..=n {
-            for k in j + 1..=n {
-                let d = self.vec_at(body(k)) - self.vec_at(body(j));
-                let r2 = d.norm_squared();
-                let f = d * (g / (r2 * r2.sqrt()));
-                let (aj, ak) = (
-                    self.vec_at(body(j) + 6) + f * mass(k),
-                    self.vec_at(body(k) + 6) - f * mass(j),
-                );
-                self.grid[body(j) + 6..body(j) + 9].copy_from_slice(aj.as_slice());
-                self.grid[body(k) + 6..body(k) + 9].copy_from_slice(ak.as_slice());
-            }
-        }
+        push_state(&self.planets, &mut self.grid, &mut self.work);
     }
 
     /// Integrates the planets until the grid covers time `t`.
     pub fn extend_to(&mut self, t: f64) -> Result<(), SymplecticError> {
+        let extension = self.extension(t)?;
+        self.append(extension)
+    }
+
+    /// The grid states from the newest one until `t` is covered, computed from a copy of the
+    /// planets without changing the ephemeris (so that the particles can read it meanwhile):
+    /// [`Ephemeris::append`] adds them. Exactly the states [`Ephemeris::extend_to`] computes.
+    pub(crate) fn extension(&self, t: f64) -> Result<Extension, SymplecticError> {
         // Grid times are start + k·τ with an integer k: exact only below 2⁵³ steps, and a
         // request that far out would run for ages. Refuse it by name instead.
         let steps_needed = (t - self.start_time) / self.grid_step();
@@ -193,17 +162,49 @@ impl Ephemeris {
                 reason: "beyond 2^52 planet steps from the start (or not finite): grid times would lose exactness",
             });
         }
-        while self.grid_time(self.planet_steps()) < t {
-            let step = self.planet_steps();
-            self.integrator.step(&mut self.planets)?;
-            if let Some(body) = self.planets.first_non_finite() {
-                return Err(SymplecticError::BlowUp { step, body });
+        let mut planets = self.planets.clone();
+        let mut states = Vec::new();
+        let mut work = WorkCounters::default();
+        let mut step = self.planet_steps();
+        while self.grid_time(step) < t {
+            if let Err(e) = self.integrator.step(&mut planets) {
+                return Ok(Extension {
+                    planets,
+                    states,
+                    work,
+                    error: Some(e),
+                });
+            }
+            if let Some(body) = planets.first_non_finite() {
+                let error = Some(SymplecticError::BlowUp { step, body });
+                return Ok(Extension {
+                    planets,
+                    states,
+                    work,
+                    error,
+                });
             }
             // Keep the planets' clock on the grid (no accumulation of rounding).
-            self.planets.set_time(self.grid_time(step + 1));
-            self.push_state();
+            planets.set_time(self.grid_time(step + 1));
+            push_state(&planets, &mut states, &mut work);
+            step += 1;
         }
-        Ok(())
+        Ok(Extension {
+            planets,
+            states,
+            work,
+            error: None,
+        })
+    }
+
+    /// Appends the states of an [`Ephemeris::extension`] computed from this ephemeris's newest
+    /// state (and the planets where they stopped); returns the planets' error if the
+    /// extension stopped on one.
+    pub(crate) fn append(&mut self, extension: Extension) -> Result<(), SymplecticError> {
+        self.planets = extension.planets;
+        self.grid.extend_from_slice(&extension.states);
+        self.work += extension.work;
+        extension.error.map_or(Ok(()), Err)
     }
 
     /// Drops the grid states no longer needed for times `>= t`.
@@ -252,20 +253,22 @@ impl Ephemeris {
         out: &mut BodyStates,
         accelerations: bool,
     ) -> Result<(), SymplecticError> {
-        let newest = self.grid_time(self.planet_steps());
-        if t > newest {
-            return Err(SymplecticError::BeyondEphemeris { time: t, newest });
+        self.view().interpolate(t, out, accelerations)
+    }
+
+    /// The grid as the interpolation reads it, with what it needs per call (the newest index
+    /// and time, `1/τ`) computed once: for many interpolations between two extensions.
+    pub(crate) fn view(&self) -> GridView<'_> {
+        let tau = self.grid_step();
+        let last = self.planet_steps();
+        GridView {
+            ephemeris: self,
+            tau,
+            inv_tau: 1.0 / tau,
+            last,
+            newest: self.grid_time(last),
+            oldest: self.grid_time(self.first_index),
         }
-        if !t.is_finite() {
-            return Err(SymplecticError::InvalidParameter {
-                name: "ephemeris time",
-                value: t,
-                reason: "must be finite",
-            });
-        }
-        self.check_retained(t)?;
-        self.interpolate_unchecked(t, out, accelerations);
-        Ok(())
     }
 
     /// Time of the oldest retained grid state.
@@ -298,67 +301,190 @@ impl Ephemeris {
 
     /// The interpolation proper; `t` must lie in the retained window.
     fn interpolate_unchecked(&self, t: f64, out: &mut BodyStates, accelerations: bool) {
-        let tau = self.grid_step();
-        let rel = (t - self.start_time) / tau;
-        let last = self.planet_steps();
-        // The grid point at or before t (rounding of `rel` corrected against the grid times),
-        // so that the result depends on t and the grid only, not on how far the grid reaches:
-        // a time on a grid point takes that state, anything else the interval after it.
-        let mut k = (rel.floor().max(0.0) as u64).clamp(self.first_index, last);
-        if k > self.first_index && t < self.grid_time(k) {
-            k -= 1;
-        }
-        if k < last && self.grid_time(k + 1) <= t {
-            k += 1;
-        }
-        let n1 = self.planets.len() + 1;
-        out.resize(n1);
-        out.time = t;
-        out.gm[0] = self.planets.g() * self.planets.sun_mass();
-        for (i, &m) in self.planets.masses().iter().enumerate() {
-            out.gm[i + 1] = self.planets.g() * m;
-        }
-        let stride = self.stride();
-        let base = self.offset + (k - self.first_index) as usize * stride;
-        if t == self.grid_time(k) || k == last {
-            // On a grid point: the stored state itself.
-            for j in 0..n1 {
-                let o = base + 9 * j;
-                out.positions[j] = self.vec_at(o);
-                out.velocities[j] = self.vec_at(o + 3);
-                out.accelerations[j] = self.vec_at(o + 6);
-            }
-            return;
-        }
-        let x = (t - self.grid_time(k)) / tau;
-        let w = QuinticHermite::at(x);
-        for j in 0..n1 {
-            let a = base + 9 * j;
-            let b = a + stride;
-            let (p0, v0, a0) = (
-                self.vec_at(a),
-                self.vec_at(a + 3) * tau,
-                self.vec_at(a + 6) * (tau * tau),
-            );
-            let (p1, v1, a1) = (
-                self.vec_at(b),
-                self.vec_at(b + 3) * tau,
-                self.vec_at(b + 6) * (tau * tau),
-            );
-            let combine = |c: &[f64; 6]| {
-                p0 * c[0] + v0 * c[1] + a0 * c[2] + p1 * c[3] + v1 * c[4] + a1 * c[5]
-            };
-            out.positions[j] = combine(&w.value);
-            out.velocities[j] = combine(&w.first) / tau;
-            if accelerations {
-                out.accelerations[j] = combine(&w.second) / (tau * tau);
-            }
-        }
+        self.view().interpolate_unchecked(t, out, accelerations);
     }
 
     fn vec_at(&self, o: usize) -> Vec3 {
         Vec3::from_column_slice(&self.grid[o..o + 3])
     }
+}
+
+/// [`Ephemeris::view`]: the retained grid with the per-call constants of the interpolation.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct GridView<'a> {
+    ephemeris: &'a Ephemeris,
+    tau: f64,
+    inv_tau: f64,
+    /// Index of the newest grid state, and its time.
+    last: u64,
+    newest: f64,
+    /// Time of the oldest retained grid state.
+    oldest: f64,
+}
+
+impl GridView<'_> {
+    /// [`Ephemeris::interpolate`].
+    pub(crate) fn interpolate(
+        &self,
+        t: f64,
+        out: &mut BodyStates,
+        accelerations: bool,
+    ) -> Result<(), SymplecticError> {
+        if t > self.newest {
+            return Err(SymplecticError::BeyondEphemeris {
+                time: t,
+                newest: self.newest,
+            });
+        }
+        if !t.is_finite() {
+            return Err(SymplecticError::InvalidParameter {
+                name: "ephemeris time",
+                value: t,
+                reason: "must be finite",
+            });
+        }
+        if t < self.oldest {
+            return Err(SymplecticError::InvalidParameter {
+                name: "ephemeris time",
+                value: t,
+                reason:
+                    "precedes the retained window of planet states (discarded or before the start)",
+            });
+        }
+        self.interpolate_unchecked(t, out, accelerations);
+        Ok(())
+    }
+
+    /// The interpolation proper; `t` must lie in the retained window.
+    fn interpolate_unchecked(&self, t: f64, out: &mut BodyStates, accelerations: bool) {
+        let (e, tau, last) = (self.ephemeris, self.tau, self.last);
+        let rel = (t - e.start_time) * self.inv_tau;
+        // The grid point at or before t (rounding of `rel` corrected against the grid times),
+        // so that the result depends on t and the grid only, not on how far the grid reaches:
+        // a time on a grid point takes that state, anything else the interval after it.
+        // (`as u64` truncates: the floor of a non-negative `rel`, without a libm call.)
+        let mut k = (rel.max(0.0) as u64).clamp(e.first_index, last);
+        if k > e.first_index && t < e.grid_time(k) {
+            k -= 1;
+        }
+        if k < last && e.grid_time(k + 1) <= t {
+            k += 1;
+        }
+        let n1 = e.planets.len() + 1;
+        out.resize(n1);
+        out.time = t;
+        out.gm[0] = e.planets.g() * e.planets.sun_mass();
+        for (i, &m) in e.planets.masses().iter().enumerate() {
+            out.gm[i + 1] = e.planets.g() * m;
+        }
+        let stride = e.stride();
+        let base = e.offset + (k - e.first_index) as usize * stride;
+        if t == e.grid_time(k) || k == last {
+            // On a grid point: the stored state itself.
+            for j in 0..n1 {
+                let o = base + 9 * j;
+                out.positions[j] = e.vec_at(o);
+                out.velocities[j] = e.vec_at(o + 3);
+                out.accelerations[j] = e.vec_at(o + 6);
+            }
+            return;
+        }
+        let x = (t - e.grid_time(k)) * self.inv_tau;
+        let w = QuinticHermite::at(x);
+        // The weights with the scaling to the unit interval folded in (the stored velocities
+        // and accelerations are per day): one multiply-add per datum and component.
+        let (tau2, inv_tau) = (tau * tau, self.inv_tau);
+        let fold = |c: &[f64; 6], s: f64| {
+            [
+                c[0] * s,
+                c[1] * (tau * s),
+                c[2] * (tau2 * s),
+                c[3] * s,
+                c[4] * (tau * s),
+                c[5] * (tau2 * s),
+            ]
+        };
+        let value = fold(&w.value, 1.0);
+        let first = fold(&w.first, inv_tau);
+        let second = if accelerations {
+            fold(&w.second, inv_tau * inv_tau)
+        } else {
+            [0.0; 6]
+        };
+        let grid = &e.grid[base..base + 2 * stride];
+        let (before, after) = grid.split_at(stride);
+        let (before, after) = (before.as_chunks::<9>().0, after.as_chunks::<9>().0);
+        for (j, (a, b)) in before.iter().zip(after).enumerate().take(n1) {
+            out.positions[j] = combine(a, b, &value);
+            out.velocities[j] = combine(a, b, &first);
+            if accelerations {
+                out.accelerations[j] = combine(a, b, &second);
+            }
+        }
+    }
+}
+
+/// Grid states computed ahead by [`Ephemeris::extension`].
+pub(crate) struct Extension {
+    planets: Planets,
+    states: Vec<f64>,
+    work: WorkCounters,
+    error: Option<SymplecticError>,
+}
+
+/// Appends to `grid` the barycentric positions, velocities and accelerations of every body at
+/// the state of `planets` (`9 (n+1)` values; no allocation once `grid` has its capacity),
+/// counting the `n(n+1)/2` pair forces in `work`.
+fn push_state(planets: &Planets, grid: &mut Vec<f64>, work: &mut WorkCounters) {
+    let n = planets.len();
+    let g = planets.g();
+    let m0 = planets.sun_mass();
+    let (sun_pos, sun_vel) = planets.sun_barycentric_state();
+    let base = grid.len();
+    grid.resize(base + 9 * (n + 1), 0.0);
+    let body = |j: usize| base + 9 * j;
+    let vec_at = |grid: &[f64], o: usize| Vec3::from_column_slice(&grid[o..o + 3]);
+    grid[body(0)..body(0) + 3].copy_from_slice(sun_pos.as_slice());
+    grid[body(0) + 3..body(0) + 6].copy_from_slice(sun_vel.as_slice());
+    for i in 0..n {
+        let m = planets.masses()[i];
+        let o = body(i + 1);
+        let q = planets.positions()[i] + sun_pos;
+        let v = planets.momenta()[i] / m;
+        grid[o..o + 3].copy_from_slice(q.as_slice());
+        grid[o + 3..o + 6].copy_from_slice(v.as_slice());
+    }
+    let mass = |j: usize| if j == 0 { m0 } else { planets.masses()[j - 1] };
+    work.force_evaluations += (n * (n + 1) / 2) as u64;
+    for j in 0..=n {
+        for k in j + 1..=n {
+            let d = vec_at(grid, body(k)) - vec_at(grid, body(j));
+            let r2 = d.norm_squared();
+            let f = d * (g / (r2 * r2.sqrt()));
+            let (aj, ak) = (
+                vec_at(grid, body(j) + 6) + f * mass(k),
+                vec_at(grid, body(k) + 6) - f * mass(j),
+            );
+            grid[body(j) + 6..body(j) + 9].copy_from_slice(aj.as_slice());
+            grid[body(k) + 6..body(k) + 9].copy_from_slice(ak.as_slice());
+        }
+    }
+}
+
+/// `Σ_k c_k d_k` over the six data `d = (p₀, v₀, a₀, p₁, v₁, a₁)` of one body (`a` and `b` its
+/// nine stored values at the two grid points).
+#[inline(always)]
+fn combine(a: &[f64; 9], b: &[f64; 9], c: &[f64; 6]) -> Vec3 {
+    let mut out = [0.0; 3];
+    for (i, o) in out.iter_mut().enumerate() {
+        *o = a[i] * c[0]
+            + a[3 + i] * c[1]
+            + a[6 + i] * c[2]
+            + b[i] * c[3]
+            + b[3 + i] * c[4]
+            + b[6 + i] * c[5];
+    }
+    Vec3::new(out[0], out[1], out[2])
 }
 
 /// Weights of the quintic Hermite interpolant on `[0, 1]` for the data

@@ -36,20 +36,29 @@ pub fn stumpff(z: f64) -> [f64; 4] {
         x *= 0.25;
         n += 1;
     }
-    // Series (Horner form) for c2 and c3 at small x, then c1 = 1 − x c3, c0 = 1 − x c2.
+    // Series (Horner form) for c2 and c3 at small x, then c1 = 1 − x c3, c0 = 1 − x c2. The
+    // divisors are multiplied as reciprocals (constant-folded): a division costs several
+    // times a multiplication, and twelve of them made up most of a call.
     let c3 = (1.0
-        - x / 20.0
+        - x * (1.0 / 20.0)
             * (1.0
-                - x / 42.0
+                - x * (1.0 / 42.0)
                     * (1.0
-                        - x / 72.0 * (1.0 - x / 110.0 * (1.0 - x / 156.0 * (1.0 - x / 210.0))))))
-        / 6.0;
+                        - x * (1.0 / 72.0)
+                            * (1.0
+                                - x * (1.0 / 110.0)
+                                    * (1.0 - x * (1.0 / 156.0) * (1.0 - x * (1.0 / 210.0)))))))
+        * (1.0 / 6.0);
     let c2 = (1.0
-        - x / 12.0
+        - x * (1.0 / 12.0)
             * (1.0
-                - x / 30.0
-                    * (1.0 - x / 56.0 * (1.0 - x / 90.0 * (1.0 - x / 132.0 * (1.0 - x / 182.0))))))
-        / 2.0;
+                - x * (1.0 / 30.0)
+                    * (1.0
+                        - x * (1.0 / 56.0)
+                            * (1.0
+                                - x * (1.0 / 90.0)
+                                    * (1.0 - x * (1.0 / 132.0) * (1.0 - x * (1.0 / 182.0)))))))
+        * 0.5;
     let mut c = [1.0 - x * c2, 1.0 - x * c3, c2, c3];
     for _ in 0..n {
         let [c0, c1, c2, c3] = c;
@@ -77,6 +86,18 @@ pub struct DriftInfo {
 /// Errors when `mu <= 0`, the state is not finite, `r = 0`, or the solver fails (it cannot
 /// for finite input, but a non-finite intermediate is reported rather than returned).
 pub fn drift(r: &mut Vec3, v: &mut Vec3, mu: f64, dt: f64) -> Result<DriftInfo, SymplecticError> {
+    let r0 = r.norm();
+    drift_from_distance(r, v, r0, mu, dt)
+}
+
+/// [`drift`] with `r0 = |r|` already computed by the caller (bit for bit `r.norm()`).
+pub(crate) fn drift_from_distance(
+    r: &mut Vec3,
+    v: &mut Vec3,
+    r0: f64,
+    mu: f64,
+    dt: f64,
+) -> Result<DriftInfo, SymplecticError> {
     if !(mu.is_finite() && mu > 0.0) {
         return Err(SymplecticError::InvalidParameter {
             name: "mu",
@@ -84,7 +105,6 @@ pub fn drift(r: &mut Vec3, v: &mut Vec3, mu: f64, dt: f64) -> Result<DriftInfo, 
             reason: "must be finite and > 0",
         });
     }
-    let r0 = r.norm();
     if !(r0.is_finite() && r0 > 0.0 && v.iter().all(|x| x.is_finite()) && dt.is_finite()) {
         return Err(SymplecticError::InvalidState {
             what: "Kepler drift",
@@ -149,10 +169,14 @@ pub fn drift(r: &mut Vec3, v: &mut Vec3, mu: f64, dt: f64) -> Result<DriftInfo, 
         let f = r0 * g1 + eta * g2 + mu * g3 - dt_eff;
         let fp = r0 * g0 + eta * g1 + mu * g2;
         let fpp = eta * g0 + (mu - beta * r0) * g1;
-        // Halley, ds = f/(f' − f f''/2f'), written with one division; Newton where the
-        // Halley denominator is not safely positive (f' = r > 0).
+        // Halley, ds = f/(f' − f f''/2f'), written with one division, where it is a modest
+        // change of Newton's step (|f f''| < f'², so |ds| is 2/3 to 2 Newton steps); Newton
+        // otherwise (f' = r > 0). Without the upper bound a large −f f'' (far from the root,
+        // near a pericentre passage) made the Halley step tiny though f was not, and the
+        // test below accepted a wrong anomaly: e = 0.99, a third of an orbit from
+        // pericentre, gave positions off by several AU in one drift of eight.
         let denominator = 2.0 * fp * fp - f * fpp;
-        let ds = if denominator > fp * fp {
+        let ds = if denominator > fp * fp && denominator < 3.0 * fp * fp {
             2.0 * f * fp / denominator
         } else {
             f / fp
@@ -184,10 +208,12 @@ pub fn drift(r: &mut Vec3, v: &mut Vec3, mu: f64, dt: f64) -> Result<DriftInfo, 
         }
     };
     let rr = r0 * g0 + eta * g1 + mu * g2;
-    let f = 1.0 - mu * g2 / r0;
+    // Two divisions for the four quotients.
+    let (inv_r0, inv_rr) = (1.0 / r0, 1.0 / rr);
+    let f = 1.0 - mu * g2 * inv_r0;
     let g = r0 * g1 + eta * g2;
-    let fdot = -mu * g1 / (rr * r0);
-    let gdot = 1.0 - mu * g2 / rr;
+    let fdot = -mu * g1 * (inv_rr * inv_r0);
+    let gdot = 1.0 - mu * g2 * inv_rr;
     let (r_old, v_old) = (*r, *v);
     *r = r_old * f + v_old * g;
     *v = r_old * fdot + v_old * gdot;

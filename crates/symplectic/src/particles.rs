@@ -149,6 +149,44 @@ pub struct ParticleStepInfo {
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ParticleScratch {
     bodies: BodyStates,
+    kick: KickTerms,
+}
+
+/// The barycentric `E₁` terms at one time and position: `F₁ = K₁/r`, `∂F₁/∂q` and
+/// `Σ G m_j (q − q_j)·q̇_j/|q − q_j|³` (`∂F₁/∂t`), kept to serve the next kick at the same
+/// `(t, q)` without evaluating the forces again. `NaN` time: holds nothing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct KickTerms {
+    time: f64,
+    position: Vec3,
+    f1: f64,
+    gradient: Vec3,
+    dt_part: f64,
+}
+
+impl Default for KickTerms {
+    fn default() -> Self {
+        Self {
+            time: f64::NAN,
+            position: Vec3::zeros(),
+            f1: f64::NAN,
+            gradient: Vec3::zeros(),
+            dt_part: f64::NAN,
+        }
+    }
+}
+
+impl KickTerms {
+    /// Whether these are the terms at `(time, position)` (bit for bit; the bodies are a
+    /// function of the time, so nothing else enters).
+    fn holds(&self, time: f64, position: &Vec3) -> bool {
+        self.time.to_bits() == time.to_bits()
+            && self
+                .position
+                .iter()
+                .zip(position.iter())
+                .all(|(a, b)| a.to_bits() == b.to_bits())
+    }
 }
 
 impl ParticleScratch {
@@ -423,7 +461,16 @@ impl ParticleIntegrator {
 
     /// `F₀ = K₀/r`.
     fn f0(&self, p: &TestParticle, bodies: &BodyStates) -> Result<f64, SymplecticError> {
-        let r = p.position.norm();
+        self.f0_at_distance(p, p.position.norm(), bodies)
+    }
+
+    /// `F₀` with `r = |q|` given.
+    fn f0_at_distance(
+        &self,
+        p: &TestParticle,
+        r: f64,
+        bodies: &BodyStates,
+    ) -> Result<f64, SymplecticError> {
         let mu = self.kepler_mu(bodies);
         let f0 = 0.5 * p.velocity.norm_squared() - mu / r + p.p4 + self.b0;
         check_positive("K0/r", f0, p.time)
@@ -444,7 +491,8 @@ impl ParticleIntegrator {
         h: f64,
         bodies: &BodyStates,
     ) -> Result<f64, SymplecticError> {
-        let f0 = self.f0(p, bodies)?;
+        let r = p.position.norm();
+        let f0 = self.f0_at_distance(p, r, bodies)?;
         let dt = h / f0;
         let mu = self.kepler_mu(bodies);
         if mu.is_nan() || mu <= 0.0 {
@@ -454,7 +502,7 @@ impl ParticleIntegrator {
                 reason: "B1 must be smaller than G M (the Kepler part needs a positive μ)",
             });
         }
-        let info = crate::kepler::drift(&mut p.position, &mut p.velocity, mu, dt)?;
+        let info = crate::kepler::drift_from_distance(&mut p.position, &mut p.velocity, r, mu, dt)?;
         p.work.kepler_solves += 1;
         p.work.kepler_iterations += u64::from(info.iterations);
         p.time += dt;
@@ -468,32 +516,60 @@ impl ParticleIntegrator {
         h: f64,
         bodies: &BodyStates,
     ) -> Result<(), SymplecticError> {
+        self.perturbation_cached(p, h, bodies, &mut KickTerms::default())
+    }
+
+    /// The barycentric `E₁` terms at `(t, q)` ([`KickTerms`]): one square root and one
+    /// division per body.
+    fn barycentric_kick_terms(&self, time: f64, q: Vec3, bodies: &BodyStates) -> KickTerms {
+        let inv_r = 1.0 / q.norm();
+        let q_r3 = q * (inv_r * inv_r * inv_r);
+        let mut f1 = self.b0 + self.b1 * inv_r;
+        let mut gradient = -q_r3 * self.b1;
+        let mut dt_part = 0.0;
+        for ((gm, qj), vj) in bodies
+            .gm
+            .iter()
+            .zip(&bodies.positions)
+            .zip(&bodies.velocities)
+        {
+            let d = q - qj;
+            let inv_d = 1.0 / d.norm();
+            let inv_d3 = inv_d * inv_d * inv_d;
+            f1 += gm * (inv_d - inv_r);
+            gradient += (q_r3 - d * inv_d3) * *gm;
+            dt_part += gm * d.dot(vj) * inv_d3;
+        }
+        KickTerms {
+            time,
+            position: q,
+            f1,
+            gradient,
+            dt_part,
+        }
+    }
+
+    /// [`ParticleIntegrator::perturbation`], reusing in the barycentric variant the terms of
+    /// the last kick at the same time and position (`cache`): the closing `E₁` of a step and
+    /// the opening one of the next are at the same `(t, q)`, and `F₁` depends on nothing else
+    /// there, so the second costs no force evaluation and the result is bit for bit the same.
+    pub(crate) fn perturbation_cached(
+        &self,
+        p: &mut TestParticle,
+        h: f64,
+        bodies: &BodyStates,
+        cache: &mut KickTerms,
+    ) -> Result<(), SymplecticError> {
         match self.variant {
             Variant::Barycentric => {
-                let q = p.position;
-                let r = q.norm();
-                let q_r3 = q / (r * r * r);
-                let mut f1 = self.b0 + self.b1 / r;
-                let mut grad = -q_r3 * self.b1;
-                let mut dt_part = 0.0;
-                for ((gm, qj), vj) in bodies
-                    .gm
-                    .iter()
-                    .zip(&bodies.positions)
-                    .zip(&bodies.velocities)
-                {
-                    let d = q - qj;
-                    let dn = d.norm();
-                    let d3 = dn * dn * dn;
-                    f1 += gm * (1.0 / dn - 1.0 / r);
-                    grad += (q_r3 - d / d3) * *gm;
-                    dt_part += gm * d.dot(vj) / d3;
+                if !cache.holds(p.time, &p.position) {
+                    *cache = self.barycentric_kick_terms(p.time, p.position, bodies);
                 }
                 p.work.force_evaluations += bodies.gm.len() as u64;
-                let f1 = check_positive("K1/r", f1, p.time)?;
+                let f1 = check_positive("K1/r", cache.f1, p.time)?;
                 let sigma = h / f1;
-                p.velocity += grad * sigma;
-                p.p4 += dt_part * sigma;
+                p.velocity += cache.gradient * sigma;
+                p.p4 += cache.dt_part * sigma;
             }
             Variant::Mixed => {
                 let (s_over_m0, s_dot_over_m0) = planets_momentum_over_m0(bodies);
@@ -561,6 +637,7 @@ impl ParticleIntegrator {
             p,
             &mut scratch.bodies,
             f64::NAN,
+            &mut scratch.kick,
             &mut |t: f64, out: &mut BodyStates| ephemeris.bodies_at(t, out),
         )?;
         let hamiltonian = self.hamiltonian(p, &scratch.bodies);
@@ -574,12 +651,14 @@ impl ParticleIntegrator {
     /// [`Population`](crate::Population): the stages of the scheme, fetching the bodies with
     /// `fetch` whenever the particle's time differs from `bodies_time` (the time `bodies`
     /// holds, `NaN` if none), and once more at the end, so that `bodies` ends at the particle's
-    /// new time. Returns that time.
+    /// new time. `kick` carries the last barycentric kick's terms between stages and steps
+    /// ([`KickTerms`]). Returns that time.
     pub(crate) fn advance(
         &self,
         p: &mut TestParticle,
         bodies: &mut BodyStates,
         mut bodies_time: f64,
+        kick: &mut KickTerms,
         fetch: &mut impl FnMut(f64, &mut BodyStates) -> Result<(), SymplecticError>,
     ) -> Result<f64, SymplecticError> {
         let h = p.step;
@@ -592,7 +671,9 @@ impl ParticleIntegrator {
                 ParticlePiece::KeplerDrift => {
                     self.kepler_drift(p, s.coefficient * h, bodies)?;
                 }
-                ParticlePiece::Perturbation => self.perturbation(p, s.coefficient * h, bodies)?,
+                ParticlePiece::Perturbation => {
+                    self.perturbation_cached(p, s.coefficient * h, bodies, kick)?
+                }
             }
         }
         if bodies_time != p.time {

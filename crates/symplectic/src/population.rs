@@ -6,9 +6,9 @@ use std::path::Path;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::ephemeris::{BodyStates, Ephemeris};
+use crate::ephemeris::{BodyStates, Ephemeris, GridView};
 use crate::kepler::Elements;
-use crate::particles::{ParticleIntegrator, TestParticle};
+use crate::particles::{KickTerms, ParticleIntegrator, TestParticle};
 use crate::run::ParticleStatus;
 use crate::{SymplecticError, Variant, Vec3, WorkCounters};
 
@@ -109,7 +109,40 @@ pub const DEFAULT_WINDOW_STEPS: u32 = 256;
 ///
 /// **Memory:** [`Population::bytes_per_particle`] per particle (one [`PopulationMember`]), plus
 /// the ephemeris window (`72 (n+1)` bytes per retained planet step: 360 bytes for the Sun and
-/// four giants, at most about `2 ×` [`Population::window_steps`] steps).
+/// four giants, at most about `3 ×` [`Population::window_steps`] steps).
+///
+/// **Threads.** The particles of a window are spread over rayon's threads; meanwhile one task
+/// integrates the planets of the next window ([`Ephemeris`] states computed from a copy of the
+/// planets and appended after the window: the same states in the same order as extending in
+/// turn), so the planets' integration is not a serial stage between windows.
+///
+/// **What bounds a particle step** (barycentric variant, S2, the Sun and four giants; counted
+/// from the code, one step = `E₁(h/2) E₀(h) E₁(h/2)`):
+///
+/// - *The planets at the particle's new time:* one quintic Hermite interpolation of positions
+///   and velocities of 5 bodies, about 390 flops (60 for the weights, 330 for
+///   `5 × 2 × 3` dot products of length 6), reading two grid states (720 bytes, from a
+///   retained window of at most about 280 kB, in L2).
+/// - *The kicks:* the closing `E₁` of a step and the opening one of the next are at the same
+///   `(t, q)`, where `F₁` and its derivatives are the same numbers: they are evaluated once
+///   ([`ParticleIntegrator`]'s kick cache, bit for bit the same result), 5 body terms of about
+///   35 flops, one square root and one division each, then two updates of `v` and `p₄`.
+/// - *The Kepler drift* ([`kepler::drift`](crate::kepler::drift)): `F₀` and `Δt = h/F₀`, the
+///   universal-variable solve (Stumpff series of 12 multiply-adds, one Halley iteration from
+///   the third-order series guess: 1.00 iterations per solve on the issue-21 comets) and the
+///   `f, g` update, about 140 flops, one square root and 7 divisions, in one dependent chain.
+/// - *The removal rules:* Hill spheres of 4 planets compared squared, energy and perihelion
+///   without square roots beyond `|q|`, about 110 flops.
+///
+/// In all about 850 flops, 7 square roots and 17 divisions per particle step, mostly in
+/// dependent chains (a step is latency-bound, not bandwidth-bound: a particle's 184 bytes
+/// stay in registers and L1 through the window). Measured share of the time (`perf`, 10³
+/// comets, 2026-11-25): drift 44 %, kicks 23 %, interpolation 20 %, removal and bookkeeping
+/// 13 %; about 0.18 µs per step on this project's 2-core machine (`docs/performance.md`).
+/// **The ephemeris:** one planet step per grid interval, shared by all `N` particles: with the
+/// default S6 at 730.5 d (12 Kepler solves and 24 pair forces per step, plus 10 pair forces
+/// for the stored accelerations) about 1.4 µs per planet step, i.e. `0.7/N` µs per
+/// particle-year, comparable to the particles' own cost only for `N` below about 10.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Population {
     ephemeris: Ephemeris,
@@ -129,11 +162,14 @@ struct Worker {
     bodies: BodyStates,
     /// Time `bodies` holds (`NaN` if none).
     bodies_time: f64,
+    /// The last barycentric kick's terms.
+    kick: KickTerms,
 }
 
 /// The read-only context of a window.
 struct WindowContext<'a> {
-    ephemeris: &'a Ephemeris,
+    /// The planets, read through one view of the grid for the whole window.
+    grid: GridView<'a>,
     integrator: ParticleIntegrator,
     rules: RemovalRules,
     /// `(m_j/3m₀)^{1/3}` per planet.
@@ -287,11 +323,7 @@ impl Population {
     /// `G M`, the sum of `G m_j` over the Sun and the planets (the `μ` of barycentric
     /// elements), summed as [`BodyStates::total_gm`] does.
     pub fn total_gm(&self) -> f64 {
-        let planets = self.ephemeris.planets();
-        let g = planets.g();
-        std::iter::once(g * planets.sun_mass())
-            .chain(planets.masses().iter().map(|m| g * m))
-            .sum()
+        total_gm(self.ephemeris.planets())
     }
 
     /// Barycentric position of member `i` at its own time.
@@ -355,8 +387,19 @@ impl Population {
             }
             let end = (self.time.max(oldest) + window).min(t_end);
             self.ephemeris.discard_before(oldest);
+            // Covered already by the previous window's extension, except at the start.
             self.ephemeris.extend_to((end + window).max(needed))?;
-            let (steps, beyond) = self.run_window(end);
+            // The planets of the next window are integrated while the particles step through
+            // this one (the same states, in the same order, as extending in turn).
+            let ahead = (end + window).min(t_end) + window;
+            let ephemeris = &self.ephemeris;
+            let members = &mut self.members;
+            let (integrator, rules) = (self.integrator, self.rules);
+            let (extension, (steps, beyond)) = rayon::join(
+                || ephemeris.extension(ahead),
+                || run_window(ephemeris, integrator, rules, members, end),
+            );
+            self.ephemeris.append(extension?)?;
             self.particle_steps += steps;
             needed = beyond;
             self.time = self.time.max(end);
@@ -364,36 +407,6 @@ impl Population {
         }
         self.time = self.time.max(t_end);
         Ok(self.progress())
-    }
-
-    /// One window: every active particle steps while its time is before `end`. Returns the
-    /// steps taken and the latest time a step needed beyond the ephemeris.
-    fn run_window(&mut self, end: f64) -> (u64, f64) {
-        let planets = self.ephemeris.planets();
-        let m0 = planets.sun_mass();
-        let ctx = WindowContext {
-            ephemeris: &self.ephemeris,
-            integrator: self.integrator,
-            rules: self.rules,
-            hill_coefficients: planets
-                .masses()
-                .iter()
-                .map(|m| (m / (3.0 * m0)).cbrt())
-                .collect(),
-            total_gm: self.total_gm(),
-            end,
-        };
-        self.members
-            .par_iter_mut()
-            .with_min_len(8)
-            .map_init(
-                || Worker {
-                    bodies: BodyStates::default(),
-                    bodies_time: f64::NAN,
-                },
-                |w, m| ctx.advance_member(m, w),
-            )
-            .reduce(|| (0, f64::NEG_INFINITY), |a, b| (a.0 + b.0, a.1.max(b.1)))
     }
 
     fn oldest_active_time(&self) -> Option<f64> {
@@ -512,6 +525,49 @@ impl Population {
     }
 }
 
+/// One window: every active member steps while its time is before `end`, reading `ephemeris`.
+/// Returns the steps taken and the latest time a step needed beyond the ephemeris.
+fn run_window(
+    ephemeris: &Ephemeris,
+    integrator: ParticleIntegrator,
+    rules: RemovalRules,
+    members: &mut [PopulationMember],
+    end: f64,
+) -> (u64, f64) {
+    let planets = ephemeris.planets();
+    let m0 = planets.sun_mass();
+    let ctx = WindowContext {
+        grid: ephemeris.view(),
+        integrator,
+        rules,
+        hill_coefficients: planets
+            .masses()
+            .iter()
+            .map(|m| (m / (3.0 * m0)).cbrt())
+            .collect(),
+        total_gm: total_gm(planets),
+        end,
+    };
+    members
+        .par_iter_mut()
+        .map_init(
+            || Worker {
+                bodies: BodyStates::default(),
+                bodies_time: f64::NAN,
+                kick: KickTerms::default(),
+            },
+            |w, m| ctx.advance_member(m, w),
+        )
+        .reduce(|| (0, f64::NEG_INFINITY), |a, b| (a.0 + b.0, a.1.max(b.1)))
+}
+
+fn total_gm(planets: &crate::Planets) -> f64 {
+    let g = planets.g();
+    std::iter::once(g * planets.sun_mass())
+        .chain(planets.masses().iter().map(|m| g * m))
+        .sum()
+}
+
 const POPULATION_FORMAT: &str = "symplectic-population";
 const POPULATION_VERSION: u32 = 1;
 
@@ -537,9 +593,8 @@ impl WindowContext<'_> {
                 &mut m.particle,
                 &mut w.bodies,
                 bodies_time,
-                &mut |t: f64, out: &mut BodyStates| {
-                    self.ephemeris.interpolate(t, out, accelerations)
-                },
+                &mut w.kick,
+                &mut |t: f64, out: &mut BodyStates| self.grid.interpolate(t, out, accelerations),
             );
             match result {
                 Ok(t) => {
@@ -586,17 +641,19 @@ impl WindowContext<'_> {
         };
         let rules = &self.rules;
         if let Some(factor) = rules.hill_factor {
+            // Compared squared (no square root per planet and step); the distances are taken
+            // only for the report.
             let sun = bodies.positions[0];
             for (j, c) in self.hill_coefficients.iter().enumerate() {
                 let planet = bodies.positions[j + 1];
-                let distance = (q - planet).norm();
-                let hill_radius = (planet - sun).norm() * c;
-                if distance < factor * hill_radius {
+                let distance2 = (q - planet).norm_squared();
+                let hill2 = (planet - sun).norm_squared() * (c * c);
+                if distance2 < factor * factor * hill2 {
                     return Some(ParticleStatus::HillSphereEntry {
                         time: p.time,
                         planet: j + 1,
-                        distance,
-                        hill_radius,
+                        distance: distance2.sqrt(),
+                        hill_radius: (planet - sun).norm() * c,
                     });
                 }
             }
@@ -605,12 +662,13 @@ impl WindowContext<'_> {
             return None;
         }
         // Barycentric osculating energy and perihelion from the energy and angular momentum
-        // (no angles): e² = 1 + 2E h²/μ², q = h²/(μ (1 + e)).
+        // (no angles): e² = 1 + 2E h²/μ², q = h²/(μ (1 + e)). Multiplied through by r (and
+        // μ²) so that no division is needed per step: 2E r = v² r − 2μ.
         let mu = self.total_gm;
         let r = q.norm();
-        let energy = 0.5 * p.velocity.norm_squared() - mu / r;
+        let v2r = p.velocity.norm_squared() * r;
         if let Some(limit) = rules.ejection_distance {
-            if energy >= 0.0 && r > limit {
+            if v2r >= 2.0 * mu && r > limit {
                 return Some(ParticleStatus::Ejected {
                     time: p.time,
                     distance: r,
@@ -619,9 +677,14 @@ impl WindowContext<'_> {
         }
         if let Some(limit) = rules.min_perihelion {
             let h2 = q.cross(&p.velocity).norm_squared();
-            let e = (1.0 + 2.0 * energy * h2 / (mu * mu)).max(0.0).sqrt();
-            let perihelion = h2 / (mu * (1.0 + e));
-            if perihelion < limit {
+            // r μ² e² = r μ² + (v² r − 2μ) h².
+            let r_mu2_e2 = (r * mu * mu + (v2r - 2.0 * mu) * h2).max(0.0);
+            // q < L ⟺ h² − Lμ < Lμ e: true when the left side is negative, otherwise compared
+            // squared; q itself only for the report.
+            let (u, w) = (h2 - limit * mu, limit * mu);
+            if u < 0.0 || u * u * (r * mu * mu) < w * w * r_mu2_e2 {
+                let e = (r_mu2_e2 / r).sqrt() / mu;
+                let perihelion = h2 / (mu * (1.0 + e));
                 return Some(ParticleStatus::PerihelionBelowLimit {
                     time: p.time,
                     perihelion,
