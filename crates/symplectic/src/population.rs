@@ -548,8 +548,13 @@ fn run_window(
         total_gm: total_gm(planets),
         end,
     };
+    // One particle per rayon job (`with_max_len(1)`): a thread that finishes the next
+    // window's planets (see `Population::advance_to`) can then take over particles that the
+    // other threads have not reached; with rayon's default splitting, a handful of particles
+    // were cut into one piece per thread, run whole, and that thread stayed idle.
     members
         .par_iter_mut()
+        .with_max_len(1)
         .map_init(
             || Worker {
                 bodies: BodyStates::default(),
