@@ -62,6 +62,8 @@ fn run<R: Real>(steps: usize, granular: bool) {
         }
         sum.iterations += last.iterations;
         sum.unconverged_substeps += last.unconverged_substeps;
+        sum.friction_iterations += last.friction_iterations;
+        sum.unconverged_friction_substeps += last.unconverged_friction_substeps;
     }
     let wall = t.elapsed().as_secs_f64();
     let n = steps as f64;
@@ -78,6 +80,14 @@ fn run<R: Real>(steps: usize, granular: bool) {
         sum.iterations as f64 / n,
         sum.unconverged_substeps
     );
+    if granular {
+        println!(
+            "mean friction iterations per step: {:.2} ({} steps at the cap without meeting the tolerance; last residual {:.2e})",
+            sum.friction_iterations as f64 / n,
+            sum.unconverged_friction_substeps,
+            last.last_friction_residual
+        );
+    }
     let phases: Vec<String> = sum
         .phases
         .iter()
