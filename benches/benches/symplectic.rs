@@ -1,6 +1,7 @@
 //! One planetary step of S2 and S6 (outer Solar System, four planets, τ = 365 d) and one
 //! test-particle step (Chegodaeva's particle 1, barycentric variant, B₁ = 0.21e-6, planets
-//! interpolated from a pre-computed ephemeris): `cargo bench -p benches --bench symplectic`.
+//! interpolated from a pre-computed ephemeris), and a population of comets advanced by one
+//! synchronisation window: `cargo bench -p benches --bench symplectic`.
 //! The `symplectic-100myr` experiment weights its counted steps with these costs.
 //! Peer anchor: REBOUND 5.2 WHFast, democratic heliocentric, ≈ 0.55 µs per step on
 //! one core of this machine; measured here with REBOUND 5.2.2 (safe_mode 0, 1e6 steps):
@@ -96,5 +97,39 @@ fn particle_step(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, planet_step, particle_step);
+/// `Population::advance_to` over one synchronisation window (256 planet steps, 512 years) of
+/// the issue-21 comets (S2 at a first step of 547.875 d, planets S6 at 730.5 d: the
+/// `comet_throughput` defaults), from the end of a first window (so that the ephemeris is
+/// in its steady state: each window integrates the next window's planets), for N = 10, 10³
+/// and 10⁴ on rayon's threads (`RAYON_NUM_THREADS`); the throughput is in particle-years
+/// (criterion's "elements" per second). The peer figures (REBOUND WHFast,
+/// the same comets) come from `benches/scripts/comets_vs_rebound.py` (`docs/performance.md`).
+fn population_window(c: &mut Criterion) {
+    let window_years = f64::from(symplectic::DEFAULT_WINDOW_STEPS) * 2.0;
+    let mut group = c.benchmark_group("population-window");
+    group.sample_size(10);
+    for n in [10usize, 1_000, 10_000] {
+        let (mut start, _) = benches::scattered_disk_population(
+            n,
+            Scheme::S2,
+            547.875,
+            Integrator::S6 { step: 730.5 },
+        )
+        .unwrap();
+        start.advance_to(window_years * 365.25, |_| {}).unwrap();
+        group.throughput(criterion::Throughput::Elements(
+            (n as f64 * window_years) as u64,
+        ));
+        group.bench_function(format!("n{n}"), |b| {
+            b.iter_batched_ref(
+                || start.clone(),
+                |p| p.advance_to(2.0 * window_years * 365.25, |_| {}).unwrap(),
+                criterion::BatchSize::LargeInput,
+            )
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, planet_step, particle_step, population_window);
 criterion_main!(benches);

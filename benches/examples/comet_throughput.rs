@@ -28,15 +28,9 @@
 //! (`id,status,time,x,y,z,vx,vy,vz`, each at its own time).
 use std::time::Instant;
 
-use symplectic::kepler::state_from_elements;
-use symplectic::samples::{sample_elements, SCATTERED_DISK};
-use symplectic::{
-    outer_solar_system, Ephemeris, Frame, Integrator, ParticleIntegrator, Population, RemovalRules,
-    Scheme, Variant,
-};
+use symplectic::{outer_solar_system, Frame, Integrator, Population, Scheme};
 
 const DAYS_PER_YEAR: f64 = 365.25;
-const SEED: u64 = 2026;
 
 fn main() {
     if let Err(e) = run() {
@@ -68,28 +62,11 @@ fn run() -> Result<(), String> {
         Some("s2") => Integrator::S2 { step: planet_step },
         Some(other) => return Err(format!("unknown planet map {other:?}; {usage}")),
     };
-    let planets = outer_solar_system(Frame::EclipticJ2000);
-    let g = planets.g();
-    let mu = g * (planets.sun_mass() + planets.masses().iter().sum::<f64>());
-    let states = sample_elements(&SCATTERED_DISK, n, SEED)
-        .iter()
-        .map(|el| state_from_elements(el, mu))
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| e.to_string())?;
-    let ids: Vec<u64> = (0..n as u64).collect();
+    let (mut population, states) = benches::scattered_disk_population(n, scheme, dt0, planet_map)?;
     if let Ok(path) = std::env::var("COMET_THROUGHPUT_INITIAL") {
-        write_initial(&path, &planets, &states).map_err(|e| format!("{path}: {e}"))?;
+        write_initial(&path, &outer_solar_system(Frame::EclipticJ2000), &states)
+            .map_err(|e| format!("{path}: {e}"))?;
     }
-    let ephemeris = Ephemeris::new(planets, planet_map).map_err(|e| e.to_string())?;
-    let integrator = ParticleIntegrator::new(Variant::Barycentric, scheme, 0.0, 0.21e-6)
-        .map_err(|e| e.to_string())?;
-    let rules = RemovalRules {
-        hill_factor: Some(1.0),
-        min_perihelion: Some(26.0),
-        ejection_distance: Some(1000.0),
-    };
-    let mut population = Population::new(ephemeris, integrator, rules, 0.0, dt0, &states, &ids)
-        .map_err(|e| e.to_string())?;
     let start = Instant::now();
     let progress = population
         .advance_to(years * DAYS_PER_YEAR, |_| {})

@@ -127,3 +127,60 @@ pub fn dam_break_fluid<R: Real>() -> (Vec<Vec3<R>>, Aabb<R>) {
     .expect("valid tank");
     (p, tank)
 }
+
+/// Seed of the issue-21 comet population.
+pub const COMET_SEED: u64 = 2026;
+
+/// The issue-21 comet population (the `comet_throughput` example and the `population-step`
+/// benchmark): the four giants of `outer_solar_system` (ecliptic J2000) integrated by
+/// `planet_map`; `n` comets with barycentric perihelia 32–40 AU, semi-major axes 40–100 AU,
+/// inclinations 0–30° and random angles (`symplectic::samples::SCATTERED_DISK`, seed
+/// [`COMET_SEED`]), integrated by `scheme` in the barycentric variant with `B₀ = 0`,
+/// `B₁ = 0.21·10⁻⁶` and a first step of `first_step_days`; removal at Hill-sphere entry,
+/// perihelion below 26 AU or ejection beyond 1000 AU. Returns the population at time 0 and
+/// the comets' initial barycentric states.
+pub fn scattered_disk_population(
+    n: usize,
+    scheme: symplectic::Scheme,
+    first_step_days: f64,
+    planet_map: symplectic::Integrator,
+) -> Result<
+    (
+        symplectic::Population,
+        Vec<(symplectic::Vec3, symplectic::Vec3)>,
+    ),
+    String,
+> {
+    use symplectic::kepler::state_from_elements;
+    use symplectic::samples::{sample_elements, SCATTERED_DISK};
+    use symplectic::{
+        outer_solar_system, Ephemeris, Frame, ParticleIntegrator, Population, RemovalRules, Variant,
+    };
+    let planets = outer_solar_system(Frame::EclipticJ2000);
+    let mu = planets.g() * (planets.sun_mass() + planets.masses().iter().sum::<f64>());
+    let states = sample_elements(&SCATTERED_DISK, n, COMET_SEED)
+        .iter()
+        .map(|el| state_from_elements(el, mu))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| e.to_string())?;
+    let ids: Vec<u64> = (0..n as u64).collect();
+    let ephemeris = Ephemeris::new(planets, planet_map).map_err(|e| e.to_string())?;
+    let integrator = ParticleIntegrator::new(Variant::Barycentric, scheme, 0.0, 0.21e-6)
+        .map_err(|e| e.to_string())?;
+    let rules = RemovalRules {
+        hill_factor: Some(1.0),
+        min_perihelion: Some(26.0),
+        ejection_distance: Some(1000.0),
+    };
+    let population = Population::new(
+        ephemeris,
+        integrator,
+        rules,
+        0.0,
+        first_step_days,
+        &states,
+        &ids,
+    )
+    .map_err(|e| e.to_string())?;
+    Ok((population, states))
+}
