@@ -8,7 +8,7 @@ Units: AU, days, degrees in elements; spans in years (Julian, 365.25 days).
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass, field, asdict
+from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Union
 
 import numpy as np
@@ -36,10 +36,10 @@ class Planets:
         ``"ecliptic_j2000"`` or ``"equatorial"``.
     names : list of str
         The giants' names.
-    masses_msun : ndarray, shape (5,)
-        Masses of the Sun and the giants (solar masses).
-    positions_au, velocities_au_per_day : ndarray, shape (5, 3)
-        Heliocentric positions (AU) and velocities (AU/day), the Sun's first (zero).
+    masses_msun : ndarray, shape (4,)
+        Masses of the giants (solar masses).
+    positions_au, velocities_au_per_day : ndarray, shape (4, 3)
+        Heliocentric positions (AU) and velocities (AU/day) of the giants at the epoch.
     """
 
     frame: str
