@@ -265,7 +265,7 @@ impl Population {
             let v = member.particle.velocity;
             flat.extend_from_slice(&[q.x, q.y, q.z, v.x, v.y, v.z]);
         }
-        Ok(flat.into_pyarray(py).reshape([m.len(), 6])?)
+        flat.into_pyarray(py).reshape([m.len(), 6])
     }
 
     /// Identifiers, in member order.

@@ -9,6 +9,9 @@ use neighbour_search::{Method, NeighbourLists};
 use crate::arrays::{points, Points};
 use crate::rust_err;
 
+/// CSR arrays: offsets (N + 1) and indices.
+type Csr<'py> = (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<u32>>);
+
 /// Neighbour lists of `positions` within `radius`, as `(offsets, indices)` CSR arrays.
 #[pyfunction]
 #[pyo3(signature = (positions, radius, method = "cell-start-grid"))]
@@ -17,7 +20,7 @@ fn neighbour_lists<'py>(
     positions: &Bound<'py, PyAny>,
     radius: f64,
     method: &str,
-) -> PyResult<(Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<u32>>)> {
+) -> PyResult<Csr<'py>> {
     let method: Method = method.parse().map_err(PyValueError::new_err)?;
     let points = points(positions, "positions")?;
     let lists = py.detach(|| {

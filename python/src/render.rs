@@ -23,7 +23,7 @@ pub(crate) fn render_image<R: Real>(
 /// An image as an (H, W, 3) uint8 array.
 pub(crate) fn to_numpy(py: Python<'_>, image: RgbImage) -> PyResult<Bound<'_, PyArray3<u8>>> {
     let (w, h) = (image.width, image.height);
-    Ok(image.data.into_pyarray(py).reshape([h, w, 3])?)
+    image.data.into_pyarray(py).reshape([h, w, 3])
 }
 
 fn bounds<R: Real>(p: &[Vec3<R>]) -> Option<([f32; 3], [f32; 3])> {

@@ -57,7 +57,7 @@ struct LastStats(Option<StepStats>);
 
 impl<R: Real> FrameObserver<R> for LastStats {
     fn frame(&mut self, _: &SceneSim<R>, stats: &StepStats) -> Result<(), SimError> {
-        self.0 = Some(stats.clone());
+        self.0 = Some(*stats);
         Ok(())
     }
 }
@@ -100,7 +100,7 @@ impl Simulation {
         let rows = pick(&self.lock()).map_err(rust_err)?;
         let n = rows.len();
         let flat: Vec<f64> = rows.into_iter().flatten().collect();
-        Ok(flat.into_pyarray(py).reshape([n, 3])?)
+        flat.into_pyarray(py).reshape([n, 3])
     }
 }
 
