@@ -51,7 +51,7 @@ def neighbour_lists():
     print(f"  Python median {py:.6f} s  ratio {py / rust:.3f}")
 
 
-def dask_population(n=100_000, years=20.0):
+def dask_population(n=100_000, years=500.0):
     from dask.distributed import Client, LocalCluster
     from partisim.dask import run_population_dask
 
