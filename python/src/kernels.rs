@@ -41,6 +41,23 @@ fn gradients<R: numpy::Element + sph_core::Real>(
     Ok(out.into_pyarray(py).into_any().unbind())
 }
 
+impl Kernel {
+    /// `f64` or `f32` applied to each element of `r`, by its dtype.
+    fn elementwise(
+        &self,
+        py: Python<'_>,
+        r: &Bound<'_, PyAny>,
+        f64: impl Fn(&AnyKernel<f64>, f64) -> f64,
+        f32: impl Fn(&AnyKernel<f32>, f32) -> f32,
+    ) -> PyResult<Py<PyAny>> {
+        if is_f64(untyped(r, "r")?, "r")? {
+            values::<f64>(py, r, |x| f64(&self.f64, x))
+        } else {
+            values::<f32>(py, r, |x| f32(&self.f32, x))
+        }
+    }
+}
+
 #[pymethods]
 impl Kernel {
     /// The kernel's name.
@@ -57,22 +74,12 @@ impl Kernel {
 
     /// W(r) (1/m³) for distances r (m) of any shape, float64 or float32.
     fn value(&self, py: Python<'_>, r: &Bound<'_, PyAny>) -> PyResult<Py<PyAny>> {
-        let a = untyped(r, "r")?;
-        if is_f64(a, "r")? {
-            values::<f64>(py, r, |x| self.f64.value(x))
-        } else {
-            values::<f32>(py, r, |x| self.f32.value(x))
-        }
+        self.elementwise(py, r, |k, x| k.value(x), |k, x| k.value(x))
     }
 
     /// dW/dr (1/m⁴) for distances r (m) of any shape.
     fn derivative(&self, py: Python<'_>, r: &Bound<'_, PyAny>) -> PyResult<Py<PyAny>> {
-        let a = untyped(r, "r")?;
-        if is_f64(a, "r")? {
-            values::<f64>(py, r, |x| self.f64.derivative(x))
-        } else {
-            values::<f32>(py, r, |x| self.f32.derivative(x))
-        }
+        self.elementwise(py, r, |k, x| k.derivative(x), |k, x| k.derivative(x))
     }
 
     /// ∇W (1/m⁴) for difference vectors r_vectors (m) of shape (..., 3).
