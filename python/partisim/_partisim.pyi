@@ -44,14 +44,14 @@ class Simulation:
     def run(self, frames: int, progress: bool = True) -> None:
         """Advances `frames` frames (progress bar on stderr); Ctrl-C stops between frames."""
     @property
-    def positions(self) -> npt.NDArray[np.float64]:
-        """(N, 3) positions (m), in the scene's particle order."""
+    def positions(self) -> _Float:
+        """(N, 3) positions (m), in the scene's particle order and precision."""
     @property
-    def velocities(self) -> npt.NDArray[np.float64]:
-        """(N, 3) velocities (m/s), in the scene's particle order."""
+    def velocities(self) -> _Float:
+        """(N, 3) velocities (m/s), in the scene's particle order and precision."""
     @property
-    def densities(self) -> npt.NDArray[np.float64]:
-        """(N,) densities (kg/m³), in the scene's particle order."""
+    def densities(self) -> _Float:
+        """(N,) densities (kg/m³), in the scene's particle order and precision."""
     @property
     def time(self) -> float:
         """Simulated time (s)."""

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 use std::sync::Mutex;
 
-use numpy::{IntoPyArray, PyArrayMethods, PyArray1, PyArray2};
+use numpy::{IntoPyArray, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use sph_core::{Real, Vec3};
@@ -79,28 +79,20 @@ fn run_in<R: Real>(
     (result, last.0, interrupt.err)
 }
 
-fn vectors<R: Real>(sim: &SceneSim<R>, v: &[Vec3<R>]) -> Result<Vec<[f64; 3]>, SimError> {
-    Ok(sim
-        .to_original_order(v)?
-        .iter()
-        .map(|p| [p.x.as_f64(), p.y.as_f64(), p.z.as_f64()])
-        .collect())
+/// Per-particle vectors in the scene's order, as an (N, 3) array of the scene's precision.
+fn array2<'py, R: Real + numpy::Element>(
+    py: Python<'py>,
+    sim: &SceneSim<R>,
+    v: &[Vec3<R>],
+) -> PyResult<Bound<'py, PyAny>> {
+    let ordered = sim.to_original_order(v).map_err(rust_err)?;
+    let flat: Vec<R> = ordered.iter().flat_map(|p| [p.x, p.y, p.z]).collect();
+    Ok(flat.into_pyarray(py).reshape([ordered.len(), 3])?.into_any())
 }
 
 impl Simulation {
     fn lock(&self) -> std::sync::MutexGuard<'_, AnySim> {
         self.sim.lock().unwrap_or_else(|p| p.into_inner())
-    }
-
-    fn array2<'py>(
-        &self,
-        py: Python<'py>,
-        pick: impl Fn(&AnySim) -> Result<Vec<[f64; 3]>, SimError>,
-    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let rows = pick(&self.lock()).map_err(rust_err)?;
-        let n = rows.len();
-        let flat: Vec<f64> = rows.into_iter().flatten().collect();
-        flat.into_pyarray(py).reshape([n, 3])
     }
 }
 
@@ -153,25 +145,26 @@ impl Simulation {
         result.map_err(rust_err)
     }
 
-    /// Positions (m), shape (N, 3), in the scene's particle order.
+    /// Positions (m), shape (N, 3), in the scene's particle order and precision.
     #[getter]
-    fn positions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        self.array2(py, |s| each!(s, s => vectors(s, &s.state.positions)))
+    fn positions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        each!(&*self.lock(), s => array2(py, s, &s.state.positions))
     }
 
-    /// Velocities (m/s), shape (N, 3), in the scene's particle order.
+    /// Velocities (m/s), shape (N, 3), in the scene's particle order and precision.
     #[getter]
-    fn velocities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        self.array2(py, |s| each!(s, s => vectors(s, &s.state.velocities)))
+    fn velocities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        each!(&*self.lock(), s => array2(py, s, &s.state.velocities))
     }
 
-    /// Densities (kg/m³), shape (N,), in the scene's particle order.
+    /// Densities (kg/m³), shape (N,), in the scene's particle order and precision.
     #[getter]
-    fn densities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let d = each!(&*self.lock(), s => s
+    fn densities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        each!(&*self.lock(), s => Ok(s
             .to_original_order(&s.state.densities)
-            .map(|d| d.iter().map(|x| x.as_f64()).collect::<Vec<f64>>()));
-        Ok(d.map_err(rust_err)?.into_pyarray(py))
+            .map_err(rust_err)?
+            .into_pyarray(py)
+            .into_any()))
     }
 
     /// Simulated time (s).
