@@ -42,6 +42,12 @@ impl NeighbourLists {
         &self.indices
     }
 
+    /// The CSR arrays `(offsets, indices)` by value, without a copy (for a caller that
+    /// hands them on, e.g. to Python as numpy arrays).
+    pub fn into_parts(self) -> (Vec<usize>, Vec<u32>) {
+        (self.offsets, self.indices)
+    }
+
     /// Total number of (ordered) neighbour pairs, i.e. `indices().len()`.
     pub fn pair_count(&self) -> usize {
         self.indices.len()

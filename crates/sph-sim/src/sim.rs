@@ -118,6 +118,25 @@ impl<R: Real> SceneSim<R> {
         Ok(stats)
     }
 
+    /// `per_particle` (one value per particle in the solver's current order, e.g.
+    /// `&self.state.positions`) in the order the scene created the particles: element `k`
+    /// of the result belongs to the particle with id `k` ([`SceneSim::ids`] follows every
+    /// reordering the solver does). Errors if `per_particle` is not one value per particle.
+    pub fn to_original_order<T: Copy>(&self, per_particle: &[T]) -> Result<Vec<T>, SimError> {
+        if per_particle.len() != self.ids.len() {
+            return Err(SimError::Invalid(format!(
+                "{} values for {} particles: need one value per particle",
+                per_particle.len(),
+                self.ids.len()
+            )));
+        }
+        let mut out = per_particle.to_vec();
+        for (&id, &value) in self.ids.iter().zip(per_particle) {
+            out[id as usize] = value;
+        }
+        Ok(out)
+    }
+
     /// Writes the solver's passive points (upscaling) of the current frame to `path` (legacy
     /// VTK, the format of [`SceneSim::write_vtk`]); returns `false` and writes nothing when
     /// the solver has none ([`FluidSolver::passive_points`]; an upscaling solver seeds them

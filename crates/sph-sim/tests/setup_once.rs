@@ -65,3 +65,25 @@ fn an_edited_scene_is_sampled_again() {
     assert_eq!(edited, lattice.len());
     assert!(edited < before, "{edited} vs {before}");
 }
+
+/// `to_original_order` undoes the solver's reordering: the result indexed by id equals the
+/// solver-order values looked up through `ids` (checked after frames that reorder), and at
+/// the start (no reordering yet) it is the solver's order itself.
+#[test]
+fn values_come_back_in_the_scenes_order() {
+    let scene = dam_break();
+    let mut sim = SceneSim::<f32>::new(&scene).unwrap();
+    let initial = sim.state.positions.clone();
+    assert_eq!(sim.to_original_order(&sim.state.positions).unwrap(), initial);
+    let mut reordered = false;
+    for _ in 0..3 {
+        reordered |= sim.advance().unwrap().reordered;
+    }
+    assert!(reordered, "the dam break's solver reorders its particles");
+    let ordered = sim.to_original_order(&sim.state.positions).unwrap();
+    for (k, &id) in sim.ids.iter().enumerate() {
+        assert_eq!(ordered[id as usize], sim.state.positions[k]);
+    }
+    let err = sim.to_original_order(&[0u8; 3]).unwrap_err();
+    assert!(err.to_string().contains("need one value per particle"), "{err}");
+}

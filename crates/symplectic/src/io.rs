@@ -255,19 +255,41 @@ impl PopulationSpec {
 
     /// Reads the particle file and builds the population at the epoch (nothing is written).
     pub fn population(&self, spec_path: &Path) -> Result<Population, SymplecticError> {
-        let mut ephemeris = self.ephemeris()?;
-        let integrator = self.particle_integrator()?;
         let file = self.particle_file(spec_path);
         let rows = read_particle_rows(&file, self.particles.kind)?;
+        self.population_from_rows(&rows, &file)
+    }
+
+    /// Builds the population at the epoch from rows given directly (a front end's array
+    /// rather than the particle file; `origin` names them in messages, `line` the row).
+    /// Each row is checked as the file's are: finite values, a state off the origin,
+    /// elements whose `a` and `e` agree; identifiers must be distinct.
+    pub fn population_from_rows(
+        &self,
+        rows: &[ParticleRow],
+        origin: &Path,
+    ) -> Result<Population, SymplecticError> {
+        let mut ephemeris = self.ephemeris()?;
+        let integrator = self.particle_integrator()?;
         check_memory(rows.len(), available_memory())?;
+        let kind = self.particles.kind;
+        for row in rows {
+            let names = particle_columns(kind);
+            if let Some(c) = row.values.iter().position(|v| !v.is_finite()) {
+                let reason = format!("{} is not a finite number", row.values[c]);
+                return Err(particle_error(origin, row.line, names[c], reason));
+            }
+            check_row(&row.values, kind)
+                .map_err(|(name, reason)| particle_error(origin, row.line, name, reason))?;
+        }
         let epoch = self.particles.epoch_days;
         let mut bodies = crate::BodyStates::default();
         ephemeris.bodies_at(epoch, &mut bodies)?;
         let states = rows
             .iter()
             .map(|row| {
-                to_integrator_state(row, self.particles.kind, integrator.variant, &bodies)
-                    .map_err(|reason| particle_error(&file, row.line, "", reason))
+                to_integrator_state(row, kind, integrator.variant, &bodies)
+                    .map_err(|reason| particle_error(origin, row.line, "", reason))
             })
             .collect::<Result<Vec<_>, _>>()?;
         let ids: Vec<u64> = rows.iter().map(|r| r.id).collect();

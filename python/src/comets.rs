@@ -1,0 +1,282 @@
+//! `symplectic`: comet populations (Chegodaeva 2004's shared planet ephemeris), with the
+//! population specification of `cargo xtask comets` and its Parquet tables.
+
+use std::path::{Path, PathBuf};
+
+use numpy::{IntoPyArray, PyArrayMethods, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyBytes, PyDict};
+use symplectic::io::{population_table, status_label, write_parquet, ParticleRow, PopulationSpec};
+use symplectic::Population as RustPopulation;
+
+use crate::arrays::{check_shape, is_f64, untyped};
+use crate::rust_err;
+
+/// The planets of a population: the Sun (with the inner planets' masses) and the four
+/// giants at the epoch 1994-09-05 0h, heliocentric, in `frame`.
+#[pyfunction]
+#[pyo3(signature = (frame = "ecliptic_j2000"))]
+fn outer_solar_system_table(py: Python<'_>, frame: &str) -> PyResult<Py<PyDict>> {
+    let f = match frame {
+        "ecliptic_j2000" => symplectic::Frame::EclipticJ2000,
+        "equatorial" => symplectic::Frame::Equatorial,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "frame {other:?}: expected \"ecliptic_j2000\" or \"equatorial\""
+            )))
+        }
+    };
+    let planets = symplectic::outer_solar_system(f);
+    let d = PyDict::new(py);
+    let flat = |v: &[symplectic::Vec3]| -> Vec<f64> { v.iter().flat_map(|p| p.iter().copied()).collect() };
+    let n = planets.len();
+    let velocities = planets.heliocentric_velocities();
+    d.set_item("names", symplectic::solar_system::GIANT_PLANETS.map(|g| g.name).to_vec())?;
+    d.set_item("masses_msun", planets.masses().to_vec().into_pyarray(py))?;
+    d.set_item("sun_mass_msun", planets.sun_mass())?;
+    d.set_item(
+        "positions_au",
+        flat(planets.positions()).into_pyarray(py).reshape([n, 3])?,
+    )?;
+    d.set_item(
+        "velocities_au_per_day",
+        flat(&velocities).into_pyarray(py).reshape([n, 3])?,
+    )?;
+    d.set_item("g", planets.g())?;
+    Ok(d.unbind())
+}
+
+/// A population of test particles (`symplectic::Population`).
+#[pyclass(module = "partisim")]
+struct Population {
+    inner: RustPopulation,
+}
+
+fn spec_from_json(spec_json: &str) -> PyResult<PopulationSpec> {
+    // The specification's TOML checks and field-naming messages, from a JSON document.
+    let value: toml::Value = serde_json::from_str(spec_json)
+        .map_err(|e| rust_err(format!("population spec: {e}")))?;
+    let text = toml::to_string(&value).map_err(|e| rust_err(format!("population spec: {e}")))?;
+    PopulationSpec::parse(&text, Path::new("population spec")).map_err(rust_err)
+}
+
+fn rows(particles: &Bound<'_, PyAny>, ids: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<ParticleRow>> {
+    let a = untyped(particles, "particles")?;
+    check_shape(a, "particles", "(N, 6)", Some(2), Some(6))?;
+    if !is_f64(a, "particles")? {
+        return Err(pyo3::exceptions::PyTypeError::new_err(
+            "particles: expected a float64 array, got float32 (orbits need float64)",
+        ));
+    }
+    let p: PyReadonlyArray2<'_, f64> = particles.extract()?;
+    let p = p.as_array();
+    let ids: Vec<u64> = match ids {
+        Some(ids) => {
+            let ia = untyped(ids, "ids")?;
+            check_shape(ia, "ids", "(N,)", Some(1), None)?;
+            let ids: PyReadonlyArray1<'_, u64> = ids.extract().map_err(|_| {
+                pyo3::exceptions::PyTypeError::new_err("ids: expected a uint64 array")
+            })?;
+            ids.as_array().to_vec()
+        }
+        None => (0..p.nrows() as u64).collect(),
+    };
+    if ids.len() != p.nrows() {
+        return Err(PyValueError::new_err(format!(
+            "ids: {} identifiers for {} particles",
+            ids.len(),
+            p.nrows()
+        )));
+    }
+    Ok(p.rows()
+        .into_iter()
+        .zip(ids)
+        .enumerate()
+        .map(|(k, (r, id))| ParticleRow {
+            line: k as u64,
+            id,
+            values: [r[0], r[1], r[2], r[3], r[4], r[5]],
+        })
+        .collect())
+}
+
+#[pymethods]
+impl Population {
+    /// Builds a population from a specification (the tables of a population TOML file,
+    /// as JSON) and particle rows `(N, 6)` of the specification's `particles.kind`.
+    #[staticmethod]
+    #[pyo3(signature = (spec_json, particles, ids = None))]
+    fn from_spec_json(
+        py: Python<'_>,
+        spec_json: &str,
+        particles: &Bound<'_, PyAny>,
+        ids: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let spec = spec_from_json(spec_json)?;
+        let rows = rows(particles, ids)?;
+        let inner = py
+            .detach(|| spec.population_from_rows(&rows, Path::new("particles")))
+            .map_err(rust_err)?;
+        Ok(Self { inner })
+    }
+
+    /// Reads a population TOML file and its particle CSV (`cargo xtask comets` input).
+    #[staticmethod]
+    fn from_spec_file(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        let inner = py
+            .detach(|| PopulationSpec::from_file(&path).and_then(|s| s.population(&path)))
+            .map_err(rust_err)?;
+        Ok(Self { inner })
+    }
+
+    /// Advances every active particle to `t_days` (days after the planets' epoch), in
+    /// synchronisation windows; Ctrl-C stops between windows (the windows done are kept).
+    fn advance_to_days(&mut self, py: Python<'_>, t_days: f64) -> PyResult<()> {
+        if !t_days.is_finite() {
+            return Err(PyValueError::new_err(format!(
+                "end time {t_days} days: must be finite"
+            )));
+        }
+        let window = f64::from(self.inner.window_steps()) * self.inner.ephemeris().grid_step();
+        loop {
+            // The same windows advance_to cuts, one call each: a particle's trajectory does
+            // not depend on where the calls stop (Population's determinism).
+            let end = (self.inner.time() + window).min(t_days);
+            let inner = &mut self.inner;
+            py.detach(|| inner.advance_to(end, |_| {})).map_err(rust_err)?;
+            py.check_signals()?;
+            if end >= t_days {
+                return Ok(());
+            }
+        }
+    }
+
+    /// The population's time (days after the planets' epoch).
+    #[getter]
+    fn time_days(&self) -> f64 {
+        self.inner.time()
+    }
+
+    /// Particle steps done in total.
+    #[getter]
+    fn particle_steps(&self) -> u64 {
+        self.inner.progress().particle_steps
+    }
+
+    /// Number of particles (active and removed).
+    fn __len__(&self) -> usize {
+        self.inner.members().len()
+    }
+
+    /// Each particle's status label (`active`, `hill_sphere_<planet>`, `perihelion`,
+    /// `ejected`, `regularisation_lost`, `failed`), in identifier order.
+    #[getter]
+    fn status(&self) -> Vec<String> {
+        self.inner
+            .members()
+            .iter()
+            .map(|m| status_label(&m.status).0)
+            .collect()
+    }
+
+    /// The snapshot table (the columns of `cargo xtask comets`' Parquet snapshots) as a
+    /// dict of numpy arrays (`status` a list of str).
+    fn table<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let batch = population_table(&self.inner).map_err(rust_err)?;
+        let d = PyDict::new(py);
+        let schema = batch.schema();
+        for (field, col) in schema.fields().iter().zip(batch.columns()) {
+            let any = col.as_any();
+            if let Some(a) = any.downcast_ref::<arrow_array::Float64Array>() {
+                d.set_item(field.name(), a.values().to_vec().into_pyarray(py))?;
+            } else if let Some(a) = any.downcast_ref::<arrow_array::UInt64Array>() {
+                d.set_item(field.name(), a.values().to_vec().into_pyarray(py))?;
+            } else if let Some(a) = any.downcast_ref::<arrow_array::StringArray>() {
+                let v: Vec<&str> = a.iter().map(|s| s.unwrap_or("")).collect();
+                d.set_item(field.name(), v)?;
+            }
+        }
+        Ok(d)
+    }
+
+    /// Writes the snapshot table as Parquet (readable by pandas and polars), atomically.
+    fn write_parquet(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        let inner = &self.inner;
+        py.detach(|| population_table(inner).and_then(|b| write_parquet(&path, &b)))
+            .map_err(rust_err)
+    }
+
+    /// The members `start..stop` as a population of their own (`Population::shard`).
+    fn shard(&self, start: usize, stop: usize) -> PyResult<Self> {
+        if start > stop {
+            return Err(PyValueError::new_err(format!(
+                "shard {start}..{stop}: start after stop"
+            )));
+        }
+        Ok(Self {
+            inner: self.inner.shard(start..stop).map_err(rust_err)?,
+        })
+    }
+
+    /// Joins shards of one population advanced to the same time (`Population::merge`).
+    #[staticmethod]
+    fn merge(py: Python<'_>, shards: Vec<PyRef<'_, Population>>) -> PyResult<Self> {
+        let shards: Vec<RustPopulation> = shards.iter().map(|s| s.inner.clone()).collect();
+        let inner = py.detach(|| RustPopulation::merge(shards)).map_err(rust_err)?;
+        Ok(Self { inner })
+    }
+
+    /// Writes the whole population atomically (the Rust checkpoint format).
+    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        let inner = &self.inner;
+        py.detach(|| inner.save(&path)).map_err(rust_err)
+    }
+
+    /// Reads a population written by `save`.
+    #[staticmethod]
+    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        let inner = py.detach(|| RustPopulation::load(&path)).map_err(rust_err)?;
+        Ok(Self { inner })
+    }
+
+    /// The whole population as bytes (JSON of the Rust state, float round trip exact), for
+    /// pickling across processes.
+    fn to_bytes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
+        let v = serde_json::to_vec(&self.inner).map_err(rust_err)?;
+        Ok(PyBytes::new(py, &v))
+    }
+
+    /// A population from `to_bytes`.
+    #[staticmethod]
+    fn from_bytes(data: &[u8]) -> PyResult<Self> {
+        let inner = serde_json::from_slice(data)
+            .map_err(|e| rust_err(format!("not a population's bytes: {e}")))?;
+        Ok(Self { inner })
+    }
+
+    /// Barycentric states `(N, 6)`: x, y, z (AU), vx, vy, vz (AU/day), in identifier order.
+    #[getter]
+    fn states<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let m = self.inner.members();
+        let mut flat = Vec::with_capacity(6 * m.len());
+        for (i, member) in m.iter().enumerate() {
+            let q = self.inner.barycentric_position(i);
+            let v = member.particle.velocity;
+            flat.extend_from_slice(&[q.x, q.y, q.z, v.x, v.y, v.z]);
+        }
+        flat.into_pyarray(py).reshape([m.len(), 6])
+    }
+
+    /// Identifiers, in member order.
+    #[getter]
+    fn ids<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u64>> {
+        let ids: Vec<u64> = self.inner.members().iter().map(|m| m.id).collect();
+        ids.into_pyarray(py)
+    }
+}
+
+pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Population>()?;
+    m.add_function(wrap_pyfunction!(outer_solar_system_table, m)?)
+}
