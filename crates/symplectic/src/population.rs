@@ -8,6 +8,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::ephemeris::{BodyStates, Ephemeris, GridView};
 use crate::kepler::Elements;
+use crate::lanes::{self, norm, norm_squared, KickLanes, Mask, LANES, V, V3};
+use crate::particles::ParticlePiece;
 use crate::particles::{KickTerms, ParticleIntegrator, TestParticle};
 use crate::run::ParticleStatus;
 use crate::{SymplecticError, Variant, Vec3, WorkCounters};
@@ -176,6 +178,41 @@ struct WindowContext<'a> {
     hill_coefficients: Vec<f64>,
     total_gm: f64,
     end: f64,
+    /// `G m_j` of the Sun and the planets, as the interpolation gives them.
+    gm: Vec<f64>,
+    /// `μ'` of the Kepler drift when the particles go through the lanes (barycentric variant,
+    /// valid `μ'`); `None`: one particle at a time ([`WindowContext::advance_member`]).
+    lanes_mu: Option<f64>,
+}
+
+/// What one scalar step of a member did ([`WindowContext::step_member`]).
+enum StepOutcome {
+    /// The step was taken (the member may have been removed at its end).
+    Stepped,
+    /// The step failed; the member is removed with the reason.
+    Failed,
+    /// The step needs the planets at this time, beyond the ephemeris: redone next window.
+    Beyond(f64),
+}
+
+/// One lane of [`WindowContext::advance_lanes`].
+struct Slot {
+    /// The member in the lane (index in the chunk).
+    member: Option<usize>,
+    /// The member's bodies (at `bodies_time`) and the scalar path's scratch.
+    worker: Worker,
+    /// Whether the lanes' kick terms hold this member's at its `(t, q)`.
+    kick_valid: bool,
+}
+
+/// The lanes of [`WindowContext::advance_lanes`]: the particles' slots and the bodies and kick
+/// terms per lane.
+struct LaneState {
+    slots: [Slot; LANES],
+    /// Barycentric positions and velocities of each body, lane `l` at the time of its member.
+    positions: Vec<V3>,
+    velocities: Vec<V3>,
+    kick: KickLanes,
 }
 
 impl Population {
@@ -536,6 +573,15 @@ fn run_window(
 ) -> (u64, f64) {
     let planets = ephemeris.planets();
     let m0 = planets.sun_mass();
+    // The bodies' `G m` exactly as the interpolation fills them (any retained time will do).
+    let mut bodies = BodyStates::default();
+    let lanes_mu = match ephemeris.interpolate(ephemeris.newest_time(), &mut bodies, false) {
+        Ok(()) if integrator.variant == Variant::Barycentric => {
+            let mu = integrator.kepler_mu(&bodies);
+            (mu.is_finite() && mu > 0.0).then_some(mu)
+        }
+        _ => None,
+    };
     let ctx = WindowContext {
         grid: ephemeris.view(),
         integrator,
@@ -547,23 +593,39 @@ fn run_window(
             .collect(),
         total_gm: total_gm(planets),
         end,
+        gm: bodies.gm,
+        lanes_mu,
     };
-    // One particle per rayon job (`with_max_len(1)`): a thread that finishes the next
-    // window's planets (see `Population::advance_to`) can then take over particles that the
-    // other threads have not reached; with rayon's default splitting, a handful of particles
-    // were cut into one piece per thread, run whole, and that thread stayed idle.
+    // Chunks of particles, each stepped `LANES` at a time (a lane whose particle is done
+    // takes the chunk's next one): one chunk on one thread; on more, about four chunks per
+    // thread, so that a thread that finishes the next window's planets (see
+    // `Population::advance_to`) can take over chunks that the others have not reached.
+    let threads = rayon::current_num_threads();
+    let chunk = if threads <= 1 {
+        members.len().max(1)
+    } else {
+        members.len().div_ceil(4 * threads).max(LANES)
+    };
     members
-        .par_iter_mut()
+        .par_chunks_mut(chunk)
         .with_max_len(1)
-        .map_init(
-            || Worker {
-                bodies: BodyStates::default(),
-                bodies_time: f64::NAN,
-                kick: KickTerms::default(),
-            },
-            |w, m| ctx.advance_member(m, w),
-        )
-        .reduce(|| (0, f64::NEG_INFINITY), |a, b| (a.0 + b.0, a.1.max(b.1)))
+        .map(|chunk| ctx.advance_chunk(chunk))
+        .reduce(|| (0, f64::NEG_INFINITY), sum_steps)
+}
+
+/// Adds two `(steps, beyond)` pairs.
+fn sum_steps(a: (u64, f64), b: (u64, f64)) -> (u64, f64) {
+    (a.0 + b.0, a.1.max(b.1))
+}
+
+impl Worker {
+    fn new() -> Self {
+        Self {
+            bodies: BodyStates::default(),
+            bodies_time: f64::NAN,
+            kick: KickTerms::default(),
+        }
+    }
 }
 
 fn total_gm(planets: &crate::Planets) -> f64 {
@@ -585,57 +647,268 @@ struct Envelope {
 }
 
 impl WindowContext<'_> {
-    /// Steps one member through the window; returns its steps and the time it needed beyond
-    /// the ephemeris (`-∞` if none).
-    fn advance_member(&self, m: &mut PopulationMember, w: &mut Worker) -> (u64, f64) {
-        let mut steps = 0;
-        let accelerations = self.integrator.variant == Variant::Mixed;
-        while m.status == ParticleStatus::Active && m.particle.time < self.end {
-            let saved = m.particle.clone();
-            let bodies_time = w.bodies_time;
-            w.bodies_time = f64::NAN;
-            let result = self.integrator.advance(
-                &mut m.particle,
-                &mut w.bodies,
-                bodies_time,
-                &mut w.kick,
-                &mut |t: f64, out: &mut BodyStates| self.grid.interpolate(t, out, accelerations),
-            );
-            match result {
-                Ok(t) => {
-                    w.bodies_time = t;
-                    steps += 1;
-                    m.sun_position = w.bodies.positions[0];
-                    if let Some(status) = self.removal(&m.particle, &w.bodies) {
-                        m.status = status;
+    /// Steps the members of a chunk through the window: through the lanes when they apply,
+    /// one at a time otherwise. Returns the steps and the latest time needed beyond the
+    /// ephemeris.
+    fn advance_chunk(&self, members: &mut [PopulationMember]) -> (u64, f64) {
+        match self.lanes_mu {
+            Some(mu) => self.advance_lanes(members, mu),
+            None => {
+                let mut w = Worker::new();
+                members
+                    .iter_mut()
+                    .map(|m| self.advance_member(m, &mut w))
+                    .fold((0, f64::NEG_INFINITY), sum_steps)
+            }
+        }
+    }
+
+    /// [`LANES`] members at a time ([`crate::lanes`]), each on its own clock: a lane whose
+    /// member is done with the window (or removed) takes the next one, until none is left.
+    fn advance_lanes(&self, members: &mut [PopulationMember], mu: f64) -> (u64, f64) {
+        let zero = [V::splat(0.0); 3];
+        let mut lanes = LaneState {
+            slots: std::array::from_fn(|_| Slot {
+                member: None,
+                worker: Worker::new(),
+                kick_valid: false,
+            }),
+            positions: vec![zero; self.gm.len()],
+            velocities: vec![zero; self.gm.len()],
+            kick: KickLanes::zero(),
+        };
+        let mut next = 0;
+        let mut total = (0, f64::NEG_INFINITY);
+        loop {
+            for slot in &mut lanes.slots {
+                while slot.member.is_none() && next < members.len() {
+                    let m = &members[next];
+                    if m.status == ParticleStatus::Active && m.particle.time < self.end {
+                        slot.member = Some(next);
+                        slot.worker.bodies_time = f64::NAN;
+                        slot.kick_valid = false;
+                    }
+                    next += 1;
+                }
+            }
+            if lanes.slots.iter().all(|s| s.member.is_none()) {
+                return total;
+            }
+            total = sum_steps(total, self.lane_step(members, &mut lanes, mu));
+        }
+    }
+
+    /// One step of every member in a lane: [`ParticleIntegrator::advance`] and the removal
+    /// rules, lane by lane bit for bit; a lane the lanes cannot finish is redone by
+    /// [`WindowContext::step_member`] from its unchanged state.
+    fn lane_step(
+        &self,
+        members: &mut [PopulationMember],
+        lanes: &mut LaneState,
+        mu: f64,
+    ) -> (u64, f64) {
+        let live: Mask = std::array::from_fn(|l| lanes.slots[l].member.is_some());
+        // Empty lanes repeat a live one; their results are dropped.
+        let fill = lanes.slots.iter().find_map(|s| s.member).unwrap_or(0);
+        let index: [usize; LANES] = std::array::from_fn(|l| lanes.slots[l].member.unwrap_or(fill));
+        let gather = |f: &dyn Fn(&TestParticle) -> f64| V(index.map(|i| f(&members[i].particle)));
+        let mut q: V3 = [0, 1, 2].map(|i| gather(&|p| p.position[i]));
+        let mut v: V3 = [0, 1, 2].map(|i| gather(&|p| p.velocity[i]));
+        let (mut t, mut p4, step) = (
+            gather(&|p| p.time),
+            gather(&|p| p.p4),
+            gather(&|p| p.step),
+        );
+        let (b0, b1) = (self.integrator.b0, self.integrator.b1);
+        let mut redo: Mask = [false; LANES];
+        let mut iterations = [0u32; LANES];
+        let (mut drifts, mut kicks) = (0u64, 0u64);
+        for (k, stage) in self.integrator.stages().iter().enumerate() {
+            self.fetch_lanes(lanes, &t, live, &mut redo);
+            let h = stage.coefficient * step;
+            match stage.piece {
+                ParticlePiece::KeplerDrift => {
+                    // ParticleIntegrator::kepler_drift: F₀, Δt = h/F₀, the drift.
+                    let r = norm(&q);
+                    let f0 = 0.5 * norm_squared(&v) - mu / r + p4 + b0;
+                    for (l, flag) in redo.iter_mut().enumerate() {
+                        *flag |= !(f0.0[l] > 0.0 && f0.0[l].is_finite());
+                    }
+                    let dt = h / f0;
+                    let it = lanes::drift(&mut q, &mut v, r, mu, dt, live, &mut redo);
+                    for (total, it) in iterations.iter_mut().zip(it) {
+                        *total += it;
+                    }
+                    t = t + dt;
+                    drifts += 1;
+                    for slot in &mut lanes.slots {
+                        slot.kick_valid = false;
                     }
                 }
-                Err(SymplecticError::BeyondEphemeris { time, .. }) => {
-                    m.particle = saved;
-                    return (steps, time);
-                }
-                Err(SymplecticError::RegularisationLost {
-                    quantity,
-                    value,
-                    time,
-                }) => {
-                    m.particle = saved;
-                    m.status = ParticleStatus::RegularisationLost {
-                        time,
-                        quantity: quantity.to_string(),
-                        value,
-                    };
-                }
-                Err(e) => {
-                    m.particle = saved;
-                    m.status = ParticleStatus::IntegrationFailed {
-                        time: m.particle.time,
-                        reason: e.to_string(),
-                    };
+                ParticlePiece::Perturbation => {
+                    // ParticleIntegrator::perturbation_cached, barycentric: the terms kept
+                    // from the last kick at the same (t, q) (the closing kick of the previous
+                    // step), computed otherwise.
+                    let need: Mask = std::array::from_fn(|l| {
+                        live[l] && !redo[l] && !(k == 0 && lanes.slots[l].kick_valid)
+                    });
+                    if need.iter().any(|&n| n) {
+                        let fresh =
+                            KickLanes::at(b0, b1, &q, &self.gm, &lanes.positions, &lanes.velocities);
+                        lanes.kick = KickLanes::select(need, &fresh, &lanes.kick);
+                    }
+                    let f1 = lanes.kick.f1;
+                    for (l, flag) in redo.iter_mut().enumerate() {
+                        *flag |= !(f1.0[l] > 0.0 && f1.0[l].is_finite());
+                    }
+                    let sigma = h / f1;
+                    for (vi, gi) in v.iter_mut().zip(&lanes.kick.gradient) {
+                        *vi = *vi + *gi * sigma;
+                    }
+                    p4 = p4 + lanes.kick.dt_part * sigma;
+                    kicks += 1;
+                    for slot in &mut lanes.slots {
+                        slot.kick_valid = true;
+                    }
                 }
             }
         }
+        self.fetch_lanes(lanes, &t, live, &mut redo);
+        let finite: [Mask; 7] = [q[0], q[1], q[2], v[0], v[1], v[2], p4].map(lanes::finite);
+        let (mut steps, mut beyond) = (0, f64::NEG_INFINITY);
+        let forces = kicks * self.gm.len() as u64;
+        for (l, slot) in lanes.slots.iter_mut().enumerate() {
+            let Some(i) = slot.member else { continue };
+            let m = &mut members[i];
+            if redo[l] || !finite.iter().all(|f| f[l]) {
+                slot.kick_valid = false;
+                let outcome = self.step_member(m, &mut slot.worker);
+                // The lanes' copy of the bodies was not updated: fetch again.
+                slot.worker.bodies_time = f64::NAN;
+                match outcome {
+                    StepOutcome::Stepped => steps += 1,
+                    StepOutcome::Failed => {}
+                    StepOutcome::Beyond(time) => {
+                        beyond = beyond.max(time);
+                        slot.member = None;
+                        continue;
+                    }
+                }
+            } else {
+                let p = &mut m.particle;
+                p.position = Vec3::new(q[0].0[l], q[1].0[l], q[2].0[l]);
+                p.velocity = Vec3::new(v[0].0[l], v[1].0[l], v[2].0[l]);
+                p.time = t.0[l];
+                p.p4 = p4.0[l];
+                p.steps += 1;
+                p.work.kepler_solves += drifts;
+                p.work.kepler_iterations += u64::from(iterations[l]);
+                p.work.force_evaluations += forces;
+                steps += 1;
+                m.sun_position = slot.worker.bodies.positions[0];
+                if let Some(status) = self.removal(&m.particle, &slot.worker.bodies) {
+                    m.status = status;
+                }
+            }
+            if !(m.status == ParticleStatus::Active && m.particle.time < self.end) {
+                slot.member = None;
+            }
+        }
+        (steps, beyond)
+    }
+
+    /// The bodies at each live lane's time `t` where its slot holds another time (as
+    /// [`ParticleIntegrator::advance`] fetches them), copied into the lanes; a lane whose
+    /// time the ephemeris does not hold is marked for the scalar path.
+    fn fetch_lanes(&self, lanes: &mut LaneState, t: &V, live: Mask, redo: &mut Mask) {
+        for l in 0..LANES {
+            let w = &mut lanes.slots[l].worker;
+            if !live[l] || redo[l] || w.bodies_time == t.0[l] {
+                continue;
+            }
+            w.bodies_time = f64::NAN;
+            if self.grid.interpolate(t.0[l], &mut w.bodies, false).is_err() {
+                redo[l] = true;
+                continue;
+            }
+            w.bodies_time = t.0[l];
+            for (j, (pj, vj)) in lanes
+                .positions
+                .iter_mut()
+                .zip(lanes.velocities.iter_mut())
+                .enumerate()
+            {
+                for i in 0..3 {
+                    pj[i].0[l] = w.bodies.positions[j][i];
+                    vj[i].0[l] = w.bodies.velocities[j][i];
+                }
+            }
+        }
+    }
+
+    /// Steps one member through the window with the scalar path; returns its steps and the
+    /// time it needed beyond the ephemeris (`-∞` if none).
+    fn advance_member(&self, m: &mut PopulationMember, w: &mut Worker) -> (u64, f64) {
+        let mut steps = 0;
+        while m.status == ParticleStatus::Active && m.particle.time < self.end {
+            match self.step_member(m, w) {
+                StepOutcome::Stepped => steps += 1,
+                StepOutcome::Failed => {}
+                StepOutcome::Beyond(time) => return (steps, time),
+            }
+        }
         (steps, f64::NEG_INFINITY)
+    }
+
+    /// One step of one member with the scalar path ([`ParticleIntegrator::advance`]), with the
+    /// removal rules; a step that fails leaves the member's state as it was.
+    fn step_member(&self, m: &mut PopulationMember, w: &mut Worker) -> StepOutcome {
+        let accelerations = self.integrator.variant == Variant::Mixed;
+        let saved = m.particle.clone();
+        let bodies_time = w.bodies_time;
+        w.bodies_time = f64::NAN;
+        let result = self.integrator.advance(
+            &mut m.particle,
+            &mut w.bodies,
+            bodies_time,
+            &mut w.kick,
+            &mut |t: f64, out: &mut BodyStates| self.grid.interpolate(t, out, accelerations),
+        );
+        match result {
+            Ok(t) => {
+                w.bodies_time = t;
+                m.sun_position = w.bodies.positions[0];
+                if let Some(status) = self.removal(&m.particle, &w.bodies) {
+                    m.status = status;
+                }
+                StepOutcome::Stepped
+            }
+            Err(SymplecticError::BeyondEphemeris { time, .. }) => {
+                m.particle = saved;
+                StepOutcome::Beyond(time)
+            }
+            Err(SymplecticError::RegularisationLost {
+                quantity,
+                value,
+                time,
+            }) => {
+                m.particle = saved;
+                m.status = ParticleStatus::RegularisationLost {
+                    time,
+                    quantity: quantity.to_string(),
+                    value,
+                };
+                StepOutcome::Failed
+            }
+            Err(e) => {
+                m.particle = saved;
+                m.status = ParticleStatus::IntegrationFailed {
+                    time: m.particle.time,
+                    reason: e.to_string(),
+                };
+                StepOutcome::Failed
+            }
+        }
     }
 
     /// The first removal rule the particle meets, with the bodies at its time.
