@@ -63,6 +63,12 @@ impl V {
         self.map(f64::sqrt)
     }
 
+    /// `f64::max` per lane.
+    #[inline(always)]
+    pub(crate) fn max(self, other: f64) -> Self {
+        self.map(|a| a.max(other))
+    }
+
     /// `mask ? a : b` per lane.
     #[inline(always)]
     pub(crate) fn select(mask: Mask, a: Self, b: Self) -> Self {

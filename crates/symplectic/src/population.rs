@@ -199,7 +199,9 @@ enum StepOutcome {
 struct Slot {
     /// The member in the lane (index in the chunk).
     member: Option<usize>,
-    /// The member's bodies (at `bodies_time`) and the scalar path's scratch.
+    /// Time of the lane's bodies in [`LaneState`] (`NaN`: none).
+    bodies_time: f64,
+    /// The scalar path's scratch.
     worker: Worker,
     /// Whether the lanes' kick terms hold this member's at its `(t, q)`.
     kick_valid: bool,
@@ -213,6 +215,8 @@ struct LaneState {
     positions: Vec<V3>,
     velocities: Vec<V3>,
     kick: KickLanes,
+    /// One lane's body positions, for [`WindowContext::removal`].
+    column: Vec<Vec3>,
 }
 
 impl Population {
@@ -670,12 +674,14 @@ impl WindowContext<'_> {
         let mut lanes = LaneState {
             slots: std::array::from_fn(|_| Slot {
                 member: None,
+                bodies_time: f64::NAN,
                 worker: Worker::new(),
                 kick_valid: false,
             }),
             positions: vec![zero; self.gm.len()],
             velocities: vec![zero; self.gm.len()],
             kick: KickLanes::zero(),
+            column: Vec::with_capacity(self.gm.len()),
         };
         let mut next = 0;
         let mut total = (0, f64::NEG_INFINITY);
@@ -685,7 +691,7 @@ impl WindowContext<'_> {
                     let m = &members[next];
                     if m.status == ParticleStatus::Active && m.particle.time < self.end {
                         slot.member = Some(next);
-                        slot.worker.bodies_time = f64::NAN;
+                        slot.bodies_time = f64::NAN;
                         slot.kick_valid = false;
                     }
                     next += 1;
@@ -711,14 +717,17 @@ impl WindowContext<'_> {
         // Empty lanes repeat a live one; their results are dropped.
         let fill = lanes.slots.iter().find_map(|s| s.member).unwrap_or(0);
         let index: [usize; LANES] = std::array::from_fn(|l| lanes.slots[l].member.unwrap_or(fill));
-        let gather = |f: &dyn Fn(&TestParticle) -> f64| V(index.map(|i| f(&members[i].particle)));
-        let mut q: V3 = [0, 1, 2].map(|i| gather(&|p| p.position[i]));
-        let mut v: V3 = [0, 1, 2].map(|i| gather(&|p| p.velocity[i]));
-        let (mut t, mut p4, step) = (
-            gather(&|p| p.time),
-            gather(&|p| p.p4),
-            gather(&|p| p.step),
-        );
+        let zero = V::splat(0.0);
+        let (mut q, mut v): (V3, V3) = ([zero; 3], [zero; 3]);
+        let (mut t, mut p4, mut step) = (zero, zero, zero);
+        for (l, &i) in index.iter().enumerate() {
+            let p = &members[i].particle;
+            for c in 0..3 {
+                q[c].0[l] = p.position[c];
+                v[c].0[l] = p.velocity[c];
+            }
+            (t.0[l], p4.0[l], step.0[l]) = (p.time, p.p4, p.step);
+        }
         let (b0, b1) = (self.integrator.b0, self.integrator.b1);
         let mut redo: Mask = [false; LANES];
         let mut iterations = [0u32; LANES];
@@ -775,6 +784,7 @@ impl WindowContext<'_> {
         }
         self.fetch_lanes(lanes, &t, live, &mut redo);
         let finite: [Mask; 7] = [q[0], q[1], q[2], v[0], v[1], v[2], p4].map(lanes::finite);
+        let removal = self.removal_lanes(&q, &v, &lanes.positions);
         let (mut steps, mut beyond) = (0, f64::NEG_INFINITY);
         let forces = kicks * self.gm.len() as u64;
         for (l, slot) in lanes.slots.iter_mut().enumerate() {
@@ -782,9 +792,10 @@ impl WindowContext<'_> {
             let m = &mut members[i];
             if redo[l] || !finite.iter().all(|f| f[l]) {
                 slot.kick_valid = false;
-                let outcome = self.step_member(m, &mut slot.worker);
-                // The lanes' copy of the bodies was not updated: fetch again.
+                // The scalar path fetches its own bodies; the lane's are not updated.
                 slot.worker.bodies_time = f64::NAN;
+                let outcome = self.step_member(m, &mut slot.worker);
+                slot.bodies_time = f64::NAN;
                 match outcome {
                     StepOutcome::Stepped => steps += 1,
                     StepOutcome::Failed => {}
@@ -805,9 +816,14 @@ impl WindowContext<'_> {
                 p.work.kepler_iterations += u64::from(iterations[l]);
                 p.work.force_evaluations += forces;
                 steps += 1;
-                m.sun_position = slot.worker.bodies.positions[0];
-                if let Some(status) = self.removal(&m.particle, &slot.worker.bodies) {
-                    m.status = status;
+                let column = |x: &V3| Vec3::new(x[0].0[l], x[1].0[l], x[2].0[l]);
+                m.sun_position = column(&lanes.positions[0]);
+                if removal[l] {
+                    lanes.column.clear();
+                    lanes.column.extend(lanes.positions.iter().map(column));
+                    if let Some(status) = self.removal(&m.particle, &lanes.column) {
+                        m.status = status;
+                    }
                 }
             }
             if !(m.status == ParticleStatus::Active && m.particle.time < self.end) {
@@ -817,31 +833,26 @@ impl WindowContext<'_> {
         (steps, beyond)
     }
 
-    /// The bodies at each live lane's time `t` where its slot holds another time (as
-    /// [`ParticleIntegrator::advance`] fetches them), copied into the lanes; a lane whose
-    /// time the ephemeris does not hold is marked for the scalar path.
+    /// The bodies at each live lane's time `t` where its lane holds another time (as
+    /// [`ParticleIntegrator::advance`] fetches them); a lane whose time the ephemeris does not
+    /// hold is marked for the scalar path.
     fn fetch_lanes(&self, lanes: &mut LaneState, t: &V, live: Mask, redo: &mut Mask) {
-        for l in 0..LANES {
-            let w = &mut lanes.slots[l].worker;
-            if !live[l] || redo[l] || w.bodies_time == t.0[l] {
-                continue;
-            }
-            w.bodies_time = f64::NAN;
-            if self.grid.interpolate(t.0[l], &mut w.bodies, false).is_err() {
-                redo[l] = true;
-                continue;
-            }
-            w.bodies_time = t.0[l];
-            for (j, (pj, vj)) in lanes
-                .positions
-                .iter_mut()
-                .zip(lanes.velocities.iter_mut())
-                .enumerate()
-            {
-                for i in 0..3 {
-                    pj[i].0[l] = w.bodies.positions[j][i];
-                    vj[i].0[l] = w.bodies.velocities[j][i];
-                }
+        let need: Mask = std::array::from_fn(|l| {
+            live[l] && !redo[l] && lanes.slots[l].bodies_time != t.0[l]
+        });
+        if !need.iter().any(|&n| n) {
+            return;
+        }
+        let bad = self.grid.interpolate_lanes(
+            *t,
+            need,
+            &mut lanes.positions,
+            &mut lanes.velocities,
+        );
+        for (l, slot) in lanes.slots.iter_mut().enumerate() {
+            if need[l] {
+                redo[l] |= bad[l];
+                slot.bodies_time = if bad[l] { f64::NAN } else { t.0[l] };
             }
         }
     }
@@ -878,7 +889,7 @@ impl WindowContext<'_> {
             Ok(t) => {
                 w.bodies_time = t;
                 m.sun_position = w.bodies.positions[0];
-                if let Some(status) = self.removal(&m.particle, &w.bodies) {
+                if let Some(status) = self.removal(&m.particle, &w.bodies.positions) {
                     m.status = status;
                 }
                 StepOutcome::Stepped
@@ -911,19 +922,69 @@ impl WindowContext<'_> {
         }
     }
 
+    /// Per lane, whether [`WindowContext::removal`] removes the barycentric particle at `q`,
+    /// `v` among the bodies at `positions`: the same tests with the same operations, so that
+    /// only the lanes it flags need the scalar form (which names the rule).
+    fn removal_lanes(&self, q: &V3, v: &V3, positions: &[V3]) -> Mask {
+        let rules = &self.rules;
+        let mut hit = [false; LANES];
+        let mut flag = |test: Mask| {
+            for (h, t) in hit.iter_mut().zip(test) {
+                *h |= t;
+            }
+        };
+        let sub = |a: &V3, b: &V3| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+        if let Some(factor) = rules.hill_factor {
+            let sun = &positions[0];
+            for (c, planet) in self.hill_coefficients.iter().zip(&positions[1..]) {
+                let distance2 = norm_squared(&sub(q, planet));
+                let hill2 = norm_squared(&sub(planet, sun)) * (c * c);
+                let limit = factor * factor * hill2;
+                flag(std::array::from_fn(|l| distance2.0[l] < limit.0[l]));
+            }
+        }
+        if rules.min_perihelion.is_none() && rules.ejection_distance.is_none() {
+            return hit;
+        }
+        let mu = self.total_gm;
+        let r = norm(q);
+        let v2r = norm_squared(v) * r;
+        if let Some(limit) = rules.ejection_distance {
+            flag(std::array::from_fn(|l| {
+                v2r.0[l] >= 2.0 * mu && r.0[l] > limit
+            }));
+        }
+        if let Some(limit) = rules.min_perihelion {
+            let h = [
+                q[1] * v[2] - q[2] * v[1],
+                q[2] * v[0] - q[0] * v[2],
+                q[0] * v[1] - q[1] * v[0],
+            ];
+            let h2 = norm_squared(&h);
+            let r_mu2_e2 = (r * mu * mu + (v2r - 2.0 * mu) * h2).max(0.0);
+            let (u, w) = (h2 - limit * mu, limit * mu);
+            let left = u * u * (r * mu * mu);
+            let right = w * w * r_mu2_e2;
+            flag(std::array::from_fn(|l| {
+                u.0[l] < 0.0 || left.0[l] < right.0[l]
+            }));
+        }
+        hit
+    }
+
     /// The first removal rule the particle meets, with the bodies at its time.
-    fn removal(&self, p: &TestParticle, bodies: &BodyStates) -> Option<ParticleStatus> {
+    fn removal(&self, p: &TestParticle, positions: &[Vec3]) -> Option<ParticleStatus> {
         let q = match self.integrator.variant {
             Variant::Barycentric => p.position,
-            Variant::Mixed => p.position + bodies.positions[0],
+            Variant::Mixed => p.position + positions[0],
         };
         let rules = &self.rules;
         if let Some(factor) = rules.hill_factor {
             // Compared squared (no square root per planet and step); the distances are taken
             // only for the report.
-            let sun = bodies.positions[0];
+            let sun = positions[0];
             for (j, c) in self.hill_coefficients.iter().enumerate() {
-                let planet = bodies.positions[j + 1];
+                let planet = positions[j + 1];
                 let distance2 = (q - planet).norm_squared();
                 let hill2 = (planet - sun).norm_squared() * (c * c);
                 if distance2 < factor * factor * hill2 {
