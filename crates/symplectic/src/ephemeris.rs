@@ -516,7 +516,12 @@ impl GridView<'_> {
                     V(b.map(|x| x[6 + i])),
                 ];
                 let sum = |c: &[V; 6]| {
-                    d[0] * c[0] + d[1] * c[1] + d[2] * c[2] + d[3] * c[3] + d[4] * c[4] + d[5] * c[5]
+                    d[0] * c[0]
+                        + d[1] * c[1]
+                        + d[2] * c[2]
+                        + d[3] * c[3]
+                        + d[4] * c[4]
+                        + d[5] * c[5]
                 };
                 let (p, v) = (sum(&value), sum(&first));
                 if all {

@@ -130,6 +130,12 @@ pub(crate) fn norm(a: &V3) -> V {
     norm_squared(a).sqrt()
 }
 
+/// Lane `l` of `x`.
+#[inline(always)]
+pub(crate) fn lane(x: &V3, l: usize) -> crate::Vec3 {
+    crate::Vec3::new(x[0].0[l], x[1].0[l], x[2].0[l])
+}
+
 /// Whether every lane of `x` is finite, per lane.
 #[inline(always)]
 pub(crate) fn finite(x: V) -> Mask {
