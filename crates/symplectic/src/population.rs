@@ -136,11 +136,36 @@ pub const DEFAULT_WINDOW_STEPS: u32 = 256;
 /// - *The removal rules:* Hill spheres of 4 planets compared squared, energy and perihelion
 ///   without square roots beyond `|q|`, about 110 flops.
 ///
-/// In all about 850 flops, 7 square roots and 17 divisions per particle step, mostly in
-/// dependent chains (a step is latency-bound, not bandwidth-bound: a particle's 184 bytes
-/// stay in registers and L1 through the window). Measured share of the time (`perf`, 10³
-/// comets, 2026-11-25): drift 44 %, kicks 23 %, interpolation 20 %, removal and bookkeeping
-/// 13 %; about 0.18 µs per step on this project's 2-core machine (`docs/performance.md`).
+/// In all about 850 flops, 7 square roots and 17 divisions per particle step, but about
+/// 2200 machine instructions on the scalar path (SSE2 scalar code, loads, stores, the checks;
+/// counted with callgrind, 10² comets, 2026-11-25): at about 0.175 µs (≈ 610 cycles) per
+/// step the processor retired nearly four instructions per cycle, so one particle at a time
+/// is bound by the number of instructions, not by the latency of its chains (stepping whole
+/// particles in turn, round-robin, gained nothing). A particle's 184 bytes stay in registers
+/// and L1 through the window; the step is not bandwidth-bound.
+///
+/// **Lanes.** In the barycentric variant (either scheme) a window therefore steps its
+/// particles four at a time: the states of four particles, each on its own clock, are held
+/// in `[f64; 4]` values that compile to pairs of packed SSE2 instructions (`mulpd`, `addpd`,
+/// `divpd`, `sqrtpd`; no `target-cpu` needed). Each lane interpolates the planets at its own
+/// time (its own grid interval; the Hermite weights computed packed, the grid data gathered
+/// lane by lane), kicks with its own bodies, drifts (the Halley iteration runs until every
+/// lane has passed its own test, each lane keeping its own result and iteration count; the
+/// Stumpff reductions are counted per lane) and tests the removal rules, which name the rule
+/// with the scalar code only for a lane that meets one. Every lane performs exactly the
+/// scalar path's operations in the same order, so the result is bit for bit that of
+/// [`ParticleIntegrator::advance`] (a property test compares whole populations, removals and
+/// lost regularisation included, with the scalar path). What the lanes leave out — a
+/// non-positive `F₀` or `F₁`, a drift longer than the orbital period, a Halley iteration that
+/// fails or does not converge, a non-finite state, a time beyond the ephemeris — the scalar
+/// step redoes from the particle's unchanged state. A lane whose particle is done with the
+/// window (or removed) takes the next particle of its chunk (the whole population on one
+/// thread, about a quarter of a thread's share on more). The mixed variant goes one particle
+/// at a time. Lanes: about 1700 instructions per particle step (callgrind) and 1.55× less CPU
+/// time per step than the scalar path at `N` = 10³–10⁵ (one thread, 0.11 µs per step);
+/// 1.17× at `N` = 10, where the planets' own integration is a third of the time (2026-11-25,
+/// shared machine, CPU time of paired runs). Two lanes gave 1.4× and eight 1.4× (SSE2 has 16
+/// registers of two `f64`: four lanes fill them without spilling much).
 /// **The ephemeris:** one planet step per grid interval, shared by all `N` particles: with the
 /// default S6 at 730.5 d (12 Kepler solves and 24 pair forces per step, plus 10 pair forces
 /// for the stored accelerations) about 1.4 µs per planet step, i.e. `0.7/N` µs per
