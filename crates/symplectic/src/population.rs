@@ -154,7 +154,7 @@ pub const DEFAULT_WINDOW_STEPS: u32 = 256;
 /// Stumpff reductions are counted per lane) and tests the removal rules, which name the rule
 /// with the scalar code only for a lane that meets one. Every lane performs exactly the
 /// scalar path's operations in the same order, so the result is bit for bit that of
-/// [`ParticleIntegrator::advance`] (a property test compares whole populations, removals and
+/// [`ParticleIntegrator::step`] (a property test compares whole populations, removals and
 /// lost regularisation included, with the scalar path). What the lanes leave out — a
 /// non-positive `F₀` or `F₁`, a drift longer than the orbital period, a Halley iteration that
 /// fails or does not converge, a non-finite state, a time beyond the ephemeris — the scalar
