@@ -432,6 +432,7 @@ impl GridView<'_> {
     /// own time `t`: lane `l` of `positions[j]` and `velocities[j]`, bit for bit the scalar
     /// values (the same grid interval, weights and sums per lane). Returns the lanes whose
     /// time the view does not hold (left unchanged; the scalar path reports them).
+    #[inline(always)]
     pub(crate) fn interpolate_lanes(
         &self,
         t: V,

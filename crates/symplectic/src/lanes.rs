@@ -153,6 +153,7 @@ pub(crate) struct KickLanes {
 }
 
 impl KickLanes {
+    #[inline(always)]
     pub(crate) fn zero() -> Self {
         Self {
             f1: V::splat(0.0),
@@ -196,6 +197,7 @@ impl KickLanes {
     }
 
     /// `mask ? a : b` per lane.
+    #[inline(always)]
     pub(crate) fn select(mask: Mask, a: &Self, b: &Self) -> Self {
         Self {
             f1: V::select(mask, a.f1, b.f1),
