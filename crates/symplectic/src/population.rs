@@ -146,26 +146,29 @@ pub const DEFAULT_WINDOW_STEPS: u32 = 256;
 ///
 /// **Lanes.** In the barycentric variant (either scheme) a window therefore steps its
 /// particles four at a time: the states of four particles, each on its own clock, are held
-/// in `[f64; 4]` values that compile to pairs of packed SSE2 instructions (`mulpd`, `addpd`,
-/// `divpd`, `sqrtpd`; no `target-cpu` needed). Each lane interpolates the planets at its own
-/// time (its own grid interval; the Hermite weights computed packed, the grid data gathered
-/// lane by lane), kicks with its own bodies, drifts (the Halley iteration runs until every
-/// lane has passed its own test, each lane keeping its own result and iteration count; the
-/// Stumpff reductions are counted per lane) and tests the removal rules, which name the rule
-/// with the scalar code only for a lane that meets one. Every lane performs exactly the
-/// scalar path's operations in the same order, so the result is bit for bit that of
-/// [`ParticleIntegrator::step`] (a property test compares whole populations, removals and
-/// lost regularisation included, with the scalar path). What the lanes leave out — a
+/// in `[f64; 4]` values, compiled as AVX code (four `f64` per register) when the processor
+/// has it (detected at run time) and as pairs of SSE2 instructions otherwise (`mulpd`,
+/// `addpd`, `divpd`, `sqrtpd`; no `target-cpu` needed either way). Each lane interpolates the
+/// planets at its own time (its own grid interval; the Hermite weights computed packed, the
+/// grid data gathered lane by lane), kicks with its own bodies, drifts (the Halley iteration
+/// runs until every lane has passed its own test, each lane keeping its own result and
+/// iteration count; the Stumpff reductions are counted per lane) and tests the removal
+/// rules, which name the rule with the scalar code only for a lane that meets one. Every lane
+/// performs exactly the scalar path's operations in the same order (IEEE `+ − × ÷ √` round
+/// alike in scalar, SSE2 and AVX form; Rust contracts nothing to FMA and FMA is not
+/// enabled), so the result is bit for bit that of [`ParticleIntegrator::step`] (a property
+/// test compares whole populations, removals and lost regularisation included, through the
+/// AVX lanes, the portable lanes and the scalar path). What the lanes leave out — a
 /// non-positive `F₀` or `F₁`, a drift longer than the orbital period, a Halley iteration that
 /// fails or does not converge, a non-finite state, a time beyond the ephemeris — the scalar
 /// step redoes from the particle's unchanged state. A lane whose particle is done with the
 /// window (or removed) takes the next particle of its chunk (the whole population on one
 /// thread, about a quarter of a thread's share on more). The mixed variant goes one particle
-/// at a time. Lanes: about 1700 instructions per particle step (callgrind) and 1.55× less CPU
-/// time per step than the scalar path at `N` = 10³–10⁵ (one thread, 0.11 µs per step);
-/// 1.17× at `N` = 10, where the planets' own integration is a third of the time (2026-11-25,
-/// shared machine, CPU time of paired runs). Two lanes gave 1.4× and eight 1.4× (SSE2 has 16
-/// registers of two `f64`: four lanes fill them without spilling much).
+/// at a time. Measured (one thread, CPU time of paired runs on a shared machine,
+/// 2026-11-25): 0.10 µs per step, 1.7× less than the scalar path at `N` = 10³–10⁵ (SSE2-only
+/// lanes: 1.55×; about 1700 instructions per step instead of 2200); 1.26× at `N` = 10, where
+/// the planets' own integration is about a third of the time. Two SSE2 lanes gave 1.4× and
+/// eight 1.4×.
 /// **The ephemeris:** one planet step per grid interval, shared by all `N` particles: with the
 /// default S6 at 730.5 d (12 Kepler solves and 24 pair forces per step, plus 10 pair forces
 /// for the stored accelerations) about 1.4 µs per planet step, i.e. `0.7/N` µs per
