@@ -1,5 +1,6 @@
 //! A population of test particles advanced in parallel against one shared planet ephemeris.
 
+use std::collections::VecDeque;
 use std::ops::Range;
 use std::path::Path;
 
@@ -214,6 +215,13 @@ struct WindowContext<'a> {
     /// Whether the lanes run as AVX code (the same operations, four `f64` per register).
     avx: bool,
 }
+
+/// Chunks of at most this many members take turns in the lanes
+/// ([`WindowContext::advance_lanes`]).
+const ROTATION_MAX_MEMBERS: usize = 16 * LANES;
+
+/// Lane steps per turn of a member in a small chunk.
+const ROTATION_STEPS: u32 = 32;
 
 /// How [`Population::advance_with`] steps the barycentric particles.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -768,24 +776,41 @@ impl WindowContext<'_> {
             kick: KickLanes::zero(),
             column: Vec::with_capacity(self.gm.len()),
         };
-        let mut next = 0;
+        let mut queue: VecDeque<usize> = (0..members.len())
+            .filter(|&i| {
+                let m = &members[i];
+                m.status == ParticleStatus::Active && m.particle.time < self.end
+            })
+            .collect();
+        // A small chunk takes turns: a member leaves its lane after ROTATION_STEPS steps for
+        // one that waits, so that the chunk's members finish the window together instead of
+        // the last few running with idle lanes (a turn costs one kick evaluation and one
+        // interpolation more, nothing else: the trajectory is the same).
+        let rotate = members.len() <= ROTATION_MAX_MEMBERS;
+        let mut stint = [0u32; LANES];
         let mut total = (0, f64::NEG_INFINITY);
         loop {
-            for slot in &mut lanes.slots {
-                while slot.member.is_none() && next < members.len() {
-                    let m = &members[next];
-                    if m.status == ParticleStatus::Active && m.particle.time < self.end {
-                        slot.member = Some(next);
-                        slot.bodies_time = f64::NAN;
-                        slot.kick_valid = false;
-                    }
-                    next += 1;
+            for (slot, stint) in lanes.slots.iter_mut().zip(&mut stint) {
+                if slot.member.is_none() {
+                    slot.member = queue.pop_front();
+                    slot.bodies_time = f64::NAN;
+                    slot.kick_valid = false;
+                    *stint = 0;
                 }
             }
             if lanes.slots.iter().all(|s| s.member.is_none()) {
                 return total;
             }
             total = sum_steps(total, self.lane_step(members, &mut lanes, mu));
+            if rotate && !queue.is_empty() {
+                for (slot, stint) in lanes.slots.iter_mut().zip(&mut stint) {
+                    *stint += 1;
+                    if let Some(i) = slot.member.filter(|_| *stint >= ROTATION_STEPS) {
+                        queue.push_back(i);
+                        slot.member = None;
+                    }
+                }
+            }
         }
     }
 
