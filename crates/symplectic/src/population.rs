@@ -214,6 +214,7 @@ struct WindowContext<'a> {
     /// valid `μ'`); `None`: one particle at a time ([`WindowContext::advance_member`]).
     lanes_mu: Option<f64>,
     /// Whether the lanes run as AVX code (the same operations, four `f64` per register).
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     avx: bool,
 }
 
