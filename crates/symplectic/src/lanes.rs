@@ -4,7 +4,9 @@
 //! particle alone keeps the floating-point units mostly idle, waiting on latencies. Here
 //! [`LANES`] independent particles, each on its own clock, go through the same operations
 //! side by side in `[f64; LANES]` values ([`V`]), which the compiler turns into packed
-//! SSE2 instructions (`mulpd`, `addpd`, `divpd`, `sqrtpd`) and the processor overlaps.
+//! instructions (`mulpd`, `addpd`, `divpd`, `sqrtpd`): pairs of SSE2 ones in portable code,
+//! single AVX ones where the population's window compiles the lanes for AVX after detecting
+//! it at run time.
 //!
 //! **Bit for bit the scalar path.** Each lane performs exactly the IEEE operations of
 //! [`ParticleIntegrator::advance`](crate::ParticleIntegrator) in the same order (packed

@@ -166,11 +166,12 @@ pub const DEFAULT_WINDOW_STEPS: u32 = 256;
 /// window (or removed) takes the next particle of its chunk (the whole population on one
 /// thread, about a quarter of a thread's share on more); in a chunk of at most 64 particles
 /// they take turns every 32 steps, so that the last few do not run with idle lanes. The mixed
-/// variant goes one particle at a time. Measured (one thread, CPU time of paired runs on a shared machine,
-/// 2026-11-25): 0.10 µs per step, 1.7× less than the scalar path at `N` = 10³–10⁵ (SSE2-only
-/// lanes: 1.55×; about 1700 instructions per step instead of 2200); 1.3× at `N` = 10, where
-/// the planets' own integration is about half of the time. Two SSE2 lanes gave 1.4× and
-/// eight 1.4×.
+/// variant goes one particle at a time. Measured (one thread, CPU time of paired runs on a
+/// shared machine, 2026-11-25): 0.10 µs per step, 1.7× less than the scalar path at
+/// `N` = 10³–10⁵ (SSE2-only lanes: 1.55×; about 1700 instructions per step instead of 2200);
+/// 1.3× at `N` = 10, where the planets' own integration is about half of the time. Two SSE2
+/// lanes gave 1.4× and eight 1.4× (`docs/performance.md`).
+///
 /// **The ephemeris:** one planet step per grid interval, shared by all `N` particles: with the
 /// default S6 at 730.5 d (12 Kepler solves and 24 pair forces per step, plus 10 pair forces
 /// for the stored accelerations) about 1.4 µs per planet step, i.e. `0.7/N` µs per
