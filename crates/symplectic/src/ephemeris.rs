@@ -3,6 +3,9 @@
 
 use serde::{Deserialize, Serialize};
 
+use std::ops::{Add, Mul, Sub};
+
+use crate::lanes::{Mask, LANES, V, V3};
 use crate::{Integrator, Planets, SymplecticError, Vec3, WorkCounters};
 
 /// Largest number of planet steps an [`Ephemeris`] covers (2⁵²: its grid times `t₀ + kτ` stay
@@ -424,6 +427,116 @@ impl GridView<'_> {
     }
 }
 
+impl GridView<'_> {
+    /// [`GridView::interpolate`] without accelerations for the lanes in `mask`, each at its
+    /// own time `t`: lane `l` of `positions[j]` and `velocities[j]`, bit for bit the scalar
+    /// values (the same grid interval, weights and sums per lane). Returns the lanes whose
+    /// time the view does not hold (left unchanged; the scalar path reports them).
+    #[inline(always)]
+    pub(crate) fn interpolate_lanes(
+        &self,
+        t: V,
+        mask: Mask,
+        positions: &mut [V3],
+        velocities: &mut [V3],
+    ) -> Mask {
+        let (e, last) = (self.ephemeris, self.last);
+        let stride = e.stride();
+        let mut bad = [false; LANES];
+        let mut base = [usize::MAX; LANES];
+        let mut blend = [false; LANES];
+        let mut x = V::splat(0.0);
+        for l in 0..LANES {
+            let tl = t.0[l];
+            if !mask[l] {
+                continue;
+            }
+            if !(tl <= self.newest && tl.is_finite() && tl >= self.oldest) {
+                bad[l] = true;
+                continue;
+            }
+            // GridView::interpolate_unchecked's grid point at or before t.
+            let rel = (tl - e.start_time) * self.inv_tau;
+            let mut k = (rel.max(0.0) as u64).clamp(e.first_index, last);
+            if k > e.first_index && tl < e.grid_time(k) {
+                k -= 1;
+            }
+            if k < last && e.grid_time(k + 1) <= tl {
+                k += 1;
+            }
+            let b = e.offset + (k - e.first_index) as usize * stride;
+            if tl == e.grid_time(k) || k == last {
+                // On a grid point: the stored state itself.
+                for (j, (pj, vj)) in positions.iter_mut().zip(velocities.iter_mut()).enumerate() {
+                    for i in 0..3 {
+                        pj[i].0[l] = e.grid[b + 9 * j + i];
+                        vj[i].0[l] = e.grid[b + 9 * j + 3 + i];
+                    }
+                }
+            } else {
+                base[l] = b;
+                blend[l] = true;
+                x.0[l] = (tl - e.grid_time(k)) * self.inv_tau;
+            }
+        }
+        let Some(fill) = base.iter().copied().find(|&b| b != usize::MAX) else {
+            return bad;
+        };
+        let base = base.map(|b| if b == usize::MAX { fill } else { b });
+        let w = QuinticHermite::at(x);
+        let (tau, inv_tau) = (self.tau, self.inv_tau);
+        let tau2 = tau * tau;
+        let fold = |c: &[V; 6], s: f64| {
+            [
+                c[0] * s,
+                c[1] * (tau * s),
+                c[2] * (tau2 * s),
+                c[3] * s,
+                c[4] * (tau * s),
+                c[5] * (tau2 * s),
+            ]
+        };
+        let value = fold(&w.value, 1.0);
+        let first = fold(&w.first, inv_tau);
+        // Each lane's two grid states, body by body (one bounds check per lane and body).
+        let states = base.map(|b| {
+            let (before, after) = e.grid[b..b + 2 * stride].split_at(stride);
+            (before.as_chunks::<9>().0, after.as_chunks::<9>().0)
+        });
+        let all = blend == [true; LANES];
+        for (j, (pj, vj)) in positions.iter_mut().zip(velocities.iter_mut()).enumerate() {
+            let (a, b) = (states.map(|s| &s.0[j]), states.map(|s| &s.1[j]));
+            for i in 0..3 {
+                // combine(): the six data of component i, lane by lane.
+                let d = [
+                    V(a.map(|x| x[i])),
+                    V(a.map(|x| x[3 + i])),
+                    V(a.map(|x| x[6 + i])),
+                    V(b.map(|x| x[i])),
+                    V(b.map(|x| x[3 + i])),
+                    V(b.map(|x| x[6 + i])),
+                ];
+                let sum = |c: &[V; 6]| {
+                    d[0] * c[0]
+                        + d[1] * c[1]
+                        + d[2] * c[2]
+                        + d[3] * c[3]
+                        + d[4] * c[4]
+                        + d[5] * c[5]
+                };
+                let (p, v) = (sum(&value), sum(&first));
+                if all {
+                    (pj[i], vj[i]) = (p, v);
+                } else {
+                    pj[i] = V::select(blend, p, pj[i]);
+                    vj[i] = V::select(blend, v, vj[i]);
+                }
+            }
+        }
+        bad
+    }
+}
+
 /// Grid states computed ahead by [`Ephemeris::extension`].
 pub(crate) struct Extension {
     planets: Planets,
@@ -490,14 +603,20 @@ fn combine(a: &[f64; 9], b: &[f64; 9], c: &[f64; 6]) -> Vec3 {
 /// Weights of the quintic Hermite interpolant on `[0, 1]` for the data
 /// `(p₀, v₀, a₀, p₁, v₁, a₁)` (derivatives scaled to the unit interval), and of its first and
 /// second derivatives.
-struct QuinticHermite {
-    value: [f64; 6],
-    first: [f64; 6],
-    second: [f64; 6],
+/// Generic over `f64` and [`V`] (the same operations per lane).
+struct QuinticHermite<T = f64> {
+    value: [T; 6],
+    first: [T; 6],
+    second: [T; 6],
 }
 
-impl QuinticHermite {
-    fn at(x: f64) -> Self {
+impl<T> QuinticHermite<T>
+where
+    T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T> + Mul<f64, Output = T>,
+    f64: Mul<T, Output = T> + Sub<T, Output = T>,
+{
+    #[inline(always)]
+    fn at(x: T) -> Self {
         let x2 = x * x;
         let x3 = x2 * x;
         let x4 = x3 * x;

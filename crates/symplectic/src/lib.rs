@@ -153,6 +153,7 @@ pub mod ephemeris;
 #[cfg(feature = "io")]
 pub mod io;
 pub mod kepler;
+mod lanes;
 mod maps;
 mod particles;
 mod planets;

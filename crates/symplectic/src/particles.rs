@@ -477,7 +477,7 @@ impl ParticleIntegrator {
     }
 
     /// `μ'` of the Kepler part of `Γ₀`.
-    fn kepler_mu(&self, bodies: &BodyStates) -> f64 {
+    pub(crate) fn kepler_mu(&self, bodies: &BodyStates) -> f64 {
         match self.variant {
             Variant::Barycentric => bodies.total_gm() - self.b1,
             Variant::Mixed => bodies.gm[0] - self.b1,
