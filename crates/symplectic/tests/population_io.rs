@@ -219,16 +219,22 @@ fn rows_given_directly_build_the_files_population() {
     let spec = PopulationSpec::from_file(&spec_path).unwrap();
     let from_file = spec.population(&spec_path).unwrap();
     let rows = read_particle_rows(&dir.join("p.csv"), ParticleKind::BarycentricElements).unwrap();
-    let direct = spec.population_from_rows(&rows, Path::new("array")).unwrap();
+    let direct = spec
+        .population_from_rows(&rows, Path::new("array"))
+        .unwrap();
     assert_eq!(direct.members(), from_file.members());
     assert_eq!(direct.window_steps(), 7);
 
     let mut bad = rows.clone();
     bad[1].values[2] = f64::NAN;
-    let err = spec.population_from_rows(&bad, Path::new("array")).unwrap_err();
+    let err = spec
+        .population_from_rows(&bad, Path::new("array"))
+        .unwrap_err();
     assert!(err.to_string().contains("not a finite number"), "{err}");
     let mut bad: Vec<ParticleRow> = rows.clone();
     bad[0].values[1] = 1.5;
-    let err = spec.population_from_rows(&bad, Path::new("array")).unwrap_err();
+    let err = spec
+        .population_from_rows(&bad, Path::new("array"))
+        .unwrap_err();
     assert!(err.to_string().contains("bound"), "{err}");
 }

@@ -1,0 +1,610 @@
+//! The window engine of a [`Population`](super::Population): every active member steps
+//! through a synchronisation window, four at a time in SIMD lanes when they apply
+//! ([`crate::lanes`]), one at a time otherwise.
+
+use std::collections::VecDeque;
+
+use rayon::prelude::*;
+
+use super::members::{PopulationMember, RemovalRules};
+use crate::ephemeris::{BodyStates, Ephemeris, GridView};
+use crate::lanes::{self, norm, norm_squared, KickLanes, Mask, LANES, V, V3};
+use crate::particles::ParticlePiece;
+use crate::particles::{KickTerms, ParticleIntegrator, TestParticle};
+use crate::run::ParticleStatus;
+use crate::{SymplecticError, Variant, Vec3};
+
+/// Per-thread scratch of [`Population::advance_to`](crate::Population::advance_to).
+struct Worker {
+    bodies: BodyStates,
+    /// Time `bodies` holds (`NaN` if none).
+    bodies_time: f64,
+    /// The last barycentric kick's terms.
+    kick: KickTerms,
+}
+
+/// The read-only context of a window.
+struct WindowContext<'a> {
+    /// The planets, read through one view of the grid for the whole window.
+    grid: GridView<'a>,
+    integrator: ParticleIntegrator,
+    rules: RemovalRules,
+    /// `(m_j/3m₀)^{1/3}` per planet.
+    hill_coefficients: Vec<f64>,
+    total_gm: f64,
+    end: f64,
+    /// `G m_j` of the Sun and the planets, as the interpolation gives them.
+    gm: Vec<f64>,
+    /// `μ'` of the Kepler drift when the particles go through the lanes (barycentric variant,
+    /// valid `μ'`); `None`: one particle at a time ([`WindowContext::advance_member`]).
+    lanes_mu: Option<f64>,
+    /// Whether the lanes run as AVX code (the same operations, four `f64` per register).
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
+    avx: bool,
+}
+
+/// Chunks of at most this many members take turns in the lanes
+/// ([`WindowContext::advance_lanes`]).
+const ROTATION_MAX_MEMBERS: usize = 16 * LANES;
+
+/// Lane steps per turn of a member in a small chunk.
+const ROTATION_STEPS: u32 = 32;
+
+/// How [`Population::advance_with`](super::Population) steps the barycentric particles.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum StepPath {
+    /// One at a time.
+    Scalar,
+    /// In lanes, compiled for AVX when the processor has it.
+    Lanes,
+    /// In lanes, portable code only (SSE2 on x86-64).
+    #[cfg_attr(not(test), allow(dead_code))]
+    PortableLanes,
+}
+
+/// Whether the processor runs AVX instructions.
+fn avx_available() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// What one scalar step of a member did ([`WindowContext::step_member`]).
+enum StepOutcome {
+    /// The step was taken (the member may have been removed at its end).
+    Stepped,
+    /// The step failed; the member is removed with the reason.
+    Failed,
+    /// The step needs the planets at this time, beyond the ephemeris: redone next window.
+    Beyond(f64),
+}
+
+/// One lane of [`WindowContext::advance_lanes`].
+struct Slot {
+    /// The member in the lane (index in the chunk).
+    member: Option<usize>,
+    /// Time of the lane's bodies in [`LaneState`] (`NaN`: none).
+    bodies_time: f64,
+    /// The scalar path's scratch.
+    worker: Worker,
+    /// Whether the lanes' kick terms hold this member's at its `(t, q)`.
+    kick_valid: bool,
+}
+
+/// The lanes of [`WindowContext::advance_lanes`]: the particles' slots and the bodies and kick
+/// terms per lane.
+struct LaneState {
+    slots: [Slot; LANES],
+    /// Barycentric positions and velocities of each body, lane `l` at the time of its member.
+    positions: Vec<V3>,
+    velocities: Vec<V3>,
+    kick: KickLanes,
+    /// One lane's body positions, for [`WindowContext::removal`].
+    column: Vec<Vec3>,
+}
+
+/// One window: every active member steps while its time is before `end`, reading `ephemeris`.
+/// Returns the steps taken and the latest time a step needed beyond the ephemeris.
+pub(super) fn run_window(
+    ephemeris: &Ephemeris,
+    integrator: ParticleIntegrator,
+    rules: RemovalRules,
+    members: &mut [PopulationMember],
+    end: f64,
+    path: StepPath,
+) -> (u64, f64) {
+    let planets = ephemeris.planets();
+    let m0 = planets.sun_mass();
+    // The bodies' `G m` exactly as the interpolation fills them (any retained time will do).
+    let mut bodies = BodyStates::default();
+    let lanes_mu = match ephemeris.interpolate(ephemeris.newest_time(), &mut bodies, false) {
+        Ok(()) if path != StepPath::Scalar && integrator.variant == Variant::Barycentric => {
+            let mu = integrator.kepler_mu(&bodies);
+            (mu.is_finite() && mu > 0.0).then_some(mu)
+        }
+        _ => None,
+    };
+    let ctx = WindowContext {
+        grid: ephemeris.view(),
+        integrator,
+        rules,
+        hill_coefficients: planets
+            .masses()
+            .iter()
+            .map(|m| (m / (3.0 * m0)).cbrt())
+            .collect(),
+        total_gm: total_gm(planets),
+        end,
+        gm: bodies.gm,
+        lanes_mu,
+        avx: path == StepPath::Lanes && avx_available(),
+    };
+    // Chunks of particles, each stepped `LANES` at a time (a lane whose particle is done
+    // takes the chunk's next one): one chunk on one thread; on more, about four chunks per
+    // thread, so that a thread that finishes the next window's planets (see
+    // `Population::advance_to`) can take over chunks that the others have not reached.
+    let threads = rayon::current_num_threads();
+    let chunk = if threads <= 1 {
+        members.len().max(1)
+    } else {
+        members.len().div_ceil(4 * threads).max(LANES)
+    };
+    members
+        .par_chunks_mut(chunk)
+        .with_max_len(1)
+        .map(|chunk| ctx.advance_chunk(chunk))
+        .reduce(|| (0, f64::NEG_INFINITY), sum_steps)
+}
+
+/// Adds two `(steps, beyond)` pairs.
+fn sum_steps(a: (u64, f64), b: (u64, f64)) -> (u64, f64) {
+    (a.0 + b.0, a.1.max(b.1))
+}
+
+impl Worker {
+    fn new() -> Self {
+        Self {
+            bodies: BodyStates::default(),
+            bodies_time: f64::NAN,
+            kick: KickTerms::default(),
+        }
+    }
+}
+
+pub(super) fn total_gm(planets: &crate::Planets) -> f64 {
+    let g = planets.g();
+    std::iter::once(g * planets.sun_mass())
+        .chain(planets.masses().iter().map(|m| g * m))
+        .sum()
+}
+
+impl WindowContext<'_> {
+    /// Steps the members of a chunk through the window: through the lanes when they apply,
+    /// one at a time otherwise. Returns the steps and the latest time needed beyond the
+    /// ephemeris.
+    fn advance_chunk(&self, members: &mut [PopulationMember]) -> (u64, f64) {
+        match self.lanes_mu {
+            #[cfg(target_arch = "x86_64")]
+            Some(mu) if self.avx => {
+                // SAFETY: `avx` is set only when the processor runs AVX (`avx_available`).
+                #[allow(unsafe_code)]
+                unsafe {
+                    self.advance_lanes_avx(members, mu)
+                }
+            }
+            Some(mu) => self.advance_lanes(members, mu),
+            None => {
+                let mut w = Worker::new();
+                members
+                    .iter_mut()
+                    .map(|m| self.advance_member(m, &mut w))
+                    .fold((0, f64::NEG_INFINITY), sum_steps)
+            }
+        }
+    }
+
+    /// [`WindowContext::advance_lanes`] compiled for AVX: the same operations (IEEE `+ − × ÷ √`
+    /// round alike in SSE2 and AVX; no FMA is enabled), four lanes per register instead of
+    /// two.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    fn advance_lanes_avx(&self, members: &mut [PopulationMember], mu: f64) -> (u64, f64) {
+        self.advance_lanes(members, mu)
+    }
+
+    /// [`LANES`] members at a time ([`crate::lanes`]), each on its own clock: a lane whose
+    /// member is done with the window (or removed) takes the next one, until none is left.
+    #[inline(always)]
+    fn advance_lanes(&self, members: &mut [PopulationMember], mu: f64) -> (u64, f64) {
+        let zero = [V::splat(0.0); 3];
+        let mut lanes = LaneState {
+            slots: std::array::from_fn(|_| Slot {
+                member: None,
+                bodies_time: f64::NAN,
+                worker: Worker::new(),
+                kick_valid: false,
+            }),
+            positions: vec![zero; self.gm.len()],
+            velocities: vec![zero; self.gm.len()],
+            kick: KickLanes::zero(),
+            column: Vec::with_capacity(self.gm.len()),
+        };
+        let mut queue: VecDeque<usize> = (0..members.len())
+            .filter(|&i| {
+                let m = &members[i];
+                m.status == ParticleStatus::Active && m.particle.time < self.end
+            })
+            .collect();
+        // A small chunk takes turns: a member leaves its lane after ROTATION_STEPS steps for
+        // one that waits, so that the chunk's members finish the window together instead of
+        // the last few running with idle lanes (a turn costs one kick evaluation and one
+        // interpolation more, nothing else: the trajectory is the same).
+        let rotate = members.len() <= ROTATION_MAX_MEMBERS;
+        let mut stint = [0u32; LANES];
+        let mut total = (0, f64::NEG_INFINITY);
+        loop {
+            for (slot, stint) in lanes.slots.iter_mut().zip(&mut stint) {
+                if slot.member.is_none() {
+                    slot.member = queue.pop_front();
+                    slot.bodies_time = f64::NAN;
+                    slot.kick_valid = false;
+                    *stint = 0;
+                }
+            }
+            if lanes.slots.iter().all(|s| s.member.is_none()) {
+                return total;
+            }
+            total = sum_steps(total, self.lane_step(members, &mut lanes, mu));
+            if rotate && !queue.is_empty() {
+                for (slot, stint) in lanes.slots.iter_mut().zip(&mut stint) {
+                    *stint += 1;
+                    if let Some(i) = slot.member.filter(|_| *stint >= ROTATION_STEPS) {
+                        queue.push_back(i);
+                        slot.member = None;
+                    }
+                }
+            }
+        }
+    }
+
+    /// One step of every member in a lane: [`ParticleIntegrator::advance`] and the removal
+    /// rules, lane by lane bit for bit; a lane the lanes cannot finish is redone by
+    /// [`WindowContext::step_member`] from its unchanged state.
+    #[inline(always)]
+    fn lane_step(
+        &self,
+        members: &mut [PopulationMember],
+        lanes: &mut LaneState,
+        mu: f64,
+    ) -> (u64, f64) {
+        let live: Mask = std::array::from_fn(|l| lanes.slots[l].member.is_some());
+        // Empty lanes repeat a live one; their results are dropped.
+        let fill = lanes.slots.iter().find_map(|s| s.member).unwrap_or(0);
+        let index: [usize; LANES] = std::array::from_fn(|l| lanes.slots[l].member.unwrap_or(fill));
+        let zero = V::splat(0.0);
+        let (mut q, mut v): (V3, V3) = ([zero; 3], [zero; 3]);
+        let (mut t, mut p4, mut step) = (zero, zero, zero);
+        for (l, &i) in index.iter().enumerate() {
+            let p = &members[i].particle;
+            for c in 0..3 {
+                q[c].0[l] = p.position[c];
+                v[c].0[l] = p.velocity[c];
+            }
+            (t.0[l], p4.0[l], step.0[l]) = (p.time, p.p4, p.step);
+        }
+        let (b0, b1) = (self.integrator.b0, self.integrator.b1);
+        let mut redo: Mask = [false; LANES];
+        let mut iterations = [0u32; LANES];
+        let (mut drifts, mut kicks) = (0u64, 0u64);
+        for (k, stage) in self.integrator.stages().iter().enumerate() {
+            self.fetch_lanes(lanes, &t, live, &mut redo);
+            let h = stage.coefficient * step;
+            match stage.piece {
+                ParticlePiece::KeplerDrift => {
+                    // ParticleIntegrator::kepler_drift: F₀, Δt = h/F₀, the drift.
+                    let r = norm(&q);
+                    let f0 = 0.5 * norm_squared(&v) - mu / r + p4 + b0;
+                    for (l, flag) in redo.iter_mut().enumerate() {
+                        *flag |= !(f0.0[l] > 0.0 && f0.0[l].is_finite());
+                    }
+                    let dt = h / f0;
+                    let it = lanes::drift(&mut q, &mut v, r, mu, dt, live, &mut redo);
+                    for (total, it) in iterations.iter_mut().zip(it) {
+                        *total += it;
+                    }
+                    t = t + dt;
+                    drifts += 1;
+                    for slot in &mut lanes.slots {
+                        slot.kick_valid = false;
+                    }
+                }
+                ParticlePiece::Perturbation => {
+                    // ParticleIntegrator::perturbation_cached, barycentric: the terms kept
+                    // from the last kick at the same (t, q) (the closing kick of the previous
+                    // step), computed otherwise.
+                    let need: Mask = std::array::from_fn(|l| {
+                        live[l] && !redo[l] && !(k == 0 && lanes.slots[l].kick_valid)
+                    });
+                    if need.iter().any(|&n| n) {
+                        let fresh = KickLanes::at(
+                            b0,
+                            b1,
+                            &q,
+                            &self.gm,
+                            &lanes.positions,
+                            &lanes.velocities,
+                        );
+                        lanes.kick = KickLanes::select(need, &fresh, &lanes.kick);
+                    }
+                    let f1 = lanes.kick.f1;
+                    for (l, flag) in redo.iter_mut().enumerate() {
+                        *flag |= !(f1.0[l] > 0.0 && f1.0[l].is_finite());
+                    }
+                    let sigma = h / f1;
+                    for (vi, gi) in v.iter_mut().zip(&lanes.kick.gradient) {
+                        *vi = *vi + *gi * sigma;
+                    }
+                    p4 = p4 + lanes.kick.dt_part * sigma;
+                    kicks += 1;
+                    for slot in &mut lanes.slots {
+                        slot.kick_valid = true;
+                    }
+                }
+            }
+        }
+        self.fetch_lanes(lanes, &t, live, &mut redo);
+        let finite: [Mask; 7] = [q[0], q[1], q[2], v[0], v[1], v[2], p4].map(lanes::finite);
+        let removal = self.removal_lanes(&q, &v, &lanes.positions);
+        let (mut steps, mut beyond) = (0, f64::NEG_INFINITY);
+        let forces = kicks * self.gm.len() as u64;
+        for (l, slot) in lanes.slots.iter_mut().enumerate() {
+            let Some(i) = slot.member else { continue };
+            let m = &mut members[i];
+            if redo[l] || !finite.iter().all(|f| f[l]) {
+                slot.kick_valid = false;
+                // The scalar path fetches its own bodies; the lane's are not updated.
+                slot.worker.bodies_time = f64::NAN;
+                let outcome = self.step_member(m, &mut slot.worker);
+                slot.bodies_time = f64::NAN;
+                match outcome {
+                    StepOutcome::Stepped => steps += 1,
+                    StepOutcome::Failed => {}
+                    StepOutcome::Beyond(time) => {
+                        beyond = beyond.max(time);
+                        slot.member = None;
+                        continue;
+                    }
+                }
+            } else {
+                let p = &mut m.particle;
+                p.position = lanes::lane(&q, l);
+                p.velocity = lanes::lane(&v, l);
+                p.time = t.0[l];
+                p.p4 = p4.0[l];
+                p.steps += 1;
+                p.work.kepler_solves += drifts;
+                p.work.kepler_iterations += u64::from(iterations[l]);
+                p.work.force_evaluations += forces;
+                steps += 1;
+                m.sun_position = lanes::lane(&lanes.positions[0], l);
+                if removal[l] {
+                    lanes.column.clear();
+                    lanes
+                        .column
+                        .extend(lanes.positions.iter().map(|x| lanes::lane(x, l)));
+                    if let Some(status) = self.removal(&m.particle, &lanes.column) {
+                        m.status = status;
+                    }
+                }
+            }
+            if !(m.status == ParticleStatus::Active && m.particle.time < self.end) {
+                slot.member = None;
+            }
+        }
+        (steps, beyond)
+    }
+
+    /// The bodies at each live lane's time `t` where its lane holds another time (as
+    /// [`ParticleIntegrator::advance`] fetches them); a lane whose time the ephemeris does not
+    /// hold is marked for the scalar path.
+    #[inline(always)]
+    fn fetch_lanes(&self, lanes: &mut LaneState, t: &V, live: Mask, redo: &mut Mask) {
+        let need: Mask =
+            std::array::from_fn(|l| live[l] && !redo[l] && lanes.slots[l].bodies_time != t.0[l]);
+        if !need.iter().any(|&n| n) {
+            return;
+        }
+        let bad =
+            self.grid
+                .interpolate_lanes(*t, need, &mut lanes.positions, &mut lanes.velocities);
+        for (l, slot) in lanes.slots.iter_mut().enumerate() {
+            if need[l] {
+                redo[l] |= bad[l];
+                slot.bodies_time = if bad[l] { f64::NAN } else { t.0[l] };
+            }
+        }
+    }
+
+    /// Steps one member through the window with the scalar path; returns its steps and the
+    /// time it needed beyond the ephemeris (`-∞` if none).
+    fn advance_member(&self, m: &mut PopulationMember, w: &mut Worker) -> (u64, f64) {
+        let mut steps = 0;
+        while m.status == ParticleStatus::Active && m.particle.time < self.end {
+            match self.step_member(m, w) {
+                StepOutcome::Stepped => steps += 1,
+                StepOutcome::Failed => {}
+                StepOutcome::Beyond(time) => return (steps, time),
+            }
+        }
+        (steps, f64::NEG_INFINITY)
+    }
+
+    /// One step of one member with the scalar path ([`ParticleIntegrator::advance`]), with the
+    /// removal rules; a step that fails leaves the member's state as it was.
+    #[inline(never)]
+    fn step_member(&self, m: &mut PopulationMember, w: &mut Worker) -> StepOutcome {
+        let accelerations = self.integrator.variant == Variant::Mixed;
+        let saved = m.particle.clone();
+        let bodies_time = w.bodies_time;
+        w.bodies_time = f64::NAN;
+        let result = self.integrator.advance(
+            &mut m.particle,
+            &mut w.bodies,
+            bodies_time,
+            &mut w.kick,
+            &mut |t: f64, out: &mut BodyStates| self.grid.interpolate(t, out, accelerations),
+        );
+        match result {
+            Ok(t) => {
+                w.bodies_time = t;
+                m.sun_position = w.bodies.positions[0];
+                if let Some(status) = self.removal(&m.particle, &w.bodies.positions) {
+                    m.status = status;
+                }
+                StepOutcome::Stepped
+            }
+            Err(SymplecticError::BeyondEphemeris { time, .. }) => {
+                m.particle = saved;
+                StepOutcome::Beyond(time)
+            }
+            Err(SymplecticError::RegularisationLost {
+                quantity,
+                value,
+                time,
+            }) => {
+                m.particle = saved;
+                m.status = ParticleStatus::RegularisationLost {
+                    time,
+                    quantity: quantity.to_string(),
+                    value,
+                };
+                StepOutcome::Failed
+            }
+            Err(e) => {
+                m.particle = saved;
+                m.status = ParticleStatus::IntegrationFailed {
+                    time: m.particle.time,
+                    reason: e.to_string(),
+                };
+                StepOutcome::Failed
+            }
+        }
+    }
+
+    /// Per lane, whether [`WindowContext::removal`] removes the barycentric particle at `q`,
+    /// `v` among the bodies at `positions`: the same tests with the same operations, so that
+    /// only the lanes it flags need the scalar form (which names the rule).
+    #[inline(always)]
+    fn removal_lanes(&self, q: &V3, v: &V3, positions: &[V3]) -> Mask {
+        let rules = &self.rules;
+        let mut hit = [false; LANES];
+        let mut flag = |test: Mask| {
+            for (h, t) in hit.iter_mut().zip(test) {
+                *h |= t;
+            }
+        };
+        let sub = |a: &V3, b: &V3| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+        if let Some(factor) = rules.hill_factor {
+            let sun = &positions[0];
+            for (c, planet) in self.hill_coefficients.iter().zip(&positions[1..]) {
+                let distance2 = norm_squared(&sub(q, planet));
+                let hill2 = norm_squared(&sub(planet, sun)) * (c * c);
+                let limit = factor * factor * hill2;
+                flag(std::array::from_fn(|l| distance2.0[l] < limit.0[l]));
+            }
+        }
+        if rules.min_perihelion.is_none() && rules.ejection_distance.is_none() {
+            return hit;
+        }
+        let mu = self.total_gm;
+        let r = norm(q);
+        let v2r = norm_squared(v) * r;
+        if let Some(limit) = rules.ejection_distance {
+            flag(std::array::from_fn(|l| {
+                v2r.0[l] >= 2.0 * mu && r.0[l] > limit
+            }));
+        }
+        if let Some(limit) = rules.min_perihelion {
+            let h = [
+                q[1] * v[2] - q[2] * v[1],
+                q[2] * v[0] - q[0] * v[2],
+                q[0] * v[1] - q[1] * v[0],
+            ];
+            let h2 = norm_squared(&h);
+            let r_mu2_e2 = (r * mu * mu + (v2r - 2.0 * mu) * h2).max(0.0);
+            let (u, w) = (h2 - limit * mu, limit * mu);
+            let left = u * u * (r * mu * mu);
+            let right = w * w * r_mu2_e2;
+            flag(std::array::from_fn(|l| {
+                u.0[l] < 0.0 || left.0[l] < right.0[l]
+            }));
+        }
+        hit
+    }
+
+    /// The first removal rule the particle meets, with the bodies at its time.
+    fn removal(&self, p: &TestParticle, positions: &[Vec3]) -> Option<ParticleStatus> {
+        let q = match self.integrator.variant {
+            Variant::Barycentric => p.position,
+            Variant::Mixed => p.position + positions[0],
+        };
+        let rules = &self.rules;
+        if let Some(factor) = rules.hill_factor {
+            // Compared squared (no square root per planet and step); the distances are taken
+            // only for the report.
+            let sun = positions[0];
+            for (j, c) in self.hill_coefficients.iter().enumerate() {
+                let planet = positions[j + 1];
+                let distance2 = (q - planet).norm_squared();
+                let hill2 = (planet - sun).norm_squared() * (c * c);
+                if distance2 < factor * factor * hill2 {
+                    return Some(ParticleStatus::HillSphereEntry {
+                        time: p.time,
+                        planet: j + 1,
+                        distance: distance2.sqrt(),
+                        hill_radius: (planet - sun).norm() * c,
+                    });
+                }
+            }
+        }
+        if rules.min_perihelion.is_none() && rules.ejection_distance.is_none() {
+            return None;
+        }
+        // Barycentric osculating energy and perihelion from the energy and angular momentum
+        // (no angles): e² = 1 + 2E h²/μ², q = h²/(μ (1 + e)). Multiplied through by r (and
+        // μ²) so that no division is needed per step: 2E r = v² r − 2μ.
+        let mu = self.total_gm;
+        let r = q.norm();
+        let v2r = p.velocity.norm_squared() * r;
+        if let Some(limit) = rules.ejection_distance {
+            if v2r >= 2.0 * mu && r > limit {
+                return Some(ParticleStatus::Ejected {
+                    time: p.time,
+                    distance: r,
+                });
+            }
+        }
+        if let Some(limit) = rules.min_perihelion {
+            let h2 = q.cross(&p.velocity).norm_squared();
+            // r μ² e² = r μ² + (v² r − 2μ) h².
+            let r_mu2_e2 = (r * mu * mu + (v2r - 2.0 * mu) * h2).max(0.0);
+            // q < L ⟺ h² − Lμ < Lμ e: true when the left side is negative, otherwise compared
+            // squared; q itself only for the report.
+            let (u, w) = (h2 - limit * mu, limit * mu);
+            if u < 0.0 || u * u * (r * mu * mu) < w * w * r_mu2_e2 {
+                let e = (r_mu2_e2 / r).sqrt() / mu;
+                let perihelion = h2 / (mu * (1.0 + e));
+                return Some(ParticleStatus::PerihelionBelowLimit {
+                    time: p.time,
+                    perihelion,
+                });
+            }
+        }
+        None
+    }
+}
