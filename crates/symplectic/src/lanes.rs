@@ -21,7 +21,7 @@
 //! particle's step with the scalar path from its unchanged state, so the outcome (including
 //! the error) is the scalar one.
 
-use std::ops::{Add, Div, Mul, Sub};
+use std::ops::{Add, Div, Mul, Neg, Sub};
 
 /// Particles stepped side by side.
 pub(crate) const LANES: usize = 4;
@@ -114,6 +114,14 @@ lane_op!(Add, add, +);
 lane_op!(Sub, sub, -);
 lane_op!(Mul, mul, *);
 lane_op!(Div, div, /);
+
+impl Neg for V {
+    type Output = V;
+    #[inline(always)]
+    fn neg(self) -> V {
+        self.map(|a| -a)
+    }
+}
 
 /// nalgebra's `a.dot(b)` for 3-vectors: `(a₀b₀ + a₁b₁) + a₂b₂`.
 #[inline(always)]
@@ -274,8 +282,8 @@ fn stumpff(z: V, mask: Mask) -> [V; 4] {
     c
 }
 
-/// [`kepler::drift_from_distance`](crate::kepler) per lane for the lanes in `live`, with `mu`
-/// valid (finite, `> 0`). Returns the Halley iterations of each lane and sets `redo` for the
+/// [`kepler::drift_from_distance`](crate::kepler) per lane for the lanes in `live`, with each
+/// lane's `mu` valid (finite, `> 0`). Returns the Halley iterations of each lane and sets `redo` for the
 /// lanes the scalar path must take over (its checks, the period reduction, its fallback, a
 /// non-finite result); those lanes' `r`, `v` are unspecified.
 #[inline(always)]
@@ -283,7 +291,7 @@ pub(crate) fn drift(
     r: &mut V3,
     v: &mut V3,
     r0: V,
-    mu: f64,
+    mu: V,
     dt: V,
     live: Mask,
     redo: &mut Mask,
@@ -303,7 +311,7 @@ pub(crate) fn drift(
             && v_ok.iter().all(|f| f[l])
             && dt_ok[l]
             && dt.0[l] != 0.0
-            && !(beta.0[l] > 0.0 && long.0[l] > two_pi_mu * two_pi_mu);
+            && !(beta.0[l] > 0.0 && long.0[l] > two_pi_mu.0[l] * two_pi_mu.0[l]);
         if checks {
             todo[l] = true;
         } else {

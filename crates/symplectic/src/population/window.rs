@@ -313,7 +313,7 @@ impl WindowContext<'_> {
                         *flag |= !(f0.0[l] > 0.0 && f0.0[l].is_finite());
                     }
                     let dt = h / f0;
-                    let it = lanes::drift(&mut q, &mut v, r, mu, dt, live, &mut redo);
+                    let it = lanes::drift(&mut q, &mut v, r, V::splat(mu), dt, live, &mut redo);
                     for (total, it) in iterations.iter_mut().zip(it) {
                         *total += it;
                     }
