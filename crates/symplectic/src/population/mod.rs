@@ -250,7 +250,8 @@ impl Population {
     pub fn progress(&self) -> PopulationProgress {
         let active = self
             .members
-            .iter()
+            .par_iter()
+            .with_min_len(4096)
             .filter(|m| m.status == ParticleStatus::Active)
             .count();
         PopulationProgress {
@@ -368,11 +369,14 @@ impl Population {
     }
 
     fn oldest_active_time(&self) -> Option<f64> {
+        // In parallel: once per window over every member (the minimum of finite times does
+        // not depend on the order).
         self.members
-            .iter()
+            .par_iter()
+            .with_min_len(4096)
             .filter(|m| m.status == ParticleStatus::Active)
             .map(|m| m.particle.time)
-            .reduce(f64::min)
+            .reduce_with(f64::min)
     }
 
     /// The members in `range` as a population of their own, with a copy of the ephemeris:
