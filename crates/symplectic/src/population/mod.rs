@@ -109,8 +109,10 @@ pub const DEFAULT_WINDOW_STEPS: u32 = 256;
 ///
 /// **The ephemeris:** one planet step per grid interval, shared by all `N` particles: with the
 /// default S6 at 730.5 d (12 Kepler solves and 24 pair forces per step, plus 10 pair forces
-/// for the stored accelerations) about 1.4 µs per planet step, i.e. `0.7/N` µs per
-/// particle-year, comparable to the particles' own cost only for `N` below about 10.
+/// for the stored accelerations; the four planets' Kepler drifts go through the lanes too,
+/// bit for bit the scalar drifts) about 1 µs per planet step (the bare S6 map 0.72 µs,
+/// criterion `planet-step/S6`, 2026-11-25, loaded machine), i.e. about `0.5/N` µs per
+/// particle-year, comparable to the particles' own cost only for `N` near 10.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Population {
     ephemeris: Ephemeris,
