@@ -133,6 +133,8 @@ struct Case {
     cone: ConeMatch,
     scene: Scene,
     run: SceneRun,
+    /// Wall-clock time of the run (s).
+    wall_s: f64,
 }
 
 /// The measured heap of a case.
@@ -176,13 +178,31 @@ impl Experiment for GranularRepose {
             .set_length(scenes.iter().map(|s| s.frame_count() as u64).sum());
         let mut cases = Vec::new();
         for ((tag, theta_deg, cone, _), scene) in plan.into_iter().zip(scenes) {
+            let t0 = std::time::Instant::now();
             let run = run_scene_until_rest(ctx, &scene, rest_criterion(&scene))?;
+            // On stderr, not through the progress bar (hidden when not a terminal): a
+            // diagnostic line per run.
+            let angle = base_of(&scene)
+                .ok()
+                .and_then(|b| {
+                    let opts = ReposeOptions::planar(b.top_y, scene.particle_spacing);
+                    angle_of_repose(&on_base(&run.final_positions, b), &opts).ok()
+                })
+                .map_or(f64::NAN, |m| m.angle_deg);
+            eprintln!("{}", format_args!(
+                "  {tag}: angle {angle:.2} deg, {} particles, {} at {:.2} s, {:.0} s wall",
+                run.particles,
+                if run.rest_from_s.is_some() { "at rest" } else { "NOT at rest" },
+                run.rest_from_s.unwrap_or(run.frames.last().map_or(0.0, |f| f.t_s)),
+                t0.elapsed().as_secs_f64()
+            ));
             cases.push(Case {
                 tag,
                 theta_deg,
                 cone,
                 scene,
                 run,
+                wall_s: t0.elapsed().as_secs_f64(),
             });
         }
 
@@ -259,6 +279,7 @@ impl Experiment for GranularRepose {
 fn check_run(out: &mut Outcome, case: &Case) -> Result<Option<Base>> {
     let tag = &case.tag;
     out.metric(format!("{tag}/particles"), case.run.particles as f64);
+    out.metric(format!("{tag}/wall_s"), case.wall_s);
     if let Some(e) = &case.run.blow_up {
         out.check(solver_error_check(tag, e));
         return Ok(None);
@@ -280,17 +301,20 @@ fn check_run(out: &mut Outcome, case: &Case) -> Result<Option<Base>> {
     Ok(Some(base_of(&case.scene)?))
 }
 
+/// The particles above the base, between its edges.
+fn on_base(positions: &[Vec3<f64>], base: Base) -> Vec<Vec3<f64>> {
+    positions
+        .iter()
+        .copied()
+        .filter(|p| p.y > base.top_y && p.x > base.x0 && p.x < base.x1)
+        .collect()
+}
+
 /// The heap's checks; returns its measurement.
 fn check_heap(out: &mut Outcome, case: &Case, base: Base) -> Option<Measured> {
     let tag = &case.tag;
     let s = case.scene.particle_spacing;
-    let on_base: Vec<Vec3<f64>> = case
-        .run
-        .final_positions
-        .iter()
-        .copied()
-        .filter(|p| p.y > base.top_y && p.x > base.x0 && p.x < base.x1)
-        .collect();
+    let on_base = on_base(&case.run.final_positions, base);
     let opts = ReposeOptions::planar(base.top_y, s)
         .with_spacing(s)
         .with_steepest_run(STEEPEST_RUN_M);
