@@ -37,19 +37,22 @@ pub struct FrameRow {
     pub last_solve_error: f64,
     /// Wall-clock time of the frame's phases (s).
     pub wall_s: f64,
-    /// Largest particle speed at the end of the frame (m/s).
+    /// Largest particle speed at the end of the frame (m/s): of the particles in the
+    /// [`RestCriterion`]'s region if there is one.
     pub max_speed_m_s: f64,
 }
 
 /// When a run counts as at rest and stops before the scene's duration (which is then a cap):
-/// the largest particle speed has stayed below `speed_m_s` for `hold_s` (checked at the end
-/// of each frame).
+/// the largest speed of the particles in `region` has stayed below `speed_m_s` for `hold_s`
+/// (checked at the end of each frame).
 #[derive(Debug, Clone, Copy)]
 pub struct RestCriterion {
     /// Speed bound (m/s).
     pub speed_m_s: f64,
     /// How long every particle must stay below it (s).
     pub hold_s: f64,
+    /// The particles that count: those inside this box (m); `None` = all.
+    pub region: Option<sph_core::Aabb<f64>>,
 }
 
 /// A scene run to its end (or to a blow-up).
@@ -79,9 +82,16 @@ fn to_f64<R: Real>(p: &[Vec3<R>]) -> Vec<Vec3<f64>> {
         .collect()
 }
 
-fn max_speed<R: Real>(v: &[Vec3<R>]) -> f64 {
-    v.iter()
-        .map(|v| v.norm().as_f64())
+fn max_speed<R: Real>(x: &[Vec3<R>], v: &[Vec3<R>], region: Option<sph_core::Aabb<f64>>) -> f64 {
+    let inside = |p: &Vec3<R>| {
+        region.is_none_or(|b| {
+            (0..3).all(|a| p[a].as_f64() >= b.min[a] && p[a].as_f64() <= b.max[a])
+        })
+    };
+    x.iter()
+        .zip(v)
+        .filter(|(p, _)| inside(p))
+        .map(|(_, v)| v.norm().as_f64())
         .fold(0.0, f64::max)
 }
 
@@ -118,7 +128,11 @@ fn run_in<R: Real>(
                 max_density_ratio: s.max_density_ratio,
                 last_solve_error: s.last_solve_error,
                 wall_s: s.total_s(),
-                max_speed_m_s: max_speed(&sim.state.velocities),
+                max_speed_m_s: max_speed(
+                    &sim.state.positions,
+                    &sim.state.velocities,
+                    rest.and_then(|c| c.region),
+                ),
             }),
             Err(e) => {
                 run.blow_up = Some(format!("{e:#}"));

@@ -12,7 +12,8 @@
 //! by surface avalanches that stop, not by a runout). Each scene runs with both matchings
 //! (the scenes choose simple shear; plane strain is the same scene with the field changed).
 //!
-//! **Rest**: a run stops once the largest particle speed has stayed below
+//! **Rest**: a run stops once the largest speed of the heap's particles (those above the
+//! base, between its edges; all particles for θ = 0) has stayed below
 //! [`REST_SPEED_FRACTION`] `· √(g s)` (`s` the particle spacing, the grain size) for
 //! [`REST_HOLD_S`]; the scene's duration is a cap, and a run that reaches it is not at rest
 //! (a failing check with the speed).
@@ -24,6 +25,9 @@
 //! horizontal run of [`STEEPEST_RUN_M`]. On lattice heaps of this size at the quick spacing
 //! (10 mm, heaps 14–34 particles tall) both are within 0.8° of the true angle for 15°–42°
 //! (`iisph-granular/tests/measure.rs`, `quick_repose_heap_measured_within_one_degree`).
+//!
+//! In full mode (and in quick mode with `DIAG_WIDE_IN_QUICK`) the 30° simple-shear heap also
+//! runs in a slab twice as deep (`wide/…` metrics): the side walls' share in the angle.
 //!
 //! **Checks**, per matching and θ ∈ {20°, 30°, 40°}: at rest before the cap; the heap is a
 //! heap (its apex below the block's top, so it formed by flow; material at both edges of the
@@ -69,6 +73,32 @@ const DRAINED_FRACTION: f64 = 0.02;
 /// (a-priori bound of this project: a liquid at rest is flat; half the layer allows a
 /// particle's roughness on a layer of about ten particles).
 const FLAT_RELIEF_FRACTION: f64 = 0.5;
+
+/// Full mode also runs the 30° simple-shear heap in a slab this many times deeper (the
+/// `wide/…` metrics), to show the side walls' share in the angle.
+const WIDE_SLAB_FACTOR: f64 = 2.0;
+/// Whether quick mode runs the deeper slab too (a diagnostic: set it to measure the side
+/// walls' share without a full run; off, as quick mode must stay within its time).
+const DIAG_WIDE_IN_QUICK: bool = false;
+
+/// Deepens the slab (tank, base and block along z) by `factor`.
+fn widen(scene: &mut Scene, factor: f64) -> Result<()> {
+    if let Some(t) = &mut scene.tank {
+        t.max.z = t.min.z + factor * (t.max.z - t.min.z);
+    }
+    for solid in &mut scene.solids {
+        if let SolidSpec::Box { min, max } = solid {
+            max[2] = min[2] + factor * (max[2] - min[2]);
+        }
+    }
+    for fluid in &mut scene.fluids {
+        if let FluidSpec::Block { min, max, .. } = fluid {
+            max[2] = min[2] + factor * (max[2] - min[2]);
+        }
+    }
+    scene.check()?;
+    Ok(())
+}
 
 /// The geometry of a fixed-base scene: the base (the first solid, a box) and the block.
 #[derive(Debug, Clone, Copy)]
@@ -118,11 +148,18 @@ fn scene_for(theta_deg: f64, cone: ConeMatch, shift_m: f64, ctx: &Context) -> Re
     Ok(scene)
 }
 
-fn rest_criterion(scene: &Scene) -> RestCriterion {
+/// The rest criterion of a run: the heap's particles (above the base, between its edges)
+/// for θ > 0, all particles for θ = 0 (which must come to rest everywhere).
+fn rest_criterion(scene: &Scene, theta_deg: f64) -> RestCriterion {
     let g = Vec3::from(scene.gravity).norm();
+    let region = base_of(scene).ok().filter(|_| theta_deg > 0.0).map(|b| sph_core::Aabb {
+        min: Vec3::new(b.x0, b.top_y, f64::NEG_INFINITY),
+        max: Vec3::new(b.x1, f64::INFINITY, f64::INFINITY),
+    });
     RestCriterion {
         speed_m_s: REST_SPEED_FRACTION * (g * scene.particle_spacing).sqrt(),
         hold_s: REST_HOLD_S,
+        region,
     }
 }
 
@@ -170,16 +207,31 @@ impl Experiment for GranularRepose {
             ConeMatch::SimpleShear,
             repeat_shift,
         ));
+        let wide = ctx.mode == crate::Mode::Full || DIAG_WIDE_IN_QUICK;
+        if wide {
+            plan.push((
+                "wide/simple-shear/theta=30".into(),
+                30.0,
+                ConeMatch::SimpleShear,
+                0.0,
+            ));
+        }
         let scenes: Vec<Scene> = plan
             .iter()
-            .map(|(_, t, c, shift)| scene_for(*t, *c, *shift, ctx))
+            .map(|(tag, t, c, shift)| {
+                let mut scene = scene_for(*t, *c, *shift, ctx)?;
+                if tag.starts_with("wide/") {
+                    widen(&mut scene, WIDE_SLAB_FACTOR)?;
+                }
+                Ok(scene)
+            })
             .collect::<Result<_>>()?;
         ctx.progress
             .set_length(scenes.iter().map(|s| s.frame_count() as u64).sum());
         let mut cases = Vec::new();
         for ((tag, theta_deg, cone, _), scene) in plan.into_iter().zip(scenes) {
             let t0 = std::time::Instant::now();
-            let run = run_scene_until_rest(ctx, &scene, rest_criterion(&scene))?;
+            let run = run_scene_until_rest(ctx, &scene, rest_criterion(&scene, theta_deg))?;
             // On stderr, not through the progress bar (hidden when not a terminal): a
             // diagnostic line per run.
             let angle = base_of(&scene)
@@ -216,7 +268,7 @@ impl Experiment for GranularRepose {
                 continue;
             };
             if let Ok(p) = surface_profile(&case.run.final_positions, PileShape::Planar, case.scene.particle_spacing) {
-                if !case.tag.starts_with("repeat") {
+                if is_sweep(&case.tag) {
                     profiles.push((case.tag.clone(), p.iter().map(|p| (p.d_m, p.y_m)).collect()));
                 }
             }
@@ -238,7 +290,7 @@ impl Experiment for GranularRepose {
                     case.run.particles.to_string(),
                 ]);
                 by_tag.push((case.tag.clone(), m));
-                if !case.tag.starts_with("repeat") {
+                if is_sweep(&case.tag) {
                     measured.push((case.cone, case.theta_deg, m));
                 }
             }
@@ -288,13 +340,13 @@ fn check_run(out: &mut Outcome, case: &Case) -> Result<Option<Base>> {
     let end_t = case.run.frames.last().map_or(f64::NAN, |f| f.t_s);
     out.metric(format!("{tag}/end_time_s"), end_t);
     out.metric(format!("{tag}/max_speed_at_end_m_s"), end_speed);
-    let rest = rest_criterion(&case.scene);
+    let rest = rest_criterion(&case.scene, case.theta_deg);
     out.check(Check::less_than(
         format!("{tag}/at rest before the cap: time of rest (s)"),
         case.run.rest_from_s.unwrap_or(f64::INFINITY),
         case.scene.duration_s,
         format!(
-            "validity of the measurement: every particle slower than {:.4} m/s ({REST_SPEED_FRACTION} sqrt(g s)) for {REST_HOLD_S} s before the {} s cap (speed at the end {end_speed:.4} m/s)",
+            "validity of the measurement: every particle of the heap (all for theta = 0) slower than {:.4} m/s ({REST_SPEED_FRACTION} sqrt(g s)) for {REST_HOLD_S} s before the {} s cap (speed at the end {end_speed:.4} m/s)",
             rest.speed_m_s, case.scene.duration_s
         ),
     ));
@@ -435,6 +487,9 @@ fn check_order_and_spread(
         out.metric("repeat/angle_difference_deg", (a.angle_deg - b.angle_deg).abs());
         out.metric("repeat/steepest_difference_deg", (a.steepest_deg - b.steepest_deg).abs());
     }
+    if let (Some(a), Some(w)) = (find("simple-shear/theta=30"), find("wide/simple-shear/theta=30")) {
+        out.metric("wide/angle_minus_narrow_deg", w.angle_deg - a.angle_deg);
+    }
     let flanks = by_tag
         .iter()
         .map(|(_, m)| m.flank_difference_deg)
@@ -521,4 +576,9 @@ fn plot_profiles(ctx: &mut Context, profiles: &[(String, Vec<(f64, f64)>)]) -> R
         "free-surface profile (highest particle per bin of one spacing) of each run at rest",
     );
     Ok(())
+}
+
+/// Whether a run is one of the sweep (not a repeat or a side-wall variant).
+fn is_sweep(tag: &str) -> bool {
+    !(tag.starts_with("repeat/") || tag.starts_with("wide/"))
 }
