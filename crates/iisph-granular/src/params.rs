@@ -378,8 +378,14 @@ mod tests {
         assert!(close(ConeMatch::PlaneStrain.alpha(0.0), 0.0));
         assert!(close(ConeMatch::SimpleShear.alpha(0.0), 0.0));
         for t in [20.0f64, 40.0] {
-            assert!(close(ConeMatch::PlaneStrain.alpha(t), r2 * t.to_radians().sin()));
-            assert!(close(ConeMatch::SimpleShear.alpha(t), r2 * t.to_radians().tan()));
+            assert!(close(
+                ConeMatch::PlaneStrain.alpha(t),
+                r2 * t.to_radians().sin()
+            ));
+            assert!(close(
+                ConeMatch::SimpleShear.alpha(t),
+                r2 * t.to_radians().tan()
+            ));
             // The simple-shear cone is the wider one for every θ in (0, 90).
             assert!(ConeMatch::SimpleShear.alpha(t) > ConeMatch::PlaneStrain.alpha(t));
         }

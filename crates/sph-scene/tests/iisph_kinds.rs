@@ -215,7 +215,9 @@ fn granular_cone_match() {
     };
     assert_eq!(p.cone_match, Some(ConeMatch::SimpleShear));
     assert!((alpha(&s) - ConeMatch::SimpleShear.alpha(30.0)).abs() < 1e-12);
-    let e = granular("\ncone_match = \"simple_shear\"").unwrap_err().to_string();
+    let e = granular("\ncone_match = \"simple_shear\"")
+        .unwrap_err()
+        .to_string();
     assert!(
         e.contains("solver.cone_match") && e.contains("simple-shear") && e.contains("line"),
         "{e}"

@@ -84,9 +84,8 @@ fn to_f64<R: Real>(p: &[Vec3<R>]) -> Vec<Vec3<f64>> {
 
 fn max_speed<R: Real>(x: &[Vec3<R>], v: &[Vec3<R>], region: Option<sph_core::Aabb<f64>>) -> f64 {
     let inside = |p: &Vec3<R>| {
-        region.is_none_or(|b| {
-            (0..3).all(|a| p[a].as_f64() >= b.min[a] && p[a].as_f64() <= b.max[a])
-        })
+        region
+            .is_none_or(|b| (0..3).all(|a| p[a].as_f64() >= b.min[a] && p[a].as_f64() <= b.max[a]))
     };
     x.iter()
         .zip(v)

@@ -152,10 +152,13 @@ fn scene_for(theta_deg: f64, cone: ConeMatch, shift_m: f64, ctx: &Context) -> Re
 /// for θ > 0, all particles for θ = 0 (which must come to rest everywhere).
 fn rest_criterion(scene: &Scene, theta_deg: f64) -> RestCriterion {
     let g = Vec3::from(scene.gravity).norm();
-    let region = base_of(scene).ok().filter(|_| theta_deg > 0.0).map(|b| sph_core::Aabb {
-        min: Vec3::new(b.x0, b.top_y, f64::NEG_INFINITY),
-        max: Vec3::new(b.x1, f64::INFINITY, f64::INFINITY),
-    });
+    let region = base_of(scene)
+        .ok()
+        .filter(|_| theta_deg > 0.0)
+        .map(|b| sph_core::Aabb {
+            min: Vec3::new(b.x0, b.top_y, f64::NEG_INFINITY),
+            max: Vec3::new(b.x1, f64::INFINITY, f64::INFINITY),
+        });
     RestCriterion {
         speed_m_s: REST_SPEED_FRACTION * (g * scene.particle_spacing).sqrt(),
         hold_s: REST_HOLD_S,
@@ -196,7 +199,12 @@ impl Experiment for GranularRepose {
         let mut plan: Vec<(String, f64, ConeMatch, f64)> = Vec::new();
         for cone in MATCHES {
             for theta in THETAS {
-                plan.push((format!("{}/theta={theta:.0}", cone.name()), theta, cone, 0.0));
+                plan.push((
+                    format!("{}/theta={theta:.0}", cone.name()),
+                    theta,
+                    cone,
+                    0.0,
+                ));
             }
         }
         plan.push(("theta=0".into(), 0.0, ConeMatch::SimpleShear, 0.0));
@@ -241,13 +249,21 @@ impl Experiment for GranularRepose {
                     angle_of_repose(&on_base(&run.final_positions, b), &opts).ok()
                 })
                 .map_or(f64::NAN, |m| m.angle_deg);
-            eprintln!("{}", format_args!(
-                "  {tag}: angle {angle:.2} deg, {} particles, {} at {:.2} s, {:.0} s wall",
-                run.particles,
-                if run.rest_from_s.is_some() { "at rest" } else { "NOT at rest" },
-                run.rest_from_s.unwrap_or(run.frames.last().map_or(0.0, |f| f.t_s)),
-                t0.elapsed().as_secs_f64()
-            ));
+            eprintln!(
+                "{}",
+                format_args!(
+                    "  {tag}: angle {angle:.2} deg, {} particles, {} at {:.2} s, {:.0} s wall",
+                    run.particles,
+                    if run.rest_from_s.is_some() {
+                        "at rest"
+                    } else {
+                        "NOT at rest"
+                    },
+                    run.rest_from_s
+                        .unwrap_or(run.frames.last().map_or(0.0, |f| f.t_s)),
+                    t0.elapsed().as_secs_f64()
+                )
+            );
             cases.push(Case {
                 tag,
                 theta_deg,
@@ -267,7 +283,11 @@ impl Experiment for GranularRepose {
             let Some(base) = check_run(&mut out, case)? else {
                 continue;
             };
-            if let Ok(p) = surface_profile(&case.run.final_positions, PileShape::Planar, case.scene.particle_spacing) {
+            if let Ok(p) = surface_profile(
+                &case.run.final_positions,
+                PileShape::Planar,
+                case.scene.particle_spacing,
+            ) {
                 if is_sweep(&case.tag) {
                     profiles.push((case.tag.clone(), p.iter().map(|p| (p.d_m, p.y_m)).collect()));
                 }
@@ -281,7 +301,10 @@ impl Experiment for GranularRepose {
                     case.tag.clone(),
                     format!("{}", case.theta_deg),
                     case.cone.name().to_string(),
-                    format!("{:.3}", case.cone.predicted_repose_angle_deg(case.theta_deg)),
+                    format!(
+                        "{:.3}",
+                        case.cone.predicted_repose_angle_deg(case.theta_deg)
+                    ),
                     format!("{:.3}", m.angle_deg),
                     format!("{:.3}", m.steepest_deg),
                     format!("{:.3}", m.flank_difference_deg),
@@ -383,7 +406,12 @@ fn check_heap(out: &mut Outcome, case: &Case, base: Base) -> Option<Measured> {
         }
     };
     let predicted = case.cone.predicted_repose_angle_deg(case.theta_deg);
-    let flank = |side: i8| m.flanks.iter().find(|f| f.side == side).map_or(f64::NAN, |f| f.angle_deg);
+    let flank = |side: i8| {
+        m.flanks
+            .iter()
+            .find(|f| f.side == side)
+            .map_or(f64::NAN, |f| f.angle_deg)
+    };
     let measured = Measured {
         angle_deg: m.angle_deg,
         steepest_deg: m.steepest_deg.unwrap_or(f64::NAN),
@@ -393,18 +421,29 @@ fn check_heap(out: &mut Outcome, case: &Case, base: Base) -> Option<Measured> {
     out.metric(format!("{tag}/predicted_deg"), predicted);
     out.metric(format!("{tag}/angle_deg"), measured.angle_deg);
     out.metric(format!("{tag}/steepest_deg"), measured.steepest_deg);
-    out.metric(format!("{tag}/flank_difference_deg"), measured.flank_difference_deg);
+    out.metric(
+        format!("{tag}/flank_difference_deg"),
+        measured.flank_difference_deg,
+    );
     out.metric(format!("{tag}/heap_height_m"), measured.height_m);
-    out.metric(format!("{tag}/rest_from_s"), case.run.rest_from_s.unwrap_or(f64::NAN));
+    out.metric(
+        format!("{tag}/rest_from_s"),
+        case.run.rest_from_s.unwrap_or(f64::NAN),
+    );
     out.check(Check::less_than(
         format!("{tag}/heap formed by flow: apex below the block's top (m)"),
-        m.profile.iter().map(|p| p.y_m).fold(f64::NEG_INFINITY, f64::max),
+        m.profile
+            .iter()
+            .map(|p| p.y_m)
+            .fold(f64::NEG_INFINITY, f64::max),
         base.block_top_y - s,
         "validity: an apex at the block's top is a block that did not fail, not a heap",
     ));
-    let edge_gap = m.profile.first().map_or(f64::INFINITY, |p| p.d_m - base.x0).max(
-        m.profile.last().map_or(f64::INFINITY, |p| base.x1 - p.d_m),
-    );
+    let edge_gap = m
+        .profile
+        .first()
+        .map_or(f64::INFINITY, |p| p.d_m - base.x0)
+        .max(m.profile.last().map_or(f64::INFINITY, |p| base.x1 - p.d_m));
     out.check(Check::less_than(
         format!("{tag}/heap covers the base: largest gap to an edge (m)"),
         edge_gap,
@@ -440,9 +479,16 @@ fn check_drained(out: &mut Outcome, case: &Case, base: Base) -> Result<()> {
     let tank = case.scene.tank.expect("the repose scenes have a tank");
     let mut worst: f64 = 0.0;
     for (lo, hi) in [(tank.min.x, base.x0), (base.x1, tank.max.x)] {
-        let trough: Vec<Vec3<f64>> = pos.iter().copied().filter(|p| p.x > lo && p.x < hi).collect();
+        let trough: Vec<Vec3<f64>> = pos
+            .iter()
+            .copied()
+            .filter(|p| p.x > lo && p.x < hi)
+            .collect();
         let profile = surface_profile(&trough, PileShape::Planar, s)?;
-        let y_hi = profile.iter().map(|p| p.y_m).fold(f64::NEG_INFINITY, f64::max);
+        let y_hi = profile
+            .iter()
+            .map(|p| p.y_m)
+            .fold(f64::NEG_INFINITY, f64::max);
         let y_lo = profile.iter().map(|p| p.y_m).fold(f64::INFINITY, f64::min);
         let layer = trough.len() as f64 * s.powi(3) / ((hi - lo) * (tank.max.z - tank.min.z));
         worst = worst.max((y_hi - y_lo) / layer);
@@ -472,7 +518,10 @@ fn check_order_and_spread(
         if angles.len() == THETAS.len() {
             let increasing = angles.windows(2).all(|w| w[1] > w[0]);
             out.check(Check::equals(
-                format!("{}/measured angle increases with theta (20 < 30 < 40)", cone.name()),
+                format!(
+                    "{}/measured angle increases with theta (20 < 30 < 40)",
+                    cone.name()
+                ),
                 f64::from(u8::from(increasing)),
                 1.0,
                 "physics: a larger friction angle holds a steeper slope",
@@ -484,10 +533,19 @@ fn check_order_and_spread(
         find("simple-shear/theta=30"),
         find("repeat/simple-shear/theta=30"),
     ) {
-        out.metric("repeat/angle_difference_deg", (a.angle_deg - b.angle_deg).abs());
-        out.metric("repeat/steepest_difference_deg", (a.steepest_deg - b.steepest_deg).abs());
+        out.metric(
+            "repeat/angle_difference_deg",
+            (a.angle_deg - b.angle_deg).abs(),
+        );
+        out.metric(
+            "repeat/steepest_difference_deg",
+            (a.steepest_deg - b.steepest_deg).abs(),
+        );
     }
-    if let (Some(a), Some(w)) = (find("simple-shear/theta=30"), find("wide/simple-shear/theta=30")) {
+    if let (Some(a), Some(w)) = (
+        find("simple-shear/theta=30"),
+        find("wide/simple-shear/theta=30"),
+    ) {
         out.metric("wide/angle_minus_narrow_deg", w.angle_deg - a.angle_deg);
     }
     let flanks = by_tag
@@ -504,7 +562,12 @@ fn plot_angles(ctx: &mut Context, measured: &[(ConeMatch, f64, Measured)]) -> Re
             .collect::<Vec<_>>()
     };
     let mut series = vec![
-        Series::styled("simple-shear match: β = θ", curve(ConeMatch::SimpleShear), SeriesStyle::Dashed, 0),
+        Series::styled(
+            "simple-shear match: β = θ",
+            curve(ConeMatch::SimpleShear),
+            SeriesStyle::Dashed,
+            0,
+        ),
         Series::styled(
             "plane-strain match (eq. 14): β = atan(sin θ)",
             curve(ConeMatch::PlaneStrain),
