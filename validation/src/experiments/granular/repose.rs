@@ -602,7 +602,7 @@ fn plot_angles(ctx: &mut Context, measured: &[(ConeMatch, f64, Measured)]) -> Re
         x_range: Some((0.0, 50.0)),
         y_range: Some((0.0, 50.0)),
         ..PlotSpec::new(
-            "Angle of repose of fixed-base heaps at rest against the yield cone's prediction",
+            "Angle of repose of fixed-base heaps against the yield cone's prediction",
             "friction angle θ (deg)",
             "angle of repose β (deg)",
         )
@@ -628,7 +628,7 @@ fn plot_profiles(ctx: &mut Context, profiles: &[(String, Vec<(f64, f64)>)]) -> R
         legend: Legend::UpperRight,
         series,
         ..PlotSpec::new(
-            "Surface profiles at rest (the base spans x = 0.8–1.6 m, top at 0.25 m)",
+            "Surface profiles at the end of each run (the base spans x = 0.8–1.6 m, top at 0.25 m)",
             "x (m)",
             "height of the highest particle (m)",
         )
@@ -636,7 +636,7 @@ fn plot_profiles(ctx: &mut Context, profiles: &[(String, Vec<(f64, f64)>)]) -> R
     plot_xy(&ctx.path("profiles.png"), &spec)?;
     ctx.add_plot(
         "profiles.png",
-        "free-surface profile (highest particle per bin of one spacing) of each run at rest",
+        "free-surface profile (highest particle per bin of one spacing) at the end of each run",
     );
     Ok(())
 }
