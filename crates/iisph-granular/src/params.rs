@@ -36,6 +36,70 @@ pub const MAX_PRESSURE_ITERATIONS: usize = 100_000;
 /// of repose no longer changes beyond 50); an iteration is two neighbour passes.
 pub const MAX_FRICTION_ITERATIONS: usize = 1000;
 
+/// How the Drucker–Prager cone `‖s‖_F ≤ α p` is matched to the friction angle `θ`: which
+/// state of stress the cone is made to agree with Mohr–Coulomb's `|τ| ≤ tan θ · σ_n` in
+/// ([`GranularParams::cone_match`]).
+///
+/// The two matches predict different angles for a slope at rest (derivation in the crate
+/// docs, "The yield cone's matching and the angle of repose"): in a surface layer that has
+/// flowed and stopped the stress is close to simple shear with `p ≈ σ_n`, so the slope
+/// angle `β` at rest obeys `tan β = α / √2`, i.e.
+///
+/// | match | `α` | slope at rest `β` | θ = 20°, 30°, 40° |
+/// | --- | --- | --- | --- |
+/// | [`ConeMatch::PlaneStrain`] (the thesis's eq. 14) | `√2 sin θ` | `atan(sin θ)` | 18.9°, 26.6°, 32.7° |
+/// | [`ConeMatch::SimpleShear`] | `√2 tan θ` | `θ` | 20°, 30°, 40° |
+///
+/// In scene files: `cone_match = "plane-strain"` or `"simple-shear"` (`[solver]`, kind
+/// `"granular"`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Deserialize),
+    serde(rename_all = "kebab-case")
+)]
+#[non_exhaustive]
+pub enum ConeMatch {
+    /// `α = √2 sin θ` (Neder 2024 eq. 14, after Alduán & Otaduy 2011): the cone agrees with
+    /// Mohr–Coulomb in plane strain with zero dilatancy. A slope rests at `atan(sin θ)`,
+    /// below `θ`. The default, so that the thesis's experiments run as printed.
+    #[default]
+    PlaneStrain,
+    /// `α = √2 tan θ`: the cone agrees with Mohr–Coulomb in simple shear (`|τ| ≤ tan θ · p`,
+    /// the `μ_s = tan θ` of μ(I)-type continuum codes). A slope rests at `θ`: the friction
+    /// angle *is* the angle of repose.
+    SimpleShear,
+}
+
+impl ConeMatch {
+    /// The Drucker–Prager coefficient `α` of the cone `‖s‖_F ≤ α p` for friction angle `θ`
+    /// (degrees).
+    pub fn alpha(self, friction_angle_deg: f64) -> f64 {
+        let t = friction_angle_deg.to_radians();
+        std::f64::consts::SQRT_2
+            * match self {
+                ConeMatch::PlaneStrain => t.sin(),
+                ConeMatch::SimpleShear => t.tan(),
+            }
+    }
+
+    /// The angle (degrees) at which a cohesionless slope comes to rest under this match,
+    /// `atan(α / √2)`: `atan(sin θ)` (plane strain) or `θ` (simple shear).
+    pub fn predicted_repose_angle_deg(self, friction_angle_deg: f64) -> f64 {
+        (self.alpha(friction_angle_deg) / std::f64::consts::SQRT_2)
+            .atan()
+            .to_degrees()
+    }
+
+    /// The name used in scene files: `"plane-strain"` or `"simple-shear"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ConeMatch::PlaneStrain => "plane-strain",
+            ConeMatch::SimpleShear => "simple-shear",
+        }
+    }
+}
+
 /// Parameters of [`crate::Iisph`]. Lengths absolute, in metres; SI units throughout.
 ///
 /// | field | default ([`IisphParams::for_spacing`]) | source |
@@ -75,6 +139,7 @@ pub struct IisphParams<R: Real> {
 /// | field | default ([`GranularParams::with_friction_angle`]) | source |
 /// | --- | --- | --- |
 /// | `friction_angle_deg` | given | `θ` of eq. 14 (degrees, in [0, 90)) |
+/// | `cone_match` | [`ConeMatch::PlaneStrain`] (`α = √2 sin θ`) | eq. 14; [`ConeMatch::SimpleShear`] makes `θ` the angle of repose |
 /// | `drag_coefficient` | 0 (off) | `C_D` of eq. 6 (dimensionless) |
 /// | `air_velocity` | 0 m/s | `v_a` of eq. 5 (a uniform field) |
 /// | `air_density` | 1.2041 kg/m³ ([`AIR_DENSITY`]) | `ρ_a` of eq. 6 |
@@ -84,8 +149,10 @@ pub struct IisphParams<R: Real> {
 #[derive(Debug, Clone, PartialEq)]
 pub struct GranularParams<R: Real> {
     /// Friction angle `θ` (degrees, in [0, 90)): the Drucker–Prager coefficient is
-    /// `α = √2 sin θ`.
+    /// `α = √2 sin θ` or `√2 tan θ`, by [`GranularParams::cone_match`].
     pub friction_angle_deg: R,
+    /// How the cone is matched to `θ` (see [`ConeMatch`]).
+    pub cone_match: ConeMatch,
     /// Drag coefficient `C_D` (dimensionless, ≥ 0); 0 switches the drag off.
     pub drag_coefficient: R,
     /// Velocity of the surrounding air (m/s), uniform.
@@ -106,6 +173,7 @@ impl<R: Real> GranularParams<R> {
     pub fn with_friction_angle(friction_angle_deg: R) -> Self {
         Self {
             friction_angle_deg,
+            cone_match: ConeMatch::default(),
             drag_coefficient: R::zero(),
             air_velocity: Vec3::zeros(),
             air_density: R::of_f64(AIR_DENSITY),
@@ -115,9 +183,22 @@ impl<R: Real> GranularParams<R> {
         }
     }
 
-    /// The Drucker–Prager friction coefficient `α = √2 sin θ` (Neder 2024 eq. 14).
+    /// The same with the cone matched by `cone_match`.
+    pub fn with_cone_match(self, cone_match: ConeMatch) -> Self {
+        Self { cone_match, ..self }
+    }
+
+    /// The Drucker–Prager friction coefficient `α` ([`ConeMatch::alpha`]): `√2 sin θ`
+    /// (Neder 2024 eq. 14) or `√2 tan θ`.
     pub fn alpha(&self) -> R {
-        R::of_f64(std::f64::consts::SQRT_2 * self.friction_angle_deg.as_f64().to_radians().sin())
+        R::of_f64(self.cone_match.alpha(self.friction_angle_deg.as_f64()))
+    }
+
+    /// The angle (degrees) at which a slope of this material comes to rest
+    /// ([`ConeMatch::predicted_repose_angle_deg`]).
+    pub fn predicted_repose_angle_deg(&self) -> f64 {
+        self.cone_match
+            .predicted_repose_angle_deg(self.friction_angle_deg.as_f64())
     }
 
     fn validate(&self, common: &CommonParams<R>) -> Result<(), SolverError> {
@@ -278,5 +359,63 @@ impl<R: Real> IisphParams<R> {
             ));
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{ConeMatch, GranularParams};
+
+    /// `α` of both matches against values computed by hand (sin 30° = 1/2, tan 45° = 1,
+    /// tan 30° = 1/√3) and against the closed forms at 20° and 40°.
+    #[test]
+    fn cone_alpha_values() {
+        let r2 = std::f64::consts::SQRT_2;
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
+        assert!(close(ConeMatch::PlaneStrain.alpha(30.0), r2 / 2.0));
+        assert!(close(ConeMatch::SimpleShear.alpha(30.0), r2 / 3f64.sqrt()));
+        assert!(close(ConeMatch::SimpleShear.alpha(45.0), r2));
+        assert!(close(ConeMatch::PlaneStrain.alpha(0.0), 0.0));
+        assert!(close(ConeMatch::SimpleShear.alpha(0.0), 0.0));
+        for t in [20.0f64, 40.0] {
+            assert!(close(
+                ConeMatch::PlaneStrain.alpha(t),
+                r2 * t.to_radians().sin()
+            ));
+            assert!(close(
+                ConeMatch::SimpleShear.alpha(t),
+                r2 * t.to_radians().tan()
+            ));
+            // The simple-shear cone is the wider one for every θ in (0, 90).
+            assert!(ConeMatch::SimpleShear.alpha(t) > ConeMatch::PlaneStrain.alpha(t));
+        }
+    }
+
+    /// The slope each match holds: `atan(sin θ)` = 18.9°, 26.6°, 32.7° (plane strain, as
+    /// issue 19 computes) and `θ` (simple shear).
+    #[test]
+    fn predicted_repose_angles() {
+        let ps: Vec<f64> = [20.0, 30.0, 40.0]
+            .iter()
+            .map(|&t| ConeMatch::PlaneStrain.predicted_repose_angle_deg(t))
+            .collect();
+        for (got, want) in ps.iter().zip([18.88, 26.57, 32.73]) {
+            assert!((got - want).abs() < 0.01, "{got} vs {want}");
+        }
+        for t in [0.0, 20.0, 30.0, 40.0, 89.0] {
+            let b = ConeMatch::SimpleShear.predicted_repose_angle_deg(t);
+            assert!((b - t).abs() < 1e-9, "{b} vs {t}");
+        }
+    }
+
+    /// The default is the thesis's match, and `alpha()` follows the field.
+    #[test]
+    fn params_follow_the_match() {
+        let g = GranularParams::<f64>::with_friction_angle(30.0);
+        assert_eq!(g.cone_match, ConeMatch::PlaneStrain);
+        assert!((g.alpha() - std::f64::consts::SQRT_2 * 0.5).abs() < 1e-12);
+        let g = g.with_cone_match(ConeMatch::SimpleShear);
+        assert!((g.alpha() - ConeMatch::SimpleShear.alpha(30.0)).abs() < 1e-12);
+        assert!((g.predicted_repose_angle_deg() - 30.0).abs() < 1e-9);
     }
 }

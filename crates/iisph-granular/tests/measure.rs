@@ -365,3 +365,118 @@ fn resolution_estimate_covers_the_error_of_a_lattice_cone() {
         );
     }
 }
+
+/// A planar heap on the floor `y = 0` between `x_lo` and `x_hi` whose surface height at `x`
+/// is `top(x)`, sampled on a cubic lattice of spacing `s` whose columns start at `x_lo +
+/// phase · s` (3 layers in `z`, jitter `j` per coordinate).
+fn heap_of(
+    top: impl Fn(f64) -> f64,
+    (x_lo, x_hi): (f64, f64),
+    phase: f64,
+    s: f64,
+    j: f64,
+    seed: u64,
+) -> Vec<Vec3<f64>> {
+    let mut rng = Jitter(seed);
+    let mut out = Vec::new();
+    let mut x = x_lo + phase * s;
+    while x < x_hi {
+        let mut y = 0.5 * s;
+        while y <= top(x) {
+            for k in 0..3 {
+                out.push(Vec3::new(
+                    x + rng.offset(j),
+                    y + rng.offset(j),
+                    (k as f64 + 0.5) * s + rng.offset(j),
+                ));
+            }
+            y += s;
+        }
+        x += s;
+    }
+    out
+}
+
+/// The resolution of the `granular-repose` measurement in quick mode: a heap on a base of
+/// half-width 0.4 m at spacing 10 mm (13.7 particles tall at 18.9°, 33.6 at 40°), measured
+/// as the experiment does (bins of one spacing, the 20–80 % band, the steepest run of
+/// 0.2 m: shorter runs follow the lattice's steps, 2.8° off at 0.1 m and 1.6° at 0.15 m),
+/// over slopes of 15°–42°, lattice phases and jitter up to 0.15 spacing. The
+/// oracle is the shape's angle; the bound (1°) is what the experiment needs (issue 19:
+/// resolution better than ±1° in quick mode). The largest errors seen are printed (run with
+/// `--nocapture`).
+#[test]
+fn quick_repose_heap_measured_within_one_degree() {
+    let (s, half) = (0.01, 0.4);
+    let opts = ReposeOptions::planar(0.0, s)
+        .with_spacing(s)
+        .with_steepest_run(0.2);
+    let (mut worst_fit, mut worst_steep) = (0.0f64, 0.0f64);
+    let mut seed = 11;
+    for beta in [15.0, 18.9, 20.0, 26.6, 30.0, 32.7, 36.0, 40.0, 42.0] {
+        let tan = f64::to_radians(beta).tan();
+        for phase in [0.0, 0.25, 0.5, 0.75] {
+            for j in [0.0, 0.05 * s, 0.15 * s] {
+                seed += 1;
+                let (x0, x1) = (1.0 - half, 1.0 + half);
+                let pts = heap_of(
+                    |x| half * tan - (x - 1.0).abs() * tan,
+                    (x0, x1),
+                    phase,
+                    s,
+                    j,
+                    seed,
+                );
+                let m = angle_of_repose(&pts, &opts).unwrap();
+                assert_eq!(m.flanks.len(), 2);
+                let steep = m.steepest_deg.unwrap();
+                worst_fit = worst_fit.max((m.angle_deg - beta).abs());
+                worst_steep = worst_steep.max((steep - beta).abs());
+                assert!(
+                    (m.angle_deg - beta).abs() < 1.0 && (steep - beta).abs() < 1.0,
+                    "slope {beta}, phase {phase}, jitter {j}: fit {:.3}, steepest {steep:.3}",
+                    m.angle_deg
+                );
+            }
+        }
+    }
+    println!("largest error: fit {worst_fit:.3} deg, steepest 0.2 m {worst_steep:.3} deg");
+}
+
+/// The steepest-slope measure finds the steep part of a concave flank (30° above, 15° below
+/// a knee at half height) that the band fit averages away, and stays on the straight
+/// flank's angle for a straight one.
+#[test]
+fn steepest_slope_of_a_kinked_flank() {
+    let s = 0.005;
+    let (t30, t15) = (f64::to_radians(30.0).tan(), f64::to_radians(15.0).tan());
+    let (h, knee) = (0.3, 0.15);
+    let x_knee = (h - knee) / t30;
+    let top = |x: f64| {
+        let d = (x - 1.0).abs();
+        if d <= x_knee {
+            h - d * t30
+        } else {
+            knee - (d - x_knee) * t15
+        }
+    };
+    let half = x_knee + knee / t15;
+    let pts = heap_of(top, (1.0 - half, 1.0 + half), 0.3, s, 0.0, 3);
+    let m = angle_of_repose(&pts, &ReposeOptions::planar(0.0, s).with_steepest_run(0.1)).unwrap();
+    let steep = m.steepest_deg.unwrap();
+    assert!((steep - 30.0).abs() < 1.0, "steepest {steep}");
+    assert!(m.angle_deg < 25.0, "band fit {}", m.angle_deg);
+    // Without the option there is no steepest slope; with a run longer than the band, none.
+    let m = angle_of_repose(&pts, &ReposeOptions::planar(0.0, s)).unwrap();
+    assert_eq!(m.steepest_deg, None);
+    let m = angle_of_repose(&pts, &ReposeOptions::planar(0.0, s).with_steepest_run(5.0)).unwrap();
+    assert_eq!(m.steepest_deg, None);
+    let e = angle_of_repose(&pts, &ReposeOptions::planar(0.0, s).with_steepest_run(-1.0));
+    assert!(matches!(
+        e,
+        Err(MeasureError::InvalidOption {
+            option: "steepest_run_m",
+            ..
+        })
+    ));
+}

@@ -135,7 +135,11 @@
 //! # viscosity = 0.0                # kinematic viscosity ν of an explicit SPH viscosity
 //! #                                # force, m²/s (>= 0)
 //! # kind = "granular" only:
-//! # friction_angle_deg = 30.0      # required, in [0, 90): Drucker–Prager α = √2 sin θ
+//! # friction_angle_deg = 30.0      # required, in [0, 90): the friction angle θ
+//! # cone_match = "plane-strain"    # how the Drucker–Prager cone is matched to θ:
+//! #                                # "plane-strain" (default, the thesis's eq. 14:
+//! #                                # α = √2 sin θ, slopes rest at atan(sin θ)) or
+//! #                                # "simple-shear" (α = √2 tan θ: slopes rest at θ)
 //! # drag_coefficient = 0.0         # C_D of the air drag (>= 0; 0 = off)
 //! # air_velocity = [0.0, 0.0, 0.0] # m/s, uniform
 //! # upscaling_factor = 8           # passive points per particle (>= 1; absent = off)

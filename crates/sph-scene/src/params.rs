@@ -218,6 +218,9 @@ impl Scene {
     fn granular_params<R: Real>(&self, s: &GranularSpec) -> IisphParams<R> {
         let mut p = self.iisph_params::<R>(&s.iisph);
         let mut g = GranularParams::with_friction_angle(r(s.friction_angle_deg));
+        if let Some(m) = s.cone_match {
+            g.cone_match = m;
+        }
         if let Some(c) = s.drag_coefficient {
             g.drag_coefficient = r(c);
         }

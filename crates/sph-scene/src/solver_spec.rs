@@ -4,6 +4,7 @@
 //! range-checked by [`Scene::check`](crate::Scene::check), and turned into the solvers'
 //! parameters by [`Scene::solver_params`](crate::Scene::solver_params).
 
+use iisph_granular::ConeMatch;
 use serde::Deserialize;
 
 /// Which solver a scene is meant for: the tag (`kind`) of the `[solver]` table, and
@@ -158,8 +159,13 @@ pub struct GranularSpec {
     /// The IISPH settings.
     #[serde(flatten)]
     pub iisph: IisphSettings,
-    /// Friction angle `θ` (degrees, in [0, 90); required): Drucker–Prager `α = √2 sin θ`.
+    /// Friction angle `θ` (degrees, in [0, 90); required): Drucker–Prager `α = √2 sin θ`
+    /// or `√2 tan θ`, by `cone_match`.
     pub friction_angle_deg: f64,
+    /// How the yield cone is matched to `θ`: `"plane-strain"` (`α = √2 sin θ`, the thesis's
+    /// eq. 14; the default) or `"simple-shear"` (`α = √2 tan θ`: `θ` is then the angle of
+    /// repose). See [`ConeMatch`].
+    pub cone_match: Option<ConeMatch>,
     /// Drag coefficient `C_D` (≥ 0; default 0 = no drag).
     pub drag_coefficient: Option<f64>,
     /// Uniform air velocity (m/s; default 0).
@@ -296,6 +302,7 @@ impl SolverSpec {
                 common,
                 iisph,
                 friction_angle_deg: 0.0,
+                cone_match: None,
                 drag_coefficient: None,
                 air_velocity: None,
                 upscaling_factor: None,

@@ -254,6 +254,13 @@ const SCENE_CASES: &[SceneCase] = &[
         )],
     },
     SceneCase {
+        name: "unknown_cone_match",
+        edits: &[(
+            "kind = \"pbf\"\nsubsteps = 2\niterations = 3\nxsph_c = 0.01",
+            "kind = \"granular\"\nsubsteps = 2\nfriction_angle_deg = 30.0\ncone_match = \"coulomb\"",
+        )],
+    },
+    SceneCase {
         name: "iisph_unknown_field",
         edits: &[(
             "kind = \"pbf\"\nsubsteps = 2\niterations = 3\nxsph_c = 0.01",

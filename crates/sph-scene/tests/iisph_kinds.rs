@@ -184,3 +184,42 @@ fn quick_iterations_below_the_minimum_refused() {
         Scene::parse_str(&text, &fixture_dir("iisph_quick").join("iisph_quick.toml")).unwrap_err();
     assert_names(&e, "iisph_quick", "quick.iterations", "min_iterations = 2");
 }
+
+/// `cone_match` reads in kebab case, defaults to the thesis's plane-strain match, reaches
+/// the solver's parameters, and a wrong name is refused at the field.
+#[test]
+fn granular_cone_match() {
+    use iisph_granular::ConeMatch;
+    use sph_scene::SolverParams;
+    let granular = |extra: &str| {
+        with_solver(
+            "granular_cone",
+            &format!("kind = \"granular\"\nsubsteps = 4\nfriction_angle_deg = 30.0{extra}"),
+        )
+    };
+    let alpha = |s: &Scene| {
+        let SolverParams::Iisph(p) = s.solver_params::<f64>().unwrap() else {
+            panic!("not IISPH")
+        };
+        p.granular.unwrap().alpha()
+    };
+    let s = granular("").unwrap();
+    let SolverSpec::Granular(p) = &s.solver else {
+        panic!("{:?}", s.solver)
+    };
+    assert_eq!(p.cone_match, None);
+    assert!((alpha(&s) - ConeMatch::PlaneStrain.alpha(30.0)).abs() < 1e-12);
+    let s = granular("\ncone_match = \"simple-shear\"").unwrap();
+    let SolverSpec::Granular(p) = &s.solver else {
+        panic!("{:?}", s.solver)
+    };
+    assert_eq!(p.cone_match, Some(ConeMatch::SimpleShear));
+    assert!((alpha(&s) - ConeMatch::SimpleShear.alpha(30.0)).abs() < 1e-12);
+    let e = granular("\ncone_match = \"simple_shear\"")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("solver.cone_match") && e.contains("simple-shear") && e.contains("line"),
+        "{e}"
+    );
+}
