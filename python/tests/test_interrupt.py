@@ -2,6 +2,7 @@
 or windows with KeyboardInterrupt, keeping the work done."""
 
 import _thread
+import signal
 import threading
 
 import numpy as np
@@ -9,6 +10,16 @@ import pytest
 
 import partisim
 from conftest import REPO
+
+
+@pytest.fixture(autouse=True)
+def python_handles_sigint():
+    """Python's own SIGINT handler for the test: a process started with SIGINT ignored (a
+    background job of a non-interactive shell, as some CI runners start their jobs) has none,
+    and `_thread.interrupt_main` then does nothing."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
 
 
 def interrupt_after(seconds: float) -> threading.Timer:
