@@ -37,6 +37,12 @@ pub struct FrameRow {
     pub last_solve_error: f64,
     /// Wall-clock time of the frame's phases (s).
     pub wall_s: f64,
+    /// Friction-stress iterations over the frame's substeps (granular; 0 for water).
+    pub friction_iterations: usize,
+    /// Substeps whose friction solve hit its cap (granular).
+    pub unconverged_friction_substeps: usize,
+    /// Residual of the frame's last friction solve (mean unyielded strain per step).
+    pub last_friction_residual: f64,
     /// Largest particle speed at the end of the frame (m/s): of the particles in the
     /// [`RestCriterion`]'s region if there is one.
     pub max_speed_m_s: f64,
@@ -126,6 +132,9 @@ fn run_in<R: Real>(
                 unconverged_substeps: s.unconverged_substeps,
                 max_density_ratio: s.max_density_ratio,
                 last_solve_error: s.last_solve_error,
+                friction_iterations: s.friction_iterations,
+                unconverged_friction_substeps: s.unconverged_friction_substeps,
+                last_friction_residual: s.last_friction_residual,
                 wall_s: s.total_s(),
                 max_speed_m_s: max_speed(
                     &sim.state.positions,

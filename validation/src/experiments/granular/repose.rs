@@ -362,6 +362,19 @@ fn check_run(out: &mut Outcome, case: &Case) -> Result<Option<Base>> {
     let end_speed = case.run.frames.last().map_or(f64::NAN, |f| f.max_speed_m_s);
     let end_t = case.run.frames.last().map_or(f64::NAN, |f| f.t_s);
     out.metric(format!("{tag}/end_time_s"), end_t);
+    let (capped, substeps, residual) = last_second_friction(&case.run.frames, end_t);
+    out.metric(
+        format!("{tag}/last_second/friction_capped_substep_fraction"),
+        capped,
+    );
+    out.metric(
+        format!("{tag}/last_second/friction_iterations_per_substep"),
+        substeps,
+    );
+    out.metric(
+        format!("{tag}/last_second/mean_friction_residual"),
+        residual,
+    );
     out.metric(format!("{tag}/max_speed_at_end_m_s"), end_speed);
     let rest = rest_criterion(&case.scene, case.theta_deg);
     out.check(Check::less_than(
@@ -374,6 +387,22 @@ fn check_run(out: &mut Outcome, case: &Case) -> Result<Option<Base>> {
         ),
     ));
     Ok(Some(base_of(&case.scene)?))
+}
+
+/// Over the run's last second: the fraction of substeps whose friction solve hit its cap,
+/// the friction iterations per substep, and the mean residual of the frames' last friction
+/// solves (whether the creep of a heap is the solver's, not the model's).
+fn last_second_friction(frames: &[super::FrameRow], end_t: f64) -> (f64, f64, f64) {
+    let last: Vec<_> = frames.iter().filter(|f| f.t_s > end_t - 1.0).collect();
+    let substeps = last.iter().map(|f| f.substeps).sum::<usize>().max(1) as f64;
+    let capped = last
+        .iter()
+        .map(|f| f.unconverged_friction_substeps)
+        .sum::<usize>() as f64;
+    let iterations = last.iter().map(|f| f.friction_iterations).sum::<usize>() as f64;
+    let residual =
+        last.iter().map(|f| f.last_friction_residual).sum::<f64>() / last.len().max(1) as f64;
+    (capped / substeps, iterations / substeps, residual)
 }
 
 /// The particles above the base, between its edges.
