@@ -15,6 +15,8 @@ pub(crate) struct Scratch<R: Real> {
     pub density: Vec<R>,
     /// `∇Ψ(x_i)` of a volume boundary.
     pub bgrad: Vec<Vec3<R>>,
+    /// The drag's occlusion `max_j o_ij` (eq. 6; 0 without drag).
+    pub occlusion: Vec<R>,
     /// `v_i^adv` (eq. 18).
     pub v_adv: Vec<Vec3<R>>,
     /// Source term `ρ0 − ρ_i^adv` (eq. 19) of the linear system.
@@ -52,6 +54,7 @@ impl<R: Real> Scratch<R> {
         let z = Vec3::zeros();
         self.density.resize(n, R::zero());
         self.bgrad.resize(n, z);
+        self.occlusion.resize(n, R::zero());
         self.v_adv.resize(n, z);
         self.source.resize(n, R::zero());
         self.aii.resize(n, R::zero());

@@ -288,7 +288,7 @@ impl<R: Real> IisphScheme<R> {
             &state.masses[..],
         );
         let s = &mut self.scratch;
-        density_pass(&self.c, x, m, nb, volume, s);
+        density_pass(&self.c, x, v, m, nb, volume, s);
         advection_pass(&self.c, self.params.common.gravity, x, v, m, nb, s);
         predicted_density_pass(&self.c, x, m, nb, s);
         Ok(())
@@ -399,7 +399,7 @@ impl<R: Real> IisphScheme<R> {
         // Algorithm 1, lines 2–5: density, drag, advection (with the friction of the kept
         // stress), predicted density, a_ii.
         let t = Instant::now();
-        density_pass(&c, x, m, nb, volume, s);
+        density_pass(&c, x, v, m, nb, volume, s);
         advection_pass(&c, g, x, v, m, nb, s);
         if c.granular {
             friction::predict(&c, x, m, nb, s);
