@@ -66,15 +66,15 @@ fn friction_accel<R: Real>(
 }
 
 /// The strain rate `ε_i` (eqs. 7–8) of the velocity field `v`: `∇u_i = Σ_j V_j (u_j − u_i)
-/// ⊗ ∇W_ij − u_i ⊗ ∇Ψ_i` (`V_j = m_j/ρ_j`; the static walls' share `Σ_b V_b (0 − u_i) ⊗
-/// ∇W_ib` makes them no-slip, as the friction force of eq. 31 treats them).
+/// ⊗ ∇W_ij − u_i ⊗ ∇Ψ_i` (`V_j = m_j/ρ_j`, given in `vol`; the static walls' share
+/// `Σ_b V_b (0 − u_i) ⊗ ∇W_ib` makes them no-slip, as the friction force of eq. 31 treats
+/// them).
 #[inline]
 #[allow(clippy::too_many_arguments)]
 fn strain_rate_at<R: Real>(
     x: &[Vec3<R>],
     v: &[Vec3<R>],
-    m: &[R],
-    rho: &[R],
+    vol: &[R],
     offsets: &[usize],
     indices: &[u32],
     gs: &[R],
@@ -86,7 +86,7 @@ fn strain_rate_at<R: Real>(
     for k in offsets[i]..offsets[i + 1] {
         let j = indices[k] as usize;
         let gw = grad(&xi, &x[j], gs[k]);
-        let du = (v[j] - vi) * (m[j] / rho[j]);
+        let du = (v[j] - vi) * vol[j];
         for a in 0..3 {
             for b in 0..3 {
                 g[a][b] += du[a] * gw[b];
@@ -114,7 +114,7 @@ fn divide_by_rho2<R: Real>(stress: &[Sym3<R>], rho: &[R], out: &mut [Sym3<R>]) {
         });
 }
 
-/// `friction_accel = a^f(s)` of the current stress.
+/// `friction_accel = a^f(s)` of the current stress (`stress_over_rho2`).
 fn accelerations<R: Real>(
     c: &Consts<R>,
     x: &[Vec3<R>],
@@ -131,8 +131,40 @@ fn accelerations<R: Real>(
         .for_each(|(i, a)| *a = friction_accel(c, x, m, offsets, indices, gs, st, bgrad, i));
 }
 
-/// Step 1: `a^f` of the kept stress (at this step's positions and densities), added to the
-/// advection velocity `v^adv`. Expects the densities of the step.
+/// `friction_accel = a^f(s)` of the current stress and, in the same pass, the trial
+/// velocities `v_trial = v^base + Δt a^f(s)`.
+fn accelerations_and_velocities<R: Real>(
+    c: &Consts<R>,
+    x: &[Vec3<R>],
+    m: &[R],
+    nb: &NeighbourLists,
+    s: &mut Scratch<R>,
+) {
+    let (offsets, indices) = (nb.offsets(), nb.indices());
+    let (gs, st, bgrad, vb) = (
+        &s.grad_scale[..],
+        &s.stress_over_rho2[..],
+        &s.bgrad[..],
+        &s.v_base[..],
+    );
+    let dt = c.dt;
+    s.friction_accel
+        .par_iter_mut()
+        .zip(s.v_trial.par_iter_mut())
+        .enumerate()
+        .with_min_len(MIN_LEN)
+        .for_each(|(i, (a, vt))| {
+            *a = friction_accel(c, x, m, offsets, indices, gs, st, bgrad, i);
+            *vt = vb[i] + *a * dt;
+        });
+}
+
+/// Step 1: `a^f` of the kept stress, added to the advection velocity `v^adv`. Expects the
+/// densities of the step. `a^f` is the one the last step's solve ended with (carried with
+/// the stress, at the last step's positions and densities), unless `s.friction_accel_current`
+/// is false (a restored state without it), when it is computed afresh at this step's
+/// positions. The approximation moves only the friction the pressure solve sees: [`solve`]
+/// subtracts the same `a^f` again for `v^base` and recomputes the friction of its stress.
 pub(crate) fn predict<R: Real>(
     c: &Consts<R>,
     x: &[Vec3<R>],
@@ -140,8 +172,11 @@ pub(crate) fn predict<R: Real>(
     nb: &NeighbourLists,
     s: &mut Scratch<R>,
 ) {
-    divide_by_rho2(&s.stress, &s.density, &mut s.stress_over_rho2);
-    accelerations(c, x, m, nb, s);
+    if !s.friction_accel_current {
+        divide_by_rho2(&s.stress, &s.density, &mut s.stress_over_rho2);
+        accelerations(c, x, m, nb, s);
+        s.friction_accel_current = true;
+    }
     let dt = c.dt;
     s.v_adv
         .par_iter_mut()
@@ -165,24 +200,27 @@ pub(crate) fn solve<R: Real>(
     let (offsets, indices) = (nb.offsets(), nb.indices());
     let dt = c.dt;
     // v^base = v^adv + Δt (a^p − a^f_prev); the trial velocity of the kept stress is
-    // v^adv + Δt a^p.
+    // v^adv + Δt a^p; the volumes V_i = m_i/ρ_i of the strain rate.
     {
-        let (gs, pi, bgrad, va, af) = (
+        let (gs, pi, bgrad, va, af, rho) = (
             &s.grad_scale[..],
             &s.p_over_rho2[..],
             &s.bgrad[..],
             &s.v_adv[..],
             &s.friction_accel[..],
+            &s.density[..],
         );
         s.v_base
             .par_iter_mut()
             .zip(s.v_trial.par_iter_mut())
+            .zip(s.volume.par_iter_mut())
             .enumerate()
             .with_min_len(MIN_LEN)
-            .for_each(|(i, (vb, vt))| {
+            .for_each(|(i, ((vb, vt), vol))| {
                 let ap = pressure_accel(c, x, m, offsets, indices, gs, pi, bgrad, i);
                 *vt = va[i] + ap * dt;
                 *vb = *vt - af[i] * dt;
+                *vol = m[i] / rho[i];
             });
     }
     let mut outcome = FrictionOutcome {
@@ -197,16 +235,17 @@ pub(crate) fn solve<R: Real>(
     for k in 0..max_iterations {
         // The strain rate of the trial velocities and the stress update.
         {
-            let (gs, bgrad, rho, pr, vt) = (
+            let (gs, bgrad, rho, pr, vt, vol) = (
                 &s.grad_scale[..],
                 &s.bgrad[..],
                 &s.density[..],
                 &s.pressure[..],
                 &s.v_trial[..],
+                &s.volume[..],
             );
             let update = |i: usize, st: &mut Sym3<R>, so: &mut Sym3<R>| -> f64 {
                 let eps = deviatoric(&strain_rate_at(
-                    x, vt, m, rho, offsets, indices, gs, bgrad, i,
+                    x, vt, vol, offsets, indices, gs, bgrad, i,
                 ));
                 let trial: Sym3<R> = std::array::from_fn(|e| st[e] - eps[e] * inv_d);
                 let bound = c.alpha * pr[i];
@@ -231,13 +270,7 @@ pub(crate) fn solve<R: Real>(
         }
         outcome.iterations = k + 1;
         // a^f of the new stress and the velocities it gives.
-        accelerations(c, x, m, nb, s);
-        s.v_trial
-            .par_iter_mut()
-            .zip(s.v_base.par_iter())
-            .zip(s.friction_accel.par_iter())
-            .with_min_len(MIN_LEN)
-            .for_each(|((vt, vb), a)| *vt = vb + a * dt);
+        accelerations_and_velocities(c, x, m, nb, s);
         if outcome.residual <= tolerance {
             return outcome;
         }

@@ -34,13 +34,19 @@ pub(crate) struct Scratch<R: Real> {
     pub stress: Vec<Sym3<R>>,
     /// `s_i / ρ_i²`.
     pub stress_over_rho2: Vec<Sym3<R>>,
-    /// Friction acceleration `F^f_i / m_i` of the current stress.
+    /// Friction acceleration `F^f_i / m_i` of the current stress; kept between steps (the
+    /// next step's predicted friction, see `friction::predict`).
     pub friction_accel: Vec<Vec3<R>>,
+    /// Whether `friction_accel` is that of `stress` (false after a restore without it).
+    pub friction_accel_current: bool,
+    /// `V_i = m_i / ρ_i` of the step (granular).
+    pub volume: Vec<R>,
     /// Velocity at the step's end without friction, `v^adv + Δt (a^p − a^f_prev)`.
     pub v_base: Vec<Vec3<R>>,
     /// Velocity at the step's end with the current stress iterate.
     pub v_trial: Vec<Vec3<R>>,
     pub perm_sym: Vec<Sym3<R>>,
+    pub perm_vec: Vec<Vec3<R>>,
     pub x_new: Vec<Vec3<R>>,
     pub v_new: Vec<Vec3<R>>,
     pub density_new: Vec<R>,
@@ -65,6 +71,7 @@ impl<R: Real> Scratch<R> {
         self.stress.resize(ng, [R::zero(); 6]);
         self.stress_over_rho2.resize(ng, [R::zero(); 6]);
         self.friction_accel.resize(ng, z);
+        self.volume.resize(ng, R::zero());
         self.v_base.resize(ng, z);
         self.v_trial.resize(ng, z);
         self.x_new.resize(n, z);
