@@ -231,7 +231,7 @@ pub(crate) fn solve<R: Real>(
     if n == 0 {
         return outcome;
     }
-    let inv_d = c.inv_friction_d;
+    let inv_d = c.stress_step;
     for k in 0..max_iterations {
         // The strain rate of the trial velocities and the stress update.
         {
@@ -277,4 +277,81 @@ pub(crate) fn solve<R: Real>(
     }
     outcome.converged = false;
     outcome
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::params::DEFAULT_FRICTION_RELAXATION;
+    use sph_core::Vec3;
+    use sph_kernels::{CubicSpline, Kernel};
+
+    /// The lattice offsets `r` within the support and their `∇W(r)` (cubic spline,
+    /// `h = 2 s`, `s = 1`).
+    fn lattice() -> Vec<(Vec3<f64>, Vec3<f64>)> {
+        let k = CubicSpline::new(2.0).unwrap();
+        let mut out = Vec::new();
+        for a in -2i32..=2 {
+            for b in -2i32..=2 {
+                for c in -2i32..=2 {
+                    let r = Vec3::new(a as f64, b as f64, c as f64);
+                    let g = k.gradient(&r);
+                    if g.norm() > 0.0 {
+                        out.push((r, g));
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// `|g(k)|²` with `g(k) = Σ_r sin(k·r) ∇W(r)`.
+    fn g2(l: &[(Vec3<f64>, Vec3<f64>)], k: Vec3<f64>) -> f64 {
+        let g: Vec3<f64> = l.iter().map(|(r, gw)| gw * k.dot(r).sin()).sum();
+        g.norm_squared()
+    }
+
+    /// The stability bound of `DEFAULT_FRICTION_RELAXATION`. On a full lattice with uniform
+    /// density the map from a stress wave `S e^{ik·x}` to the strain rate it causes is
+    /// `c sym(S g gᵀ)` (`c = V Δt m/ρ0²`): eigenvalues `(2/3) c |g|²` (the deviatoric mode
+    /// along `g`), `c |g|²/2` (two shear modes), 0 (two). The diagonal is `c Σ_r |∇W(r)|²/3`;
+    /// the mean of the five eigenvalues over the Brillouin zone must equal it (Parseval: a
+    /// check of the symbol), and `2/λ_max` of the symbol relative to the diagonal bounds a
+    /// stable Jacobi relaxation. The default must lie inside the bound and within 2 % of it
+    /// (the optimal Jacobi `ω = 2/(λ_min + λ_max)` with `λ_min → 0` for smooth modes).
+    #[test]
+    fn friction_symbol_bound() {
+        let l = lattice();
+        let diag: f64 = l.iter().map(|(_, g)| g.norm_squared()).sum::<f64>() / 3.0;
+        // Parseval on an 8³ grid of the zone (exact for offsets of at most 2 spacings).
+        let n = 8;
+        let mut mean = 0.0;
+        for a in 0..n {
+            for b in 0..n {
+                for c in 0..n {
+                    let step = 2.0 * std::f64::consts::PI / n as f64;
+                    let k = Vec3::new(a as f64, b as f64, c as f64) * step;
+                    mean += (2.0 / 3.0 + 0.5 + 0.5) * g2(&l, k) / 5.0;
+                }
+            }
+        }
+        mean /= (n * n * n) as f64;
+        assert!((mean / diag - 1.0).abs() < 1e-12, "{mean} vs {diag}");
+        // The maximum over a fine grid of the zone (the symbol is even in each axis).
+        let m = 60;
+        let mut max = 0.0f64;
+        for a in 0..=m {
+            for b in 0..=a {
+                for c in 0..=b {
+                    let k = Vec3::new(a as f64, b as f64, c as f64) * (std::f64::consts::PI / m as f64);
+                    max = max.max(2.0 / 3.0 * g2(&l, k) / diag);
+                }
+            }
+        }
+        let bound = 2.0 / max;
+        assert!((max - 5.64).abs() < 0.01, "lambda_max {max}");
+        assert!(
+            DEFAULT_FRICTION_RELAXATION < bound && DEFAULT_FRICTION_RELAXATION > 0.98 * bound,
+            "{DEFAULT_FRICTION_RELAXATION} against the bound {bound}"
+        );
+    }
 }
