@@ -40,29 +40,29 @@ pub(crate) struct FrictionOutcome {
 }
 
 /// The friction acceleration `F^f_i/m_i = −Σ_j m_j (s_i/ρ_i² + s_j/ρ_j²) ∇W_ij − ρ0
-/// (s_i/ρ_i²) ∇Ψ_i` (Neder 2024 eqs. 26 and 31) from `s/ρ²`.
+/// (s_i/ρ_i²) ∇Ψ_i` (Neder 2024 eqs. 26 and 31), evaluated as `−(s_i/ρ_i²) G_i − Σ_j
+/// (m_j s_j/ρ_j²) ∇W_ij` from `q_j = m_j s_j/ρ_j²` and the step's `G_i = Σ_j m_j ∇W_ij +
+/// ρ0 ∇Ψ_i` (the density pass's `grad_sum`): one symmetric product per pair.
 #[inline]
 #[allow(clippy::too_many_arguments)]
 fn friction_accel<R: Real>(
-    c: &Consts<R>,
     x: &[Vec3<R>],
     m: &[R],
     offsets: &[usize],
     indices: &[u32],
     gs: &[R],
-    st: &[Sym3<R>],
-    bgrad: &[Vec3<R>],
+    q: &[Sym3<R>],
+    grad_sum: &[Vec3<R>],
     i: usize,
 ) -> Vec3<R> {
-    let (xi, si) = (x[i], st[i]);
+    let xi = x[i];
     let mut f = Vec3::zeros();
     for k in offsets[i]..offsets[i + 1] {
         let j = indices[k] as usize;
-        let sj = st[j];
-        let sum: Sym3<R> = std::array::from_fn(|e| si[e] + sj[e]);
-        f -= sym_mul(&sum, &grad(&xi, &x[j], gs[k])) * m[j];
+        f += sym_mul(&q[j], &grad(&xi, &x[j], gs[k]));
     }
-    f - sym_mul(&si, &bgrad[i]) * c.rho0
+    let inv_mi = R::one() / m[i];
+    -(f + sym_mul(&q[i], &grad_sum[i]) * inv_mi)
 }
 
 /// The strain rate `ε_i` (eqs. 7–8) of the velocity field `v`: `∇u_i = Σ_j V_j (u_j − u_i)
@@ -102,33 +102,31 @@ fn strain_rate_at<R: Real>(
     strain_rate(&g)
 }
 
-/// `out_i = s_i / ρ_i²` for the densities of the step.
-fn divide_by_rho2<R: Real>(stress: &[Sym3<R>], rho: &[R], out: &mut [Sym3<R>]) {
+/// `out_i = m_i s_i / ρ_i²` for the densities of the step.
+fn weight_stress<R: Real>(stress: &[Sym3<R>], m: &[R], rho: &[R], out: &mut [Sym3<R>]) {
     out.par_iter_mut()
         .zip(stress.par_iter())
-        .zip(rho.par_iter())
+        .zip(m.par_iter().zip(rho.par_iter()))
         .with_min_len(MIN_LEN)
-        .for_each(|((o, s), &r)| {
-            let inv = R::one() / (r * r);
-            *o = s.map(|e| e * inv);
+        .for_each(|((o, s), (&mi, &r))| {
+            let w = mi / (r * r);
+            *o = s.map(|e| e * w);
         });
 }
 
-/// `friction_accel = a^f(s)` of the current stress (`stress_over_rho2`).
-fn accelerations<R: Real>(
-    c: &Consts<R>,
-    x: &[Vec3<R>],
-    m: &[R],
-    nb: &NeighbourLists,
-    s: &mut Scratch<R>,
-) {
+/// `friction_accel = a^f(s)` of the current stress (`mass_stress_over_rho2`).
+fn accelerations<R: Real>(x: &[Vec3<R>], m: &[R], nb: &NeighbourLists, s: &mut Scratch<R>) {
     let (offsets, indices) = (nb.offsets(), nb.indices());
-    let (gs, st, bgrad) = (&s.grad_scale[..], &s.stress_over_rho2[..], &s.bgrad[..]);
+    let (gs, q, gsum) = (
+        &s.grad_scale[..],
+        &s.mass_stress_over_rho2[..],
+        &s.grad_sum[..],
+    );
     s.friction_accel
         .par_iter_mut()
         .enumerate()
         .with_min_len(MIN_LEN)
-        .for_each(|(i, a)| *a = friction_accel(c, x, m, offsets, indices, gs, st, bgrad, i));
+        .for_each(|(i, a)| *a = friction_accel(x, m, offsets, indices, gs, q, gsum, i));
 }
 
 /// `friction_accel = a^f(s)` of the current stress and, in the same pass, the trial
@@ -141,10 +139,10 @@ fn accelerations_and_velocities<R: Real>(
     s: &mut Scratch<R>,
 ) {
     let (offsets, indices) = (nb.offsets(), nb.indices());
-    let (gs, st, bgrad, vb) = (
+    let (gs, q, gsum, vb) = (
         &s.grad_scale[..],
-        &s.stress_over_rho2[..],
-        &s.bgrad[..],
+        &s.mass_stress_over_rho2[..],
+        &s.grad_sum[..],
         &s.v_base[..],
     );
     let dt = c.dt;
@@ -154,7 +152,7 @@ fn accelerations_and_velocities<R: Real>(
         .enumerate()
         .with_min_len(MIN_LEN)
         .for_each(|(i, (a, vt))| {
-            *a = friction_accel(c, x, m, offsets, indices, gs, st, bgrad, i);
+            *a = friction_accel(x, m, offsets, indices, gs, q, gsum, i);
             *vt = vb[i] + *a * dt;
         });
 }
@@ -173,8 +171,8 @@ pub(crate) fn predict<R: Real>(
     s: &mut Scratch<R>,
 ) {
     if !s.friction_accel_current {
-        divide_by_rho2(&s.stress, &s.density, &mut s.stress_over_rho2);
-        accelerations(c, x, m, nb, s);
+        weight_stress(&s.stress, m, &s.density, &mut s.mass_stress_over_rho2);
+        accelerations(x, m, nb, s);
         s.friction_accel_current = true;
     }
     let dt = c.dt;
@@ -250,8 +248,8 @@ pub(crate) fn solve<R: Real>(
                 let trial: Sym3<R> = std::array::from_fn(|e| st[e] - eps[e] * inv_d);
                 let bound = c.alpha * pr[i];
                 *st = yield_clamp(&trial, c.alpha, pr[i]);
-                let inv = R::one() / (rho[i] * rho[i]);
-                *so = st.map(|e| e * inv);
+                let w = m[i] / (rho[i] * rho[i]);
+                *so = st.map(|e| e * w);
                 // Strain counts as residual where the material should be rigid: inside the
                 // yield surface (a yielding particle flows).
                 if bound > R::zero() && frobenius(&trial) <= bound {
@@ -262,7 +260,7 @@ pub(crate) fn solve<R: Real>(
             };
             let total = par_update_sum(
                 &mut s.stress,
-                &mut s.stress_over_rho2,
+                &mut s.mass_stress_over_rho2,
                 &mut s.error_partials,
                 update,
             );

@@ -22,7 +22,8 @@ pub(crate) fn grad<R: Real>(xi: &Vec3<R>, xj: &Vec3<R>, f: R) -> Vec3<R> {
 }
 
 /// Eq. 3 + eq. 29: `ρ_i`, `∇Ψ_i`, `W'(r)/r` of every pair, and the diagonal `a_ii` of
-/// eq. 24 (it needs only `x`, `m` and the particle's own density):
+/// eq. 24 (it needs only `x`, `m` and the particle's own density) with its gradient sum
+/// `G_i = Σ_j m_j ∇W_ij + ρ0 ∇Ψ_i` (kept for the friction acceleration):
 /// `a_ii = Σ_j m_j (d_ii − d_ji)·∇W_ij + ρ0 d_ii·∇Ψ_i
 ///       = −Δt²/ρ_i² (|Σ_j m_j ∇W_ij + ρ0 ∇Ψ_i|² + m_i Σ_j m_j |∇W_ij|²)`.
 /// With drag, the same loop also takes the occlusion `max_j o_ij` of eq. 6 (it needs the
@@ -42,7 +43,7 @@ pub(crate) fn density_pass<R: Real>(
     s.grad_scale.resize(indices.len(), R::zero());
     let dt2 = c.dt * c.dt;
     let outputs = (
-        (&mut s.density[..], &mut s.bgrad[..]),
+        (&mut s.density[..], &mut s.bgrad[..], &mut s.grad_sum[..]),
         (&mut s.aii[..], &mut s.occlusion[..]),
     );
     par_csr_blocks(
@@ -50,17 +51,17 @@ pub(crate) fn density_pass<R: Real>(
         outputs,
         &mut s.grad_scale[..],
         &|first,
-          ((rho_b, bg_b), (aii_b, occ_b)): (
-            (&mut [R], &mut [Vec3<R>]),
+          ((rho_b, bg_b, gsum_b), (aii_b, occ_b)): (
+            (&mut [R], &mut [Vec3<R>], &mut [Vec3<R>]),
             (&mut [R], &mut [R]),
         ),
           gs: &mut [R]| {
             let base = offsets[first];
             let block = rho_b
                 .iter_mut()
-                .zip(bg_b.iter_mut())
+                .zip(bg_b.iter_mut().zip(gsum_b.iter_mut()))
                 .zip(aii_b.iter_mut().zip(occ_b.iter_mut()));
-            for (l, ((rho, bg), (aii, occ_out))) in block.enumerate() {
+            for (l, ((rho, (bg, gsum)), (aii, occ_out))) in block.enumerate() {
                 let i = first + l;
                 let (xi, mi) = (x[i], m[i]);
                 let upstream = if c.drag { upstream(c, &v[i]) } else { Vec3::zeros() };
@@ -96,6 +97,7 @@ pub(crate) fn density_pass<R: Real>(
                 }
                 *rho = sum;
                 let gi = sum_grad + *bg * c.rho0;
+                *gsum = gi;
                 *aii = -dt2 / (sum * sum) * (gi.norm_squared() + mi * sum_grad_sq);
             }
             0.0

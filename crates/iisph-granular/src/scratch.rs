@@ -13,6 +13,8 @@ pub(crate) struct Scratch<R: Real> {
     pub grad_scale: Vec<R>,
     /// `ρ_i` at the step's start positions, boundary included (eq. 3 + eq. 29).
     pub density: Vec<R>,
+    /// `G_i = Σ_j m_j ∇W_ij + ρ0 ∇Ψ_i` (the diagonal's gradient sum, reused by the friction).
+    pub grad_sum: Vec<Vec3<R>>,
     /// `∇Ψ(x_i)` of a volume boundary.
     pub bgrad: Vec<Vec3<R>>,
     /// The drag's occlusion `max_j o_ij` (eq. 6; 0 without drag).
@@ -32,8 +34,8 @@ pub(crate) struct Scratch<R: Real> {
     /// Frictional stress `s_i` (Pa, deviatoric, inside the yield surface); kept between
     /// steps (the friction solve's warm start).
     pub stress: Vec<Sym3<R>>,
-    /// `s_i / ρ_i²`.
-    pub stress_over_rho2: Vec<Sym3<R>>,
+    /// `m_i s_i / ρ_i²`.
+    pub mass_stress_over_rho2: Vec<Sym3<R>>,
     /// Friction acceleration `F^f_i / m_i` of the current stress; kept between steps (the
     /// next step's predicted friction, see `friction::predict`).
     pub friction_accel: Vec<Vec3<R>>,
@@ -60,6 +62,7 @@ impl<R: Real> Scratch<R> {
         let z = Vec3::zeros();
         self.density.resize(n, R::zero());
         self.bgrad.resize(n, z);
+        self.grad_sum.resize(n, z);
         self.occlusion.resize(n, R::zero());
         self.v_adv.resize(n, z);
         self.source.resize(n, R::zero());
@@ -69,7 +72,7 @@ impl<R: Real> Scratch<R> {
         self.accel.resize(n, z);
         let ng = if granular { n } else { 0 };
         self.stress.resize(ng, [R::zero(); 6]);
-        self.stress_over_rho2.resize(ng, [R::zero(); 6]);
+        self.mass_stress_over_rho2.resize(ng, [R::zero(); 6]);
         self.friction_accel.resize(ng, z);
         self.volume.resize(ng, R::zero());
         self.v_base.resize(ng, z);
