@@ -6,17 +6,21 @@
 //! one time step to the next (permuted with the particles) and corrected each step until the
 //! velocity field it produces has no strain rate where the material is not yielding:
 //!
-//! 1. [`predict`]: `a^f_i` of the kept stress enters the advection velocity, so the pressure
-//!    solve sees the friction of the last step;
+//! 1. [`predict`]: `a^f_i` of the kept stress (the one the last step's solve ended with)
+//!    enters the advection velocity, so the pressure solve sees the friction of the last
+//!    step;
 //! 2. [`solve`], after the pressure solve: `v^base_i = v^adv_i + Δt (a^p_i − a^f_i)` is the
 //!    velocity without friction; then, per iteration, the strain rate `ε_i` of `v = v^base +
-//!    Δt a^f(s)` (eqs. 7–8, walls no-slip), the update `s_i ← Y_i(dev(s_i − D⁻¹ ε_i))`
-//!    (eqs. 10–14: `Y_i` the radial return to `‖s‖ ≤ α p_i`), and the new `a^f(s)` (eq. 26
+//!    Δt a^f(s)` (eqs. 7–8, walls no-slip), the update `s_i ← Y_i(dev(s_i − 2ω D⁻¹ ε_i))`
+//!    (eqs. 10–14: `Y_i` the radial return to `‖s‖ ≤ α p_i`, `ω` the relaxation), and the new `a^f(s)` (eq. 26
 //!    with eq. 31). It stops once the mean unyielded strain per step is below the tolerance.
 //!
 //! The factor 2 in the prototype `D` (eq. 9) makes `s ← s − D⁻¹ε` a Jacobi step relaxed by
-//! ½ on the exact self-coupling `Δε_i = (D/2) Δs_i` (see [`crate::granular`]), as IISPH
-//! relaxes its pressure Jacobi by `ω = ½`.
+//! ½ on the exact self-coupling `Δε_i = (D/2) Δs_i` (see [`crate::granular`]); the update
+//! here is relaxed by `ω` ([`crate::GranularParams::friction_relaxation`], default 0.35),
+//! the stability bound `ω < 2/λ_max = 0.355` of the prototype lattice's symbol (the crate
+//! docs derive it; the test below recomputes it): at ½ mid-wavelength modes grow until
+//! the yield cone clips them, and the residual stalls.
 
 use neighbour_search::NeighbourLists;
 use rayon::prelude::*;

@@ -21,6 +21,12 @@ pub(crate) fn grad<R: Real>(xi: &Vec3<R>, xj: &Vec3<R>, f: R) -> Vec3<R> {
     (xi - xj) * f
 }
 
+/// A block's outputs of [`density_pass`]: `(ρ, ∇Ψ, G)` and `(a_ii, occlusion)`.
+type DensityOutputs<'a, R> = (
+    (&'a mut [R], &'a mut [Vec3<R>], &'a mut [Vec3<R>]),
+    (&'a mut [R], &'a mut [R]),
+);
+
 /// Eq. 3 + eq. 29: `ρ_i`, `∇Ψ_i`, `W'(r)/r` of every pair, and the diagonal `a_ii` of
 /// eq. 24 (it needs only `x`, `m` and the particle's own density) with its gradient sum
 /// `G_i = Σ_j m_j ∇W_ij + ρ0 ∇Ψ_i` (kept for the friction acceleration):
@@ -51,10 +57,7 @@ pub(crate) fn density_pass<R: Real>(
         outputs,
         &mut s.grad_scale[..],
         &|first,
-          ((rho_b, bg_b, gsum_b), (aii_b, occ_b)): (
-            (&mut [R], &mut [Vec3<R>], &mut [Vec3<R>]),
-            (&mut [R], &mut [R]),
-        ),
+          ((rho_b, bg_b, gsum_b), (aii_b, occ_b)): DensityOutputs<'_, R>,
           gs: &mut [R]| {
             let base = offsets[first];
             let block = rho_b
