@@ -10,7 +10,7 @@ use sph_solver::csr::par_csr_blocks;
 use sph_solver::step::{par_update_sum, MIN_LEN};
 use sph_solver::Boundary;
 
-use crate::granular::{drag_force, occlusion};
+use crate::granular::{drag_force, occlusion_of_cosine};
 use crate::kernels::Consts;
 use crate::params::IisphParams;
 use crate::scratch::Scratch;
@@ -33,7 +33,8 @@ type DensityOutputs<'a, R> = (
 /// `a_ii = Σ_j m_j (d_ii − d_ji)·∇W_ij + ρ0 d_ii·∇Ψ_i
 ///       = −Δt²/ρ_i² (|Σ_j m_j ∇W_ij + ρ0 ∇Ψ_i|² + m_i Σ_j m_j |∇W_ij|²)`.
 /// With drag, the same loop also takes the occlusion `max_j o_ij` of eq. 6 (it needs the
-/// pair's offset and distance, which the density computes anyway) into `s.occlusion`.
+/// pair's offset and distance, which the density computes anyway) into `s.occlusion`, as
+/// the occlusion of the largest `cos φ` ([`occlusion_of_cosine`]: one division per pair).
 #[allow(clippy::needless_range_loop)] // k addresses the CSR pair arrays (indices, scales)
 pub(crate) fn density_pass<R: Real>(
     c: &Consts<R>,
@@ -68,7 +69,7 @@ pub(crate) fn density_pass<R: Real>(
                 let i = first + l;
                 let (xi, mi) = (x[i], m[i]);
                 let upstream = if c.drag { upstream(c, &v[i]) } else { Vec3::zeros() };
-                let mut occ = R::zero();
+                let mut max_cos = c.cos_cone;
                 let mut sum = mi * c.w0;
                 let mut sum_grad = Vec3::zeros();
                 let mut sum_grad_sq = R::zero();
@@ -86,11 +87,13 @@ pub(crate) fn density_pass<R: Real>(
                     let gw = d * f;
                     sum_grad += gw * m[j];
                     sum_grad_sq += m[j] * gw.norm_squared();
-                    if c.drag {
-                        occ = occ.max(occlusion(&upstream, &(x[j] - xi), c.cos_cone));
+                    if c.drag && r > R::zero() {
+                        // cos φ of x_j − x_i against the upstream direction (the distance
+                        // is the density's).
+                        max_cos = max_cos.max(upstream.dot(&(-d)) / r);
                     }
                 }
-                *occ_out = occ;
+                *occ_out = occlusion_of_cosine(max_cos, c.cos_cone);
                 if let Some(b) = volume {
                     let smp = b.sample(&xi);
                     sum += c.rho0 * smp.volume;
