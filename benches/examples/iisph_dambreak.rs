@@ -54,6 +54,9 @@ fn run<R: Real>(steps: usize, granular: bool) {
     let mut solver = Iisph::with_boundary(q, Box::new(b)).expect("params");
     let mut sum = StepStats::new(solver.phase_names());
     let mut last = StepStats::default();
+    // Friction iterations per step -> number of steps (granular).
+    let mut histogram = std::collections::BTreeMap::<usize, usize>::new();
+    let mut max_ratio = 0.0f64;
     let t = Instant::now();
     for _ in 0..steps {
         last = FluidSolver::step(&mut solver, &mut state).expect("step");
@@ -63,6 +66,8 @@ fn run<R: Real>(steps: usize, granular: bool) {
         sum.iterations += last.iterations;
         sum.unconverged_substeps += last.unconverged_substeps;
         sum.friction_iterations += last.friction_iterations;
+        *histogram.entry(last.friction_iterations).or_default() += 1;
+        max_ratio = max_ratio.max(last.max_density_ratio);
         sum.unconverged_friction_substeps += last.unconverged_friction_substeps;
     }
     let wall = t.elapsed().as_secs_f64();
@@ -87,6 +92,8 @@ fn run<R: Real>(steps: usize, granular: bool) {
             sum.unconverged_friction_substeps,
             last.last_friction_residual
         );
+        let bins: Vec<String> = histogram.iter().map(|(k, n)| format!("{k}:{n}")).collect();
+        println!("friction iterations per step (iterations:steps): {}", bins.join(" "));
     }
     let phases: Vec<String> = sum
         .phases
@@ -102,6 +109,16 @@ fn run<R: Real>(steps: usize, granular: bool) {
         "end: max rho/rho0 {:.5}, mean rho/rho0 {:.5}, last iteration's average compression {:.5}, neighbour pairs {}",
         last.max_density_ratio, last.mean_density_ratio, last.last_solve_error, last.neighbour_pairs
     );
+    println!("max rho/rho0 over all steps {max_ratio:.5}");
+    // FNV-1a of the end positions' bits: equal checksums mean bitwise equal runs.
+    let checksum = state
+        .positions
+        .iter()
+        .flat_map(|x| [x.x, x.y, x.z])
+        .fold(0xcbf2_9ce4_8422_2325u64, |h, c| {
+            (h ^ c.as_f64().to_bits()).wrapping_mul(0x0000_0100_0000_01b3)
+        });
+    println!("end positions checksum: {checksum:016x}");
 }
 
 fn main() {

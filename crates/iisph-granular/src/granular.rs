@@ -138,7 +138,14 @@ pub fn occlusion<R: Real>(upstream: &Vec3<R>, d: &Vec3<R>, cos_cone: R) -> R {
     if !len.is_finite_value() || len <= R::zero() {
         return R::zero();
     }
-    let cos_phi = upstream.dot(d) / len;
+    occlusion_of_cosine(upstream.dot(d) / len, cos_cone)
+}
+
+/// [`occlusion`] from `cos φ`: 0 for `cos φ ≤ cos_cone`, else `min(1, (cos φ − cos_cone) /
+/// (1 − cos_cone))`. Non-decreasing in `cos φ` (also in floating point), so the largest
+/// occlusion over the neighbours is that of the largest cosine.
+#[inline]
+pub fn occlusion_of_cosine<R: Real>(cos_phi: R, cos_cone: R) -> R {
     if cos_phi <= cos_cone {
         R::zero()
     } else {

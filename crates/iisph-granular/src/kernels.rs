@@ -21,8 +21,9 @@ pub(crate) struct Consts<R: Real> {
     pub rho0: R,
     pub dt: R,
     pub h: R,
-    /// `(1/d)` of the prototype friction coefficient (granular only, else 0).
-    pub inv_friction_d: R,
+    /// `2ω/d`: the step of the stress update `s ← s − (2ω/d) ε` for the prototype friction
+    /// coefficient `d` and the relaxation `ω` (granular only, else 0).
+    pub stress_step: R,
     /// Drucker–Prager `α = √2 sin θ` (0 for water).
     pub alpha: R,
     /// Coulomb coefficient `tan θ` of the contact response (0 for water).
@@ -46,8 +47,8 @@ impl<R: Real> Consts<R> {
         let dt = p.substep_dt();
         let rho0 = p.common.rest_density;
         let g = p.granular.as_ref();
-        let inv_friction_d = match g {
-            Some(_) => {
+        let stress_step = match g {
+            Some(g) => {
                 let d =
                     prototype_friction_coefficient(&kernel, p.common.particle_spacing, rho0, dt)
                         .ok_or(SolverError::InvalidParameter {
@@ -56,7 +57,7 @@ impl<R: Real> Consts<R> {
                             value: h.as_f64(),
                             reason: "no finite prototype friction coefficient D (eq. 9)",
                         })?;
-                R::one() / d
+                R::of_f64(2.0) * g.friction_relaxation / d
             }
             None => R::zero(),
         };
@@ -67,7 +68,7 @@ impl<R: Real> Consts<R> {
             rho0,
             dt,
             h,
-            inv_friction_d,
+            stress_step,
             alpha: g.map_or(R::zero(), |g| g.alpha()),
             wall_friction: g.map_or(R::zero(), |g| {
                 R::of_f64(g.friction_angle_deg.as_f64().to_radians().tan())

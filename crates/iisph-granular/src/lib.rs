@@ -59,9 +59,13 @@
 //!    axis, `φ` being the angle between `x_j − x_i` and the upstream direction `−v_rel`
 //!    ([`granular::occlusion`]).
 //! 3. **Stress, predicted** (granular): the stress `s_i` is kept from the last step (see
-//!    7.); its friction acceleration `a^f_i = −Σ_j m_j (s_i/ρ_i² + s_j/ρ_j²) ∇W_ij −
-//!    ρ0 (s_i/ρ_i²) ∇Ψ_i` (eqs. 26, 31) at this step's positions and densities enters the
-//!    advection, so the pressure solve sees the friction that holds the material.
+//!    7.) with the friction acceleration `a^f_i = −Σ_j m_j (s_i/ρ_i² + s_j/ρ_j²) ∇W_ij −
+//!    ρ0 (s_i/ρ_i²) ∇Ψ_i` (eqs. 26, 31) its solve ended with (at the last step's positions
+//!    and densities; permuted with the particles and saved with the state); that `a^f`
+//!    enters the advection, so the pressure solve sees the friction that holds the
+//!    material. Recomputing it at this step's positions would cost a neighbour pass; step 7
+//!    subtracts the same `a^f` for `v^base` and recomputes the friction of the stress, so
+//!    the approximation moves only the friction the pressure solve predicts.
 //! 4. **Advection** (eqs. 17–18): `v^adv_i = v_i + Δt (g + a^visc_i + F^drag_i/m_i +
 //!    a^f_i)`.
 //! 5. **Predicted density** (eq. 19 with the boundary term): `ρ^adv_i = ρ_i + Δt Σ_j m_j
@@ -86,8 +90,10 @@
 //!    pressure solve: `v^base_i = v^adv_i + Δt (a^p_i − a^f_i)` is the velocity without
 //!    friction; each iteration takes the strain rate of `v = v^base + Δt a^f(s)`,
 //!    `∇u_i = Σ_j V_j (u_j − u_i) ⊗ ∇W_ij − u_i ⊗ ∇Ψ_i` (`V_j = m_j/ρ_j`, walls no-slip),
-//!    `ε_i = (∇u_i + ∇u_iᵀ)/2`, corrects the stress `s_i ← Y_i(dev(s_i − D⁻¹ ε_i))` with the
-//!    prototype `D = d I` of eq. 9, the deviatoric part `dev s = s − (Tr s/3) I` and the
+//!    `ε_i = (∇u_i + ∇u_iᵀ)/2`, corrects the stress `s_i ← Y_i(dev(s_i − 2ω D⁻¹ ε_i))` with the
+//!    prototype `D = d I` of eq. 9 and the relaxation `ω = 0.35`
+//!    ([`GranularParams::friction_relaxation`]; the thesis's update is `ω = ½`, see the
+//!    deviations), the deviatoric part `dev s = s − (Tr s/3) I` and the
 //!    Drucker–Prager radial return `Y_i(s) = s · min(1, α p_i / ‖s‖)`, `α = √2 sin θ`
 //!    (eqs. 13–14, with this step's pressure; `√2 tan θ` with [`ConeMatch::SimpleShear`],
 //!    see below), and recomputes `a^f(s)`. It stops once the
@@ -182,18 +188,39 @@
 //!   stress is a state of the particle (kept between steps, permuted with them), its
 //!   friction enters the pressure solve's advection, and after the pressure solve it is
 //!   corrected by relaxed Jacobi iterations of the thesis' own update `s ← s − D⁻¹ε`, with
-//!   the yield criterion applied in every iteration (step 7 above). With it the same column
-//!   stops (front 2.03 `L0` at 0.8 s, 2.05 at 1.2 s, `tests/solver.rs`) and the heaps
+//!   the yield criterion applied in every iteration (step 7 above), relaxed (next item).
+//!   With it the same column stops (front 2.03 `L0` at 0.8 s, 2.05 at 1.2 s, `tests/solver.rs`) and the heaps
 //!   stand at 15.3°, 22.5° and 27.6° (15.0°, 24.0° and 31.1° when the scenes also start
-//!   uncompressed at the walls, `initial_masses = "calibrated"`). The factor 2 of eq. 9
-//!   makes the update a Jacobi step relaxed by ½ on the exact self-coupling; a step of 2×
-//!   that (unrelaxed) diverged in the first frames of a repose scene.
+//!   uncompressed at the walls, `initial_masses = "calibrated"`; these figures are of the
+//!   thesis's relaxation ½).
 //!   Solving the friction before the pressure instead (with the last step's pressure in
 //!   the yield bound and in the predicted velocity, nearer Algorithm 1's line order, and
 //!   then incompressible as a water step) cut the 100k pile's pressure iterations from 15
 //!   to 9.4 per step and its step time by 10 %, but let the `a = 4` column run into the
 //!   far wall (runout 8.1 `L0` against 6.75) and lowered the 40° heap to 25.7° (quick
 //!   experiments, 2026-11-23); we keep the order after the pressure solve.
+//! - **Relaxation of the stress update** ([`GranularParams::friction_relaxation`], `ω =
+//!   0.35`, [`DEFAULT_FRICTION_RELAXATION`]). A stress `s_i` changes its own strain rate by
+//!   `(D/2) s_i` (see the sign above), so the thesis's `s ← s − D⁻¹ε` is a Jacobi step
+//!   relaxed by ½ on that self-coupling, and `s ← s − 2ω D⁻¹ε` relaxes it by `ω`. A relaxed
+//!   Jacobi iteration converges only if `ω λ < 2` for every eigenvalue `λ` of the operator
+//!   (strain rate from stress) relative to its diagonal. On the prototype lattice (a full
+//!   simple cubic lattice, uniform density, so `Σ_j ∇W_ij = 0`) the operator is a
+//!   convolution: a stress wave `S e^{ik·x}` causes the strain rate `c sym(S g gᵀ)` with `c
+//!   = V Δt m/ρ0²` and `g(k) = Σ_r sin(k·r) ∇W(r)` (`r` the lattice offsets), whose
+//!   eigenvalues on deviatoric `S` are `(2/3) c |g|²` (the mode along `g`), `c |g|²/2`
+//!   (twice) and 0 (twice); the diagonal is `c Σ_r |∇W(r)|²/3`, the symbol's mean (Parseval).
+//!   For the cubic spline at `h = 2 s` the largest ratio is `λ_max = 5.64`, at `k ≈ 0.33 π/s
+//!   (1, 1, 1)` (the checkerboard `k = π/s` is in the wide stencil's null space), so the
+//!   update is stable for `ω < 2/5.64 = 0.355`; 0.35 is just inside, near the optimum
+//!   `2/(λ_min + λ_max)` for smooth modes (`λ_min → 0`). At the thesis's ½ (`ω λ_max = 2.8`)
+//!   those modes grow by 1.8 per iteration until the yield cone clips them: that is the
+//!   residual that stalled at 2–3·10⁻⁴ per step with the solve at its cap, and the clipped
+//!   stress pattern raises the density (dam break, 100 steps: max `ρ/ρ0` 1.144 at ½, 1.034
+//!   at 0.35, 1.029 at 0.25); a larger `ω` (0.75, 1.0) meets the tolerance in fewer
+//!   iterations only because it drives more particles onto the cone (max `ρ/ρ0` 1.118,
+//!   1.094). `friction::tests::friction_symbol_bound` recomputes `λ_max` and the Parseval
+//!   check. Other kernels or ratios `h/s` have another bound.
 //! - **Yield criterion**: radial return to the Drucker–Prager cone in the Frobenius norm
 //!   (Alduán & Otaduy 2011); the thesis' per-component approximation is not used.
 //! - **Coulomb friction at contacts** (not in the thesis). A particle with `p = 0` (an
@@ -237,14 +264,18 @@
 //!   released blocks of the earlier repose scenes (collapse deposits, 2 s, plane-strain
 //!   cone) stood at 15.0°, 24.0°, 31.1° for θ = 20°, 30°, 40°, their steepest 5 cm at
 //!   17.3–18.1°, 25.6–26.4°, 33.7–35.6°, near `atan(sin θ)` (issue 19). Fixed-base heaps
-//!   (`granular-repose`, quick, 3-particle slab) stand 3.5–5.5° above the prediction of
-//!   either match (23.7°, 34.9°, 43.9° simple shear; 22.4°, 31.6°, 38.2° plane strain, at
-//!   4 s): see that experiment's deviations. Planar column collapses of aspect ratio 0.5–7 run out 0.56, 1.12, 2.11,
+//!   (`granular-repose`, quick, 3-particle slab) stand 3.7–5.7° above the prediction of
+//!   either match (23.7°, 34.8°, 43.7° simple shear; 22.7°, 32.3°, 38.4° plane strain, at
+//!   4 s, with the friction relaxation 0.35; 23.7°, 34.9°, 43.9° and 22.4°, 31.6°, 38.2°
+//!   at ½, the heaps 2–4 % lower): see that experiment's deviations. Planar column collapses of aspect ratio 0.5–7 run out 0.56, 1.12, 2.11,
 //!   3.86 and 5.73 `L0`, within ±30 % of Lube et al.'s (2005) law
-//!   (`granular-column-collapse`). The friction solve
-//!   often stops at its 20-iteration cap with a mean unyielded strain of 2–3·10⁻⁴ per
-//!   step; 400 iterations leave that residual and the angle (19.2° against 19.8° at 50, on
-//!   a flat 0.6 m × 0.15 m block at θ = 30°) unchanged, and 10 iterations give 21.7°.
+//!   (`granular-column-collapse`). At the thesis's relaxation ½ the friction solve often
+//!   stopped at its 20-iteration cap with a mean unyielded strain of 2–3·10⁻⁴ per step
+//!   (400 iterations left that residual and the angle, 19.2° against 19.8° at 50 on a flat
+//!   0.6 m × 0.15 m block at θ = 30°, unchanged; 10 iterations gave 21.7°): the unstable
+//!   modes of the deviations above. At `ω = 0.35` the dam break's solve (59,319 particles,
+//!   100 steps) meets the tolerance in 1–4 iterations (1.92 per step, none at the cap,
+//!   against 2.35 per step and 2 at the cap at ½).
 //!
 //! # Performance: method and bound
 //!
@@ -265,11 +296,16 @@
 //! by the arithmetic, not by memory bandwidth. A water step with `k` iterations is
 //! `2k + 3` neighbour passes (density, predicted density, `2k − 1` iteration passes, forces,
 //! and the density at the end positions of the frame's last substep); the granular model
-//! adds the kept stress's friction acceleration (one pass), the base velocity (one) and
-//! two passes per friction iteration (strain rate and stress update; friction
-//! acceleration), each reading a 6-component stress or a velocity per pair: `2k_f + 2`
-//! passes for `k_f` friction iterations, so with the default cap of 20 a granular step
-//! can cost several water steps.
+//! adds the base velocity (one pass) and two passes per friction iteration (strain rate
+//! and stress update; friction acceleration with the trial velocities), each reading a
+//! 6-component stress or a velocity per pair: `2k_f + 1` passes for `k_f` friction
+//! iterations, so with the default cap of 20 a granular step can cost several water
+//! steps. What the granular step adds beyond that is folded into passes that run anyway:
+//! the drag's occlusion is taken in the density pass (it needs the pair's offset and
+//! distance), the kept stress's friction is carried from the last step (step 3),
+//! `V_j = m_j/ρ_j` is computed once per step, and the friction acceleration reads
+//! `m_j s_j/ρ_j²` and the density pass's `G_i = Σ_j m_j ∇W_ij + ρ0 ∇Ψ_i`
+//! (`a^f_i = −(s_i/ρ_i²) G_i − Σ_j (m_j s_j/ρ_j²) ∇W_ij`, one symmetric product per pair).
 //! Every parallel loop writes one particle's values and reduces in fixed chunks, so results
 //! are bitwise identical for any number of threads.
 
@@ -287,7 +323,7 @@ mod walls;
 pub use kernels::IISPH_KERNEL;
 pub use params::{
     ConeMatch, GranularParams, IisphParams, AIR_DENSITY, DEFAULT_DRAG_CONE_HALF_ANGLE_DEG,
-    DEFAULT_FRICTION_MAX_ITERATIONS, DEFAULT_FRICTION_TOLERANCE, MAX_FRICTION_ITERATIONS,
+    DEFAULT_FRICTION_MAX_ITERATIONS, DEFAULT_FRICTION_RELAXATION, DEFAULT_FRICTION_TOLERANCE, MAX_FRICTION_ITERATIONS,
     MAX_PRESSURE_ITERATIONS,
 };
 pub use solver::{Iisph, IisphScheme, IISPH_PHASES, IISPH_STATE_ARRAYS};

@@ -22,6 +22,20 @@ pub const DEFAULT_FRICTION_MAX_ITERATIONS: usize = 20;
 /// particles (dimensionless).
 pub const DEFAULT_FRICTION_TOLERANCE: f64 = 1e-4;
 
+/// Default relaxation `ω` of the friction-stress Jacobi update, relative to the exact
+/// self-coupling `D/2` of a particle's stress with its own strain rate: `s ← s − 2ω D⁻¹ε`.
+/// The update is stable only for `ω < 2 / λ_max`, `λ_max` the largest eigenvalue of the
+/// strain-from-stress operator relative to its diagonal. On the prototype lattice (a full
+/// simple cubic lattice, cubic spline, `h = 2 s`) the operator is a convolution, its symbol
+/// at wave vector `k` is `c (2/3) |g(k)|²` for the deviatoric mode along `g` (and
+/// `c |g(k)|²/2` for the shear modes) with `g(k) = Σ_r sin(k·r) ∇W(r)`, against the diagonal
+/// `c Σ_r |∇W(r)|² / 3`; its maximum, at `k ≈ 0.33 π/s (1, 1, 1)`, is `λ_max = 5.64`, so
+/// `ω < 0.355` (the friction module's docs and `tests::friction_symbol_bound` give the
+/// derivation and check it). 0.35 is just inside; the thesis's factor 2 in eq. 9 (`ω = ½`)
+/// is outside, and there the iteration amplifies those modes until the yield cone stops
+/// them.
+pub const DEFAULT_FRICTION_RELAXATION: f64 = 0.35;
+
 /// Most relaxed-Jacobi pressure iterations per time step ([`IisphParams::max_iterations`],
 /// and so [`IisphParams::min_iterations`]) accepted, bounded by what can finish. The count
 /// is a cap: a solve stops at the tolerance, after 2–20 iterations at the default 0.1 %
@@ -146,6 +160,7 @@ pub struct IisphParams<R: Real> {
 /// | `drag_cone_half_angle_deg` | 30° ([`DEFAULT_DRAG_CONE_HALF_ANGLE_DEG`]) | the occlusion cone of §5.6 (no value given) |
 /// | `friction_max_iterations` | [`DEFAULT_FRICTION_MAX_ITERATIONS`] | cap of the friction-stress solve (our choice; hitting it is counted in `StepStats::unconverged_friction_substeps`) |
 /// | `friction_tolerance` | [`DEFAULT_FRICTION_TOLERANCE`] | mean unyielded strain per step at which the friction solve stops (our choice, see the crate docs) |
+/// | `friction_relaxation` | [`DEFAULT_FRICTION_RELAXATION`] (0.35) | `ω` of the stress update relative to the exact self-coupling; the stability bound of the prototype lattice (the thesis's eq. 9 implies ½) |
 #[derive(Debug, Clone, PartialEq)]
 pub struct GranularParams<R: Real> {
     /// Friction angle `θ` (degrees, in [0, 90)): the Drucker–Prager coefficient is
@@ -166,6 +181,10 @@ pub struct GranularParams<R: Real> {
     /// The friction solve stops once the mean strain per time step of the particles inside
     /// the yield surface, `Σ_i ‖dev ε_i‖ Δt / N` (dimensionless), is at most this (> 0).
     pub friction_tolerance: R,
+    /// Relaxation `ω` (in (0, 1]) of the stress update `s ← Y(dev(s − 2ω D⁻¹ ε))`, relative
+    /// to the exact self-coupling `D/2` (Neder 2024's eq. 9, with its factor 2, is `ω = ½`);
+    /// see [`DEFAULT_FRICTION_RELAXATION`] for the stability bound `ω < 0.355`.
+    pub friction_relaxation: R,
 }
 
 impl<R: Real> GranularParams<R> {
@@ -180,6 +199,7 @@ impl<R: Real> GranularParams<R> {
             drag_cone_half_angle_deg: R::of_f64(DEFAULT_DRAG_CONE_HALF_ANGLE_DEG),
             friction_max_iterations: DEFAULT_FRICTION_MAX_ITERATIONS,
             friction_tolerance: R::of_f64(DEFAULT_FRICTION_TOLERANCE),
+            friction_relaxation: R::of_f64(DEFAULT_FRICTION_RELAXATION),
         }
     }
 
@@ -240,6 +260,14 @@ impl<R: Real> GranularParams<R> {
                 "friction_tolerance",
                 tol.as_f64(),
                 "must be finite and > 0",
+            ));
+        }
+        let w = self.friction_relaxation;
+        if !(w.is_finite_value() && w > R::zero() && w <= R::one()) {
+            return Err(invalid(
+                "friction_relaxation",
+                w.as_f64(),
+                "must be in (0, 1]",
             ));
         }
         Ok(())

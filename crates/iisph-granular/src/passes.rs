@@ -10,7 +10,7 @@ use sph_solver::csr::par_csr_blocks;
 use sph_solver::step::{par_update_sum, MIN_LEN};
 use sph_solver::Boundary;
 
-use crate::granular::{drag_force, occlusion};
+use crate::granular::{drag_force, occlusion_of_cosine};
 use crate::kernels::Consts;
 use crate::params::IisphParams;
 use crate::scratch::Scratch;
@@ -21,14 +21,25 @@ pub(crate) fn grad<R: Real>(xi: &Vec3<R>, xj: &Vec3<R>, f: R) -> Vec3<R> {
     (xi - xj) * f
 }
 
+/// A block's outputs of [`density_pass`]: `(ρ, ∇Ψ, G)` and `(a_ii, occlusion)`.
+type DensityOutputs<'a, R> = (
+    (&'a mut [R], &'a mut [Vec3<R>], &'a mut [Vec3<R>]),
+    (&'a mut [R], &'a mut [R]),
+);
+
 /// Eq. 3 + eq. 29: `ρ_i`, `∇Ψ_i`, `W'(r)/r` of every pair, and the diagonal `a_ii` of
-/// eq. 24 (it needs only `x`, `m` and the particle's own density):
+/// eq. 24 (it needs only `x`, `m` and the particle's own density) with its gradient sum
+/// `G_i = Σ_j m_j ∇W_ij + ρ0 ∇Ψ_i` (kept for the friction acceleration):
 /// `a_ii = Σ_j m_j (d_ii − d_ji)·∇W_ij + ρ0 d_ii·∇Ψ_i
 ///       = −Δt²/ρ_i² (|Σ_j m_j ∇W_ij + ρ0 ∇Ψ_i|² + m_i Σ_j m_j |∇W_ij|²)`.
+/// With drag, the same loop also takes the occlusion `max_j o_ij` of eq. 6 (it needs the
+/// pair's offset and distance, which the density computes anyway) into `s.occlusion`, as
+/// the occlusion of the largest `cos φ` ([`occlusion_of_cosine`]: one division per pair).
 #[allow(clippy::needless_range_loop)] // k addresses the CSR pair arrays (indices, scales)
 pub(crate) fn density_pass<R: Real>(
     c: &Consts<R>,
     x: &[Vec3<R>],
+    v: &[Vec3<R>],
     m: &[R],
     nb: &NeighbourLists,
     volume: Option<&dyn Boundary<R>>,
@@ -38,17 +49,27 @@ pub(crate) fn density_pass<R: Real>(
     let indices = nb.indices();
     s.grad_scale.resize(indices.len(), R::zero());
     let dt2 = c.dt * c.dt;
-    let outputs = (&mut s.density[..], &mut s.bgrad[..], &mut s.aii[..]);
+    let outputs = (
+        (&mut s.density[..], &mut s.bgrad[..], &mut s.grad_sum[..]),
+        (&mut s.aii[..], &mut s.occlusion[..]),
+    );
     par_csr_blocks(
         offsets,
         outputs,
         &mut s.grad_scale[..],
-        &|first, (rho_b, bg_b, aii_b): (&mut [R], &mut [Vec3<R>], &mut [R]), gs: &mut [R]| {
+        &|first,
+          ((rho_b, bg_b, gsum_b), (aii_b, occ_b)): DensityOutputs<'_, R>,
+          gs: &mut [R]| {
             let base = offsets[first];
-            let block = rho_b.iter_mut().zip(bg_b.iter_mut()).zip(aii_b.iter_mut());
-            for (l, ((rho, bg), aii)) in block.enumerate() {
+            let block = rho_b
+                .iter_mut()
+                .zip(bg_b.iter_mut().zip(gsum_b.iter_mut()))
+                .zip(aii_b.iter_mut().zip(occ_b.iter_mut()));
+            for (l, ((rho, (bg, gsum)), (aii, occ_out))) in block.enumerate() {
                 let i = first + l;
                 let (xi, mi) = (x[i], m[i]);
+                let upstream = if c.drag { upstream(c, &v[i]) } else { Vec3::zeros() };
+                let mut max_cos = c.cos_cone;
                 let mut sum = mi * c.w0;
                 let mut sum_grad = Vec3::zeros();
                 let mut sum_grad_sq = R::zero();
@@ -66,7 +87,13 @@ pub(crate) fn density_pass<R: Real>(
                     let gw = d * f;
                     sum_grad += gw * m[j];
                     sum_grad_sq += m[j] * gw.norm_squared();
+                    if c.drag && r > R::zero() {
+                        // cos φ of x_j − x_i against the upstream direction (the distance
+                        // is the density's).
+                        max_cos = max_cos.max(upstream.dot(&(-d)) / r);
+                    }
                 }
+                *occ_out = occlusion_of_cosine(max_cos, c.cos_cone);
                 if let Some(b) = volume {
                     let smp = b.sample(&xi);
                     sum += c.rho0 * smp.volume;
@@ -76,6 +103,7 @@ pub(crate) fn density_pass<R: Real>(
                 }
                 *rho = sum;
                 let gi = sum_grad + *bg * c.rho0;
+                *gsum = gi;
                 *aii = -dt2 / (sum * sum) * (gi.norm_squared() + mi * sum_grad_sq);
             }
             0.0
@@ -83,8 +111,21 @@ pub(crate) fn density_pass<R: Real>(
     );
 }
 
-/// Eqs. 5–6 and 17–18: drag, viscosity, `v^adv`; the warm start `p⁰ = p(t − Δt) / 2` and
-/// its `p/ρ²`.
+/// The direction the air comes from at a particle of velocity `v` (`−(v_a − v)/|v_a − v|`,
+/// 0 in still air relative to the particle).
+#[inline]
+fn upstream<R: Real>(c: &Consts<R>, v: &Vec3<R>) -> Vec3<R> {
+    let rel = c.air_velocity - v;
+    let len = rel.norm();
+    if len > R::zero() {
+        -rel / len
+    } else {
+        Vec3::zeros()
+    }
+}
+
+/// Eqs. 5–6 and 17–18: drag (with the occlusion of [`density_pass`]), viscosity, `v^adv`;
+/// the warm start `p⁰ = p(t − Δt) / 2` and its `p/ρ²`.
 pub(crate) fn advection_pass<R: Real>(
     c: &Consts<R>,
     g: Vec3<R>,
@@ -96,51 +137,34 @@ pub(crate) fn advection_pass<R: Real>(
 ) {
     let offsets = nb.offsets();
     let indices = nb.indices();
-    let (rho, gs) = (&s.density[..], &s.grad_scale[..]);
+    let (rho, gs, occlusion) = (&s.density[..], &s.grad_scale[..], &s.occlusion[..]);
     let half = R::of_f64(0.5);
     let eps_h2 = R::of_f64(0.01) * c.h * c.h;
-    let neighbour_terms = c.drag || c.visc > R::zero();
     // The body for particle i: writes v^adv, the warm start and p/ρ².
     let body = |i: usize, va: &mut Vec3<R>, pr: &mut R, pi: &mut R| {
         let (xi, vi, mi, rhoi) = (x[i], v[i], m[i], rho[i]);
         *pr *= half;
         *pi = *pr / (rhoi * rhoi);
-        if !neighbour_terms {
-            *va = vi + g * c.dt;
-            return;
-        }
-        let mut visc = Vec3::zeros();
-        let upstream = {
-            let rel = c.air_velocity - vi;
-            let len = rel.norm();
-            if c.drag && len > R::zero() {
-                -rel / len
-            } else {
-                Vec3::zeros()
-            }
-        };
-        let mut occ = R::zero();
-        for k in offsets[i]..offsets[i + 1] {
-            let j = indices[k] as usize;
-            let xj = x[j];
-            if c.visc > R::zero() {
+        let mut acc = g;
+        if c.visc > R::zero() {
+            let mut visc = Vec3::zeros();
+            for k in offsets[i]..offsets[i + 1] {
+                let j = indices[k] as usize;
+                let xj = x[j];
                 let gw = grad(&xi, &xj, gs[k]);
                 let vol_j = m[j] / rho[j];
                 let xij = xi - xj;
                 visc += gw * (vol_j * (vi - v[j]).dot(&xij) / (xij.norm_squared() + eps_h2));
             }
-            if c.drag {
-                occ = occ.max(occlusion(&upstream, &(xj - xi), c.cos_cone));
-            }
+            acc += visc * c.visc;
         }
-        let mut acc = g + visc * c.visc;
         if c.drag {
             let f = drag_force(
                 c.air_velocity - vi,
                 c.air_density,
                 c.drag_coefficient,
                 c.area,
-                R::one() - occ,
+                R::one() - occlusion[i],
             );
             acc += f / mi;
         }

@@ -13,8 +13,12 @@ pub(crate) struct Scratch<R: Real> {
     pub grad_scale: Vec<R>,
     /// `ρ_i` at the step's start positions, boundary included (eq. 3 + eq. 29).
     pub density: Vec<R>,
+    /// `G_i = Σ_j m_j ∇W_ij + ρ0 ∇Ψ_i` (the diagonal's gradient sum, reused by the friction).
+    pub grad_sum: Vec<Vec3<R>>,
     /// `∇Ψ(x_i)` of a volume boundary.
     pub bgrad: Vec<Vec3<R>>,
+    /// The drag's occlusion `max_j o_ij` (eq. 6; 0 without drag).
+    pub occlusion: Vec<R>,
     /// `v_i^adv` (eq. 18).
     pub v_adv: Vec<Vec3<R>>,
     /// Source term `ρ0 − ρ_i^adv` (eq. 19) of the linear system.
@@ -30,15 +34,21 @@ pub(crate) struct Scratch<R: Real> {
     /// Frictional stress `s_i` (Pa, deviatoric, inside the yield surface); kept between
     /// steps (the friction solve's warm start).
     pub stress: Vec<Sym3<R>>,
-    /// `s_i / ρ_i²`.
-    pub stress_over_rho2: Vec<Sym3<R>>,
-    /// Friction acceleration `F^f_i / m_i` of the current stress.
+    /// `m_i s_i / ρ_i²`.
+    pub mass_stress_over_rho2: Vec<Sym3<R>>,
+    /// Friction acceleration `F^f_i / m_i` of the current stress; kept between steps (the
+    /// next step's predicted friction, see `friction::predict`).
     pub friction_accel: Vec<Vec3<R>>,
+    /// Whether `friction_accel` is that of `stress` (false after a restore without it).
+    pub friction_accel_current: bool,
+    /// `V_i = m_i / ρ_i` of the step (granular).
+    pub volume: Vec<R>,
     /// Velocity at the step's end without friction, `v^adv + Δt (a^p − a^f_prev)`.
     pub v_base: Vec<Vec3<R>>,
     /// Velocity at the step's end with the current stress iterate.
     pub v_trial: Vec<Vec3<R>>,
     pub perm_sym: Vec<Sym3<R>>,
+    pub perm_vec: Vec<Vec3<R>>,
     pub x_new: Vec<Vec3<R>>,
     pub v_new: Vec<Vec3<R>>,
     pub density_new: Vec<R>,
@@ -52,6 +62,8 @@ impl<R: Real> Scratch<R> {
         let z = Vec3::zeros();
         self.density.resize(n, R::zero());
         self.bgrad.resize(n, z);
+        self.grad_sum.resize(n, z);
+        self.occlusion.resize(n, R::zero());
         self.v_adv.resize(n, z);
         self.source.resize(n, R::zero());
         self.aii.resize(n, R::zero());
@@ -60,8 +72,9 @@ impl<R: Real> Scratch<R> {
         self.accel.resize(n, z);
         let ng = if granular { n } else { 0 };
         self.stress.resize(ng, [R::zero(); 6]);
-        self.stress_over_rho2.resize(ng, [R::zero(); 6]);
+        self.mass_stress_over_rho2.resize(ng, [R::zero(); 6]);
         self.friction_accel.resize(ng, z);
+        self.volume.resize(ng, R::zero());
         self.v_base.resize(ng, z);
         self.v_trial.resize(ng, z);
         self.x_new.resize(n, z);

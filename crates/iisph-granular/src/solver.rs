@@ -49,11 +49,13 @@ const REORDER: usize = 8;
 
 /// Names of the arrays IISPH carries between frames ([`sph_solver::SolverState::arrays`]):
 /// the pressures of the warm start (1 per particle), the frictional stress (granular; 6 per
-/// particle, `[xx, yy, zz, xy, xz, yz]`), and the upscaling's passive points and their
-/// velocities (3 per point).
-pub const IISPH_STATE_ARRAYS: [&str; 4] = [
+/// particle, `[xx, yy, zz, xy, xz, yz]`), its friction acceleration (granular; 3 per
+/// particle, m/s², the next step's predicted friction), and the upscaling's passive points
+/// and their velocities (3 per point).
+pub const IISPH_STATE_ARRAYS: [&str; 5] = [
     "pressure",
     "stress",
+    "friction_acceleration",
     "passive_positions",
     "passive_velocities",
 ];
@@ -123,13 +125,20 @@ impl<R: Real> SubstepScheme<R> for IisphScheme<R> {
     ) -> Result<(), SolverError> {
         let n = state.len();
         if self.scratch.pressure.len() != n {
-            self.scratch.pressure.clear();
-            self.scratch.stress.clear();
+            let s = &mut self.scratch;
+            s.pressure.clear();
+            s.stress.clear();
+            // A zero stress has zero friction.
+            s.friction_accel.clear();
+            s.friction_accel_current = true;
         } else if let Some(perm) = permutation {
             let s = &mut self.scratch;
             apply_permutation(&mut s.pressure, perm, &mut s.perm_scalar);
             if s.stress.len() == n {
                 apply_permutation(&mut s.stress, perm, &mut s.perm_sym);
+            }
+            if s.friction_accel.len() == n {
+                apply_permutation(&mut s.friction_accel, perm, &mut s.perm_vec);
             }
         }
         self.scratch.resize(n, self.c.granular);
@@ -153,8 +162,8 @@ impl<R: Real> SubstepScheme<R> for IisphScheme<R> {
         self.time_step(state, at, last, stats)
     }
 
-    /// `pressure` and (granular) `stress` once a frame has run; the passive points and
-    /// their velocities once seeded.
+    /// `pressure` and (granular) `stress` and `friction_acceleration` once a frame has run;
+    /// the passive points and their velocities once seeded.
     fn save_arrays(&self, arrays: &mut Vec<(String, Vec<R>)>) {
         let s = &self.scratch;
         if !s.pressure.is_empty() {
@@ -165,6 +174,13 @@ impl<R: Real> SubstepScheme<R> for IisphScheme<R> {
                 "stress".into(),
                 s.stress.iter().flatten().copied().collect(),
             ));
+            if s.friction_accel_current && s.friction_accel.len() == s.stress.len() {
+                let a = &s.friction_accel;
+                arrays.push((
+                    "friction_acceleration".into(),
+                    a.iter().flat_map(|v| [v.x, v.y, v.z]).collect(),
+                ));
+            }
         }
         if let Some(u) = self.upscaler.as_ref().filter(|u| u.seeded()) {
             let flat = |v: &[Vec3<R>]| v.iter().flat_map(|p| [p.x, p.y, p.z]).collect();
@@ -174,9 +190,11 @@ impl<R: Real> SubstepScheme<R> for IisphScheme<R> {
     }
 
     /// Accepts the arrays of [`IISPH_STATE_ARRAYS`] that fit: `pressure` (`n` values),
-    /// `stress` (granular only, `6 n`), and both or neither of the passive arrays (upscaling
-    /// only, `3 k n` each for `k` points per particle). An absent `pressure` or `stress` is
-    /// the cold start of a fresh solver; absent passive arrays are seeded by the next frame.
+    /// `stress` (granular only, `6 n`), `friction_acceleration` (granular only, `3 n`), and
+    /// both or neither of the passive arrays (upscaling only, `3 k n` each for `k` points
+    /// per particle). An absent `pressure` or `stress` is the cold start of a fresh solver;
+    /// an absent `friction_acceleration` is recomputed from the stress by the next step
+    /// (bitwise resumption needs it); absent passive arrays are seeded by the next frame.
     fn restore_arrays(
         &mut self,
         arrays: &[(String, Vec<R>)],
@@ -194,6 +212,10 @@ impl<R: Real> SubstepScheme<R> for IisphScheme<R> {
                 name: "stress",
                 len: 6 * n,
             });
+            accepted.push(ArraySpec {
+                name: "friction_acceleration",
+                len: 3 * n,
+            });
         }
         if self.upscaler.is_some() {
             for name in ["passive_positions", "passive_velocities"] {
@@ -204,7 +226,7 @@ impl<R: Real> SubstepScheme<R> for IisphScheme<R> {
             }
         }
         let found = match_arrays(self.name(), arrays, &accepted)?;
-        let k = if granular { 2 } else { 1 };
+        let k = if granular { 3 } else { 1 };
         let passive = (
             found.get(k).copied().flatten(),
             found.get(k + 1).copied().flatten(),
@@ -216,22 +238,31 @@ impl<R: Real> SubstepScheme<R> for IisphScheme<R> {
                     .into(),
             });
         }
+        let vec3 = |f: &[R]| {
+            f.chunks_exact(3)
+                .map(|c| Vec3::new(c[0], c[1], c[2]))
+                .collect::<Vec<_>>()
+        };
         let s = &mut self.scratch;
         s.pressure.clear();
         s.stress.clear();
+        s.friction_accel.clear();
         if let Some(p) = found[0] {
             s.pressure.extend_from_slice(p);
         }
-        if let Some(st) = found.get(1).copied().flatten().filter(|_| granular) {
+        let stress = found.get(1).copied().flatten().filter(|_| granular);
+        let accel = found.get(2).copied().flatten().filter(|_| granular);
+        if let Some(st) = stress {
             s.stress
                 .extend(st.chunks_exact(6).map(|c| std::array::from_fn(|e| c[e])));
         }
+        // Without a stress the friction is zero; with one, its acceleration is restored or
+        // recomputed by the next step.
+        s.friction_accel_current = stress.is_none() || accel.is_some();
+        if let (Some(a), Some(_)) = (accel, stress) {
+            s.friction_accel = vec3(a);
+        }
         if let (Some(u), (Some(x), Some(v))) = (self.upscaler.as_mut(), passive) {
-            let vec3 = |f: &[R]| {
-                f.chunks_exact(3)
-                    .map(|c| Vec3::new(c[0], c[1], c[2]))
-                    .collect()
-            };
             u.restore(vec3(x), vec3(v));
         }
         Ok(())
@@ -288,7 +319,7 @@ impl<R: Real> IisphScheme<R> {
             &state.masses[..],
         );
         let s = &mut self.scratch;
-        density_pass(&self.c, x, m, nb, volume, s);
+        density_pass(&self.c, x, v, m, nb, volume, s);
         advection_pass(&self.c, self.params.common.gravity, x, v, m, nb, s);
         predicted_density_pass(&self.c, x, m, nb, s);
         Ok(())
@@ -399,7 +430,7 @@ impl<R: Real> IisphScheme<R> {
         // Algorithm 1, lines 2–5: density, drag, advection (with the friction of the kept
         // stress), predicted density, a_ii.
         let t = Instant::now();
-        density_pass(&c, x, m, nb, volume, s);
+        density_pass(&c, x, v, m, nb, volume, s);
         advection_pass(&c, g, x, v, m, nb, s);
         if c.granular {
             friction::predict(&c, x, m, nb, s);

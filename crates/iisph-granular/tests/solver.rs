@@ -149,6 +149,10 @@ fn invalid_parameters_named() {
     let e = Iisph::new(p.clone(), vec![]).unwrap_err();
     assert!(e.to_string().contains("friction_max_iterations"), "{e}");
     p.granular = Some(GranularParams::with_friction_angle(30.0));
+    p.granular.as_mut().unwrap().friction_relaxation = 1.5;
+    let e = Iisph::new(p.clone(), vec![]).unwrap_err();
+    assert!(e.to_string().contains("friction_relaxation"), "{e}");
+    p.granular.as_mut().unwrap().friction_relaxation = 0.35;
     p.granular.as_mut().unwrap().friction_tolerance = f64::NAN;
     let e = Iisph::new(p, vec![]).unwrap_err();
     assert!(e.to_string().contains("friction_tolerance"), "{e}");
