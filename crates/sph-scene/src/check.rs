@@ -136,13 +136,23 @@ fn check_fluid(
     f: &FluidSpec,
     tank: Option<&Aabb<f64>>,
 ) -> Result<(), SceneError> {
-    let (FluidSpec::Block { velocity, .. } | FluidSpec::Mesh { velocity, .. }) = f;
-    ctx.finite3(&format!("{field}.velocity"), velocity)?;
+    ctx.finite3(&format!("{field}.velocity"), &f.velocity())?;
     let (b, bfield) = match f {
         FluidSpec::Block { min, max, .. } => {
             (ctx.check_box(field, min, max)?, format!("{field}.max"))
         }
         FluidSpec::Mesh { mesh, .. } => (mesh.mesh.bounds(), placement_field(field, mesh)),
+        FluidSpec::Cylinder {
+            base_center,
+            radius,
+            height,
+            ..
+        } => {
+            ctx.finite3(&format!("{field}.base_center"), base_center)?;
+            ctx.positive(&format!("{field}.radius"), *radius)?;
+            ctx.positive(&format!("{field}.height"), *height)?;
+            (f.bounds(), format!("{field}.base_center"))
+        }
     };
     let Some(t) = tank else {
         return Ok(());

@@ -179,6 +179,9 @@ fn fluid(
         ("scale", f.scale.is_some()),
         ("translate", f.translate.is_some()),
         ("fit", f.fit.is_some()),
+        ("base_center", f.base_center.is_some()),
+        ("radius", f.radius.is_some()),
+        ("height", f.height.is_some()),
     ];
     Ok(match f.kind {
         RawFluidKind::Block => {
@@ -195,6 +198,22 @@ fn fluid(
             forbid(ctx, field, "mesh", &present, &own)?;
             let mesh = meshes.mesh_spec(ctx, field, MeshFields::of_fluid(f))?;
             FluidSpec::Mesh { mesh, velocity }
+        }
+        RawFluidKind::Cylinder => {
+            let own = ["base_center", "radius", "height"];
+            forbid(ctx, field, "cylinder", &present, &own)?;
+            let required = |name: &str, v| require(ctx, &format!("{field}.{name}"), "cylinder", v);
+            FluidSpec::Cylinder {
+                base_center: require(
+                    ctx,
+                    &format!("{field}.base_center"),
+                    "cylinder",
+                    f.base_center,
+                )?,
+                radius: required("radius", f.radius)?,
+                height: required("height", f.height)?,
+                velocity,
+            }
         }
     })
 }

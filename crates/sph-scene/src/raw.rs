@@ -56,6 +56,7 @@ pub(crate) struct RawBox {
 pub(crate) enum RawFluidKind {
     Block,
     Mesh,
+    Cylinder,
 }
 
 #[derive(Debug, Deserialize)]
@@ -69,6 +70,9 @@ pub(crate) struct RawFluid {
     pub scale: Option<f64>,
     pub translate: Option<[f64; 3]>,
     pub fit: Option<RawBox>,
+    pub base_center: Option<[f64; 3]>,
+    pub radius: Option<f64>,
+    pub height: Option<f64>,
 }
 
 #[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]

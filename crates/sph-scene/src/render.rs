@@ -5,7 +5,7 @@
 use ssfr_render::{Obstacle, RenderConfig, RenderParams, SceneInfo, SsfrError};
 
 use crate::error::Ctx;
-use crate::{FluidSpec, Scene, SceneError, SolidSpec};
+use crate::{Scene, SceneError, SolidSpec};
 
 fn f3(a: [f64; 3]) -> [f32; 3] {
     [a[0] as f32, a[1] as f32, a[2] as f32]
@@ -21,13 +21,8 @@ impl Scene {
     pub fn render_info(&self) -> SceneInfo {
         let mut liquid: Option<([f32; 3], [f32; 3])> = None;
         for f in &self.fluids {
-            let (lo, hi) = match f {
-                FluidSpec::Block { min, max, .. } => (f3(*min), f3(*max)),
-                FluidSpec::Mesh { mesh, .. } => {
-                    let b = mesh.mesh.bounds();
-                    (f3(b.min.into()), f3(b.max.into()))
-                }
-            };
+            let b = f.bounds();
+            let (lo, hi) = (f3(b.min.into()), f3(b.max.into()));
             liquid = Some(match liquid {
                 None => (lo, hi),
                 Some((a, b)) => (

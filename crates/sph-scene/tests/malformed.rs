@@ -289,8 +289,19 @@ fn too_many_particles() {
 
 #[test]
 fn field_of_another_kind() {
-    let e = err_with("other_kind", "velocity = [0.0, 0.0, 0.0]", "radius = 1.0");
-    assert_names(&e, "other_kind", "fluid[0].radius", "unknown field");
+    let e = err_with(
+        "other_kind",
+        "velocity = [0.0, 0.0, 0.0]",
+        "normal = [0.0, 1.0, 0.0]",
+    );
+    assert_names(&e, "other_kind", "fluid[0].normal", "unknown field");
+    let e = err_with("other_kind_r", "velocity = [0.0, 0.0, 0.0]", "radius = 1.0");
+    assert_names(
+        &e,
+        "other_kind_r",
+        "fluid[0].radius",
+        "not a field of kind = \"block\"",
+    );
     let e = err_with(
         "other_kind2",
         "velocity = [0.0, 0.0, 0.0]",
