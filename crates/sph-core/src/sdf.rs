@@ -75,14 +75,14 @@ pub trait Sdf<R: Real>: Send + Sync {
 }
 
 /// Appends `(a, b) ∩ [0, t_max]` to `out` when it is not empty.
-fn push_clipped(a: f64, b: f64, t_max: f64, out: &mut Vec<(f64, f64)>) {
+pub(crate) fn push_clipped(a: f64, b: f64, t_max: f64, out: &mut Vec<(f64, f64)>) {
     let (a, b) = (a.max(0.0), b.min(t_max));
     if a < b {
         out.push((a, b));
     }
 }
 
-fn v64<R: Real>(v: &Vec3<R>) -> Vec3<f64> {
+pub(crate) fn v64<R: Real>(v: &Vec3<R>) -> Vec3<f64> {
     Vec3::new(v.x.as_f64(), v.y.as_f64(), v.z.as_f64())
 }
 
@@ -97,7 +97,7 @@ pub fn push_fingerprint<R: Real>(out: &mut Vec<u8>, tag: &str, values: &[R]) {
     }
 }
 
-fn check_positive<R: Real>(name: &'static str, value: R) -> Result<(), CoreError> {
+pub(crate) fn check_positive<R: Real>(name: &'static str, value: R) -> Result<(), CoreError> {
     if !(value.is_finite_value() && value > R::zero()) {
         return Err(CoreError::InvalidParameter {
             name,
@@ -108,7 +108,7 @@ fn check_positive<R: Real>(name: &'static str, value: R) -> Result<(), CoreError
     Ok(())
 }
 
-fn check_finite_vec<R: Real>(name: &'static str, v: &Vec3<R>) -> Result<(), CoreError> {
+pub(crate) fn check_finite_vec<R: Real>(name: &'static str, v: &Vec3<R>) -> Result<(), CoreError> {
     if let Some(a) = (0..3).find(|&a| !v[a].is_finite_value()) {
         return Err(CoreError::InvalidParameter {
             name,
@@ -462,6 +462,7 @@ mod tests {
                 Box::new(Inverted(unit_box())),
                 Box::new(Sphere::new(Vec3::new(0.5, -0.5, 0.2), 1.5).unwrap()),
                 Box::new(Plane::new(Vec3::new(0.0, 1.0, 0.0), Vec3::new(1.0, 2.0, -0.5)).unwrap()),
+                Box::new(crate::CylinderSdf::new(Vec3::new(0.3, -1.0, 0.1), 1.2, 2.5).unwrap()),
             ];
             let mut prints = Vec::new();
             for s in &shapes {
@@ -538,6 +539,7 @@ mod tests {
                 Box::new(Inverted(unit_box())),
                 Box::new(Sphere::new(Vec3::new(0.5, -0.5, 0.2), 1.5).unwrap()),
                 Box::new(Plane::new(Vec3::new(0.0, 1.0, 0.0), Vec3::new(1.0, 2.0, -0.5)).unwrap()),
+                Box::new(crate::CylinderSdf::new(Vec3::new(0.3, -1.0, 0.1), 1.2, 2.5).unwrap()),
             ];
             for s in &shapes {
                 let g = s.gradient(&p);

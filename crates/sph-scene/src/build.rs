@@ -8,8 +8,8 @@
 use std::sync::Arc;
 
 use sph_core::{
-    sampling::cubic_lattice, Aabb, BoxSdf, GridSdf, Inverted, Plane, Real, Sdf, Sphere,
-    TriangleMesh, Vec3,
+    sampling::cubic_lattice, Aabb, BoxSdf, CylinderSdf, GridSdf, Inverted, Plane, Real, Sdf,
+    Sphere, TriangleMesh, Vec3,
 };
 
 use crate::error::Ctx;
@@ -154,6 +154,18 @@ impl Scene {
             SolidSpec::Plane { point, normal } => Box::new(
                 Plane::new(cast3::<R>(&v3(*point)), cast3::<R>(&v3(*normal)))
                     .map_err(|e| core("normal", e))?,
+            ),
+            SolidSpec::Cylinder {
+                base_center,
+                radius,
+                height,
+            } => Box::new(
+                CylinderSdf::new(
+                    cast3::<R>(&v3(*base_center)),
+                    R::of_f64(*radius),
+                    R::of_f64(*height),
+                )
+                .map_err(|e| core("radius", e))?,
             ),
             SolidSpec::Mesh { mesh, sdf_cell } => {
                 let cell = sdf_cell.unwrap_or(self.particle_spacing * 0.5);

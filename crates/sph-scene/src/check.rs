@@ -148,9 +148,7 @@ fn check_fluid(
             height,
             ..
         } => {
-            ctx.finite3(&format!("{field}.base_center"), base_center)?;
-            ctx.positive(&format!("{field}.radius"), *radius)?;
-            ctx.positive(&format!("{field}.height"), *height)?;
+            check_cylinder(ctx, field, base_center, *radius, *height)?;
             (f.bounds(), format!("{field}.base_center"))
         }
     };
@@ -174,6 +172,20 @@ fn check_fluid(
     }
 }
 
+/// A cylinder's fields at `field` (fluid or solid): a finite base centre, a positive radius
+/// and height.
+fn check_cylinder(
+    ctx: &Ctx,
+    field: &str,
+    base_center: &[f64; 3],
+    radius: f64,
+    height: f64,
+) -> Result<(), SceneError> {
+    ctx.finite3(&format!("{field}.base_center"), base_center)?;
+    ctx.positive(&format!("{field}.radius"), radius)?;
+    ctx.positive(&format!("{field}.height"), height)
+}
+
 /// One solid at `field`.
 fn check_solid(ctx: &Ctx, field: &str, s: &SolidSpec) -> Result<(), SceneError> {
     match s {
@@ -194,6 +206,11 @@ fn check_solid(ctx: &Ctx, field: &str, s: &SolidSpec) -> Result<(), SceneError> 
             }
             Ok(())
         }
+        SolidSpec::Cylinder {
+            base_center,
+            radius,
+            height,
+        } => check_cylinder(ctx, field, base_center, *radius, *height),
         SolidSpec::Mesh { sdf_cell, .. } => match sdf_cell {
             Some(c) => ctx.positive(&format!("{field}.sdf_cell"), *c),
             None => Ok(()),

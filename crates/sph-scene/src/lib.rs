@@ -189,6 +189,7 @@
 //! radius = 0.1
 //! # kind = "box":   min, max (m)
 //! # kind = "plane": point (m), normal (points into the free side, normalised)
+//! # kind = "cylinder": base_center (m), radius (m, > 0), height (m, > 0): vertical axis
 //! # kind = "mesh":  path, scale/translate or fit (as for fluids), sdf_cell (m, grid spacing of
 //! #                 the signed distance field, default particle_spacing / 2)
 //!

@@ -163,6 +163,9 @@ fn required_box(
     })
 }
 
+/// The fields of `kind = "cylinder"` (fluid and solid).
+const CYLINDER_FIELDS: [&str; 3] = ["base_center", "radius", "height"];
+
 /// One `[[fluid]]` table at `field`.
 fn fluid(
     ctx: &Ctx,
@@ -200,8 +203,7 @@ fn fluid(
             FluidSpec::Mesh { mesh, velocity }
         }
         RawFluidKind::Cylinder => {
-            let own = ["base_center", "radius", "height"];
-            forbid(ctx, field, "cylinder", &present, &own)?;
+            forbid(ctx, field, "cylinder", &present, &CYLINDER_FIELDS)?;
             let required = |name: &str, v| require(ctx, &format!("{field}.{name}"), "cylinder", v);
             FluidSpec::Cylinder {
                 base_center: require(
@@ -238,6 +240,8 @@ fn solid(
         ("translate", s.translate.is_some()),
         ("fit", s.fit.is_some()),
         ("sdf_cell", s.sdf_cell.is_some()),
+        ("base_center", s.base_center.is_some()),
+        ("height", s.height.is_some()),
     ];
     let vector = |name: &str, kind: &str, v: Option<[f64; 3]>| {
         require(ctx, &format!("{field}.{name}"), kind, v)
@@ -270,6 +274,14 @@ fn solid(
             SolidSpec::Mesh {
                 mesh,
                 sdf_cell: s.sdf_cell,
+            }
+        }
+        RawSolidKind::Cylinder => {
+            forbid(ctx, field, "cylinder", &present, &CYLINDER_FIELDS)?;
+            SolidSpec::Cylinder {
+                base_center: vector("base_center", "cylinder", s.base_center)?,
+                radius: require(ctx, &format!("{field}.radius"), "cylinder", s.radius)?,
+                height: require(ctx, &format!("{field}.height"), "cylinder", s.height)?,
             }
         }
     })

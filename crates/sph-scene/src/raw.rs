@@ -82,6 +82,7 @@ pub(crate) enum RawSolidKind {
     Box,
     Plane,
     Mesh,
+    Cylinder,
 }
 
 #[derive(Debug, Deserialize)]
@@ -99,6 +100,8 @@ pub(crate) struct RawSolid {
     pub translate: Option<[f64; 3]>,
     pub fit: Option<RawBox>,
     pub sdf_cell: Option<f64>,
+    pub base_center: Option<[f64; 3]>,
+    pub height: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]

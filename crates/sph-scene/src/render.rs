@@ -16,7 +16,7 @@ const SOLID_COLOUR: [f32; 3] = [0.55, 0.45, 0.40];
 
 impl Scene {
     /// What the renderer's defaults need from the scene: tank, liquid bounds, spacing, and
-    /// the box and sphere solids as obstacles (mesh solids as their bounding box; planes are
+    /// the box and sphere solids as obstacles (mesh and cylinder solids as their bounding box; planes are
     /// not drawn).
     pub fn render_info(&self) -> SceneInfo {
         let mut liquid: Option<([f32; 3], [f32; 3])> = None;
@@ -53,6 +53,15 @@ impl Scene {
                         colour: SOLID_COLOUR,
                     })
                 }
+                SolidSpec::Cylinder {
+                    base_center: c,
+                    radius: r,
+                    height: h,
+                } => Some(Obstacle::Box {
+                    min: f3([c[0] - r, c[1], c[2] - r]),
+                    max: f3([c[0] + r, c[1] + h, c[2] + r]),
+                    colour: SOLID_COLOUR,
+                }),
                 SolidSpec::Plane { .. } => None,
             })
             .collect();

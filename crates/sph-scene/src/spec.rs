@@ -209,6 +209,15 @@ pub enum SolidSpec {
         /// Grid spacing (m) of its signed distance field; `None` = `particle_spacing / 2`.
         sdf_cell: Option<f64>,
     },
+    /// A solid cylinder with a vertical axis (along `y`), as a [`sph_core::CylinderSdf`].
+    Cylinder {
+        /// Centre of the base disc (m).
+        base_center: [f64; 3],
+        /// Radius (m, > 0).
+        radius: f64,
+        /// Height (m, > 0).
+        height: f64,
+    },
 }
 
 /// The `[quick]` overrides (all optional).

@@ -352,6 +352,27 @@ const SCENE_CASES: &[SceneCase] = &[
         )],
     },
     SceneCase {
+        name: "solid_cylinder_negative_height",
+        edits: &[(
+            "kind = \"sphere\"\ncenter = [1.6, 0.3, 0.5]\nradius = 0.2",
+            "kind = \"cylinder\"\nbase_center = [1.6, 0.1, 0.5]\nradius = 0.2\nheight = -0.3",
+        )],
+    },
+    SceneCase {
+        name: "solid_cylinder_with_center",
+        edits: &[(
+            "kind = \"sphere\"\ncenter = [1.6, 0.3, 0.5]\nradius = 0.2",
+            "kind = \"cylinder\"\ncenter = [1.6, 0.1, 0.5]\nradius = 0.2\nheight = 0.3",
+        )],
+    },
+    SceneCase {
+        name: "fluid_overlaps_solid_cylinder",
+        edits: &[(
+            "kind = \"sphere\"\ncenter = [1.6, 0.3, 0.5]\nradius = 0.2",
+            "kind = \"cylinder\"\nbase_center = [0.4, 0.0, 0.5]\nradius = 0.2\nheight = 0.3",
+        )],
+    },
+    SceneCase {
         name: "render_negative_radius",
         edits: &[(
             "vtk = false\n",
