@@ -1,5 +1,8 @@
 //! The solid cylinder with a vertical axis, [`CylinderSdf`].
 
+// NaN-rejecting checks (a NaN ray is outside) are written as `!(x < 0.0)` on purpose.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use crate::sdf::{check_finite_vec, check_positive, push_clipped, push_fingerprint, v64};
 use crate::{Aabb, CoreError, Real, Sdf, Vec3};
 
