@@ -82,6 +82,19 @@ pub(crate) fn push_clipped(a: f64, b: f64, t_max: f64, out: &mut Vec<(f64, f64)>
     }
 }
 
+/// The two distinct real roots `t1 < t2` of `a t² + 2 b t + c = 0` (`a > 0`), in the stable
+/// form that avoids cancelling `b` against the discriminant; `None` without two distinct
+/// roots (or with `a ≤ 0`, or a NaN).
+pub(crate) fn quadratic_roots(a: f64, b: f64, c: f64) -> Option<(f64, f64)> {
+    let disc = b * b - a * c;
+    if !(a > 0.0 && disc > 0.0) {
+        return None;
+    }
+    let q = -(b + b.signum() * disc.sqrt());
+    let (t1, t2) = (q / a, c / q);
+    Some((t1.min(t2), t1.max(t2)))
+}
+
 pub(crate) fn v64<R: Real>(v: &Vec3<R>) -> Vec3<f64> {
     Vec3::new(v.x.as_f64(), v.y.as_f64(), v.z.as_f64())
 }
@@ -243,11 +256,8 @@ impl<R: Real> Sdf<R> for Sphere<R> {
         let d = x - v64(&self.center);
         let r = self.radius.as_f64();
         let (a, b, c) = (dir.norm_squared(), d.dot(dir), d.norm_squared() - r * r);
-        let disc = b * b - a * c;
-        if a > 0.0 && disc > 0.0 {
-            let q = -(b + b.signum() * disc.sqrt());
-            let (t1, t2) = (q / a, c / q);
-            push_clipped(t1.min(t2), t1.max(t2), t_max, out);
+        if let Some((t1, t2)) = quadratic_roots(a, b, c) {
+            push_clipped(t1, t2, t_max, out);
         }
         true
     }

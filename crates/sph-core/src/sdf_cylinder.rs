@@ -3,7 +3,9 @@
 // NaN-rejecting checks (a NaN ray is outside) are written as `!(x < 0.0)` on purpose.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-use crate::sdf::{check_finite_vec, check_positive, push_clipped, push_fingerprint, v64};
+use crate::sdf::{
+    check_finite_vec, check_positive, push_clipped, push_fingerprint, quadratic_roots, v64,
+};
 use crate::{Aabb, CoreError, Real, Sdf, Vec3};
 
 /// Solid cylinder with a vertical axis (along `y`): the points within `radius` of the axis
@@ -123,14 +125,11 @@ impl<R: Real> Sdf<R> for CylinderSdf<R> {
                 return true;
             }
         } else {
-            let disc = b * b - a * cc;
-            if !(disc > 0.0) {
+            let Some((t1, t2)) = quadratic_roots(a, b, cc) else {
                 return true;
-            }
-            let q = -(b + b.signum() * disc.sqrt());
-            let (t1, t2) = (q / a, cc / q);
-            t_in = t_in.max(t1.min(t2));
-            t_out = t_out.min(t1.max(t2));
+            };
+            t_in = t_in.max(t1);
+            t_out = t_out.min(t2);
         }
         push_clipped(t_in, t_out, t_max, out);
         true
