@@ -1,6 +1,6 @@
 //! Measurements on particle output, usable on any scene's positions (a VTK frame read back,
 //! a `SceneSim` state, an experiment's run): the **angle of repose** of a settled pile and the
-//! **runout** of a collapsed column.
+//! **runout** of a collapsed column, planar ([`runout`]) or axisymmetric ([`radial_runout`]).
 //!
 //! Conventions: SI units (m, degrees for angles); gravity along −y, so "up" is +y and the
 //! floor is the plane `y = floor_y`. Heights and distances are those of particle **centres**
@@ -63,7 +63,18 @@
 //! plus the particle radius ([`RunoutOptions::particle_radius_m`]), the edge of the last
 //! particle.
 //!
-//! References: G. Lube, H. E. Huppert, R. S. J. Sparks & A. Freundt, "Collapses of
+//! # Radial runout ([`radial_runout`])
+//!
+//! An axisymmetric column of radius `R0` and height `H0` collapses around its vertical axis;
+//! `R∞` is the mean radius of the connected deposit's outline (the largest set of particles
+//! connected by steps shorter than a gap, its outermost particle in each of several
+//! azimuthal sectors, the particle radius added, averaged over the sectors), compared by
+//! Lube, Huppert, Sparks & Hallworth (2004) as `(R∞ − R0)/R0` against `a = H0/R0`. The
+//! deposit's slope is [`angle_of_repose`] with [`PileShape::Conical`] on the same axis.
+//!
+//! References: G. Lube, H. E. Huppert, R. S. J. Sparks & M. A. Hallworth, "Axisymmetric
+//! collapses of granular columns", *J. Fluid Mech.* 508, 175–199 (2004),
+//! doi:10.1017/S0022112004009036. G. Lube, H. E. Huppert, R. S. J. Sparks & A. Freundt, "Collapses of
 //! two-dimensional granular columns", *Physical Review E* 72, 041301 (2005),
 //! doi:10.1103/PhysRevE.72.041301.
 
@@ -684,4 +695,192 @@ pub fn normalised_runout(runout_m: f64, initial_length_m: f64) -> Result<f64, Me
         });
     }
     Ok((runout_m - initial_length_m) / initial_length_m)
+}
+
+const RADIAL_RUNOUT: &str = "radial runout";
+
+/// Options of [`radial_runout`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RadialRunoutOptions {
+    /// The vertical axis `[x, z]` (m) the deposit spread from (the initial column's axis).
+    pub axis_xz: [f64; 2],
+    /// Number of equal azimuthal sectors (≥ 1) whose fronts are averaged.
+    pub sectors: usize,
+    /// Two particles closer than this (m, > 0) are connected; one to two particle spacings.
+    pub max_gap_m: f64,
+    /// Added to each sector's outermost particle centre: the particle radius (m, ≥ 0).
+    pub particle_radius_m: f64,
+}
+
+impl RadialRunoutOptions {
+    /// 16 sectors around `axis_xz`, particles connected up to two spacings apart
+    /// (`max_gap_m = 2 · particle_spacing_m`), plus the particle radius.
+    pub fn connected(axis_xz: [f64; 2], particle_spacing_m: f64) -> Self {
+        Self {
+            axis_xz,
+            sectors: 16,
+            max_gap_m: 2.0 * particle_spacing_m,
+            particle_radius_m: 0.5 * particle_spacing_m,
+        }
+    }
+
+    fn validate(&self) -> Result<(), MeasureError> {
+        let bad = |option, value, reason| {
+            Err(MeasureError::InvalidOption {
+                what: RADIAL_RUNOUT,
+                option,
+                value,
+                reason,
+            })
+        };
+        let [x, z] = self.axis_xz;
+        if !(x.is_finite() && z.is_finite()) {
+            let v = if x.is_finite() { z } else { x };
+            return bad("axis_xz", v, "must be finite");
+        }
+        if self.sectors == 0 || self.sectors > 1 << 20 {
+            return bad("sectors", self.sectors as f64, "must be in [1, 2^20]");
+        }
+        if !(self.max_gap_m.is_finite() && self.max_gap_m > 0.0) {
+            return bad("max_gap_m", self.max_gap_m, "must be finite and > 0");
+        }
+        if !(self.particle_radius_m.is_finite() && self.particle_radius_m >= 0.0) {
+            return bad(
+                "particle_radius_m",
+                self.particle_radius_m,
+                "must be finite and >= 0",
+            );
+        }
+        Ok(())
+    }
+}
+
+/// The result of [`radial_runout`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct RadialRunout {
+    /// The runout `R∞` (m): the mean over the sectors of [`RadialRunout::sector_fronts_m`].
+    pub radius_m: f64,
+    /// Each sector's front (m): the largest distance from the axis of a deposit particle in
+    /// the sector, plus the particle radius; sector `k` covers the azimuths
+    /// `atan2(z − z_axis, x − x_axis) ∈ [−π + 2πk/n, −π + 2π(k+1)/n)`.
+    pub sector_fronts_m: Vec<f64>,
+    /// Indices (into the input) of the deposit's particles, ascending.
+    pub deposit: Vec<usize>,
+}
+
+/// The runout of an axisymmetric deposit (a column collapsed around a vertical axis): the
+/// mean radius of the **connected deposit**'s outline.
+///
+/// 1. The deposit is the largest set of particles connected by steps shorter than
+///    [`RadialRunoutOptions::max_gap_m`] (the largest connected component of the graph
+///    joining particles closer than that; a cell grid finds the pairs in `O(N)`), so grains
+///    thrown ahead of it and separated from it do not count.
+/// 2. Around the axis, in each of [`RadialRunoutOptions::sectors`] equal azimuthal sectors,
+///    the front is the largest horizontal distance from the axis of a deposit particle, plus
+///    the particle radius.
+/// 3. `R∞` is the mean of the sectors' fronts: the mean radius of the outline (a deposit
+///    that is not round, with fingers or lobes, is measured by its mean extent; the sectors'
+///    spread shows how round it is).
+///
+/// Lube et al. (2004, J. Fluid Mech. 508, 175) compare `(R∞ − R0)/R0` with `a = H0/R0`
+/// ([`normalised_runout`] with `L0 = R0`). Resolution: a sector's outermost particle centre
+/// lies within about one spacing inside the true edge, so `R∞` is within about half a
+/// spacing of it with the radius added; a sector must be wide enough at the front (arc
+/// `2π R∞ / n` of a few spacings) for its outermost particle to be on the edge.
+///
+/// Errors ([`MeasureError`]): no particles; a non-finite position (with its index); options
+/// out of range; a sector that holds no deposit particle (the deposit does not surround the
+/// axis).
+pub fn radial_runout<R: Real>(
+    positions: &[Vec3<R>],
+    options: &RadialRunoutOptions,
+) -> Result<RadialRunout, MeasureError> {
+    check_finite(RADIAL_RUNOUT, positions)?;
+    options.validate()?;
+    let pts: Vec<[f64; 3]> = positions
+        .iter()
+        .map(|p| [p.x.as_f64(), p.y.as_f64(), p.z.as_f64()])
+        .collect();
+    let deposit = largest_cluster(&pts, options.max_gap_m);
+    let n = options.sectors;
+    let [cx, cz] = options.axis_xz;
+    let mut fronts = vec![f64::NEG_INFINITY; n];
+    for &i in &deposit {
+        let (dx, dz) = (pts[i][0] - cx, pts[i][2] - cz);
+        let phi = dz.atan2(dx);
+        let k = ((phi + std::f64::consts::PI) / std::f64::consts::TAU * n as f64) as usize;
+        let k = k.min(n - 1);
+        fronts[k] = fronts[k].max(dx.hypot(dz));
+    }
+    if let Some(k) = fronts.iter().position(|f| !f.is_finite()) {
+        return Err(MeasureError::Degenerate {
+            what: RADIAL_RUNOUT,
+            reason: format!(
+                "sector {k} of {n} around the axis ({cx}, {cz}) holds no particle of the \
+                 connected deposit ({} of {} particles): the deposit does not surround the axis",
+                deposit.len(),
+                pts.len()
+            ),
+        });
+    }
+    for f in &mut fronts {
+        *f += options.particle_radius_m;
+    }
+    Ok(RadialRunout {
+        radius_m: fronts.iter().sum::<f64>() / n as f64,
+        sector_fronts_m: fronts,
+        deposit,
+    })
+}
+
+/// The indices (ascending) of the largest set of points connected by steps shorter than
+/// `gap` (union–find over the pairs a cell grid of cell `gap` proposes); ties go to the set
+/// of the lowest index.
+fn largest_cluster(pts: &[[f64; 3]], gap: f64) -> Vec<usize> {
+    use std::collections::HashMap;
+    let cell = |p: &[f64; 3]| p.map(|c| (c / gap).floor() as i64);
+    let mut grid: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
+    for (i, p) in pts.iter().enumerate() {
+        grid.entry(cell(p)).or_default().push(i);
+    }
+    let mut parent: Vec<usize> = (0..pts.len()).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    let gap2 = gap * gap;
+    for (i, p) in pts.iter().enumerate() {
+        let c = cell(p);
+        for d in 0..27i64 {
+            let key = [c[0] + d % 3 - 1, c[1] + (d / 3) % 3 - 1, c[2] + d / 9 - 1];
+            let Some(others) = grid.get(&key) else {
+                continue;
+            };
+            for &j in others {
+                if j <= i {
+                    continue;
+                }
+                let q = &pts[j];
+                let d2 = (0..3).map(|a| (p[a] - q[a]).powi(2)).sum::<f64>();
+                if d2 < gap2 {
+                    let (ri, rj) = (root(&mut parent, i), root(&mut parent, j));
+                    if ri != rj {
+                        parent[ri.max(rj)] = ri.min(rj);
+                    }
+                }
+            }
+        }
+    }
+    let mut size = vec![0usize; pts.len()];
+    let roots: Vec<usize> = (0..pts.len()).map(|i| root(&mut parent, i)).collect();
+    for &r in &roots {
+        size[r] += 1;
+    }
+    let best = (0..pts.len())
+        .max_by(|&a, &b| size[a].cmp(&size[b]).then(b.cmp(&a)))
+        .unwrap_or(0);
+    (0..pts.len()).filter(|&i| roots[i] == best).collect()
 }

@@ -12,8 +12,8 @@
 //! `D = (0.6 H − δ) / tan α` the run of the 20–80 % band.
 
 use iisph_granular::measure::{
-    angle_of_repose, normalised_runout, runout, surface_profile, FrontMethod, MeasureError,
-    PileShape, ReposeOptions, RunoutOptions,
+    angle_of_repose, normalised_runout, radial_runout, runout, surface_profile, FrontMethod,
+    MeasureError, PileShape, RadialRunoutOptions, ReposeOptions, RunoutOptions,
 };
 use proptest::prelude::*;
 use sph_core::Vec3;
@@ -479,4 +479,186 @@ fn steepest_slope_of_a_kinked_flank() {
             ..
         })
     ));
+}
+
+/// The outermost bottom-layer centre of a lattice cone of slope `alpha` and height `h`
+/// (layer centres at `(l + ½) s`): the bottom layer reaches `(h − s/2) / tan α`.
+fn cone_outline(alpha_deg: f64, h: f64, s: f64) -> f64 {
+    (h - 0.5 * s) / alpha_deg.to_radians().tan()
+}
+
+/// The largest connected set by breadth-first search over all pairs (the naive oracle of the
+/// deposit): ties to the set holding the lowest index.
+fn naive_largest_cluster(pts: &[Vec3<f64>], gap: f64) -> Vec<usize> {
+    let n = pts.len();
+    let mut label = vec![usize::MAX; n];
+    let mut best: (usize, usize) = (0, usize::MAX);
+    for start in 0..n {
+        if label[start] != usize::MAX {
+            continue;
+        }
+        label[start] = start;
+        let mut queue = vec![start];
+        let mut size = 0;
+        while let Some(i) = queue.pop() {
+            size += 1;
+            for j in 0..n {
+                if label[j] == usize::MAX && (pts[i] - pts[j]).norm() < gap {
+                    label[j] = start;
+                    queue.push(j);
+                }
+            }
+        }
+        if best.1 == usize::MAX || size > best.0 {
+            best = (size, start);
+        }
+    }
+    (0..n).filter(|&i| label[i] == best.1).collect()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    /// A lattice cone's runout is its bottom layer's outline: each sector's outermost centre
+    /// lies within one spacing inside it (the lattice's resolution along a ray in a sector at
+    /// least three spacings wide), the particle radius then added; jitter `j` moves it by
+    /// at most `√2 j` more.
+    #[test]
+    fn radial_runout_of_a_cone_is_its_outline(
+        alpha in 15.0f64..45.0,
+        layers in 6.0f64..16.0,
+        sectors in 1usize..24,
+        jitter_over_s in 0.0f64..0.1,
+        seed in any::<u64>(),
+    ) {
+        let s = 0.01;
+        let h = layers * s;
+        let j = jitter_over_s * s;
+        let outline = cone_outline(alpha, h, s);
+        prop_assume!(std::f64::consts::TAU * outline / sectors as f64 >= 3.0 * s);
+        let axis = (0.37, -0.21);
+        let mut pts = cone(alpha, h, s, axis, j, seed);
+        let opts = RadialRunoutOptions {
+            sectors,
+            ..RadialRunoutOptions::connected([axis.0, axis.1], s)
+        };
+        let clean = radial_runout(&pts, &opts).unwrap();
+        let centre = clean.radius_m - 0.5 * s;
+        let jit = std::f64::consts::SQRT_2 * j;
+        prop_assert!(centre >= outline - s - jit && centre <= outline + jit,
+            "runout {} against the outline {outline} (s = {s})", clean.radius_m);
+        prop_assert_eq!(clean.deposit.len(), pts.len());
+        // grains thrown ahead, separated from the deposit, do not count
+        let n = pts.len();
+        for k in 0..8 {
+            let phi = k as f64 * 0.8;
+            let r = outline + 3.0 * s;
+            pts.push(Vec3::new(axis.0 + r * phi.cos(), 0.5 * s, axis.1 + r * phi.sin()));
+        }
+        let thrown = radial_runout(&pts, &opts).unwrap();
+        prop_assert_eq!(thrown.radius_m, clean.radius_m);
+        prop_assert_eq!(thrown.deposit, (0..n).collect::<Vec<_>>());
+    }
+
+    /// The deposit is the largest connected set, as the naive search over all pairs finds it.
+    #[test]
+    fn deposit_is_the_largest_connected_set(
+        blobs in proptest::collection::vec((-0.1f64..0.1, -0.1f64..0.1, 1usize..40), 1..5),
+        gap in 0.005f64..0.03,
+        seed in any::<u64>(),
+    ) {
+        let mut rng = Jitter(seed);
+        let mut pts = Vec::new();
+        for &(x, z, count) in &blobs {
+            for _ in 0..count {
+                pts.push(Vec3::new(x + rng.offset(0.02), rng.offset(0.02), z + rng.offset(0.02)));
+            }
+        }
+        let opts = RadialRunoutOptions { sectors: 1, ..RadialRunoutOptions::connected([0.0, 0.0], gap / 2.0) };
+        let got = radial_runout(&pts, &opts).unwrap();
+        prop_assert_eq!(got.deposit, naive_largest_cluster(&pts, gap));
+    }
+}
+
+/// An elliptical layer (semi-axes 0.3 m along x, 0.15 m along z): each sector's front is the
+/// largest ellipse radius over the sector's azimuths (oracle: 1000 azimuths per sector), to
+/// within one spacing (lattice) and the particle radius added.
+#[test]
+fn radial_runout_of_an_ellipse_is_its_mean_sector_outline() {
+    let (a, b, s) = (0.3, 0.15, 0.005);
+    let mut pts = Vec::new();
+    let n = (a / s) as i64 + 1;
+    for i in -n..=n {
+        for k in -n..=n {
+            let (x, z) = (i as f64 * s, k as f64 * s);
+            if (x / a).powi(2) + (z / b).powi(2) < 1.0 {
+                pts.push(Vec3::new(x, 0.5 * s, z));
+            }
+        }
+    }
+    let sectors = 12;
+    let opts = RadialRunoutOptions {
+        sectors,
+        ..RadialRunoutOptions::connected([0.0, 0.0], s)
+    };
+    let got = radial_runout(&pts, &opts).unwrap();
+    let r_of = |phi: f64| 1.0 / ((phi.cos() / a).powi(2) + (phi.sin() / b).powi(2)).sqrt();
+    let tau = std::f64::consts::TAU;
+    for (k, front) in got.sector_fronts_m.iter().enumerate() {
+        let oracle = (0..1000)
+            .map(|m| -std::f64::consts::PI + tau * (k as f64 + m as f64 / 1000.0) / sectors as f64)
+            .map(r_of)
+            .fold(0.0, f64::max);
+        let centre = front - 0.5 * s;
+        assert!(
+            centre <= oracle && centre >= oracle - s,
+            "sector {k}: front {front} against the outline {oracle}"
+        );
+    }
+}
+
+#[test]
+fn radial_runout_bad_input_is_named() {
+    let s = 0.01;
+    let half: Vec<Vec3<f64>> = (0..20)
+        .flat_map(|i| {
+            (0..10).map(move |k| Vec3::new(i as f64 * s - 0.1, 0.005, k as f64 * s + 0.001))
+        })
+        .collect();
+    let opts = RadialRunoutOptions::connected([0.0, 0.0], s);
+    let e = radial_runout(&half, &opts).unwrap_err();
+    assert!(matches!(e, MeasureError::Degenerate { .. }), "{e}");
+    assert!(e.to_string().contains("does not surround the axis"), "{e}");
+    let e = radial_runout::<f64>(&[], &opts).unwrap_err();
+    assert!(matches!(e, MeasureError::Empty { .. }), "{e}");
+    let bad = |o: RadialRunoutOptions, name: &str| {
+        let e = radial_runout(&half, &o).unwrap_err();
+        assert!(e.to_string().contains(name), "{e}");
+    };
+    bad(RadialRunoutOptions { sectors: 0, ..opts }, "sectors");
+    bad(
+        RadialRunoutOptions {
+            max_gap_m: 0.0,
+            ..opts
+        },
+        "max_gap_m",
+    );
+    bad(
+        RadialRunoutOptions {
+            particle_radius_m: f64::NAN,
+            ..opts
+        },
+        "particle_radius_m",
+    );
+    bad(
+        RadialRunoutOptions {
+            axis_xz: [f64::INFINITY, 0.0],
+            ..opts
+        },
+        "axis_xz",
+    );
+    let mut nan = half.clone();
+    nan[3].y = f64::NAN;
+    let e = radial_runout(&nan, &opts).unwrap_err();
+    assert!(matches!(e, MeasureError::NonFinite { index: 3, .. }), "{e}");
 }

@@ -12,8 +12,8 @@
 //! - [`ParticleSet`], a structure-of-arrays particle container with an allocation-free
 //!   [`ParticleSet::permute`] used to keep particles sorted by cell,
 //! - [`Aabb`], an axis-aligned box,
-//! - the signed-distance-field trait [`Sdf`] with analytic [`Plane`], [`BoxSdf`], [`Sphere`]
-//!   and the complement [`Inverted`] (a tank is `Inverted<BoxSdf>`),
+//! - the signed-distance-field trait [`Sdf`] with analytic [`Plane`], [`BoxSdf`], [`Sphere`],
+//!   [`CylinderSdf`] and the complement [`Inverted`] (a tank is `Inverted<BoxSdf>`),
 //! - [`SampledGrid`], a scalar field sampled on a regular grid with trilinear interpolation
 //!   (module [`grid`]),
 //! - [`TriangleMesh`] and its sampled signed distance [`GridSdf`] (module [`mesh`]),
@@ -28,6 +28,7 @@ mod particles;
 mod real;
 pub mod sampling;
 mod sdf;
+mod sdf_cylinder;
 
 pub use aabb::Aabb;
 pub use error::CoreError;
@@ -38,6 +39,7 @@ pub use particles::{
 };
 pub use real::Real;
 pub use sdf::{push_fingerprint, BoxSdf, Inverted, Plane, Sdf, Sphere};
+pub use sdf_cylinder::CylinderSdf;
 
 /// A 3D column vector of [`Real`] (nalgebra).
 pub type Vec3<R> = nalgebra::Vector3<R>;

@@ -75,14 +75,27 @@ pub trait Sdf<R: Real>: Send + Sync {
 }
 
 /// Appends `(a, b) ∩ [0, t_max]` to `out` when it is not empty.
-fn push_clipped(a: f64, b: f64, t_max: f64, out: &mut Vec<(f64, f64)>) {
+pub(crate) fn push_clipped(a: f64, b: f64, t_max: f64, out: &mut Vec<(f64, f64)>) {
     let (a, b) = (a.max(0.0), b.min(t_max));
     if a < b {
         out.push((a, b));
     }
 }
 
-fn v64<R: Real>(v: &Vec3<R>) -> Vec3<f64> {
+/// The two distinct real roots `t1 < t2` of `a t² + 2 b t + c = 0` (`a > 0`), in the stable
+/// form that avoids cancelling `b` against the discriminant; `None` without two distinct
+/// roots (or with `a ≤ 0`, or a NaN).
+pub(crate) fn quadratic_roots(a: f64, b: f64, c: f64) -> Option<(f64, f64)> {
+    let disc = b * b - a * c;
+    if !(a > 0.0 && disc > 0.0) {
+        return None;
+    }
+    let q = -(b + b.signum() * disc.sqrt());
+    let (t1, t2) = (q / a, c / q);
+    Some((t1.min(t2), t1.max(t2)))
+}
+
+pub(crate) fn v64<R: Real>(v: &Vec3<R>) -> Vec3<f64> {
     Vec3::new(v.x.as_f64(), v.y.as_f64(), v.z.as_f64())
 }
 
@@ -97,7 +110,7 @@ pub fn push_fingerprint<R: Real>(out: &mut Vec<u8>, tag: &str, values: &[R]) {
     }
 }
 
-fn check_positive<R: Real>(name: &'static str, value: R) -> Result<(), CoreError> {
+pub(crate) fn check_positive<R: Real>(name: &'static str, value: R) -> Result<(), CoreError> {
     if !(value.is_finite_value() && value > R::zero()) {
         return Err(CoreError::InvalidParameter {
             name,
@@ -108,7 +121,7 @@ fn check_positive<R: Real>(name: &'static str, value: R) -> Result<(), CoreError
     Ok(())
 }
 
-fn check_finite_vec<R: Real>(name: &'static str, v: &Vec3<R>) -> Result<(), CoreError> {
+pub(crate) fn check_finite_vec<R: Real>(name: &'static str, v: &Vec3<R>) -> Result<(), CoreError> {
     if let Some(a) = (0..3).find(|&a| !v[a].is_finite_value()) {
         return Err(CoreError::InvalidParameter {
             name,
@@ -243,11 +256,8 @@ impl<R: Real> Sdf<R> for Sphere<R> {
         let d = x - v64(&self.center);
         let r = self.radius.as_f64();
         let (a, b, c) = (dir.norm_squared(), d.dot(dir), d.norm_squared() - r * r);
-        let disc = b * b - a * c;
-        if a > 0.0 && disc > 0.0 {
-            let q = -(b + b.signum() * disc.sqrt());
-            let (t1, t2) = (q / a, c / q);
-            push_clipped(t1.min(t2), t1.max(t2), t_max, out);
+        if let Some((t1, t2)) = quadratic_roots(a, b, c) {
+            push_clipped(t1, t2, t_max, out);
         }
         true
     }
@@ -462,6 +472,7 @@ mod tests {
                 Box::new(Inverted(unit_box())),
                 Box::new(Sphere::new(Vec3::new(0.5, -0.5, 0.2), 1.5).unwrap()),
                 Box::new(Plane::new(Vec3::new(0.0, 1.0, 0.0), Vec3::new(1.0, 2.0, -0.5)).unwrap()),
+                Box::new(crate::CylinderSdf::new(Vec3::new(0.3, -1.0, 0.1), 1.2, 2.5).unwrap()),
             ];
             let mut prints = Vec::new();
             for s in &shapes {
@@ -538,6 +549,7 @@ mod tests {
                 Box::new(Inverted(unit_box())),
                 Box::new(Sphere::new(Vec3::new(0.5, -0.5, 0.2), 1.5).unwrap()),
                 Box::new(Plane::new(Vec3::new(0.0, 1.0, 0.0), Vec3::new(1.0, 2.0, -0.5)).unwrap()),
+                Box::new(crate::CylinderSdf::new(Vec3::new(0.3, -1.0, 0.1), 1.2, 2.5).unwrap()),
             ];
             for s in &shapes {
                 let g = s.gradient(&p);

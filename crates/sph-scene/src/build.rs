@@ -8,8 +8,8 @@
 use std::sync::Arc;
 
 use sph_core::{
-    sampling::cubic_lattice, Aabb, BoxSdf, GridSdf, Inverted, Plane, Real, Sdf, Sphere,
-    TriangleMesh, Vec3,
+    sampling::cubic_lattice, Aabb, BoxSdf, CylinderSdf, GridSdf, Inverted, Plane, Real, Sdf,
+    Sphere, TriangleMesh, Vec3,
 };
 
 use crate::error::Ctx;
@@ -46,8 +46,10 @@ impl Scene {
         let samples = self.fluid_samples(&ctx)?;
         let (mut positions, mut velocities) = (Vec::new(), Vec::new());
         for (f, pts) in self.fluids.iter().zip(samples.iter()) {
-            let (FluidSpec::Block { velocity, .. } | FluidSpec::Mesh { velocity, .. }) = f;
-            velocities.extend(std::iter::repeat_n(cast3::<R>(&v3(*velocity)), pts.len()));
+            velocities.extend(std::iter::repeat_n(
+                cast3::<R>(&v3(f.velocity())),
+                pts.len(),
+            ));
             positions.extend(pts.iter().map(cast3::<R>));
         }
         Ok(FluidParticles {
@@ -59,14 +61,7 @@ impl Scene {
     /// Upper bound of the particle count of fluid `i` (lattice points over its box).
     fn lattice_estimate(&self, i: usize) -> f64 {
         let s = self.particle_spacing;
-        let b = match &self.fluids[i] {
-            FluidSpec::Block { min, max, .. } => Aabb {
-                min: v3(*min),
-                max: v3(*max),
-            },
-            FluidSpec::Mesh { mesh, .. } => mesh.mesh.bounds(),
-        };
-        let e = b.extent();
+        let e = self.fluids[i].bounds().extent();
         (0..3)
             .map(|a| ((e[a] / s) + 1e-9).floor().max(1.0))
             .product()
@@ -86,6 +81,15 @@ impl Scene {
                         max: *max,
                     },
                     FluidSpec::Mesh { mesh, .. } => FluidKey::Mesh(Arc::clone(&mesh.mesh)),
+                    FluidSpec::Cylinder {
+                        base_center,
+                        radius,
+                        height,
+                        ..
+                    } => FluidKey::Cylinder {
+                        base_center: *base_center,
+                        radius_height: [*radius, *height],
+                    },
                 })
                 .collect(),
         };
@@ -122,6 +126,13 @@ impl Scene {
                     .filter(|p| grid.signed_distance(p) < 0.0)
                     .collect())
             }
+            FluidSpec::Cylinder {
+                base_center,
+                radius,
+                height,
+                ..
+            } => cylinder_lattice(v3(*base_center), *radius, *height, s, MAX_PARTICLES)
+                .map_err(lattice_err),
         }
     }
 
@@ -143,6 +154,18 @@ impl Scene {
             SolidSpec::Plane { point, normal } => Box::new(
                 Plane::new(cast3::<R>(&v3(*point)), cast3::<R>(&v3(*normal)))
                     .map_err(|e| core("normal", e))?,
+            ),
+            SolidSpec::Cylinder {
+                base_center,
+                radius,
+                height,
+            } => Box::new(
+                CylinderSdf::new(
+                    cast3::<R>(&v3(*base_center)),
+                    R::of_f64(*radius),
+                    R::of_f64(*height),
+                )
+                .map_err(|e| core("radius", e))?,
             ),
             SolidSpec::Mesh { mesh, sdf_cell } => {
                 let cell = sdf_cell.unwrap_or(self.particle_spacing * 0.5);
@@ -212,6 +235,18 @@ impl Scene {
                     ));
                 }
             }
+            if let FluidSpec::Cylinder { height, .. } = &self.fluids[i] {
+                // The first layer sits half a spacing above the base (as in a block).
+                let s = self.particle_spacing;
+                if *height < s * (1.0 - 1e-9) {
+                    return Err(ctx.invalid(
+                        format!("{field}.height"),
+                        format!(
+                            "the cylinder is {height} m high, less than one particle_spacing ({s} m): it cannot hold a layer of particles"
+                        ),
+                    ));
+                }
+            }
         }
         let samples = self.fluid_samples(ctx)?;
         for (i, pts) in samples.iter().enumerate() {
@@ -276,4 +311,104 @@ fn build_grid<R: Real>(
     }
     GridSdf::new(mesh, R::of_f64(cell), R::of_f64(margin))
         .map_err(|e| ctx.invalid(field, format!("building the signed distance grid: {e}")))
+}
+
+/// The points of a cubic lattice of spacing `s` inside the vertical cylinder of radius
+/// `radius` and height `height` on the base centre `c` (see the crate documentation): the
+/// lattice is centred on the axis (the axis passes through the corners of four lattice cells,
+/// so the points sit at `c + ((i + ½) s, (j + ½) s, (k + ½) s)`), its first layer half a
+/// spacing above the base, `⌊height / s⌋` layers (at least one), and a point is kept when
+/// its horizontal distance to the axis is **< `radius`**, so that `N s³` approximates the
+/// volume `π r² H` without bias.
+pub(crate) fn cylinder_lattice(
+    c: Vec3<f64>,
+    radius: f64,
+    height: f64,
+    s: f64,
+    max_points: usize,
+) -> Result<Vec<Vec3<f64>>, sph_core::CoreError> {
+    if !(s.is_finite() && s > 0.0) {
+        return Err(sph_core::CoreError::InvalidParameter {
+            name: "lattice spacing",
+            value: s,
+            reason: "must be finite and > 0",
+        });
+    }
+    let n = (radius / s).ceil().max(1.0);
+    let layers = (height / s + 1e-9).floor().max(1.0);
+    let estimate = 4.0 * n * n * layers;
+    if !(estimate <= max_points as f64) {
+        return Err(sph_core::CoreError::InvalidParameter {
+            name: "lattice point count",
+            value: estimate,
+            reason: "exceeds the allowed maximum",
+        });
+    }
+    let (n, layers) = (n as i64, layers as i64);
+    let mut out = Vec::new();
+    for i in -n..n {
+        let dx = (i as f64 + 0.5) * s;
+        for k in -n..n {
+            let dz = (k as f64 + 0.5) * s;
+            if dx.hypot(dz) >= radius {
+                continue;
+            }
+            for j in 0..layers {
+                out.push(Vec3::new(c.x + dx, c.y + (j as f64 + 0.5) * s, c.z + dz));
+            }
+        }
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// Against the shape itself (not the lattice rule): every point lies inside the
+        /// cylinder, the set is mirror-symmetric about the axis in x and z, the layers are
+        /// `⌊H/s⌋`, and the count per layer matches the disc area to within the band of cells
+        /// the circle crosses (`|N s² − π r²| ≤ 2π r · √2 s`, the area of cells within half a
+        /// cell diagonal of the circle).
+        #[test]
+        fn cylinder_lattice_fills_the_cylinder(
+            cx in -1.0..1.0f64, cy in -1.0..1.0f64, cz in -1.0..1.0f64,
+            r_over_s in 0.8..12.0f64, h_over_s in 1.0..8.0f64, s in 0.01..0.1f64,
+        ) {
+            let (r, h) = (r_over_s * s, h_over_s * s);
+            let c = Vec3::new(cx, cy, cz);
+            let pts = cylinder_lattice(c, r, h, s, 1 << 20).unwrap();
+            let tol = 1e-9;
+            for p in &pts {
+                prop_assert!((p.x - cx).hypot(p.z - cz) < r + tol);
+                prop_assert!(p.y > cy && p.y < cy + h + tol);
+            }
+            let layers = (h / s + 1e-9).floor() as usize;
+            prop_assert_eq!(pts.len() % layers, 0);
+            let per_layer = (pts.len() / layers) as f64;
+            let area = std::f64::consts::PI * r * r;
+            let band = 2.0 * std::f64::consts::PI * r * std::f64::consts::SQRT_2 * s;
+            prop_assert!((per_layer * s * s - area).abs() <= band,
+                "{per_layer} points of {s}² against π r² = {area}");
+            // mirror symmetry about the axis
+            let key = |x: f64, y: f64, z: f64| {
+                let half = |d: f64| (2.0 * d / s).round() as i64;
+                (half(x - cx), half(y - cy), half(z - cz))
+            };
+            let set: std::collections::HashSet<_> =
+                pts.iter().map(|p| key(p.x, p.y, p.z)).collect();
+            for p in &pts {
+                prop_assert!(set.contains(&key(2.0 * cx - p.x, p.y, p.z)));
+                prop_assert!(set.contains(&key(p.x, p.y, 2.0 * cz - p.z)));
+            }
+        }
+    }
+
+    #[test]
+    fn cylinder_lattice_refuses_too_many_points() {
+        let e = cylinder_lattice(Vec3::zeros(), 1.0, 1.0, 0.001, 1000).unwrap_err();
+        assert!(e.to_string().contains("lattice point count"), "{e}");
+    }
 }

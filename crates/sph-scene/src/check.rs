@@ -136,13 +136,21 @@ fn check_fluid(
     f: &FluidSpec,
     tank: Option<&Aabb<f64>>,
 ) -> Result<(), SceneError> {
-    let (FluidSpec::Block { velocity, .. } | FluidSpec::Mesh { velocity, .. }) = f;
-    ctx.finite3(&format!("{field}.velocity"), velocity)?;
+    ctx.finite3(&format!("{field}.velocity"), &f.velocity())?;
     let (b, bfield) = match f {
         FluidSpec::Block { min, max, .. } => {
             (ctx.check_box(field, min, max)?, format!("{field}.max"))
         }
         FluidSpec::Mesh { mesh, .. } => (mesh.mesh.bounds(), placement_field(field, mesh)),
+        FluidSpec::Cylinder {
+            base_center,
+            radius,
+            height,
+            ..
+        } => {
+            check_cylinder(ctx, field, base_center, *radius, *height)?;
+            (f.bounds(), format!("{field}.base_center"))
+        }
     };
     let Some(t) = tank else {
         return Ok(());
@@ -162,6 +170,20 @@ fn check_fluid(
         )),
         None => Ok(()),
     }
+}
+
+/// A cylinder's fields at `field` (fluid or solid): a finite base centre, a positive radius
+/// and height.
+fn check_cylinder(
+    ctx: &Ctx,
+    field: &str,
+    base_center: &[f64; 3],
+    radius: f64,
+    height: f64,
+) -> Result<(), SceneError> {
+    ctx.finite3(&format!("{field}.base_center"), base_center)?;
+    ctx.positive(&format!("{field}.radius"), radius)?;
+    ctx.positive(&format!("{field}.height"), height)
 }
 
 /// One solid at `field`.
@@ -184,6 +206,11 @@ fn check_solid(ctx: &Ctx, field: &str, s: &SolidSpec) -> Result<(), SceneError> 
             }
             Ok(())
         }
+        SolidSpec::Cylinder {
+            base_center,
+            radius,
+            height,
+        } => check_cylinder(ctx, field, base_center, *radius, *height),
         SolidSpec::Mesh { sdf_cell, .. } => match sdf_cell {
             Some(c) => ctx.positive(&format!("{field}.sdf_cell"), *c),
             None => Ok(()),

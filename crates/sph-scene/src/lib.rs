@@ -177,12 +177,19 @@
 //! #   kept), centred in it
 //! velocity = [0.0, -1.0, 0.0]      # m/s (default 0)
 //!
+//! # [[fluid]]
+//! # kind = "cylinder"              # a vertical cylinder (axis along y), filled with fluid
+//! # base_center = [0.3, 0.0, 0.3]  # m, centre of the base disc
+//! # radius = 0.1                   # m, > 0
+//! # height = 0.2                   # m, >= particle_spacing
+//!
 //! [[solid]]                        # obstacles, in file order after the tank
 //! kind = "sphere"                  # center (m), radius (m, > 0)
 //! center = [0.8, 0.2, 0.3]
 //! radius = 0.1
 //! # kind = "box":   min, max (m)
 //! # kind = "plane": point (m), normal (points into the free side, normalised)
+//! # kind = "cylinder": base_center (m), radius (m, > 0), height (m, > 0): vertical axis
 //! # kind = "mesh":  path, scale/translate or fit (as for fluids), sdf_cell (m, grid spacing of
 //! #                 the signed distance field, default particle_spacing / 2)
 //!
@@ -210,6 +217,11 @@
 //!   mesh's bounding box whose signed distance to the mesh is **< 0** (centre inside the
 //!   surface), so that `N s³` approximates the mesh volume without bias. The distance is a
 //!   [`GridSdf`](sph_core::GridSdf) with cell = `particle_spacing` (only its sign matters).
+//! * Cylinders ([`FluidSpec::Cylinder`]) are filled with a cubic lattice centred on their
+//!   axis (the axis through the corners of four lattice cells, the first layer half a
+//!   spacing above the base, `⌊height/s⌋` layers), keeping the points whose distance to the
+//!   axis is **< radius**: mirror-symmetric about the axis, with `N s³` approximating
+//!   `π r² H` without bias.
 //! * Meshes must be closed
 //!   ([`TriangleMesh::check_closed`](sph_core::TriangleMesh::check_closed)). OBJ files are
 //!   read by the crate's own reader (`v` and `f` statements; polygons split into a fan of
@@ -222,7 +234,7 @@
 //!   before it is opened).
 //! * After parsing, every value is checked ([`Scene::check`]): spacing, durations, radii and cells finite and
 //!   positive, every number finite, `min < max`, substeps/iterations ≥ 1, fluids inside the tank
-//!   (block or mesh bounds inside the tank box, every particle strictly inside it), blocks at
+//!   (block or mesh bounds inside the tank box, every particle strictly inside it), blocks and cylinders at
 //!   least one spacing thick, no fluid particle inside (or on) a solid, at most
 //!   [`MAX_PARTICLES`] particles, mesh files that exist and are closed. The scene with its
 //!   `[quick]` overrides is validated too, so [`Scene::quick`] cannot fail.

@@ -163,6 +163,9 @@ fn required_box(
     })
 }
 
+/// The fields of `kind = "cylinder"` (fluid and solid).
+const CYLINDER_FIELDS: [&str; 3] = ["base_center", "radius", "height"];
+
 /// One `[[fluid]]` table at `field`.
 fn fluid(
     ctx: &Ctx,
@@ -179,6 +182,9 @@ fn fluid(
         ("scale", f.scale.is_some()),
         ("translate", f.translate.is_some()),
         ("fit", f.fit.is_some()),
+        ("base_center", f.base_center.is_some()),
+        ("radius", f.radius.is_some()),
+        ("height", f.height.is_some()),
     ];
     Ok(match f.kind {
         RawFluidKind::Block => {
@@ -195,6 +201,21 @@ fn fluid(
             forbid(ctx, field, "mesh", &present, &own)?;
             let mesh = meshes.mesh_spec(ctx, field, MeshFields::of_fluid(f))?;
             FluidSpec::Mesh { mesh, velocity }
+        }
+        RawFluidKind::Cylinder => {
+            forbid(ctx, field, "cylinder", &present, &CYLINDER_FIELDS)?;
+            let required = |name: &str, v| require(ctx, &format!("{field}.{name}"), "cylinder", v);
+            FluidSpec::Cylinder {
+                base_center: require(
+                    ctx,
+                    &format!("{field}.base_center"),
+                    "cylinder",
+                    f.base_center,
+                )?,
+                radius: required("radius", f.radius)?,
+                height: required("height", f.height)?,
+                velocity,
+            }
         }
     })
 }
@@ -219,6 +240,8 @@ fn solid(
         ("translate", s.translate.is_some()),
         ("fit", s.fit.is_some()),
         ("sdf_cell", s.sdf_cell.is_some()),
+        ("base_center", s.base_center.is_some()),
+        ("height", s.height.is_some()),
     ];
     let vector = |name: &str, kind: &str, v: Option<[f64; 3]>| {
         require(ctx, &format!("{field}.{name}"), kind, v)
@@ -251,6 +274,14 @@ fn solid(
             SolidSpec::Mesh {
                 mesh,
                 sdf_cell: s.sdf_cell,
+            }
+        }
+        RawSolidKind::Cylinder => {
+            forbid(ctx, field, "cylinder", &present, &CYLINDER_FIELDS)?;
+            SolidSpec::Cylinder {
+                base_center: vector("base_center", "cylinder", s.base_center)?,
+                radius: require(ctx, &format!("{field}.radius"), "cylinder", s.radius)?,
+                height: require(ctx, &format!("{field}.height"), "cylinder", s.height)?,
             }
         }
     })

@@ -56,6 +56,7 @@ pub(crate) struct RawBox {
 pub(crate) enum RawFluidKind {
     Block,
     Mesh,
+    Cylinder,
 }
 
 #[derive(Debug, Deserialize)]
@@ -69,6 +70,9 @@ pub(crate) struct RawFluid {
     pub scale: Option<f64>,
     pub translate: Option<[f64; 3]>,
     pub fit: Option<RawBox>,
+    pub base_center: Option<[f64; 3]>,
+    pub radius: Option<f64>,
+    pub height: Option<f64>,
 }
 
 #[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]
@@ -78,6 +82,7 @@ pub(crate) enum RawSolidKind {
     Box,
     Plane,
     Mesh,
+    Cylinder,
 }
 
 #[derive(Debug, Deserialize)]
@@ -95,6 +100,8 @@ pub(crate) struct RawSolid {
     pub translate: Option<[f64; 3]>,
     pub fit: Option<RawBox>,
     pub sdf_cell: Option<f64>,
+    pub base_center: Option<[f64; 3]>,
+    pub height: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -5,7 +5,7 @@
 use ssfr_render::{Obstacle, RenderConfig, RenderParams, SceneInfo, SsfrError};
 
 use crate::error::Ctx;
-use crate::{FluidSpec, Scene, SceneError, SolidSpec};
+use crate::{Scene, SceneError, SolidSpec};
 
 fn f3(a: [f64; 3]) -> [f32; 3] {
     [a[0] as f32, a[1] as f32, a[2] as f32]
@@ -16,18 +16,13 @@ const SOLID_COLOUR: [f32; 3] = [0.55, 0.45, 0.40];
 
 impl Scene {
     /// What the renderer's defaults need from the scene: tank, liquid bounds, spacing, and
-    /// the box and sphere solids as obstacles (mesh solids as their bounding box; planes are
+    /// the box and sphere solids as obstacles (mesh and cylinder solids as their bounding box; planes are
     /// not drawn).
     pub fn render_info(&self) -> SceneInfo {
         let mut liquid: Option<([f32; 3], [f32; 3])> = None;
         for f in &self.fluids {
-            let (lo, hi) = match f {
-                FluidSpec::Block { min, max, .. } => (f3(*min), f3(*max)),
-                FluidSpec::Mesh { mesh, .. } => {
-                    let b = mesh.mesh.bounds();
-                    (f3(b.min.into()), f3(b.max.into()))
-                }
-            };
+            let b = f.bounds();
+            let (lo, hi) = (f3(b.min.into()), f3(b.max.into()));
             liquid = Some(match liquid {
                 None => (lo, hi),
                 Some((a, b)) => (
@@ -58,6 +53,15 @@ impl Scene {
                         colour: SOLID_COLOUR,
                     })
                 }
+                SolidSpec::Cylinder {
+                    base_center: c,
+                    radius: r,
+                    height: h,
+                } => Some(Obstacle::Box {
+                    min: f3([c[0] - r, c[1], c[2] - r]),
+                    max: f3([c[0] + r, c[1] + h, c[2] + r]),
+                    colour: SOLID_COLOUR,
+                }),
                 SolidSpec::Plane { .. } => None,
             })
             .collect();

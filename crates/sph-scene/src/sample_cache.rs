@@ -24,8 +24,15 @@ pub(crate) struct SampleKey {
 /// One fluid's part of a [`SampleKey`].
 #[derive(Clone)]
 pub(crate) enum FluidKey {
-    Block { min: [f64; 3], max: [f64; 3] },
+    Block {
+        min: [f64; 3],
+        max: [f64; 3],
+    },
     Mesh(Arc<TriangleMesh<f64>>),
+    Cylinder {
+        base_center: [f64; 3],
+        radius_height: [f64; 2],
+    },
 }
 
 impl PartialEq for SampleKey {
@@ -42,6 +49,20 @@ impl PartialEq for SampleKey {
                         bits(a) == bits(c) && bits(b) == bits(d)
                     }
                     (FluidKey::Mesh(a), FluidKey::Mesh(b)) => Arc::ptr_eq(a, b),
+                    (
+                        FluidKey::Cylinder {
+                            base_center: a,
+                            radius_height: [r, h],
+                        },
+                        FluidKey::Cylinder {
+                            base_center: c,
+                            radius_height: [q, k],
+                        },
+                    ) => {
+                        bits(a) == bits(c)
+                            && r.to_bits() == q.to_bits()
+                            && h.to_bits() == k.to_bits()
+                    }
                     _ => false,
                 })
     }

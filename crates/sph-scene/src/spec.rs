@@ -133,6 +133,49 @@ pub enum FluidSpec {
         /// Initial velocity (m/s).
         velocity: [f64; 3],
     },
+    /// A solid cylinder with a vertical axis (along `y`): the points within `radius` of the
+    /// axis through `base_center`, from `base_center[1]` up to `base_center[1] + height`.
+    Cylinder {
+        /// Centre of the base disc (m).
+        base_center: [f64; 3],
+        /// Radius (m, > 0).
+        radius: f64,
+        /// Height (m, > 0).
+        height: f64,
+        /// Initial velocity (m/s).
+        velocity: [f64; 3],
+    },
+}
+
+impl FluidSpec {
+    /// The initial velocity (m/s).
+    pub fn velocity(&self) -> [f64; 3] {
+        match self {
+            FluidSpec::Block { velocity, .. }
+            | FluidSpec::Mesh { velocity, .. }
+            | FluidSpec::Cylinder { velocity, .. } => *velocity,
+        }
+    }
+
+    /// The axis-aligned bounding box of the fluid's region (m).
+    pub fn bounds(&self) -> Aabb<f64> {
+        match self {
+            FluidSpec::Block { min, max, .. } => Aabb {
+                min: (*min).into(),
+                max: (*max).into(),
+            },
+            FluidSpec::Mesh { mesh, .. } => mesh.mesh.bounds(),
+            FluidSpec::Cylinder {
+                base_center: c,
+                radius: r,
+                height: h,
+                ..
+            } => Aabb {
+                min: [c[0] - r, c[1], c[2] - r].into(),
+                max: [c[0] + r, c[1] + h, c[2] + r].into(),
+            },
+        }
+    }
 }
 
 /// A solid obstacle (particles live outside it).
@@ -165,6 +208,15 @@ pub enum SolidSpec {
         mesh: MeshSpec,
         /// Grid spacing (m) of its signed distance field; `None` = `particle_spacing / 2`.
         sdf_cell: Option<f64>,
+    },
+    /// A solid cylinder with a vertical axis (along `y`), as a [`sph_core::CylinderSdf`].
+    Cylinder {
+        /// Centre of the base disc (m).
+        base_center: [f64; 3],
+        /// Radius (m, > 0).
+        radius: f64,
+        /// Height (m, > 0).
+        height: f64,
     },
 }
 

@@ -303,6 +303,76 @@ const SCENE_CASES: &[SceneCase] = &[
         )],
     },
     SceneCase {
+        name: "cylinder_negative_radius",
+        edits: &[(
+            "kind = \"block\"\nmin = [0.0, 0.0, 0.0]\nmax = [0.5, 0.5, 1.0]",
+            "kind = \"cylinder\"\nbase_center = [0.3, 0.0, 0.5]\nradius = -0.2\nheight = 0.4",
+        )],
+    },
+    SceneCase {
+        name: "cylinder_zero_height",
+        edits: &[(
+            "kind = \"block\"\nmin = [0.0, 0.0, 0.0]\nmax = [0.5, 0.5, 1.0]",
+            "kind = \"cylinder\"\nbase_center = [0.3, 0.0, 0.5]\nradius = 0.2\nheight = 0.0",
+        )],
+    },
+    SceneCase {
+        name: "cylinder_thinner_than_spacing",
+        edits: &[(
+            "kind = \"block\"\nmin = [0.0, 0.0, 0.0]\nmax = [0.5, 0.5, 1.0]",
+            "kind = \"cylinder\"\nbase_center = [0.3, 0.0, 0.5]\nradius = 0.2\nheight = 0.01",
+        )],
+    },
+    SceneCase {
+        name: "cylinder_missing_height",
+        edits: &[(
+            "kind = \"block\"\nmin = [0.0, 0.0, 0.0]\nmax = [0.5, 0.5, 1.0]",
+            "kind = \"cylinder\"\nbase_center = [0.3, 0.0, 0.5]\nradius = 0.2",
+        )],
+    },
+    SceneCase {
+        name: "cylinder_with_block_field",
+        edits: &[(
+            "kind = \"block\"\nmin = [0.0, 0.0, 0.0]\nmax = [0.5, 0.5, 1.0]",
+            "kind = \"cylinder\"\nbase_center = [0.3, 0.0, 0.5]\nradius = 0.2\nheight = 0.4\nmin = [0.0, 0.0, 0.0]",
+        )],
+    },
+    SceneCase {
+        name: "cylinder_outside_tank",
+        edits: &[(
+            "kind = \"block\"\nmin = [0.0, 0.0, 0.0]\nmax = [0.5, 0.5, 1.0]",
+            "kind = \"cylinder\"\nbase_center = [0.1, 0.0, 0.5]\nradius = 0.2\nheight = 0.4",
+        )],
+    },
+    SceneCase {
+        name: "cylinder_radius_below_spacing",
+        edits: &[(
+            "kind = \"block\"\nmin = [0.0, 0.0, 0.0]\nmax = [0.5, 0.5, 1.0]",
+            "kind = \"cylinder\"\nbase_center = [0.3, 0.0, 0.5]\nradius = 0.02\nheight = 0.4",
+        )],
+    },
+    SceneCase {
+        name: "solid_cylinder_negative_height",
+        edits: &[(
+            "kind = \"sphere\"\ncenter = [1.6, 0.3, 0.5]\nradius = 0.2",
+            "kind = \"cylinder\"\nbase_center = [1.6, 0.1, 0.5]\nradius = 0.2\nheight = -0.3",
+        )],
+    },
+    SceneCase {
+        name: "solid_cylinder_with_center",
+        edits: &[(
+            "kind = \"sphere\"\ncenter = [1.6, 0.3, 0.5]\nradius = 0.2",
+            "kind = \"cylinder\"\ncenter = [1.6, 0.1, 0.5]\nradius = 0.2\nheight = 0.3",
+        )],
+    },
+    SceneCase {
+        name: "fluid_overlaps_solid_cylinder",
+        edits: &[(
+            "kind = \"sphere\"\ncenter = [1.6, 0.3, 0.5]\nradius = 0.2",
+            "kind = \"cylinder\"\nbase_center = [0.4, 0.0, 0.5]\nradius = 0.2\nheight = 0.3",
+        )],
+    },
+    SceneCase {
         name: "render_negative_radius",
         edits: &[(
             "vtk = false\n",

@@ -289,8 +289,19 @@ fn too_many_particles() {
 
 #[test]
 fn field_of_another_kind() {
-    let e = err_with("other_kind", "velocity = [0.0, 0.0, 0.0]", "radius = 1.0");
-    assert_names(&e, "other_kind", "fluid[0].radius", "unknown field");
+    let e = err_with(
+        "other_kind",
+        "velocity = [0.0, 0.0, 0.0]",
+        "normal = [0.0, 1.0, 0.0]",
+    );
+    assert_names(&e, "other_kind", "fluid[0].normal", "unknown field");
+    let e = err_with("other_kind_r", "velocity = [0.0, 0.0, 0.0]", "radius = 1.0");
+    assert_names(
+        &e,
+        "other_kind_r",
+        "fluid[0].radius",
+        "not a field of kind = \"block\"",
+    );
     let e = err_with(
         "other_kind2",
         "velocity = [0.0, 0.0, 0.0]",
@@ -404,4 +415,36 @@ fn unreadable_scene_file() {
         msg.contains("unreadable.toml") && msg.contains("cannot read the scene file"),
         "{msg}"
     );
+}
+
+/// A cylinder solid and a cylinder fluid parse, and the solid's distance is that of
+/// `sph_core::CylinderSdf` with the file's values (after the tank, in file order).
+#[test]
+fn cylinder_fluid_and_solid_parse() {
+    let text = VALID
+        .replacen(
+            "kind = \"sphere\"\ncenter = [1.6, 0.3, 0.5]\nradius = 0.2",
+            "kind = \"cylinder\"\nbase_center = [1.6, 0.1, 0.5]\nradius = 0.2\nheight = 0.3",
+            1,
+        )
+        .replacen(
+            "kind = \"block\"\nmin = [0.0, 0.0, 0.0]\nmax = [0.5, 0.5, 1.0]",
+            "kind = \"cylinder\"\nbase_center = [0.3, 0.0, 0.5]\nradius = 0.2\nheight = 0.4",
+            1,
+        );
+    let dir = fixture_dir("cylinders");
+    let s = Scene::parse_str(&text, &dir.join("cylinders.toml")).unwrap();
+    assert!(matches!(s.solids[0], sph_scene::SolidSpec::Cylinder { .. }));
+    assert!(matches!(s.fluids[0], sph_scene::FluidSpec::Cylinder { .. }));
+    let solids = s.build_solids::<f64>().unwrap();
+    let oracle = sph_core::CylinderSdf::new(sph_core::Vec3::new(1.6, 0.1, 0.5), 0.2, 0.3).unwrap();
+    for p in [[1.6, 0.2, 0.5], [1.0, 0.0, 0.0], [1.7, 0.5, 0.6]] {
+        let p = sph_core::Vec3::from(p);
+        use sph_core::Sdf;
+        assert_eq!(solids[1].signed_distance(&p), oracle.signed_distance(&p));
+    }
+    // a 4-spacing radius disc of 52 points (lattice centred on the axis), 8 layers
+    assert_eq!(s.fluids[0].bounds().extent().y, 0.4);
+    let n = s.fluid_positions::<f64>().unwrap().len();
+    assert_eq!(n, 52 * 8 + 64);
 }

@@ -191,3 +191,35 @@ fn shipped_dam_break_iisph() {
     assert_eq!(s.boundary.model, BoundaryModel::VolumeMap);
     assert_eq!(s.solver.substeps(), 8);
 }
+
+/// The cylinder fluid of the axisymmetric collapse: the counts the scene's comment states
+/// (a 16- and 8-spacing disc of 812 and 208 lattice points, 16 and 8 layers), every particle
+/// inside the cylinder, the centroid on the axis, velocities zero.
+#[test]
+fn cylinder_fluid_of_the_axisymmetric_collapse() {
+    let s = Scene::load(&scene_path("granular_column_collapse_axisymmetric.toml")).unwrap();
+    let FluidSpec::Cylinder {
+        base_center: c,
+        radius,
+        height,
+        ..
+    } = s.fluids[0]
+    else {
+        panic!("not a cylinder: {:?}", s.fluids[0]);
+    };
+    for (scene, expected) in [(s.clone(), 812 * 16), (s.quick(), 208 * 8)] {
+        let p = scene.fluid_positions::<f64>().unwrap();
+        assert_eq!(p.len(), expected);
+        let n = p.len() as f64;
+        let (mx, mz) = p
+            .iter()
+            .fold((0.0, 0.0), |(x, z), q| (x + q.x / n, z + q.z / n));
+        assert!((mx - c[0]).abs() < 1e-9 && (mz - c[2]).abs() < 1e-9);
+        for q in &p {
+            assert!((q.x - c[0]).hypot(q.z - c[2]) < radius);
+            assert!(q.y > c[1] && q.y < c[1] + height);
+        }
+        let v = scene.fluid_velocities::<f64>().unwrap();
+        assert!(v.iter().all(|v| v.norm() == 0.0));
+    }
+}

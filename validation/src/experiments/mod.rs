@@ -28,6 +28,7 @@ pub fn registry() -> Vec<Box<dyn Experiment>> {
         Box::new(pbf::pbf_performance::PbfPerformance),
         Box::new(granular::repose::GranularRepose),
         Box::new(granular::column_collapse::GranularColumnCollapse),
+        Box::new(granular::axisymmetric_collapse::GranularColumnCollapseAxisymmetric),
         Box::new(granular::iisph_convergence::IisphConvergence),
         Box::new(granular::granular_performance::GranularPerformance),
         Box::new(ssfr::ssfr_depth_accuracy::SsfrDepthAccuracy),

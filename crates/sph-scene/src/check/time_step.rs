@@ -26,7 +26,7 @@ use sph_solver::{DEFAULT_SUPPORT_OVER_SPACING, MAX_SUBSTEPS};
 use crate::error::Ctx;
 use crate::geom::v3;
 use crate::limits::MAX_FRAMES;
-use crate::{FluidSpec, QuickSpec, Scene, SceneError};
+use crate::{QuickSpec, Scene, SceneError};
 
 /// Checks the time stepping of `scene`; `quick` are the overrides applied to it (the field
 /// names then point at `quick.*` for the values they set).
@@ -90,11 +90,7 @@ pub(super) fn check(ctx: &Ctx, scene: &Scene, quick: Option<&QuickSpec>) -> Resu
     let v0 = scene
         .fluids
         .iter()
-        .map(|f| match f {
-            FluidSpec::Block { velocity, .. } | FluidSpec::Mesh { velocity, .. } => {
-                v3(*velocity).norm()
-            }
-        })
+        .map(|f| v3(f.velocity()).norm())
         .fold(0.0, f64::max);
     let travel = (v0 + g * dt) * dt;
     if !(travel <= h) {

@@ -40,28 +40,29 @@ pub struct GranularColumnCollapse;
 
 /// The aspect ratios `a = H0/L0` run.
 const ASPECT_RATIOS: [f64; 5] = [0.5, 1.0, 2.0, 4.0, 7.0];
-/// Relative band around the law of each regime.
-const BAND: f64 = 0.3;
+/// Relative band around the law of each regime (this project's, set a priori; see the module
+/// documentation). Shared with the axisymmetric collapse.
+pub(super) const BAND: f64 = 0.3;
 /// The shipped template scene.
 const TEMPLATE: &str = "granular_column_collapse";
 
-/// One regime of the law: `coefficient · a^exponent` for `a_min ≤ a ≤ a_max`.
+/// One regime of a runout law: `coefficient · a^exponent` for `a_min ≤ a ≤ a_max`.
 #[derive(Debug, Clone, Copy)]
-struct Regime {
-    a_min: f64,
-    a_max: f64,
-    coefficient: f64,
-    exponent: f64,
+pub(super) struct Regime {
+    pub(super) a_min: f64,
+    pub(super) a_max: f64,
+    pub(super) coefficient: f64,
+    pub(super) exponent: f64,
 }
 
 impl Regime {
-    fn at(&self, a: f64) -> f64 {
+    pub(super) fn at(&self, a: f64) -> f64 {
         self.coefficient * a.powf(self.exponent)
     }
 }
 
 /// The band `[lo, hi]` of the normalised runout at `a`, and the regime's name.
-fn band(laws: &[Regime; 2], a: f64) -> (f64, f64, &'static str) {
+pub(super) fn band(laws: &[Regime; 2], a: f64) -> (f64, f64, &'static str) {
     let [linear, power] = laws;
     if a <= linear.a_max {
         let v = linear.at(a);
@@ -111,10 +112,12 @@ fn column_scene(base: &Scene, a: f64, laws: &[Regime; 2]) -> Result<Scene> {
     Ok(scene)
 }
 
-fn load_laws(ctx: &Context) -> Result<[Regime; 2]> {
+/// The two regimes (`linear`, `power`) of the runout law in the reference file `file`
+/// (columns `regime, a_min, a_max, coefficient, exponent`).
+pub(super) fn load_laws(ctx: &Context, file: &str) -> Result<[Regime; 2]> {
     let table = load_reference_csv(
         ctx,
-        "granular/lube_2005_runout_law.csv",
+        file,
         &["regime", "a_min", "a_max", "coefficient", "exponent"],
     )?;
     let get = |name: &str| -> Result<Regime> {
@@ -139,7 +142,7 @@ impl Experiment for GranularColumnCollapse {
     }
 
     fn run(&self, ctx: &mut Context) -> Result<Outcome> {
-        let laws = load_laws(ctx)?;
+        let laws = load_laws(ctx, "granular/lube_2005_runout_law.csv")?;
         let base = shipped(TEMPLATE, ctx.mode)?;
         let scenes: Vec<(f64, Scene)> = ASPECT_RATIOS
             .iter()
@@ -230,7 +233,21 @@ impl Experiment for GranularColumnCollapse {
             "runout.csv",
             "runout of each column against the band of Lube et al. (2005)",
         );
-        plot_runout(ctx, &laws, &simulated)?;
+        plot_runout(
+            ctx,
+            &laws,
+            &simulated,
+            &RunoutPlot {
+                title: "Granular column collapse: runout",
+                x_label: "aspect ratio a = H0/L0",
+                y_label: "normalised runout (L∞ − L0)/L0",
+                laws: [
+                    "Lube et al. 2005: 1.2 a (a < 1.8)",
+                    "Lube et al. 2005: 1.9 a^(2/3) (a > 2.8)",
+                ],
+                caption: "normalised runout against aspect ratio, IISPH against both regimes of Lube et al. (2005)",
+            },
+        )?;
         out.note(format!(
             "front = connected deposit (gaps up to 2 spacings) plus the particle radius; L0 = {} m; friction angle and spacing from scenes/{TEMPLATE}.toml",
             match base.fluids.first() {
@@ -242,7 +259,24 @@ impl Experiment for GranularColumnCollapse {
     }
 }
 
-fn plot_runout(ctx: &mut Context, laws: &[Regime; 2], simulated: &[(f64, f64)]) -> Result<()> {
+/// The labels of a runout plot.
+pub(super) struct RunoutPlot {
+    pub(super) title: &'static str,
+    pub(super) x_label: &'static str,
+    pub(super) y_label: &'static str,
+    /// The legend of the linear and the power regime.
+    pub(super) laws: [&'static str; 2],
+    pub(super) caption: &'static str,
+}
+
+/// `runout.png`: the simulated normalised runouts `(a, r)` over both regimes of `laws` and
+/// their ±[`BAND`] bands, log–log.
+pub(super) fn plot_runout(
+    ctx: &mut Context,
+    laws: &[Regime; 2],
+    simulated: &[(f64, f64)],
+    labels: &RunoutPlot,
+) -> Result<()> {
     let [linear, power] = *laws;
     let curve = |law: Regime, lo: f64, hi: f64, scale: f64| -> Vec<(f64, f64)> {
         (0..=40)
@@ -256,16 +290,8 @@ fn plot_runout(ctx: &mut Context, laws: &[Regime; 2], simulated: &[(f64, f64)]) 
     let lin_hi = linear.a_max.min(a_hi);
     let pow_lo = power.a_min.max(a_lo);
     let series = vec![
-        Series::line(
-            "Lube et al. 2005: 1.2 a (a < 1.8)",
-            curve(linear, a_lo, lin_hi, 1.0),
-            3,
-        ),
-        Series::line(
-            "Lube et al. 2005: 1.9 a^(2/3) (a > 2.8)",
-            curve(power, pow_lo, a_hi, 1.0),
-            2,
-        ),
+        Series::line(labels.laws[0], curve(linear, a_lo, lin_hi, 1.0), 3),
+        Series::line(labels.laws[1], curve(power, pow_lo, a_hi, 1.0), 2),
         Series::styled(
             "±30 % band",
             curve(linear, a_lo, lin_hi, 1.0 + BAND),
@@ -300,17 +326,9 @@ fn plot_runout(ctx: &mut Context, laws: &[Regime; 2], simulated: &[(f64, f64)]) 
     let spec = PlotSpec {
         legend: Legend::UpperLeft,
         series,
-        ..PlotSpec::new(
-            "Granular column collapse: runout",
-            "aspect ratio a = H0/L0",
-            "normalised runout (L∞ − L0)/L0",
-        )
-        .log_log()
+        ..PlotSpec::new(labels.title, labels.x_label, labels.y_label).log_log()
     };
     plot_xy(&ctx.path("runout.png"), &spec)?;
-    ctx.add_plot(
-        "runout.png",
-        "normalised runout against aspect ratio, IISPH against both regimes of Lube et al. (2005)",
-    );
+    ctx.add_plot("runout.png", labels.caption);
     Ok(())
 }

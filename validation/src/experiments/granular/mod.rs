@@ -1,9 +1,11 @@
 //! Experiments of the IISPH solver for water and granular matter (crate `iisph-granular`:
 //! Neder 2024, after Ihmsen et al. 2014 and Alduán & Otaduy 2011): the angle of repose, the
-//! collapse of granular columns against Lube et al. (2005), the convergence of the pressure
+//! collapse of granular columns against Lube et al. (2005, planar; 2004, axisymmetric), the
+//! convergence of the pressure
 //! solve, and the cost of a granular step. Shared here: scene variants edited from the shipped
 //! files ([`scene_edit`]) and a scene run that keeps a blow-up as a result ([`run_scene`]).
 
+pub mod axisymmetric_collapse;
 pub mod column_collapse;
 pub mod granular_performance;
 pub mod iisph_convergence;

@@ -72,7 +72,7 @@
 //! Every node costs one distance and one gradient; each band node 78 more distances (the
 //! planarity probes); each quadrature node (near edges, corners and curved surfaces)
 //! `polar × azimuth` rays. Along a ray, solids with closed-form ray intervals
-//! ([`Sdf::ray_inside_intervals`](sph_core::Sdf::ray_inside_intervals): planes, spheres, boxes and their complements) give the
+//! ([`Sdf::ray_inside_intervals`](sph_core::Sdf::ray_inside_intervals): planes, spheres, boxes, vertical cylinders and their complements) give the
 //! inside stretches directly (exact up to `f64` rounding of the stored shape). Other solids
 //! (meshes, user solids) are searched: a ray samples `φ` at `ray_samples` points, refines
 //! each sign change by regula falsi to `|φ| ≤ 1e-10 h` and searches intervals whose end
