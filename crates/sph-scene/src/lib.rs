@@ -145,6 +145,8 @@
 //! # upscaling_factor = 8           # passive points per particle (>= 1; absent = off)
 //! # friction_max_iterations = 20   # friction-stress iterations per step at most (>= 1)
 //! # friction_tolerance = 1e-4      # mean unyielded strain per step to stop at (> 0)
+//! # friction_relaxation = 0.35     # ω of the stress update, in (0, 1] (0.35 = the stability
+//! #                                # bound; the thesis's eq. 9 implies 0.5, outside it)
 //! ```
 //!
 //! ```toml

@@ -233,6 +233,9 @@ impl Scene {
         if let Some(t) = s.friction_tolerance {
             g.friction_tolerance = r(t);
         }
+        if let Some(w) = s.friction_relaxation {
+            g.friction_relaxation = r(w);
+        }
         p.granular = Some(g);
         p.upscaling_factor = s.upscaling_factor;
         p
@@ -262,6 +265,37 @@ kind = "block"
 min = [0.0, 0.0, 0.0]
 max = [0.2, 0.2, 0.2]
 "#;
+
+    /// `friction_relaxation` reaches the granular parameters, absent gives the crate's
+    /// default, and a value the solver refuses is named by its scene field.
+    #[test]
+    fn friction_relaxation_reaches_the_granular_parameters() {
+        let text = |extra: &str| {
+            format!(
+                "name = \"relax\"\n[simulation]\nparticle_spacing = 0.05\nduration = 0.1\nframe_dt = 0.02\n[solver]\nkind = \"granular\"\nsubsteps = 1\nfriction_angle_deg = 30.0\n{extra}\n[[fluid]]\nkind = \"block\"\nmin = [0.0, 0.0, 0.0]\nmax = [0.2, 0.2, 0.2]\n"
+            )
+        };
+        let relaxation = |extra: &str| {
+            let scene = Scene::parse_str(&text(extra), Path::new("relax.toml")).unwrap();
+            let crate::SolverSpec::Granular(g) = &scene.solver else {
+                panic!("not granular")
+            };
+            scene
+                .granular_params::<f64>(g)
+                .granular
+                .expect("granular parameters")
+                .friction_relaxation
+        };
+        assert_eq!(relaxation("friction_relaxation = 0.3"), 0.3);
+        assert_eq!(relaxation(""), iisph_granular::DEFAULT_FRICTION_RELAXATION);
+        let error = Scene::parse_str(&text("friction_relaxation = 1.5"), Path::new("relax.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            error.contains("solver.friction_relaxation") && error.contains("(0, 1]"),
+            "{error}"
+        );
+    }
 
     /// A parameter a solver refuses is named by the scene field it comes from (generic: by
     /// the words of its name, not a list of fields).

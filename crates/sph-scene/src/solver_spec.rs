@@ -177,6 +177,10 @@ pub struct GranularSpec {
     /// Mean unyielded strain per step at which the friction iterations stop (> 0; default
     /// 1e-4).
     pub friction_tolerance: Option<f64>,
+    /// Relaxation `ω` of the friction-stress update, relative to the exact self-coupling
+    /// (in (0, 1]; default 0.35, the update's stability bound on the prototype lattice; the
+    /// thesis's eq. 9 implies ½, which lies outside it: see the `iisph-granular` docs).
+    pub friction_relaxation: Option<f64>,
 }
 
 /// Default `max_iterations` of the IISPH kinds (SPlisHSPlasH's default cap).
@@ -308,6 +312,7 @@ impl SolverSpec {
                 upscaling_factor: None,
                 friction_max_iterations: None,
                 friction_tolerance: None,
+                friction_relaxation: None,
             }),
         }
     }
