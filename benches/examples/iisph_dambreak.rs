@@ -93,7 +93,10 @@ fn run<R: Real>(steps: usize, granular: bool) {
             last.last_friction_residual
         );
         let bins: Vec<String> = histogram.iter().map(|(k, n)| format!("{k}:{n}")).collect();
-        println!("friction iterations per step (iterations:steps): {}", bins.join(" "));
+        println!(
+            "friction iterations per step (iterations:steps): {}",
+            bins.join(" ")
+        );
     }
     let phases: Vec<String> = sum
         .phases

@@ -99,7 +99,10 @@ fn a_killed_population_study_resumes_to_identical_files() {
         let mut child = comets(&spec, &resumed).spawn().unwrap();
         let start = Instant::now();
         while !resumed.join("checkpoint.json").exists() && child.try_wait().unwrap().is_none() {
-            assert!(start.elapsed() < Duration::from_secs(300), "no checkpoint written");
+            assert!(
+                start.elapsed() < Duration::from_secs(300),
+                "no checkpoint written"
+            );
             std::thread::sleep(Duration::from_millis(1));
         }
         std::thread::sleep(straight_time.mul_f64(fraction));

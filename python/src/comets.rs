@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use numpy::{IntoPyArray, PyArrayMethods, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
@@ -29,10 +29,16 @@ fn outer_solar_system_table(py: Python<'_>, frame: &str) -> PyResult<Py<PyDict>>
     };
     let planets = symplectic::outer_solar_system(f);
     let d = PyDict::new(py);
-    let flat = |v: &[symplectic::Vec3]| -> Vec<f64> { v.iter().flat_map(|p| p.iter().copied()).collect() };
+    let flat =
+        |v: &[symplectic::Vec3]| -> Vec<f64> { v.iter().flat_map(|p| p.iter().copied()).collect() };
     let n = planets.len();
     let velocities = planets.heliocentric_velocities();
-    d.set_item("names", symplectic::solar_system::GIANT_PLANETS.map(|g| g.name).to_vec())?;
+    d.set_item(
+        "names",
+        symplectic::solar_system::GIANT_PLANETS
+            .map(|g| g.name)
+            .to_vec(),
+    )?;
     d.set_item("masses_msun", planets.masses().to_vec().into_pyarray(py))?;
     d.set_item("sun_mass_msun", planets.sun_mass())?;
     d.set_item(
@@ -55,13 +61,16 @@ struct Population {
 
 fn spec_from_json(spec_json: &str) -> PyResult<PopulationSpec> {
     // The specification's TOML checks and field-naming messages, from a JSON document.
-    let value: toml::Value = serde_json::from_str(spec_json)
-        .map_err(|e| rust_err(format!("population spec: {e}")))?;
+    let value: toml::Value =
+        serde_json::from_str(spec_json).map_err(|e| rust_err(format!("population spec: {e}")))?;
     let text = toml::to_string(&value).map_err(|e| rust_err(format!("population spec: {e}")))?;
     PopulationSpec::parse(&text, Path::new("population spec")).map_err(rust_err)
 }
 
-fn rows(particles: &Bound<'_, PyAny>, ids: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<ParticleRow>> {
+fn rows(
+    particles: &Bound<'_, PyAny>,
+    ids: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Vec<ParticleRow>> {
     let a = untyped(particles, "particles")?;
     check_shape(a, "particles", "(N, 6)", Some(2), Some(6))?;
     if !is_f64(a, "particles")? {
@@ -144,7 +153,8 @@ impl Population {
             // not depend on where the calls stop (Population's determinism).
             let end = (self.inner.time() + window).min(t_days);
             let inner = &mut self.inner;
-            py.detach(|| inner.advance_to(end, |_| {})).map_err(rust_err)?;
+            py.detach(|| inner.advance_to(end, |_| {}))
+                .map_err(rust_err)?;
             py.check_signals()?;
             if end >= t_days {
                 return Ok(());
@@ -223,7 +233,9 @@ impl Population {
     #[staticmethod]
     fn merge(py: Python<'_>, shards: Vec<PyRef<'_, Population>>) -> PyResult<Self> {
         let shards: Vec<RustPopulation> = shards.iter().map(|s| s.inner.clone()).collect();
-        let inner = py.detach(|| RustPopulation::merge(shards)).map_err(rust_err)?;
+        let inner = py
+            .detach(|| RustPopulation::merge(shards))
+            .map_err(rust_err)?;
         Ok(Self { inner })
     }
 
@@ -236,7 +248,9 @@ impl Population {
     /// Reads a population written by `save`.
     #[staticmethod]
     fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
-        let inner = py.detach(|| RustPopulation::load(&path)).map_err(rust_err)?;
+        let inner = py
+            .detach(|| RustPopulation::load(&path))
+            .map_err(rust_err)?;
         Ok(Self { inner })
     }
 

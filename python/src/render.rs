@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use numpy::{IntoPyArray, PyArrayMethods, PyArray3};
+use numpy::{IntoPyArray, PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
 use sph_core::{Real, Vec3};
 use ssfr_render::{RenderConfig, RenderParams, Renderer, RgbImage, SceneInfo, SsfrError};
@@ -49,8 +49,8 @@ fn render_json<'py>(
     config_json: &str,
     tank: Option<([f32; 3], [f32; 3])>,
 ) -> PyResult<Bound<'py, PyArray3<u8>>> {
-    let config: RenderConfig = serde_json::from_str(config_json)
-        .map_err(|e| rust_err(format!("render options: {e}")))?;
+    let config: RenderConfig =
+        serde_json::from_str(config_json).map_err(|e| rust_err(format!("render options: {e}")))?;
     let points = points(positions, "positions")?;
     let image = py.detach(|| {
         let run = |liquid, f: &dyn Fn(&RenderParams) -> Result<RgbImage, SsfrError>| {

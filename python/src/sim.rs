@@ -87,7 +87,10 @@ fn array2<'py, R: Real + numpy::Element>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let ordered = sim.to_original_order(v).map_err(rust_err)?;
     let flat: Vec<R> = ordered.iter().flat_map(|p| [p.x, p.y, p.z]).collect();
-    Ok(flat.into_pyarray(py).reshape([ordered.len(), 3])?.into_any())
+    Ok(flat
+        .into_pyarray(py)
+        .reshape([ordered.len(), 3])?
+        .into_any())
 }
 
 impl Simulation {

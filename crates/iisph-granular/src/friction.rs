@@ -246,9 +246,7 @@ pub(crate) fn solve<R: Real>(
                 &s.volume[..],
             );
             let update = |i: usize, st: &mut Sym3<R>, so: &mut Sym3<R>| -> f64 {
-                let eps = deviatoric(&strain_rate_at(
-                    x, vt, vol, offsets, indices, gs, bgrad, i,
-                ));
+                let eps = deviatoric(&strain_rate_at(x, vt, vol, offsets, indices, gs, bgrad, i));
                 let trial: Sym3<R> = std::array::from_fn(|e| st[e] - eps[e] * inv_d);
                 let bound = c.alpha * pr[i];
                 *st = yield_clamp(&trial, c.alpha, pr[i]);
@@ -344,7 +342,8 @@ mod tests {
         for a in 0..=m {
             for b in 0..=a {
                 for c in 0..=b {
-                    let k = Vec3::new(a as f64, b as f64, c as f64) * (std::f64::consts::PI / m as f64);
+                    let k =
+                        Vec3::new(a as f64, b as f64, c as f64) * (std::f64::consts::PI / m as f64);
                     max = max.max(2.0 / 3.0 * g2(&l, k) / diag);
                 }
             }

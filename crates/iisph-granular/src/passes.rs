@@ -57,9 +57,7 @@ pub(crate) fn density_pass<R: Real>(
         offsets,
         outputs,
         &mut s.grad_scale[..],
-        &|first,
-          ((rho_b, bg_b, gsum_b), (aii_b, occ_b)): DensityOutputs<'_, R>,
-          gs: &mut [R]| {
+        &|first, ((rho_b, bg_b, gsum_b), (aii_b, occ_b)): DensityOutputs<'_, R>, gs: &mut [R]| {
             let base = offsets[first];
             let block = rho_b
                 .iter_mut()
@@ -68,7 +66,11 @@ pub(crate) fn density_pass<R: Real>(
             for (l, ((rho, (bg, gsum)), (aii, occ_out))) in block.enumerate() {
                 let i = first + l;
                 let (xi, mi) = (x[i], m[i]);
-                let upstream = if c.drag { upstream(c, &v[i]) } else { Vec3::zeros() };
+                let upstream = if c.drag {
+                    upstream(c, &v[i])
+                } else {
+                    Vec3::zeros()
+                };
                 let mut max_cos = c.cos_cone;
                 let mut sum = mi * c.w0;
                 let mut sum_grad = Vec3::zeros();

@@ -117,7 +117,9 @@ fn granular_resumes_without_the_friction_acceleration() {
     let n = state.len();
     solver.step(&mut state).unwrap();
     let mut saved = solver.save_state();
-    saved.arrays.retain(|(name, _)| name != "friction_acceleration");
+    saved
+        .arrays
+        .retain(|(name, _)| name != "friction_acceleration");
     let mut fresh = common::block_solver(p, BLOCK, TANK).0;
     fresh.restore_state(&saved, n).unwrap();
     assert!(fresh.save_state().array("friction_acceleration").is_none());

@@ -74,7 +74,10 @@ fn values_come_back_in_the_scenes_order() {
     let scene = dam_break();
     let mut sim = SceneSim::<f32>::new(&scene).unwrap();
     let initial = sim.state.positions.clone();
-    assert_eq!(sim.to_original_order(&sim.state.positions).unwrap(), initial);
+    assert_eq!(
+        sim.to_original_order(&sim.state.positions).unwrap(),
+        initial
+    );
     let mut reordered = false;
     for _ in 0..3 {
         reordered |= sim.advance().unwrap().reordered;
@@ -85,5 +88,8 @@ fn values_come_back_in_the_scenes_order() {
         assert_eq!(ordered[id as usize], sim.state.positions[k]);
     }
     let err = sim.to_original_order(&[0u8; 3]).unwrap_err();
-    assert!(err.to_string().contains("need one value per particle"), "{err}");
+    assert!(
+        err.to_string().contains("need one value per particle"),
+        "{err}"
+    );
 }
