@@ -102,6 +102,27 @@ fn pcisph_field_under_pbf_is_refused_with_path_and_line() {
 }
 
 #[test]
+fn missing_field_of_a_flattened_part_is_not_called_unknown() {
+    let shipped = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenes/granular_repose_30.toml"
+    ))
+    .unwrap();
+    let text = shipped.replacen("substeps = 16", "", 1);
+    assert_ne!(text, shipped, "the shipped scene sets substeps");
+    let file = fixture_dir("no_substeps").join("no_substeps.toml");
+    let e = Scene::parse_str(&text, &file).unwrap_err();
+    assert_names(
+        &e,
+        "no_substeps",
+        "solver.substeps",
+        "missing field `substeps`",
+    );
+    let msg = e.to_string();
+    assert!(!msg.contains("has no such field"), "{msg}");
+}
+
+#[test]
 fn unknown_solver_kind_names_the_allowed_kinds() {
     let e = err_with("bad_solver_kind", "kind = \"pbf\"", "kind = \"sph\"");
     assert_names(

@@ -267,6 +267,50 @@ fn sphere_matches_axisymmetric_reference() {
     }
 }
 
+/// The Wendland C2 kernel's sphere error, the bound of `sample_matches_naive_references`'s
+/// sphere case (which uses this kernel): over a ∈ [h, 4h] and φ ∈ (−0.9h, 0.99h), the range
+/// that test draws from, at 32 × 64 directions.
+fn wendland_sphere_error(a_over_h: f64) -> f64 {
+    let h = 0.1;
+    let k = WendlandC2::new(h).unwrap();
+    let o = VolumeMapOptions {
+        polar_directions: 32,
+        azimuth_directions: 64,
+        ..Default::default()
+    };
+    let (c, a) = (Vec3::repeat(0.5), a_over_h * h);
+    let b = boundary(
+        Box::new(Sphere::new(c, a).unwrap()),
+        KernelKind::WendlandC2,
+        h,
+        unit_domain(),
+        o,
+    );
+    let mut r = rng(13);
+    let mut worst: f64 = 0.0;
+    for _ in 0..400 {
+        let dir = Vec3::new(r() - 0.5, r() - 0.5, r() - 0.5).normalize();
+        let d = -0.9 * h + 1.89 * h * r();
+        let e = (b.sample(&(c + dir * (a + d))).volume - sphere_ref(&k, a, a + d)).abs();
+        worst = worst.max(e);
+    }
+    worst
+}
+
+#[test]
+fn wendland_sphere_matches_axisymmetric_reference() {
+    // Measured max |error| (Wendland C2, 32 × 64 directions, 400 points per radius at
+    // φ ∈ (−0.9h, 0.99h), 2026-11-25): a = 1, 1.25, 1.5, 1.78, 2, 2.5, 3, 4 h: 4.3e-3,
+    // 3.6e-3, 2.8e-3, 5.1e-3, 3.9e-3, 3.2e-3, 6.1e-3, 2.8e-3, largest within 0.1h of the
+    // surface; larger than Poly6's 2.1e-3 (above), whose bound the proptest below had used
+    // for this kernel and failed by (3.6e-3 at a = 1.78h, φ = 0). Bound: the largest + 50 %.
+    for a in [1.0, 1.25, 1.5, 1.78, 2.0, 2.5, 3.0, 4.0] {
+        let e = wendland_sphere_error(a);
+        eprintln!("Wendland C2 sphere a = {a} h: max |error| {e:.2e}");
+        assert!(e < 9e-3, "sphere a = {a} h: {e}");
+    }
+}
+
 #[test]
 fn tank_corner_matches_cartesian_quadrature() {
     let h = 0.1;
@@ -405,9 +449,9 @@ proptest! {
         let b = VolumeMapBoundary::new(vec![solid], KernelKind::WendlandC2, h, unit_domain(), 0.0, o).unwrap();
         let v = b.sample(&x).volume;
         // Planes: f32 storage of the node planes (6e-8 relative; bound 1e-6); spheres: the
-        // measured 32 × 64 sphere error (≤ 2.1e-3 for Poly6,
-        // sphere_matches_axisymmetric_reference) + 50 %.
-        let tol = if shape == 0 { 1e-6 } else { 3e-3 };
+        // measured 32 × 64 sphere error of this kernel over this range (≤ 6.1e-3,
+        // wendland_sphere_matches_axisymmetric_reference) + 50 %.
+        let tol = if shape == 0 { 1e-6 } else { 9e-3 };
         prop_assert!((v - reference).abs() < tol, "shape {} x {:?}: {} vs {}", shape, x, v, reference);
     }
 }

@@ -74,7 +74,13 @@ fn variant<T: DeserializeOwned>(
             SceneError::Syntax { file, field, .. } if e.path().iter().next().is_none() => {
                 let line = ctx.lines.and_then(|l| l.line_of(&field));
                 let at = line.map(|l| format!(" (line {l})")).unwrap_or_default();
-                let reason = format!("{}{at}; {note}", e.inner().message().trim());
+                let message = e.inner().message().trim();
+                // The note explains an unknown field only; a missing one is not the kind's.
+                let reason = if message.starts_with("unknown field `") {
+                    format!("{message}{at}; {note}")
+                } else {
+                    format!("{message}{at}")
+                };
                 SceneError::Syntax {
                     file,
                     field,
