@@ -60,6 +60,7 @@
 //! |---|---|---|
 //! | half-space, tank wall away from edges | 1e-6 (f32 node storage) | same |
 //! | sphere `a = 1.5 h`, `4 h` (Poly6) | 8.6e-3, 9.4e-3 | 1.8e-3, 2.1e-3 |
+//! | sphere `a = h … 4 h` (Wendland C2, within 0.9 h of the surface) | — | 2.8e-3 … 6.1e-3 |
 //! | tank corner (Poly6) | 3.4e-3 (trilinear `C`: 1.7e-2) | — |
 //! | icosphere `GridSdf` (cell h/10) | — | 5.9e-3 |
 //!
