@@ -179,14 +179,16 @@ impl Population {
         self.inner.members().len()
     }
 
-    /// Each particle's status label (`active`, `hill_sphere_<planet>`, `perihelion`,
-    /// `ejected`, `regularisation_lost`, `failed`), in identifier order.
+    /// Each particle's status label (`active`, `hill_sphere_<planet name>`,
+    /// `collision_<planet name>`, `perihelion`, `ejected`, `regularisation_lost`, `failed`),
+    /// in identifier order.
     #[getter]
     fn status(&self) -> Vec<String> {
+        let planets = self.inner.ephemeris().planets();
         self.inner
             .members()
             .iter()
-            .map(|m| status_label(&m.status).0)
+            .map(|m| status_label(&m.status, planets).0)
             .collect()
     }
 

@@ -326,6 +326,45 @@ pub(crate) struct GridView<'a> {
 }
 
 impl GridView<'_> {
+    /// The grid step `τ`.
+    pub(crate) fn step(&self) -> f64 {
+        self.tau
+    }
+
+    /// The time of the retained grid state at or before `t` (the state the interpolation at
+    /// `t` starts from); errors as [`GridView::interpolate`] does.
+    pub(crate) fn grid_time_at_or_before(&self, t: f64) -> Result<f64, SymplecticError> {
+        if t > self.newest {
+            return Err(SymplecticError::BeyondEphemeris {
+                time: t,
+                newest: self.newest,
+            });
+        }
+        if !(t.is_finite() && t >= self.oldest) {
+            return Err(SymplecticError::InvalidParameter {
+                name: "ephemeris time",
+                value: t,
+                reason: "not finite, or precedes the retained window of planet states",
+            });
+        }
+        Ok(self.ephemeris.grid_time(self.grid_index(t)))
+    }
+
+    /// Index of the grid point at or before `t` (rounding corrected against the grid times).
+    #[inline(always)]
+    fn grid_index(&self, t: f64) -> u64 {
+        let e = self.ephemeris;
+        let rel = (t - e.start_time) * self.inv_tau;
+        let mut k = (rel.max(0.0) as u64).clamp(e.first_index, self.last);
+        if k > e.first_index && t < e.grid_time(k) {
+            k -= 1;
+        }
+        if k < self.last && e.grid_time(k + 1) <= t {
+            k += 1;
+        }
+        k
+    }
+
     /// [`Ephemeris::interpolate`].
     pub(crate) fn interpolate(
         &self,
@@ -361,18 +400,11 @@ impl GridView<'_> {
     /// The interpolation proper; `t` must lie in the retained window.
     fn interpolate_unchecked(&self, t: f64, out: &mut BodyStates, accelerations: bool) {
         let (e, tau, last) = (self.ephemeris, self.tau, self.last);
-        let rel = (t - e.start_time) * self.inv_tau;
         // The grid point at or before t (rounding of `rel` corrected against the grid times),
         // so that the result depends on t and the grid only, not on how far the grid reaches:
         // a time on a grid point takes that state, anything else the interval after it.
         // (`as u64` truncates: the floor of a non-negative `rel`, without a libm call.)
-        let mut k = (rel.max(0.0) as u64).clamp(e.first_index, last);
-        if k > e.first_index && t < e.grid_time(k) {
-            k -= 1;
-        }
-        if k < last && e.grid_time(k + 1) <= t {
-            k += 1;
-        }
+        let k = self.grid_index(t);
         let n1 = e.planets.len() + 1;
         out.resize(n1);
         out.time = t;

@@ -13,7 +13,7 @@ use serde::Deserialize;
 
 use crate::kepler::{state_from_elements, ConicElements};
 use crate::{
-    outer_solar_system, Ephemeris, Frame, Integrator, ParticleIntegrator, ParticleStatus,
+    outer_solar_system, Ephemeris, Frame, Integrator, ParticleIntegrator, ParticleStatus, Planets,
     Population, RemovalRules, Scheme, SymplecticError, Variant, Vec3,
 };
 
@@ -555,7 +555,7 @@ pub fn population_table(population: &Population) -> Result<RecordBatch, Symplect
         let el = population.elements(i)?;
         let q = population.barycentric_position(i);
         let v = m.particle.velocity;
-        let (label, removal_time) = status_label(&m.status);
+        let (label, removal_time) = status_label(&m.status, population.ephemeris().planets());
         status.push(label);
         let row = [
             m.particle.time,
@@ -609,13 +609,17 @@ pub fn population_table(population: &Population) -> Result<RecordBatch, Symplect
     })
 }
 
-/// A short label of a status (`active`, `hill_sphere_<planet>`, `perihelion`, `ejected`,
-/// `regularisation_lost`, `failed`) and the removal time (NaN if active).
-pub fn status_label(s: &ParticleStatus) -> (String, f64) {
+/// A short label of a status (`active`, `hill_sphere_<planet>`, `collision_<planet>` with the
+/// planet's name, `perihelion`, `ejected`, `regularisation_lost`, `failed`) and the removal
+/// time (NaN if active).
+pub fn status_label(s: &ParticleStatus, planets: &Planets) -> (String, f64) {
     match s {
         ParticleStatus::Active => ("active".into(), f64::NAN),
         ParticleStatus::HillSphereEntry { time, planet, .. } => {
-            (format!("hill_sphere_{planet}"), *time)
+            (format!("hill_sphere_{}", planets.name(*planet)), *time)
+        }
+        ParticleStatus::Collision { time, planet, .. } => {
+            (format!("collision_{}", planets.name(*planet)), *time)
         }
         ParticleStatus::PerihelionBelowLimit { time, .. } => ("perihelion".into(), *time),
         ParticleStatus::Ejected { time, .. } => ("ejected".into(), *time),

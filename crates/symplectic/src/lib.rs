@@ -149,6 +149,7 @@
 //! comet_throughput -- N YEARS [s2|s6]` measures it, and `docs/performance.md` compares it
 //! with REBOUND's WHFast from one script.
 
+pub mod encounter;
 pub mod ephemeris;
 #[cfg(feature = "io")]
 pub mod io;
@@ -165,6 +166,10 @@ pub mod solar_system;
 pub mod study;
 mod work;
 
+pub use encounter::{
+    integrate_through, Encounter, EncounterOutcome, Encounters, DEFAULT_ENCOUNTER_HILL_FACTOR,
+    DEFAULT_ENCOUNTER_TOLERANCE,
+};
 pub use ephemeris::{BodyStates, Ephemeris};
 pub use maps::{Integrator, Piece, Stage, S2_STAGES, S6_C1, S6_C2, S6_D1, S6_D2, S6_STAGES};
 pub use particles::{

@@ -177,6 +177,11 @@ impl Default for KickTerms {
 }
 
 impl KickTerms {
+    /// `F₁ = K₁/r` of these terms (`NaN` if they hold nothing).
+    pub(crate) fn f1(&self) -> f64 {
+        self.f1
+    }
+
     /// Whether these are the terms at `(time, position)` (bit for bit; the bodies are a
     /// function of the time, so nothing else enters).
     fn holds(&self, time: f64, position: &Vec3) -> bool {

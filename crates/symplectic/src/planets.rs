@@ -27,6 +27,12 @@ pub struct Planets {
     /// Work done so far (Kepler solves, pairwise forces).
     #[serde(default)]
     work: WorkCounters,
+    /// Names of the planets (empty: unnamed, reported as `planet_<j>`).
+    #[serde(default)]
+    names: Vec<String>,
+    /// Physical radii of the planets (empty: no collisions detected).
+    #[serde(default)]
+    radii: Vec<f64>,
 }
 
 impl Planets {
@@ -93,7 +99,53 @@ impl Planets {
             momenta,
             time: 0.0,
             work: WorkCounters::default(),
+            names: Vec::new(),
+            radii: Vec::new(),
         })
+    }
+
+    /// The same planets with names (reported in statuses: `hill_sphere_Neptune`) and physical
+    /// radii (a particle closer than a radius to the planet's centre has collided), one of
+    /// each per planet in order.
+    pub fn with_names_and_radii(
+        mut self,
+        names: &[&str],
+        radii: &[f64],
+    ) -> Result<Self, SymplecticError> {
+        if names.len() != self.len() || radii.len() != self.len() {
+            return Err(SymplecticError::InvalidState {
+                what: "planets",
+                reason: format!(
+                    "{} planets, {} names, {} radii: need one name and one radius per planet",
+                    self.len(),
+                    names.len(),
+                    radii.len()
+                ),
+            });
+        }
+        if let Some(r) = radii.iter().find(|r| !(r.is_finite() && **r > 0.0)) {
+            return Err(SymplecticError::InvalidParameter {
+                name: "planet radius",
+                value: *r,
+                reason: "must be finite and > 0",
+            });
+        }
+        self.names = names.iter().map(|n| n.to_string()).collect();
+        self.radii = radii.to_vec();
+        Ok(self)
+    }
+
+    /// Name of planet `j` (1-based, as in statuses): its given name or `planet_<j>`.
+    pub fn name(&self, j: usize) -> String {
+        match j.checked_sub(1).and_then(|i| self.names.get(i)) {
+            Some(n) => n.clone(),
+            None => format!("planet_{j}"),
+        }
+    }
+
+    /// Physical radius of planet `j` (1-based), if given.
+    pub fn radius(&self, j: usize) -> Option<f64> {
+        j.checked_sub(1).and_then(|i| self.radii.get(i)).copied()
     }
 
     /// Number of planets.

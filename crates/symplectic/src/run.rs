@@ -45,6 +45,19 @@ pub enum ParticleStatus {
         /// The planet's Hill radius then, `|Q_j| (m_j / 3m₀)^{1/3}`.
         hill_radius: f64,
     },
+    /// Came closer to a planet's centre than its physical radius
+    /// ([`Planets::radius`](crate::Planets::radius)) while integrated through an encounter
+    /// ([`Encounters`](crate::Encounters)).
+    Collision {
+        /// Time when detected (end of the encounter integrator's step).
+        time: f64,
+        /// The planet (1-based; its name: [`Planets::name`](crate::Planets::name)).
+        planet: usize,
+        /// Distance to the planet's centre then.
+        distance: f64,
+        /// The planet's radius.
+        radius: f64,
+    },
     /// The step failed for another reason (non-finite state, Kepler solver); the particle is
     /// kept at its state before the step (a [`Population`](crate::Population) goes on with the
     /// others).

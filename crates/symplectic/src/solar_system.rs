@@ -48,6 +48,16 @@ pub struct GiantPlanet {
     pub velocity_au_per_day: [f64; 3],
 }
 
+/// The astronomical unit in kilometres (IAU 2012 Resolution B2: 149 597 870.7 km).
+pub const AU_KM: f64 = 149_597_870.7;
+
+/// Equatorial radii (1 bar level) of Jupiter, Saturn, Uranus and Neptune in km: 71 492,
+/// 60 268, 25 559, 24 764 (B. A. Archinal et al., "Report of the IAU Working Group on
+/// Cartographic Coordinates and Rotational Elements: 2015", *Celestial Mechanics and Dynamical
+/// Astronomy* 130, 22 (2018), doi:10.1007/s10569-017-9805-5, Table 5). A particle closer
+/// than this to a planet's centre has collided with it.
+pub const GIANT_PLANET_RADII_KM: [f64; 4] = [71_492.0, 60_268.0, 25_559.0, 24_764.0];
+
 /// Jupiter, Saturn, Uranus and Neptune as printed in Table 2.1.
 pub const GIANT_PLANETS: [GiantPlanet; 4] = [
     GiantPlanet {
@@ -113,9 +123,13 @@ pub fn outer_solar_system(frame: Frame) -> Planets {
         &positions,
         &velocities,
     );
+    let names: Vec<&str> = GIANT_PLANETS.iter().map(|p| p.name).collect();
+    let radii = GIANT_PLANET_RADII_KM.map(|r| r / AU_KM);
     // The constants above are finite, positive and non-zero: construction cannot fail
     // (checked by the unit test below).
-    built.expect("the tabulated outer Solar System is a valid state")
+    built
+        .and_then(|p| p.with_names_and_radii(&names, &radii))
+        .expect("the tabulated outer Solar System is a valid state")
 }
 
 #[cfg(test)]

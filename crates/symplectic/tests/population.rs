@@ -225,6 +225,7 @@ fn removal_is_per_particle_with_reason_and_time() {
                 planet,
                 distance,
                 hill_radius,
+                ..
             } => {
                 assert_eq!(*time, m.particle.time);
                 assert!(distance < hill_radius && (1..=4).contains(planet));

@@ -3,6 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::encounter::Encounter;
 use crate::particles::TestParticle;
 use crate::run::ParticleStatus;
 use crate::{SymplecticError, Vec3};
@@ -62,6 +63,11 @@ pub struct PopulationMember {
     /// Barycentric position of the Sun at the particle's time (to turn the mixed variant's
     /// heliocentric position into a barycentric one without the ephemeris).
     pub sun_position: Vec3,
+    /// The encounter mode's state while the particle is in it
+    /// ([`Encounters`](crate::Encounters)); `particle`
+    /// then holds its position, velocity and time, not `p₄`.
+    #[serde(default)]
+    pub encounter: Option<Box<Encounter>>,
 }
 
 /// Where a [`Population`](crate::Population) stands after a synchronisation.

@@ -10,7 +10,7 @@ use crate::ephemeris::{BodyStates, Ephemeris};
 use crate::kepler::Elements;
 use crate::particles::ParticleIntegrator;
 use crate::run::ParticleStatus;
-use crate::{SymplecticError, Variant, Vec3, WorkCounters};
+use crate::{Encounters, SymplecticError, Variant, Vec3, WorkCounters};
 
 mod members;
 #[cfg(test)]
@@ -118,6 +118,10 @@ pub struct Population {
     ephemeris: Ephemeris,
     integrator: ParticleIntegrator,
     rules: RemovalRules,
+    /// Integration through close encounters (`None`: none; Hill-sphere entry is then a
+    /// removal rule, and lost regularisation removes).
+    #[serde(default)]
+    encounters: Option<Encounters>,
     members: Vec<PopulationMember>,
     /// Synchronisation time reached.
     time: f64,
@@ -169,6 +173,7 @@ impl Population {
                     particle,
                     status: ParticleStatus::Active,
                     sun_position: bodies.positions[0],
+                    encounter: None,
                 })
             })
             .collect::<Result<Vec<_>, SymplecticError>>()?;
@@ -176,6 +181,7 @@ impl Population {
             ephemeris,
             integrator,
             rules,
+            encounters: None,
             members,
             time,
             window_steps: DEFAULT_WINDOW_STEPS,
@@ -216,6 +222,38 @@ impl Population {
         }
         self.window_steps = steps;
         Ok(())
+    }
+
+    /// Integrates the particles through close encounters with `encounters`
+    /// ([`Encounters`], the module [`encounter`](crate::encounter)) instead of removing them;
+    /// `None` turns it off. Barycentric variant only, and not with the removal rule
+    /// [`RemovalRules::hill_factor`] (one removes at Hill-sphere entry, the other integrates
+    /// through it).
+    pub fn set_encounters(&mut self, encounters: Option<Encounters>) -> Result<(), SymplecticError> {
+        if let Some(e) = &encounters {
+            e.validate()?;
+            if self.integrator.variant != Variant::Barycentric {
+                return Err(SymplecticError::InvalidParameter {
+                    name: "encounters",
+                    value: e.hill_factor,
+                    reason: "close encounters are integrated for the barycentric variant only",
+                });
+            }
+            if let Some(f) = self.rules.hill_factor {
+                return Err(SymplecticError::InvalidParameter {
+                    name: "hill_factor",
+                    value: f,
+                    reason: "removes at Hill-sphere entry, while `encounters` integrates through it: set one of them",
+                });
+            }
+        }
+        self.encounters = encounters;
+        Ok(())
+    }
+
+    /// The close-encounter settings, if any.
+    pub fn encounters(&self) -> Option<Encounters> {
+        self.encounters
     }
 
     /// Planet steps per synchronisation window.
@@ -355,7 +393,7 @@ impl Population {
             let ahead = (end + window).min(t_end) + window;
             let ephemeris = &self.ephemeris;
             let members = &mut self.members;
-            let (integrator, rules) = (self.integrator, self.rules);
+            let (integrator, rules) = (self.integrator, (self.rules, self.encounters));
             let (extension, (steps, beyond)) = rayon::join(
                 || ephemeris.extension(ahead),
                 || run_window(ephemeris, integrator, rules, members, end, path),
@@ -403,6 +441,7 @@ impl Population {
             ephemeris: self.ephemeris.clone(),
             integrator: self.integrator,
             rules: self.rules,
+            encounters: self.encounters,
             members: Vec::new(),
             time: self.time,
             window_steps: self.window_steps,
@@ -424,6 +463,7 @@ impl Population {
         for s in &shards[1..] {
             let same = s.integrator == first.integrator
                 && s.rules == first.rules
+                && s.encounters == first.encounters
                 && s.time.to_bits() == first.time.to_bits()
                 && s.ephemeris.integrator() == first.ephemeris.integrator()
                 && s.ephemeris.grid_time(0).to_bits() == first.ephemeris.grid_time(0).to_bits();

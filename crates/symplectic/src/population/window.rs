@@ -7,6 +7,7 @@ use std::collections::VecDeque;
 use rayon::prelude::*;
 
 use super::members::{PopulationMember, RemovalRules};
+use crate::encounter::{regularisation, Encounter, EncounterScratch, Encounters};
 use crate::ephemeris::{BodyStates, Ephemeris, GridView};
 use crate::lanes::{self, norm, norm_squared, KickLanes, Mask, LANES, V, V3};
 use crate::particles::ParticlePiece;
@@ -21,6 +22,8 @@ struct Worker {
     bodies_time: f64,
     /// The last barycentric kick's terms.
     kick: KickTerms,
+    /// The encounter mode's buffers.
+    encounter: EncounterScratch,
 }
 
 /// The read-only context of a window.
@@ -29,6 +32,12 @@ struct WindowContext<'a> {
     grid: GridView<'a>,
     integrator: ParticleIntegrator,
     rules: RemovalRules,
+    /// Integration through close encounters.
+    encounters: Option<Encounters>,
+    /// The planets (names and radii).
+    planets: &'a crate::Planets,
+    /// Radius of each planet, if known.
+    radii: Vec<Option<f64>>,
     /// `(m_j/3m₀)^{1/3}` per planet.
     hill_coefficients: Vec<f64>,
     total_gm: f64,
@@ -78,7 +87,8 @@ fn avx_available() -> bool {
 enum StepOutcome {
     /// The step was taken (the member may have been removed at its end).
     Stepped,
-    /// The step failed; the member is removed with the reason.
+    /// The step failed; the member is removed with the reason (or switched to the
+    /// encounter mode).
     Failed,
     /// The step needs the planets at this time, beyond the ephemeris: redone next window.
     Beyond(f64),
@@ -113,7 +123,7 @@ struct LaneState {
 pub(super) fn run_window(
     ephemeris: &Ephemeris,
     integrator: ParticleIntegrator,
-    rules: RemovalRules,
+    (rules, encounters): (RemovalRules, Option<Encounters>),
     members: &mut [PopulationMember],
     end: f64,
     path: StepPath,
@@ -133,6 +143,9 @@ pub(super) fn run_window(
         grid: ephemeris.view(),
         integrator,
         rules,
+        encounters,
+        planets,
+        radii: (1..=planets.len()).map(|j| planets.radius(j)).collect(),
         hill_coefficients: planets
             .masses()
             .iter()
@@ -172,6 +185,7 @@ impl Worker {
             bodies: BodyStates::default(),
             bodies_time: f64::NAN,
             kick: KickTerms::default(),
+            encounter: EncounterScratch::default(),
         }
     }
 }
@@ -249,8 +263,18 @@ impl WindowContext<'_> {
         let mut total = (0, f64::NEG_INFINITY);
         loop {
             for (slot, stint) in lanes.slots.iter_mut().zip(&mut stint) {
-                if slot.member.is_none() {
-                    slot.member = queue.pop_front();
+                while slot.member.is_none() {
+                    let Some(i) = queue.pop_front() else { break };
+                    // A member in the encounter mode goes on in it first; it takes the lane
+                    // if handed back to the map before the window's end.
+                    if members[i].encounter.is_some() {
+                        let done = self.run_encounter(&mut members[i], &mut slot.worker);
+                        total = sum_steps(total, done);
+                        if !self.in_map_within_window(&members[i]) {
+                            continue;
+                        }
+                    }
+                    slot.member = Some(i);
                     slot.bodies_time = f64::NAN;
                     slot.kick_valid = false;
                     *stint = 0;
@@ -359,7 +383,7 @@ impl WindowContext<'_> {
         }
         self.fetch_lanes(lanes, &t, live, &mut redo);
         let finite: [Mask; 7] = [q[0], q[1], q[2], v[0], v[1], v[2], p4].map(lanes::finite);
-        let removal = self.removal_lanes(&q, &v, &lanes.positions);
+        let removal = self.removal_lanes(&q, &v, &lanes.positions, &lanes.kick.f1);
         let (mut steps, mut beyond) = (0, f64::NEG_INFINITY);
         let forces = kicks * self.gm.len() as u64;
         for (l, slot) in lanes.slots.iter_mut().enumerate() {
@@ -380,6 +404,11 @@ impl WindowContext<'_> {
                         continue;
                     }
                 }
+                if m.encounter.is_some() {
+                    let (s, b) = self.run_encounter(m, &mut slot.worker);
+                    (steps, beyond) = (steps + s, beyond.max(b));
+                    slot.kick_valid = false;
+                }
             } else {
                 let p = &mut m.particle;
                 p.position = lanes::lane(&q, l);
@@ -397,12 +426,16 @@ impl WindowContext<'_> {
                     lanes
                         .column
                         .extend(lanes.positions.iter().map(|x| lanes::lane(x, l)));
-                    if let Some(status) = self.removal(&m.particle, &lanes.column) {
-                        m.status = status;
+                    let f1 = lanes.kick.f1.0[l];
+                    if self.transition(m, &lanes.column, f1, &mut slot.worker) {
+                        let (s, b) = self.run_encounter(m, &mut slot.worker);
+                        (steps, beyond) = (steps + s, beyond.max(b));
+                        slot.bodies_time = f64::NAN;
+                        slot.kick_valid = false;
                     }
                 }
             }
-            if !(m.status == ParticleStatus::Active && m.particle.time < self.end) {
+            if !self.in_map_within_window(m) {
                 slot.member = None;
             }
         }
@@ -435,6 +468,14 @@ impl WindowContext<'_> {
     fn advance_member(&self, m: &mut PopulationMember, w: &mut Worker) -> (u64, f64) {
         let mut steps = 0;
         while m.status == ParticleStatus::Active && m.particle.time < self.end {
+            if m.encounter.is_some() {
+                let (s, beyond) = self.run_encounter(m, w);
+                steps += s;
+                if m.encounter.is_some() || beyond > f64::NEG_INFINITY {
+                    return (steps, beyond);
+                }
+                continue;
+            }
             match self.step_member(m, w) {
                 StepOutcome::Stepped => steps += 1,
                 StepOutcome::Failed => {}
@@ -442,6 +483,12 @@ impl WindowContext<'_> {
             }
         }
         (steps, f64::NEG_INFINITY)
+    }
+
+    /// Whether `m` is active, in the map (not in the encounter mode) and before the window's
+    /// end: whether it steps on in a lane.
+    fn in_map_within_window(&self, m: &PopulationMember) -> bool {
+        m.status == ParticleStatus::Active && m.particle.time < self.end && m.encounter.is_none()
     }
 
     /// One step of one member with the scalar path ([`ParticleIntegrator::advance`]), with the
@@ -463,9 +510,10 @@ impl WindowContext<'_> {
             Ok(t) => {
                 w.bodies_time = t;
                 m.sun_position = w.bodies.positions[0];
-                if let Some(status) = self.removal(&m.particle, &w.bodies.positions) {
-                    m.status = status;
-                }
+                let positions = std::mem::take(&mut w.bodies.positions);
+                let f1 = w.kick.f1();
+                self.transition(m, &positions, f1, w);
+                w.bodies.positions = positions;
                 StepOutcome::Stepped
             }
             Err(SymplecticError::BeyondEphemeris { time, .. }) => {
@@ -478,11 +526,18 @@ impl WindowContext<'_> {
                 time,
             }) => {
                 m.particle = saved;
-                m.status = ParticleStatus::RegularisationLost {
-                    time,
-                    quantity: quantity.to_string(),
-                    value,
-                };
+                if let Some(settings) = self.encounters {
+                    // Not removed: the encounter integrator takes over from the state before
+                    // the step.
+                    w.bodies_time = f64::NAN;
+                    self.begin_encounter(m, &settings, w);
+                } else {
+                    m.status = ParticleStatus::RegularisationLost {
+                        time,
+                        quantity: quantity.to_string(),
+                        value,
+                    };
+                }
                 StepOutcome::Failed
             }
             Err(e) => {
@@ -500,7 +555,7 @@ impl WindowContext<'_> {
     /// `v` among the bodies at `positions`: the same tests with the same operations, so that
     /// only the lanes it flags need the scalar form (which names the rule).
     #[inline(always)]
-    fn removal_lanes(&self, q: &V3, v: &V3, positions: &[V3]) -> Mask {
+    fn removal_lanes(&self, q: &V3, v: &V3, positions: &[V3], f1: &V) -> Mask {
         let rules = &self.rules;
         let mut hit = [false; LANES];
         let mut flag = |test: Mask| {
@@ -509,7 +564,14 @@ impl WindowContext<'_> {
             }
         };
         let sub = |a: &V3, b: &V3| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-        if let Some(factor) = rules.hill_factor {
+        if self.encounters.is_some() {
+            // The regularisation margin of the switch ([`WindowContext::transition`]).
+            let r = norm(q);
+            let part = V::splat(self.integrator.b0) + V::splat(self.integrator.b1) / r;
+            let half = V::splat(0.5) * part;
+            flag(std::array::from_fn(|l| !(f1.0[l] >= half.0[l])));
+        }
+        if let Some(factor) = self.switch_factor() {
             let sun = &positions[0];
             for (c, planet) in self.hill_coefficients.iter().zip(&positions[1..]) {
                 let distance2 = norm_squared(&sub(q, planet));
@@ -547,31 +609,189 @@ impl WindowContext<'_> {
         hit
     }
 
-    /// The first removal rule the particle meets, with the bodies at its time.
-    fn removal(&self, p: &TestParticle, positions: &[Vec3]) -> Option<ParticleStatus> {
+    /// The Hill factor that the lanes flag: the encounter switch's, or the removal rule's.
+    #[inline(always)]
+    fn switch_factor(&self) -> Option<f64> {
+        match &self.encounters {
+            Some(e) => Some(e.hill_factor),
+            None => self.rules.hill_factor,
+        }
+    }
+
+    /// Applies to `m`, just stepped by the map, the first rule it meets with the bodies at its
+    /// time (`positions`) and `F₁` at its end (`f1`): removal, or the switch to the encounter
+    /// mode ([`Encounters`]). Returns whether it switched.
+    fn transition(
+        &self,
+        m: &mut PopulationMember,
+        positions: &[Vec3],
+        f1: f64,
+        w: &mut Worker,
+    ) -> bool {
+        if let Some(settings) = self.encounters {
+            // The same operations as the lanes' flags (`removal_lanes`).
+            let r = m.particle.position.norm();
+            let part = self.integrator.b0 + self.integrator.b1 / r;
+            let margin_lost = !(f1 >= 0.5 * part);
+            let near = self.hill_entry(&m.particle, positions, settings.hill_factor);
+            if margin_lost || near.is_some() {
+                self.begin_encounter(m, &settings, w);
+                return true;
+            }
+        }
+        if let Some(status) = self.removal(&m.particle, positions) {
+            m.status = status;
+        }
+        false
+    }
+
+    /// Switches `m` (at its time, in the map) to the encounter mode, or removes it if the
+    /// switch fails.
+    fn begin_encounter(&self, m: &mut PopulationMember, settings: &Encounters, w: &mut Worker) {
+        let p = &m.particle;
+        // One map step's time from here: `h/F₁` with the ephemeris' planets (`h/(B₀ + B₁/r)`
+        // where `F₁` is not positive).
+        let map_dt = match self.grid.interpolate(p.time, &mut w.bodies, false) {
+            Ok(()) => {
+                let (f1, part) = regularisation(&self.integrator, &p.position, &w.bodies);
+                p.step / if f1 > 0.0 { f1 } else { part }
+            }
+            Err(_) => 0.0,
+        };
+        w.bodies_time = f64::NAN;
+        match Encounter::begin(p, &self.grid, settings, map_dt, &mut w.encounter) {
+            Ok(e) => m.encounter = Some(Box::new(e)),
+            Err(e) => {
+                m.status = ParticleStatus::IntegrationFailed {
+                    time: p.time,
+                    reason: format!("encounter integrator: {e}"),
+                }
+            }
+        }
+    }
+
+    /// Advances `m` in the encounter mode until it is handed back to the map, removed, or
+    /// reaches the window's end. Returns its steps and the time it needed beyond the
+    /// ephemeris (`-∞` if none).
+    fn run_encounter(&self, m: &mut PopulationMember, w: &mut Worker) -> (u64, f64) {
+        let Some(settings) = self.encounters else {
+            return (0, f64::NEG_INFINITY);
+        };
+        let mut steps = 0;
+        while m.status == ParticleStatus::Active && m.particle.time < self.end {
+            let Some(e) = m.encounter.as_deref_mut() else {
+                break;
+            };
+            if e.steps > 0 && e.time >= e.earliest_hand_back {
+                let g = e.geometry(&self.hill_coefficients, &self.radii);
+                if g.nearest_ratio >= settings.hill_factor {
+                    match self.grid.interpolate(e.time, &mut w.bodies, false) {
+                        Err(SymplecticError::BeyondEphemeris { time, .. }) => return (steps, time),
+                        Err(err) => {
+                            m.status = ParticleStatus::IntegrationFailed {
+                                time: e.time,
+                                reason: err.to_string(),
+                            };
+                            break;
+                        }
+                        Ok(()) => {
+                            let (q, _) = e.particle();
+                            let (f1, part) = regularisation(&self.integrator, &q, &w.bodies);
+                            if f1 >= 0.75 * part {
+                                m.particle = e.hand_back(&self.integrator, &m.particle, &w.bodies);
+                                m.sun_position = w.bodies.positions[0];
+                                m.encounter = None;
+                                w.bodies_time = f64::NAN;
+                                break;
+                            }
+                        }
+                    }
+                }
+            }
+            let mut forces = 0;
+            if let Err(err) = e.step(&self.gm, &settings, &mut w.encounter, &mut forces) {
+                m.status = ParticleStatus::IntegrationFailed {
+                    time: e.time,
+                    reason: format!("encounter integrator: {err}"),
+                };
+                break;
+            }
+            steps += 1;
+            m.particle.work.force_evaluations += forces;
+            let (q, v) = e.particle();
+            (m.particle.position, m.particle.velocity, m.particle.time) = (q, v, e.time);
+            m.sun_position = Vec3::from_column_slice(&e.state[0..3]);
+            let g = e.geometry(&self.hill_coefficients, &self.radii);
+            if let Some((planet, distance, radius)) = g.collision {
+                m.status = ParticleStatus::Collision {
+                    time: e.time,
+                    planet,
+                    distance,
+                    radius,
+                };
+            } else if g.nearest_ratio >= settings.hill_factor {
+                if let Some(status) = self.orbit_removal(&m.particle) {
+                    m.status = status;
+                }
+            }
+        }
+        (steps, f64::NEG_INFINITY)
+    }
+
+    /// The planet (1-based) whose `factor` Hill radii the particle is inside, with the
+    /// distance and the Hill radius.
+    fn hill_entry(
+        &self,
+        p: &TestParticle,
+        positions: &[Vec3],
+        factor: f64,
+    ) -> Option<(usize, f64, f64)> {
         let q = match self.integrator.variant {
             Variant::Barycentric => p.position,
             Variant::Mixed => p.position + positions[0],
         };
-        let rules = &self.rules;
-        if let Some(factor) = rules.hill_factor {
-            // Compared squared (no square root per planet and step); the distances are taken
-            // only for the report.
-            let sun = positions[0];
-            for (j, c) in self.hill_coefficients.iter().enumerate() {
-                let planet = positions[j + 1];
-                let distance2 = (q - planet).norm_squared();
-                let hill2 = (planet - sun).norm_squared() * (c * c);
-                if distance2 < factor * factor * hill2 {
-                    return Some(ParticleStatus::HillSphereEntry {
-                        time: p.time,
-                        planet: j + 1,
-                        distance: distance2.sqrt(),
-                        hill_radius: (planet - sun).norm() * c,
-                    });
-                }
+        // Compared squared (no square root per planet and step); the distances are taken
+        // only for the report.
+        let sun = positions[0];
+        for (j, c) in self.hill_coefficients.iter().enumerate() {
+            let planet = positions[j + 1];
+            let distance2 = (q - planet).norm_squared();
+            let hill2 = (planet - sun).norm_squared() * (c * c);
+            if distance2 < factor * factor * hill2 {
+                return Some((j + 1, distance2.sqrt(), (planet - sun).norm() * c));
             }
         }
+        None
+    }
+
+    /// The first removal rule the particle meets, with the bodies at its time.
+    fn removal(&self, p: &TestParticle, positions: &[Vec3]) -> Option<ParticleStatus> {
+        if let Some(factor) = self.rules.hill_factor {
+            if let Some((planet, distance, hill_radius)) = self.hill_entry(p, positions, factor) {
+                return Some(ParticleStatus::HillSphereEntry {
+                    time: p.time,
+                    planet,
+                    distance,
+                    hill_radius,
+                });
+            }
+        }
+        let q = match self.integrator.variant {
+            Variant::Barycentric => p.position,
+            Variant::Mixed => p.position + positions[0],
+        };
+        self.orbit_removal_at(p, &q)
+    }
+
+    /// The perihelion and ejection rules for a barycentric particle.
+    fn orbit_removal(&self, p: &TestParticle) -> Option<ParticleStatus> {
+        self.orbit_removal_at(p, &p.position)
+    }
+
+    /// The perihelion and ejection rules at barycentric position `q`.
+    fn orbit_removal_at(&self, p: &TestParticle, q: &Vec3) -> Option<ParticleStatus> {
+        let q = *q;
+        let rules = &self.rules;
         if rules.min_perihelion.is_none() && rules.ejection_distance.is_none() {
             return None;
         }
