@@ -64,7 +64,7 @@ fn run() -> Result<(), String> {
     };
     let (mut population, states) = benches::scattered_disk_population(n, scheme, dt0, planet_map)?;
     if let Ok(path) = std::env::var("COMET_THROUGHPUT_INITIAL") {
-        write_initial(&path, &outer_solar_system(Frame::EclipticJ2000), &states)
+        benches::write_comet_states(&path, &outer_solar_system(Frame::EclipticJ2000), &states)
             .map_err(|e| format!("{path}: {e}"))?;
     }
     let start = Instant::now();
@@ -105,39 +105,6 @@ fn run() -> Result<(), String> {
         },
     );
     Ok(())
-}
-
-fn write_initial(
-    path: &str,
-    planets: &symplectic::Planets,
-    states: &[(symplectic::Vec3, symplectic::Vec3)],
-) -> std::io::Result<()> {
-    use std::fmt::Write as _;
-    let mut out = String::from("kind,id,gm,x,y,z,vx,vy,vz\n");
-    let g = planets.g();
-    let (sun_q, sun_v) = planets.sun_barycentric_state();
-    let row = |out: &mut String,
-               kind: &str,
-               id: usize,
-               gm: f64,
-               q: &symplectic::Vec3,
-               v: &symplectic::Vec3| {
-        writeln!(
-            out,
-            "{kind},{id},{gm:e},{:e},{:e},{:e},{:e},{:e},{:e}",
-            q.x, q.y, q.z, v.x, v.y, v.z
-        )
-        .ok();
-    };
-    row(&mut out, "body", 0, g * planets.sun_mass(), &sun_q, &sun_v);
-    let velocities = planets.barycentric_velocities();
-    for (i, (m, q)) in planets.masses().iter().zip(planets.positions()).enumerate() {
-        row(&mut out, "body", i + 1, g * m, &(q + sun_q), &velocities[i]);
-    }
-    for (i, (q, v)) in states.iter().enumerate() {
-        row(&mut out, "particle", i, 0.0, q, v);
-    }
-    std::fs::write(path, out)
 }
 
 fn write_final(path: &str, population: &Population) -> std::io::Result<()> {

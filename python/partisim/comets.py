@@ -224,8 +224,9 @@ class Population:
 
     @property
     def status(self) -> List[str]:
-        """Each particle's status: ``active``, ``hill_sphere_<planet>``, ``perihelion``,
-        ``ejected``, ``regularisation_lost`` or ``failed`` (identifier order)."""
+        """Each particle's status: ``active``, ``hill_sphere_<planet name>``,
+        ``collision_<planet name>`` (with ``[encounters]``), ``perihelion``, ``ejected``,
+        ``regularisation_lost`` or ``failed`` (identifier order)."""
         return self._inner.status
 
     @property

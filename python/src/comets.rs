@@ -193,7 +193,7 @@ impl Population {
     }
 
     /// The snapshot table (the columns of `cargo xtask comets`' Parquet snapshots) as a
-    /// dict of numpy arrays (`status` a list of str).
+    /// dict of numpy arrays (`status` and `class` lists of str, `in_encounter` booleans).
     fn table<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let batch = population_table(&self.inner).map_err(rust_err)?;
         let d = PyDict::new(py);
@@ -207,6 +207,9 @@ impl Population {
             } else if let Some(a) = any.downcast_ref::<arrow_array::StringArray>() {
                 let v: Vec<&str> = a.iter().map(|s| s.unwrap_or("")).collect();
                 d.set_item(field.name(), v)?;
+            } else if let Some(a) = any.downcast_ref::<arrow_array::BooleanArray>() {
+                let v: Vec<bool> = a.iter().map(|b| b.unwrap_or(false)).collect();
+                d.set_item(field.name(), v.into_pyarray(py))?;
             }
         }
         Ok(d)

@@ -7,7 +7,9 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use arrow_array::{ArrayRef, Float64Array, RecordBatch, StringArray, UInt64Array};
+use arrow_array::{
+    ArrayRef, BooleanArray, Float64Array, RecordBatch, StringArray, UInt64Array,
+};
 use arrow_schema::{DataType, Field, Schema};
 use serde::Deserialize;
 
@@ -36,6 +38,11 @@ pub struct PopulationSpec {
     /// When particles are removed (all rules off if the table is absent).
     #[serde(default)]
     pub removal: RemovalRules,
+    /// Integration through close encounters ([`Encounters`](crate::Encounters); off if the
+    /// table is absent; `[encounters]` with no field takes the defaults: 3 Hill radii,
+    /// tolerance 10⁻¹²).
+    #[serde(default)]
+    pub encounters: Option<crate::Encounters>,
 }
 
 /// The planetary system.
@@ -305,6 +312,7 @@ impl PopulationSpec {
         if let Some(w) = self.integrator.window_steps {
             population.set_window_steps(w)?;
         }
+        population.set_encounters(self.encounters)?;
         Ok(population)
     }
 }
@@ -545,18 +553,23 @@ pub fn available_memory() -> Option<u64> {
 /// The table of every particle now: `id`, `status`, `time_days` (the particle's own time:
 /// the steps are variable, so each particle is at the first step end at or after the
 /// snapshot time), `removal_time_days` (NaN if active), barycentric osculating `a_au`, `e`,
-/// `i_deg`, `q_au`, and the barycentric state `x_au … vz_au_per_day`.
+/// `i_deg`, `q_au`, the barycentric state `x_au … vz_au_per_day`, the Tisserand parameter
+/// with respect to Jupiter `tisserand_jupiter` and the dynamical class `class`
+/// ([`classify`](crate::classify): `trans_neptunian`, `centaur`, `jupiter_family`, `other`),
+/// and `in_encounter` (whether the particle is being integrated through an encounter).
 pub fn population_table(population: &Population) -> Result<RecordBatch, SymplecticError> {
     let members = population.members();
     let n = members.len();
-    let mut cols: Vec<Vec<f64>> = (0..12).map(|_| Vec::with_capacity(n)).collect();
+    let mut cols: Vec<Vec<f64>> = (0..13).map(|_| Vec::with_capacity(n)).collect();
     let mut status = Vec::with_capacity(n);
+    let mut class = Vec::with_capacity(n);
     for (i, m) in members.iter().enumerate() {
         let el = population.elements(i)?;
         let q = population.barycentric_position(i);
         let v = m.particle.velocity;
         let (label, removal_time) = status_label(&m.status, population.ephemeris().planets());
         status.push(label);
+        class.push(crate::classify(&el).label());
         let row = [
             m.particle.time,
             removal_time,
@@ -570,6 +583,7 @@ pub fn population_table(population: &Population) -> Result<RecordBatch, Symplect
             v.x,
             v.y,
             v.z,
+            crate::tisserand_jupiter(&el),
         ];
         for (c, x) in cols.iter_mut().zip(row) {
             c.push(x);
@@ -588,6 +602,7 @@ pub fn population_table(population: &Population) -> Result<RecordBatch, Symplect
         "vx_au_per_day",
         "vy_au_per_day",
         "vz_au_per_day",
+        "tisserand_jupiter",
     ];
     let mut fields = vec![
         Field::new("id", DataType::UInt64, false),
@@ -601,6 +616,12 @@ pub fn population_table(population: &Population) -> Result<RecordBatch, Symplect
         fields.push(Field::new(*name, DataType::Float64, false));
         arrays.push(Arc::new(Float64Array::from(c)));
     }
+    fields.push(Field::new("class", DataType::Utf8, false));
+    arrays.push(Arc::new(StringArray::from(class)));
+    fields.push(Field::new("in_encounter", DataType::Boolean, false));
+    arrays.push(Arc::new(BooleanArray::from_iter(
+        members.iter().map(|m| Some(m.encounter.is_some())),
+    )));
     RecordBatch::try_new(Arc::new(Schema::new(fields)), arrays).map_err(|e| {
         SymplecticError::Output {
             path: String::new(),

@@ -149,6 +149,7 @@
 //! comet_throughput -- N YEARS [s2|s6]` measures it, and `docs/performance.md` compares it
 //! with REBOUND's WHFast from one script.
 
+pub mod classes;
 pub mod encounter;
 pub mod ephemeris;
 #[cfg(feature = "io")]
@@ -166,6 +167,7 @@ pub mod solar_system;
 pub mod study;
 mod work;
 
+pub use classes::{classify, tisserand_jupiter, DynamicalClass};
 pub use encounter::{
     integrate_through, Encounter, EncounterOutcome, Encounters, DEFAULT_ENCOUNTER_HILL_FACTOR,
     DEFAULT_ENCOUNTER_TOLERANCE,

@@ -38,6 +38,15 @@ pub const NEAR_CIRCULAR: SampleRanges = SampleRanges {
     inclination: (0.0, std::f64::consts::PI / 180.0),
 };
 
+/// Centaurs among the giant planets: `a` 5.5–30 AU, `e` 0–0.2, `i` 0–10°, random angles
+/// (the population of the Centaur throughput and validation runs).
+pub const CENTAURS: SampleRanges = SampleRanges {
+    perihelion: None,
+    semi_major_axis: (5.5, 30.0),
+    eccentricity: (0.0, 0.2),
+    inclination: (0.0, 10.0 * std::f64::consts::PI / 180.0),
+};
+
 /// SplitMix64 (Steele, Lea & Flood 2014): a tiny, fully specified generator, so that the
 /// samples are the same on every platform and in the Python driver of the peer code.
 #[derive(Debug, Clone)]

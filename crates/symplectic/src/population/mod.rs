@@ -139,11 +139,46 @@ impl Population {
     /// `ids` (one per state, distinct). The ephemeris is extended to `time` if needed; the
     /// particles are built in parallel. Errors name the offending particle by its identifier.
     pub fn new(
-        mut ephemeris: Ephemeris,
+        ephemeris: Ephemeris,
         integrator: ParticleIntegrator,
         rules: RemovalRules,
         time: f64,
         initial_dt: f64,
+        states: &[(Vec3, Vec3)],
+        ids: &[u64],
+    ) -> Result<Self, SymplecticError> {
+        Self::build(ephemeris, integrator, rules, time, |_| initial_dt, states, ids)
+    }
+
+    /// [`Population::new`] with each particle's first physical step given (`initial_dts[i]`
+    /// for `states[i]`): for populations spread over distances where one first step does not
+    /// fit all (the step law is `Δt ∝ r` far from the planets, so a first step proportional to
+    /// the initial distance gives every particle the same step in `s`).
+    pub fn with_first_steps(
+        ephemeris: Ephemeris,
+        integrator: ParticleIntegrator,
+        rules: RemovalRules,
+        time: f64,
+        initial_dts: &[f64],
+        states: &[(Vec3, Vec3)],
+        ids: &[u64],
+    ) -> Result<Self, SymplecticError> {
+        if initial_dts.len() != states.len() {
+            return Err(SymplecticError::InvalidParameter {
+                name: "initial_dts",
+                value: initial_dts.len() as f64,
+                reason: "need one first step per particle state",
+            });
+        }
+        Self::build(ephemeris, integrator, rules, time, |i| initial_dts[i], states, ids)
+    }
+
+    fn build(
+        mut ephemeris: Ephemeris,
+        integrator: ParticleIntegrator,
+        rules: RemovalRules,
+        time: f64,
+        initial_dt: impl Fn(usize) -> f64 + Sync,
         states: &[(Vec3, Vec3)],
         ids: &[u64],
     ) -> Result<Self, SymplecticError> {
@@ -161,9 +196,10 @@ impl Population {
         let members = states
             .par_iter()
             .zip(ids)
-            .map(|(&(position, velocity), &id)| {
+            .enumerate()
+            .map(|(i, (&(position, velocity), &id))| {
                 let particle = integrator
-                    .particle_from_bodies(position, velocity, time, initial_dt, &bodies, &planets)
+                    .particle_from_bodies(position, velocity, time, initial_dt(i), &bodies, &planets)
                     .map_err(|e| SymplecticError::InvalidState {
                         what: "population particle",
                         reason: format!("particle {id}: {e}"),

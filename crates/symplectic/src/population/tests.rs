@@ -53,6 +53,7 @@ proptest! {
         hill in prop::option::of(0.5f64..3.0),
         min_perihelion in prop::option::of(5.0f64..30.0),
         ejection in prop::option::of(60.0f64..200.0),
+        encounters in any::<bool>(),
     ) {
         let scheme = if s6 { Scheme::S6 } else { Scheme::S2 };
         let rules = RemovalRules {
@@ -63,6 +64,9 @@ proptest! {
         let b1 = if small_b1 { 3e-8 } else { crate::PAPER_B1 };
         let mut start = population(n, seed, scheme, b1, rules);
         start.set_window_steps(window).unwrap();
+        if encounters && hill.is_none() {
+            start.set_encounters(Some(crate::Encounters::default())).unwrap();
+        }
         let t_end = 400.0 * 365.25;
         let threads = if two_threads { 2 } else { 1 };
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();

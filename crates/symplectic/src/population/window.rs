@@ -34,8 +34,6 @@ struct WindowContext<'a> {
     rules: RemovalRules,
     /// Integration through close encounters.
     encounters: Option<Encounters>,
-    /// The planets (names and radii).
-    planets: &'a crate::Planets,
     /// Radius of each planet, if known.
     radii: Vec<Option<f64>>,
     /// `(m_j/3m₀)^{1/3}` per planet.
@@ -144,7 +142,6 @@ pub(super) fn run_window(
         integrator,
         rules,
         encounters,
-        planets,
         radii: (1..=planets.len()).map(|j| planets.radius(j)).collect(),
         hill_coefficients: planets
             .masses()
