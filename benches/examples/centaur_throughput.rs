@@ -44,11 +44,11 @@ fn run() -> Result<(), String> {
     let step_per_au = arg(2, 2.0)?;
     let tolerance = arg(3, symplectic::DEFAULT_ENCOUNTER_TOLERANCE)?;
     let seed = arg(4, benches::CENTAUR_SEED as f64)? as u64;
-    let (mut population, states) =
-        benches::centaur_population(n, seed, step_per_au, tolerance)?;
+    let (mut population, states) = benches::centaur_population(n, seed, step_per_au, tolerance)?;
     if let Ok(path) = std::env::var("CENTAUR_THROUGHPUT_INITIAL") {
         let planets = population.ephemeris().planets().clone();
-        benches::write_comet_states(&path, &planets, &states).map_err(|e| format!("{path}: {e}"))?;
+        benches::write_comet_states(&path, &planets, &states)
+            .map_err(|e| format!("{path}: {e}"))?;
     }
     let start = Instant::now();
     let progress = population
@@ -78,7 +78,10 @@ fn run() -> Result<(), String> {
         .map(|m| m.particle.time.min(end) / DAYS_PER_YEAR)
         .sum();
     let ends: Vec<String> = ends.iter().map(|(k, v)| format!("end_{k}={v}")).collect();
-    let classes: Vec<String> = classes.iter().map(|(k, v)| format!("class_{k}={v}")).collect();
+    let classes: Vec<String> = classes
+        .iter()
+        .map(|(k, v)| format!("class_{k}={v}"))
+        .collect();
     println!(
         "particles={n} particle_years_per_s={:.4e} particle_steps_per_s={:.4e} threads={} \
          seconds={seconds:.3} active={} {} {}",

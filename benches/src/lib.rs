@@ -242,9 +242,16 @@ pub fn centaur_population(
         min_perihelion: Some(2.5),
         ejection_distance: Some(100.0),
     };
-    let mut population =
-        Population::with_first_steps(ephemeris, integrator, rules, 0.0, &first_steps, &states, &ids)
-            .map_err(|e| e.to_string())?;
+    let mut population = Population::with_first_steps(
+        ephemeris,
+        integrator,
+        rules,
+        0.0,
+        &first_steps,
+        &states,
+        &ids,
+    )
+    .map_err(|e| e.to_string())?;
     population
         .set_encounters(Some(Encounters {
             tolerance,

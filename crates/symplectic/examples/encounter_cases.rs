@@ -56,12 +56,21 @@ fn main() -> Result<(), symplectic::SymplecticError> {
                 tolerance: 1e-14,
                 ..Default::default()
             };
-            let back = symplectic::integrate_through(&reversed, position, -velocity, t_close, &settings)?;
+            let back =
+                symplectic::integrate_through(&reversed, position, -velocity, t_close, &settings)?;
             let t_end = 2.0 * t_close;
             for (j, (bq, bv)) in back.bodies.iter().enumerate() {
                 row(case, "body", j, bodies.gm[j], *bq, -*bv, t_end);
             }
-            row(case, "particle", planet, 0.0, back.position, -back.velocity, t_end);
+            row(
+                case,
+                "particle",
+                planet,
+                0.0,
+                back.position,
+                -back.velocity,
+                t_end,
+            );
             case += 1;
         }
     }

@@ -123,8 +123,14 @@ mod tests {
         assert!((tisserand_jupiter(&encke) - 3.03).abs() < 0.02);
         assert_eq!(classify(&encke), DynamicalClass::Other);
         assert_eq!(classify(&el(17.8, 0.967, 162.0)), DynamicalClass::Other);
-        assert_eq!(classify(&el(67.9, 0.44, 44.0)), DynamicalClass::TransNeptunian);
-        assert_eq!(classify(&el(39.5, 0.25, 17.1)), DynamicalClass::TransNeptunian);
+        assert_eq!(
+            classify(&el(67.9, 0.44, 44.0)),
+            DynamicalClass::TransNeptunian
+        );
+        assert_eq!(
+            classify(&el(39.5, 0.25, 17.1)),
+            DynamicalClass::TransNeptunian
+        );
         assert_eq!(classify(&el(-5.0, 1.5, 10.0)), DynamicalClass::Other);
     }
 }

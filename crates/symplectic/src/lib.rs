@@ -65,6 +65,17 @@
 //!   result is a deterministic function of the input: bit-identical on any number of
 //!   threads, across shards, after a resume, and equal bit for bit to each particle
 //!   integrated alone with [`ParticleIntegrator::step`];
+//! - [`encounter`]: close encounters integrated through ([`Population::set_encounters`],
+//!   [`Encounters`]): inside 3 Hill radii of a planet (MERCURY's and MERCURIUS' changeover),
+//!   or where `B₀, B₁` no longer dominate (the paper's condition 35, read as a factor 2), a
+//!   particle is integrated by Bulirsch–Stoer together with the Sun and the planets, which
+//!   are advanced from the last grid state rather than interpolated, and handed back to the
+//!   map afterwards; ends by collision with a planet's radius
+//!   ([`ParticleStatus::Collision`]), and never for lost regularisation. Checked against
+//!   REBOUND's IAS15 on single encounters with Jupiter and Neptune down to 0.02 Hill radii
+//!   (within 5·10⁻¹² AU) and against a fine fixed-step RK4 (property test);
+//! - [`classes`]: the dynamical class (trans-Neptunian, Centaur, Jupiter-family) by
+//!   Tisserand parameter and perihelion after Levison (1996), in the population tables;
 //! - [`samples`]: seeded sample populations (SplitMix64) shared with the peer scripts;
 //! - with the feature `io`: `io` (the population TOML, the particle CSV with line/column
 //!   errors, Parquet tables readable by pandas and polars) and `study` (a whole study with
@@ -139,8 +150,8 @@
 //! ejection from energy and angular momentum: ≈ 40 flops, 1 square root): about 1000 flops
 //! and 30 square roots or divisions, all on data in L1. S6 has 3 drifts, 4 kicks and 3
 //! interpolations. Each particle is one [`PopulationMember`] of
-//! [`Population::bytes_per_particle`] bytes (184 on x86-64), stepped many times per window
-//! while it sits in L1, so memory traffic is 2 × 184 bytes per particle per window, not per
+//! [`Population::bytes_per_particle`] bytes (192 on x86-64; 184 before the encounter state), stepped many times per window
+//! while it sits in L1, so memory traffic is 2 × 192 bytes per particle per window, not per
 //! step. The ephemeris window (360 bytes per planet step for five bodies, ≈ 2 ×
 //! [`DEFAULT_WINDOW_STEPS`] steps, ≈ 180 KB) is shared read-only by all threads and stays in
 //! L2; extending it costs one planet step per grid point, once for the whole population

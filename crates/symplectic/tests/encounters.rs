@@ -29,9 +29,7 @@ fn parse(text: &str) -> Vec<Vec<String>> {
 }
 
 fn cases() -> Vec<Case> {
-    let rows = parse(include_str!(
-        "../../../reference-data/comet-encounters/initial.csv"
-    ));
+    let rows = parse(include_str!("data/encounters_initial.csv"));
     let mut out: Vec<Case> = Vec::new();
     for r in rows {
         let case: usize = r[0].parse().unwrap();
@@ -61,22 +59,20 @@ fn cases() -> Vec<Case> {
 
 /// IAS15's final particle state per case and epsilon: (closest distance, position, velocity).
 fn reference() -> Vec<(usize, f64, f64, Vec3, Vec3)> {
-    parse(include_str!(
-        "../../../reference-data/comet-encounters/final.csv"
-    ))
-    .into_iter()
-    .map(|r| {
-        let f = |i: usize| r[i].parse::<f64>().unwrap();
-        let closest = if r[4].is_empty() { f64::NAN } else { f(4) };
-        (
-            r[0].parse().unwrap(),
-            f(2),
-            closest,
-            Vec3::new(f(5), f(6), f(7)),
-            Vec3::new(f(8), f(9), f(10)),
-        )
-    })
-    .collect()
+    parse(include_str!("data/encounters_ias15.csv"))
+        .into_iter()
+        .map(|r| {
+            let f = |i: usize| r[i].parse::<f64>().unwrap();
+            let closest = if r[4].is_empty() { f64::NAN } else { f(4) };
+            (
+                r[0].parse().unwrap(),
+                f(2),
+                closest,
+                Vec3::new(f(5), f(6), f(7)),
+                Vec3::new(f(8), f(9), f(10)),
+            )
+        })
+        .collect()
 }
 
 /// Each encounter ends where IAS15's does. Tolerance (per case, from the two codes' own
@@ -95,15 +91,25 @@ fn single_encounters_agree_with_ias15() {
     let mut inside_a_tenth = 0;
     for (k, c) in cases().iter().enumerate() {
         let ias: Vec<_> = reference.iter().filter(|r| r.0 == k).collect();
-        let (loose, exact) = (ias.iter().find(|r| r.1 == 1e-9).unwrap(), ias.iter().find(|r| r.1 == 1e-11).unwrap());
-        let ours = integrate_through(&c.bodies, c.position, c.velocity, c.t_end, &settings).unwrap();
-        let ours_tight = integrate_through(&c.bodies, c.position, c.velocity, c.t_end, &tight).unwrap();
+        let (loose, exact) = (
+            ias.iter().find(|r| r.1 == 1e-9).unwrap(),
+            ias.iter().find(|r| r.1 == 1e-11).unwrap(),
+        );
+        let ours =
+            integrate_through(&c.bodies, c.position, c.velocity, c.t_end, &settings).unwrap();
+        let ours_tight =
+            integrate_through(&c.bodies, c.position, c.velocity, c.t_end, &tight).unwrap();
         let scale = exact.3.norm();
-        let tol_q = 10.0 * ((loose.3 - exact.3).norm() + (ours.position - ours_tight.position).norm())
+        let tol_q = 10.0
+            * ((loose.3 - exact.3).norm() + (ours.position - ours_tight.position).norm())
             + 1e-13 * scale;
-        let tol_v = 10.0 * ((loose.4 - exact.4).norm() + (ours.velocity - ours_tight.velocity).norm())
+        let tol_v = 10.0
+            * ((loose.4 - exact.4).norm() + (ours.velocity - ours_tight.velocity).norm())
             + 1e-13 * exact.4.norm();
-        let (dq, dv) = ((ours.position - exact.3).norm(), (ours.velocity - exact.4).norm());
+        let (dq, dv) = (
+            (ours.position - exact.3).norm(),
+            (ours.velocity - exact.4).norm(),
+        );
         let hill = {
             let sun = c.bodies.positions[0];
             let p = c.bodies.positions[c.planet];
@@ -118,10 +124,19 @@ fn single_encounters_agree_with_ias15() {
         if loose.2 < 0.1 * hill {
             inside_a_tenth += 1;
         }
-        assert!(dq <= tol_q, "case {k}: position differs by {dq:e} AU > {tol_q:e}");
-        assert!(dv <= tol_v, "case {k}: velocity differs by {dv:e} AU/day > {tol_v:e}");
+        assert!(
+            dq <= tol_q,
+            "case {k}: position differs by {dq:e} AU > {tol_q:e}"
+        );
+        assert!(
+            dv <= tol_v,
+            "case {k}: velocity differs by {dv:e} AU/day > {tol_v:e}"
+        );
     }
-    assert!(inside_a_tenth >= 2, "the reference must hold passes inside 0.1 R_H");
+    assert!(
+        inside_a_tenth >= 2,
+        "the reference must hold passes inside 0.1 R_H"
+    );
 }
 
 /// Classical RK4 (the fixture's, inertial N-body equations with the particle as a massless
@@ -134,7 +149,13 @@ fn rk4_oracle(bodies: &BodyStates, q: Vec3, v: Vec3, t_end: f64, steps: usize) -
     qs.push(q);
     let mut vs = bodies.velocities.clone();
     vs.push(v);
-    common::rk4(&m, &mut qs, &mut vs, (t_end - bodies.time) / steps as f64, steps);
+    common::rk4(
+        &m,
+        &mut qs,
+        &mut vs,
+        (t_end - bodies.time) / steps as f64,
+        steps,
+    );
     (qs[qs.len() - 1], vs[vs.len() - 1])
 }
 

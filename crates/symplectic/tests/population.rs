@@ -6,8 +6,8 @@ use proptest::prelude::*;
 use symplectic::kepler::state_from_elements;
 use symplectic::samples::{sample_elements, SampleRanges, SCATTERED_DISK};
 use symplectic::{
-    outer_solar_system, Ephemeris, Frame, Integrator, ParticleIntegrator, ParticleScratch,
-    Encounters, ParticleStatus, Population, RemovalRules, Scheme, TestParticle, Variant, Vec3,
+    outer_solar_system, Encounters, Ephemeris, Frame, Integrator, ParticleIntegrator,
+    ParticleScratch, ParticleStatus, Population, RemovalRules, Scheme, TestParticle, Variant, Vec3,
 };
 
 const DAYS_PER_YEAR: f64 = 365.25;
@@ -285,7 +285,12 @@ fn advance_counting_encounters(pop: &mut Population, years: f64) -> usize {
     while t < years * DAYS_PER_YEAR {
         t += DAYS_PER_YEAR;
         pop.advance_to(t, |_| {}).unwrap();
-        seen.extend(pop.members().iter().filter(|m| m.encounter.is_some()).map(|m| m.id));
+        seen.extend(
+            pop.members()
+                .iter()
+                .filter(|m| m.encounter.is_some())
+                .map(|m| m.id),
+        );
     }
     seen.len()
 }
@@ -362,12 +367,26 @@ fn encounters_carry_comets_that_the_removal_rule_stops() {
         .iter()
         .map(|m| (m.particle.position, m.particle.velocity))
         .collect();
-    let mut without = Population::new(ephemeris(), without.integrator(), rules, 0.0, 30.0, &st, &ids).unwrap();
+    let mut without = Population::new(
+        ephemeris(),
+        without.integrator(),
+        rules,
+        0.0,
+        30.0,
+        &st,
+        &ids,
+    )
+    .unwrap();
     without.advance_to(years * DAYS_PER_YEAR, |_| {}).unwrap();
     let stopped: Vec<u64> = without
         .members()
         .iter()
-        .filter(|m| matches!(m.status, ParticleStatus::HillSphereEntry { .. } | ParticleStatus::RegularisationLost { .. }))
+        .filter(|m| {
+            matches!(
+                m.status,
+                ParticleStatus::HillSphereEntry { .. } | ParticleStatus::RegularisationLost { .. }
+            )
+        })
         .map(|m| m.id)
         .collect();
     assert!(!stopped.is_empty());
@@ -379,7 +398,12 @@ fn encounters_carry_comets_that_the_removal_rule_stops() {
     assert!(went_on > 0, "of {} stopped, none went on", stopped.len());
     for m in with.members() {
         assert!(
-            !matches!(m.status, ParticleStatus::RegularisationLost { .. } | ParticleStatus::IntegrationFailed { .. } | ParticleStatus::HillSphereEntry { .. }),
+            !matches!(
+                m.status,
+                ParticleStatus::RegularisationLost { .. }
+                    | ParticleStatus::IntegrationFailed { .. }
+                    | ParticleStatus::HillSphereEntry { .. }
+            ),
             "{}: {:?}",
             m.id,
             m.status

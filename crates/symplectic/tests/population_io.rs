@@ -238,3 +238,44 @@ fn rows_given_directly_build_the_files_population() {
         .unwrap_err();
     assert!(err.to_string().contains("bound"), "{err}");
 }
+
+/// A study with an `[encounters]` table builds a population integrated through encounters,
+/// and its table carries the classes, the Tisserand parameter and the encounter flag; an
+/// `[encounters]` table together with the Hill-sphere removal rule is refused by name.
+#[test]
+fn a_study_with_encounters_integrates_through_them() {
+    use symplectic::io::{population_table, PopulationSpec};
+    let spec_text = SPEC.replace("b1 = 0.21e-6", "b1 = 4e-6").replace(
+        "hill_factor = 1.0\nmin_perihelion = 26.0",
+        "min_perihelion = 2.5",
+    ) + "\n[encounters]\n";
+    let rows = "id,a,e,i,node,peri,mean_anomaly\n\
+        0,14.0,0.17,2.2,334.0,262.0,65.0\n\
+        1,5.6,0.05,3.0,20.0,30.0,40.0\n\
+        2,9.0,0.1,1.0,120.0,230.0,300.0\n";
+    let (path, _) = study("encounters", &spec_text, rows);
+    let spec = PopulationSpec::from_file(&path).unwrap();
+    let mut pop = spec.population(&path).unwrap();
+    assert_eq!(pop.encounters(), Some(symplectic::Encounters::default()));
+    pop.advance_to(5.0 * 365.25, |_| {}).unwrap();
+    let table = population_table(&pop).unwrap();
+    let schema = table.schema();
+    for column in ["tisserand_jupiter", "class", "in_encounter"] {
+        assert!(schema.field_with_name(column).is_ok(), "{column}");
+    }
+    let classes = table
+        .column_by_name("class")
+        .unwrap()
+        .as_any()
+        .downcast_ref::<arrow_array::StringArray>()
+        .unwrap();
+    // a = 14 AU, q = 11.6 AU: a Centaur.
+    assert_eq!(classes.value(0), "centaur");
+    let both = spec_text.replace("[removal]\n", "[removal]\nhill_factor = 1.0\n");
+    let (bad, _) = study("encounters-bad", &both, rows);
+    let err = PopulationSpec::from_file(&bad)
+        .unwrap()
+        .population(&bad)
+        .unwrap_err();
+    assert!(err.to_string().contains("hill_factor"), "{err}");
+}

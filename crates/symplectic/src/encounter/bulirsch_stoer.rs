@@ -47,11 +47,7 @@ pub(crate) fn derivative(gm: &[f64], y: &[f64], dy: &mut [f64], forces: &mut u64
         // Pairs among the massive bodies once each; the massless ones feel every massive one.
         let first = if i < massive { i + 1 } else { 0 };
         for j in first..massive {
-            let d = [
-                q[3 * j] - qi[0],
-                q[3 * j + 1] - qi[1],
-                q[3 * j + 2] - qi[2],
-            ];
+            let d = [q[3 * j] - qi[0], q[3 * j + 1] - qi[1], q[3 * j + 2] - qi[2]];
             let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
             let inv_r3 = 1.0 / (r2 * r2.sqrt());
             *forces += 1;
@@ -128,7 +124,9 @@ impl BulirschStoer {
             if !(h.is_finite() && h > 0.0) || *t + h == *t {
                 return Err(SymplecticError::InvalidState {
                     what: "encounter integrator",
-                    reason: format!("step {h:e} days at t = {t} days is below the time's resolution"),
+                    reason: format!(
+                        "step {h:e} days at t = {t} days is below the time's resolution"
+                    ),
                 });
             }
             let mut err = f64::INFINITY;
@@ -239,7 +237,11 @@ fn scaled_difference(a: &[f64], b: &[f64], tolerance: f64) -> f64 {
             // An object at rest at the origin (a zero vector) converges when its difference is 0.
             let e = if d == 0.0 { 0.0 } else { d / scale };
             // A NaN difference counts as not converged.
-            worst = if e.is_nan() { f64::INFINITY } else { worst.max(e) };
+            worst = if e.is_nan() {
+                f64::INFINITY
+            } else {
+                worst.max(e)
+            };
         }
     }
     worst
@@ -275,6 +277,9 @@ mod tests {
         assert!((t - period).abs() < 1e-12);
         let error = ((y[3] - 1.0).powi(2) + y[4].powi(2) + y[5].powi(2)).sqrt();
         // Tolerance: 10 × tol per step, the local bound the controller enforces.
-        assert!(error < 10.0 * 1e-12 * steps as f64, "error {error:e} after {steps} steps");
+        assert!(
+            error < 10.0 * 1e-12 * steps as f64,
+            "error {error:e} after {steps} steps"
+        );
     }
 }

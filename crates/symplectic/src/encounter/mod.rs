@@ -180,8 +180,20 @@ impl Encounter {
         let n1 = scratch.bodies.gm.len();
         let planets = &mut scratch.planets;
         planets.clear();
-        planets.extend(scratch.bodies.positions.iter().flat_map(|x| x.iter().copied()));
-        planets.extend(scratch.bodies.velocities.iter().flat_map(|x| x.iter().copied()));
+        planets.extend(
+            scratch
+                .bodies
+                .positions
+                .iter()
+                .flat_map(|x| x.iter().copied()),
+        );
+        planets.extend(
+            scratch
+                .bodies
+                .velocities
+                .iter()
+                .flat_map(|x| x.iter().copied()),
+        );
         let bs = settings.integrator();
         let mut t = t_grid;
         let mut h = grid.step() / 8.0;
@@ -375,7 +387,15 @@ pub fn integrate_through(
     };
     while t < t_end {
         let remaining = t_end - t;
-        let taken = bs.step(&bodies.gm, &mut state, &mut t, h, remaining, &mut scratch, &mut forces)?;
+        let taken = bs.step(
+            &bodies.gm,
+            &mut state,
+            &mut t,
+            h,
+            remaining,
+            &mut scratch,
+            &mut forces,
+        )?;
         if taken.step >= remaining {
             t = t_end;
         }

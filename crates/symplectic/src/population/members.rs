@@ -15,8 +15,10 @@ use crate::{SymplecticError, Vec3};
 pub struct RemovalRules {
     /// Remove a particle inside `hill_factor` Hill radii of a planet: the Hill radius of
     /// planet `j` is `|Q_j| (m_j/3m₀)^{1/3}` with `Q_j` its heliocentric position at the
-    /// particle's time. The method does not resolve planetary encounters; removal at Hill
-    /// sphere entry is the standard treatment (Holman & Wisdom 1993, AJ 105, 1987). Checked
+    /// particle's time. The map alone does not resolve planetary encounters; removal at Hill
+    /// sphere entry is the standard treatment (Holman & Wisdom 1993, AJ 105, 1987), and
+    /// [`Population::set_encounters`](crate::Population::set_encounters) the alternative
+    /// that integrates through them (not together with this rule). Checked
     /// at step ends: an encounter shorter than a step can be missed, as in any fixed-step
     /// integrator with this rule.
     pub hill_factor: Option<f64>,

@@ -77,7 +77,7 @@ pub const DEFAULT_WINDOW_STEPS: u32 = 256;
 /// counted with callgrind, 10² comets, 2026-11-25): at about 0.175 µs (≈ 610 cycles) per
 /// step the processor retired nearly four instructions per cycle, so one particle at a time
 /// is bound by the number of instructions, not by the latency of its chains (stepping whole
-/// particles in turn, round-robin, gained nothing). A particle's 184 bytes stay in registers
+/// particles in turn, round-robin, gained nothing). A particle's 192 bytes stay in registers
 /// and L1 through the window; the step is not bandwidth-bound.
 ///
 /// **Lanes.** In the barycentric variant (either scheme) a window therefore steps its
@@ -147,7 +147,15 @@ impl Population {
         states: &[(Vec3, Vec3)],
         ids: &[u64],
     ) -> Result<Self, SymplecticError> {
-        Self::build(ephemeris, integrator, rules, time, |_| initial_dt, states, ids)
+        Self::build(
+            ephemeris,
+            integrator,
+            rules,
+            time,
+            |_| initial_dt,
+            states,
+            ids,
+        )
     }
 
     /// [`Population::new`] with each particle's first physical step given (`initial_dts[i]`
@@ -170,7 +178,15 @@ impl Population {
                 reason: "need one first step per particle state",
             });
         }
-        Self::build(ephemeris, integrator, rules, time, |i| initial_dts[i], states, ids)
+        Self::build(
+            ephemeris,
+            integrator,
+            rules,
+            time,
+            |i| initial_dts[i],
+            states,
+            ids,
+        )
     }
 
     fn build(
@@ -199,7 +215,14 @@ impl Population {
             .enumerate()
             .map(|(i, (&(position, velocity), &id))| {
                 let particle = integrator
-                    .particle_from_bodies(position, velocity, time, initial_dt(i), &bodies, &planets)
+                    .particle_from_bodies(
+                        position,
+                        velocity,
+                        time,
+                        initial_dt(i),
+                        &bodies,
+                        &planets,
+                    )
                     .map_err(|e| SymplecticError::InvalidState {
                         what: "population particle",
                         reason: format!("particle {id}: {e}"),
@@ -265,7 +288,10 @@ impl Population {
     /// `None` turns it off. Barycentric variant only, and not with the removal rule
     /// [`RemovalRules::hill_factor`] (one removes at Hill-sphere entry, the other integrates
     /// through it).
-    pub fn set_encounters(&mut self, encounters: Option<Encounters>) -> Result<(), SymplecticError> {
+    pub fn set_encounters(
+        &mut self,
+        encounters: Option<Encounters>,
+    ) -> Result<(), SymplecticError> {
         if let Some(e) = &encounters {
             e.validate()?;
             if self.integrator.variant != Variant::Barycentric {
