@@ -67,7 +67,7 @@ impl DynamicalClass {
 /// but the parameter is not used for unbound orbits).
 pub fn tisserand_jupiter(el: &Elements) -> f64 {
     let a = el.semi_major_axis;
-    if !(a > 0.0) {
+    if a.is_nan() || a <= 0.0 {
         return f64::NAN;
     }
     let a_j = JUPITER_SEMI_MAJOR_AXIS_AU;

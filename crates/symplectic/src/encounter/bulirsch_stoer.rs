@@ -107,6 +107,7 @@ impl BulirschStoer {
     /// One accepted step from `(t, y)` of at most `max_step` (`f64::INFINITY`: none), trying
     /// `proposed` first; `y` and `t` advance. Errors if the step shrinks below the time's
     /// resolution or the state stops being finite.
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn step(
         &self,
         gm: &[f64],

@@ -171,6 +171,13 @@ pub(super) fn run_window(
         .reduce(|| (0, f64::NEG_INFINITY), sum_steps)
 }
 
+/// `x < y`, or either is NaN (the regularisation margin of the encounter switch: a NaN `F₁`
+/// switches too).
+#[inline(always)]
+fn below_or_nan(x: f64, y: f64) -> bool {
+    matches!(x.partial_cmp(&y), None | Some(std::cmp::Ordering::Less))
+}
+
 /// Adds two `(steps, beyond)` pairs.
 fn sum_steps(a: (u64, f64), b: (u64, f64)) -> (u64, f64) {
     (a.0 + b.0, a.1.max(b.1))
@@ -566,7 +573,7 @@ impl WindowContext<'_> {
             let r = norm(q);
             let part = V::splat(self.integrator.b0) + V::splat(self.integrator.b1) / r;
             let half = V::splat(0.5) * part;
-            flag(std::array::from_fn(|l| !(f1.0[l] >= half.0[l])));
+            flag(std::array::from_fn(|l| below_or_nan(f1.0[l], half.0[l])));
         }
         if let Some(factor) = self.switch_factor() {
             let sun = &positions[0];
@@ -629,7 +636,7 @@ impl WindowContext<'_> {
             // The same operations as the lanes' flags (`removal_lanes`).
             let r = m.particle.position.norm();
             let part = self.integrator.b0 + self.integrator.b1 / r;
-            let margin_lost = !(f1 >= 0.5 * part);
+            let margin_lost = below_or_nan(f1, 0.5 * part);
             let near = self.hill_entry(&m.particle, positions, settings.hill_factor);
             if margin_lost || near.is_some() {
                 self.begin_encounter(m, &settings, w);
