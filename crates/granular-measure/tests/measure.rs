@@ -11,7 +11,7 @@
 //! evenly spread points; the tests allow `2 δ / D` (points one per bin, not exactly even), with
 //! `D = (0.6 H − δ) / tan α` the run of the 20–80 % band.
 
-use iisph_granular::measure::{
+use granular_measure::{
     angle_of_repose, normalised_runout, radial_runout, runout, surface_profile, FrontMethod,
     MeasureError, PileShape, RadialRunoutOptions, ReposeOptions, RunoutOptions,
 };
