@@ -1,9 +1,10 @@
-//! Shared helpers of the experiments: CSV output, reference-data loading, plotting and a
-//! small deterministic random-number generator.
+//! Shared helpers of the experiments: CSV output, reference-data loading, plotting,
+//! summary statistics and a small deterministic random-number generator.
 
 mod data;
 mod plot;
 mod rng;
+pub mod stats;
 pub mod solar_system;
 
 pub use data::{load_reference_csv, write_csv_columns, write_csv_rows, ReferenceTable};

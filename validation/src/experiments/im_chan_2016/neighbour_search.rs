@@ -28,6 +28,7 @@ use neighbour_search::{
 };
 use sph_core::{Real, Vec3};
 
+use crate::helpers::stats::median;
 use crate::helpers::{
     load_reference_csv, plot_xy, write_csv_rows, Legend, Marker, PlotSpec, Series, SeriesStyle,
     SplitMix64,
@@ -736,14 +737,13 @@ fn time_search(method: Method, pos: &[Vec3<f64>], reps: usize) -> Result<Timing>
             .map_err(|e| anyhow!("{} on {} particles: {e}", method.name(), pos.len()))?;
         times.push(t.elapsed().as_secs_f64());
     }
-    times.sort_by(f64::total_cmp);
     Ok(Timing {
         method,
         threads: rayon::current_num_threads(),
         n: pos.len(),
         reps,
-        median_s: times[times.len() / 2],
-        min_s: times[0],
+        median_s: median(&times),
+        min_s: times.iter().copied().fold(f64::INFINITY, f64::min),
         pairs: lists.pair_count(),
     })
 }
