@@ -4,8 +4,8 @@
 mod data;
 mod plot;
 mod rng;
-pub mod stats;
 pub mod solar_system;
+pub mod stats;
 
 pub use data::{load_reference_csv, write_csv_columns, write_csv_rows, ReferenceTable};
 pub use plot::{ensure_fonts, plot_xy, Legend, Marker, PlotSpec, Series, SeriesStyle};
