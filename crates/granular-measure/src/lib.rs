@@ -1,3 +1,7 @@
+#![doc = include_str!("../README.md")]
+//!
+//! ## In detail
+//!
 //! Measurements of granular heaps and deposits on particle output, usable on any scene's
 //! positions (a VTK frame read back, a simulation state, an experiment's run): the **angle of
 //! repose** of a settled pile ([`repose`]) and the **runout** of a collapsed column, planar
@@ -17,25 +21,6 @@
 //! doi:10.1017/S0022112004009036. G. Lube, H. E. Huppert, R. S. J. Sparks & A. Freundt,
 //! "Collapses of two-dimensional granular columns", *Physical Review E* 72, 041301 (2005),
 //! doi:10.1103/PhysRevE.72.041301.
-//!
-//! ```
-//! use granular_measure::{angle_of_repose, runout, ReposeOptions, RunoutOptions};
-//! use sph_core::Vec3;
-//!
-//! // A planar wedge sloping at 45° from x = 0 (apex, 1 m high) to x = 1, sampled every 1 cm.
-//! let s = 0.01;
-//! let mut heap = Vec::new();
-//! for i in 0..=100 {
-//!     for j in 0..=(100 - i) {
-//!         heap.push(Vec3::new(i as f64 * s, j as f64 * s, 0.0));
-//!     }
-//! }
-//! let m = angle_of_repose(&heap, &ReposeOptions::planar(0.0, s).with_spacing(s))?;
-//! assert!((m.angle_deg - 45.0).abs() <= m.resolution_deg.unwrap());
-//! let front = runout(&heap, &RunoutOptions::connected(0.0, s))?;
-//! assert!((front - 1.005).abs() < 1e-9); // the last centre at x = 1 m plus half a spacing
-//! # Ok::<(), granular_measure::MeasureError>(())
-//! ```
 
 mod error;
 pub mod repose;
