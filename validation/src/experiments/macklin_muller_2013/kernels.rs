@@ -23,6 +23,8 @@
 //!     `∇²W(0)·h^(D+2)`) against `reference-data/kernels/normalisation_constants.csv`,
 //!     relative error `< 64ε`.
 
+use std::f64::consts::PI;
+
 use anyhow::{Context as _, Result};
 use sph_core::{Vec2, Vec3};
 use sph_kernels::quadrature::gauss_legendre;
