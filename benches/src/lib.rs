@@ -1,7 +1,7 @@
 //! Scenes and peer adapters shared by the criterion benchmarks.
 
 use rayon::prelude::*;
-use sph_core::{sampling::cubic_lattice, Aabb, Real, Vec3};
+use sph_core::{Aabb, Real, Vec3};
 
 /// The neighbour-search anchor scene of SPlisHSPlasH's `DamBreakModel.json` at particle
 /// radius 0.0125 m (support 0.05 m): a fluid block of 39³ = 59,319 particles at spacing
