@@ -68,14 +68,6 @@ pub fn module_name(id: &str) -> String {
     id.replace('-', "_")
 }
 
-/// The experiment's file module (the segment before its type name).
-fn file_module(e: &dyn Experiment) -> Option<&'static str> {
-    let path = e.type_path();
-    let mut segments: Vec<&'static str> = path.split("::").collect();
-    segments.pop();
-    segments.pop()
-}
-
 /// The Markdown table of every registered experiment, by paper: crates, scenes and the
 /// reference-data directory (when `reference_dir/<id>/` exists).
 pub fn experiment_table(experiments: &[Box<dyn Experiment>], reference_dir: &Path) -> String {
@@ -122,6 +114,14 @@ pub const TABLE_END: &str = "<!-- end of experiments -->";
 mod tests {
     use super::*;
     use crate::{registry, workspace_root};
+
+/// The experiment's file module (the segment before its type name).
+fn file_module(e: &dyn Experiment) -> Option<&'static str> {
+    let path = e.type_path();
+    let mut segments: Vec<&'static str> = path.split("::").collect();
+    segments.pop();
+    segments.pop()
+}
 
     #[test]
     fn every_experiment_lives_in_its_paper_folder_under_its_id() {
