@@ -9,7 +9,7 @@
 
 use benches::{dam_break_anchor, kiddo_search};
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use neighbour_search::point_sets::{jittered_lattice, splash};
+use neighbour_search::point_sets;
 use neighbour_search::{CellOrder, CellSorter, Method, NeighbourLists, Vec3};
 use std::hint::black_box;
 use std::time::Duration;
@@ -55,14 +55,14 @@ fn run_methods(c: &mut Criterion, group_name: &str, points: &[Vec3<f32>], thread
 
 fn uniform(c: &mut Criterion) {
     for n in [10_000, 100_000, 1_000_000] {
-        let points = jittered_lattice::<f32>(n, SPACING).expect("a valid lattice");
+        let points = point_sets::jittered_lattice::<f32>(n, SPACING).expect("a valid lattice");
         run_methods(c, "uniform-block", &points, None);
     }
 }
 
 fn splash(c: &mut Criterion) {
     for n in [10_000, 100_000, 1_000_000] {
-        let points = splash::<f32>(n, SPACING).expect("a valid lattice");
+        let points = point_sets::splash::<f32>(n, SPACING).expect("a valid lattice");
         run_methods(c, "splash", &points, None);
     }
 }
