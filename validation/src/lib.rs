@@ -25,6 +25,7 @@ pub mod deviations;
 pub mod experiments;
 pub mod helpers;
 pub mod papers;
+pub mod report;
 pub mod runner;
 pub mod sim;
 

@@ -312,7 +312,6 @@
 mod friction;
 pub mod granular;
 mod kernels;
-pub mod measure;
 mod params;
 mod passes;
 mod scratch;

@@ -36,6 +36,7 @@ use symplectic::{
 
 use super::symplectic_order::wisdom_holman_estimate;
 use crate::helpers::solar_system::{particles, thread_cpu_seconds, to_barycentric, DAYS_PER_YEAR};
+use crate::helpers::stats::median;
 use crate::helpers::{plot_xy, write_csv_rows, Legend, PlotSpec, Series, SeriesStyle};
 use crate::{fmt_num, Check, Context, Experiment, Mode, Outcome};
 
@@ -235,16 +236,6 @@ fn start_or_resume(ctx: &Context, scheme: Scheme, span_day: f64) -> Result<(RunS
         }
     }
     Ok((RunState::new(ctx, scheme, span_day)?, false))
-}
-
-/// Median of the finite values.
-fn median(mut v: Vec<f64>) -> f64 {
-    v.retain(|x| x.is_finite());
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 /// Values of `f(sample)` over the first and the last tenth of `samples`.
@@ -552,10 +543,10 @@ fn check_particle(out: &mut Outcome, runs: &[RunState; 2], i: usize, name: &str)
     let n2 = active_samples(&s2.samples, i);
     let n_common = n2.min(active_samples(&s6.samples, i));
     let (f2, l2) = tenths(&s2.samples[..n2], |x| x.max_abs_error[i]);
-    let (m_f2, m_l2) = (median(f2), median(l2));
+    let (m_f2, m_l2) = (median(&f2), median(&l2));
     let (_, c2) = tenths(&s2.samples[..n_common], |x| x.max_abs_error[i]);
     let (_, c6) = tenths(&s6.samples[..n_common], |x| x.max_abs_error[i]);
-    let (m_c2, m_c6) = (median(c2), median(c6));
+    let (m_c2, m_c6) = (median(&c2), median(&c6));
     let common_yr = s2
         .samples
         .get(n_common.wrapping_sub(1))

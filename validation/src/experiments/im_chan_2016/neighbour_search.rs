@@ -22,12 +22,16 @@
 use std::time::Instant;
 
 use anyhow::{anyhow, Context as _, Result};
+use neighbour_search::point_sets::{
+    cell_faces, jittered_block, lattice_block, negative_coordinates, random_cloud, to_real,
+    two_clusters, PointSet,
+};
 use neighbour_search::{
     BruteForce, CellOrder, CellSorter, Method, NeighbourLists, NeighbourSearch, SearchError,
-    CELL_MARGIN,
 };
 use sph_core::{Real, Vec3};
 
+use crate::helpers::stats::median;
 use crate::helpers::{
     load_reference_csv, plot_xy, write_csv_rows, Legend, Marker, PlotSpec, Series, SeriesStyle,
     SplitMix64,
@@ -139,7 +143,7 @@ impl References {
 }
 
 /// Every method against the oracle on every cloud, f64 and f32.
-fn measure_correctness(ctx: &Context, clouds: &[Cloud]) -> Result<Vec<CorrectnessRow>> {
+fn measure_correctness(ctx: &Context, clouds: &[PointSet]) -> Result<Vec<CorrectnessRow>> {
     let mut rows: Vec<CorrectnessRow> = Vec::new();
     for cloud in clouds {
         ctx.progress
@@ -241,7 +245,7 @@ fn write_correctness(ctx: &mut Context, rows: &[CorrectnessRow]) -> Result<()> {
 fn check_determinism(
     ctx: &Context,
     out: &mut Outcome,
-    clouds: &[Cloud],
+    clouds: &[PointSet],
     pool_threads: usize,
 ) -> Result<()> {
     ctx.progress.set_message("determinism (1 thread vs pool)");
@@ -502,123 +506,17 @@ fn claim_note(ratio: f64, lo: f64, hi: f64, threads: usize, n: usize) -> String 
     )
 }
 
-/// A point cloud for the correctness test, in f64 (converted to each precision).
-struct Cloud {
-    name: &'static str,
-    points: Vec<[f64; 3]>,
-    radius: f64,
-}
-
-fn clouds(mode: Mode) -> Vec<Cloud> {
+fn clouds(mode: Mode) -> Vec<PointSet> {
     let n = mode.pick(3000usize, 12000);
     let mut rng = SplitMix64::new(0x5eed_2016);
     // The generators draw from one stream, in this order.
     vec![
-        uniform_block(n),
+        lattice_block(n, SPACING),
         random_cloud(&mut rng, n),
         two_clusters(&mut rng, n),
         negative_coordinates(&mut rng, n),
         cell_faces(&mut rng, n),
     ]
-}
-
-/// Search radius giving ~30 neighbours for `n` particles spread uniformly over `volume`.
-fn radius_for(volume: f64, n: usize) -> f64 {
-    (30.0 * volume * 3.0 / (4.0 * std::f64::consts::PI * n as f64)).cbrt()
-}
-
-/// Uniform block: lattice at spacing s, h = 2s (pairs at exactly h: ties decided identically).
-fn uniform_block(n: usize) -> Cloud {
-    let side = (n as f64).cbrt().round() as usize;
-    let s = SPACING;
-    let mut block = Vec::with_capacity(side * side * side);
-    for i in 0..side {
-        for j in 0..side {
-            for k in 0..side {
-                block.push([i as f64 * s, j as f64 * s, k as f64 * s]);
-            }
-        }
-    }
-    Cloud {
-        name: "uniform-block",
-        points: block,
-        radius: 2.0 * s,
-    }
-}
-
-/// Random cloud in the unit cube, ~30 neighbours.
-fn random_cloud(rng: &mut SplitMix64, n: usize) -> Cloud {
-    let points = (0..n)
-        .map(|_| [rng.unit(), rng.unit(), rng.unit()])
-        .collect();
-    Cloud {
-        name: "random",
-        points,
-        radius: radius_for(1.0, n),
-    }
-}
-
-/// Two clusters 1e6 apart along x (f32 quantises the far one to a 0.0625 lattice).
-fn two_clusters(rng: &mut SplitMix64, n: usize) -> Cloud {
-    let points = (0..n)
-        .map(|i| {
-            let off = if i % 2 == 0 { 0.0 } else { 1.0e6 };
-            [off + 0.5 * rng.unit(), 0.5 * rng.unit(), 0.5 * rng.unit()]
-        })
-        .collect();
-    Cloud {
-        name: "two-clusters-1e6-apart",
-        points,
-        radius: 0.1,
-    }
-}
-
-/// Negative coordinates (and straddling zero, where floor ≠ truncation).
-fn negative_coordinates(rng: &mut SplitMix64, n: usize) -> Cloud {
-    let points = (0..n)
-        .map(|_| {
-            [
-                rng.range(-1.2, 0.3),
-                rng.range(-1.2, 0.3),
-                rng.range(-1.2, 0.3),
-            ]
-        })
-        .collect();
-    Cloud {
-        name: "negative-coordinates",
-        points,
-        radius: radius_for(1.5f64.powi(3), n),
-    }
-}
-
-/// On cell faces: coordinates on the cell boundaries k·h(1 + CELL_MARGIN), on multiples of h
-/// (pairs at exactly h), or random, in [−4h, 4h].
-fn cell_faces(rng: &mut SplitMix64, n: usize) -> Cloud {
-    let h = 0.1;
-    let face = h * (1.0 + CELL_MARGIN);
-    let coord = |rng: &mut SplitMix64| {
-        let k = rng.below(9) as f64 - 4.0;
-        match rng.below(4) {
-            0 | 1 => k * face,
-            2 => k * h,
-            _ => rng.range(-4.0 * h, 4.0 * h),
-        }
-    };
-    let points = (0..n)
-        .map(|_| [coord(rng), coord(rng), coord(rng)])
-        .collect();
-    Cloud {
-        name: "cell-faces",
-        points,
-        radius: h,
-    }
-}
-
-fn to_real<R: Real>(points: &[[f64; 3]]) -> Vec<Vec3<R>> {
-    points
-        .iter()
-        .map(|p| Vec3::new(R::of_f64(p[0]), R::of_f64(p[1]), R::of_f64(p[2])))
-        .collect()
 }
 
 struct CorrectnessRow {
@@ -634,7 +532,7 @@ struct CorrectnessRow {
     error: String,
 }
 
-fn correctness<R: Real>(cloud: &Cloud) -> Result<Vec<CorrectnessRow>> {
+fn correctness<R: Real>(cloud: &PointSet) -> Result<Vec<CorrectnessRow>> {
     let pos = to_real::<R>(&cloud.points);
     let radius = R::of_f64(cloud.radius);
     let mut oracle_lists = NeighbourLists::new();
@@ -686,18 +584,7 @@ fn correctness<R: Real>(cloud: &Cloud) -> Result<Vec<CorrectnessRow>> {
 /// sorted by cell in lexicographic order (the searches then skip their own sort).
 fn timing_block(side: usize) -> Result<Vec<Vec3<f64>>> {
     let mut rng = SplitMix64::new(0xb10c_0000 + side as u64);
-    let mut pos = Vec::with_capacity(side * side * side);
-    for i in 0..side {
-        for j in 0..side {
-            for k in 0..side {
-                pos.push(Vec3::new(
-                    (i as f64 + rng.unit()) * SPACING,
-                    (j as f64 + rng.unit()) * SPACING,
-                    (k as f64 + rng.unit()) * SPACING,
-                ));
-            }
-        }
-    }
+    let pos = jittered_block(&mut rng, side, SPACING);
     let mut sorter = CellSorter::new();
     let perm = sorter
         .permutation(&pos, RADIUS, CellOrder::Lexicographic)?
@@ -736,14 +623,13 @@ fn time_search(method: Method, pos: &[Vec3<f64>], reps: usize) -> Result<Timing>
             .map_err(|e| anyhow!("{} on {} particles: {e}", method.name(), pos.len()))?;
         times.push(t.elapsed().as_secs_f64());
     }
-    times.sort_by(f64::total_cmp);
     Ok(Timing {
         method,
         threads: rayon::current_num_threads(),
         n: pos.len(),
         reps,
-        median_s: times[times.len() / 2],
-        min_s: times[0],
+        median_s: median(&times),
+        min_s: times.iter().copied().fold(f64::INFINITY, f64::min),
         pairs: lists.pair_count(),
     })
 }

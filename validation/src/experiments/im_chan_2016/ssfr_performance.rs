@@ -11,6 +11,7 @@ use anyhow::Result;
 use sph_core::{sampling::cubic_lattice, Aabb, Vec3};
 use ssfr_render::{FrameStats, ParticleView, Renderer};
 
+use crate::helpers::stats::{median, spread};
 use crate::helpers::write_csv_rows;
 use crate::sim::shipped_scene;
 use crate::{Check, Context, Experiment, Outcome};
@@ -22,12 +23,6 @@ pub struct SsfrPerformance;
 /// Frames rendered per size; the first also renders the background, the others are timed
 /// (medians of the frame and of each stage are reported).
 const REPEATS: usize = 11;
-
-/// Median and spread (largest − smallest) of `xs`.
-fn median_spread(xs: &mut [f64]) -> (f64, f64) {
-    xs.sort_by(f64::total_cmp);
-    (xs[xs.len() / 2], xs[xs.len() - 1] - xs[0])
-}
 
 /// A lattice of about `n` particles filling the water column; returns positions and spacing.
 pub fn column_particles(n: usize) -> Result<(Vec<Vec3<f32>>, f32)> {
@@ -73,9 +68,9 @@ fn record_frames(
 ) {
     // The first frame also renders the background; time the others.
     let timed = &runs[1..];
-    let (median, spread) = median_spread(&mut timed.iter().map(|x| x.0).collect::<Vec<_>>());
-    out.metric(format!("{label}/frame_median_s"), median);
-    out.metric(format!("{label}/frame_spread_s"), spread);
+    let frame_s: Vec<f64> = timed.iter().map(|x| x.0).collect();
+    out.metric(format!("{label}/frame_median_s"), median(&frame_s));
+    out.metric(format!("{label}/frame_spread_s"), spread(&frame_s));
     let last = runs[runs.len() - 1].1;
     let background_s = runs[0].1.times.background_s;
     out.metric(format!("{label}/background_s"), background_s);
@@ -83,14 +78,10 @@ fn record_frames(
         let secs = if stage == "background" {
             background_s
         } else {
-            let (m, spread) = median_spread(
-                &mut timed
-                    .iter()
-                    .map(|x| x.1.times.stages()[k].1)
-                    .collect::<Vec<_>>(),
-            );
+            let stage_s: Vec<f64> = timed.iter().map(|x| x.1.times.stages()[k].1).collect();
+            let m = median(&stage_s);
             out.metric(format!("{label}/{stage}_s"), m);
-            out.metric(format!("{label}/{stage}_spread_s"), spread);
+            out.metric(format!("{label}/{stage}_spread_s"), spread(&stage_s));
             m
         };
         rows.push(vec![

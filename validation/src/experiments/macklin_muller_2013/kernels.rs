@@ -27,6 +27,7 @@ use std::f64::consts::PI;
 
 use anyhow::{Context as _, Result};
 use sph_core::{Vec2, Vec3};
+use sph_kernels::quadrature::gauss_legendre;
 use sph_kernels::{
     CubicSpline, CubicSpline2D, Kernel, KernelError, Poly6, Real, Spiky, ViscosityKernel,
     WendlandC2, WendlandC2Planar,
@@ -305,32 +306,6 @@ struct Analysis {
     constants: Vec<Constants>,
     /// `(q, W·h^D, dW/dr·h^(D+1))` for the first `h`.
     curve: Vec<(f64, f64, f64)>,
-}
-
-/// Nodes and weights of the `n`-point Gauss–Legendre rule on [−1, 1] (Newton on `P_n`).
-fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
-    let mut rule = Vec::with_capacity(n);
-    for i in 0..n {
-        let mut x = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-        let mut dp = 0.0;
-        for _ in 0..100 {
-            let (mut p0, mut p1) = (1.0, x);
-            for k in 2..=n {
-                let k = k as f64;
-                let p2 = ((2.0 * k - 1.0) * x * p1 - (k - 1.0) * p0) / k;
-                p0 = p1;
-                p1 = p2;
-            }
-            dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
-            let dx = p1 / dp;
-            x -= dx;
-            if dx.abs() < 1e-16 {
-                break;
-            }
-        }
-        rule.push((x, 2.0 / ((1.0 - x * x) * dp * dp)));
-    }
-    rule
 }
 
 /// Worst scaled error, propagating NaN.
@@ -673,19 +648,4 @@ fn curve_specs(f64s: &[&Analysis]) -> (PlotSpec, PlotSpec) {
         ));
     }
     (values_plot, deriv_plot)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn gauss_legendre_integrates_polynomials() {
-        let gl = gauss_legendre(16);
-        let w: f64 = gl.iter().map(|p| p.1).sum();
-        assert!((w - 2.0).abs() < 1e-14);
-        // ∫_{-1}^{1} x^30 dx = 2/31
-        let i: f64 = gl.iter().map(|p| p.1 * p.0.powi(30)).sum();
-        assert!((i - 2.0 / 31.0).abs() < 1e-14);
-    }
 }

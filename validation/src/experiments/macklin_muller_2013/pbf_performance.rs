@@ -22,6 +22,7 @@ use anyhow::Result;
 use sph_core::Real;
 use sph_scene::Scene;
 
+use crate::helpers::stats::median;
 use crate::helpers::{load_reference_csv, write_csv_rows, ReferenceTable};
 use crate::sim::{scene_sim, shipped_scene};
 use crate::{fmt_num, Check, Context, Experiment, Outcome};
@@ -96,7 +97,11 @@ fn time_scene<R: Real>(ctx: &Context, scene: &Scene) -> Result<Timing> {
     let n = sim.state.len() as f64;
     Ok(Timing {
         solve_us_per_particle_iteration: 1e6 * phases[3] / (n * iterations_done.max(1) as f64),
-        search_us_per_particle: 1e6 * median(&mut search_per_frame) / (n * steps as f64),
+        // The median, not the mean, of the search's cost per frame: wall-clock noise on a
+        // shared machine is one-sided (a preempted thread only adds time), and one preempted
+        // frame of ten moved the mean by up to 20 % on this machine (2026-11-25: 0.85-0.89 of
+        // the anchor in most quick runs, 1.01 and 1.20 in two); the phase table keeps the means.
+        search_us_per_particle: 1e6 * median(&search_per_frame) / (n * steps as f64),
         particles: sim.state.len(),
         steps,
         iterations: scene.solver.iterations(),
@@ -104,20 +109,6 @@ fn time_scene<R: Real>(ctx: &Context, scene: &Scene) -> Result<Timing> {
         percent: phases.map(|p| 100.0 * p / total),
         threads: rayon::current_num_threads(),
     })
-}
-
-/// The median of `values` (reordered): the search's cost per frame. Wall-clock noise on a
-/// shared machine is one-sided (a preempted thread only adds time), and one preempted frame
-/// of ten moved the mean by up to 20 % on this machine (2026-11-25: 0.85-0.89 of the anchor
-/// in most quick runs, 1.01 and 1.20 in two), so the median is the estimator of what the
-/// search costs; the phase table keeps the means.
-fn median(values: &mut [f64]) -> f64 {
-    values.sort_by(f64::total_cmp);
-    match values.len() {
-        0 => f64::NAN,
-        n if n % 2 == 1 => values[n / 2],
-        n => 0.5 * (values[n / 2 - 1] + values[n / 2]),
-    }
 }
 
 /// Table 1 of the paper (particles, steps, iterations, time per step, phase percentages).

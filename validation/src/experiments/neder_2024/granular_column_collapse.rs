@@ -13,7 +13,7 @@
 //! spacing per step.
 //!
 //! The runout `L∞` is the front of the connected deposit
-//! ([`iisph_granular::measure::runout`], `FrontMethod::ConnectedBulk` with gaps up to two
+//! ([`granular_measure::runout`], `FrontMethod::ConnectedBulk` with gaps up to two
 //! spacings, plus the particle radius), so grains thrown ahead do not count.
 //!
 //! Checks, per column: the run completes; the deposit has stopped (the front moved less than
@@ -25,7 +25,7 @@
 //! friction angle is not expected to do better than that spread.
 
 use anyhow::{bail, Result};
-use iisph_granular::measure::{normalised_runout, runout, RunoutOptions};
+use granular_measure::{normalised_runout, runout, RunoutOptions};
 use sph_scene::{FluidSpec, Scene};
 
 use super::scene_edit::{set_block_and_tank, shipped};
@@ -137,7 +137,7 @@ impl Experiment for GranularColumnCollapse {
         "granular-column-collapse"
     }
     fn crates(&self) -> &'static [&'static str] {
-        &["iisph-granular"]
+        &["iisph-granular", "granular-measure"]
     }
     fn scenes(&self) -> &'static [&'static str] {
         &["granular_column_collapse"]

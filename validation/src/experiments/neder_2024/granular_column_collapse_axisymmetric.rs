@@ -18,10 +18,10 @@
 //! frictionless symmetry walls, and the tank's walls are no-slip.
 //!
 //! The runout `R∞` is the mean radius of the connected deposit's outline
-//! ([`iisph_granular::measure::radial_runout`]: the largest set of particles connected by
+//! ([`granular_measure::radial_runout`]: the largest set of particles connected by
 //! steps shorter than two spacings, the outermost particle of each of 16 azimuthal sectors
 //! around the column's axis, plus the particle radius, averaged), so grains thrown ahead do
-//! not count. The deposit's slope is [`iisph_granular::measure::angle_of_repose`] on the
+//! not count. The deposit's slope is [`granular_measure::angle_of_repose`] on the
 //! deposit around the same axis (the surface profile `y(r)` in bins of one spacing, fitted
 //! between 20 % and 80 % of the deposit's height).
 //!
@@ -36,7 +36,7 @@
 //! static slope of the yield cone), not checked: the paper gives no law for them here.
 
 use anyhow::{bail, Result};
-use iisph_granular::measure::{
+use granular_measure::{
     angle_of_repose, normalised_runout, radial_runout, surface_profile, PileShape,
     RadialRunoutOptions, ReposeOptions, SurfacePoint,
 };
@@ -237,7 +237,7 @@ impl Experiment for GranularColumnCollapseAxisymmetric {
         "granular-column-collapse-axisymmetric"
     }
     fn crates(&self) -> &'static [&'static str] {
-        &["iisph-granular"]
+        &["iisph-granular", "granular-measure"]
     }
     fn scenes(&self) -> &'static [&'static str] {
         &["granular_column_collapse_axisymmetric"]

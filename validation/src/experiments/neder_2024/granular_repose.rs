@@ -18,7 +18,7 @@
 //! [`REST_HOLD_S`]; the scene's duration is a cap, and a run that reaches it is not at rest
 //! (a failing check with the speed).
 //!
-//! **Measure** ([`iisph_granular::measure::angle_of_repose`] on the particles above the base,
+//! **Measure** ([`granular_measure::angle_of_repose`] on the particles above the base,
 //! between its edges): the free-surface profile (highest particle per bin of one spacing),
 //! each flank's least-squares slope between 20 % and 80 % of the heap height (away from the
 //! rounded crest and the toe), the mean of the two flanks; and the steepest slope over a
@@ -38,7 +38,7 @@
 //! and its surface in the troughs is flat.
 
 use anyhow::Result;
-use iisph_granular::measure::{angle_of_repose, surface_profile, PileShape, ReposeOptions};
+use granular_measure::{angle_of_repose, surface_profile, PileShape, ReposeOptions};
 use iisph_granular::ConeMatch;
 use sph_core::Vec3;
 use sph_scene::{FluidSpec, Scene, SolidSpec, SolverSpec};
@@ -191,7 +191,7 @@ impl Experiment for GranularRepose {
         "granular-repose"
     }
     fn crates(&self) -> &'static [&'static str] {
-        &["iisph-granular"]
+        &["iisph-granular", "granular-measure"]
     }
     fn scenes(&self) -> &'static [&'static str] {
         &[

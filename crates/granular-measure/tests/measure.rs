@@ -11,27 +11,20 @@
 //! evenly spread points; the tests allow `2 δ / D` (points one per bin, not exactly even), with
 //! `D = (0.6 H − δ) / tan α` the run of the 20–80 % band.
 
-use iisph_granular::measure::{
+use granular_measure::{
     angle_of_repose, normalised_runout, radial_runout, runout, surface_profile, FrontMethod,
     MeasureError, PileShape, RadialRunoutOptions, ReposeOptions, RunoutOptions,
 };
 use proptest::prelude::*;
+use sph_core::random::SplitMix64;
 use sph_core::Vec3;
 
-/// A small deterministic generator for jitter (SplitMix64).
-struct Jitter(u64);
+/// A small deterministic generator for jitter.
+struct Jitter(SplitMix64);
 
 impl Jitter {
-    fn unit(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 53) as f64
-    }
     fn offset(&mut self, amplitude: f64) -> f64 {
-        amplitude * (2.0 * self.unit() - 1.0)
+        amplitude * (2.0 * self.0.unit() - 1.0)
     }
 }
 
@@ -41,7 +34,7 @@ fn cone(alpha_deg: f64, h: f64, s: f64, (cx, cz): (f64, f64), j: f64, seed: u64)
     let tan = alpha_deg.to_radians().tan();
     let r_base = h / tan;
     let n = (r_base / s).ceil() as i64 + 1;
-    let mut rng = Jitter(seed);
+    let mut rng = Jitter(SplitMix64::new(seed));
     let mut out = Vec::new();
     for i in -n..=n {
         for k in -n..=n {
@@ -81,7 +74,7 @@ fn wedge(
     let tan_l = left_deg.map(|a| a.to_radians().tan());
     let x_lo = tan_l.map_or(x_apex, |t| x_apex - h / t);
     let x_hi = x_apex + h / tan_r;
-    let mut rng = Jitter(seed);
+    let mut rng = Jitter(SplitMix64::new(seed));
     let mut out = Vec::new();
     let mut i = 0;
     loop {
@@ -377,7 +370,7 @@ fn heap_of(
     j: f64,
     seed: u64,
 ) -> Vec<Vec3<f64>> {
-    let mut rng = Jitter(seed);
+    let mut rng = Jitter(SplitMix64::new(seed));
     let mut out = Vec::new();
     let mut x = x_lo + phase * s;
     while x < x_hi {
@@ -567,7 +560,7 @@ proptest! {
         gap in 0.005f64..0.03,
         seed in any::<u64>(),
     ) {
-        let mut rng = Jitter(seed);
+        let mut rng = Jitter(SplitMix64::new(seed));
         let mut pts = Vec::new();
         for &(x, z, count) in &blobs {
             for _ in 0..count {
