@@ -293,12 +293,13 @@ pub use error::SceneError;
 pub use limits::{
     MAX_FRAMES, MAX_MESH_FILE_BYTES, MAX_PARTICLES, MAX_SCENE_FILE_BYTES, MAX_SDF_NODES,
 };
-pub use params::SolverParams;
-pub use solver_spec::{
-    GranularSpec, IisphSettings, IisphSpec, PbfSpec, PcisphSpec, SolverCommon, SolverKind,
-    SolverSpec, DEFAULT_IISPH_MAX_ITERATIONS, DEFAULT_IISPH_MIN_ITERATIONS,
-};
+pub use solver_spec::{SolverKind, SolverParams, SolverSpec};
+// The settings of each solver, owned by its crate (the variants of `SolverSpec`).
+pub use iisph_granular::{GranularSettings, IisphSettings, WaterSettings};
+pub use pbf::PbfSettings;
+pub use pcisph::PcisphSettings;
 pub use spec::{
     BoundaryModel, BoundarySpec, FluidSpec, InitialMasses, MeshPlacement, MeshSpec, OutputSpec,
     Precision, QuickSpec, Scene, SolidSpec,
 };
+pub use sph_solver::CommonSettings;

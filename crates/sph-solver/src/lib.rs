@@ -56,6 +56,7 @@ mod fluid_solver;
 pub mod frame;
 pub mod initial;
 mod params;
+pub mod settings;
 pub mod state;
 mod stats;
 pub mod step;
@@ -74,6 +75,7 @@ pub use params::{
     CommonParams, DEFAULT_SUPPORT_OVER_SPACING, MAX_ITERATIONS_PER_FRAME, MAX_SUBSTEPS,
     VOLUME_MAP_CONTACT_FRACTION,
 };
+pub use settings::{CommonSettings, SceneValues, SolverSettings};
 pub use state::{ArraySpec, SolverState};
 pub use stats::{PhaseTimes, StepStats, MAX_PHASES};
 
