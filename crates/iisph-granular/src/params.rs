@@ -379,7 +379,7 @@ impl<R: Real> IisphParams<R> {
             return Err(invalid(
                 "upscaling_factor",
                 0.0,
-                "must be >= 1 passive point per particle (or None for no upscaling)",
+                "must be >= 1 passive point per particle (none given = no upscaling)",
             ));
         }
         if self.upscaling_factor.is_some_and(|k| k > 4096) {
