@@ -315,6 +315,7 @@ mod kernels;
 mod params;
 mod passes;
 mod scratch;
+mod settings;
 mod solver;
 pub mod upscale;
 mod walls;
@@ -323,8 +324,10 @@ pub use kernels::IISPH_KERNEL;
 pub use params::{
     ConeMatch, GranularParams, IisphParams, AIR_DENSITY, DEFAULT_DRAG_CONE_HALF_ANGLE_DEG,
     DEFAULT_FRICTION_MAX_ITERATIONS, DEFAULT_FRICTION_RELAXATION, DEFAULT_FRICTION_TOLERANCE,
-    MAX_FRICTION_ITERATIONS, MAX_PRESSURE_ITERATIONS,
+    DEFAULT_MAX_ITERATIONS, DEFAULT_MIN_ITERATIONS, MAX_FRICTION_ITERATIONS,
+    MAX_PRESSURE_ITERATIONS,
 };
+pub use settings::{GranularSettings, IisphSettings, WaterSettings};
 pub use solver::{Iisph, IisphScheme, IISPH_PHASES, IISPH_STATE_ARRAYS};
 pub use walls::volume_map_walls;
 

@@ -5,7 +5,7 @@
 //! would be.
 
 use anyhow::Result;
-use sph_scene::{FluidSpec, IisphSettings, IisphSpec, Scene, SolverCommon, SolverSpec};
+use sph_scene::{CommonSettings, FluidSpec, IisphSettings, Scene, SolverSpec, WaterSettings};
 
 use crate::{workspace_root, Mode};
 
@@ -43,13 +43,8 @@ pub fn set_block_and_tank(
 /// IISPH (water) with `substeps` and the IISPH settings `iisph`, every other setting the
 /// solver's default.
 pub fn iisph_solver(substeps: usize, iisph: IisphSettings) -> SolverSpec {
-    SolverSpec::Iisph(IisphSpec {
-        common: SolverCommon {
-            substeps,
-            rest_density: None,
-            support_over_spacing: None,
-            reorder_every: None,
-        },
+    SolverSpec::Iisph(WaterSettings {
+        common: CommonSettings::new(substeps),
         iisph,
     })
 }
