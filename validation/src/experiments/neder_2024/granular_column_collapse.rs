@@ -13,7 +13,7 @@
 //! spacing per step.
 //!
 //! The runout `L∞` is the front of the connected deposit
-//! ([`granular_measure::runout`], `FrontMethod::ConnectedBulk` with gaps up to two
+//! ([`granular_measure::runout()`], `FrontMethod::ConnectedBulk` with gaps up to two
 //! spacings, plus the particle radius), so grains thrown ahead do not count.
 //!
 //! Checks, per column: the run completes; the deposit has stopped (the front moved less than
