@@ -85,9 +85,7 @@ fn stats_without_clock(dir: &Path) -> Vec<Vec<String>> {
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     let keep: Vec<usize> = (0..header.len())
-        .filter(|&i| {
-            matches!(header[i], "time_s" | "max_speed_m_s") || !header[i].ends_with("_s")
-        })
+        .filter(|&i| matches!(header[i], "time_s" | "max_speed_m_s") || !header[i].ends_with("_s"))
         .collect();
     lines
         .map(|l| {

@@ -147,26 +147,15 @@ pub fn encode<R: Real>(c: &Checkpoint<R>) -> Vec<u8> {
     file
 }
 
-/// Writes `bytes` to `path` atomically: a temporary file beside it, `fsync`, rename (and an
-/// `fsync` of the directory where the platform allows it).
+/// Writes `bytes` to `path` atomically (`atomic-write-file`: a temporary file beside it,
+/// `fsync`, rename, `fsync` of the directory); a failed write leaves `path` as it was.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), SimError> {
-    let tmp = path.with_extension(format!("tmp{}", std::process::id()));
     let write = || -> std::io::Result<()> {
-        let mut f = std::fs::File::create(&tmp)?;
+        let mut f = atomic_write_file::AtomicWriteFile::open(path)?;
         f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)?;
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            if let Ok(d) = std::fs::File::open(dir) {
-                d.sync_all().ok();
-            }
-        }
-        Ok(())
+        f.commit()
     };
-    write().map_err(|e| {
-        std::fs::remove_file(&tmp).ok();
-        SimError::output(path, format!("writing the checkpoint: {e}"))
-    })
+    write().map_err(|e| SimError::output(path, format!("writing the checkpoint: {e}")))
 }
 
 // ---- reading ----
