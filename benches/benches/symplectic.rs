@@ -14,8 +14,8 @@ use symplectic::{
 };
 
 fn outer_solar_system() -> Planets {
-    // Hairer, Lubich & Wanner, Table 2.1 (reference-data/symplectic/outer_solar_system.csv).
-    let text = include_str!("../../reference-data/symplectic/outer_solar_system.csv");
+    // Hairer, Lubich & Wanner, Table 2.1 (reference-data/symplectic-100myr/outer_solar_system.csv).
+    let text = include_str!("../../reference-data/symplectic-100myr/outer_solar_system.csv");
     let rows: Vec<Vec<f64>> = text
         .lines()
         .filter(|l| !l.starts_with('#'))
@@ -62,8 +62,8 @@ fn particle_step(c: &mut Criterion) {
         &rot(&equatorial.heliocentric_velocities()),
     )
     .unwrap();
-    // Particle 1 of reference-data/symplectic/particles.csv (heliocentric ecliptic).
-    let text = include_str!("../../reference-data/symplectic/particles.csv");
+    // Particle 1 of reference-data/symplectic-100myr/particles.csv (heliocentric ecliptic).
+    let text = include_str!("../../reference-data/symplectic-100myr/particles.csv");
     let row: Vec<f64> = text
         .lines()
         .filter(|l| !l.starts_with('#'))

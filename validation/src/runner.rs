@@ -576,6 +576,9 @@ mod tests {
         fn source(&self) -> &'static str {
             "test"
         }
+        fn crates(&self) -> &'static [&'static str] {
+            &[]
+        }
         fn run(&self, _ctx: &mut Context) -> Result<Outcome> {
             let mut o = Outcome::new();
             o.metric("m", 1.0);
@@ -591,6 +594,9 @@ mod tests {
         fn source(&self) -> &'static str {
             "test"
         }
+        fn crates(&self) -> &'static [&'static str] {
+            &[]
+        }
         fn run(&self, _ctx: &mut Context) -> Result<Outcome> {
             panic!("boom")
         }
@@ -602,6 +608,9 @@ mod tests {
         }
         fn source(&self) -> &'static str {
             "test"
+        }
+        fn crates(&self) -> &'static [&'static str] {
+            &[]
         }
         fn run(&self, _ctx: &mut Context) -> Result<Outcome> {
             bail!("no data")
@@ -615,6 +624,9 @@ mod tests {
         }
         fn source(&self) -> &'static str {
             "test"
+        }
+        fn crates(&self) -> &'static [&'static str] {
+            &[]
         }
         fn run(&self, _ctx: &mut Context) -> Result<Outcome> {
             let mut o = Outcome::new();

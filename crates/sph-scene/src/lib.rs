@@ -170,7 +170,7 @@
 //!
 //! [[fluid]]
 //! kind = "mesh"                    # a closed triangle mesh (OBJ), filled with fluid
-//! path = "../reference-data/meshes/bunny.obj"   # relative to this scene file
+//! path = "meshes/bunny.obj"   # relative to this scene file
 //! scale = 0.05                     # uniform scale applied first (default 1, > 0)
 //! translate = [0.8, 0.4, 0.3]      # m, then this translation (default 0)
 //! # or, instead of scale/translate:
