@@ -115,13 +115,13 @@ mod tests {
     use super::*;
     use crate::{registry, workspace_root};
 
-/// The experiment's file module (the segment before its type name).
-fn file_module(e: &dyn Experiment) -> Option<&'static str> {
-    let path = e.type_path();
-    let mut segments: Vec<&'static str> = path.split("::").collect();
-    segments.pop();
-    segments.pop()
-}
+    /// The experiment's file module (the segment before its type name).
+    fn file_module(e: &dyn Experiment) -> Option<&'static str> {
+        let path = e.type_path();
+        let mut segments: Vec<&'static str> = path.split("::").collect();
+        segments.pop();
+        segments.pop()
+    }
 
     #[test]
     fn every_experiment_lives_in_its_paper_folder_under_its_id() {
