@@ -58,3 +58,16 @@ pub fn run_frames<R: sph_core::Real>(
         .inc(plan.last_frame.saturating_sub(outcome.frame) as u64);
     Ok(outcome)
 }
+
+/// Advances `sim` by `frames` frames through the one frame loop ([`run_frames`], with
+/// `observers`), a divergence being an error (the solver's, naming the frame, step and
+/// particle): for experiments whose scenes must not blow up.
+pub fn advance_frames<R: sph_core::Real>(
+    ctx: &crate::Context,
+    sim: &mut SceneSim<R>,
+    frames: usize,
+    observers: &mut [&mut dyn FrameObserver<R>],
+) -> Result<()> {
+    run_frames(ctx, sim, frames, observers)?.diverged_as_error()?;
+    Ok(())
+}

@@ -112,6 +112,11 @@ impl FrameRecord {
         }
     }
 
+    /// Seconds of phase `name` (0 if the solver has no such phase).
+    pub fn phase_s(&self, name: &str) -> f64 {
+        self.phases.get(name).unwrap_or(0.0)
+    }
+
     /// The header of the statistics CSV for a solver with phases `phases`:
     /// [`STATS_COLUMNS`], then `<phase>_s` for each phase and `total_s` (the wall-clock
     /// columns), then [`STATS_EXTRA_COLUMNS`].
