@@ -1,7 +1,7 @@
 //! Observers of the frame loop that measure rather than write files: [`Recorder`] keeps
 //! every [`FrameRecord`], [`DensityLimit`] ends a run whose density has left any liquid's
 //! range, [`RestObserver`] ends it when the material has come to rest, [`Snapshots`] keeps
-//! the positions at chosen frames, and [`OnFrame`] runs a closure after each frame (a
+//! the positions at chosen frames, [`FrameTimer`] times the frames, and [`OnFrame`] runs a closure after each frame (a
 //! measurement of the experiment's own). The observers writing files are in [`crate::run`],
 //! [`crate::checkpoint`] and [`crate::render`].
 
@@ -175,6 +175,32 @@ impl<R: Real> FrameObserver<R> for Snapshots {
     }
     fn frame(&mut self, sim: &SceneSim<R>, _: &FrameRecord) -> Result<Flow, SimError> {
         self.take(sim);
+        Ok(Flow::Continue)
+    }
+}
+
+/// The wall-clock seconds of each frame, for the timing experiments: from this observer's
+/// previous call (or the run's start) to its call after the frame, that is the solver's
+/// step, the frame's record and the observers given before it. Given last, it times the
+/// frame and every other observer of it.
+#[derive(Debug, Clone, Default)]
+pub struct FrameTimer {
+    /// Seconds of each frame, in order.
+    pub frame_s: Vec<f64>,
+    last: Option<std::time::Instant>,
+}
+
+impl<R: Real> FrameObserver<R> for FrameTimer {
+    fn start(&mut self, _: &SceneSim<R>, _: &RunPlan) -> Result<(), SimError> {
+        self.last = Some(std::time::Instant::now());
+        Ok(())
+    }
+    fn frame(&mut self, _: &SceneSim<R>, _: &FrameRecord) -> Result<Flow, SimError> {
+        let now = std::time::Instant::now();
+        if let Some(t0) = self.last {
+            self.frame_s.push((now - t0).as_secs_f64());
+        }
+        self.last = Some(now);
         Ok(Flow::Continue)
     }
 }
