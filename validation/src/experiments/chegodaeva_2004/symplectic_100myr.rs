@@ -312,9 +312,6 @@ fn run_both(ctx: &mut Context, span_yr: f64) -> Result<[RunState; 2]> {
     r6.context("S6 run")?;
     for p in &paths {
         std::fs::remove_file(p).ok();
-        let mut tmp = p.as_os_str().to_owned();
-        tmp.push(".tmp");
-        std::fs::remove_file(tmp).ok();
     }
     Ok([s2_state, s6_state])
 }

@@ -27,9 +27,11 @@ use ssfr_render::{
 
 use super::shapes::Shape;
 use crate::helpers::{plot_xy, write_csv_rows, Legend, PlotSpec, Series};
-use crate::sim::{scene_sim, shipped_scene};
+use crate::sim::{advance_frames, scene_sim, shipped_scene, SceneSim};
 use crate::{Check, Context, Experiment, Outcome};
+use sph_sim::observe::OnFrame;
 use sph_sim::render::render_params;
+use sph_sim::{Flow, FrameRecord};
 
 /// The experiment.
 pub struct SsfrRefraction;
@@ -176,16 +178,18 @@ fn dam_break_frames(
     );
     let mut sim = scene_sim::<f32>(&scene)?;
     let mut out = Vec::new();
+    if frames.contains(&sim.frame) {
+        out.push((sim.time_s, sim.state.positions.clone()));
+    }
     let last = frames.iter().copied().max().unwrap_or(0);
-    for f in 0..=last {
-        if frames.contains(&f) {
+    let mut keep = OnFrame(|sim: &SceneSim<f32>, _: &FrameRecord| {
+        if frames.contains(&sim.frame) {
             out.push((sim.time_s, sim.state.positions.clone()));
         }
-        if f < last {
-            sim.advance()?;
-        }
-        ctx.progress.inc(1);
-    }
+        Flow::Continue
+    });
+    advance_frames(ctx, &mut sim, last, &mut [&mut keep])?;
+    ctx.progress.inc(1);
     Ok(out)
 }
 

@@ -11,9 +11,11 @@
 use anyhow::Result;
 use sph_core::{ParticleSet, Real, Vec3};
 use sph_scene::{BoundaryModel, Scene, SolidSpec, SolverKind};
+use sph_sim::observe::OnFrame;
+use sph_sim::{Flow, FrameRecord};
 
 use crate::helpers::{plot_xy, write_csv_rows, Legend, PlotSpec, Series, SeriesStyle};
-use crate::sim::{scene_sim, shipped_scene, SceneSim};
+use crate::sim::{run_frames, scene_sim, shipped_scene, SceneSim};
 use crate::{Check, Context, Experiment, Outcome};
 
 /// The experiment.
@@ -163,16 +165,12 @@ fn run<R: Real>(ctx: &Context, scene: &Scene, label: String) -> Result<RestRun> 
     let mut sim = scene_sim::<R>(scene)?;
     remove_inside_solids(&mut sim, scene)?;
     let (mut out, unit) = new_rest_run(&sim, scene, label);
-    for _ in 0..scene.frame_count() {
-        match sim.advance() {
-            Ok(st) => out.energy.push((sim.time_s, st.kinetic_energy / unit)),
-            Err(e) => {
-                out.blow_up = Some(format!("{e}"));
-                break;
-            }
-        }
-        ctx.progress.inc(1);
-    }
+    let mut energy = OnFrame(|sim: &SceneSim<R>, r: &FrameRecord| {
+        out.energy.push((sim.time_s, r.kinetic_energy_j / unit));
+        Flow::Continue
+    });
+    let outcome = run_frames(ctx, &mut sim, scene.frame_count(), &mut [&mut energy])?;
+    out.blow_up = outcome.divergence().map(|d| d.to_string());
     measure_rest(&sim, scene.particle_spacing, &mut out);
     Ok(out)
 }

@@ -1,5 +1,5 @@
-//! Shared by the PBF/PCISPH experiments: a scene run recording the density and energy of
-//! every frame, which keeps a blow-up as a result instead of an error.
+//! Shared by the PBF/PCISPH experiments: a scene run through the frame loop recording every
+//! frame, which keeps a blow-up as a result instead of an error.
 //!
 //! A run also stops as diverged when a frame ends with `max ρ/ρ0 >` [`DIVERGED_DENSITY_RATIO`]:
 //! the solver reports no error then (its state is finite and inside the tank), but a liquid
@@ -9,29 +9,15 @@
 use anyhow::Result;
 use sph_core::Real;
 use sph_scene::{Scene, SolverKind};
-use sph_solver::SolverError;
+use sph_sim::observe::{DensityLimit, Recorder};
+use sph_sim::FrameRecord;
 
-use crate::sim::{scene_sim, SceneSim};
+use crate::sim::{run_frames, scene_sim, SceneSim};
 use crate::Context;
 
 /// `max ρ/ρ0` above which a run counts as diverged (twice the rest density: 100 %
 /// compression of a liquid whose solvers aim at 0.1–1 %).
 pub const DIVERGED_DENSITY_RATIO: f64 = 2.0;
-
-/// One frame's statistics.
-#[derive(Debug, Clone, Copy)]
-pub struct FrameStats {
-    /// Time at the end of the frame (s).
-    pub t_s: f64,
-    /// `max ρ/ρ0`.
-    pub max_density_ratio: f64,
-    /// `mean ρ/ρ0`.
-    pub mean_density_ratio: f64,
-    /// Kinetic energy (J).
-    pub kinetic_energy_j: f64,
-    /// Wall-clock time of the frame (s).
-    pub wall_s: f64,
-}
 
 /// A run: the frames done, and the blow-up that ended it early, if any.
 #[derive(Debug, Clone)]
@@ -40,8 +26,8 @@ pub struct FluidRun {
     pub label: String,
     /// Particles simulated.
     pub particles: usize,
-    /// Statistics of each completed frame.
-    pub frames: Vec<FrameStats>,
+    /// The record of each completed frame.
+    pub frames: Vec<FrameRecord>,
     /// Potential energy of the initial state above the tank floor, `Σ m_i |g| (y_i − y_floor)`
     /// (J): the most kinetic energy a scene starting at rest can ever have.
     pub initial_potential_energy_j: f64,
@@ -52,11 +38,11 @@ pub struct FluidRun {
 
 impl FluidRun {
     /// Mean over the completed frames from `from_s` on of `f`.
-    pub fn mean_from(&self, from_s: f64, f: impl Fn(&FrameStats) -> f64) -> f64 {
+    pub fn mean_from(&self, from_s: f64, f: impl Fn(&FrameRecord) -> f64) -> f64 {
         let v: Vec<f64> = self
             .frames
             .iter()
-            .filter(|s| s.t_s >= from_s)
+            .filter(|s| s.time_s >= from_s)
             .map(f)
             .collect();
         v.iter().sum::<f64>() / v.len() as f64
@@ -107,44 +93,20 @@ pub fn potential_energy_j<R: Real>(sim: &SceneSim<R>) -> f64 {
 
 fn run_in<R: Real>(ctx: &Context, scene: &Scene, label: String) -> Result<FluidRun> {
     let mut sim = scene_sim::<R>(scene)?;
-    let frames = scene.frame_count();
     let initial_potential_energy_j = potential_energy_j(&sim);
-    let mut run = FluidRun {
+    let mut recorder = Recorder::default();
+    let mut limit = DensityLimit {
+        limit: DIVERGED_DENSITY_RATIO,
+    };
+    let frames = scene.frame_count();
+    let outcome = run_frames(ctx, &mut sim, frames, &mut [&mut recorder, &mut limit])?;
+    Ok(FluidRun {
         label,
         initial_potential_energy_j,
         particles: sim.state.len(),
-        frames: Vec::with_capacity(frames),
-        blow_up: None,
-    };
-    for _ in 0..frames {
-        match sim.advance() {
-            Ok(s) => {
-                run.frames.push(FrameStats {
-                    t_s: sim.time_s,
-                    max_density_ratio: s.max_density_ratio,
-                    mean_density_ratio: s.mean_density_ratio,
-                    kinetic_energy_j: s.kinetic_energy,
-                    wall_s: s.total_s(),
-                });
-                if s.max_density_ratio.is_nan() || s.max_density_ratio > DIVERGED_DENSITY_RATIO {
-                    run.blow_up = Some(format!(
-                        "diverged: max rho/rho0 = {:.3} > {DIVERGED_DENSITY_RATIO} at t = {:.3} s (frame {})",
-                        s.max_density_ratio, sim.time_s, sim.frame
-                    ));
-                    break;
-                }
-            }
-            Err(e) => match e.solver_error() {
-                Some(SolverError::BlowUp { .. }) => {
-                    run.blow_up = Some(format!("{e:#}"));
-                    break;
-                }
-                _ => return Err(e.into()),
-            },
-        }
-        ctx.progress.inc(1);
-    }
-    Ok(run)
+        frames: recorder.records,
+        blow_up: outcome.divergence().map(|d| d.to_string()),
+    })
 }
 
 /// Runs `scene` with the given solver, substeps and iterations (everything else as in the

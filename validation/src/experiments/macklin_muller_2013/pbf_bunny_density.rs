@@ -57,7 +57,7 @@ fn write_density(ctx: &mut Context, runs: &BunnyRuns) -> Result<()> {
     let mut rows = Vec::new();
     let frames = runs.all().iter().map(|r| r.frames.len()).min().unwrap_or(0);
     for k in 0..frames {
-        let mut row = vec![format!("{:.4}", runs.pbf.frames[k].t_s)];
+        let mut row = vec![format!("{:.4}", runs.pbf.frames[k].time_s)];
         for r in runs.all() {
             let f = &r.frames[k];
             row.push(format!("{:.6}", f.max_density_ratio));
@@ -109,8 +109,8 @@ fn density_metrics(out: &mut Outcome, runs: &BunnyRuns) {
     out.metric("pcisph_mean_compression_after_impact", excess(pci));
     out.metric("pbf_peak_density_ratio", pbf.peak_density_ratio());
     out.metric("pcisph_peak_density_ratio", pci.peak_density_ratio());
-    out.metric("pbf_wall_s_per_frame", pbf.mean_from(0.0, |s| s.wall_s));
-    out.metric("pcisph_wall_s_per_frame", pci.mean_from(0.0, |s| s.wall_s));
+    out.metric("pbf_wall_s_per_frame", pbf.mean_from(0.0, |s| s.total_s));
+    out.metric("pcisph_wall_s_per_frame", pci.mean_from(0.0, |s| s.total_s));
     out.metric("pbf_mean_density_ratio_after_impact", mean_after(pbf));
     out.metric("pcisph_mean_density_ratio_after_impact", mean_after(pci));
     out.metric(
@@ -173,7 +173,7 @@ fn density_series(run: &FluidRun, col: usize, max: bool) -> Series {
         .iter()
         .map(|s| {
             (
-                s.t_s,
+                s.time_s,
                 if max {
                     s.max_density_ratio
                 } else {
@@ -196,7 +196,7 @@ fn density_series(run: &FluidRun, col: usize, max: bool) -> Series {
 }
 
 fn plot_density(ctx: &mut Context, runs: &BunnyRuns) -> Result<()> {
-    let t_end = runs.pbf.frames.last().map_or(1.0, |s| s.t_s);
+    let t_end = runs.pbf.frames.last().map_or(1.0, |s| s.time_s);
     let plots = [
         (&runs.pbf, &runs.pci, "volume-map walls", "density.png", "volume-map walls: max and average density over the bunny drop (Fig. 4: blue rest density, red PCISPH, green PBF)"),
         (&runs.pbf_c, &runs.pci_c, "collision walls", "density_collision.png", "collision walls (the paper's SDF handling): max and average density over the bunny drop"),

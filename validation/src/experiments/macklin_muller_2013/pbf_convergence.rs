@@ -27,7 +27,7 @@ use sph_core::Real;
 use sph_scene::{Scene, SolverParams};
 
 use crate::helpers::{plot_xy, write_csv_rows, Legend, PlotSpec, Series, SeriesStyle};
-use crate::sim::{scene_sim, shipped_scene};
+use crate::sim::{advance_frames, scene_sim, shipped_scene};
 use crate::{Check, Context, Experiment, Outcome};
 
 /// The experiment.
@@ -123,10 +123,7 @@ fn sweep<R: Real>(ctx: &Context, scene: &Scene) -> Result<(Vec<Row>, usize)> {
         .set_length((frames + 2 * ITERATIONS.len()) as u64);
     ctx.progress
         .set_message("frames to t = 1 s, then one-step solves");
-    for _ in 0..frames {
-        sim.advance()?;
-        ctx.progress.inc(1);
-    }
+    advance_frames(ctx, &mut sim, frames, &mut [])?;
     let SolverParams::Pbf(base) = scene.solver_params::<R>()? else {
         anyhow::bail!(
             "{}: the convergence sweep needs a PBF scene, not kind = \"{}\"",

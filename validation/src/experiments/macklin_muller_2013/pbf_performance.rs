@@ -21,10 +21,11 @@
 use anyhow::Result;
 use sph_core::Real;
 use sph_scene::Scene;
+use sph_sim::observe::Recorder;
 
 use crate::helpers::stats::median;
 use crate::helpers::{load_reference_csv, write_csv_rows, ReferenceTable};
-use crate::sim::{scene_sim, shipped_scene};
+use crate::sim::{advance_frames, scene_sim, shipped_scene};
 use crate::{fmt_num, Check, Context, Experiment, Outcome};
 
 /// The experiment.
@@ -68,16 +69,14 @@ struct Timing {
 
 fn time_scene<R: Real>(ctx: &Context, scene: &Scene) -> Result<Timing> {
     let mut sim = scene_sim::<R>(scene)?;
-    for _ in 0..WARM_UP_FRAMES {
-        sim.advance()?;
-        ctx.progress.inc(1);
-    }
+    advance_frames(ctx, &mut sim, WARM_UP_FRAMES, &mut [])?;
+    let mut measured = Recorder::default();
+    advance_frames(ctx, &mut sim, MEASURED_FRAMES, &mut [&mut measured])?;
     let mut phases = [0.0f64; 5];
     let mut total = 0.0;
     let mut iterations_done = 0usize;
     let mut search_per_frame = Vec::with_capacity(MEASURED_FRAMES);
-    for _ in 0..MEASURED_FRAMES {
-        let s = sim.advance()?;
+    for s in &measured.records {
         search_per_frame.push(s.phase_s("create_hash_grid") + s.phase_s("detect_neighbours"));
         iterations_done += s.iterations;
         let p = [
@@ -90,8 +89,7 @@ fn time_scene<R: Real>(ctx: &Context, scene: &Scene) -> Result<Timing> {
         for (a, b) in phases.iter_mut().zip(p) {
             *a += b;
         }
-        total += s.total_s();
-        ctx.progress.inc(1);
+        total += s.total_s;
     }
     let steps = scene.solver.substeps();
     let n = sim.state.len() as f64;

@@ -46,7 +46,7 @@ fn with_pressure_clamp(scene: &sph_scene::Scene, clamp: bool) -> sph_scene::Scen
 }
 
 fn compression(run: &FluidRun) -> f64 {
-    if run.frames.iter().any(|s| s.t_s >= FROM_S) {
+    if run.frames.iter().any(|s| s.time_s >= FROM_S) {
         run.mean_from(FROM_S, |s| s.max_density_ratio - 1.0)
     } else {
         f64::INFINITY
@@ -178,7 +178,7 @@ fn plot_panel(
             run.label.clone(),
             run.frames
                 .iter()
-                .map(|s| (s.t_s, (s.max_density_ratio - 1.0).max(1e-4)))
+                .map(|s| (s.time_s, (s.max_density_ratio - 1.0).max(1e-4)))
                 .collect(),
             if i >= 7 { i + 1 } else { i },
         ));
@@ -229,7 +229,7 @@ impl Experiment for PbfStability {
         let rows = runs.iter().map(|run| run_summary(&mut out, run)).collect();
         write_stability(ctx, rows)?;
         check_stability(&mut out, &runs);
-        let t_end = runs[0].frames.last().map_or(1.5, |f| f.t_s);
+        let t_end = runs[0].frames.last().map_or(1.5, |f| f.time_s);
         let clamped_end = PBF_ITERATIONS.len() + PCISPH_SUBSTEPS.len();
         plot_panel(
             ctx,

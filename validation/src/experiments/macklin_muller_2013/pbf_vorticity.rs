@@ -20,11 +20,13 @@
 use anyhow::Result;
 use sph_core::Real;
 use sph_scene::{Scene, SolverSpec};
+use sph_sim::observe::OnFrame;
+use sph_sim::{Flow, FrameRecord};
 
 use crate::helpers::{
     plot_xy, side_view_png, write_csv_rows, Legend, PlotSpec, Series, SeriesStyle,
 };
-use crate::sim::{scene_sim, shipped_scene};
+use crate::sim::{advance_frames, scene_sim, shipped_scene, SceneSim};
 use crate::{Check, Context, Experiment, Outcome};
 
 /// The experiment.
@@ -133,20 +135,31 @@ fn simulate<R: Real>(ctx: &Context, scene: &Scene, perturb_seed: Option<u64>) ->
     let mut lists = neighbour_search::NeighbourLists::new();
     let frames = scene.frame_count();
     let mut series = Vec::with_capacity(frames);
-    for k in 0..frames {
-        let stats = sim.advance()?;
+    let mut failed = None;
+    let mut measure = OnFrame(|sim: &SceneSim<R>, r: &FrameRecord| {
+        let k = r.frame - 1;
         let ens = if k >= frames / 2 {
-            enstrophy(&sim.state, h, rho0, &mut lists)?
+            match enstrophy(&sim.state, h, rho0, &mut lists) {
+                Ok(e) => e,
+                Err(e) => {
+                    failed = Some(e);
+                    return Flow::Stop("the enstrophy could not be measured".into());
+                }
+            }
         } else {
             f64::NAN
         };
         series.push((
             sim.time_s,
             quantile_y(&sim.state.positions),
-            stats.kinetic_energy,
+            r.kinetic_energy_j,
             ens,
         ));
-        ctx.progress.inc(1);
+        Flow::Continue
+    });
+    advance_frames(ctx, &mut sim, frames, &mut [&mut measure])?;
+    if let Some(e) = failed {
+        return Err(e);
     }
     let last_frame = sim
         .state

@@ -18,16 +18,15 @@
 //! of the wall-clock time of `step`, measured around it: a phase left out of the breakdown
 //! would show here).
 
-use std::time::Instant;
-
 use anyhow::{anyhow, Result};
 use sph_core::Real;
 use sph_scene::{Scene, SolverKind};
+use sph_sim::observe::{FrameTimer, Recorder};
 
 use super::scene_edit::{set_block_and_tank, shipped};
 use super::solver_error_check;
 use crate::helpers::write_csv_rows;
-use crate::sim::scene_sim;
+use crate::sim::{advance_frames, scene_sim};
 use crate::{Check, Context, Experiment, Mode, Outcome};
 
 /// The experiment.
@@ -61,7 +60,7 @@ fn pile_scene(mode: Mode, measured_steps: usize) -> Result<Scene> {
 }
 
 /// One timed run: per-phase seconds summed over the measured steps, the wall time of
-/// `advance` summed likewise, steps, iterations, unconverged steps.
+/// each frame ([`FrameTimer`]: the step, its record and the recorder) summed likewise, steps, iterations, unconverged steps.
 struct Timed {
     threads: usize,
     particles: usize,
@@ -93,14 +92,11 @@ fn time_in<R: Real>(ctx: &Context, scene: &Scene, threads: usize) -> Result<Time
             friction_iterations: 0,
             friction_unconverged: 0,
         };
-        for i in 0..steps {
-            let t0 = Instant::now();
-            let s = sim.advance()?;
-            let wall = t0.elapsed().as_secs_f64();
-            ctx.progress.inc(1);
-            if i < WARM_UP_STEPS {
-                continue;
-            }
+        let mut recorder = Recorder::default();
+        let mut timer = FrameTimer::default();
+        advance_frames(ctx, &mut sim, steps, &mut [&mut recorder, &mut timer])?;
+        let measured = recorder.records.iter().zip(&timer.frame_s);
+        for (s, wall) in measured.skip(WARM_UP_STEPS) {
             if t.phases.is_empty() {
                 t.phases = s.phases.iter().map(|(n, _)| (n, 0.0)).collect();
             }

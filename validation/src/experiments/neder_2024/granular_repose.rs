@@ -270,7 +270,7 @@ impl Experiment for GranularRepose {
                         "NOT at rest"
                     },
                     run.rest_from_s
-                        .unwrap_or(run.frames.last().map_or(0.0, |f| f.t_s)),
+                        .unwrap_or(run.frames.last().map_or(0.0, |f| f.time_s)),
                     t0.elapsed().as_secs_f64()
                 )
             );
@@ -369,8 +369,8 @@ fn check_run(out: &mut Outcome, case: &Case) -> Result<Option<Base>> {
         out.check(solver_error_check(tag, e));
         return Ok(None);
     }
-    let end_speed = case.run.frames.last().map_or(f64::NAN, |f| f.max_speed_m_s);
-    let end_t = case.run.frames.last().map_or(f64::NAN, |f| f.t_s);
+    let end_speed = case.run.rest_speeds_m_s.last().copied().unwrap_or(f64::NAN);
+    let end_t = case.run.frames.last().map_or(f64::NAN, |f| f.time_s);
     out.metric(format!("{tag}/end_time_s"), end_t);
     let (capped, substeps, residual) = last_second_friction(&case.run.frames, end_t);
     out.metric(
@@ -402,8 +402,8 @@ fn check_run(out: &mut Outcome, case: &Case) -> Result<Option<Base>> {
 /// Over the run's last second: the fraction of substeps whose friction solve hit its cap,
 /// the friction iterations per substep, and the mean residual of the frames' last friction
 /// solves (whether the creep of a heap is the solver's, not the model's).
-fn last_second_friction(frames: &[super::FrameRow], end_t: f64) -> (f64, f64, f64) {
-    let last: Vec<_> = frames.iter().filter(|f| f.t_s > end_t - 1.0).collect();
+fn last_second_friction(frames: &[sph_sim::FrameRecord], end_t: f64) -> (f64, f64, f64) {
+    let last: Vec<_> = frames.iter().filter(|f| f.time_s > end_t - 1.0).collect();
     let substeps = last.iter().map(|f| f.substeps).sum::<usize>().max(1) as f64;
     let capped = last
         .iter()

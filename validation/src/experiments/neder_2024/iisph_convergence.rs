@@ -30,10 +30,12 @@
 use anyhow::Result;
 use sph_core::{ParticleSet, Real};
 use sph_scene::{BoundaryModel, IisphSettings, Scene};
+use sph_sim::observe::{OnFrame, Recorder};
+use sph_sim::{Flow, FrameRecord, RunPlan};
 
 use super::scene_edit::{iisph_solver, shipped};
 use crate::helpers::{plot_xy, write_csv_rows, Legend, PlotSpec, Series, SeriesStyle};
-use crate::sim::{scene_sim, SceneSim};
+use crate::sim::{advance_frames, scene_sim, SceneSim};
 use crate::{Check, Context, Experiment, Mode, Outcome};
 
 /// The experiment.
@@ -91,15 +93,15 @@ fn window<R: Real>(
 ) -> Result<(f64, f64, f64)> {
     sim.state = state.clone();
     let steps = sim.scene.frame_count();
+    let mut recorder = Recorder::default();
+    let plan = RunPlan::next(sim, steps);
+    sph_sim::run_frames(sim, &plan, &mut [&mut recorder])?.diverged_as_error()?;
     let (mut err, mut max, mut it, mut n) = (0.0, 0.0, 0.0, 0.0);
-    for i in 0..steps {
-        let s = sim.advance()?;
-        if i > 0 {
-            err += s.last_solve_error;
-            max += s.max_density_ratio - 1.0;
-            it += s.iterations as f64;
-            n += 1.0;
-        }
+    for s in recorder.records.iter().skip(1) {
+        err += s.last_solve_error;
+        max += s.max_density_ratio - 1.0;
+        it += s.iterations as f64;
+        n += 1.0;
     }
     ctx.progress.inc(1);
     Ok((err / n, max / n, it / n))
@@ -130,8 +132,7 @@ fn run_in<R: Real>(ctx: &Context) -> Result<Results> {
         .collect();
     let mut states = Vec::new();
     let mut reference = Vec::with_capacity(steps);
-    for _ in 0..steps {
-        let s = sim.advance()?;
+    let mut measure = OnFrame(|sim: &SceneSim<R>, s: &FrameRecord| {
         reference.push((
             sim.time_s,
             s.iterations,
@@ -142,8 +143,9 @@ fn run_in<R: Real>(ctx: &Context) -> Result<Results> {
         if state_steps.contains(&sim.frame) {
             states.push(sim.state.clone());
         }
-        ctx.progress.inc(1);
-    }
+        Flow::Continue
+    });
+    advance_frames(ctx, &mut sim, steps, &mut [&mut measure])?;
     let mut by_iterations = Vec::new();
     for &k in &ITERATIONS {
         let scene = iisph_scene(

@@ -5,7 +5,10 @@ use anyhow::Result;
 use sph_core::Real;
 use sph_scene::Scene;
 
-use crate::sim::scene_sim;
+use sph_sim::observe::OnFrame;
+use sph_sim::{Flow, FrameRecord, SceneSim};
+
+use crate::sim::{advance_frames, scene_sim};
 use crate::Context;
 
 /// Column width `a` of the scene (m).
@@ -79,12 +82,12 @@ pub(crate) fn simulate<R: Real>(ctx: &Context, scene: &Scene) -> Result<FrontRun
         0.0,
         (front_x(&sim.state.positions, radius) - x_wall) / COLUMN_WIDTH_M,
     )];
-    for _ in 0..frames {
-        sim.advance()?;
+    let mut front = OnFrame(|sim: &SceneSim<R>, _: &FrameRecord| {
         let z = (front_x(&sim.state.positions, radius) - x_wall) / COLUMN_WIDTH_M;
         series.push((sim.time_s * t_scale, z));
-        ctx.progress.inc(1);
-    }
+        Flow::Continue
+    });
+    advance_frames(ctx, &mut sim, frames, &mut [&mut front])?;
     Ok(FrontRun {
         series,
         particles: sim.state.len(),
