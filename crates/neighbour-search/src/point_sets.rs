@@ -155,7 +155,7 @@ fn hash01(x: u64) -> f64 {
 }
 
 /// A cube of about `n` points on the cubic lattice of `spacing` (`sph_core`'s
-/// [`cubic_lattice`](sph_core::sampling::cubic_lattice) of `round(∛n)` points per edge), each
+/// [`cubic_lattice`] of `round(∛n)` points per edge), each
 /// coordinate moved by up to ±0.5 % of the spacing (`(hash01(1 ^ (3i + a)) − ½) · 0.01 ·
 /// spacing` for point `i`, axis `a`), so that the lattice's exact distances do not all fall on
 /// the radius; with radius `2 · spacing` each point has about 30 neighbours. Errors: a
