@@ -98,7 +98,7 @@ fn particle_step(c: &mut Criterion) {
 }
 
 /// `Population::advance_to` over one synchronisation window (256 planet steps, 512 years) of
-/// the issue-21 comets (S2 at a first step of 547.875 d, planets S6 at 730.5 d: the
+/// the scattered-disk comets (S2 at a first step of 547.875 d, planets S6 at 730.5 d: the
 /// `comet_throughput` defaults), from the end of a first window (so that the ephemeris is
 /// in its steady state: each window integrates the next window's planets), for N = 10, 10³
 /// and 10⁴ on rayon's threads (`RAYON_NUM_THREADS`); the throughput is in particle-years

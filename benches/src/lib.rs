@@ -80,10 +80,10 @@ pub fn dam_break_fluid<R: Real>() -> (Vec<Vec3<R>>, Aabb<R>) {
     (p, tank)
 }
 
-/// Seed of the issue-21 comet population.
+/// Seed of the scattered-disk comet population.
 pub const COMET_SEED: u64 = 2026;
 
-/// The issue-21 comet population (the `comet_throughput` example and the `population-step`
+/// The scattered-disk comet population (the `comet_throughput` example and the `population-step`
 /// benchmark): the four giants of `outer_solar_system` (ecliptic J2000) integrated by
 /// `planet_map`; `n` comets with barycentric perihelia 32–40 AU, semi-major axes 40–100 AU,
 /// inclinations 0–30° and random angles (`symplectic::samples::SCATTERED_DISK`, seed

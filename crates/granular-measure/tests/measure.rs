@@ -395,7 +395,7 @@ fn heap_of(
 /// as the experiment does (bins of one spacing, the 20–80 % band, the steepest run of
 /// 0.2 m: shorter runs follow the lattice's steps, 2.8° off at 0.1 m and 1.6° at 0.15 m),
 /// over slopes of 15°–42°, lattice phases and jitter up to 0.15 spacing. The
-/// oracle is the shape's angle; the bound (1°) is what the experiment needs (issue 19:
+/// oracle is the shape's angle; the bound (1°) is what the repose experiment needs (its
 /// resolution better than ±1° in quick mode). The largest errors seen are printed (run with
 /// `--nocapture`).
 #[test]

@@ -422,8 +422,8 @@ mod tests {
         }
     }
 
-    /// The slope each match holds: `atan(sin θ)` = 18.9°, 26.6°, 32.7° (plane strain, as
-    /// issue 19 computes) and `θ` (simple shear).
+    /// The slope each match holds: `atan(sin θ)` = 18.9°, 26.6°, 32.7° (plane strain)
+    /// and `θ` (simple shear).
     #[test]
     fn predicted_repose_angles() {
         let ps: Vec<f64> = [20.0, 30.0, 40.0]
