@@ -1,14 +1,15 @@
 //! Build + query time of every neighbour-search method, side by side with kiddo's k-d tree.
 //!
-//! `cargo bench -p benches --bench neighbour_search` (or `cargo xtask bench`). Scenes:
-//! a jittered uniform block at rest spacing 0.025 with h = 0.05 (~30 neighbours each) and a
+//! `cargo bench -p benches --bench neighbour_search` (or `cargo xtask bench`). Scenes
+//! (`neighbour_search::point_sets`): a jittered uniform block at rest spacing 0.025 with h = 0.05 (~30 neighbours each) and a
 //! splash-like sparse cloud, at 10k, 100k and 1M particles (f32, in generation order), on
 //! the default rayon pool; and SPlisHSPlasH's dam-break anchor scene (59k fluid + 129k
 //! boundary particles) sorted by cell (as a solver keeps them) on one thread and on two,
 //! and unsorted on one thread. kiddo builds its tree from the same points each iteration.
 
-use benches::{dam_break_anchor, kiddo_search, splash_cloud, uniform_block};
+use benches::{dam_break_anchor, kiddo_search};
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use neighbour_search::point_sets;
 use neighbour_search::{CellOrder, CellSorter, Method, NeighbourLists, Vec3};
 use std::hint::black_box;
 use std::time::Duration;
@@ -54,13 +55,15 @@ fn run_methods(c: &mut Criterion, group_name: &str, points: &[Vec3<f32>], thread
 
 fn uniform(c: &mut Criterion) {
     for n in [10_000, 100_000, 1_000_000] {
-        run_methods(c, "uniform-block", &uniform_block::<f32>(n, SPACING), None);
+        let points = point_sets::jittered_lattice::<f32>(n, SPACING).expect("a valid lattice");
+        run_methods(c, "uniform-block", &points, None);
     }
 }
 
 fn splash(c: &mut Criterion) {
     for n in [10_000, 100_000, 1_000_000] {
-        run_methods(c, "splash", &splash_cloud::<f32>(n, SPACING), None);
+        let points = point_sets::splash::<f32>(n, SPACING).expect("a valid lattice");
+        run_methods(c, "splash", &points, None);
     }
 }
 

@@ -14,8 +14,8 @@ use symplectic::{
 };
 
 fn outer_solar_system() -> Planets {
-    // Hairer, Lubich & Wanner, Table 2.1 (reference-data/symplectic/outer_solar_system.csv).
-    let text = include_str!("../../reference-data/symplectic/outer_solar_system.csv");
+    // Hairer, Lubich & Wanner, Table 2.1 (reference-data/symplectic-100myr/outer_solar_system.csv).
+    let text = include_str!("../../reference-data/symplectic-100myr/outer_solar_system.csv");
     let rows: Vec<Vec<f64>> = text
         .lines()
         .filter(|l| !l.starts_with('#'))
@@ -62,8 +62,8 @@ fn particle_step(c: &mut Criterion) {
         &rot(&equatorial.heliocentric_velocities()),
     )
     .unwrap();
-    // Particle 1 of reference-data/symplectic/particles.csv (heliocentric ecliptic).
-    let text = include_str!("../../reference-data/symplectic/particles.csv");
+    // Particle 1 of reference-data/symplectic-100myr/particles.csv (heliocentric ecliptic).
+    let text = include_str!("../../reference-data/symplectic-100myr/particles.csv");
     let row: Vec<f64> = text
         .lines()
         .filter(|l| !l.starts_with('#'))
@@ -98,7 +98,7 @@ fn particle_step(c: &mut Criterion) {
 }
 
 /// `Population::advance_to` over one synchronisation window (256 planet steps, 512 years) of
-/// the issue-21 comets (S2 at a first step of 547.875 d, planets S6 at 730.5 d: the
+/// the scattered-disk comets (S2 at a first step of 547.875 d, planets S6 at 730.5 d: the
 /// `comet_throughput` defaults), from the end of a first window (so that the ephemeris is
 /// in its steady state: each window integrates the next window's planets), for N = 10, 10³
 /// and 10⁴ on rayon's threads (`RAYON_NUM_THREADS`); the throughput is in particle-years

@@ -3,7 +3,7 @@
 //!
 //! `cargo run --release -p benches --example comet_throughput -- N YEARS [s2|s6] [DT0_DAYS] [PLANETS] [PLANET_STEP_DAYS]`
 //!
-//! builds the issue-21 population: the four giant planets of `outer_solar_system` (ecliptic
+//! builds the scattered-disk population: the four giant planets of `outer_solar_system` (ecliptic
 //! J2000) integrated by `PLANETS` (`s2` or `s6`, default `s6`: the planets are shared by every
 //! particle, so their accuracy costs little per particle) at `PLANET_STEP_DAYS` (default
 //! 730.5 d); `N` comets with barycentric perihelia 32–40 AU, semi-major axes 40–100 AU,

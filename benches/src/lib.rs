@@ -1,55 +1,7 @@
 //! Scenes and peer adapters shared by the criterion benchmarks.
 
 use rayon::prelude::*;
-use sph_core::{sampling::cubic_lattice, Aabb, Real, Vec3};
-
-/// Deterministic pseudo-random number in [0, 1) from an integer (splitmix64).
-pub fn hash01(mut x: u64) -> f64 {
-    x = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    x = (x ^ (x >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    x = (x ^ (x >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    x ^= x >> 31;
-    (x >> 11) as f64 / (1u64 << 53) as f64
-}
-
-fn jitter<R: Real>(p: &mut [Vec3<R>], amplitude: f64, seed: u64) {
-    for (i, q) in p.iter_mut().enumerate() {
-        for a in 0..3 {
-            let r = hash01(seed ^ (3 * i as u64 + a as u64)) - 0.5;
-            q[a] += R::of_f64(r * amplitude);
-        }
-    }
-}
-
-/// A cube of about `n` particles on a lattice of `spacing`, jittered by ±0.5 % of the
-/// spacing (so that the lattice's exact distances do not all fall on the radius); with
-/// `h = 2·spacing` each particle has about 30 neighbours.
-pub fn uniform_block<R: Real>(n: usize, spacing: f64) -> Vec<Vec3<R>> {
-    let side = (n as f64).cbrt().round().max(1.0);
-    let edge = R::of_f64(side * spacing);
-    let b = Aabb::new(Vec3::zeros(), Vec3::repeat(edge)).expect("valid box");
-    let mut p = cubic_lattice(&b, R::of_f64(spacing), usize::MAX).expect("valid lattice");
-    jitter(&mut p, 0.01 * spacing, 1);
-    p
-}
-
-/// A splash-like cloud of about `n` particles: half in a jittered pool (lattice of
-/// `spacing`), half as droplets scattered uniformly over a region 4× wider and 4× taller
-/// than the pool (a few neighbours each at `h = 2·spacing`).
-pub fn splash_cloud<R: Real>(n: usize, spacing: f64) -> Vec<Vec3<R>> {
-    let mut p = uniform_block::<R>(n / 2, spacing);
-    let side = ((n / 2) as f64).cbrt().round() * spacing;
-    let drops = n - p.len().min(n);
-    for i in 0..drops as u64 {
-        let u = |k: u64| hash01(0xdead_beef ^ (3 * i + k));
-        p.push(Vec3::new(
-            R::of_f64((u(0) * 4.0 - 1.5) * side),
-            R::of_f64((1.0 + u(1) * 4.0) * side),
-            R::of_f64((u(2) * 4.0 - 1.5) * side),
-        ));
-    }
-    p
-}
+use sph_core::{Aabb, Real, Vec3};
 
 /// The neighbour-search anchor scene of SPlisHSPlasH's `DamBreakModel.json` at particle
 /// radius 0.0125 m (support 0.05 m): a fluid block of 39³ = 59,319 particles at spacing
@@ -128,10 +80,10 @@ pub fn dam_break_fluid<R: Real>() -> (Vec<Vec3<R>>, Aabb<R>) {
     (p, tank)
 }
 
-/// Seed of the issue-21 comet population.
+/// Seed of the scattered-disk comet population.
 pub const COMET_SEED: u64 = 2026;
 
-/// The issue-21 comet population (the `comet_throughput` example and the `population-step`
+/// The scattered-disk comet population (the `comet_throughput` example and the `population-step`
 /// benchmark): the four giants of `outer_solar_system` (ecliptic J2000) integrated by
 /// `planet_map`; `n` comets with barycentric perihelia 32–40 AU, semi-major axes 40–100 AU,
 /// inclinations 0–30° and random angles (`symplectic::samples::SCATTERED_DISK`, seed

@@ -1,11 +1,11 @@
 //! `particles repose DIR`: the angle of repose of the last (or a given) frame of a scene
-//! run, measured with [`iisph_granular::measure::angle_of_repose`], so that any granular
+//! run, measured with [`granular_measure::angle_of_repose`], so that any granular
 //! scene's output can be measured, not only the experiment's.
 
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
-use iisph_granular::measure::{angle_of_repose, ReposeOptions};
+use granular_measure::{angle_of_repose, ReposeOptions};
 use sph_sim::RunDir;
 
 use crate::render::scene_of_run;

@@ -72,5 +72,8 @@ pub fn run(a: &RunArgs) -> Result<()> {
                 .unwrap_or_else(|| PathBuf::from("target").join("cache").join("volume-maps"))
         }),
     };
-    Ok(run_scene(&a.scene, &opts)?)
+    // A blow-up fails the command (exit status 1) with the solver's message naming the
+    // frame, step and particle.
+    run_scene(&a.scene, &opts)?.diverged_as_error()?;
+    Ok(())
 }

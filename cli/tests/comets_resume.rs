@@ -1,6 +1,6 @@
 //! `particles comets`: a population study killed with SIGKILL at a random moment and started
 //! again with the same command writes the same files, byte for byte (snapshots, final table,
-//! checkpoint), as an uninterrupted run (issue 21: "kill -9 at a random moment, rerun the
+//! checkpoint), as an uninterrupted run ("kill -9 at a random moment, rerun the
 //! same command: identical output files").
 
 use std::path::{Path, PathBuf};

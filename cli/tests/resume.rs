@@ -78,13 +78,14 @@ fn run_ok(args: &[&str]) {
     );
 }
 
-/// The statistics without the wall-clock columns (those named `*_s` but `time_s`).
+/// The statistics without the wall-clock columns (those named `*_s` but `time_s` and
+/// `max_speed_m_s`).
 fn stats_without_clock(dir: &Path) -> Vec<Vec<String>> {
     let text = std::fs::read_to_string(dir.join("stats.csv")).unwrap();
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     let keep: Vec<usize> = (0..header.len())
-        .filter(|&i| header[i] == "time_s" || !header[i].ends_with("_s"))
+        .filter(|&i| matches!(header[i], "time_s" | "max_speed_m_s") || !header[i].ends_with("_s"))
         .collect();
     lines
         .map(|l| {

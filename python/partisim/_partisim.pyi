@@ -1,7 +1,7 @@
 """Type stubs of the extension module (the Rust side of partisim)."""
 
 from os import PathLike
-from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -40,9 +40,17 @@ class Simulation:
     def from_scene(path: _Path, quick: bool = False) -> Simulation:
         """Loads, checks and builds a scene (quick: its [quick] overrides)."""
     def step(self) -> Dict[str, Any]:
-        """Advances one frame; returns its statistics."""
-    def run(self, frames: int, progress: bool = True) -> None:
-        """Advances `frames` frames (progress bar on stderr); Ctrl-C stops between frames."""
+        """Advances one frame; returns its statistics (a blow-up raises PartisimError)."""
+    def run(
+        self,
+        frames: int,
+        progress: bool = True,
+        callback: Optional[Callable[[Dict[str, Any]], Any]] = None,
+    ) -> Dict[str, Any]:
+        """Advances `frames` frames (progress bar on stderr). `callback(stats)` after each
+        frame: False or a string (the reason) stops the run. Returns how it ended:
+        {"ending": "completed" | "stopped" | "diverged", "frame", "time_s", "reason"}.
+        Ctrl-C stops between frames with KeyboardInterrupt (the frames done are kept)."""
     @property
     def positions(self) -> _Float:
         """(N, 3) positions (m), in the scene's particle order and precision."""
@@ -63,7 +71,8 @@ class Simulation:
         """"f32" or "f64" (the scene's)."""
     @property
     def stats(self) -> Optional[Dict[str, Any]]:
-        """The last frame's StepStats as a dict (times in s, kinetic energy in J)."""
+        """The last frame's record as a dict (frame, time_s, particles, density ratios,
+        iterations, kinetic_energy_j, max_speed_m_s, phases_s, total_s ...; times in s)."""
     def write_vtk(self, path: _Path) -> None:
         """Writes a legacy VTK particle frame (the format of `cargo xtask run`)."""
     def render(self) -> npt.NDArray[np.uint8]:

@@ -5,11 +5,13 @@ use std::sync::Mutex;
 
 use numpy::{IntoPyArray, PyArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyString};
 use sph_core::{Real, Vec3};
 use sph_sim::run::ProgressObserver;
-use sph_sim::{run_frames, FrameObserver, RunPlan, Scene, SceneSim, SimError};
-use sph_solver::StepStats;
+use sph_sim::{
+    run_frames, Ending, Flow, FrameObserver, FrameRecord, RunOutcome, RunPlan, Scene, SceneSim,
+    SimError,
+};
 
 use crate::rust_err;
 
@@ -32,33 +34,52 @@ macro_rules! each {
 #[pyclass(module = "partisim")]
 struct Simulation {
     sim: Mutex<AnySim>,
-    stats: Option<StepStats>,
+    record: Option<FrameRecord>,
 }
 
-/// Stops the frame loop when Python has a pending signal (Ctrl-C), keeping the error.
-struct Interrupt {
+/// The frame record as a Python dict: its serde form (`phases_s` a dict by phase name).
+fn record_dict<'py>(py: Python<'py>, r: &FrameRecord) -> PyResult<Bound<'py, PyAny>> {
+    let json = serde_json::to_string(r).map_err(rust_err)?;
+    py.import("json")?.call_method1("loads", (json,))
+}
+
+/// Python's side of a run: Ctrl-C (a pending signal) and the caller's callback, asked
+/// after each frame; the first Python error (KeyboardInterrupt, or the callback's) is kept
+/// and ends the run.
+struct PythonSide {
+    callback: Option<Py<PyAny>>,
     err: Option<PyErr>,
+    last: Option<FrameRecord>,
 }
 
-impl<R: Real> FrameObserver<R> for Interrupt {
-    fn frame(&mut self, _: &SceneSim<R>, _: &StepStats) -> Result<(), SimError> {
-        match Python::attach(|py| py.check_signals()) {
-            Ok(()) => Ok(()),
-            Err(e) => {
-                self.err = Some(e);
-                Err(SimError::Invalid("interrupted".into()))
-            }
+impl PythonSide {
+    fn ask(&mut self, py: Python<'_>, record: &FrameRecord) -> PyResult<Flow> {
+        py.check_signals()?;
+        let Some(cb) = &self.callback else {
+            return Ok(Flow::Continue);
+        };
+        let answer = cb.call1(py, (record_dict(py, record)?,))?;
+        let answer = answer.bind(py);
+        if answer.is_none() || answer.is_truthy()? && !answer.is_instance_of::<PyString>() {
+            return Ok(Flow::Continue);
         }
+        Ok(Flow::Stop(match answer.extract::<String>() {
+            Ok(reason) => reason,
+            Err(_) => "stopped by the callback".into(),
+        }))
     }
 }
 
-/// Keeps the last frame's statistics.
-struct LastStats(Option<StepStats>);
-
-impl<R: Real> FrameObserver<R> for LastStats {
-    fn frame(&mut self, _: &SceneSim<R>, stats: &StepStats) -> Result<(), SimError> {
-        self.0 = Some(*stats);
-        Ok(())
+impl<R: Real> FrameObserver<R> for PythonSide {
+    fn frame(&mut self, _: &SceneSim<R>, record: &FrameRecord) -> Result<Flow, SimError> {
+        self.last = Some(*record);
+        match Python::attach(|py| self.ask(py, record)) {
+            Ok(flow) => Ok(flow),
+            Err(e) => {
+                self.err = Some(e);
+                Ok(Flow::Interrupt)
+            }
+        }
     }
 }
 
@@ -66,17 +87,22 @@ fn run_in<R: Real>(
     sim: &mut SceneSim<R>,
     frames: usize,
     progress: bool,
-) -> (Result<(), SimError>, Option<StepStats>, Option<PyErr>) {
-    let plan = RunPlan {
-        first_frame: sim.frame,
-        last_frame: sim.frame + frames,
-        resumed: false,
-    };
+    side: &mut PythonSide,
+) -> Result<RunOutcome, SimError> {
+    let plan = RunPlan::next(sim, frames);
     let mut bar = ProgressObserver::new(progress);
-    let mut last = LastStats(None);
-    let mut interrupt = Interrupt { err: None };
-    let result = run_frames(sim, &plan, &mut [&mut bar, &mut last, &mut interrupt]);
-    (result, last.0, interrupt.err)
+    run_frames(sim, &plan, &mut [&mut bar, side])
+}
+
+/// How a run ended, as a dict: `ending` ("completed", "stopped" or "diverged"), `frame`,
+/// `time_s`, `reason` (the stop's or the divergence's, else None).
+fn outcome_dict<'py>(py: Python<'py>, o: &RunOutcome) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("ending", o.ending.name())?;
+    d.set_item("frame", o.frame)?;
+    d.set_item("time_s", o.time_s)?;
+    d.set_item("reason", o.ending.reason())?;
+    Ok(d)
 }
 
 /// Per-particle vectors in the scene's order, as an (N, 3) array of the scene's precision.
@@ -97,6 +123,34 @@ impl Simulation {
     fn lock(&self) -> std::sync::MutexGuard<'_, AnySim> {
         self.sim.lock().unwrap_or_else(|p| p.into_inner())
     }
+
+    /// Runs `frames` frames with the GIL released; a Python error (Ctrl-C, the callback's)
+    /// is raised after the frames done are kept.
+    fn run_frames(
+        &mut self,
+        py: Python<'_>,
+        frames: usize,
+        progress: bool,
+        callback: Option<Py<PyAny>>,
+    ) -> PyResult<RunOutcome> {
+        let sim = &self.sim;
+        let mut side = PythonSide {
+            callback,
+            err: None,
+            last: None,
+        };
+        let result = py.detach(|| {
+            let mut guard = sim.lock().unwrap_or_else(|p| p.into_inner());
+            each!(&mut *guard, s => run_in(s, frames, progress, &mut side))
+        });
+        if side.last.is_some() {
+            self.record = side.last;
+        }
+        if let Some(e) = side.err {
+            return Err(e);
+        }
+        result.map_err(rust_err)
+    }
 }
 
 #[pymethods]
@@ -115,37 +169,42 @@ impl Simulation {
         });
         Ok(Self {
             sim: Mutex::new(sim.map_err(rust_err)?),
-            stats: None,
+            record: None,
         })
     }
 
-    /// Advances one frame (the scene's frame interval); returns the frame's statistics.
-    fn step(&mut self, py: Python<'_>) -> PyResult<Py<PyDict>> {
-        let sim = &self.sim;
-        let stats = py.detach(|| {
-            let mut guard = sim.lock().unwrap_or_else(|p| p.into_inner());
-            each!(&mut *guard, s => s.advance())
-        });
-        self.stats = Some(stats.map_err(rust_err)?);
-        self.stats(py).map(|s| s.expect("just set"))
+    /// Advances one frame (the scene's frame interval) through the frame loop; returns the
+    /// frame's statistics. A blow-up raises PartisimError naming the frame, step and
+    /// particle (the state keeps its last good substep).
+    fn step<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let outcome = self.run_frames(py, 1, false, None)?;
+        if let Ending::Diverged(_) = outcome.ending {
+            return Err(rust_err(outcome.ending.reason().unwrap_or_default()));
+        }
+        match &self.record {
+            Some(r) => record_dict(py, r),
+            None => Err(rust_err("no frame was advanced")),
+        }
     }
 
     /// Advances `frames` frames through the frame loop, with a progress bar on stderr if
-    /// `progress`; Ctrl-C stops it between frames (the frames done are kept).
-    #[pyo3(signature = (frames, progress = true))]
-    fn run(&mut self, py: Python<'_>, frames: usize, progress: bool) -> PyResult<()> {
-        let sim = &self.sim;
-        let (result, last, interrupted) = py.detach(|| {
-            let mut guard = sim.lock().unwrap_or_else(|p| p.into_inner());
-            each!(&mut *guard, s => run_in(s, frames, progress))
-        });
-        if last.is_some() {
-            self.stats = last;
-        }
-        if let Some(e) = interrupted {
-            return Err(e);
-        }
-        result.map_err(rust_err)
+    /// `progress`. `callback(stats)`, if given, is called after each frame with its
+    /// statistics (the dict of `stats`); returning False or a string stops the run after
+    /// that frame (the string is the reason). Returns how the run ended, a dict with
+    /// `ending` ("completed", "stopped" or "diverged": a blow-up is a result, the state
+    /// keeps its last good substep), `frame`, `time_s` and `reason`. Ctrl-C stops it
+    /// between frames with KeyboardInterrupt, and an exception of the callback ends it
+    /// with that exception; the frames done are kept either way.
+    #[pyo3(signature = (frames, progress = true, callback = None))]
+    fn run<'py>(
+        &mut self,
+        py: Python<'py>,
+        frames: usize,
+        progress: bool,
+        callback: Option<Py<PyAny>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let outcome = self.run_frames(py, frames, progress, callback)?;
+        outcome_dict(py, &outcome)
     }
 
     /// Positions (m), shape (N, 3), in the scene's particle order and precision.
@@ -191,35 +250,11 @@ impl Simulation {
         }
     }
 
-    /// The last frame's statistics (`StepStats`) as a dict, or None before the first frame.
+    /// The last frame's statistics (the frame loop's record) as a dict, or None before the
+    /// first frame.
     #[getter]
-    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Option<Py<PyDict>>> {
-        let Some(s) = &self.stats else {
-            return Ok(None);
-        };
-        let d = PyDict::new(py);
-        d.set_item("substeps", s.substeps)?;
-        d.set_item("iterations", s.iterations)?;
-        d.set_item("unconverged_substeps", s.unconverged_substeps)?;
-        d.set_item("last_solve_error", s.last_solve_error)?;
-        d.set_item("friction_iterations", s.friction_iterations)?;
-        d.set_item(
-            "unconverged_friction_substeps",
-            s.unconverged_friction_substeps,
-        )?;
-        d.set_item("last_friction_residual", s.last_friction_residual)?;
-        d.set_item("neighbour_pairs", s.neighbour_pairs)?;
-        d.set_item("max_density_ratio", s.max_density_ratio)?;
-        d.set_item("mean_density_ratio", s.mean_density_ratio)?;
-        d.set_item("kinetic_energy_j", s.kinetic_energy)?;
-        d.set_item("reordered", s.reordered)?;
-        let phases = PyDict::new(py);
-        for (name, secs) in s.phases.iter() {
-            phases.set_item(name, secs)?;
-        }
-        d.set_item("phases_s", phases)?;
-        d.set_item("total_s", s.total_s())?;
-        Ok(Some(d.unbind()))
+    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.record.as_ref().map(|r| record_dict(py, r)).transpose()
     }
 
     /// Writes the particles as a legacy VTK frame (the format of `cargo xtask run`).

@@ -47,3 +47,30 @@ def test_a_population_stops_between_windows():
         pop.advance(1e6)  # hours if not interrupted
     timer.join()
     assert 0 < pop.time_years < 1e6
+
+
+def test_a_callback_stop_and_an_interrupt_both_leave_the_simulation_usable():
+    sim = partisim.Simulation.from_scene(REPO / "scenes" / "dam_break.toml", quick=True)
+    seen = []
+
+    def until_frame_3(stats):
+        seen.append(stats["frame"])
+        return "frame 3 reached" if stats["frame"] == 3 else None
+
+    outcome = sim.run(100, progress=False, callback=until_frame_3)
+    assert outcome["ending"] == "stopped" and outcome["reason"] == "frame 3 reached"
+    assert outcome["frame"] == 3 == sim.frame and seen == [1, 2, 3]
+    assert sim.stats["frame"] == 3 and sim.stats["particles"] == len(sim.positions)
+
+    timer = interrupt_after(0.5)
+    with pytest.raises(KeyboardInterrupt):
+        sim.run(2000, progress=False)  # minutes if not interrupted
+    timer.join()
+    interrupted_at = sim.frame
+    assert 3 < interrupted_at < 2003 and sim.stats["frame"] == interrupted_at
+
+    # Both stops left a simulation that goes on frame by frame.
+    assert sim.run(1, progress=False)["ending"] == "completed"
+    assert sim.frame == interrupted_at + 1 and np.isfinite(sim.positions).all()
+    assert sim.step()["frame"] == interrupted_at + 2
+    assert sim.run(2, progress=False, callback=lambda s: False)["frame"] == interrupted_at + 3

@@ -32,8 +32,16 @@ def test_frames_equal_xtask_run(rust_run):
     check_frame(sim, read_vtk_frame(rust_run / "frame_00000.vtk"))
     stats = sim.step()
     assert stats["substeps"] == 4 and stats["neighbour_pairs"] > 0
+    # The dict and stats.csv are the same frame record: the counts agree exactly.
+    header, row = (rust_run / "stats.csv").read_text().splitlines()[:2]
+    csv = dict(zip(header.split(","), row.split(",")))
+    for key in ("frame", "particles", "iterations", "neighbour_pairs", "substeps"):
+        assert int(csv[key]) == stats[key], key
+    assert set(stats["phases_s"]) | {"total"} == {k[:-2] for k in csv if k.endswith("_s")} - {
+        "time", "max_speed_m"}
     check_frame(sim, read_vtk_frame(rust_run / "frame_00001.vtk"))
-    sim.run(FRAMES - 1, progress=False)
+    outcome = sim.run(FRAMES - 1, progress=False)
+    assert outcome["ending"] == "completed" and outcome["frame"] == FRAMES
     assert sim.frame == FRAMES and sim.time == pytest.approx(FRAMES * 0.016, rel=1e-12)
     assert sim.stats["reordered"] in (True, False)
     check_frame(sim, read_vtk_frame(rust_run / f"frame_{FRAMES:05}.vtk"))

@@ -6,8 +6,13 @@
 //! [`runner`] for the output layout (`<out>/<id>/verdict.json`, `<out>/summary.json`,
 //! `<out>/report.md`).
 //!
-//! Adding an experiment: implement [`Experiment`] in a new module under
-//! `src/experiments/`, and list it in [`experiments::registry`].
+//! Adding an experiment: implement [`Experiment`] in a new module
+//! `src/experiments/<paper>/<id>.rs` (the folder of the paper whose crates it validates,
+//! [`papers::Paper`]; a folder `<id>/` with a `mod.rs` for a large one), put its reference
+//! data in `reference-data/<id>/` with a `SOURCE.md`, and list it in
+//! [`experiments::registry`]. The paper → crates → experiments → scenes → reference-data
+//! table of `docs/papers.md` is generated from the registry ([`papers::experiment_table`]) and
+//! checked by `cargo test -p validation`, as is that layout.
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -19,6 +24,8 @@ use serde::{Deserialize, Serialize};
 pub mod deviations;
 pub mod experiments;
 pub mod helpers;
+pub mod papers;
+pub mod report;
 pub mod runner;
 pub mod sim;
 
@@ -85,6 +92,18 @@ pub trait Experiment: Sync {
     fn id(&self) -> &'static str;
     /// The paper and figure/table/claim this experiment reproduces.
     fn source(&self) -> &'static str;
+    /// The workspace crates (package directory names under `crates/`) whose results the
+    /// experiment checks.
+    fn crates(&self) -> &'static [&'static str];
+    /// The shipped scenes (`scenes/<name>.toml`) the experiment runs or edits, by name.
+    fn scenes(&self) -> &'static [&'static str] {
+        &[]
+    }
+    /// The Rust path of the experiment's type; its module path names the experiment's paper
+    /// folder and file ([`papers::Paper::of_experiment`]). Not meant to be overridden.
+    fn type_path(&self) -> &'static str {
+        std::any::type_name::<Self>()
+    }
     /// Runs the experiment, writing files under [`Context::out_dir`].
     fn run(&self, ctx: &mut Context) -> anyhow::Result<Outcome>;
 }

@@ -1,4 +1,5 @@
-//! Runs the selected experiments and writes the results.
+//! Runs the selected experiments and records their verdicts; [`crate::report`] writes them
+//! out (`verdict.json`, `summary.json`, `report.md`, the terminal table).
 //!
 //! Output layout (`<out>` defaults to `target/validation` under the workspace root):
 //!
@@ -9,7 +10,6 @@
 //! - `<out>/report.md` — every check in one table, then each experiment's notes and plots.
 
 use std::collections::BTreeMap;
-use std::fmt::Write as _;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
@@ -20,7 +20,8 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
 use crate::deviations::{CheckVerdict, Deviations};
-use crate::{fmt_num, reference_data_dir, Artifact, Check, Context, Experiment, Mode, Outcome};
+use crate::report;
+use crate::{reference_data_dir, Artifact, Check, Context, Experiment, Mode, Outcome};
 
 /// What to run and where to write.
 #[derive(Debug, Clone)]
@@ -168,12 +169,6 @@ pub struct Verdict {
     pub files: Vec<Artifact>,
 }
 
-#[derive(Serialize)]
-struct Summary<'a> {
-    mode: Mode,
-    experiments: &'a [Verdict],
-}
-
 /// Selects experiments by id, in registry order; unknown ids are an error naming the
 /// known ones.
 pub fn select<'a>(
@@ -276,13 +271,8 @@ pub fn run_one(
         plots: ctx.plots().to_vec(),
         files: ctx.files().to_vec(),
     };
-    write_json(&dir.join("verdict.json"), &verdict)?;
+    report::write_json(&dir.join("verdict.json"), &verdict)?;
     Ok(verdict)
-}
-
-fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<()> {
-    let text = serde_json::to_string_pretty(value)?;
-    std::fs::write(path, text + "\n").with_context(|| format!("writing {}", path.display()))
 }
 
 /// The deviations list of `reference_dir`, refusing entries that name no registered
@@ -347,19 +337,10 @@ pub fn run_with(
         );
         verdicts.push(v);
     }
-    write_json(
-        &opts.out.join("summary.json"),
-        &Summary {
-            mode: opts.mode,
-            experiments: &verdicts,
-        },
-    )?;
-    let report = report_markdown(opts.mode, &verdicts);
-    let report_path = opts.out.join("report.md");
-    std::fs::write(&report_path, report)
-        .with_context(|| format!("writing {}", report_path.display()))?;
-    print!("{}", terminal_table(&verdicts));
-    println!("summary: {}", opts.out.join("summary.json").display());
+    let (summary_path, report_path) =
+        report::write_summary_and_report(&opts.out, opts.mode, &verdicts)?;
+    print!("{}", report::terminal_table(&verdicts));
+    println!("summary: {}", summary_path.display());
     println!("report:  {}", report_path.display());
     Ok(verdicts)
 }
@@ -370,203 +351,10 @@ pub fn succeeded(verdicts: &[Verdict]) -> bool {
     verdicts.iter().all(|v| !v.status.fails_run())
 }
 
-/// The final terminal table: one row per experiment, then each check that is not a plain
-/// pass (deviations with their documented summary, failures with their figure).
-pub fn terminal_table(verdicts: &[Verdict]) -> String {
-    let mut s = String::new();
-    let w = verdicts
-        .iter()
-        .map(|v| v.id.len())
-        .max()
-        .unwrap_or(2)
-        .max(10);
-    let _ = writeln!(
-        s,
-        "\n{:<w$}  {:<9}  {:>9}  checks",
-        "experiment", "status", "wall [s]"
-    );
-    let _ = writeln!(s, "{}", "-".repeat(w + 34));
-    for v in verdicts {
-        let passed = v
-            .checks
-            .iter()
-            .filter(|c| c.verdict == CheckVerdict::Pass)
-            .count();
-        let _ = writeln!(
-            s,
-            "{:<w$}  {:<9}  {:>9.2}  {}/{} pass",
-            v.id,
-            v.status.label(),
-            v.wall_s,
-            passed,
-            v.checks.len()
-        );
-        if let Some(e) = &v.error {
-            let _ = writeln!(s, "    error: {}", e.replace('\n', "\n           "));
-        }
-        for c in v.checks.iter().filter(|c| c.verdict != CheckVerdict::Pass) {
-            let _ = writeln!(
-                s,
-                "    {} {}: value {} (bound {})",
-                c.verdict.label(),
-                c.check.name,
-                fmt_num(c.check.value),
-                c.check.bound
-            );
-            if let Some(d) = &c.deviation {
-                let _ = writeln!(s, "        documented: {d}");
-            }
-        }
-    }
-    let count = |st: Status| verdicts.iter().filter(|v| v.status == st).count();
-    let bad = count(Status::Fail) + count(Status::Error);
-    let _ = writeln!(
-        s,
-        "{} pass, {} with documented deviations, {} FAIL, {} ERROR: {}",
-        count(Status::Pass),
-        count(Status::Deviation),
-        count(Status::Fail),
-        count(Status::Error),
-        if bad == 0 {
-            "every miss is documented (reference-data/deviations.toml)"
-        } else {
-            "undocumented failures"
-        }
-    );
-    s
-}
-
-fn cell(text: &str) -> String {
-    text.replace('|', "\\|").replace('\n', " ")
-}
-
-/// The Markdown report (paths relative to the output directory).
-pub fn report_markdown(mode: Mode, verdicts: &[Verdict]) -> String {
-    let mut s = String::new();
-    let count = |st: Status| verdicts.iter().filter(|v| v.status == st).count();
-    let _ = writeln!(s, "# Validation report\n");
-    let _ = writeln!(
-        s,
-        "Mode: **{mode}**. Experiments: {} — {} pass, {} with documented deviations, {} fail, \
-         {} error. Generated by `cargo xtask validate{}`. A deviation is a miss documented, \
-         with its figures and evidence, in `reference-data/deviations.toml`.\n",
-        verdicts.len(),
-        count(Status::Pass),
-        count(Status::Deviation),
-        count(Status::Fail),
-        count(Status::Error),
-        if mode == Mode::Full { " --full" } else { "" }
-    );
-    let _ = writeln!(
-        s,
-        "| experiment | status | wall [s] | source |\n| --- | --- | ---: | --- |"
-    );
-    for v in verdicts {
-        let _ = writeln!(
-            s,
-            "| {} | {} | {:.2} | {} |",
-            v.id,
-            v.status.as_str(),
-            v.wall_s,
-            cell(&v.source)
-        );
-    }
-    let documented: Vec<(&Verdict, &CheckRecord)> = verdicts
-        .iter()
-        .flat_map(|v| v.checks.iter().map(move |c| (v, c)))
-        .filter(|(_, c)| c.deviation.is_some())
-        .collect();
-    if !documented.is_empty() {
-        let _ = writeln!(s, "\n## Documented deviations\n");
-        let _ = writeln!(
-            s,
-            "| experiment | check | value | bound | verdict | documented finding |\n| --- | --- | ---: | --- | --- | --- |"
-        );
-        for (v, c) in documented {
-            let _ = writeln!(
-                s,
-                "| {} | {} | {} | {} | {} | {} |",
-                v.id,
-                cell(&c.check.name),
-                fmt_num(c.check.value),
-                cell(&c.check.bound),
-                c.verdict.label(),
-                cell(c.deviation.as_deref().unwrap_or(""))
-            );
-        }
-    }
-    let _ = writeln!(s, "\n## Checks\n");
-    let _ = writeln!(
-        s,
-        "| experiment | check | value | bound | origin of the bound | result |\n| --- | --- | ---: | --- | --- | --- |"
-    );
-    for v in verdicts {
-        for c in &v.checks {
-            let result = match c.verdict {
-                CheckVerdict::Pass => "pass".to_string(),
-                CheckVerdict::Deviation => "deviation (documented)".to_string(),
-                other => format!("**{}**", other.label()),
-            };
-            let _ = writeln!(
-                s,
-                "| {} | {} | {} | {} | {} | {} |",
-                v.id,
-                cell(&c.check.name),
-                fmt_num(c.check.value),
-                cell(&c.check.bound),
-                cell(&c.check.origin),
-                result
-            );
-        }
-    }
-    for v in verdicts {
-        let _ = writeln!(s, "\n## {} — {}\n", v.id, v.status.as_str());
-        let _ = writeln!(s, "Source: {}. Wall time {:.2} s.\n", v.source, v.wall_s);
-        if let Some(e) = &v.error {
-            let _ = writeln!(s, "**Error:**\n\n```text\n{e}\n```\n");
-        }
-        if !v.notes.is_empty() {
-            let _ = writeln!(s, "### Notes\n");
-            for n in &v.notes {
-                let _ = writeln!(s, "- {n}");
-            }
-            let _ = writeln!(s);
-        }
-        for p in &v.plots {
-            let _ = writeln!(
-                s,
-                "![{}]({}/{})\n\n*{}*\n",
-                cell(&p.caption),
-                v.id,
-                p.file,
-                p.caption
-            );
-        }
-        if !v.files.is_empty() {
-            let _ = writeln!(s, "### Data\n");
-            for f in &v.files {
-                let _ = writeln!(s, "- [`{}`]({}/{}): {}", f.file, v.id, f.file, f.caption);
-            }
-            let _ = writeln!(s);
-        }
-        if !v.metrics.is_empty() {
-            let _ = writeln!(
-                s,
-                "<details><summary>{} metrics</summary>\n\n| metric | value |\n| --- | ---: |",
-                v.metrics.len()
-            );
-            for (k, x) in &v.metrics {
-                let _ = writeln!(s, "| {} | {} |", cell(k), fmt_num(*x));
-            }
-            let _ = writeln!(s, "\n</details>");
-        }
-    }
-    s
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::report::terminal_table;
 
     struct Fails;
     impl Experiment for Fails {
@@ -575,6 +363,9 @@ mod tests {
         }
         fn source(&self) -> &'static str {
             "test"
+        }
+        fn crates(&self) -> &'static [&'static str] {
+            &[]
         }
         fn run(&self, _ctx: &mut Context) -> Result<Outcome> {
             let mut o = Outcome::new();
@@ -591,6 +382,9 @@ mod tests {
         fn source(&self) -> &'static str {
             "test"
         }
+        fn crates(&self) -> &'static [&'static str] {
+            &[]
+        }
         fn run(&self, _ctx: &mut Context) -> Result<Outcome> {
             panic!("boom")
         }
@@ -602,6 +396,9 @@ mod tests {
         }
         fn source(&self) -> &'static str {
             "test"
+        }
+        fn crates(&self) -> &'static [&'static str] {
+            &[]
         }
         fn run(&self, _ctx: &mut Context) -> Result<Outcome> {
             bail!("no data")
@@ -615,6 +412,9 @@ mod tests {
         }
         fn source(&self) -> &'static str {
             "test"
+        }
+        fn crates(&self) -> &'static [&'static str] {
+            &[]
         }
         fn run(&self, _ctx: &mut Context) -> Result<Outcome> {
             let mut o = Outcome::new();

@@ -44,7 +44,7 @@ fn the_example_builds_the_shipped_granular_scene() {
     let (p, q) = (
         solver.params(),
         match &setup.params {
-            sph_scene::SolverParams::Iisph(p) => p.clone(),
+            sph_scene::SolverParams::Granular(p) => p.clone(),
             other => panic!("the scene is granular IISPH, got {other:?}"),
         },
     );

@@ -1,6 +1,6 @@
 //! The granular column collapse that `scenes/granular_column_collapse.toml` describes, in
 //! quick mode (Lube, Huppert, Sparks & Freundt 2005; a = H0/L0 = 2), built from this crate
-//! alone: volume-map walls, calibrated initial masses, Drucker–Prager friction at 30°.
+//! alone (its runout measured with `granular-measure`): volume-map walls, calibrated initial masses, Drucker–Prager friction at 30°.
 //!
 //! ```sh
 //! cargo run --release -p iisph-granular --example granular_column [FRAMES]
@@ -11,9 +11,10 @@
 //! Lube et al.'s law (the `granular-column-collapse` experiment checks the five aspect
 //! ratios against the law's ±30 % band). 7 s on one thread.
 
+use granular_measure as measure;
 use iisph_granular::{
-    calibrate_masses, cubic_lattice, measure, volume_map_walls, Aabb, BoxSdf, Iisph, IisphParams,
-    Inverted, ParticleSet, Solids, Vec3, IISPH_KERNEL,
+    calibrate_masses, cubic_lattice, volume_map_walls, Aabb, BoxSdf, Iisph, IisphParams, Inverted,
+    ParticleSet, Solids, Vec3, IISPH_KERNEL,
 };
 
 /// Particle spacing (m), as the scene's `[quick]` table.

@@ -263,7 +263,7 @@
 //!   against 5.3 `L0` for water and then stops (2.03 `L0` at 0.8 s, 2.05 at 1.2 s). The
 //!   released blocks of the earlier repose scenes (collapse deposits, 2 s, plane-strain
 //!   cone) stood at 15.0°, 24.0°, 31.1° for θ = 20°, 30°, 40°, their steepest 5 cm at
-//!   17.3–18.1°, 25.6–26.4°, 33.7–35.6°, near `atan(sin θ)` (issue 19). Fixed-base heaps
+//!   17.3–18.1°, 25.6–26.4°, 33.7–35.6°, near `atan(sin θ)`. Fixed-base heaps
 //!   (`granular-repose`, quick, 3-particle slab) stand 3.7–5.7° above the prediction of
 //!   either match (23.7°, 34.8°, 43.7° simple shear; 22.7°, 32.3°, 38.4° plane strain, at
 //!   4 s, with the friction relaxation 0.35; 23.7°, 34.9°, 43.9° and 22.4°, 31.6°, 38.2°
@@ -312,10 +312,10 @@
 mod friction;
 pub mod granular;
 mod kernels;
-pub mod measure;
 mod params;
 mod passes;
 mod scratch;
+mod settings;
 mod solver;
 pub mod upscale;
 mod walls;
@@ -324,8 +324,10 @@ pub use kernels::IISPH_KERNEL;
 pub use params::{
     ConeMatch, GranularParams, IisphParams, AIR_DENSITY, DEFAULT_DRAG_CONE_HALF_ANGLE_DEG,
     DEFAULT_FRICTION_MAX_ITERATIONS, DEFAULT_FRICTION_RELAXATION, DEFAULT_FRICTION_TOLERANCE,
-    MAX_FRICTION_ITERATIONS, MAX_PRESSURE_ITERATIONS,
+    DEFAULT_MAX_ITERATIONS, DEFAULT_MIN_ITERATIONS, MAX_FRICTION_ITERATIONS,
+    MAX_PRESSURE_ITERATIONS,
 };
+pub use settings::{GranularSettings, IisphSettings, WaterSettings};
 pub use solver::{Iisph, IisphScheme, IISPH_PHASES, IISPH_STATE_ARRAYS};
 pub use walls::volume_map_walls;
 

@@ -36,6 +36,13 @@ pub const DEFAULT_FRICTION_TOLERANCE: f64 = 1e-4;
 /// them.
 pub const DEFAULT_FRICTION_RELAXATION: f64 = 0.35;
 
+/// Default [`IisphParams::min_iterations`]: Ihmsen et al. 2014 §4 ("at least two
+/// iterations"); Neder 2024 Alg. 1 line 7.
+pub const DEFAULT_MIN_ITERATIONS: usize = 2;
+
+/// Default [`IisphParams::max_iterations`]: SPlisHSPlasH's default cap.
+pub const DEFAULT_MAX_ITERATIONS: usize = 100;
+
 /// Most relaxed-Jacobi pressure iterations per time step ([`IisphParams::max_iterations`],
 /// and so [`IisphParams::min_iterations`]) accepted, bounded by what can finish. The count
 /// is a cap: a solve stops at the tolerance, after 2–20 iterations at the default 0.1 %
@@ -66,12 +73,8 @@ pub const MAX_FRICTION_ITERATIONS: usize = 1000;
 ///
 /// In scene files: `cone_match = "plane-strain"` or `"simple-shear"` (`[solver]`, kind
 /// `"granular"`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Deserialize),
-    serde(rename_all = "kebab-case")
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 #[non_exhaustive]
 pub enum ConeMatch {
     /// `α = √2 sin θ` (Neder 2024 eq. 14, after Alduán & Otaduy 2011): the cone agrees with
@@ -236,7 +239,7 @@ impl<R: Real> GranularParams<R> {
             return Err(invalid(
                 "air_velocity",
                 self.air_velocity[a].as_f64(),
-                "components must be finite",
+                "has a component that is not finite",
             ));
         }
         let cone = self.drag_cone_half_angle_deg;
@@ -305,8 +308,8 @@ impl<R: Real> IisphParams<R> {
         common.substeps = 8;
         Self {
             common,
-            min_iterations: 2,
-            max_iterations: 100,
+            min_iterations: DEFAULT_MIN_ITERATIONS,
+            max_iterations: DEFAULT_MAX_ITERATIONS,
             density_error_tolerance: R::of_f64(0.001),
             relaxation: R::of_f64(0.5),
             viscosity: R::zero(),
@@ -376,7 +379,7 @@ impl<R: Real> IisphParams<R> {
             return Err(invalid(
                 "upscaling_factor",
                 0.0,
-                "must be >= 1 passive point per particle (or None for no upscaling)",
+                "must be >= 1 passive point per particle (none given = no upscaling)",
             ));
         }
         if self.upscaling_factor.is_some_and(|k| k > 4096) {
@@ -419,8 +422,8 @@ mod tests {
         }
     }
 
-    /// The slope each match holds: `atan(sin θ)` = 18.9°, 26.6°, 32.7° (plane strain, as
-    /// issue 19 computes) and `θ` (simple shear).
+    /// The slope each match holds: `atan(sin θ)` = 18.9°, 26.6°, 32.7° (plane strain)
+    /// and `θ` (simple shear).
     #[test]
     fn predicted_repose_angles() {
         let ps: Vec<f64> = [20.0, 30.0, 40.0]

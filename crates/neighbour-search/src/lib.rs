@@ -77,6 +77,7 @@ mod csr;
 mod error;
 mod grid;
 mod lists;
+pub mod point_sets;
 mod radix;
 mod relation_table;
 mod reorder;

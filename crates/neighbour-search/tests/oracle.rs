@@ -11,11 +11,13 @@
 //! 4. `<=` instead of `<` in the distance test (`scan.rs`: scalar, AVX2 and AVX-512 paths),
 //!    i.e. a particle at exactly `h` counted as a neighbour.
 
+use neighbour_search::point_sets::{self, to_real as to_r};
 use neighbour_search::{
     BruteForce, CellStartGrid, HashedGrid, Method, NeighbourLists, NeighbourSearch, Real,
     RelationTable, SearchError, Vec3, CELL_MARGIN,
 };
 use proptest::prelude::*;
+use sph_core::random::SplitMix64;
 
 fn oracle<R: Real>(points: &[Vec3<R>], h: R) -> Result<Vec<Vec<u32>>, SearchError> {
     let mut out = NeighbourLists::new();
@@ -71,10 +73,25 @@ fn check_all<R: Real>(points: &[Vec3<R>], h: R) -> Result<(), TestCaseError> {
     Ok(())
 }
 
-fn to_r<R: Real>(p: &[[f64; 3]]) -> Vec<Vec3<R>> {
-    p.iter()
-        .map(|a| Vec3::new(R::of_f64(a[0]), R::of_f64(a[1]), R::of_f64(a[2])))
-        .collect()
+/// The fixed point sets of `point_sets` (lattice ties, far clusters, negative coordinates,
+/// points on cell faces), small, in both precisions: every method agrees with the oracle.
+#[test]
+fn fixed_point_sets_match_the_oracle() {
+    let n = 1000;
+    let mut rng = SplitMix64::new(0x5eed);
+    let sets = [
+        point_sets::lattice_block(n, 0.025),
+        point_sets::random_cloud(&mut rng, n),
+        point_sets::two_clusters(&mut rng, n),
+        point_sets::negative_coordinates(&mut rng, n),
+        point_sets::cell_faces(&mut rng, n),
+    ];
+    for set in &sets {
+        check_all::<f64>(&to_r(&set.points), set.radius)
+            .unwrap_or_else(|e| panic!("{}: {e}", set.name));
+        check_all::<f32>(&to_r(&set.points), set.radius as f32)
+            .unwrap_or_else(|e| panic!("{}: {e}", set.name));
+    }
 }
 
 fn cloud(max: usize, half: f64) -> impl Strategy<Value = Vec<[f64; 3]>> {

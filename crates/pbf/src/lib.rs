@@ -192,6 +192,7 @@ mod params;
 mod passes;
 mod scorr;
 mod scratch;
+mod settings;
 mod solver;
 
 pub use kernels::PBF_KERNEL;
@@ -200,6 +201,7 @@ pub use params::{
 };
 pub use scorr::ArtificialPressure;
 pub use scratch::PbfScratch;
+pub use settings::PbfSettings;
 pub use solver::{ConstraintEval, Pbf, PbfScheme, PBF_PHASES};
 
 pub use neighbour_search::Method;

@@ -205,7 +205,7 @@ impl<R: Real> PbfParams<R> {
                 return Err(invalid(
                     "mean_compression_tolerance",
                     tol.as_f64(),
-                    "must be finite and > 0 (or None for a fixed iteration count)",
+                    "must be finite and > 0 (none given = a fixed iteration count)",
                 ));
             }
             if self.min_solver_iterations == 0

@@ -184,10 +184,12 @@
 mod kernels;
 mod params;
 mod scratch;
+mod settings;
 mod solver;
 
 pub use kernels::PCISPH_KERNEL;
 pub use params::{PcisphParams, DEFAULT_PCISPH_XSPH, MAX_PRESSURE_ITERATIONS};
+pub use settings::PcisphSettings;
 pub use solver::{Pcisph, PcisphScheme, PCISPH_PHASES};
 
 pub use sph_core::{sampling::cubic_lattice, Aabb, BoxSdf, Inverted, Plane, Sphere};

@@ -153,7 +153,7 @@ impl<R: Real> PcisphParams<R> {
                 return Err(invalid(
                     "density_error_tolerance",
                     t.as_f64(),
-                    "must be finite and > 0 (or None for no early stop)",
+                    "must be finite and > 0 (none given = no early stop)",
                 ));
             }
         }

@@ -17,6 +17,7 @@
 //! - [`SampledGrid`], a scalar field sampled on a regular grid with trilinear interpolation
 //!   (module [`grid`]),
 //! - [`TriangleMesh`] and its sampled signed distance [`GridSdf`] (module [`mesh`]),
+//! - [`random::SplitMix64`], a small seeded generator for reproducible point sets,
 //! - [`CoreError`], the crate's error enum.
 
 mod aabb;
@@ -25,6 +26,7 @@ pub mod grid;
 pub mod input;
 pub mod mesh;
 mod particles;
+pub mod random;
 mod real;
 pub mod sampling;
 mod sdf;

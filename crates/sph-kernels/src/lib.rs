@@ -112,6 +112,7 @@ pub use sph_core::{Real, Vec3};
 mod any;
 mod cubic;
 mod muller;
+pub mod quadrature;
 mod scale;
 mod wendland;
 

@@ -15,6 +15,7 @@ use std::f64::consts::PI;
 use nalgebra::SVector;
 use proptest::collection::vec;
 use proptest::test_runner::{Config, TestCaseError, TestRunner};
+use sph_kernels::quadrature::gauss_legendre;
 use sph_kernels::{
     CubicSpline, CubicSpline2D, Kernel, KernelError, Poly6, Real, Spiky, ViscosityKernel,
     WendlandC2, WendlandC2Planar,
@@ -26,32 +27,6 @@ const C_EVAL: f64 = 16.0;
 // ---------------------------------------------------------------------------------------------
 // Quadrature
 // ---------------------------------------------------------------------------------------------
-
-/// Gauss–Legendre nodes and weights on `[-1, 1]` (Newton on `P_n`, to machine precision).
-fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
-    (0..n)
-        .map(|i| {
-            let mut x = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-            let mut dp = 0.0;
-            for _ in 0..100 {
-                let (mut p0, mut p1) = (1.0, x);
-                for k in 2..=n {
-                    let k = k as f64;
-                    let p2 = ((2.0 * k - 1.0) * x * p1 - (k - 1.0) * p0) / k;
-                    p0 = p1;
-                    p1 = p2;
-                }
-                dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
-                let dx = p1 / dp;
-                x -= dx;
-                if dx.abs() < 1e-16 {
-                    break;
-                }
-            }
-            (x, 2.0 / ((1.0 - x * x) * dp * dp))
-        })
-        .collect()
-}
 
 /// `∫_a^b f` with `panels` equal panels of the Gauss–Legendre rule `gl`.
 fn integrate(gl: &[(f64, f64)], a: f64, b: f64, panels: usize, f: impl Fn(f64) -> f64) -> f64 {

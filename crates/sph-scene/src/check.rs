@@ -1,14 +1,14 @@
 //! The value checks of a scene, on its typed fields ([`Scene::check`]): the same whether the
 //! scene was just read from a file or edited in code. One function per section, in the
 //! order of the file documentation, then the time stepping (`check/time_step.rs`), the
-//! particles (`build.rs`), the solver's own parameter checks in the scene's precision
-//! (`params.rs`) and the `[render]` table (`render.rs`); the scene with its `[quick]`
-//! overrides is checked too, so that [`Scene::quick`] gives a valid scene.
+//! particles (`build.rs`), the solver's settings (`params.rs`: the checks of the settings as
+//! written, then the parameters' own `validate`, the one range check of every solver
+//! setting) and the `[render]` table (`render.rs`); the scene with its `[quick]` overrides
+//! is checked too, so that [`Scene::quick`] gives a valid scene.
 
 // NaN-rejecting checks are written as `!(x > 0.0)` on purpose.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-mod solver;
 mod time_step;
 
 use sph_core::Aabb;
@@ -16,7 +16,7 @@ use sph_core::Aabb;
 use crate::error::Ctx;
 use crate::geom::{fmt3, v3, AXES};
 use crate::mesh_io::placement_field;
-use crate::{FluidSpec, QuickSpec, Scene, SceneError, SolidSpec, DEFAULT_IISPH_MIN_ITERATIONS};
+use crate::{FluidSpec, QuickSpec, Scene, SceneError, SolidSpec};
 
 impl Scene {
     /// Checks every value of the scene, as [`Scene::load`] does: after editing a loaded
@@ -29,7 +29,6 @@ impl Scene {
             lines: Some(&self.lines),
             ..Ctx::new(&self.source)
         };
-        solver::check(&ctx, &self.solver)?;
         self.check_sections(&ctx)?;
         time_step::check(&ctx, self, None)?;
         self.validate_particles(&ctx)?;
@@ -94,13 +93,8 @@ impl Scene {
                 return Err(ctx.invalid(format!("quick.{name}"), "must be >= 1, got 0"));
             }
         }
-        let min_iterations = match (&self.solver, self.solver.iisph()) {
-            (crate::SolverSpec::Pbf(p), _) => p.min_iterations,
-            (_, Some(i)) => Some(i.min_iterations.unwrap_or(DEFAULT_IISPH_MIN_ITERATIONS)),
-            _ => None,
-        };
         if let Some(k) = q.iterations {
-            if let Some(min) = min_iterations.filter(|&min| k < min) {
+            if let Some(min) = self.solver.min_iterations().filter(|&min| k < min) {
                 return Err(ctx.invalid(
                     "quick.iterations",
                     format!("must be >= solver.min_iterations = {min}, got {k}"),

@@ -39,7 +39,7 @@
 //! [solver]
 //! kind = "pbf"
 //! substeps = 2
-//! iterations = 3
+//! solver_iterations = 3
 //! [tank]
 //! min = [0.0, 0.0, 0.0]
 //! max = [1.0, 0.6, 0.3]
@@ -95,18 +95,21 @@
 //! frame_dt = 0.016                 # s, one output/solver frame
 //! gravity = [0.0, -9.81, 0.0]      # m/s² (default [0, -9.81, 0])
 //!
-//! [solver]                         # one table per solver, selected by `kind`; the fields of
-//!                                  # another solver are refused (unknown field)
+//! [solver]                         # one table per solver, selected by `kind` (the solver
+//!                                  # crate's settings struct: PbfSettings, PcisphSettings,
+//!                                  # WaterSettings, GranularSettings); each key is the name
+//!                                  # of the parameter it sets; the keys of another solver
+//!                                  # are refused (unknown field)
 //! kind = "pbf"                     # "pbf" | "pcisph" | "iisph" | "granular"
 //! substeps = 4                     # solver steps per frame (>= 1)
-//! iterations = 3                   # PBF: constraint iterations per step; PCISPH: max
-//!                                  # pressure iterations per step (>= 1)
-//! # Optional overrides (the solver's defaults otherwise), both solvers:
+//! solver_iterations = 3            # PBF: constraint iterations per step (>= 1; formerly
+//!                                  # `iterations`, still accepted)
+//! # Optional overrides (the solver's defaults otherwise), every solver:
 //! # rest_density = 1000.0          # kg/m³ (> 0)
 //! # support_over_spacing = 2.0     # h / particle_spacing (> 1)
-//! # xsph_c = 0.01                  # XSPH viscosity c, in [0, 1]
 //! # reorder_every = 10             # frames between particle reorderings (0 = never)
 //! # kind = "pbf" only:
+//! # xsph_c = 0.01                  # XSPH viscosity c, in [0, 1]
 //! # relative_cfm = 1.0             # CFM ε relative to the full-lattice denominator (> 0)
 //! # scorr_k = 0.1                  # artificial pressure k (>= 0)
 //! # scorr_n = 4                    # artificial pressure exponent (>= 1)
@@ -114,14 +117,18 @@
 //! # vorticity_epsilon = 0.0        # vorticity confinement ε, m/s (>= 0)
 //! # clamp_negative_constraint = false # unilateral C = max(ρ/ρ0 − 1, 0)
 //! # mean_compression_tolerance = 0.001 # stop iterating at this mean compression (> 0);
-//! #                                # `iterations` is then the maximum
-//! # min_iterations = 2             # with mean_compression_tolerance (>= 1, <= iterations)
-//! # kind = "pcisph" only:
+//! #                                # `solver_iterations` is then the maximum
+//! # min_solver_iterations = 2      # with mean_compression_tolerance (>= 1,
+//! #                                # <= solver_iterations; formerly `min_iterations`)
+//! # kind = "pcisph":
+//! # pressure_iterations = 4        # max pressure iterations per step (>= 1, required;
+//! #                                # formerly `iterations`, still accepted)
+//! # xsph_c = 0.05                  # XSPH viscosity c, in [0, 1]
 //! # clamp_negative_pressure = true
 //! # density_error_tolerance = 0.01 # relative density error to stop at (> 0)
 //! ```
 //!
-//! The IISPH kinds (crate `iisph-granular`) have no `iterations` and no `xsph_c`:
+//! The IISPH kinds (crate `iisph-granular`) have no `solver_iterations` and no `xsph_c`:
 //!
 //! ```toml
 //! [solver]
@@ -170,7 +177,7 @@
 //!
 //! [[fluid]]
 //! kind = "mesh"                    # a closed triangle mesh (OBJ), filled with fluid
-//! path = "../reference-data/meshes/bunny.obj"   # relative to this scene file
+//! path = "meshes/bunny.obj"   # relative to this scene file
 //! scale = 0.05                     # uniform scale applied first (default 1, > 0)
 //! translate = [0.8, 0.4, 0.3]      # m, then this translation (default 0)
 //! # or, instead of scale/translate:
@@ -240,11 +247,15 @@
 //!   least one spacing thick, no fluid particle inside (or on) a solid, at most
 //!   [`MAX_PARTICLES`] particles, mesh files that exist and are closed. The scene with its
 //!   `[quick]` overrides is validated too, so [`Scene::quick`] cannot fail.
-//! * The solver's own checks of the parameters made from the scene (`validate` of
-//!   `PbfParams`, `PcisphParams`, `IisphParams`) run in the scene's precision: a tolerance of
-//!   `1e-300` is `0` in `f32` and refused at its field. A parameter a solver refuses is
-//!   reported at the scene field it comes from (the longest field written in `[solver]` or
-//!   `[simulation]` whose words are all words of the parameter's name), with its line.
+//! * The `[solver]` settings are range-checked once, by the solver's own checks of the
+//!   parameters made from them (`validate` of `PbfParams`, `PcisphParams`, `IisphParams`),
+//!   run on the parameters built in `f64` and again in the scene's precision after the
+//!   conversion: a tolerance of `1e-300` is `0` in `f32` and refused at its field. A
+//!   refused parameter is reported at the scene key it comes from (keys are the parameters'
+//!   names, or the old name the file writes; `support_radius` is set as
+//!   `support_over_spacing`, PBF's `cfm_epsilon` as `relative_cfm`), with its line. Only
+//!   the checks that make sense on the file alone come before (e.g. `min_solver_iterations`
+//!   only applies with `mean_compression_tolerance`).
 //! * The `[render]` table is resolved against the scene (image size, camera, material), so
 //!   that a scene the renderer would refuse is refused when it is loaded.
 //! * Time stepping: at most [`sph_solver::MAX_SUBSTEPS`] substeps per frame and
@@ -263,11 +274,13 @@
 //!
 //! # Modules
 //!
-//! The public types are in `spec.rs` ([`Scene`], [`FluidSpec`], …), `solver_spec.rs`
-//! ([`SolverSpec`] and its settings) and `error.rs` ([`SceneError`]); `raw.rs` holds the
+//! The public types are in `spec.rs` ([`Scene`], [`FluidSpec`], …), `solver_spec.rs` (the
+//! registry of solvers, one line each, and the [`SolverKind`], [`SolverSpec`] and
+//! [`SolverParams`] that follow from it; the settings themselves are the solver crates') and
+//! `error.rs` ([`SceneError`]); `raw.rs` holds the
 //! serde input structs, `parse.rs` the reading from them to a [`Scene`] (`parse/solver.rs`
-//! for `[solver]`), `check.rs` the value checks (`check/solver.rs`, `check/time_step.rs`),
-//! `params.rs` the solver parameters, `render.rs` the renderer's view, `read.rs` the
+//! for `[solver]`), `check.rs` the value checks (`check/time_step.rs`),
+//! `params.rs` the solver parameters (built once in `f64`, converted, checked), `render.rs` the renderer's view, `read.rs` the
 //! size-limited file reading, `mesh_io.rs` OBJ loading and mesh placement, `build.rs`
 //! particle sampling and the solids' signed distance fields, `limits.rs` the bounds. No two
 //! modules import each other.
@@ -293,12 +306,13 @@ pub use error::SceneError;
 pub use limits::{
     MAX_FRAMES, MAX_MESH_FILE_BYTES, MAX_PARTICLES, MAX_SCENE_FILE_BYTES, MAX_SDF_NODES,
 };
-pub use params::SolverParams;
-pub use solver_spec::{
-    GranularSpec, IisphSettings, IisphSpec, PbfSpec, PcisphSpec, SolverCommon, SolverKind,
-    SolverSpec, DEFAULT_IISPH_MAX_ITERATIONS, DEFAULT_IISPH_MIN_ITERATIONS,
-};
+pub use solver_spec::{SolverKind, SolverParams, SolverSpec};
+// The settings of each solver, owned by its crate (the variants of `SolverSpec`).
+pub use iisph_granular::{GranularSettings, IisphSettings, WaterSettings};
+pub use pbf::PbfSettings;
+pub use pcisph::PcisphSettings;
 pub use spec::{
     BoundaryModel, BoundarySpec, FluidSpec, InitialMasses, MeshPlacement, MeshSpec, OutputSpec,
     Precision, QuickSpec, Scene, SolidSpec,
 };
+pub use sph_solver::CommonSettings;

@@ -1,238 +1,249 @@
-//! The `[solver]` table as types: [`SolverSpec`], one variant per solver, each holding the
-//! settings every solver has ([`SolverCommon`], flattened into the table) and its own; the
-//! two IISPH kinds share [`IisphSettings`]. `None` = the solver's default. The values are
-//! range-checked by [`Scene::check`](crate::Scene::check), and turned into the solvers'
-//! parameters by [`Scene::solver_params`](crate::Scene::solver_params).
+//! The solvers a scene can ask for, registered with one line each in [`solvers!`]: the
+//! solver's kind name (the `[solver]` table's `kind`) and its crate's settings struct (a
+//! [`SolverSettings`]). From that line follow [`SolverKind`], [`SolverSpec`] (the `[solver]`
+//! table as types), [`SolverParams`] (the parameters it makes, in precision `R`), the
+//! reading of the table (`parse/solver.rs`), the parameters (`params.rs`) and, through
+//! [`SolverParams::build`], the factory of `sph-sim` and the density kernel.
 
-use iisph_granular::ConeMatch;
 use serde::Deserialize;
+use sph_core::Real;
+use sph_solver::{
+    Boundary, CommonParams, CommonSettings, FluidSolver, KernelKind, SceneValues, SolverError,
+    SolverSettings,
+};
 
-/// Which solver a scene is meant for: the tag (`kind`) of the `[solver]` table, and
-/// [`SolverSpec::kind`]. Kept next to [`SolverSpec`] so that code can name a solver without
-/// its settings (e.g. to run one scene with both solvers, [`SolverSpec::with_kind`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum SolverKind {
-    /// Position Based Fluids (Macklin & Müller 2013).
-    Pbf,
-    /// Predictive-corrective incompressible SPH (Solenthaler & Pajarola 2009).
-    Pcisph,
-    /// Implicit incompressible SPH (Ihmsen et al. 2014), water.
-    Iisph,
-    /// IISPH with Drucker–Prager friction, drag and upscaling for granular matter (Neder
-    /// 2024).
-    Granular,
-}
-
-impl SolverKind {
-    /// The name used in scene files: `"pbf"`, `"pcisph"`, `"iisph"` or `"granular"`.
-    pub fn name(self) -> &'static str {
-        match self {
-            SolverKind::Pbf => "pbf",
-            SolverKind::Pcisph => "pcisph",
-            SolverKind::Iisph => "iisph",
-            SolverKind::Granular => "granular",
+/// Defines the solver enums from one line per solver:
+/// `Variant = "kind", settings::Type [flattened parts read first for their errors' lines];`.
+macro_rules! solvers {
+    ($(
+        $(#[$doc:meta])*
+        $Kind:ident = $name:literal, $Settings:ty [$($Part:ty),*];
+    )+) => {
+        /// Which solver a scene is meant for: the tag (`kind`) of the `[solver]` table, and
+        /// [`SolverSpec::kind`]. Code can name a solver without its settings with it (e.g.
+        /// to run one scene with two solvers, [`SolverSpec::with_kind`]).
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+        pub enum SolverKind {
+            $( $(#[$doc])* #[serde(rename = $name)] $Kind, )+
         }
-    }
+
+        impl SolverKind {
+            /// Every solver, in registration order.
+            pub const ALL: &'static [SolverKind] = &[$(SolverKind::$Kind),+];
+
+            /// The name used in scene files (`kind = "…"`).
+            pub fn name(self) -> &'static str {
+                match self {
+                    $( SolverKind::$Kind => $name, )+
+                }
+            }
+
+            /// The density kernel of the solver.
+            pub fn density_kernel(self) -> KernelKind {
+                match self {
+                    $( SolverKind::$Kind => <$Settings as SolverSettings>::DENSITY_KERNEL, )+
+                }
+            }
+
+            /// The keys renamed to their parameter's name: `(old key, key)`; a scene may
+            /// write either.
+            pub fn renamed(self) -> &'static [(&'static str, &'static str)] {
+                match self {
+                    $( SolverKind::$Kind => <$Settings as SolverSettings>::RENAMED, )+
+                }
+            }
+        }
+
+        /// Solver settings: the `[solver]` table, one variant per solver (its crate's
+        /// settings struct), selected by `kind`; a key of another solver is refused (unknown
+        /// field).
+        ///
+        /// Deserializes as an internally tagged table (`kind = "pbf"` + the settings). The
+        /// scene parser reads `kind` first and then the settings from the same table, so
+        /// that its errors keep the field path and line (see `parse/solver.rs`); both accept
+        /// the same tables.
+        #[derive(Debug, Clone, PartialEq, Deserialize)]
+        #[serde(tag = "kind")]
+        pub enum SolverSpec {
+            $( $(#[$doc])* #[serde(rename = $name)] $Kind($Settings), )+
+        }
+
+        impl SolverSpec {
+            /// Which solver.
+            pub fn kind(&self) -> SolverKind {
+                match self {
+                    $( SolverSpec::$Kind(_) => SolverKind::$Kind, )+
+                }
+            }
+
+            /// Settings for solver `kind` with `common`, every other setting the solver's
+            /// default (`iterations` for a solver whose table requires a count).
+            fn with_common(kind: SolverKind, common: CommonSettings, iterations: usize) -> Self {
+                match kind {
+                    $( SolverKind::$Kind => SolverSpec::$Kind(
+                        <$Settings as SolverSettings>::with_common(common, iterations)
+                    ), )+
+                }
+            }
+
+            /// The settings every solver has.
+            pub fn common(&self) -> &CommonSettings {
+                match self {
+                    $( SolverSpec::$Kind(s) => s.common(), )+
+                }
+            }
+
+            /// The settings every solver has, to edit (check the scene again after, with
+            /// [`Scene::check`](crate::Scene::check)).
+            pub fn common_mut(&mut self) -> &mut CommonSettings {
+                match self {
+                    $( SolverSpec::$Kind(s) => s.common_mut(), )+
+                }
+            }
+
+            /// The iterations per step (PBF: `solver_iterations`; PCISPH:
+            /// `pressure_iterations`; the IISPH kinds: `max_iterations` or its default).
+            pub fn iterations(&self) -> usize {
+                match self {
+                    $( SolverSpec::$Kind(s) => s.iterations(), )+
+                }
+            }
+
+            /// Sets the iterations per step ([`SolverSpec::iterations`]); not range-checked
+            /// ([`Scene::check`](crate::Scene::check) does).
+            pub fn set_iterations(&mut self, n: usize) {
+                match self {
+                    $( SolverSpec::$Kind(s) => s.set_iterations(n), )+
+                }
+            }
+
+            /// The fewest iterations per step the settings give, if the solver has such a
+            /// bound.
+            pub fn min_iterations(&self) -> Option<usize> {
+                match self {
+                    $( SolverSpec::$Kind(s) => s.min_iterations(), )+
+                }
+            }
+
+            /// The parameters in `f64` (not validated).
+            pub(crate) fn params(&self, scene: &SceneValues) -> SolverParams<f64> {
+                match self {
+                    $( SolverSpec::$Kind(s) => SolverParams::$Kind(s.params(scene)), )+
+                }
+            }
+
+            /// The checks of the settings as written ([`SolverSettings::check_written`]).
+            pub(crate) fn check_written(
+                &self,
+                key: &dyn Fn(&'static str) -> String,
+            ) -> Result<(), (&'static str, String)> {
+                match self {
+                    $( SolverSpec::$Kind(s) => s.check_written(key), )+
+                }
+            }
+
+            /// Reads the settings of `kind` with `read` (the variant, then its flattened
+            /// parts first, [`SettingsReader`]).
+            pub(crate) fn read<E>(
+                kind: SolverKind,
+                read: &mut impl SettingsReader<E>,
+            ) -> Result<SolverSpec, E> {
+                read.part::<CommonSettings>()?;
+                Ok(match kind {
+                    $( SolverKind::$Kind => {
+                        $( read.part::<$Part>()?; )*
+                        SolverSpec::$Kind(read.settings::<$Settings>()?)
+                    } )+
+                })
+            }
+        }
+
+        /// The parameters of the solver a scene asks for, in precision `R`: one variant per
+        /// solver kind, holding its crate's parameters.
+        #[derive(Debug, Clone, PartialEq)]
+        pub enum SolverParams<R: Real> {
+            $( $(#[$doc])* $Kind(<$Settings as SolverSettings>::Params<R>), )+
+        }
+
+        impl<R: Real> SolverParams<R> {
+            /// Which solver.
+            pub fn kind(&self) -> SolverKind {
+                match self {
+                    $( SolverParams::$Kind(_) => SolverKind::$Kind, )+
+                }
+            }
+
+            /// The parameters every solver has.
+            pub fn common(&self) -> &CommonParams<R> {
+                match self {
+                    $( SolverParams::$Kind(p) => <$Settings as SolverSettings>::common_params(p), )+
+                }
+            }
+
+            /// The solver's own range checks (its parameters' `validate`).
+            pub fn validate(&self) -> Result<(), SolverError> {
+                match self {
+                    $( SolverParams::$Kind(p) => <$Settings as SolverSettings>::validate(p), )+
+                }
+            }
+
+            /// The solver with these parameters and `boundary` (its constructor checks the
+            /// parameters and that the boundary fits them): the workspace's one factory.
+            pub fn build(
+                self,
+                boundary: Box<dyn Boundary<R>>,
+            ) -> Result<Box<dyn FluidSolver<R>>, SolverError> {
+                match self {
+                    $( SolverParams::$Kind(p) => <$Settings as SolverSettings>::build(p, boundary), )+
+                }
+            }
+        }
+
+        impl SolverParams<f64> {
+            /// The parameters in precision `S` (each solver's `try_convert`: an error names a
+            /// value that does not fit).
+            pub fn try_convert<S: Real>(&self) -> Result<SolverParams<S>, SolverError> {
+                Ok(match self {
+                    $( SolverParams::$Kind(p) => SolverParams::$Kind(<$Settings as SolverSettings>::convert(p)?), )+
+                })
+            }
+
+            /// The key of a refused parameter `name` (value `value`) that is not itself a key,
+            /// with the value as that key states it ([`SolverSettings::key_of`]).
+            pub(crate) fn key_of(&self, name: &str, value: f64) -> Option<(&'static str, f64)> {
+                match self {
+                    $( SolverParams::$Kind(p) => <$Settings as SolverSettings>::key_of(p, name, value), )+
+                }
+            }
+        }
+    };
 }
 
-/// Solver settings: the `[solver]` table, one variant per solver, selected by `kind`; a
-/// field of another solver is refused (unknown field). Units as in the crate documentation.
-///
-/// Deserializes as an internally tagged table (`kind = "pbf"` + the [`PbfSpec`] fields). The
-/// scene parser reads `kind` first and then the variant from the same table, so that its
-/// errors keep the field path and line (see `parse/solver.rs`); both accept the same tables.
-///
-/// Not `#[non_exhaustive]`: the workspace's matches on it should break when a solver is
-/// added.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(tag = "kind", rename_all = "lowercase")]
-pub enum SolverSpec {
-    /// Position Based Fluids (`kind = "pbf"`).
-    Pbf(PbfSpec),
-    /// PCISPH (`kind = "pcisph"`).
-    Pcisph(PcisphSpec),
-    /// IISPH for water (`kind = "iisph"`).
-    Iisph(IisphSpec),
-    /// IISPH for granular matter (`kind = "granular"`).
-    Granular(GranularSpec),
+/// Reads a solver's settings from a `[solver]` table (`parse/solver.rs`).
+pub(crate) trait SettingsReader<E> {
+    /// Reads a flattened part on its own (other keys ignored), for its errors only.
+    fn part<T: serde::de::DeserializeOwned>(&mut self) -> Result<(), E>;
+    /// Reads the whole settings.
+    fn settings<T: serde::de::DeserializeOwned>(&mut self) -> Result<T, E>;
 }
 
-/// The settings every solver has (flattened into each variant's table).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-pub struct SolverCommon {
-    /// Solver steps per frame (≥ 1).
-    pub substeps: usize,
-    /// Rest density (kg/m³, > 0).
-    pub rest_density: Option<f64>,
-    /// Support radius over particle spacing (> 1).
-    pub support_over_spacing: Option<f64>,
-    /// Reorder particles every this many frames (0 = never).
-    pub reorder_every: Option<usize>,
+solvers! {
+    /// Position Based Fluids (Macklin & Müller 2013), crate `pbf`.
+    Pbf = "pbf", pbf::PbfSettings [];
+    /// Predictive-corrective incompressible SPH (Solenthaler & Pajarola 2009), crate
+    /// `pcisph`.
+    Pcisph = "pcisph", pcisph::PcisphSettings [];
+    /// Implicit incompressible SPH (Ihmsen et al. 2014) for water, crate `iisph-granular`.
+    Iisph = "iisph", iisph_granular::WaterSettings [iisph_granular::IisphSettings];
+    /// IISPH with Drucker–Prager friction, drag and upscaling for granular matter (Neder
+    /// 2024), crate `iisph-granular`.
+    Granular = "granular", iisph_granular::GranularSettings [iisph_granular::IisphSettings];
 }
-
-/// PBF settings (`[solver] kind = "pbf"`).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PbfSpec {
-    /// The settings every solver has.
-    #[serde(flatten)]
-    pub common: SolverCommon,
-    /// Constraint (Jacobi) iterations per step (≥ 1); the maximum with
-    /// `mean_compression_tolerance`.
-    pub iterations: usize,
-    /// CFM relaxation relative to the full-lattice denominator (> 0).
-    pub relative_cfm: Option<f64>,
-    /// Artificial pressure strength `k` (≥ 0).
-    pub scorr_k: Option<f64>,
-    /// Artificial pressure exponent `n` (≥ 1).
-    pub scorr_n: Option<u32>,
-    /// Artificial pressure `|Δq|` as a fraction of `h`, in (0, 1).
-    pub scorr_delta_q: Option<f64>,
-    /// Vorticity confinement `ε` (m/s, ≥ 0).
-    pub vorticity_epsilon: Option<f64>,
-    /// XSPH viscosity `c`, in [0, 1].
-    pub xsph_c: Option<f64>,
-    /// Unilateral density constraint `max(ρ/ρ0 − 1, 0)`.
-    pub clamp_negative_constraint: Option<bool>,
-    /// Mean compression at which the Jacobi iterations stop (> 0; `iterations` is then the
-    /// maximum).
-    pub mean_compression_tolerance: Option<f64>,
-    /// Fewest iterations per step with `mean_compression_tolerance` (≥ 1, ≤ `iterations`).
-    pub min_iterations: Option<usize>,
-}
-
-/// PCISPH settings (`[solver] kind = "pcisph"`).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PcisphSpec {
-    /// The settings every solver has.
-    #[serde(flatten)]
-    pub common: SolverCommon,
-    /// Maximum pressure iterations per step (≥ 1).
-    pub iterations: usize,
-    /// XSPH viscosity `c`, in [0, 1].
-    pub xsph_c: Option<f64>,
-    /// Clamp negative pressures to zero.
-    pub clamp_negative_pressure: Option<bool>,
-    /// Relative density error at which the pressure iteration stops (> 0).
-    pub density_error_tolerance: Option<f64>,
-}
-
-/// The settings both IISPH kinds have, besides [`SolverCommon`] (flattened into their
-/// tables); see the `iisph-granular` crate.
-#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
-pub struct IisphSettings {
-    /// Most relaxed-Jacobi iterations per step (≥ `min_iterations`; default
-    /// [`DEFAULT_IISPH_MAX_ITERATIONS`]).
-    pub max_iterations: Option<usize>,
-    /// Fewest iterations per step (≥ 1; default [`DEFAULT_IISPH_MIN_ITERATIONS`]).
-    pub min_iterations: Option<usize>,
-    /// Average relative density error at which the iterations stop (> 0; default 0.001).
-    pub density_error_tolerance: Option<f64>,
-    /// Jacobi relaxation `ω`, in (0, 1] (default 0.5).
-    pub relaxation: Option<f64>,
-    /// Kinematic viscosity `ν` (m²/s, ≥ 0; default 0) of the explicit SPH viscosity force.
-    pub viscosity: Option<f64>,
-}
-
-/// IISPH settings for water (`[solver] kind = "iisph"`).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct IisphSpec {
-    /// The settings every solver has.
-    #[serde(flatten)]
-    pub common: SolverCommon,
-    /// The IISPH settings.
-    #[serde(flatten)]
-    pub iisph: IisphSettings,
-}
-
-/// IISPH settings for granular matter (`[solver] kind = "granular"`): those of
-/// [`IisphSpec`] plus friction, drag and upscaling.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct GranularSpec {
-    /// The settings every solver has.
-    #[serde(flatten)]
-    pub common: SolverCommon,
-    /// The IISPH settings.
-    #[serde(flatten)]
-    pub iisph: IisphSettings,
-    /// Friction angle `θ` (degrees, in [0, 90); required): Drucker–Prager `α = √2 sin θ`
-    /// or `√2 tan θ`, by `cone_match`.
-    pub friction_angle_deg: f64,
-    /// How the yield cone is matched to `θ`: `"plane-strain"` (`α = √2 sin θ`, the thesis's
-    /// eq. 14; the default) or `"simple-shear"` (`α = √2 tan θ`: `θ` is then the angle of
-    /// repose). See [`ConeMatch`].
-    pub cone_match: Option<ConeMatch>,
-    /// Drag coefficient `C_D` (≥ 0; default 0 = no drag).
-    pub drag_coefficient: Option<f64>,
-    /// Uniform air velocity (m/s; default 0).
-    pub air_velocity: Option<[f64; 3]>,
-    /// Passive high-resolution points per simulation particle (≥ 1; absent = no upscaling).
-    pub upscaling_factor: Option<usize>,
-    /// Most friction-stress iterations per step (≥ 1; default 20).
-    pub friction_max_iterations: Option<usize>,
-    /// Mean unyielded strain per step at which the friction iterations stop (> 0; default
-    /// 1e-4).
-    pub friction_tolerance: Option<f64>,
-    /// Relaxation `ω` of the friction-stress update, relative to the exact self-coupling
-    /// (in (0, 1]; default 0.35, the update's stability bound on the prototype lattice; the
-    /// thesis's eq. 9 implies ½, which lies outside it: see the `iisph-granular` docs).
-    pub friction_relaxation: Option<f64>,
-}
-
-/// Default `max_iterations` of the IISPH kinds (SPlisHSPlasH's default cap).
-pub const DEFAULT_IISPH_MAX_ITERATIONS: usize = 100;
-
-/// Default `min_iterations` of the IISPH kinds (Ihmsen et al. 2014: at least two).
-pub const DEFAULT_IISPH_MIN_ITERATIONS: usize = 2;
 
 impl SolverSpec {
-    /// Which solver.
-    pub fn kind(&self) -> SolverKind {
-        match self {
-            SolverSpec::Pbf(_) => SolverKind::Pbf,
-            SolverSpec::Pcisph(_) => SolverKind::Pcisph,
-            SolverSpec::Iisph(_) => SolverKind::Iisph,
-            SolverSpec::Granular(_) => SolverKind::Granular,
-        }
-    }
-
     /// The solver's name in scene files (`"pbf"`, …).
     pub fn kind_name(&self) -> &'static str {
         self.kind().name()
-    }
-
-    /// The settings every solver has.
-    pub fn common(&self) -> &SolverCommon {
-        match self {
-            SolverSpec::Pbf(s) => &s.common,
-            SolverSpec::Pcisph(s) => &s.common,
-            SolverSpec::Iisph(s) => &s.common,
-            SolverSpec::Granular(s) => &s.common,
-        }
-    }
-
-    /// The settings every solver has, to edit (check the scene again after, with
-    /// [`Scene::check`](crate::Scene::check)).
-    pub fn common_mut(&mut self) -> &mut SolverCommon {
-        match self {
-            SolverSpec::Pbf(s) => &mut s.common,
-            SolverSpec::Pcisph(s) => &mut s.common,
-            SolverSpec::Iisph(s) => &mut s.common,
-            SolverSpec::Granular(s) => &mut s.common,
-        }
-    }
-
-    /// The IISPH settings of the two IISPH kinds.
-    pub fn iisph(&self) -> Option<&IisphSettings> {
-        match self {
-            SolverSpec::Iisph(s) => Some(&s.iisph),
-            SolverSpec::Granular(s) => Some(&s.iisph),
-            _ => None,
-        }
     }
 
     /// Solver steps per frame.
@@ -240,80 +251,29 @@ impl SolverSpec {
         self.common().substeps
     }
 
-    /// PBF: constraint iterations per step; PCISPH: maximum pressure iterations per step;
-    /// IISPH and granular: `max_iterations` (default [`DEFAULT_IISPH_MAX_ITERATIONS`]).
-    pub fn iterations(&self) -> usize {
-        match self {
-            SolverSpec::Pbf(s) => s.iterations,
-            SolverSpec::Pcisph(s) => s.iterations,
-            SolverSpec::Iisph(IisphSpec { iisph, .. })
-            | SolverSpec::Granular(GranularSpec { iisph, .. }) => {
-                iisph.max_iterations.unwrap_or(DEFAULT_IISPH_MAX_ITERATIONS)
-            }
-        }
-    }
-
-    /// Sets the iterations per step (`iterations`, or `max_iterations` of the IISPH kinds);
-    /// not range-checked ([`Scene::check`](crate::Scene::check) does).
-    pub fn set_iterations(&mut self, n: usize) {
-        match self {
-            SolverSpec::Pbf(s) => s.iterations = n,
-            SolverSpec::Pcisph(s) => s.iterations = n,
-            SolverSpec::Iisph(IisphSpec { iisph, .. })
-            | SolverSpec::Granular(GranularSpec { iisph, .. }) => iisph.max_iterations = Some(n),
-        }
+    /// The density kernel of the solver.
+    pub fn density_kernel(&self) -> KernelKind {
+        self.kind().density_kernel()
     }
 
     /// These settings for solver `kind`: a copy when `kind` is this solver's; otherwise the
-    /// settings every solver has ([`SolverCommon`]) carried over, with the iteration count and
-    /// XSPH `c` between PBF and PCISPH and the [`IisphSettings`] between `iisph` and
-    /// `granular`, and the rest left to the other solver's defaults (a `granular` made from
-    /// another kind gets `friction_angle_deg = 0`, i.e. no friction).
+    /// settings every solver has ([`CommonSettings`]) and the iteration count carried over
+    /// (to a solver whose table requires one: PBF, PCISPH), with XSPH `c` between PBF and
+    /// PCISPH and the [`iisph_granular::IisphSettings`] between `iisph` and `granular`, and
+    /// the rest left to the other solver's defaults (a `granular` made from another kind
+    /// gets `friction_angle_deg = 0`, i.e. no friction).
     pub fn with_kind(&self, kind: SolverKind) -> SolverSpec {
         if self.kind() == kind {
             return self.clone();
         }
-        let common = self.common().clone();
-        let xsph_c = match self {
-            SolverSpec::Pbf(s) => s.xsph_c,
-            SolverSpec::Pcisph(s) => s.xsph_c,
-            _ => None,
-        };
-        let iisph = self.iisph().cloned().unwrap_or_default();
-        match kind {
-            SolverKind::Pbf => SolverSpec::Pbf(PbfSpec {
-                common,
-                iterations: self.iterations(),
-                relative_cfm: None,
-                scorr_k: None,
-                scorr_n: None,
-                scorr_delta_q: None,
-                vorticity_epsilon: None,
-                xsph_c,
-                clamp_negative_constraint: None,
-                mean_compression_tolerance: None,
-                min_iterations: None,
-            }),
-            SolverKind::Pcisph => SolverSpec::Pcisph(PcisphSpec {
-                common,
-                iterations: self.iterations(),
-                xsph_c,
-                clamp_negative_pressure: None,
-                density_error_tolerance: None,
-            }),
-            SolverKind::Iisph => SolverSpec::Iisph(IisphSpec { common, iisph }),
-            SolverKind::Granular => SolverSpec::Granular(GranularSpec {
-                common,
-                iisph,
-                friction_angle_deg: 0.0,
-                cone_match: None,
-                drag_coefficient: None,
-                air_velocity: None,
-                upscaling_factor: None,
-                friction_max_iterations: None,
-                friction_tolerance: None,
-                friction_relaxation: None,
-            }),
+        let mut to = SolverSpec::with_common(kind, self.common().clone(), self.iterations());
+        match (self, &mut to) {
+            (SolverSpec::Pbf(a), SolverSpec::Pcisph(b)) => b.xsph_c = a.xsph_c,
+            (SolverSpec::Pcisph(a), SolverSpec::Pbf(b)) => b.xsph_c = a.xsph_c,
+            (SolverSpec::Iisph(a), SolverSpec::Granular(b)) => b.iisph = a.iisph.clone(),
+            (SolverSpec::Granular(a), SolverSpec::Iisph(b)) => b.iisph = a.iisph.clone(),
+            _ => {}
         }
+        to
     }
 }

@@ -5,7 +5,8 @@
 mod common;
 
 use common::{assert_names, err_with, fixture_dir};
-use sph_scene::{Scene, SolverKind, SolverSpec, DEFAULT_IISPH_MAX_ITERATIONS};
+use iisph_granular::DEFAULT_MAX_ITERATIONS;
+use sph_scene::{Scene, SolverKind, SolverSpec};
 
 /// The `[solver]` table of the fixture (`kind = "pbf"` … `xsph_c = 0.01`, lines 12–15).
 const PBF_SOLVER: &str = "kind = \"pbf\"\nsubsteps = 2\niterations = 3\nxsph_c = 0.01";
@@ -24,7 +25,7 @@ fn iisph_scene_reads_with_defaults() {
     };
     assert_eq!(p.common.substeps, 8);
     assert_eq!(p.iisph.max_iterations, None);
-    assert_eq!(s.solver.iterations(), DEFAULT_IISPH_MAX_ITERATIONS);
+    assert_eq!(s.solver.iterations(), DEFAULT_MAX_ITERATIONS);
 }
 
 #[test]
@@ -198,8 +199,8 @@ fn granular_cone_match() {
         )
     };
     let alpha = |s: &Scene| {
-        let SolverParams::Iisph(p) = s.solver_params::<f64>().unwrap() else {
-            panic!("not IISPH")
+        let SolverParams::Granular(p) = s.solver_params::<f64>().unwrap() else {
+            panic!("not granular")
         };
         p.granular.unwrap().alpha()
     };

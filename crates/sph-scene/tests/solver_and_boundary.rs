@@ -31,7 +31,7 @@ fn pbf_fixture_reads_into_the_pbf_variant() {
         panic!("{:?}", s.solver)
     };
     assert_eq!(
-        (p.common.substeps, p.iterations, p.xsph_c),
+        (p.common.substeps, p.solver_iterations, p.xsph_c),
         (2, 3, Some(0.01))
     );
     assert_eq!(p.scorr_k, None);
@@ -187,7 +187,7 @@ fn solver_spec_deserializes_as_an_internally_tagged_table() {
         panic!("{s:?}")
     };
     assert_eq!(
-        (p.common.substeps, p.iterations, p.xsph_c),
+        (p.common.substeps, p.pressure_iterations, p.xsph_c),
         (1, 2, Some(0.5))
     );
     let e = toml::from_str::<SolverSpec>(
@@ -213,7 +213,7 @@ fn with_kind_keeps_the_shared_settings() {
     let SolverSpec::Pcisph(p) = &c else {
         panic!("{c:?}")
     };
-    assert_eq!((p.common.substeps, p.iterations), (2, 3));
+    assert_eq!((p.common.substeps, p.pressure_iterations), (2, 3));
     assert_eq!(
         (p.xsph_c, p.common.rest_density, p.clamp_negative_pressure),
         (Some(0.01), Some(990.0), None)
@@ -321,4 +321,45 @@ fn solver_must_be_a_table() {
     let file = fixture_dir("solver_array").join("solver_array.toml");
     let e = Scene::parse_str(&text, &file).unwrap_err();
     assert_names(&e, "solver_array", "solver", "must be a table, not array");
+}
+
+/// Every key renamed to its parameter's name (`SolverKind::renamed`) still loads under its
+/// old name, into the same settings; and a renamed key is refused where the kind has none.
+#[test]
+fn old_keys_still_load() {
+    // A table of each kind giving every renamed key under its new name.
+    let table = |kind: SolverKind| -> String {
+        let mut t = format!("kind = \"{}\"\nsubsteps = 2\n", kind.name());
+        if kind == SolverKind::Granular {
+            t.push_str("friction_angle_deg = 30.0\n");
+        }
+        if kind == SolverKind::Pbf {
+            t.push_str("mean_compression_tolerance = 0.01\n");
+        }
+        for (k, (_, new)) in kind.renamed().iter().enumerate() {
+            t.push_str(&format!("{new} = {}\n", 3 - k));
+        }
+        t
+    };
+    let mut renamed = 0;
+    for &kind in SolverKind::ALL {
+        let new = table(kind);
+        let spec: SolverSpec = toml::from_str(&new).unwrap();
+        for (old_key, new_key) in kind.renamed() {
+            let old = new.replacen(&format!("{new_key} ="), &format!("{old_key} ="), 1);
+            assert_ne!(old, new);
+            let from_old: SolverSpec = toml::from_str(&old).unwrap();
+            assert_eq!(from_old, spec, "{} {old_key}", kind.name());
+            renamed += 1;
+        }
+    }
+    // PBF: iterations, min_iterations; PCISPH: iterations.
+    assert_eq!(renamed, 3);
+    // Shipped-style scene text with the old key reads as with the new one.
+    let old = parse("old_keys", VALID);
+    let new = parse(
+        "old_keys",
+        &VALID.replacen("iterations = 3", "solver_iterations = 3", 1),
+    );
+    assert_eq!(old.solver, new.solver);
 }

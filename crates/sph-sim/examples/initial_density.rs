@@ -17,7 +17,8 @@
 use std::path::PathBuf;
 
 use sph_scene::{BoundaryModel, InitialMasses, Scene};
-use sph_sim::{density_kernel, SceneSim};
+use sph_sim::observe::OnFrame;
+use sph_sim::{density_kernel, run_frames, Flow, FrameRecord, RunPlan, SceneSim};
 use sph_solver::initial::density_ratios;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -119,23 +120,19 @@ fn report<R: sph_core::Real>(
     }
     let g = scene.gravity.iter().map(|x| x * x).sum::<f64>().sqrt();
     println!("frame  t (s)    max |v| (m/s)  g t (m/s)  max rho/rho0 (solver)");
-    for _ in 0..frames {
-        let st = sim.advance()?;
-        let vmax = sim
-            .state
-            .velocities
-            .iter()
-            .map(|v| v.norm().as_f64())
-            .fold(0.0, f64::max);
+    let mut print = OnFrame(|sim: &SceneSim<R>, r: &FrameRecord| {
         println!(
             "{:>5}  {:.4}   {:.4}         {:.4}     {:.4}",
             sim.frame,
             sim.time_s,
-            vmax,
+            r.max_speed_m_s,
             g * sim.time_s,
-            st.max_density_ratio
+            r.max_density_ratio
         );
-    }
+        Flow::Continue
+    });
+    let plan = RunPlan::next(&sim, frames);
+    run_frames(&mut sim, &plan, &mut [&mut print])?.diverged_as_error()?;
     Ok(())
 }
 

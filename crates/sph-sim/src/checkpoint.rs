@@ -38,10 +38,11 @@ use std::path::{Path, PathBuf};
 use sha2::{Digest, Sha256};
 use sph_core::{Real, Vec3};
 use sph_scene::Scene;
-use sph_solver::{SolverState, StepStats};
+use sph_solver::SolverState;
 
 use crate::error::SimError;
-use crate::frame_loop::{FrameObserver, RunPlan};
+use crate::frame_loop::{Ending, Flow, FrameObserver, RunOutcome, RunPlan};
+use crate::record::FrameRecord;
 use crate::run_dir::RunDir;
 use crate::sim::SceneSim;
 
@@ -146,26 +147,15 @@ pub fn encode<R: Real>(c: &Checkpoint<R>) -> Vec<u8> {
     file
 }
 
-/// Writes `bytes` to `path` atomically: a temporary file beside it, `fsync`, rename (and an
-/// `fsync` of the directory where the platform allows it).
+/// Writes `bytes` to `path` atomically (`atomic-write-file`: a temporary file beside it,
+/// `fsync`, rename, `fsync` of the directory); a failed write leaves `path` as it was.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), SimError> {
-    let tmp = path.with_extension(format!("tmp{}", std::process::id()));
     let write = || -> std::io::Result<()> {
-        let mut f = std::fs::File::create(&tmp)?;
+        let mut f = atomic_write_file::AtomicWriteFile::open(path)?;
         f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)?;
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            if let Ok(d) = std::fs::File::open(dir) {
-                d.sync_all().ok();
-            }
-        }
-        Ok(())
+        f.commit()
     };
-    write().map_err(|e| {
-        std::fs::remove_file(&tmp).ok();
-        SimError::output(path, format!("writing the checkpoint: {e}"))
-    })
+    write().map_err(|e| SimError::output(path, format!("writing the checkpoint: {e}")))
 }
 
 // ---- reading ----
@@ -403,8 +393,10 @@ impl<R: Real> SceneSim<R> {
     }
 }
 
-/// Writes the run's checkpoint every `every` frames and when the run completes (after the
-/// frame's other outputs, so that the files up to a checkpoint are always complete).
+/// Writes the run's checkpoint every `every` frames and when the run ends at a completed
+/// frame (completed, stopped or interrupted; not after a blow-up, whose state is a
+/// substep's), after the frame's other outputs, so that the files up to a checkpoint are
+/// always complete.
 #[derive(Debug)]
 pub struct CheckpointObserver {
     path: PathBuf,
@@ -425,15 +417,17 @@ impl<R: Real> FrameObserver<R> for CheckpointObserver {
     fn start(&mut self, _: &SceneSim<R>, _: &RunPlan) -> Result<(), SimError> {
         Ok(())
     }
-    fn frame(&mut self, sim: &SceneSim<R>, _: &StepStats) -> Result<(), SimError> {
+    fn frame(&mut self, sim: &SceneSim<R>, _: &FrameRecord) -> Result<Flow, SimError> {
         match self.every {
-            Some(e) if sim.frame.is_multiple_of(e) => sim.save_checkpoint(&self.path),
-            _ => Ok(()),
+            Some(e) if sim.frame.is_multiple_of(e) => sim.save_checkpoint(&self.path)?,
+            _ => {}
         }
+        Ok(Flow::Continue)
     }
-    fn finish(&mut self, sim: &SceneSim<R>, completed: bool) -> Result<(), SimError> {
+    fn finish(&mut self, sim: &SceneSim<R>, outcome: Option<&RunOutcome>) -> Result<(), SimError> {
+        let at_a_frame = outcome.is_some_and(|o| !matches!(o.ending, Ending::Diverged(_)));
         match self.every {
-            Some(_) if completed => sim.save_checkpoint(&self.path),
+            Some(_) if at_a_frame => sim.save_checkpoint(&self.path),
             _ => Ok(()),
         }
     }

@@ -1,16 +1,13 @@
 //! The factory: a scene's solver parameters and boundary to a running solver.
 //!
 //! Adding a solver to the workspace means one crate implementing
-//! [`sph_solver::FluidSolver`], its variant in `sph_scene::SolverSpec` and
-//! `sph_scene::SolverParams` (with the function making its parameters from the scene), and
-//! one arm in [`build_solver`].
+//! [`sph_solver::FluidSolver`] (through `sph_solver::FrameSolver`) and
+//! [`sph_solver::SolverSettings`] for its settings struct, and one registration line in
+//! `sph-scene`'s `solvers!`; [`build_solver`] and [`density_kernel`] follow from it.
 
-use iisph_granular::Iisph;
-use pbf::Pbf;
-use pcisph::Pcisph;
 use sph_core::{Aabb, Real, Vec3};
 use sph_kernels::KernelKind;
-use sph_scene::{BoundaryModel, Scene, SolverParams, SolverSpec};
+use sph_scene::{BoundaryModel, Scene, SolverParams};
 use sph_solver::boundary::{VolumeMapBoundary, VolumeMapCache, VolumeMapOptions};
 use sph_solver::{Boundary, CollisionBoundary, CommonParams, FluidSolver, SolverError};
 
@@ -29,26 +26,20 @@ fn setup_error(scene: &Scene, source: SolverError) -> SimError {
 }
 
 /// The solver with parameters `params` and boundary `boundary` (e.g. of a
-/// [`crate::SceneSetup`]). The solver's constructor checks the parameters and that the
-/// boundary fits them.
+/// [`crate::SceneSetup`]): [`SolverParams::build`], one arm per registered solver. The
+/// solver's constructor checks the parameters and that the boundary fits them.
 pub fn build_solver<R: Real>(
     params: SolverParams<R>,
     boundary: Box<dyn Boundary<R>>,
 ) -> Result<Box<dyn FluidSolver<R>>, SolverError> {
-    Ok(match params {
-        SolverParams::Pbf(p) => Box::new(Pbf::with_boundary(p, boundary)?),
-        SolverParams::Pcisph(p) => Box::new(Pcisph::with_boundary(p, boundary)?),
-        SolverParams::Iisph(p) => Box::new(Iisph::with_boundary(p, boundary)?),
-    })
+    params.build(boundary)
 }
 
 /// The density kernel of the solver a scene asks for (the kernel its volume maps are
-/// integrated with): Poly6 for PBF and PCISPH, the cubic spline for the IISPH kinds.
+/// integrated with), as its crate's settings state it: Poly6 for PBF and PCISPH, the cubic
+/// spline for the IISPH kinds.
 pub fn density_kernel(scene: &Scene) -> KernelKind {
-    match scene.solver {
-        SolverSpec::Pbf(_) | SolverSpec::Pcisph(_) => KernelKind::Poly6,
-        SolverSpec::Iisph(_) | SolverSpec::Granular(_) => KernelKind::CubicSpline,
-    }
+    scene.solver.density_kernel()
 }
 
 /// The region where the fluid can be: the tank, or else the box of the fluid's initial

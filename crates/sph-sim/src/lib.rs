@@ -13,7 +13,11 @@
 //!   (Solenthaler & Pajarola 2009) or IISPH (Ihmsen et al. 2014; granular, Neder 2024).
 //! - [`SceneSim`]: the particles, the solver and the ids that follow particles across the
 //!   solver's reordering, advanced frame by frame.
-//! - [`run_scene`]: the frame loop behind `cargo xtask run SCENE`, with a progress bar,
+//! - [`run_frames`]: the one frame loop, with [`FrameObserver`]s that may stop it
+//!   ([`Flow`]) and a typed [`RunOutcome`] (completed, stopped, interrupted, diverged); each
+//!   frame's [`FrameRecord`] feeds `stats.csv`, Python and the experiments; the observers
+//!   of [`observe`] record, stop at rest, stop at a density limit, keep snapshots.
+//! - [`run_scene`]: the run behind `cargo xtask run SCENE`, with a progress bar,
 //!   ParaView frames (legacy VTK, [`vtk::write_particle_frame`]) and `stats.csv`.
 //!
 //! ```no_run
@@ -21,17 +25,25 @@
 //! use sph_sim::SceneSim;
 //!
 //! let scene = Scene::load(std::path::Path::new("scenes/dam_break.toml")).unwrap().quick();
+//! use sph_sim::observe::Recorder;
+//! use sph_sim::{run_frames, RunPlan};
+//!
 //! let mut sim = SceneSim::<f32>::new(&scene).unwrap();
-//! for _ in 0..10 {
-//!     let stats = sim.advance().unwrap(); // one 16 ms frame
-//!     println!("{} rho_max/rho0 {:.4}", sim.frame, stats.max_density_ratio);
+//! let mut recorder = Recorder::default();
+//! let plan = RunPlan::next(&sim, 10); // ten 16 ms frames
+//! let outcome = run_frames(&mut sim, &plan, &mut [&mut recorder]).unwrap();
+//! for r in &recorder.records {
+//!     println!("{} rho_max/rho0 {:.4}", r.frame, r.max_density_ratio);
 //! }
+//! println!("{} at frame {}", outcome.ending.name(), outcome.frame);
 //! ```
 
 pub mod checkpoint;
 mod error;
 mod factory;
 pub mod frame_loop;
+pub mod observe;
+mod record;
 pub mod render;
 pub mod run;
 pub mod run_dir;
@@ -41,8 +53,9 @@ pub mod vtk;
 
 pub use error::SimError;
 pub use factory::{build_boundary, build_solver, density_kernel, VOLUME_MAP_CONTACT_FRACTION};
-pub use frame_loop::{run_frames, FrameObserver, RunPlan};
-pub use run::{run_scene, stats_header, stats_row, SceneRunOptions, STATS_COLUMNS};
+pub use frame_loop::{run_frames, Divergence, Ending, Flow, FrameObserver, RunOutcome, RunPlan};
+pub use record::{FrameRecord, STATS_COLUMNS, STATS_EXTRA_COLUMNS};
+pub use run::{run_scene, SceneRunOptions};
 pub use run_dir::RunDir;
 pub use setup::SceneSetup;
 pub use sim::SceneSim;

@@ -6,11 +6,11 @@ use std::path::{Path, PathBuf};
 
 use sph_core::Real;
 use sph_scene::Scene;
-use sph_solver::StepStats;
 use ssfr_render::{RenderParams, Renderer};
 
 use crate::error::SimError;
-use crate::frame_loop::{FrameObserver, RunPlan};
+use crate::frame_loop::{Flow, FrameObserver, RunPlan};
+use crate::record::FrameRecord;
 use crate::run_dir::RunDir;
 use crate::sim::SceneSim;
 
@@ -94,10 +94,10 @@ impl<R: Real> FrameObserver<R> for RenderObserver {
         Ok(())
     }
 
-    fn frame(&mut self, sim: &SceneSim<R>, _stats: &StepStats) -> Result<(), SimError> {
+    fn frame(&mut self, sim: &SceneSim<R>, _: &FrameRecord) -> Result<Flow, SimError> {
         if sim.frame.is_multiple_of(self.every) {
             self.render(sim)?;
         }
-        Ok(())
+        Ok(Flow::Continue)
     }
 }

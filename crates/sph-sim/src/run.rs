@@ -11,11 +11,11 @@ use std::time::Instant;
 use indicatif::{ProgressBar, ProgressStyle};
 use sph_core::Real;
 use sph_scene::Scene;
-use sph_solver::StepStats;
 
 use crate::checkpoint::CheckpointObserver;
 use crate::error::SimError;
-use crate::frame_loop::{run_frames, FrameObserver, RunPlan};
+use crate::frame_loop::{run_frames, Flow, FrameObserver, RunOutcome, RunPlan};
+use crate::record::FrameRecord;
 use crate::render::RenderObserver;
 use crate::run_dir::RunDir;
 use crate::sim::SceneSim;
@@ -52,54 +52,12 @@ impl<R: Real> FrameObserver<R> for VtkObserver {
         }
         self.write(sim)
     }
-    fn frame(&mut self, sim: &SceneSim<R>, _: &StepStats) -> Result<(), SimError> {
+    fn frame(&mut self, sim: &SceneSim<R>, _: &FrameRecord) -> Result<Flow, SimError> {
         if sim.frame.is_multiple_of(self.every) {
             self.write(sim)?;
         }
-        Ok(())
+        Ok(Flow::Continue)
     }
-}
-
-/// The columns of the statistics CSV before the solver's phase times.
-pub const STATS_COLUMNS: [&str; 9] = [
-    "frame",
-    "time_s",
-    "particles",
-    "max_density_ratio",
-    "mean_density_ratio",
-    "iterations",
-    "unconverged_substeps",
-    "neighbour_pairs",
-    "kinetic_energy_j",
-];
-
-/// The header of the statistics CSV for a solver with phases `phases`: [`STATS_COLUMNS`],
-/// then `<phase>_s` for each phase, then `total_s` (the wall-clock columns).
-pub fn stats_header(phases: &[&str]) -> Vec<String> {
-    STATS_COLUMNS
-        .iter()
-        .map(|s| s.to_string())
-        .chain(phases.iter().map(|p| format!("{p}_s")))
-        .chain(std::iter::once("total_s".to_string()))
-        .collect()
-}
-
-/// One row of the statistics CSV (see [`stats_header`]).
-pub fn stats_row(frame: usize, time_s: f64, particles: usize, s: &StepStats) -> Vec<String> {
-    let mut row = vec![
-        frame.to_string(),
-        format!("{time_s:.6}"),
-        particles.to_string(),
-        format!("{:.6}", s.max_density_ratio),
-        format!("{:.6}", s.mean_density_ratio),
-        s.iterations.to_string(),
-        s.unconverged_substeps.to_string(),
-        s.neighbour_pairs.to_string(),
-        format!("{:.6e}", s.kinetic_energy),
-    ];
-    row.extend(s.phases.iter().map(|(_, secs)| format!("{secs:.6e}")));
-    row.push(format!("{:.6e}", s.total_s()));
-    row
 }
 
 /// Writes `stats.csv`, one row per frame, flushed as each frame ends (so a killed run keeps
@@ -142,7 +100,7 @@ fn kept_stats_lines(text: &str, frame: usize) -> String {
 
 impl<R: Real> FrameObserver<R> for StatsObserver {
     fn start(&mut self, sim: &SceneSim<R>, plan: &RunPlan) -> Result<(), SimError> {
-        let header = stats_header(sim.solver().phase_names());
+        let header = FrameRecord::csv_header(sim.solver().phase_names());
         let kept = if plan.resumed && self.path.is_file() {
             let text = sph_core::input::read_text_limited(&self.path, 1 << 30, "statistics file")?;
             let kept = kept_stats_lines(&text, sim.frame);
@@ -174,13 +132,14 @@ impl<R: Real> FrameObserver<R> for StatsObserver {
         Ok(())
     }
 
-    fn frame(&mut self, sim: &SceneSim<R>, stats: &StepStats) -> Result<(), SimError> {
-        let row = stats_row(sim.frame, sim.time_s, sim.state.len(), stats);
+    fn frame(&mut self, _: &SceneSim<R>, record: &FrameRecord) -> Result<Flow, SimError> {
         let Some(w) = self.writer.as_mut() else {
             return Err(self.err("statistics written before the run started"));
         };
-        let r = w.write_record(&row).and_then(|()| Ok(w.flush()?));
-        r.map_err(|e| self.err(e))
+        let r = w
+            .write_record(record.csv_row())
+            .and_then(|()| Ok(w.flush()?));
+        r.map_err(|e| self.err(e)).map(|()| Flow::Continue)
     }
 }
 
@@ -216,16 +175,16 @@ impl<R: Real> FrameObserver<R> for ProgressObserver {
         self.bar.reset_eta();
         Ok(())
     }
-    fn frame(&mut self, _: &SceneSim<R>, stats: &StepStats) -> Result<(), SimError> {
+    fn frame(&mut self, _: &SceneSim<R>, record: &FrameRecord) -> Result<Flow, SimError> {
         self.bar.set_message(format!(
             "rho_max/rho0 {:.4}, {:.1} ms/frame",
-            stats.max_density_ratio,
-            stats.total_s() * 1e3
+            record.max_density_ratio,
+            record.total_s * 1e3
         ));
         self.bar.inc(1);
-        Ok(())
+        Ok(Flow::Continue)
     }
-    fn finish(&mut self, _: &SceneSim<R>, _: bool) -> Result<(), SimError> {
+    fn finish(&mut self, _: &SceneSim<R>, _: Option<&RunOutcome>) -> Result<(), SimError> {
         self.bar.finish();
         Ok(())
     }
@@ -267,10 +226,10 @@ pub fn last_frame(scene: &Scene, max_frames: Option<usize>) -> Result<usize, Sim
 /// progress bar, VTK frames, `stats.csv`, checkpoints, and with `opts.render` the frames
 /// rendered in process ([`crate::render::RenderObserver`]). A fresh run first removes what
 /// an earlier run left in the directory; `opts.resume` continues from its checkpoint
-/// (refused by name if it is another scene's, another version's, or damaged). A blow-up
-/// stops the run with an error naming the frame, step and particle; the files up to it are
-/// kept.
-pub fn run_scene(path: &Path, opts: &SceneRunOptions) -> Result<(), SimError> {
+/// (refused by name if it is another scene's, another version's, or damaged). Returns how
+/// the run ended: a blow-up is [`crate::frame_loop::Ending::Diverged`], naming the frame,
+/// step and particle (the files up to it are kept).
+pub fn run_scene(path: &Path, opts: &SceneRunOptions) -> Result<RunOutcome, SimError> {
     let scene = Scene::load(path)?;
     let scene = if opts.quick { scene.quick() } else { scene };
     let last = last_frame(&scene, opts.max_frames)?;
@@ -291,7 +250,7 @@ fn run_scene_in<R: Real>(
     last: usize,
     opts: &SceneRunOptions,
     mut render: Option<RenderObserver>,
-) -> Result<(), SimError> {
+) -> Result<RunOutcome, SimError> {
     let t0 = Instant::now();
     let cache = match (&opts.volume_map_cache, scene.boundary.model) {
         (Some(dir), sph_scene::BoundaryModel::VolumeMap) => Some(
@@ -325,8 +284,12 @@ fn run_scene_in<R: Real>(
     observers.push(&mut checkpoints);
     observers.push(&mut bar);
     let result = run_frames(&mut sim, &plan, &mut observers);
+    let ending = match &result {
+        Ok(o) => o.ending.name(),
+        Err(_) => "failed",
+    };
     eprintln!(
-        "{}: at frame {} after {:.1} s{}; statistics in {}",
+        "{}: {ending} at frame {} after {:.1} s{}; statistics in {}",
         scene.name,
         sim.frame,
         t0.elapsed().as_secs_f64(),

@@ -65,8 +65,9 @@ impl<R: Real> SceneSetup<R> {
     /// With `cache`, the volume maps come from (or go into) that cache
     /// ([`sph_solver::boundary::VolumeMapCache`]).
     pub fn with_cache(scene: &Scene, cache: Option<&VolumeMapCache>) -> Result<Self, SimError> {
+        // Built once in f64 and converted to `R` (checked in `R` unless `Scene::check` did).
         let params = if is_scene_precision::<R>(scene) {
-            scene.solver_params_unchecked::<R>()
+            scene.solver_params_unchecked::<R>()?
         } else {
             scene.solver_params::<R>()?
         };

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use sph_sim::{run_scene, stats_header, SceneRunOptions};
+use sph_sim::{run_scene, FrameRecord, SceneRunOptions};
 
 fn temp_dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("scene-run-{name}-{}", std::process::id()));
@@ -72,7 +72,7 @@ fn runs_a_scene_and_writes_frames_and_statistics() {
         } else {
             pcisph::PCISPH_PHASES
         };
-        assert_eq!(lines[0], stats_header(phases).join(","));
+        assert_eq!(lines[0], FrameRecord::csv_header(phases).join(","));
         assert_eq!(lines.len(), 1 + 5, "{stats}");
         let last: Vec<&str> = lines[5].split(',').collect();
         assert_eq!(last[0], "5");
@@ -133,7 +133,7 @@ fn runs_iisph_and_granular_scenes_with_passive_points() {
         let lines: Vec<&str> = stats.lines().collect();
         assert_eq!(
             lines[0],
-            stats_header(iisph_granular::IISPH_PHASES).join(",")
+            FrameRecord::csv_header(iisph_granular::IISPH_PHASES).join(",")
         );
         assert_eq!(lines.len(), 1 + 5, "{stats}");
         for f in [0, 2, 4] {

@@ -44,10 +44,14 @@
 //!   `substep`, and `save_arrays`/`restore_arrays` when it carries anything between frames,
 //!   e.g. warm-started pressures) and `pub type Dfsph<R> = FrameSolver<R, DfsphScheme<R>>`.
 //!
+//! - `settings.rs`: `DfsphSettings`, its scene-facing `[solver]` table (serde,
+//!   `deny_unknown_fields`, [`CommonSettings`] flattened, each key the name of the
+//!   parameter it sets), implementing [`SolverSettings`] (see [`settings`]).
+//!
 //! `Dfsph::new(params, solids)` and `Dfsph::with_boundary(params, boundary)` then exist, and
-//! `Dfsph<R>` is a [`FluidSolver`]. Scene files reach it through one variant of
-//! `sph_scene::SolverSpec` and one arm of `sph_sim::factory::build_solver`
-//! (`Ok(Box::new(Dfsph::with_boundary(p, b).map_err(setup)?))`).
+//! `Dfsph<R>` is a [`FluidSolver`]. Scene files reach it through one registration line in
+//! `sph-scene` (`Dfsph = "dfsph", dfsph::DfsphSettings [];`), from which the scene's solver
+//! enums, the factory and the density kernel follow.
 
 pub mod boundary;
 pub mod csr;
@@ -56,6 +60,7 @@ mod fluid_solver;
 pub mod frame;
 pub mod initial;
 mod params;
+pub mod settings;
 pub mod state;
 mod stats;
 pub mod step;
@@ -74,6 +79,7 @@ pub use params::{
     CommonParams, DEFAULT_SUPPORT_OVER_SPACING, MAX_ITERATIONS_PER_FRAME, MAX_SUBSTEPS,
     VOLUME_MAP_CONTACT_FRACTION,
 };
+pub use settings::{CommonSettings, SceneValues, SolverSettings};
 pub use state::{ArraySpec, SolverState};
 pub use stats::{PhaseTimes, StepStats, MAX_PHASES};
 

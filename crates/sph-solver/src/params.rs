@@ -90,6 +90,26 @@ impl<R: Real> CommonParams<R> {
         }
     }
 
+    /// These parameters in precision `S`, each value rounded to nearest
+    /// ([`crate::settings::convert`]: an error names the first finite value that does not
+    /// fit, as a parameter of `solver`).
+    pub fn try_convert<S: Real>(
+        &self,
+        solver: &'static str,
+    ) -> Result<CommonParams<S>, SolverError> {
+        use crate::settings::{convert, convert3};
+        Ok(CommonParams {
+            rest_density: convert(solver, "rest_density", self.rest_density)?,
+            particle_spacing: convert(solver, "particle_spacing", self.particle_spacing)?,
+            support_radius: convert(solver, "support_radius", self.support_radius)?,
+            dt: convert(solver, "dt", self.dt)?,
+            substeps: self.substeps,
+            gravity: convert3(solver, "gravity", &self.gravity)?,
+            reorder_every: self.reorder_every,
+            neighbour_method: self.neighbour_method,
+        })
+    }
+
     /// Particle mass `ρ0 s³` (kg) of a fluid sampled on a simple cubic lattice of spacing `s`.
     pub fn particle_mass(&self) -> R {
         let s = self.particle_spacing;
@@ -208,7 +228,7 @@ impl<R: Real> CommonParams<R> {
             return Err(invalid(
                 "support_radius",
                 self.support_radius.as_f64(),
-                "must exceed particle_spacing (no neighbours otherwise)",
+                "must be > 1 particle_spacing (no neighbours otherwise)",
             ));
         }
         if (self.support_radius / self.particle_spacing).as_f64() > 64.0 {

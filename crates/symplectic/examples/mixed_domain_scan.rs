@@ -7,7 +7,7 @@
 //! `cargo run --release -p symplectic --example mixed_domain_scan`.
 use symplectic::*;
 fn main() {
-    let text = std::fs::read_to_string("reference-data/symplectic/particles.csv").unwrap();
+    let text = std::fs::read_to_string("reference-data/symplectic-100myr/particles.csv").unwrap();
     let rows: Vec<Vec<f64>> = text
         .lines()
         .filter(|l| !l.starts_with('#'))

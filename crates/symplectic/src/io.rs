@@ -654,24 +654,13 @@ pub fn write_parquet(path: &Path, batch: &RecordBatch) -> Result<(), SymplecticE
         path: path.display().to_string(),
         reason: e,
     };
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".tmp");
-    let tmp = PathBuf::from(tmp);
-    {
-        let file = std::fs::File::create(&tmp).map_err(|e| err(e.to_string()))?;
-        let props = parquet::file::properties::WriterProperties::builder()
-            .set_compression(parquet::basic::Compression::SNAPPY)
-            .build();
-        let mut writer = parquet::arrow::ArrowWriter::try_new(
-            file.try_clone().map_err(|e| err(e.to_string()))?,
-            batch.schema(),
-            Some(props),
-        )
+    let file = atomic_write_file::AtomicWriteFile::open(path).map_err(|e| err(e.to_string()))?;
+    let props = parquet::file::properties::WriterProperties::builder()
+        .set_compression(parquet::basic::Compression::SNAPPY)
+        .build();
+    let mut writer = parquet::arrow::ArrowWriter::try_new(file, batch.schema(), Some(props))
         .map_err(|e| err(e.to_string()))?;
-        writer.write(batch).map_err(|e| err(e.to_string()))?;
-        writer.close().map_err(|e| err(e.to_string()))?;
-        file.sync_all().map_err(|e| err(e.to_string()))?;
-    }
-    std::fs::rename(&tmp, path).map_err(|e| err(e.to_string()))?;
-    Ok(())
+    writer.write(batch).map_err(|e| err(e.to_string()))?;
+    let file = writer.into_inner().map_err(|e| err(e.to_string()))?;
+    file.commit().map_err(|e| err(e.to_string()))
 }

@@ -1,6 +1,5 @@
 //! Several test particles and the planets advanced together, with atomic checkpoints.
 
-use std::io::Write;
 use std::path::Path;
 
 use serde::{de::DeserializeOwned, Deserialize, Serialize};
@@ -276,27 +275,9 @@ pub fn save_checkpoint<T: Serialize>(path: &Path, value: &T) -> Result<(), Sympl
         path: path.display().to_string(),
         reason: e.to_string(),
     };
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".tmp");
-    let tmp = std::path::PathBuf::from(tmp);
-    {
-        let mut f = std::fs::File::create(&tmp).map_err(io)?;
-        serde_json::to_writer(&mut f, value).map_err(|e| SymplecticError::Checkpoint {
-            path: tmp.display().to_string(),
-            reason: e.to_string(),
-        })?;
-        f.flush().map_err(io)?;
-        f.sync_all().map_err(io)?;
-    }
-    std::fs::rename(&tmp, path).map_err(io)?;
-    // Make the rename itself durable (Unix: sync the directory entry). Best effort: where a
-    // directory cannot be opened or synced, the rename has still happened atomically.
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        if let Ok(d) = std::fs::File::open(dir) {
-            d.sync_all().ok();
-        }
-    }
-    Ok(())
+    let mut f = atomic_write_file::AtomicWriteFile::open(path).map_err(io)?;
+    serde_json::to_writer(&mut f, value).map_err(|e| io(e.into()))?;
+    f.commit().map_err(io)
 }
 
 /// Reads a checkpoint written by [`save_checkpoint`].

@@ -10,7 +10,7 @@
 //!
 //! Epoch 1994 September 5, 0h; heliocentric positions (AU) and velocities (AU/day) in the
 //! equatorial frame; masses in solar masses; `G` in AU³ M☉⁻¹ day⁻². The same table is kept as
-//! reference data (`reference-data/symplectic/outer_solar_system.csv`, with its SOURCE note);
+//! reference data (`reference-data/symplectic-100myr/outer_solar_system.csv`, with its SOURCE note);
 //! the crate's tests check these constants against it digit for digit.
 //!
 //! The ecliptic frame of J2000 (the frame of the paper's orbital elements) is reached by a

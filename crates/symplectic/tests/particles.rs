@@ -53,7 +53,7 @@ fn comet_run(
 
 #[test]
 fn stored_initial_states_have_the_papers_elements() {
-    // reference-data/symplectic/particles.csv was derived by gen_particles.py (Python); here
+    // reference-data/symplectic-100myr/particles.csv was derived by gen_particles.py (Python); here
     // the Rust element routine reads the elements back: a, q, i, r0 as given, outbound.
     let mu = G * outer_solar_system_table().0[0];
     for row in particle_rows() {

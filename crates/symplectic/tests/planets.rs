@@ -335,7 +335,7 @@ fn energy_error_limits_table() {
     }
 }
 
-/// Planets of `reference-data/symplectic/ias15_10kyr.csv` at `t_day`: heliocentric positions.
+/// Planets of `reference-data/symplectic-order/ias15_10kyr.csv` at `t_day`: heliocentric positions.
 fn ias15_positions(t_day: f64) -> Vec<Vec3> {
     let text = include_str!("data/ias15_10kyr.csv");
     text.lines()

@@ -11,7 +11,7 @@ use symplectic::{
 
 #[test]
 fn shipped_system_is_the_reference_table() {
-    // reference-data/symplectic/outer_solar_system.csv (Hairer, Lubich & Wanner, Table 2.1),
+    // reference-data/symplectic-100myr/outer_solar_system.csv (Hairer, Lubich & Wanner, Table 2.1),
     // parsed independently by the test fixture: every value identical, in both frames.
     let (m, q, v) = outer_solar_system_table();
     assert_eq!(G_AU3_PER_MSUN_DAY2, G);

@@ -1,38 +1,37 @@
-//! The experiments, one module each, grouped by the paper or work they replay.
+//! The experiments, one module each (file name = experiment id), in one folder per paper of
+//! `docs/papers.md`: the paper whose crates each experiment validates.
 
 use crate::Experiment;
 
-pub mod boundary;
-pub mod granular;
-pub mod pbf;
-pub mod sph;
-pub mod ssfr;
-pub mod symplectic;
-
-pub(crate) use pbf::fluid_runs;
+pub mod chegodaeva_2004;
+pub mod im_chan_2016;
+pub mod macklin_muller_2013;
+pub mod neder_2024;
 
 /// Every registered experiment, in run order.
 pub fn registry() -> Vec<Box<dyn Experiment>> {
     vec![
-        Box::new(sph::kernels::Kernels),
-        Box::new(sph::neighbour_search::NeighbourSearchExperiment),
-        Box::new(symplectic::symplectic_100myr::Symplectic100Myr),
-        Box::new(symplectic::symplectic_order::SymplecticOrder),
-        Box::new(symplectic::comet_population::CometPopulation),
-        Box::new(boundary::boundary_rest::BoundaryRest),
-        Box::new(pbf::pbf_bunny_density::PbfBunnyDensity),
-        Box::new(pbf::pbf_stability::PbfStability),
-        Box::new(pbf::pbf_convergence::PbfConvergence),
-        Box::new(pbf::pbf_vorticity::PbfVorticity),
-        Box::new(pbf::dam_break_front::DamBreakFront),
-        Box::new(pbf::pbf_performance::PbfPerformance),
-        Box::new(granular::repose::GranularRepose),
-        Box::new(granular::column_collapse::GranularColumnCollapse),
-        Box::new(granular::axisymmetric_collapse::GranularColumnCollapseAxisymmetric),
-        Box::new(granular::iisph_convergence::IisphConvergence),
-        Box::new(granular::granular_performance::GranularPerformance),
-        Box::new(ssfr::ssfr_depth_accuracy::SsfrDepthAccuracy),
-        Box::new(ssfr::ssfr_refraction::SsfrRefraction),
-        Box::new(ssfr::ssfr_performance::SsfrPerformance),
+        Box::new(macklin_muller_2013::kernels::Kernels),
+        Box::new(im_chan_2016::neighbour_search::NeighbourSearchExperiment),
+        Box::new(chegodaeva_2004::symplectic_100myr::Symplectic100Myr),
+        Box::new(chegodaeva_2004::symplectic_order::SymplecticOrder),
+        Box::new(chegodaeva_2004::comet_population::CometPopulation),
+        Box::new(macklin_muller_2013::boundary_rest::BoundaryRest),
+        Box::new(macklin_muller_2013::pbf_bunny_density::PbfBunnyDensity),
+        Box::new(macklin_muller_2013::pbf_stability::PbfStability),
+        Box::new(macklin_muller_2013::pbf_convergence::PbfConvergence),
+        Box::new(macklin_muller_2013::pbf_vorticity::PbfVorticity),
+        Box::new(macklin_muller_2013::dam_break_front::DamBreakFront),
+        Box::new(macklin_muller_2013::pbf_performance::PbfPerformance),
+        Box::new(neder_2024::granular_repose::GranularRepose),
+        Box::new(neder_2024::granular_column_collapse::GranularColumnCollapse),
+        Box::new(
+            neder_2024::granular_column_collapse_axisymmetric::GranularColumnCollapseAxisymmetric,
+        ),
+        Box::new(neder_2024::iisph_convergence::IisphConvergence),
+        Box::new(neder_2024::granular_performance::GranularPerformance),
+        Box::new(im_chan_2016::ssfr_depth_accuracy::SsfrDepthAccuracy),
+        Box::new(im_chan_2016::ssfr_refraction::SsfrRefraction),
+        Box::new(im_chan_2016::ssfr_performance::SsfrPerformance),
     ]
 }

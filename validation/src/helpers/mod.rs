@@ -1,13 +1,13 @@
-//! Shared helpers of the experiments: CSV output, reference-data loading, plotting and a
-//! small deterministic random-number generator.
+//! Shared helpers of the experiments: CSV output, reference-data loading, plotting,
+//! summary statistics and (re-exported from `sph-core`) the seeded generator.
 
 mod data;
 mod plot;
-mod rng;
 pub mod solar_system;
+pub mod stats;
 
 pub use data::{load_reference_csv, write_csv_columns, write_csv_rows, ReferenceTable};
 pub use plot::{ensure_fonts, plot_xy, Legend, Marker, PlotSpec, Series, SeriesStyle};
-pub use rng::SplitMix64;
+pub use sph_core::random::SplitMix64;
 mod particle_image;
 pub use particle_image::side_view_png;

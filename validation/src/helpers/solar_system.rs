@@ -1,4 +1,4 @@
-//! The comet-like test particles of Chegodaeva (2004), read from `reference-data/symplectic/`
+//! The comet-like test particles of Chegodaeva (2004), read from `reference-data/symplectic-100myr/`
 //! (the planets come from `symplectic::outer_solar_system`).
 
 use anyhow::Result;
@@ -44,7 +44,7 @@ pub fn particles(ctx: &Context) -> Result<Vec<ParticleInitial>> {
         "dt0_s2_day",
         "dt0_s6_day",
     ];
-    let t = load_reference_csv(ctx, "symplectic/particles.csv", &cols)?;
+    let t = load_reference_csv(ctx, "symplectic-100myr/particles.csv", &cols)?;
     (0..t.len())
         .map(|r| {
             Ok(ParticleInitial {

@@ -80,12 +80,17 @@ pub(super) fn check(ctx: &Ctx, scene: &Scene, quick: Option<&QuickSpec>) -> Resu
     }
 
     let dt = scene.frame_dt_s / substeps as f64;
-    let h = scene
+    let ratio = scene
         .solver
         .common()
         .support_over_spacing
-        .unwrap_or(DEFAULT_SUPPORT_OVER_SPACING)
-        * scene.particle_spacing;
+        .unwrap_or(DEFAULT_SUPPORT_OVER_SPACING);
+    // No substeps, or no neighbourhood: refused by the solver's own checks, which follow
+    // (`params.rs`), at their fields.
+    if substeps == 0 || !(ratio.is_finite() && ratio > 1.0) {
+        return Ok(());
+    }
+    let h = ratio * scene.particle_spacing;
     let g = v3(scene.gravity).norm();
     let v0 = scene
         .fluids

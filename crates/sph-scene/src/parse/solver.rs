@@ -8,18 +8,20 @@
 //! without `kind` (its `deny_unknown_fields` refuses the fields of the other solvers).
 //!
 //! The settings shared by several solvers are `#[serde(flatten)]`ed into the variants
-//! ([`SolverCommon`], [`IisphSettings`]), and serde buffers flattened fields too: a wrong
+//! (`CommonSettings`, `iisph_granular::IisphSettings`: the parts listed in the solver's
+//! registration line), and serde buffers flattened fields too: a wrong
 //! value there, or an unknown field, comes without path or line. So the shared parts are
 //! read on their own first (they accept unknown fields), which reports their errors at the
 //! field, and an unknown field is named with its line from the document. The values are
-//! range-checked later, by `Scene::check`.
+//! range-checked later, by `Scene::check` (the parameters' own `validate`).
 
 use serde::de::DeserializeOwned;
 use toml::de::{DeValue, ValueDeserializer};
 
 use super::SolverTable;
 use crate::error::{serde_error, Ctx};
-use crate::{IisphSettings, SceneError, SolverCommon, SolverKind, SolverSpec};
+use crate::solver_spec::SettingsReader;
+use crate::{SceneError, SolverKind, SolverSpec};
 
 /// Reads the `[solver]` table `table` of the scene text `text`, whose `kind` has been read
 /// already.
@@ -35,27 +37,34 @@ pub(super) fn parse(
         return Err(ctx.invalid("solver", format!("must be a table, not {found}")));
     };
     t.remove("kind");
-    // The flattened parts first, for their errors' paths and lines.
-    part::<SolverCommon>(ctx, text, kind, &table)?;
-    if matches!(kind, SolverKind::Iisph | SolverKind::Granular) {
-        part::<IisphSettings>(ctx, text, kind, &table)?;
-    }
-    Ok(match kind {
-        SolverKind::Pbf => SolverSpec::Pbf(variant(ctx, text, kind, table)?),
-        SolverKind::Pcisph => SolverSpec::Pcisph(variant(ctx, text, kind, table)?),
-        SolverKind::Iisph => SolverSpec::Iisph(variant(ctx, text, kind, table)?),
-        SolverKind::Granular => SolverSpec::Granular(variant(ctx, text, kind, table)?),
-    })
+    // The flattened parts first, for their errors' paths and lines (see `SolverSpec::read`).
+    SolverSpec::read(
+        kind,
+        &mut Reader {
+            ctx,
+            text,
+            kind,
+            table,
+        },
+    )
 }
 
-/// Reads the shared part `T` from the table (other fields ignored), for its errors only.
-fn part<T: DeserializeOwned>(
-    ctx: &Ctx,
-    text: &str,
+/// The `[solver]` table without `kind`, read by [`SolverSpec::read`].
+struct Reader<'a, 'i> {
+    ctx: &'a Ctx<'a>,
+    text: &'a str,
     kind: SolverKind,
-    table: &SolverTable<'_>,
-) -> Result<(), SceneError> {
-    variant::<T>(ctx, text, kind, table.clone()).map(|_| ())
+    table: SolverTable<'i>,
+}
+
+impl SettingsReader<SceneError> for Reader<'_, '_> {
+    fn part<T: DeserializeOwned>(&mut self) -> Result<(), SceneError> {
+        variant::<T>(self.ctx, self.text, self.kind, self.table.clone()).map(|_| ())
+    }
+
+    fn settings<T: DeserializeOwned>(&mut self) -> Result<T, SceneError> {
+        variant::<T>(self.ctx, self.text, self.kind, self.table.clone())
+    }
 }
 
 /// The variant struct of `kind` from the table without `kind`.

@@ -67,7 +67,7 @@ pub const DEFAULT_WINDOW_STEPS: u32 = 256;
 ///   35 flops, one square root and one division each, then two updates of `v` and `p₄`.
 /// - *The Kepler drift* ([`kepler::drift`](crate::kepler::drift)): `F₀` and `Δt = h/F₀`, the
 ///   universal-variable solve (Stumpff series of 12 multiply-adds, one Halley iteration from
-///   the third-order series guess: 1.00 iterations per solve on the issue-21 comets) and the
+///   the third-order series guess: 1.00 iterations per solve on the scattered-disk comets) and the
 ///   `f, g` update, about 140 flops, one square root and 7 divisions, in one dependent chain.
 /// - *The removal rules:* Hill spheres of 4 planets compared squared, energy and perihelion
 ///   without square roots beyond `|q|`, about 110 flops.

@@ -7,7 +7,7 @@ use symplectic::{Planets, Vec3};
 pub const G: f64 = 2.959_122_082_86e-4;
 
 /// (masses incl. the Sun first, heliocentric positions, heliocentric velocities), from
-/// `reference-data/symplectic/outer_solar_system.csv`.
+/// `reference-data/symplectic-100myr/outer_solar_system.csv`.
 pub fn outer_solar_system_table() -> (Vec<f64>, Vec<Vec3>, Vec<Vec3>) {
     let text = include_str!("../data/outer_solar_system.csv");
     let (mut m, mut q, mut v) = (vec![], vec![], vec![]);
@@ -111,7 +111,7 @@ pub fn outer_solar_system_ecliptic() -> Planets {
     Planets::from_heliocentric(G, m[0], &m[1..], &q[1..], &v[1..]).unwrap()
 }
 
-/// One row of `reference-data/symplectic/particles.csv`.
+/// One row of `reference-data/symplectic-100myr/particles.csv`.
 #[derive(Debug, Clone)]
 pub struct ParticleRow {
     pub a: f64,

@@ -18,10 +18,10 @@
 //! reader sees either the old file, the new file or none, also when two processes write the
 //! same map at once (both write identical bytes; the last rename wins).
 
+use atomic_write_file::AtomicWriteFile;
 use std::fs;
 use std::io::Write;
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::path::Path;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -382,37 +382,10 @@ pub(crate) fn write_map<R: Real>(
     map: &VolumeMap<R>,
     key: &VolumeMapKey,
 ) -> Result<(), SolverError> {
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
     let bytes = file_bytes(map, key);
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty());
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp_name = format!(
-        ".{name}.{}.{}.tmp",
-        std::process::id(),
-        COUNTER.fetch_add(1, Ordering::Relaxed)
-    );
-    let tmp: PathBuf = dir.map_or_else(|| PathBuf::from(&tmp_name), |d| d.join(&tmp_name));
-    let result = (|| {
-        let mut f = fs::File::create(&tmp).map_err(|e| io(path, "create", e))?;
-        f.write_all(&bytes).map_err(|e| io(path, "write", e))?;
-        f.sync_all().map_err(|e| io(path, "sync", e))?;
-        drop(f);
-        fs::rename(&tmp, path).map_err(|e| io(path, "rename", e))
-    })();
-    if result.is_err() {
-        let _ = fs::remove_file(&tmp);
-    }
-    result?;
-    if let Some(d) = dir {
-        // Persist the rename itself; not every platform can open a directory.
-        if let Ok(d) = fs::File::open(d) {
-            let _ = d.sync_all();
-        }
-    }
-    Ok(())
+    let mut f = AtomicWriteFile::open(path).map_err(|e| io(path, "create", e))?;
+    f.write_all(&bytes).map_err(|e| io(path, "write", e))?;
+    f.commit().map_err(|e| io(path, "commit", e))
 }
 
 impl<R: Real> VolumeMap<R> {

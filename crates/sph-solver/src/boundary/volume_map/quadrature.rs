@@ -1,50 +1,13 @@
-//! The integrals behind the volume maps: Gauss–Legendre rules, the exact half-space volume
-//! `Ψ_plane(d)`, tabulated radial antiderivatives, and the spherical quadrature of the
+//! The integrals behind the volume maps: the exact half-space volume `Ψ_plane(d)` and
+//! tabulated radial antiderivatives (Gauss–Legendre, `sph_kernels::quadrature`), and the spherical quadrature of the
 //! difference between a solid and its tangent half-space at one grid node.
 
 use std::f64::consts::PI;
 
 use nalgebra::Matrix3;
 use sph_core::{Real, Sdf, Vec3};
+use sph_kernels::quadrature::gauss_legendre;
 use sph_kernels::Kernel;
-
-/// Gauss–Legendre nodes and weights on `[−1, 1]` (`n ≥ 1` points, exact for polynomials of
-/// degree `2n − 1`), by Newton iteration on the three-term recurrence of `P_n`.
-pub(crate) fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
-    let n = n.max(1);
-    let legendre = |x: f64| {
-        let (mut p0, mut p1) = (1.0, x);
-        for k in 2..=n {
-            let kf = k as f64;
-            let p2 = ((2.0 * kf - 1.0) * x * p1 - (kf - 1.0) * p0) / kf;
-            p0 = p1;
-            p1 = p2;
-        }
-        if n == 1 {
-            (x, 1.0)
-        } else {
-            // P_n' = n (x P_n − P_{n−1}) / (x² − 1)
-            (p1, n as f64 * (x * p1 - p0) / (x * x - 1.0))
-        }
-    };
-    let mut out = vec![(0.0, 0.0); n];
-    for i in 0..n.div_ceil(2) {
-        let mut x = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-        for _ in 0..100 {
-            let (p, dp) = legendre(x);
-            let dx = p / dp;
-            x -= dx;
-            if dx.abs() < 1e-16 {
-                break;
-            }
-        }
-        let (_, dp) = legendre(x);
-        let w = 2.0 / ((1.0 - x * x) * dp * dp);
-        out[i] = (-x, w);
-        out[n - 1 - i] = (x, w);
-    }
-    out
-}
 
 /// Points of the per-panel rule of the radial integrals (8 points: exact to degree 15,
 /// enough for every polynomial kernel of `sph-kernels` times `r²` or `r (r − d)`).
@@ -736,24 +699,6 @@ pub(crate) fn looks_planar<R: Real>(
 mod tests {
     use super::*;
     use sph_kernels::{CubicSpline, Poly6, Spiky, WendlandC2};
-
-    #[test]
-    fn gauss_legendre_integrates_monomials() {
-        for n in 1..=20 {
-            let rule = gauss_legendre(n);
-            for deg in 0..2 * n {
-                let q: f64 = rule.iter().map(|&(x, w)| w * x.powi(deg as i32)).sum();
-                let exact = if deg % 2 == 1 {
-                    0.0
-                } else {
-                    2.0 / (deg as f64 + 1.0)
-                };
-                // Rounding only: the rule is exact for degree < 2n; 1e-13 covers the
-                // accumulated f64 error of up to 20 terms of size ≤ 2.
-                assert!((q - exact).abs() < 1e-13, "n {n} deg {deg}: {q} vs {exact}");
-            }
-        }
-    }
 
     fn tables_match<K: Kernel<f64>>(k: K) {
         let t = KernelTables::new(&k);

@@ -1,0 +1,143 @@
+//! How a run through the one frame loop ends: completed, stopped by an observer (after every
+//! observer has seen the frame), interrupted, diverged by an observer's judgement or by the
+//! solver's blow-up, which is kept as an outcome with the state of its last good substep.
+
+use std::path::PathBuf;
+
+use sph_core::Vec3;
+use sph_scene::Scene;
+use sph_sim::observe::{DensityLimit, OnFrame, Recorder, RestCriterion, RestObserver, Snapshots};
+use sph_sim::{run_frames, Divergence, Ending, Flow, FrameRecord, RunPlan, SceneSim};
+
+const SCENE: &str = r#"
+name = "tiny"
+[simulation]
+precision = "f64"
+particle_spacing = 0.025
+duration = 0.16
+frame_dt = 0.016
+[solver]
+kind = "pbf"
+substeps = 2
+iterations = 2
+[tank]
+min = [0.0, 0.0, 0.0]
+max = [0.3, 0.3, 0.2]
+[[fluid]]
+kind = "block"
+min = [0.0, 0.0, 0.0]
+max = [0.1, 0.15, 0.1]
+"#;
+
+fn sim(test: &str) -> SceneSim<f64> {
+    let dir = std::env::temp_dir().join(format!("sph-sim-outcomes-{test}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path: PathBuf = dir.join("tiny.toml");
+    std::fs::write(&path, SCENE).unwrap();
+    SceneSim::new(&Scene::load(&path).unwrap()).unwrap()
+}
+
+#[test]
+fn a_run_completes_at_its_last_frame_with_a_record_per_frame() {
+    let mut sim = sim("completes");
+    let mut rec = Recorder::default();
+    let mut snaps = Snapshots::at(&[0, 3]);
+    let plan = RunPlan::next(&sim, 4);
+    let out = run_frames(&mut sim, &plan, &mut [&mut rec, &mut snaps]).unwrap();
+    assert!(out.completed() && out.ending.name() == "completed");
+    assert_eq!((out.frame, sim.frame), (4, 4));
+    let frames: Vec<usize> = rec.records.iter().map(|r| r.frame).collect();
+    assert_eq!(frames, [1, 2, 3, 4]);
+    assert!(rec
+        .records
+        .iter()
+        .all(|r| r.particles == 96 && r.substeps == 2));
+    let snapped: Vec<usize> = snaps.taken.iter().map(|(f, _)| *f).collect();
+    assert_eq!(snapped, [0, 3]);
+    // The record's largest speed is that of the state at the frame's end.
+    let v_max = sim
+        .state
+        .velocities
+        .iter()
+        .map(|v| v.norm())
+        .fold(0.0, f64::max);
+    assert_eq!(rec.records[3].max_speed_m_s, v_max);
+}
+
+#[test]
+fn an_observer_stops_the_run_after_every_observer_saw_the_frame() {
+    let mut sim = sim("stops");
+    let mut stop = OnFrame(|sim: &SceneSim<f64>, _: &FrameRecord| match sim.frame {
+        2 => Flow::Stop("enough".into()),
+        _ => Flow::Continue,
+    });
+    let mut rec = Recorder::default();
+    let plan = RunPlan::next(&sim, 10);
+    let out = run_frames(&mut sim, &plan, &mut [&mut stop, &mut rec]).unwrap();
+    assert!(matches!(&out.ending, Ending::Stopped { reason } if reason == "enough"));
+    assert_eq!((out.frame, rec.records.len()), (2, 2));
+    // The simulation goes on from there.
+    let plan = RunPlan::next(&sim, 1);
+    let out = run_frames(&mut sim, &plan, &mut []).unwrap();
+    assert!(out.completed() && sim.frame == 3);
+}
+
+#[test]
+fn an_interrupt_and_a_density_limit_are_outcomes() {
+    let mut sim = sim("interrupt");
+    let mut interrupt = OnFrame(|_: &SceneSim<f64>, _: &FrameRecord| Flow::Interrupt);
+    let plan = RunPlan::next(&sim, 5);
+    let out = run_frames(&mut sim, &plan, &mut [&mut interrupt]).unwrap();
+    assert!(matches!(out.ending, Ending::Interrupted) && out.frame == 1);
+
+    // No liquid at rest has max rho/rho0 below 0.5: the limit ends the run as diverged.
+    let mut limit = DensityLimit { limit: 0.5 };
+    let plan = RunPlan::next(&sim, 5);
+    let out = run_frames(&mut sim, &plan, &mut [&mut limit]).unwrap();
+    let d = out.divergence().expect("diverged");
+    assert!(matches!(d, Divergence::Observed(_)) && d.step_and_particle().is_none());
+    assert!(d.to_string().contains("max rho/rho0"), "{d}");
+    assert_eq!(out.frame, 2);
+}
+
+#[test]
+fn a_blow_up_is_kept_as_an_outcome_naming_the_step_and_particle() {
+    let mut sim = sim("blow_up");
+    let plan = RunPlan::next(&sim, 2);
+    run_frames(&mut sim, &plan, &mut []).unwrap();
+    // A particle thrown at an absurd speed leaves every grid the search can build.
+    sim.state.velocities[5] = Vec3::new(1e300, 0.0, 0.0);
+    let mut rec = Recorder::default();
+    let plan = RunPlan::next(&sim, 3);
+    let out = run_frames(&mut sim, &plan, &mut [&mut rec]).unwrap();
+    let d = out.divergence().expect("diverged");
+    assert!(matches!(d, Divergence::Solver(_)), "{d}");
+    assert!(d.step_and_particle().is_some(), "{d}");
+    assert!(d.to_string().contains("frame 2"), "{d}");
+    assert_eq!((out.frame, rec.records.len()), (2, 0));
+    assert!(sim
+        .state
+        .positions
+        .iter()
+        .all(|p| p.iter().all(|x| x.is_finite())));
+    // For a caller to which a blow-up is a failure, it is the solver's error.
+    let err = out.diverged_as_error().unwrap_err();
+    assert!(err.to_string().contains("blow-up"), "{err}");
+}
+
+#[test]
+fn rest_stops_the_run_once_the_speed_held_below_the_bound() {
+    let mut sim = sim("rest");
+    // Every speed is below 1 km/s: at rest from the first frame's start, held 0.03 s.
+    let mut rest = RestObserver::new(RestCriterion {
+        speed_m_s: 1e3,
+        hold_s: 0.03,
+        region: None,
+    });
+    let plan = RunPlan::next(&sim, 10);
+    let out = run_frames(&mut sim, &plan, &mut [&mut rest]).unwrap();
+    assert!(matches!(out.ending, Ending::Stopped { .. }), "{out:?}");
+    // 0.032 s >= 0.03 s after frame 2.
+    assert_eq!((out.frame, rest.speeds_m_s.len()), (2, 2));
+    assert_eq!(rest.rest_from_s, Some(0.0));
+}
