@@ -15,8 +15,9 @@
 //! with the counts of each end (labels as in the Parquet tables) and of each dynamical class
 //! of the active comets. The particle-years count each comet until its end. The clock covers
 //! `advance_to` only. `CENTAUR_THROUGHPUT_INITIAL=FILE` writes the initial barycentric states
-//! (as `comet_throughput` does) and `CENTAUR_THROUGHPUT_FINAL=FILE` each comet's end
-//! (`id,status,time_days`).
+//! (as `comet_throughput` does) and `CENTAUR_THROUGHPUT_FINAL=FILE` each comet's status
+//! and its own time and barycentric position then, its end's if it ended
+//! (`id,status,time_days,x,y,z`; days, AU).
 use std::collections::BTreeMap;
 use std::time::Instant;
 
@@ -59,11 +60,16 @@ fn run() -> Result<(), String> {
     let planets = population.ephemeris().planets().clone();
     let mut ends: BTreeMap<String, usize> = BTreeMap::new();
     let mut classes: BTreeMap<&str, usize> = BTreeMap::new();
-    let mut final_rows = String::from("id,status,time_days\n");
+    let mut final_rows = String::from("id,status,time_days,x,y,z\n");
     for (i, m) in population.members().iter().enumerate() {
         let (label, time) = status_label(&m.status, &planets);
         *ends.entry(label.clone()).or_default() += 1;
-        final_rows.push_str(&format!("{},{label},{time:e}\n", m.id));
+        let time = if time.is_nan() { m.particle.time } else { time };
+        let q = m.particle.position;
+        final_rows.push_str(&format!(
+            "{},{label},{time:e},{:e},{:e},{:e}\n",
+            m.id, q.x, q.y, q.z
+        ));
         if m.status == ParticleStatus::Active {
             let el = population.elements(i).map_err(|e| e.to_string())?;
             *classes.entry(classify(&el).label()).or_default() += 1;
