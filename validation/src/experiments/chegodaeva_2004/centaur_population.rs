@@ -47,6 +47,9 @@ const P_MIN: f64 = 0.0027;
 /// anything else from our code) and the time in years (∞ if active at the span's end).
 type Ends = Vec<(String, f64)>;
 
+/// A named end rule: which labels it counts.
+type Rule = (&'static str, fn(&str) -> bool);
+
 fn run_ours(ctx: &Context, span_years: f64) -> Result<Ends> {
     let path = workspace_root().join("populations/centaurs.toml");
     let spec = PopulationSpec::from_file(&path)?;
@@ -230,7 +233,7 @@ impl Experiment for CentaurPopulation {
                 surviving(&reference, t),
             );
         }
-        let rules: [(&str, fn(&str) -> bool); 3] = [
+        let rules: [Rule; 3] = [
             ("ended by q < 2.5 AU", |l| l == "perihelion"),
             ("ejected", |l| l == "ejected"),
             ("collided with a planet", |l| l.starts_with("collision_")),

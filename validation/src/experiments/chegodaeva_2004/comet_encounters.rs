@@ -66,8 +66,11 @@ fn cases(ctx: &Context) -> Result<Vec<Case>> {
     Ok(out)
 }
 
+/// IAS15's result of one case: case, epsilon, closest approach (AU), position, velocity.
+type Ias15Row = (usize, f64, f64, Vec3, Vec3);
+
 /// IAS15's particle state at `t_end` for `case` and `epsilon`, and the closest approach.
-fn ias15(ctx: &Context) -> Result<Vec<(usize, f64, f64, Vec3, Vec3)>> {
+fn ias15(ctx: &Context) -> Result<Vec<Ias15Row>> {
     let cols = [
         "case", "epsilon", "closest", "x", "y", "z", "vx", "vy", "vz",
     ];
