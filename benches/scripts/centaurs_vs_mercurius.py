@@ -8,13 +8,14 @@ Run from the workspace root, after `cargo build --release -p benches --example c
     flock /tmp/build.lock /work/venv-rebound/bin/python benches/scripts/centaurs_vs_mercurius.py accuracy
     flock /tmp/build.lock /work/venv-rebound/bin/python benches/scripts/centaurs_vs_mercurius.py scaling
 
-accuracy [N] [YEARS]: N = 300 Centaurs (benches::centaur_population, seed 2027) for 1 kyr.
+accuracy [N] [YEARS] [RATE_YEARS]: N = 300 Centaurs (benches::centaur_population, seed 2027) for 1 kyr.
 Each code's position error of each comet at its final time against IAS15 (REBOUND, epsilon =
 1e-9, the comet alone with the Sun and four giants, stopped at that code's final time of that
 comet); the median and 90th percentile over the comets active in every run. Ours at several
-first steps per AU (the encounter tolerance at its default 1e-12), MERCURIUS (r_crit_hill = 3)
+first steps per AU and planet steps (the encounter tolerance at its default 1e-12), MERCURIUS (r_crit_hill = 3)
 at several dt. Then the particle-years per second of each configuration on one thread
-(RAYON_NUM_THREADS = OMP_NUM_THREADS = 1) over 10 kyr, best of 3 interleaved runs.
+(RAYON_NUM_THREADS = OMP_NUM_THREADS = 1) over RATE_YEARS = 10 kyr, best of 3 interleaved
+runs (RATE_YEARS = 0: no rates, the errors only).
 scaling: ours at N = 1000, 10 kyr, on 1 and 2 threads, best of 3 interleaved runs; the ratio.
 """
 import csv
@@ -31,18 +32,22 @@ EXAMPLE = "target/release/examples/centaur_throughput"
 YEAR = 365.25
 AU_KM = 149_597_870.7
 RADII_KM = [71_492.0, 60_268.0, 25_559.0, 24_764.0]
-OURS_STEPS_PER_AU = [4.0, 2.0, 1.0, 0.5]
+# (first step in days per AU of initial distance, planets' S6 step in days): the default
+# (2, 730.5) and other comet and planet steps.
+OURS = [(4.0, 730.5), (2.0, 730.5), (1.0, 730.5), (0.5, 730.5), (2.0, 365.25), (2.0, 182.625),
+        (1.0, 182.625)]
 MERCURIUS_DT_YEARS = [0.4, 0.2, 0.1, 0.05]
 REPEATS = 3
 
 
-def run_ours(n, years, step_per_au=2.0, threads=1, initial=None, final=None):
+def run_ours(n, years, step_per_au=2.0, threads=1, initial=None, final=None, planet_step=730.5):
     env = dict(os.environ, RAYON_NUM_THREADS=str(threads))
     if initial:
         env["CENTAUR_THROUGHPUT_INITIAL"] = initial
     if final:
         env["CENTAUR_THROUGHPUT_FINAL"] = final
-    out = subprocess.run([EXAMPLE, str(n), repr(years), repr(step_per_au)], env=env,
+    args = [str(n), repr(years), repr(step_per_au), "1e-12", "2027", repr(planet_step)]
+    out = subprocess.run([EXAMPLE] + args, env=env,
                          check=True, capture_output=True, text=True).stdout
     last = out.strip().splitlines()[-1]
     return dict(kv.split("=") for kv in last.split())
@@ -106,11 +111,11 @@ def accuracy(n=300, years=1000.0, rate_years=10_000.0):
     run_ours(n, 0.001, initial=init)
     bodies, particles = read_initial(init)
     runs = {}  # label -> (times per comet, positions per comet, active mask)
-    for s in OURS_STEPS_PER_AU:
-        line = run_ours(n, years, step_per_au=s, final=fin)
+    for s, ps in OURS:
+        line = run_ours(n, years, step_per_au=s, final=fin, planet_step=ps)
         with open(fin) as f:
             rows = sorted(csv.DictReader(f), key=lambda r: int(r["id"]))
-        runs[f"ours step_per_au={s:g}d"] = (
+        runs[f"ours step_per_au={s:g}d planets={ps:g}d"] = (
             np.array([float(r["time_days"]) for r in rows]),
             np.array([[float(r[c]) for c in "xyz"] for r in rows]),
             np.array([r["status"] == "active" for r in rows]),
@@ -129,11 +134,11 @@ def accuracy(n=300, years=1000.0, rate_years=10_000.0):
     print(f"# n={n} years={years:g}, {int(active.sum())} comets active in every run; reference IAS15 "
           f"(rebound {rebound.__version__}, epsilon 1e-9, each comet alone with the five bodies); "
           f"rates: {rate_years:g} yr, one thread, best of {REPEATS}; load {os.getloadavg()[0]:.2f}")
-    rates = {label: 0.0 for label in runs}
-    for _ in range(REPEATS):
-        for s in OURS_STEPS_PER_AU:
-            label = f"ours step_per_au={s:g}d"
-            rate = float(run_ours(n, rate_years, step_per_au=s)["particle_years_per_s"])
+    rates = {label: float("nan") if rate_years <= 0 else 0.0 for label in runs}
+    for _ in range(REPEATS if rate_years > 0 else 0):
+        for s, ps in OURS:
+            label = f"ours step_per_au={s:g}d planets={ps:g}d"
+            rate = float(run_ours(n, rate_years, step_per_au=s, planet_step=ps)["particle_years_per_s"])
             rates[label] = max(rates[label], rate)
         for dt in MERCURIUS_DT_YEARS:
             label = f"mercurius dt={dt:g}yr"
@@ -158,6 +163,6 @@ def scaling(n=1000, years=10_000.0):
 if __name__ == "__main__":
     mode, args = sys.argv[1], [float(a) for a in sys.argv[2:]]
     if mode == "accuracy":
-        accuracy(int(args[0]) if args else 300, *args[1:2])
+        accuracy(int(args[0]) if args else 300, *args[1:3])
     else:
         scaling(int(args[0]) if args else 1000, *args[1:2])
