@@ -37,12 +37,8 @@ fn run() -> Result<(), String> {
     let dir = args
         .get(1)
         .map_or_else(std::env::temp_dir, std::path::PathBuf::from);
-    let (population, _) = benches::scattered_disk_population(
-        n,
-        Scheme::S2,
-        547.875,
-        Integrator::S6 { step: 730.5 },
-    )?;
+    let (population, _) =
+        benches::scattered_disk_population(n, Scheme::S2, 547.875, Integrator::S6 { step: 730.5 })?;
     let save_path = dir.join(format!("population-save-{}.json", std::process::id()));
     let table_path = dir.join(format!("population-save-{}.parquet", std::process::id()));
     let save_s = best_of_three(|| population.save(&save_path).map_err(|e| e.to_string()))?;

@@ -8,8 +8,8 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use symplectic::io::{PopulationSpec, DAYS_PER_YEAR};
-use symplectic::SymplecticError;
 use symplectic::study::{run_study, FINAL_TABLE, SNAPSHOT_DIR};
+use symplectic::SymplecticError;
 
 /// Arguments of `particles comets`.
 #[derive(clap::Args)]

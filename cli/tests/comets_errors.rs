@@ -141,7 +141,11 @@ fn ctrl_c_stops_with_the_state_saved() {
     assert!(kill.success());
     let stopping = Instant::now();
     let out = child.wait_with_output().unwrap();
-    assert!(stopping.elapsed() < Duration::from_secs(10), "{:?} to stop", stopping.elapsed());
+    assert!(
+        stopping.elapsed() < Duration::from_secs(10),
+        "{:?} to stop",
+        stopping.elapsed()
+    );
     let e = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{e}");
     assert!(

@@ -711,7 +711,11 @@ pub fn conic_elements(r: &Vec3, v: &Vec3, mu: f64) -> Result<ConicElements, Symp
     let e_vec = v.cross(&h) / mu - r / r.norm();
     let e = shape.eccentricity;
     let n = Vec3::new(-h.y, h.x, 0.0);
-    let node_dir = if n.norm() > 0.0 { n.normalize() } else { Vec3::x() };
+    let node_dir = if n.norm() > 0.0 {
+        n.normalize()
+    } else {
+        Vec3::x()
+    };
     // Angles in the orbital plane, from `from` to `to`, about `w`.
     let angle = |from: &Vec3, to: &Vec3| w.dot(&from.cross(to)).atan2(from.dot(to));
     let (peri, nu) = if e > 0.0 {

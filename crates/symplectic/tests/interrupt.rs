@@ -71,7 +71,15 @@ fn a_stopped_population_goes_on_bit_for_bit() {
             .iter()
             .map(|m| {
                 let q = &m.particle;
-                (m.id, q.time.to_bits(), q.position, q.velocity, q.p4.to_bits(), q.steps, m.status.clone())
+                (
+                    m.id,
+                    q.time.to_bits(),
+                    q.position,
+                    q.velocity,
+                    q.p4.to_bits(),
+                    q.steps,
+                    m.status.clone(),
+                )
             })
             .collect()
     };
