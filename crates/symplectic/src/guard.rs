@@ -3,11 +3,11 @@
 //! against the memory available.
 //!
 //! A front end turns Ctrl-C into [`request_stop`] (the Python package from its main thread,
-//! the command line from its signal handler); the loops of [`Population::advance_to`]
-//! (crate::Population::advance_to), the ephemeris' extension and the readers return
-//! [`SymplecticError::Interrupted`] at their next check, leaving a state that goes on: each
-//! particle on its own clock, the planets' grid as far as it was built. The front end calls
-//! [`clear_stop`] before its next run.
+//! the command line from its signal handler); the loops of
+//! [`Population::advance_to`](crate::Population::advance_to), the ephemeris' extension and
+//! the readers return [`SymplecticError::Interrupted`] at their next check, leaving a state
+//! that goes on: each particle on its own clock, the planets' grid as far as it was built.
+//! The front end calls [`clear_stop`] before its next run.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
