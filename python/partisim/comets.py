@@ -281,6 +281,8 @@ class Population:
         from .progress import make_progress
 
         end_days = float(to_years) * DAYS_PER_YEAR
+        if not np.isfinite(end_days):
+            raise ValueError(f"to_years = {to_years}: must be finite")
         start = self.time_days
         total = max(int(np.ceil((end_days - start) / DAYS_PER_YEAR)), 0)
         bar = make_progress(total, progress, "years")
