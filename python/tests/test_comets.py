@@ -172,3 +172,22 @@ def test_six_elements_and_states_at_one_time():
     np.testing.assert_allclose(at["a_au"], own["a_au"], rtol=1e-9)
     states, times = pop.states_at(50.0)
     assert states.shape == (6, 6) and (times == 50.0 * 365.25).all()
+
+
+def test_encounters_from_python_reach_a_collision():
+    """``encounters={}`` (the population file's ``[encounters]`` with its defaults) from
+    Python: a comet 2 Neptune Hill radii behind Neptune, overtaking it head-on at
+    0.002 AU/day (3.5 km/s) along its orbit, is integrated through the encounter instead of
+    removed at the Hill sphere, and hits the planet: ``collision_Neptune``."""
+    planets = partisim.outer_solar_system()
+    q, v = planets.positions_au[3], planets.velocities_au_per_day[3]
+    hill = np.linalg.norm(q) * (planets.masses_msun[3] / 3.0) ** (1.0 / 3.0)
+    u = v / np.linalg.norm(v)
+    states = np.array([np.concatenate([q - 2.0 * hill * u, v + 0.002 * u]),
+                       np.concatenate([2.0 * q, 0.5 * v])])
+    pop = partisim.Population(planets, states, kind="heliocentric_state", planet_step_days=365.25,
+                              initial_step_days=30.0, encounters={})
+    pop.advance(0.5, progress=False)
+    assert pop.status == ["active", "active"] and list(pop.table()["in_encounter"]) == [True, False]
+    pop.advance(10.0, progress=False)
+    assert pop.status == ["collision_Neptune", "active"]
