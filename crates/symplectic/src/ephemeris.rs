@@ -180,7 +180,7 @@ impl Ephemeris {
             "the planets' ephemeris grid (planet step too short for the particles' steps)",
         )?;
         while self.grid_time(step) < t {
-            if step % 1024 == 0 {
+            if step.is_multiple_of(1024) {
                 crate::guard::check_stop("integrating the planets' ephemeris")?;
             }
             if let Err(e) = self.integrator.step(&mut planets) {
