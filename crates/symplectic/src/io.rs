@@ -394,7 +394,7 @@ impl PopulationSpec {
         check_memory(rows.len(), available_memory())?;
         let kind = self.particles.kind;
         for (k, row) in rows.iter().enumerate() {
-            if k % 65536 == 0 {
+            if k.is_multiple_of(65536) {
                 crate::guard::check_stop("checking the particle rows")?;
             }
             let names = particle_columns(kind);
@@ -548,7 +548,7 @@ pub fn read_particle_rows(
             available_bytes: available_memory(),
         })?;
     for (k, record) in reader.records().enumerate() {
-        if k % 65536 == 0 {
+        if k.is_multiple_of(65536) {
             crate::guard::check_stop("reading the particle file")?;
         }
         let record = record.map_err(|e| {

@@ -184,7 +184,7 @@ impl CometRun {
             }
         }
         for iteration in 0u64.. {
-            if iteration % 1024 == 0 {
+            if iteration.is_multiple_of(1024) {
                 crate::guard::check_stop("advancing the comet run")?;
             }
             let next = self
