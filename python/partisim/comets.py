@@ -233,16 +233,25 @@ class Population:
 
     @classmethod
     def from_file(cls, path: str) -> "Population":
-        """A population TOML file and its particle CSV (the input of ``cargo xtask comets``)."""
+        """A population TOML file and its particle CSV (the input of ``particles comets``).
+
+        Only regular files are read (a named pipe or a device such as ``/dev/zero`` is
+        refused before it is opened); the specification up to 1 MiB, the particle file's
+        lines counted against the memory available before any row is kept. Errors name the
+        file and the key or the line and column. Ctrl-C stops the reading
+        (``KeyboardInterrupt``)."""
         return cls._wrap(_partisim.Population.from_spec_file(str(path)))
 
     @classmethod
     def load(cls, path: str) -> "Population":
-        """A population written by :meth:`save` (refuses foreign or truncated files)."""
+        """A population written by :meth:`save` (refuses foreign or truncated files, a
+        file that is not a regular one, and one larger than the memory available)."""
         return cls._wrap(_partisim.Population.load(str(path)))
 
     def save(self, path: str) -> None:
-        """Writes the whole population atomically; :meth:`load` resumes it bit for bit."""
+        """Writes the whole population atomically (JSON, about 470 bytes per particle,
+        through a buffer: 50,000 comets in about 0.05 s); :meth:`load` resumes it bit for
+        bit."""
         self._inner.save(str(path))
 
     def advance(
