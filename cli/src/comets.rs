@@ -5,10 +5,11 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use symplectic::io::{PopulationSpec, DAYS_PER_YEAR};
 use symplectic::study::{run_study, FINAL_TABLE, SNAPSHOT_DIR};
+use symplectic::SymplecticError;
 
 /// Arguments of `particles comets`.
 #[derive(clap::Args)]
@@ -42,9 +43,18 @@ pub fn run(args: &CometsArgs) -> Result<()> {
             .progress_chars("=> "),
     );
     let epoch = spec.particles.epoch_days;
+    // Ctrl-C asks the study to stop (it saves its state and returns); a second one ends
+    // the process at once.
+    ctrlc::set_handler(|| {
+        if symplectic::guard::stop_requested() {
+            std::process::exit(130);
+        }
+        symplectic::guard::request_stop();
+    })
+    .context("installing the Ctrl-C handler")?;
     let start = Instant::now();
     let (mut particle_years, mut last_time) = (0.0f64, f64::NAN);
-    let summary = run_study(&args.population, &out, |p| {
+    let result = run_study(&args.population, &out, |p| {
         if last_time.is_finite() {
             particle_years += (p.time - last_time) / DAYS_PER_YEAR * p.active as f64;
         }
@@ -56,7 +66,18 @@ pub fn run(args: &CometsArgs) -> Result<()> {
             p.removed,
             particle_years / start.elapsed().as_secs_f64().max(1e-9)
         ));
-    })?;
+    });
+    let summary = match result {
+        Err(SymplecticError::Interrupted { .. }) => {
+            bar.abandon();
+            bail!(
+                "interrupted (Ctrl-C) at t = {:.1} years: the state is saved in {}; run the same command again to resume",
+                (last_time - epoch) / DAYS_PER_YEAR,
+                out.join(symplectic::study::CHECKPOINT_FILE).display()
+            );
+        }
+        other => other?,
+    };
     bar.finish();
     let p = summary.progress;
     println!(

@@ -24,6 +24,7 @@ threads of its worker process (rayon): give a worker process several cores, or s
 
 from __future__ import annotations
 
+import operator
 from typing import Any, List
 
 import numpy as np
@@ -59,9 +60,14 @@ def run_population_dask(
         The merged population, equal bit for bit to ``population_spec.build().advance(to_years)``.
     """
     n = len(population_spec.particles)
-    if not (isinstance(shards, int) and 1 <= shards):
+    # Any integer as numpy has them (np.int64, ...), not a float or a bool.
+    try:
+        count = None if isinstance(shards, (bool, np.bool_)) else operator.index(shards)
+    except TypeError:
+        count = None
+    if count is None or count < 1:
         raise ValueError(f"shards = {shards!r}: must be an integer >= 1")
-    shards = min(shards, max(n, 1))
+    shards = min(count, max(n, 1))
     ids = population_spec.ids
     if ids is None:
         ids = np.arange(n, dtype=np.uint64)

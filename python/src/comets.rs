@@ -59,12 +59,72 @@ struct Population {
     inner: RustPopulation,
 }
 
+/// The Python keyword of `PopulationSpec` for a field path of the specification's tables.
+fn python_setting(field: &str) -> String {
+    let (table, key) = field.split_once('.').unwrap_or((field, ""));
+    match (table, key) {
+        ("planets", "step_days") => "planet_step_days".into(),
+        ("planets", "scheme") => "planet_scheme".into(),
+        ("planets", "frame") => "frame".into(),
+        ("removal", k) | ("encounters", k) if !k.is_empty() => format!("{table}[{k:?}]"),
+        (_, "") => table.into(),
+        (_, k) => k.into(),
+    }
+}
+
 fn spec_from_json(spec_json: &str) -> PyResult<PopulationSpec> {
-    // The specification's TOML checks and field-naming messages, from a JSON document.
-    let value: toml::Value =
-        serde_json::from_str(spec_json).map_err(|e| rust_err(format!("population spec: {e}")))?;
-    let text = toml::to_string(&value).map_err(|e| rust_err(format!("population spec: {e}")))?;
-    PopulationSpec::parse(&text, Path::new("population spec")).map_err(rust_err)
+    // The specification's checks, with messages naming the Python keyword, never a line or
+    // column of the JSON text the caller never wrote.
+    PopulationSpec::from_json(spec_json, Path::new("PopulationSpec")).map_err(|e| match e {
+        symplectic::SymplecticError::Spec { field, reason, .. } if !field.is_empty() => rust_err(
+            format!("PopulationSpec {}: {reason}", python_setting(&field)),
+        ),
+        other => rust_err(other),
+    })
+}
+
+/// Runs `work` on a thread of its own, with the GIL released, while this thread checks for
+/// Ctrl-C every 50 ms: a pending signal asks the work to stop
+/// ([`symplectic::guard::request_stop`]: the loops stop at their next check, leaving a state
+/// that goes on) and is raised (KeyboardInterrupt) once the work has returned.
+fn interruptible<T: Send>(
+    py: Python<'_>,
+    work: impl FnOnce() -> Result<T, symplectic::SymplecticError> + Send,
+) -> PyResult<T> {
+    use std::sync::mpsc::RecvTimeoutError;
+    symplectic::guard::clear_stop();
+    let (result, signal) = py.detach(|| {
+        std::thread::scope(|scope| {
+            let (tx, rx) = std::sync::mpsc::channel();
+            scope.spawn(move || {
+                // The receiver outlives the scope's threads.
+                let _ = tx.send(work());
+            });
+            let mut signal = None;
+            loop {
+                match rx.recv_timeout(std::time::Duration::from_millis(50)) {
+                    Ok(r) => return (Some(r), signal),
+                    Err(RecvTimeoutError::Timeout) if signal.is_none() => {
+                        if let Err(e) = Python::attach(|py| py.check_signals()) {
+                            symplectic::guard::request_stop();
+                            signal = Some(e);
+                        }
+                    }
+                    Err(RecvTimeoutError::Timeout) => {}
+                    // The work panicked; the scope re-raises its panic.
+                    Err(RecvTimeoutError::Disconnected) => return (None, signal),
+                }
+            }
+        })
+    });
+    symplectic::guard::clear_stop();
+    if let Some(e) = signal {
+        return Err(e);
+    }
+    match result {
+        Some(r) => r.map_err(rust_err),
+        None => Err(rust_err("the computation stopped without a result")),
+    }
 }
 
 fn rows(
@@ -80,6 +140,9 @@ fn rows(
     }
     let p: PyReadonlyArray2<'_, f64> = particles.extract()?;
     let p = p.as_array();
+    // Counted and checked against the memory before anything is copied.
+    symplectic::io::check_memory(p.nrows(), symplectic::io::available_memory())
+        .map_err(rust_err)?;
     let ids: Vec<u64> = match ids {
         Some(ids) => {
             let ia = untyped(ids, "ids")?;
@@ -98,16 +161,20 @@ fn rows(
             p.nrows()
         )));
     }
-    Ok(p.rows()
-        .into_iter()
-        .zip(ids)
-        .enumerate()
-        .map(|(k, (r, id))| ParticleRow {
-            line: k as u64,
-            id,
-            values: [r[0], r[1], r[2], r[3], r[4], r[5]],
-        })
-        .collect())
+    let mut out = Vec::new();
+    symplectic::guard::try_reserve(&mut out, p.nrows(), "the particle rows").map_err(rust_err)?;
+    out.extend(
+        p.rows()
+            .into_iter()
+            .zip(ids)
+            .enumerate()
+            .map(|(k, (r, id))| ParticleRow {
+                line: k as u64,
+                id,
+                values: [r[0], r[1], r[2], r[3], r[4], r[5]],
+            }),
+    );
+    Ok(out)
 }
 
 #[pymethods]
@@ -124,27 +191,37 @@ impl Population {
     ) -> PyResult<Self> {
         let spec = spec_from_json(spec_json)?;
         let rows = rows(particles, ids)?;
-        let inner = py
-            .detach(|| spec.population_from_rows(&rows, Path::new("particles")))
-            .map_err(rust_err)?;
+        let inner = interruptible(py, || {
+            spec.population_from_rows(&rows, Path::new("particles"))
+        })?;
         Ok(Self { inner })
     }
 
     /// Reads a population TOML file and its particle CSV (`cargo xtask comets` input).
     #[staticmethod]
     fn from_spec_file(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
-        let inner = py
-            .detach(|| PopulationSpec::from_file(&path).and_then(|s| s.population(&path)))
-            .map_err(rust_err)?;
+        let inner = interruptible(py, || {
+            PopulationSpec::from_file(&path).and_then(|s| s.population(&path))
+        })?;
         Ok(Self { inner })
     }
 
-    /// Advances every active particle to `t_days` (days after the planets' epoch), in
-    /// synchronisation windows; Ctrl-C stops between windows (the windows done are kept).
-    fn advance_to_days(&mut self, py: Python<'_>, t_days: f64) -> PyResult<()> {
+    /// Advances every active particle to `t_days` (days after the planets' epoch), one
+    /// synchronisation window at a time; after each, `callback(progress)` (if given) sees a
+    /// dict (`time_days`, `active`, `removed`, `particle_steps`) and stops the run by
+    /// returning something true. Ctrl-C stops within a window (KeyboardInterrupt), each
+    /// particle where it was on its own clock. Returns whether the callback stopped it.
+    #[pyo3(signature = (t_days, callback = None))]
+    fn advance_to_days(
+        &mut self,
+        py: Python<'_>,
+        t_days: f64,
+        callback: Option<Bound<'_, PyAny>>,
+    ) -> PyResult<bool> {
         if !t_days.is_finite() {
             return Err(PyValueError::new_err(format!(
-                "end time {t_days} days: must be finite"
+                "to_years = {}: must be finite",
+                t_days / symplectic::io::DAYS_PER_YEAR
             )));
         }
         let window = f64::from(self.inner.window_steps()) * self.inner.ephemeris().grid_step();
@@ -153,11 +230,19 @@ impl Population {
             // not depend on where the calls stop (Population's determinism).
             let end = (self.inner.time() + window).min(t_days);
             let inner = &mut self.inner;
-            py.detach(|| inner.advance_to(end, |_| {}))
-                .map_err(rust_err)?;
-            py.check_signals()?;
+            let p = interruptible(py, || inner.advance_to(end, |_| {}))?;
+            if let Some(cb) = &callback {
+                let d = PyDict::new(py);
+                d.set_item("time_days", self.inner.time())?;
+                d.set_item("active", p.active)?;
+                d.set_item("removed", p.removed)?;
+                d.set_item("particle_steps", p.particle_steps)?;
+                if cb.call1((d,))?.is_truthy()? {
+                    return Ok(true);
+                }
+            }
             if end >= t_days {
-                return Ok(());
+                return Ok(false);
             }
         }
     }
@@ -238,9 +323,7 @@ impl Population {
     #[staticmethod]
     fn merge(py: Python<'_>, shards: Vec<PyRef<'_, Population>>) -> PyResult<Self> {
         let shards: Vec<RustPopulation> = shards.iter().map(|s| s.inner.clone()).collect();
-        let inner = py
-            .detach(|| RustPopulation::merge(shards))
-            .map_err(rust_err)?;
+        let inner = interruptible(py, || RustPopulation::merge(shards))?;
         Ok(Self { inner })
     }
 
@@ -253,9 +336,7 @@ impl Population {
     /// Reads a population written by `save`.
     #[staticmethod]
     fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
-        let inner = py
-            .detach(|| RustPopulation::load(&path))
-            .map_err(rust_err)?;
+        let inner = interruptible(py, || RustPopulation::load(&path))?;
         Ok(Self { inner })
     }
 
@@ -277,14 +358,73 @@ impl Population {
     /// Barycentric states `(N, 6)`: x, y, z (AU), vx, vy, vz (AU/day), in identifier order.
     #[getter]
     fn states<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let m = self.inner.members();
-        let mut flat = Vec::with_capacity(6 * m.len());
-        for (i, member) in m.iter().enumerate() {
-            let q = self.inner.barycentric_position(i);
-            let v = member.particle.velocity;
-            flat.extend_from_slice(&[q.x, q.y, q.z, v.x, v.y, v.z]);
+        let (flat, _) = self.states_at(None)?;
+        flat.into_pyarray(py)
+            .reshape([self.inner.members().len(), 6])
+    }
+
+    /// Barycentric osculating elements (`μ = G M`) of every particle, as a dict of `(N,)`
+    /// arrays: `a_au`, `e`, `i_deg`, `node_deg`, `peri_deg`, `mean_anomaly_deg`, `q_au`, and
+    /// `time_days`, the time they hold at. Each particle at its own time, or with `at_days`
+    /// every active one carried to `at_days` along its osculating two-body orbit (a Kepler
+    /// drift about `G M`; removed particles stay at their own time).
+    #[pyo3(signature = (at_days = None))]
+    fn elements<'py>(&self, py: Python<'py>, at_days: Option<f64>) -> PyResult<Bound<'py, PyDict>> {
+        let (flat, times) = self.states_at(at_days)?;
+        let mu = self.inner.total_gm();
+        let names = [
+            "a_au",
+            "e",
+            "i_deg",
+            "node_deg",
+            "peri_deg",
+            "mean_anomaly_deg",
+            "q_au",
+        ];
+        let mut cols: Vec<Vec<f64>> = names
+            .iter()
+            .map(|_| Vec::with_capacity(times.len()))
+            .collect();
+        for s in flat.chunks_exact(6) {
+            let r = symplectic::Vec3::new(s[0], s[1], s[2]);
+            let v = symplectic::Vec3::new(s[3], s[4], s[5]);
+            let row = match symplectic::io::conic_elements(&r, &v, mu) {
+                Ok(el) => [
+                    el.perihelion / (1.0 - el.eccentricity),
+                    el.eccentricity,
+                    el.inclination.to_degrees(),
+                    el.node.to_degrees(),
+                    el.argument_of_perihelion.to_degrees(),
+                    el.mean_anomaly.to_degrees(),
+                    el.perihelion,
+                ],
+                Err(_) => [f64::NAN; 7],
+            };
+            for (c, x) in cols.iter_mut().zip(row) {
+                c.push(x);
+            }
         }
-        flat.into_pyarray(py).reshape([m.len(), 6])
+        let d = PyDict::new(py);
+        for (name, c) in names.iter().zip(cols) {
+            d.set_item(name, c.into_pyarray(py))?;
+        }
+        d.set_item("time_days", times.into_pyarray(py))?;
+        Ok(d)
+    }
+
+    /// Barycentric states `(N, 6)` at `at_days` (see `elements`), flat, and their times.
+    #[pyo3(signature = (at_days = None))]
+    fn states_at_days<'py>(
+        &self,
+        py: Python<'py>,
+        at_days: Option<f64>,
+    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>)> {
+        let (flat, times) = self.states_at(at_days)?;
+        let n = times.len();
+        Ok((
+            flat.into_pyarray(py).reshape([n, 6])?,
+            times.into_pyarray(py),
+        ))
     }
 
     /// Identifiers, in member order.
@@ -292,6 +432,39 @@ impl Population {
     fn ids<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u64>> {
         let ids: Vec<u64> = self.inner.members().iter().map(|m| m.id).collect();
         ids.into_pyarray(py)
+    }
+}
+
+impl Population {
+    /// Every member's barycentric state, flat `(N·6)`, and its time: its own, or `at_days`
+    /// for an active member carried there by a Kepler drift about `G M`.
+    fn states_at(&self, at_days: Option<f64>) -> PyResult<(Vec<f64>, Vec<f64>)> {
+        if let Some(t) = at_days {
+            if !t.is_finite() {
+                return Err(PyValueError::new_err(format!(
+                    "at_time {t}: must be finite"
+                )));
+            }
+        }
+        let m = self.inner.members();
+        let mu = self.inner.total_gm();
+        let mut flat = Vec::new();
+        symplectic::guard::try_reserve(&mut flat, 6 * m.len(), "the states").map_err(rust_err)?;
+        let mut times = Vec::with_capacity(m.len());
+        for (i, member) in m.iter().enumerate() {
+            let mut q = self.inner.barycentric_position(i);
+            let mut v = member.particle.velocity;
+            let mut t = member.particle.time;
+            if let Some(at) =
+                at_days.filter(|_| member.status == symplectic::ParticleStatus::Active)
+            {
+                symplectic::kepler::drift(&mut q, &mut v, mu, at - t).map_err(rust_err)?;
+                t = at;
+            }
+            flat.extend_from_slice(&[q.x, q.y, q.z, v.x, v.y, v.z]);
+            times.push(t);
+        }
+        Ok((flat, times))
     }
 }
 

@@ -169,7 +169,20 @@ impl Ephemeris {
         let mut states = Vec::new();
         let mut work = WorkCounters::default();
         let mut step = self.planet_steps();
+        // The grid states asked for, allocated up front and fallibly: a planet step far
+        // shorter than the particles' steps asks for more than the memory holds.
+        let new_states = ((t - self.grid_time(step)) / self.grid_step())
+            .ceil()
+            .max(0.0);
+        crate::guard::try_reserve(
+            &mut states,
+            (new_states as usize).saturating_mul(self.stride()),
+            "the planets' ephemeris grid (planet step too short for the particles' steps)",
+        )?;
         while self.grid_time(step) < t {
+            if step.is_multiple_of(1024) {
+                crate::guard::check_stop("integrating the planets' ephemeris")?;
+            }
             if let Err(e) = self.integrator.step(&mut planets) {
                 return Ok(Extension {
                     planets,

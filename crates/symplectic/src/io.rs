@@ -20,6 +20,30 @@ use crate::{
 /// Days per Julian year, the unit of spans in the specification.
 pub const DAYS_PER_YEAR: f64 = 365.25;
 
+/// Largest population specification read (bytes): a specification is a few tables of
+/// settings, a few hundred bytes; anything near this size is not one.
+pub const MAX_SPEC_FILE_BYTES: u64 = 1 << 20;
+
+/// Largest particle file read (bytes, 64 GiB): about 10⁹ rows of seven numbers. Below it,
+/// the rows are counted and checked against the memory available before any is kept.
+pub const MAX_PARTICLE_FILE_BYTES: u64 = 1 << 36;
+
+/// Most snapshot tables one study writes (`span.years / span.snapshot_every_years + 1`): a
+/// cadence far below the span writes files faster than anyone reads them.
+pub const MAX_SNAPSHOTS: f64 = 10_000.0;
+
+/// Most checkpoints one study writes (`span.years / span.checkpoint_every_years`): each
+/// rewrites the whole population.
+pub const MAX_CHECKPOINTS: f64 = 100_000.0;
+
+/// Largest planets' grid one particle step may need (bytes, 1 GiB): the grid must cover a
+/// particle's whole step plus two synchronisation windows, `(first step + 2 windows) /
+/// planet step` states of 360 bytes (positions, velocities and accelerations of the Sun and
+/// four planets). A planet step of a few seconds against particle steps of a year and a
+/// half asks for more; the giant planets' shortest period, Jupiter's 4333 days, needs
+/// nothing like it.
+pub const MAX_STEP_GRID_BYTES: f64 = (1u64 << 30) as f64;
+
 /// A population study as written in a TOML file (every table and field is checked; an
 /// unknown field is an error naming it).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -158,11 +182,24 @@ pub struct SpanSpec {
 
 impl PopulationSpec {
     /// Reads and checks a specification; errors name the file, the field and, for syntax,
-    /// the line and column.
+    /// the line and column. Only a regular file of at most [`MAX_SPEC_FILE_BYTES`] is read
+    /// (a named pipe or a device is refused before it is opened).
     pub fn from_file(path: &Path) -> Result<Self, SymplecticError> {
-        let text =
-            std::fs::read_to_string(path).map_err(|e| spec_error(path, "", e.to_string()))?;
-        Self::parse(&text, path)
+        Self::parse(&read_spec_text(path)?, path)
+    }
+
+    /// Checks a specification given as a JSON document of the same tables (a front end's
+    /// settings rather than a file; `origin` names it in messages). Errors name the field by
+    /// its path in the tables (`planets.step_days`), never a line or column of the JSON text.
+    pub fn from_json(text: &str, origin: &Path) -> Result<Self, SymplecticError> {
+        let value: serde_json::Value =
+            serde_json::from_str(text).map_err(|e| spec_error(origin, "", e.to_string()))?;
+        let spec: Self = serde_path_to_error::deserialize(value).map_err(|e| {
+            let field = e.path().to_string();
+            spec_error(origin, &field, e.inner().to_string().trim().to_string())
+        })?;
+        spec.check(origin)?;
+        Ok(spec)
     }
 
     /// Parses and checks specification text; `path` names it in messages.
@@ -215,6 +252,84 @@ impl PopulationSpec {
                 path,
                 "integrator.window_steps",
                 "must be >= 1".into(),
+            ));
+        }
+        self.check_limits(path)
+    }
+
+    /// The limits that keep a run finite: the snapshot and checkpoint counts, the planets'
+    /// grid one particle step needs, a first step that moves the particles' clocks.
+    fn check_limits(&self, path: &Path) -> Result<(), SymplecticError> {
+        let span = &self.span;
+        let snapshots = span.years / span.snapshot_every_years + 1.0;
+        if snapshots > MAX_SNAPSHOTS {
+            return Err(spec_error(
+                path,
+                "span.snapshot_every_years",
+                format!(
+                    "{} years over a span of {} years writes {snapshots:.3e} snapshot files, more than MAX_SNAPSHOTS = {MAX_SNAPSHOTS}: take at least {:.6e} years",
+                    span.snapshot_every_years,
+                    span.years,
+                    span.years / (MAX_SNAPSHOTS - 1.0)
+                ),
+            ));
+        }
+        if let Some(every) = span.checkpoint_every_years {
+            let checkpoints = span.years / every;
+            if checkpoints > MAX_CHECKPOINTS {
+                return Err(spec_error(
+                    path,
+                    "span.checkpoint_every_years",
+                    format!(
+                        "{every} years over a span of {} years writes {checkpoints:.3e} checkpoints, more than MAX_CHECKPOINTS = {MAX_CHECKPOINTS}: take at least {:.6e} years",
+                        span.years,
+                        span.years / MAX_CHECKPOINTS
+                    ),
+                ));
+            }
+        }
+        let planet_step = self.planets.step_days;
+        let first_step = self.integrator.initial_step_days;
+        let window_steps = f64::from(
+            self.integrator
+                .window_steps
+                .unwrap_or(crate::DEFAULT_WINDOW_STEPS),
+        );
+        let grid_bytes = (first_step / planet_step + 2.0 * window_steps + 1.0) * GRID_STATE_BYTES;
+        let window_bytes = (2.0 * window_steps + 1.0) * GRID_STATE_BYTES;
+        if window_bytes > MAX_STEP_GRID_BYTES {
+            return Err(spec_error(
+                path,
+                "integrator.window_steps",
+                format!(
+                    "{window_steps} planet steps per window: the planets' grid of two windows would take {window_bytes:.3e} bytes, more than MAX_STEP_GRID_BYTES = {MAX_STEP_GRID_BYTES:.3e}; take at most {:.0}",
+                    (MAX_STEP_GRID_BYTES / GRID_STATE_BYTES - 1.0) / 2.0 - 1.0
+                ),
+            ));
+        }
+        if grid_bytes > MAX_STEP_GRID_BYTES {
+            let shortest =
+                first_step / (MAX_STEP_GRID_BYTES / GRID_STATE_BYTES - 2.0 * window_steps - 1.0);
+            return Err(spec_error(
+                path,
+                "planets.step_days",
+                format!(
+                    "{planet_step} days is too short for particle steps of {first_step} days: the planets' grid of one particle step would take {grid_bytes:.3e} bytes, more than MAX_STEP_GRID_BYTES = {MAX_STEP_GRID_BYTES:.3e}; take at least {shortest:.3e} days"
+                ),
+            ));
+        }
+        // The first synchronisation, or the span's end if later: a step that does not change
+        // a time of that size in f64 never gets the particles there.
+        let reach = self.particles.epoch_days
+            + (window_steps * planet_step).max(span.years * DAYS_PER_YEAR);
+        if reach + first_step <= reach {
+            return Err(spec_error(
+                path,
+                "integrator.initial_step_days",
+                format!(
+                    "{first_step} days makes no progress in f64 at t = {reach:.6e} days, which the particles must reach: take at least {:.3e} days",
+                    2.0 * reach * f64::EPSILON
+                ),
             ));
         }
         Ok(())
@@ -278,7 +393,10 @@ impl PopulationSpec {
         let integrator = self.particle_integrator()?;
         check_memory(rows.len(), available_memory())?;
         let kind = self.particles.kind;
-        for row in rows {
+        for (k, row) in rows.iter().enumerate() {
+            if k.is_multiple_of(65536) {
+                crate::guard::check_stop("checking the particle rows")?;
+            }
             let names = particle_columns(kind);
             if let Some(c) = row.values.iter().position(|v| !v.is_finite()) {
                 let reason = format!("{} is not a finite number", row.values[c]);
@@ -290,14 +408,17 @@ impl PopulationSpec {
         let epoch = self.particles.epoch_days;
         let mut bodies = crate::BodyStates::default();
         ephemeris.bodies_at(epoch, &mut bodies)?;
-        let states = rows
-            .iter()
-            .map(|row| {
+        let mut states = Vec::new();
+        crate::guard::try_reserve(&mut states, rows.len(), "the particles' initial states")?;
+        for row in rows {
+            states.push(
                 to_integrator_state(row, kind, integrator.variant, &bodies)
-                    .map_err(|reason| particle_error(origin, row.line, "", reason))
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        let ids: Vec<u64> = rows.iter().map(|r| r.id).collect();
+                    .map_err(|reason| particle_error(origin, row.line, "", reason))?,
+            );
+        }
+        let mut ids = Vec::new();
+        crate::guard::try_reserve(&mut ids, rows.len(), "the particles' identifiers")?;
+        ids.extend(rows.iter().map(|r| r.id));
         let mut population = Population::new(
             ephemeris,
             integrator,
@@ -313,6 +434,16 @@ impl PopulationSpec {
         population.set_encounters(self.encounters)?;
         Ok(population)
     }
+}
+
+/// Bytes of one state of the planets' grid: positions, velocities and accelerations of the
+/// Sun and the four giant planets.
+const GRID_STATE_BYTES: f64 = (9 * 5 * 8) as f64;
+
+/// The text of a specification file, guarded ([`MAX_SPEC_FILE_BYTES`], regular files only).
+pub fn read_spec_text(path: &Path) -> Result<String, SymplecticError> {
+    crate::guard::read_text_limited(path, MAX_SPEC_FILE_BYTES, "MAX_SPEC_FILE_BYTES")
+        .map_err(|reason| spec_error(path, "", reason))
 }
 
 fn spec_error(path: &Path, field: &str, reason: String) -> SymplecticError {
@@ -363,6 +494,12 @@ pub fn read_particle_rows(
     path: &Path,
     kind: ParticleKind,
 ) -> Result<Vec<ParticleRow>, SymplecticError> {
+    // Only a regular file (a named pipe would block in `open`, a device never ends); its
+    // lines are counted and checked against the memory available before any row is kept.
+    crate::guard::regular_file_size(path, MAX_PARTICLE_FILE_BYTES, "MAX_PARTICLE_FILE_BYTES")
+        .map_err(|reason| particle_error(path, 0, "", reason))?;
+    let lines = count_lines(path)?;
+    check_memory(lines, available_memory())?;
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .comment(Some(b'#'))
@@ -402,8 +539,18 @@ pub fn read_particle_rows(
         ));
     }
     let mut rows = Vec::new();
+    crate::guard::try_reserve(&mut rows, lines, "the particle file's rows")?;
     let mut seen = std::collections::HashSet::new();
-    for record in reader.records() {
+    seen.try_reserve(lines)
+        .map_err(|_| SymplecticError::AllocationFailed {
+            what: "the particle file's identifiers",
+            requested_bytes: lines as u128 * 16,
+            available_bytes: available_memory(),
+        })?;
+    for (k, record) in reader.records().enumerate() {
+        if k.is_multiple_of(65536) {
+            crate::guard::check_stop("reading the particle file")?;
+        }
         let record = record.map_err(|e| {
             let line = e.position().map_or(0, |p| p.line());
             particle_error(path, line, "", e.to_string())
@@ -447,6 +594,24 @@ pub fn read_particle_rows(
         rows.push(ParticleRow { line, id, values });
     }
     Ok(rows)
+}
+
+/// Lines of the file at `path` (an upper bound of its rows), read in blocks with Ctrl-C
+/// checked.
+fn count_lines(path: &Path) -> Result<usize, SymplecticError> {
+    use std::io::Read;
+    let err = |e: std::io::Error| particle_error(path, 0, "", e.to_string());
+    let mut file = std::fs::File::open(path).map_err(err)?;
+    let mut block = vec![0u8; 1 << 20];
+    let mut lines = 1usize;
+    loop {
+        crate::guard::check_stop("counting the particle file's rows")?;
+        let n = file.read(&mut block).map_err(err)?;
+        if n == 0 {
+            return Ok(lines);
+        }
+        lines += block[..n].iter().filter(|&&b| b == b'\n').count();
+    }
 }
 
 fn check_row(v: &[f64; 6], kind: ParticleKind) -> Result<(), (&'static str, String)> {
@@ -522,6 +687,60 @@ fn to_integrator_state(
     })
 }
 
+/// The six classical elements of the state `(r, v)` about a centre of gravitational
+/// parameter `mu`, the inverse of [`state_from_elements`] (angles in radians, in `[0, 2π)`):
+/// `h = r × v`, the eccentricity vector `e = v × h/μ − r/|r|`, the node vector `n = ẑ × h`;
+/// `i = acos(h_z/|h|)`, `Ω = atan2(n_y, n_x)`, `ω` the angle from `n` to `e` and the true
+/// anomaly `ν` from `e` to `r` in the orbital plane; `M = E − e sin E` with
+/// `E = atan2(√(1−e²) sin ν, e + cos ν)`, or `M = e sinh H − H` with
+/// `sinh H = √(e²−1) sin ν/(1 + e cos ν)` for a hyperbola; `q = |h|²/(μ(1 + e))`.
+/// Conventions where an angle is undefined: `Ω = 0` for `i = 0` (then `ω` is measured from
+/// `x̂`), `ω = 0` for `e = 0` (then `ν` is measured from the node line).
+pub fn conic_elements(r: &Vec3, v: &Vec3, mu: f64) -> Result<ConicElements, SymplecticError> {
+    // Checks the state and gives q, e, i.
+    let shape = crate::kepler::elements(r, v, mu)?;
+    let h = r.cross(v);
+    if h.norm() == 0.0 {
+        return Err(SymplecticError::InvalidState {
+            what: "osculating elements",
+            reason: format!("r = {r:?}, v = {v:?}: a radial orbit has no orbital plane"),
+        });
+    }
+    let tau = std::f64::consts::TAU;
+    let w = h.normalize();
+    let e_vec = v.cross(&h) / mu - r / r.norm();
+    let e = shape.eccentricity;
+    let n = Vec3::new(-h.y, h.x, 0.0);
+    let node_dir = if n.norm() > 0.0 {
+        n.normalize()
+    } else {
+        Vec3::x()
+    };
+    // Angles in the orbital plane, from `from` to `to`, about `w`.
+    let angle = |from: &Vec3, to: &Vec3| w.dot(&from.cross(to)).atan2(from.dot(to));
+    let (peri, nu) = if e > 0.0 {
+        (angle(&node_dir, &e_vec), angle(&e_vec, r))
+    } else {
+        (0.0, angle(&node_dir, r))
+    };
+    let (s, c) = nu.sin_cos();
+    let mean_anomaly = if e < 1.0 {
+        let ea = ((1.0 - e * e).sqrt() * s).atan2(e + c);
+        (ea - e * ea.sin()).rem_euclid(tau)
+    } else {
+        let hyp = ((e * e - 1.0).sqrt() * s / (1.0 + e * c)).asinh();
+        e * hyp.sinh() - hyp
+    };
+    Ok(ConicElements {
+        perihelion: shape.perihelion,
+        eccentricity: e,
+        inclination: shape.inclination,
+        node: node_dir.y.atan2(node_dir.x).rem_euclid(tau),
+        argument_of_perihelion: peri.rem_euclid(tau),
+        mean_anomaly,
+    })
+}
+
 /// Bytes a population of `particles` needs (the members and a copy for the output tables).
 pub fn population_bytes(particles: usize) -> u128 {
     particles as u128 * (Population::bytes_per_particle() as u128 + 200)
@@ -540,13 +759,7 @@ pub fn check_memory(particles: usize, available: Option<u64>) -> Result<(), Symp
     }
 }
 
-/// `MemAvailable` of `/proc/meminfo` in bytes, where there is one.
-pub fn available_memory() -> Option<u64> {
-    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024)
-}
+pub use crate::guard::available_memory;
 
 /// The table of every particle now: `id`, `status`, `time_days` (the particle's own time:
 /// the steps are variable, so each particle is at the first step end at or after the

@@ -166,6 +166,7 @@
 pub mod classes;
 pub mod encounter;
 pub mod ephemeris;
+pub mod guard;
 #[cfg(feature = "io")]
 pub mod io;
 pub mod kepler;
@@ -331,6 +332,27 @@ pub enum SymplecticError {
         path: String,
         /// Why.
         reason: String,
+    },
+    /// A stop was requested ([`guard::request_stop`], Ctrl-C); the state is consistent and
+    /// goes on from where it stopped.
+    #[error("interrupted (Ctrl-C) while {what}")]
+    Interrupted {
+        /// What was running.
+        what: &'static str,
+    },
+    /// An allocation sized by the input was refused: more than the memory available, or the
+    /// allocator could not give it.
+    #[error(
+        "{what}: {requested_bytes} bytes asked for, {}",
+        available_bytes.map_or("refused by the allocator".to_string(), |a| format!("{a} bytes available"))
+    )]
+    AllocationFailed {
+        /// What the memory was for.
+        what: &'static str,
+        /// Bytes asked for.
+        requested_bytes: u128,
+        /// Bytes available (`MemAvailable`), where known.
+        available_bytes: Option<u64>,
     },
     /// The integration blew up: a non-finite value appeared at this step.
     #[error("blow-up at step {step}: body {body} has a non-finite state")]

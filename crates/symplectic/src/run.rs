@@ -183,7 +183,10 @@ impl CometRun {
                 });
             }
         }
-        loop {
+        for iteration in 0u64.. {
+            if iteration.is_multiple_of(1024) {
+                crate::guard::check_stop("advancing the comet run")?;
+            }
             let next = self
                 .particles
                 .iter()
@@ -275,17 +278,27 @@ pub fn save_checkpoint<T: Serialize>(path: &Path, value: &T) -> Result<(), Sympl
         path: path.display().to_string(),
         reason: e.to_string(),
     };
-    let mut f = atomic_write_file::AtomicWriteFile::open(path).map_err(io)?;
-    serde_json::to_writer(&mut f, value).map_err(|e| io(e.into()))?;
+    let f = atomic_write_file::AtomicWriteFile::open(path).map_err(io)?;
+    // Buffered: serde_json writes a number or a punctuation mark at a time, a system call
+    // each without the buffer.
+    let mut w = std::io::BufWriter::with_capacity(1 << 20, f);
+    serde_json::to_writer(&mut w, value).map_err(|e| io(e.into()))?;
+    let f = w.into_inner().map_err(|e| io(e.into_error()))?;
     f.commit().map_err(io)
 }
 
-/// Reads a checkpoint written by [`save_checkpoint`].
+/// Reads a checkpoint written by [`save_checkpoint`]: only a regular file (a named pipe or a
+/// device such as `/dev/zero` is refused before it is opened) whose text fits in the memory
+/// available (the size of its text is checked from its metadata, before it is read).
 pub fn load_checkpoint<T: DeserializeOwned>(path: &Path) -> Result<T, SymplecticError> {
-    let text = std::fs::read_to_string(path).map_err(|e| SymplecticError::Checkpoint {
-        path: path.display().to_string(),
-        reason: e.to_string(),
-    })?;
+    let limit = crate::guard::available_memory().unwrap_or(u64::MAX);
+    let text =
+        crate::guard::read_text_limited(path, limit, "the memory available").map_err(|reason| {
+            SymplecticError::Checkpoint {
+                path: path.display().to_string(),
+                reason,
+            }
+        })?;
     serde_json::from_str(&text).map_err(|e| SymplecticError::Checkpoint {
         path: path.display().to_string(),
         reason: format!("malformed checkpoint: {e}"),

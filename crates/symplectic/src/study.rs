@@ -55,11 +55,7 @@ pub fn run_study(
     out_dir: &Path,
     mut on_sync: impl FnMut(&PopulationProgress),
 ) -> Result<StudySummary, SymplecticError> {
-    let spec_text = std::fs::read_to_string(spec_path).map_err(|e| SymplecticError::Spec {
-        path: spec_path.display().to_string(),
-        field: String::new(),
-        reason: e.to_string(),
-    })?;
+    let spec_text = crate::io::read_spec_text(spec_path)?;
     let spec = PopulationSpec::parse(&spec_text, spec_path)?;
     let checkpoint_path = out_dir.join(CHECKPOINT_FILE);
     let (mut state, resumed) = if checkpoint_path.exists() {
@@ -117,7 +113,14 @@ pub fn run_study(
             break;
         }
         let t = next_snap.min(next_ck).min(end);
-        state.population.advance_to(t, &mut on_sync)?;
+        if let Err(e) = state.population.advance_to(t, &mut on_sync) {
+            // Ctrl-C: the state where it stopped is a checkpoint like any other (a resumed
+            // run continues bit for bit from wherever the particles stopped).
+            if matches!(e, SymplecticError::Interrupted { .. }) {
+                crate::save_checkpoint(&checkpoint_path, &state)?;
+            }
+            return Err(e);
+        }
         if t == next_snap {
             let path = snapshot_path(&snap_dir, state.next_snapshot);
             write_parquet(&path, &population_table(&state.population)?)?;

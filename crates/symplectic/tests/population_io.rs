@@ -279,3 +279,163 @@ fn a_study_with_encounters_integrates_through_them() {
         .unwrap_err();
     assert!(err.to_string().contains("hill_factor"), "{err}");
 }
+
+/// `key = old` replaced by `key = new` in the specification text.
+fn with(spec: &str, old: &str, new: &str) -> String {
+    assert!(spec.contains(old), "{old} not in the specification");
+    spec.replace(old, new)
+}
+
+#[test]
+fn specification_limits_name_the_key_and_the_bound() {
+    // A planet step of 10⁻⁶ days against particle steps of a year: 3.7·10⁸ grid states of
+    // one particle step (130 GB) before the first window, where the run used to allocate
+    // without end.
+    let e = bad_study(
+        "tiny_planet_step",
+        &with(SPEC, "\nstep_days = 365.25", "\nstep_days = 1e-6"),
+        GOOD_ROWS,
+    );
+    assert!(
+        e.contains("`planets.step_days`")
+            && e.contains("MAX_STEP_GRID_BYTES")
+            && e.contains("take at least"),
+        "{e}"
+    );
+    // A first step that does not move the clock of the first window's end in f64.
+    let e = bad_study(
+        "tiny_first_step",
+        &with(
+            SPEC,
+            "initial_step_days = 365.25",
+            "initial_step_days = 1e-300",
+        ),
+        GOOD_ROWS,
+    );
+    assert!(
+        e.contains("`integrator.initial_step_days`") && e.contains("no progress in f64"),
+        "{e}"
+    );
+    // A snapshot cadence of 10⁻⁶ years over 120 years: 1.2·10⁸ Parquet files.
+    let e = bad_study(
+        "snapshot_flood",
+        &with(
+            SPEC,
+            "snapshot_every_years = 50.0",
+            "snapshot_every_years = 1e-6",
+        ),
+        GOOD_ROWS,
+    );
+    assert!(
+        e.contains("`span.snapshot_every_years`") && e.contains("MAX_SNAPSHOTS"),
+        "{e}"
+    );
+    let e = bad_study(
+        "checkpoint_flood",
+        &with(
+            SPEC,
+            "checkpoint_every_years = 20.0",
+            "checkpoint_every_years = 1e-9",
+        ),
+        GOOD_ROWS,
+    );
+    assert!(
+        e.contains("`span.checkpoint_every_years`") && e.contains("MAX_CHECKPOINTS"),
+        "{e}"
+    );
+    // At the limits' edges the specification is taken (the spec and its particles only).
+    let (spec_path, _) = study(
+        "limits_edge",
+        &with(
+            SPEC,
+            "snapshot_every_years = 50.0",
+            "snapshot_every_years = 0.0121",
+        ),
+        GOOD_ROWS,
+    );
+    symplectic::io::PopulationSpec::from_file(&spec_path).unwrap();
+}
+
+/// A named pipe at `path` (`mkfifo`), or `None` where there is none.
+fn fifo(path: &Path) -> Option<()> {
+    let ok = std::process::Command::new("mkfifo")
+        .arg(path)
+        .status()
+        .ok()?
+        .success();
+    ok.then_some(())
+}
+
+#[test]
+fn devices_pipes_and_huge_files_are_refused_before_they_are_read() {
+    use symplectic::io::PopulationSpec;
+    let t = std::time::Instant::now();
+    // The specification: /dev/zero never ends (8 GB read before), a FIFO blocks in open().
+    let e = PopulationSpec::from_file(Path::new("/dev/zero"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("is a device, not a regular file"), "{e}");
+    let dir = temp_dir("fifo");
+    if fifo(&dir.join("spec.toml")).is_some() {
+        let e = PopulationSpec::from_file(&dir.join("spec.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("named pipe (FIFO)"), "{e}");
+        let e = read_particle_rows(&dir.join("spec.toml"), ParticleKind::BarycentricElements)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("named pipe (FIFO)"), "{e}");
+    }
+    // A specification larger than MAX_SPEC_FILE_BYTES, refused from its metadata.
+    let big = dir.join("big.toml");
+    let f = std::fs::File::create(&big).unwrap();
+    f.set_len(symplectic::io::MAX_SPEC_FILE_BYTES + 1).unwrap();
+    let e = PopulationSpec::from_file(&big).unwrap_err().to_string();
+    assert!(e.contains("MAX_SPEC_FILE_BYTES"), "{e}");
+    // The particle file and a saved population.
+    let e = read_particle_rows(Path::new("/dev/zero"), ParticleKind::BarycentricElements)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("is a device, not a regular file"), "{e}");
+    let e = symplectic::Population::load(Path::new("/dev/zero"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("is a device, not a regular file"), "{e}");
+    // None of them read anything: far below the seconds that reading gigabytes takes.
+    assert!(t.elapsed().as_secs() < 5, "{:?}", t.elapsed());
+}
+
+mod elements_of_states {
+    use proptest::prelude::*;
+    use symplectic::io::conic_elements;
+    use symplectic::kepler::{state_from_elements, ConicElements};
+
+    proptest! {
+        /// `conic_elements` inverts `state_from_elements` (the oracle: an independent
+        /// forward map, Kepler's equation by Newton's method and three rotations): the state
+        /// rebuilt from the recovered elements is the state. Tolerance 1e-9 relative: f64
+        /// round-off (1e-16) amplified by Kepler's equation's conditioning, at most
+        /// 1/(1 − e) = 20 for e ≤ 0.95, and by the hyperbolic functions' growth for
+        /// |M| ≤ 10.
+        #[test]
+        fn round_trip(
+            q in 1.0f64..100.0,
+            e in prop_oneof![0.01f64..0.95, 1.05f64..3.0],
+            i in 0.01f64..3.13,
+            node in 0.0f64..6.28,
+            peri in 0.0f64..6.28,
+            m in -10.0f64..10.0,
+        ) {
+            let mu = 2.96e-4;
+            let el = ConicElements { perihelion: q, eccentricity: e, inclination: i, node,
+                argument_of_perihelion: peri, mean_anomaly: m };
+            let (r, v) = state_from_elements(&el, mu).unwrap();
+            let back = conic_elements(&r, &v, mu).unwrap();
+            let (r2, v2) = state_from_elements(&back, mu).unwrap();
+            prop_assert!((r2 - r).norm() <= 1e-9 * r.norm(), "{:?} -> {:?}", el, back);
+            prop_assert!((v2 - v).norm() <= 1e-9 * v.norm(), "{:?} -> {:?}", el, back);
+            prop_assert!((back.eccentricity - e).abs() <= 1e-9 * e);
+            prop_assert!((back.inclination - i).abs() <= 1e-9);
+        }
+    }
+}

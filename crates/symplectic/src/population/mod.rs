@@ -460,8 +460,10 @@ impl Population {
                 || ephemeris.extension(ahead),
                 || run_window(ephemeris, integrator, rules, members, end, path),
             );
-            self.ephemeris.append(extension?)?;
             self.particle_steps += steps;
+            self.ephemeris.append(extension?)?;
+            // Ctrl-C: the members stopped where they were, each on its own clock.
+            crate::guard::check_stop("advancing the population")?;
             needed = beyond;
             self.time = self.time.max(end);
             on_sync(&self.progress());
@@ -522,20 +524,30 @@ impl Population {
                 reason: "nothing to merge",
             });
         };
-        for s in &shards[1..] {
+        for (k, s) in shards.iter().enumerate().skip(1) {
+            let differ = |reason: String| SymplecticError::InvalidState {
+                what: "merging shards",
+                reason: format!("shard {k} and shard 0 {reason}"),
+            };
+            if s.time.to_bits() != first.time.to_bits() {
+                return Err(differ(format!(
+                    "are at different times, t = {} and {} days ({} and {} years): advance every shard to the same time first",
+                    s.time,
+                    first.time,
+                    s.time / 365.25,
+                    first.time / 365.25
+                )));
+            }
             let same = s.integrator == first.integrator
                 && s.rules == first.rules
                 && s.encounters == first.encounters
-                && s.time.to_bits() == first.time.to_bits()
                 && s.ephemeris.integrator() == first.ephemeris.integrator()
                 && s.ephemeris.grid_time(0).to_bits() == first.ephemeris.grid_time(0).to_bits();
             if !same {
-                return Err(SymplecticError::InvalidParameter {
-                    name: "shards",
-                    value: s.time,
-                    reason:
-                        "differ in integrator, rules, planets or time: not shards of one population",
-                });
+                return Err(differ(
+                    "differ in integrator, removal rules, encounters or planets: not shards of one population"
+                        .into(),
+                ));
             }
         }
         // The ephemeris retaining the oldest state, extended to the newest of all.
@@ -566,10 +578,10 @@ impl Population {
     pub fn save(&self, path: &Path) -> Result<(), SymplecticError> {
         crate::save_checkpoint(
             path,
-            &Envelope {
-                format: POPULATION_FORMAT.into(),
+            &SavedEnvelope {
+                format: POPULATION_FORMAT,
                 version: POPULATION_VERSION,
-                population: self.clone(),
+                population: self,
             },
         )
     }
@@ -593,6 +605,14 @@ impl Population {
 
 const POPULATION_FORMAT: &str = "symplectic-population";
 const POPULATION_VERSION: u32 = 1;
+
+/// [`Envelope`] as written, borrowing the population (no copy of it).
+#[derive(Serialize)]
+struct SavedEnvelope<'a> {
+    format: &'a str,
+    version: u32,
+    population: &'a Population,
+}
 
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -284,7 +284,9 @@ impl WindowContext<'_> {
                     *stint = 0;
                 }
             }
-            if lanes.slots.iter().all(|s| s.member.is_none()) {
+            // Ctrl-C (`guard::request_stop`): every member's state is written back at each
+            // lane step, so the chunk stops here with each member on its own clock.
+            if lanes.slots.iter().all(|s| s.member.is_none()) || crate::guard::stop_requested() {
                 return total;
             }
             total = sum_steps(total, self.lane_step(members, &mut lanes, mu));
@@ -471,7 +473,10 @@ impl WindowContext<'_> {
     /// time it needed beyond the ephemeris (`-∞` if none).
     fn advance_member(&self, m: &mut PopulationMember, w: &mut Worker) -> (u64, f64) {
         let mut steps = 0;
-        while m.status == ParticleStatus::Active && m.particle.time < self.end {
+        while m.status == ParticleStatus::Active
+            && m.particle.time < self.end
+            && !crate::guard::stop_requested()
+        {
             if m.encounter.is_some() {
                 let (s, beyond) = self.run_encounter(m, w);
                 steps += s;
@@ -682,7 +687,10 @@ impl WindowContext<'_> {
             return (0, f64::NEG_INFINITY);
         };
         let mut steps = 0;
-        while m.status == ParticleStatus::Active && m.particle.time < self.end {
+        while m.status == ParticleStatus::Active
+            && m.particle.time < self.end
+            && !crate::guard::stop_requested()
+        {
             let Some(e) = m.encounter.as_deref_mut() else {
                 break;
             };
