@@ -1,3 +1,5 @@
+use std::sync::Mutex;
+
 use rayon::prelude::*;
 use sph_core::{Real, Vec3};
 
@@ -35,6 +37,7 @@ impl<R: Real> NeighbourSearch<R> for BruteForce {
         compute_cells(positions, cell, &mut self.cells)?;
         let r2 = radius * radius;
         let guard = PairGuard::new(&out.limits);
+        let failed: Mutex<Option<SearchError>> = Mutex::new(None);
         let lists: Vec<Vec<u32>> = positions
             .par_iter()
             .enumerate()
@@ -42,14 +45,34 @@ impl<R: Real> NeighbourSearch<R> for BruteForce {
                 if guard.stopped() {
                     return Vec::new();
                 }
-                let list: Vec<u32> = (0..positions.len())
-                    .filter(|&j| j != i && is_neighbour(p, &positions[j], r2))
-                    .map(|j| j as u32)
-                    .collect();
+                let mut list: Vec<u32> = Vec::new();
+                for (j, q) in positions.iter().enumerate() {
+                    if j != i && is_neighbour(p, q, r2) {
+                        if list.len() == list.capacity() {
+                            let more = list.len().max(8);
+                            if let Err(e) = list.try_reserve(more) {
+                                let err = SearchError::out_of_memory::<u32>(
+                                    "neighbour indices",
+                                    list.len() + more,
+                                    e,
+                                );
+                                if let Ok(mut f) = failed.lock() {
+                                    f.get_or_insert(err);
+                                }
+                                guard.halt();
+                                return Vec::new();
+                            }
+                        }
+                        list.push(j as u32);
+                    }
+                }
                 guard.report(list.len());
                 list
             })
             .collect();
+        if let Some(e) = failed.into_inner().ok().flatten() {
+            return Err(e);
+        }
         guard.verdict(std::iter::empty())?;
         out.reset(positions.len())?;
         let total = lists.iter().map(Vec::len).sum();
