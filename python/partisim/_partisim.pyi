@@ -12,10 +12,17 @@ _Float = Union[npt.NDArray[np.float64], npt.NDArray[np.float32]]
 class PartisimError(Exception):
     """An error reported by the Rust crates; the message is the Rust error's."""
 
+__version__: str
+
 def neighbour_lists(
-    positions: _Float, radius: float, method: str = "cell-start-grid"
+    positions: npt.ArrayLike,
+    radius: float,
+    method: str = "cell-start-grid",
+    max_pairs: Optional[int] = None,
 ) -> Tuple[npt.NDArray[np.int64], npt.NDArray[np.uint32]]:
-    """CSR neighbour lists of (N, 3) positions within radius (same length unit)."""
+    """CSR neighbour lists of (N, 3) positions within radius (same length unit), at most
+    max_pairs pairs (default: what the memory available holds); see
+    partisim.neighbour_lists."""
 
 class Kernel:
     """A smoothing kernel W(r, h) of support radius h (m)."""
@@ -24,11 +31,11 @@ class Kernel:
     @property
     def support_radius(self) -> float:
         """h (m)."""
-    def value(self, r: _Float) -> _Float:
+    def value(self, r: npt.ArrayLike) -> _Float:
         """W(r) (1/m³) for distances r (m), any shape."""
-    def derivative(self, r: _Float) -> _Float:
+    def derivative(self, r: npt.ArrayLike) -> _Float:
         """dW/dr (1/m⁴) for distances r (m), any shape."""
-    def gradient(self, r_vectors: _Float) -> _Float:
+    def gradient(self, r_vectors: npt.ArrayLike) -> _Float:
         """∇W (1/m⁴) for difference vectors x_i - x_j (m), shape (..., 3)."""
 
 def kernel(name: str, support_radius: float) -> Kernel:
@@ -78,11 +85,18 @@ class Simulation:
     def render(self) -> npt.NDArray[np.uint8]:
         """(H, W, 3) image with the scene's [render] settings."""
 
-def render_json(
-    positions: _Float, config_json: str, tank: Optional[Tuple[Sequence[float], Sequence[float]]] = None
-) -> npt.NDArray[np.uint8]: ...
+def render_options(
+    positions: npt.ArrayLike,
+    radius: float,
+    options: Dict[str, Any],
+    tank: Optional[Tuple[Sequence[float], Sequence[float]]] = None,
+) -> npt.NDArray[np.uint8]:
+    """(H, W, 3) image of spheres of radius (m) at positions (N, 3) with the other
+    [render] options as a dict; see partisim.render."""
 def read_png(path: _Path) -> npt.NDArray[np.uint8]:
     """An 8-bit RGB PNG as an (H, W, 3) uint8 array."""
+def write_png(path: _Path, image: npt.ArrayLike) -> None:
+    """An (H, W, 3) uint8 image written as an 8-bit RGB PNG, atomically."""
 def outer_solar_system_table(frame: str = "ecliptic_j2000") -> Dict[str, Any]: ...
 
 class Population:

@@ -1,11 +1,11 @@
 //! `sph-kernels`: smoothing kernels evaluated over numpy arrays.
 
 use numpy::ndarray::{ArrayD, Axis};
-use numpy::{IntoPyArray, PyReadonlyArrayDyn};
+use numpy::{IntoPyArray, PyReadonlyArrayDyn, PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use sph_kernels::{AnyKernel, Kernel as _, KernelKind};
 
-use crate::arrays::{check_shape, is_f64, untyped};
+use crate::arrays::{as_array, as_float, check_fits, check_shape};
 use crate::rust_err;
 
 /// A smoothing kernel `W(r, h)` of support radius `h` (m), evaluated elementwise.
@@ -15,9 +15,26 @@ struct Kernel {
     f32: AnyKernel<f32>,
 }
 
+/// `obj` (any array-like of real numbers) as a float64 or float32 array named `what`, after
+/// checking that its values, as float64, fit in the memory available (a broadcast view
+/// is refused by its element count before anything is copied).
+fn real_array<'py>(
+    obj: &Bound<'py, PyAny>,
+    what: &str,
+    vector: bool,
+) -> PyResult<(Bound<'py, PyUntypedArray>, bool)> {
+    let a = as_array(obj, what)?;
+    if vector {
+        check_shape(&a, what, "(..., 3)", None, Some(3))?;
+    }
+    // The result, and for a conversion the converted input besides.
+    check_fits(what, a.len(), 16)?;
+    as_float(a, what)
+}
+
 fn values<R: numpy::Element + sph_core::Real>(
     py: Python<'_>,
-    r: &Bound<'_, PyAny>,
+    r: &Bound<'_, PyUntypedArray>,
     f: impl Fn(R) -> R,
 ) -> PyResult<Py<PyAny>> {
     let r: PyReadonlyArrayDyn<'_, R> = r.extract()?;
@@ -27,7 +44,7 @@ fn values<R: numpy::Element + sph_core::Real>(
 
 fn gradients<R: numpy::Element + sph_core::Real>(
     py: Python<'_>,
-    r: &Bound<'_, PyAny>,
+    r: &Bound<'_, PyUntypedArray>,
     k: &AnyKernel<R>,
 ) -> PyResult<Py<PyAny>> {
     let r: PyReadonlyArrayDyn<'_, R> = r.extract()?;
@@ -50,10 +67,11 @@ impl Kernel {
         f64: impl Fn(&AnyKernel<f64>, f64) -> f64,
         f32: impl Fn(&AnyKernel<f32>, f32) -> f32,
     ) -> PyResult<Py<PyAny>> {
-        if is_f64(untyped(r, "r")?, "r")? {
-            values::<f64>(py, r, |x| f64(&self.f64, x))
+        let (r, is_f64) = real_array(r, "r", false)?;
+        if is_f64 {
+            values::<f64>(py, &r, |x| f64(&self.f64, x))
         } else {
-            values::<f32>(py, r, |x| f32(&self.f32, x))
+            values::<f32>(py, &r, |x| f32(&self.f32, x))
         }
     }
 }
@@ -84,12 +102,11 @@ impl Kernel {
 
     /// ∇W (1/m⁴) for difference vectors r_vectors (m) of shape (..., 3).
     fn gradient(&self, py: Python<'_>, r_vectors: &Bound<'_, PyAny>) -> PyResult<Py<PyAny>> {
-        let a = untyped(r_vectors, "r_vectors")?;
-        check_shape(a, "r_vectors", "(..., 3)", None, Some(3))?;
-        if is_f64(a, "r_vectors")? {
-            gradients(py, r_vectors, &self.f64)
+        let (a, is_f64) = real_array(r_vectors, "r_vectors", true)?;
+        if is_f64 {
+            gradients(py, &a, &self.f64)
         } else {
-            gradients(py, r_vectors, &self.f32)
+            gradients(py, &a, &self.f32)
         }
     }
 

@@ -5,6 +5,7 @@
 
 mod arrays;
 mod comets;
+mod interrupt;
 mod kernels;
 mod neighbours;
 mod render;
@@ -32,5 +33,6 @@ fn _partisim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     sim::register(m)?;
     render::register(m)?;
     comets::register(m)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

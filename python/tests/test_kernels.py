@@ -92,5 +92,18 @@ def test_bad_input_raises_clear_errors():
     k = partisim.kernel("poly6", H)
     with pytest.raises(ValueError, match=r"r_vectors: expected shape \(\.\.\., 3\)"):
         k.gradient(np.zeros((4, 2)))
-    with pytest.raises(TypeError, match="dtype int64"):
-        k.value(np.arange(3))
+    with pytest.raises(TypeError, match="r: expected real numbers.*got dtype complex128"):
+        k.value(np.arange(3) * 1j)
+
+
+def test_array_likes_and_numpy_scalars():
+    k = partisim.kernel("cubic-spline", np.float32(H))
+    r = np.linspace(0, H, 11)
+    expected = k.value(r)
+    assert np.array_equal(k.value(r.tolist()), expected)
+    assert np.array_equal(k.value(np.arange(3)), k.value(np.arange(3.0)))
+    assert k.value(0.05).shape == () and k.value(0.05) == k.value(np.array(0.05))
+    assert np.array_equal(k.derivative(r[::2]), k.derivative(np.ascontiguousarray(r[::2])))
+    v = np.random.default_rng(0).random((5, 3)) * H
+    assert np.array_equal(k.gradient(v.tolist()), k.gradient(v))
+    assert np.array_equal(k.gradient(v.T.copy().T), k.gradient(v))  # column major

@@ -42,14 +42,49 @@ def test_non_contiguous_input_is_accepted():
     assert np.array_equal(o1, o2) and np.array_equal(i1, i2)
 
 
+def test_array_likes_are_converted_as_numpy_converts_them():
+    rng = np.random.default_rng(3)
+    p = rng.random((300, 3))
+    expected = partisim.neighbour_lists(p, 0.15)
+    grid = (rng.integers(0, 6, (300, 3))).astype(np.int64)
+    as_float = partisim.neighbour_lists(grid.astype(np.float64), 1.5)
+    for like in (
+        p.tolist(),  # a list of lists
+        tuple(map(tuple, p.tolist())),  # tuples
+        p.astype(">f8"),  # big-endian float64
+        np.asfortranarray(p),  # column major
+        np.repeat(p, 2, axis=0)[::2],  # a strided view
+    ):
+        got = partisim.neighbour_lists(like, np.float64(0.15))
+        assert all(np.array_equal(a, b) for a, b in zip(got, expected))
+    for like in (grid, grid.astype(np.int32), grid.astype(np.uint16), grid.tolist()):
+        got = partisim.neighbour_lists(like, np.int64(1) + 0.5)
+        assert all(np.array_equal(a, b) for a, b in zip(got, as_float))
+    # float16 is widened to float64, float32 searched as float32 (as before).
+    half = partisim.neighbour_lists(p.astype(np.float16), 0.15)
+    assert all(np.array_equal(a, b) for a, b in
+               zip(half, partisim.neighbour_lists(p.astype(np.float16).astype(np.float64), 0.15)))
+
+
+def test_numpy_integers_are_accepted_for_max_pairs():
+    p = np.zeros((5, 3))
+    offsets, indices = partisim.neighbour_lists(p, 0.1, max_pairs=np.int64(20))
+    assert len(indices) == 20 and offsets[-1] == 20
+    with pytest.raises(partisim.PartisimError, match="more than 19 pairs"):
+        partisim.neighbour_lists(p, 0.1, max_pairs=np.uint8(19))
+
+
+def test_empty_positions_give_empty_lists():
+    offsets, indices = partisim.neighbour_lists(np.zeros((0, 3)), 0.1)
+    assert offsets.tolist() == [0] and len(indices) == 0
+
+
 def test_bad_input_raises_clear_errors():
     p = np.zeros((10, 3))
     with pytest.raises(ValueError, match=r"positions: expected shape \(N, 3\), got \[10, 2\]"):
         partisim.neighbour_lists(np.zeros((10, 2)), 0.1)
-    with pytest.raises(TypeError, match="float64 or float32 array, got dtype int64"):
-        partisim.neighbour_lists(np.zeros((10, 3), dtype=np.int64), 0.1)
-    with pytest.raises(TypeError, match="expected a numpy array, got list"):
-        partisim.neighbour_lists([[0.0, 0.0, 0.0]], 0.1)
+    with pytest.raises(TypeError, match="positions: expected real numbers.*got dtype complex128"):
+        partisim.neighbour_lists(np.zeros((10, 3), dtype=complex), 0.1)
     with pytest.raises(partisim.PartisimError, match="radius h = -0.1 must be finite and > 0"):
         partisim.neighbour_lists(p, -0.1)
     q = p.copy()
@@ -58,3 +93,14 @@ def test_bad_input_raises_clear_errors():
         partisim.neighbour_lists(q, 0.1)
     with pytest.raises(ValueError, match="unknown neighbour-search method"):
         partisim.neighbour_lists(p, 0.1, method="octree")
+
+
+def test_pairs_beyond_the_limit_are_refused_with_both_sizes():
+    # 2000 coincident points: 2000 · 1999 = 3,998,000 ordered pairs, all within any radius.
+    p = np.zeros((2000, 3))
+    offsets, indices = partisim.neighbour_lists(p, 0.1, max_pairs=3_998_000)
+    assert len(indices) == 3_998_000
+    with pytest.raises(partisim.PartisimError) as e:
+        partisim.neighbour_lists(p, 0.1, max_pairs=3_997_999)
+    msg = str(e.value)
+    assert "more than 3997999 pairs (15991996 bytes" in msg and "max_pairs = 3997999" in msg

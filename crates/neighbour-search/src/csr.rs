@@ -4,10 +4,91 @@
 // Unsafe: disjoint parallel writes through `SyncPtr` (each index written by one task), and unchecked indexing in the hot loop behind checked bounds; see the SAFETY comments.
 #![allow(unsafe_code)]
 
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
 use rayon::prelude::*;
 
 use crate::sync_ptr::SyncPtr;
-use crate::NeighbourLists;
+use crate::{NeighbourLists, SearchError, SearchLimits};
+
+/// Pairs a task finds between two reports to the shared [`PairGuard`] (one atomic
+/// addition per this many pairs: negligible next to the distance tests).
+const REPORT_EVERY: usize = 1 << 14;
+
+/// The [`SearchLimits`] of one search, shared by its parallel tasks: the pairs found so far
+/// against `max_pairs`, the caller's interrupt flag, and a stop flag that the first task
+/// to hit either (or a failed allocation) raises for all.
+pub(crate) struct PairGuard<'a> {
+    limit: usize,
+    found: AtomicUsize,
+    stop: AtomicBool,
+    interrupt: Option<&'a AtomicBool>,
+}
+
+impl<'a> PairGuard<'a> {
+    pub fn new(limits: &'a SearchLimits) -> Self {
+        Self {
+            limit: limits.max_pairs.unwrap_or(usize::MAX),
+            found: AtomicUsize::new(0),
+            stop: AtomicBool::new(false),
+            interrupt: limits.interrupt.as_deref(),
+        }
+    }
+
+    /// `true` when the search must stop (limit passed, a task failed, or interrupted).
+    #[inline]
+    pub fn stopped(&self) -> bool {
+        self.stop.load(Ordering::Relaxed)
+            || self.interrupt.is_some_and(|f| f.load(Ordering::Relaxed))
+    }
+
+    /// Adds `pairs` found by a task; `false` when the search must stop.
+    pub fn report(&self, pairs: usize) -> bool {
+        let total = self
+            .found
+            .fetch_add(pairs, Ordering::Relaxed)
+            .saturating_add(pairs);
+        if total > self.limit {
+            self.stop.store(true, Ordering::Relaxed);
+        }
+        !self.stopped()
+    }
+
+    /// Stops every task (after a failed allocation).
+    pub fn halt(&self) {
+        self.stop.store(true, Ordering::Relaxed);
+    }
+
+    /// The search's verdict once its tasks have returned: the first task's error, the pair
+    /// limit passed, or the interrupt; `Ok` when the lists are complete.
+    pub fn verdict<'t>(
+        &self,
+        mut tasks: impl Iterator<Item = &'t TaskOutput>,
+    ) -> Result<(), SearchError> {
+        if let Some(e) = tasks.find_map(|t| t.failed.clone()) {
+            return Err(e);
+        }
+        let found = self.found.load(Ordering::Relaxed);
+        if found > self.limit {
+            return Err(too_many_pairs(found, self.limit));
+        }
+        if self.stopped() {
+            return Err(SearchError::Interrupted);
+        }
+        Ok(())
+    }
+}
+
+/// [`SearchError::TooManyPairs`].
+pub(crate) fn too_many_pairs(found: usize, limit: usize) -> SearchError {
+    let bytes = |p: usize| p.saturating_mul(std::mem::size_of::<u32>());
+    SearchError::TooManyPairs {
+        found,
+        found_bytes: bytes(found),
+        limit,
+        limit_bytes: bytes(limit),
+    }
+}
 
 /// What one parallel task found: for each of its particles, `(particle, count)`, and the
 /// concatenated neighbour indices.
@@ -19,6 +100,10 @@ pub(crate) struct TaskOutput {
     start: usize,
     /// Candidate pairs tested.
     pub tests: u64,
+    /// Pairs found since the last report to the [`PairGuard`].
+    pending: usize,
+    /// Why this task stopped early, if it did.
+    failed: Option<SearchError>,
 }
 
 impl TaskOutput {
@@ -26,20 +111,58 @@ impl TaskOutput {
         self.particles.clear();
         self.neighbours.clear();
         self.tests = 0;
+        self.pending = 0;
+        self.failed = None;
+    }
+
+    /// Scans one particle with `scan` (which appends its neighbours to the task's buffer
+    /// and returns how many) and records it as particle `i`; `false` when the task must
+    /// stop (a failed allocation, the pair limit passed, or the search interrupted).
+    #[inline]
+    pub fn record(
+        &mut self,
+        i: u32,
+        guard: &PairGuard<'_>,
+        scan: impl FnOnce(&mut Vec<u32>) -> Result<u32, std::collections::TryReserveError>,
+    ) -> bool {
+        let before = self.neighbours.len();
+        match scan(&mut self.neighbours) {
+            Ok(found) => {
+                self.particles.push((i, found));
+                self.pending += found as usize;
+                self.pending < REPORT_EVERY || self.report(guard)
+            }
+            Err(e) => {
+                let want = self.neighbours.capacity().max(before) * 2;
+                self.failed = Some(SearchError::out_of_memory::<u32>(
+                    "neighbour indices",
+                    want,
+                    e,
+                ));
+                guard.halt();
+                false
+            }
+        }
+    }
+
+    /// Reports the pending pairs to `guard` (at the end of a task, so that its count is
+    /// complete); `false` when the search must stop.
+    pub fn report(&mut self, guard: &PairGuard<'_>) -> bool {
+        guard.report(std::mem::take(&mut self.pending))
     }
 }
 
 /// Writes the tasks' results into `out` for `n` particles.
 /// Every particle must appear in exactly one task. The tasks may be any type holding a
-/// [`TaskOutput`].
+/// [`TaskOutput`]. Fails only when the index buffer cannot be allocated.
 pub(crate) fn assemble_by<T: Sync>(
     out: &mut NeighbourLists,
     n: usize,
     tasks: &mut [T],
     output: impl Fn(&T) -> &TaskOutput + Sync,
     output_mut: impl Fn(&mut T) -> &mut TaskOutput,
-) {
-    out.reset(n);
+) -> Result<(), SearchError> {
+    out.reset(n)?;
     if tasks.len() == 1 && in_caller_order(n, tasks, &output) {
         // One task holding every list in caller order: its buffer becomes the indices
         // (swapped, not copied; the old index buffer becomes the task's next buffer).
@@ -48,7 +171,7 @@ pub(crate) fn assemble_by<T: Sync>(
             out.offsets[k + 1] = out.offsets[k] + c as usize;
         }
         std::mem::swap(&mut out.indices, &mut t.neighbours);
-        return;
+        return Ok(());
     }
     if in_caller_order(n, tasks, &output) {
         // Fast path (particles already sorted by cell, as a solver keeps them): the tasks'
@@ -58,8 +181,7 @@ pub(crate) fn assemble_by<T: Sync>(
             t.start = total;
             total += t.neighbours.len();
         }
-        out.indices.clear();
-        out.indices.reserve(total);
+        reserve_indices(out, total)?;
         let offs = SyncPtr(out.offsets.as_mut_ptr());
         let idx = SyncPtr(out.indices.as_mut_ptr());
         tasks.par_iter().map(&output).for_each(|t| {
@@ -82,7 +204,7 @@ pub(crate) fn assemble_by<T: Sync>(
         });
         // SAFETY: the tasks' blocks tile [0, total).
         unsafe { out.indices.set_len(total) };
-        return;
+        return Ok(());
     }
     let tasks = &*tasks;
     let offs = SyncPtr(out.offsets.as_mut_ptr());
@@ -99,8 +221,7 @@ pub(crate) fn assemble_by<T: Sync>(
         out.offsets[i + 1] += out.offsets[i];
     }
     let total = out.offsets[n];
-    out.indices.clear();
-    out.indices.reserve(total);
+    reserve_indices(out, total)?;
     let idx = SyncPtr(out.indices.as_mut_ptr());
     let offsets = &out.offsets;
     tasks.par_iter().map(&output).for_each(|t| {
@@ -122,6 +243,15 @@ pub(crate) fn assemble_by<T: Sync>(
     // SAFETY: the tasks wrote every slot of [0, total): each particle's range is covered
     // by its own list, and the ranges tile [0, total) by construction of the offsets.
     unsafe { out.indices.set_len(total) };
+    Ok(())
+}
+
+/// Empties `out.indices` and makes room for `total` of them, fallibly.
+fn reserve_indices(out: &mut NeighbourLists, total: usize) -> Result<(), SearchError> {
+    out.indices.clear();
+    out.indices
+        .try_reserve(total)
+        .map_err(|e| SearchError::out_of_memory::<u32>("neighbour indices", total, e))
 }
 
 /// `true` when the tasks, in order, list the particles 0, 1, …, n − 1.

@@ -55,4 +55,51 @@ pub enum SearchError {
         /// The method's limit.
         limit: usize,
     },
+    /// The lists would hold more pairs than [`crate::SearchLimits::max_pairs`] allows (a
+    /// radius in the wrong units, or many coincident particles); the search stopped as
+    /// soon as it found more.
+    #[error(
+        "the neighbour lists need more than {limit} pairs ({limit_bytes} bytes of indices \
+         allowed): at least {found} found (at least {found_bytes} bytes) when the search \
+         stopped; is the radius in the units of the positions, or are many particles \
+         coincident?"
+    )]
+    TooManyPairs {
+        /// Pairs found when the search stopped (a lower bound on what the lists need).
+        found: usize,
+        /// Bytes of `u32` indices `found` pairs take.
+        found_bytes: usize,
+        /// The limit on pairs.
+        limit: usize,
+        /// Bytes of `u32` indices `limit` pairs take.
+        limit_bytes: usize,
+    },
+    /// An allocation whose size the input sets failed.
+    #[error("could not allocate {bytes} bytes for {what}: {reason}")]
+    OutOfMemory {
+        /// The buffer (e.g. "neighbour indices").
+        what: &'static str,
+        /// Bytes asked for.
+        bytes: usize,
+        /// The allocator's reason.
+        reason: String,
+    },
+    /// The caller's interrupt flag ([`crate::SearchLimits::interrupt`]) was raised.
+    #[error("the neighbour search was interrupted")]
+    Interrupted,
+}
+
+impl SearchError {
+    /// [`SearchError::OutOfMemory`] for `count` elements of `T` in `what`.
+    pub(crate) fn out_of_memory<T>(
+        what: &'static str,
+        count: usize,
+        e: std::collections::TryReserveError,
+    ) -> Self {
+        SearchError::OutOfMemory {
+            what,
+            bytes: count.saturating_mul(std::mem::size_of::<T>()),
+            reason: e.to_string(),
+        }
+    }
 }

@@ -5,7 +5,7 @@ use rustc_hash::FxHashMap;
 use sph_core::{Real, Vec3};
 
 use crate::cells::{cell_size, compute_cells, Key, KeyPacker};
-use crate::csr::{assemble_by, items_per_task, TaskOutput};
+use crate::csr::{assemble_by, items_per_task, PairGuard, TaskOutput};
 use crate::radix::{sort_pairs, RadixScratch};
 use crate::runs::run_starts;
 use crate::scan::Gathered;
@@ -95,7 +95,8 @@ impl<R: Real, K: Key> SortedParticles<R, K> {
 /// with the sorted index of the run's first particle). The candidates of a cell's 27
 /// neighbour cells are first gathered into one contiguous block: measured on the dam-break
 /// anchor scene, this beats scanning the nine ranges in place (their ragged ends cost
-/// more than the copy, which is shared by the ~8 particles of a cell).
+/// more than the copy, which is shared by the ~8 particles of a cell). Keeps to the
+/// [`crate::SearchLimits`] of `out`.
 #[allow(clippy::too_many_arguments)]
 fn query_runs<R: Real>(
     runs: &[u32],
@@ -106,7 +107,7 @@ fn query_runs<R: Real>(
     out: &mut NeighbourLists,
     stats: &mut SearchStats,
     locate: impl Fn(usize) -> Ranges + Sync,
-) {
+) -> Result<(), SearchError> {
     let mut watch = Stopwatch::start();
     let n = xs.len();
     let run_count = runs.len() - 1;
@@ -115,13 +116,18 @@ fn query_runs<R: Real>(
     if tasks.len() < task_count {
         tasks.resize_with(task_count, Default::default);
     }
+    let limits = out.limits.clone();
+    let guard = PairGuard::new(&limits);
     tasks[..task_count]
         .par_iter_mut()
         .enumerate()
         .for_each(|(task, (buf, g))| {
             buf.clear();
             let first = task * per_task;
-            for r in first..(first + per_task).min(run_count) {
+            'runs: for r in first..(first + per_task).min(run_count) {
+                if guard.stopped() {
+                    break;
+                }
                 let (start, end) = (runs[r] as usize, runs[r + 1] as usize);
                 let (ranges, count) = locate(start);
                 g.clear();
@@ -136,15 +142,20 @@ fn query_runs<R: Real>(
                 let len = g.finish();
                 buf.tests += (len * (end - start)) as u64;
                 for (e, k) in (start..end).enumerate() {
-                    let found = g.neighbours_of(len, own + e, r2, &mut buf.neighbours);
-                    buf.particles.push((order[k], found));
+                    let scan = |nb: &mut Vec<u32>| g.neighbours_of(len, own + e, r2, nb);
+                    if !buf.record(order[k], &guard, scan) {
+                        break 'runs;
+                    }
                 }
             }
+            buf.report(&guard);
         });
     stats.query_s = watch.lap();
     stats.candidate_tests = tasks[..task_count].iter().map(|t| t.0.tests).sum();
-    assemble_by(out, n, &mut tasks[..task_count], |t| &t.0, |t| &mut t.0);
+    guard.verdict(tasks[..task_count].iter().map(|t| &t.0))?;
+    assemble_by(out, n, &mut tasks[..task_count], |t| &t.0, |t| &mut t.0)?;
     stats.assemble_s = watch.lap();
+    Ok(())
 }
 
 /// Merges the ranges of three z-consecutive cells (contiguous in sorted order) into one.
@@ -228,8 +239,7 @@ impl<R: Real> NeighbourSearch<R> for CellStartGrid<R> {
         let cell = cell_size(radius)?;
         let bounds = compute_cells(positions, cell, &mut self.sorted.cells)?;
         let Some((lo, hi)) = bounds else {
-            out.reset(0);
-            return Ok(());
+            return out.reset(0);
         };
         let dims: [u64; 3] = std::array::from_fn(|a| (hi[a] as i64 - lo[a] as i64 + 1) as u64);
         let total = dims[0] as f64 * dims[1] as f64 * dims[2] as f64;
@@ -255,6 +265,12 @@ impl<R: Real> NeighbourSearch<R> for CellStartGrid<R> {
         watch.lap();
         // Clear and fill the start/end table over the whole bounding grid.
         self.cell_start.clear();
+        for table in [&mut self.cell_start, &mut self.cell_end] {
+            let more = total.saturating_sub(table.len());
+            table.try_reserve(more).map_err(|e| {
+                SearchError::out_of_memory::<u32>("the cell start/end table", total, e)
+            })?;
+        }
         self.cell_start.resize(total, EMPTY);
         self.cell_end.resize(total, 0);
         let runs = &self.sorted.runs;
@@ -302,8 +318,7 @@ impl<R: Real> NeighbourSearch<R> for CellStartGrid<R> {
             out,
             &mut self.sorted.stats,
             locate,
-        );
-        Ok(())
+        )
     }
 }
 
@@ -357,7 +372,7 @@ fn hashed_search<R: Real, K: Key>(
     r2: R,
     out: &mut NeighbourLists,
     cells_s: f64,
-) {
+) -> Result<(), SearchError> {
     s.stats = SearchStats {
         cells_s,
         ..Default::default()
@@ -396,7 +411,7 @@ fn hashed_search<R: Real, K: Key>(
         out,
         &mut s.stats,
         locate,
-    );
+    )
 }
 
 impl<R: Real> NeighbourSearch<R> for HashedGrid<R> {
@@ -419,8 +434,7 @@ impl<R: Real> NeighbourSearch<R> for HashedGrid<R> {
         // Both key widths share the cell computation; the narrow one holds the cells.
         let bounds = compute_cells(positions, cell, &mut self.narrow.cells)?;
         let Some((lo, hi)) = bounds else {
-            out.reset(0);
-            return Ok(());
+            return out.reset(0);
         };
         let packer = KeyPacker::new(lo, hi, 1);
         let r2 = radius * radius;
@@ -434,11 +448,11 @@ impl<R: Real> NeighbourSearch<R> for HashedGrid<R> {
                 r2,
                 out,
                 t,
-            );
+            )?;
             self.stats = self.narrow.stats;
         } else {
             std::mem::swap(&mut self.narrow.cells, &mut self.wide.cells);
-            hashed_search(
+            let result = hashed_search(
                 &mut self.wide,
                 &mut self.map_wide,
                 &packer,
@@ -448,6 +462,7 @@ impl<R: Real> NeighbourSearch<R> for HashedGrid<R> {
                 t,
             );
             std::mem::swap(&mut self.narrow.cells, &mut self.wide.cells);
+            result?;
             self.stats = self.wide.stats;
         }
         Ok(())

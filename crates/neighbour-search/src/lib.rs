@@ -46,7 +46,11 @@
 //!
 //! Input errors ([`SearchError`]) name the offending particle or value: NaN/infinite
 //! positions, `h <= 0`, cells that overflow `i32`, a bounding grid too large for
-//! [`CellStartGrid`]. No method panics on user input.
+//! [`CellStartGrid`]. No method panics or aborts on user input: every buffer whose size
+//! the input sets is allocated fallibly ([`SearchError::OutOfMemory`]), and the
+//! [`SearchLimits`] the lists carry bound the pairs ([`SearchError::TooManyPairs`], for a
+//! radius in the wrong units or coincident particles, before the memory runs out) and let
+//! another thread stop a long search ([`SearchError::Interrupted`]).
 //!
 //! ## Performance
 //!
@@ -89,7 +93,7 @@ pub use brute::BruteForce;
 pub use cells::{is_neighbour, squared_distance, CELL_MARGIN};
 pub use error::SearchError;
 pub use grid::{CellStartGrid, HashedGrid, DEFAULT_MAX_CELLS};
-pub use lists::NeighbourLists;
+pub use lists::{NeighbourLists, SearchLimits};
 pub use relation_table::RelationTable;
 pub use reorder::{CellOrder, CellSorter};
 pub use sph_core::{Real, Vec3};

@@ -1,13 +1,48 @@
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+
+use crate::SearchError;
+
+/// Bounds a search keeps to, carried by the caller's [`NeighbourLists`]: a search that
+/// would exceed them stops with a [`SearchError`] instead of exhausting memory or running
+/// on after the caller gave up.
+///
+/// Every buffer whose size the input sets is allocated fallibly whatever the limits
+/// ([`SearchError::OutOfMemory`]); `max_pairs` bounds the pairs before the allocator has
+/// to (an operating system that overcommits memory may otherwise grant the allocations
+/// and kill the process when they are touched).
+#[derive(Debug, Clone, Default)]
+pub struct SearchLimits {
+    /// Most (ordered) pairs the lists may hold: beyond it the search stops with
+    /// [`SearchError::TooManyPairs`]. `None`: no limit but the allocator's.
+    pub max_pairs: Option<usize>,
+    /// Raised by the caller (another thread, a signal handler) to stop the search early
+    /// with [`SearchError::Interrupted`]; checked once per cell and every few thousand
+    /// pairs.
+    pub interrupt: Option<Arc<AtomicBool>>,
+}
+
 /// Neighbour lists in compressed sparse row form: the neighbours of particle `i` are
 /// `indices[offsets[i]..offsets[i + 1]]`, as indices into the caller's particle order.
 ///
 /// The buffers are kept between searches: a search refills them in place and only
-/// reallocates when the number of particles or pairs grows beyond the capacity.
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
+/// reallocates when the number of particles or pairs grows beyond the capacity. The lists
+/// also carry the [`SearchLimits`] every search into them keeps to (none by default);
+/// equality compares the lists only.
+#[derive(Debug, Clone, Default)]
 pub struct NeighbourLists {
     pub(crate) offsets: Vec<usize>,
     pub(crate) indices: Vec<u32>,
+    pub(crate) limits: SearchLimits,
 }
+
+impl PartialEq for NeighbourLists {
+    fn eq(&self, other: &Self) -> bool {
+        self.offsets == other.offsets && self.indices == other.indices
+    }
+}
+
+impl Eq for NeighbourLists {}
 
 impl NeighbourLists {
     /// Empty lists.
@@ -15,7 +50,26 @@ impl NeighbourLists {
         Self {
             offsets: vec![0],
             indices: Vec::new(),
+            limits: SearchLimits::default(),
         }
+    }
+
+    /// Empty lists whose searches keep to `limits`.
+    pub fn with_limits(limits: SearchLimits) -> Self {
+        Self {
+            limits,
+            ..Self::new()
+        }
+    }
+
+    /// The limits searches into these lists keep to.
+    pub fn limits(&self) -> &SearchLimits {
+        &self.limits
+    }
+
+    /// Replaces the limits searches into these lists keep to.
+    pub fn set_limits(&mut self, limits: SearchLimits) {
+        self.limits = limits;
     }
 
     /// Number of particles the lists describe.
@@ -84,9 +138,14 @@ impl NeighbourLists {
             + self.indices.capacity() * std::mem::size_of::<u32>()
     }
 
-    pub(crate) fn reset(&mut self, n: usize) {
+    /// Empties the lists and sizes the offsets for `n` particles (all zero).
+    pub(crate) fn reset(&mut self, n: usize) -> Result<(), SearchError> {
         self.offsets.clear();
-        self.offsets.resize(n + 1, 0);
         self.indices.clear();
+        self.offsets
+            .try_reserve(n + 1)
+            .map_err(|e| SearchError::out_of_memory::<usize>("neighbour offsets", n + 1, e))?;
+        self.offsets.resize(n + 1, 0);
+        Ok(())
     }
 }

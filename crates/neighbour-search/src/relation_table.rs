@@ -4,7 +4,7 @@ use rayon::prelude::*;
 use sph_core::{Real, Vec3};
 
 use crate::cells::{cell_size, compute_cells, Key, KeyPacker};
-use crate::csr::TaskOutput;
+use crate::csr::{PairGuard, TaskOutput};
 use crate::radix::{sort_pairs, RadixScratch};
 use crate::runs::run_starts;
 use crate::scan::Gathered;
@@ -110,8 +110,7 @@ impl<R: Real> NeighbourSearch<R> for RelationTable<R> {
         let cell = cell_size(radius)?;
         let bounds = compute_cells(positions, cell, &mut self.cells)?;
         let Some((lo, hi)) = bounds else {
-            out.reset(0);
-            return Ok(());
+            return out.reset(0);
         };
         let packer = KeyPacker::new(lo, hi, 1);
         let (cells, r2, work) = (&self.cells[..], radius * radius, &mut self.work);
@@ -126,7 +125,7 @@ impl<R: Real> NeighbourSearch<R> for RelationTable<R> {
                 work,
                 out,
                 watch,
-            );
+            )
         } else {
             self.narrow.keys.clear();
             build_and_query(
@@ -138,9 +137,8 @@ impl<R: Real> NeighbourSearch<R> for RelationTable<R> {
                 work,
                 out,
                 watch,
-            );
+            )
         }
-        Ok(())
     }
 }
 
@@ -154,9 +152,17 @@ fn build_and_query<K: Key, R: Real>(
     work: &mut Workspace<R>,
     out: &mut NeighbourLists,
     mut watch: Stopwatch,
-) {
+) -> Result<(), SearchError> {
     let n = cells.len();
     // 1. Each particle writes its 27 entries (Fig. 3a).
+    let entries = 27 * n;
+    let oom = |e| SearchError::out_of_memory::<(K, u32)>("the relation table", entries, e);
+    t.keys
+        .try_reserve(entries.saturating_sub(t.keys.len()))
+        .map_err(oom)?;
+    t.vals
+        .try_reserve(entries.saturating_sub(t.vals.len()))
+        .map_err(oom)?;
     t.keys.resize(27 * n, K::default());
     t.vals.resize(27 * n, 0);
     t.keys
@@ -193,6 +199,8 @@ fn build_and_query<K: Key, R: Real>(
     }
     let vals = &t.vals;
     let runs = &work.runs[..];
+    let limits = out.limits.clone();
+    let guard = PairGuard::new(&limits);
     work.tasks[..task_count]
         .par_iter_mut()
         .enumerate()
@@ -200,7 +208,10 @@ fn build_and_query<K: Key, R: Real>(
             buf.clear();
             let first = task * per_task;
             let last = (first + per_task).min(run_count);
-            for r in first..last {
+            'runs: for r in first..last {
+                if guard.stopped() {
+                    break;
+                }
                 let run = &vals[runs[r] as usize..runs[r + 1] as usize];
                 if !run.iter().any(|&v| v % 27 == SELF_OFFSET) {
                     continue; // a cell that holds no particle: nobody scans this run
@@ -214,15 +225,20 @@ fn build_and_query<K: Key, R: Real>(
                 for (e, &v) in run.iter().enumerate() {
                     if v % 27 == SELF_OFFSET {
                         buf.tests += len as u64;
-                        let found = g.neighbours_of(len, e, r2, &mut buf.neighbours);
-                        buf.particles.push((v / 27, found));
+                        let scan = |nb: &mut Vec<u32>| g.neighbours_of(len, e, r2, nb);
+                        if !buf.record(v / 27, &guard, scan) {
+                            break 'runs;
+                        }
                     }
                 }
             }
+            buf.report(&guard);
         });
     work.stats.query_s = watch.lap();
     work.stats.candidate_tests = work.tasks[..task_count].iter().map(|t| t.0.tests).sum();
     let tasks = &mut work.tasks[..task_count];
-    crate::csr::assemble_by(out, n, tasks, |t| &t.0, |t| &mut t.0);
+    guard.verdict(tasks.iter().map(|t| &t.0))?;
+    crate::csr::assemble_by(out, n, tasks, |t| &t.0, |t| &mut t.0)?;
     work.stats.assemble_s = watch.lap();
+    Ok(())
 }

@@ -15,6 +15,7 @@
 #![allow(unsafe_code)]
 
 use std::any::TypeId;
+use std::collections::TryReserveError;
 
 use sph_core::Real;
 
@@ -73,9 +74,16 @@ impl<R: Real> Gathered<R> {
     }
 
     /// Pads the block and scans particle `e` of it against all others: appends its
-    /// neighbours' ids to `out`, returns how many. Call [`Gathered::finish`] first.
+    /// neighbours' ids to `out`, returns how many (an error if `out` cannot grow). Call
+    /// [`Gathered::finish`] first.
     #[inline]
-    pub fn neighbours_of(&self, len: usize, e: usize, r2: R, out: &mut Vec<u32>) -> u32 {
+    pub fn neighbours_of(
+        &self,
+        len: usize,
+        e: usize,
+        r2: R,
+        out: &mut Vec<u32>,
+    ) -> Result<u32, TryReserveError> {
         let block = Block {
             xs: &self.xs,
             ys: &self.ys,
@@ -125,7 +133,8 @@ pub(crate) fn pad<R: Real>(xs: &mut Vec<R>, ys: &mut Vec<R>, zs: &mut Vec<R>, id
 
 /// Appends to `out` the ids of the candidates in `ranges` (indices into `block`) that are
 /// neighbours of the point `p` (strictly closer than `r`, `r2 = r·r`), skipping index
-/// `skip` (the particle itself); returns how many.
+/// `skip` (the particle itself); returns how many, or the error of a failed allocation
+/// (`out` unchanged).
 #[inline]
 pub(crate) fn scan_ranges<R: Real>(
     p: [R; 3],
@@ -134,7 +143,7 @@ pub(crate) fn scan_ranges<R: Real>(
     skip: usize,
     r2: R,
     out: &mut Vec<u32>,
-) -> u32 {
+) -> Result<u32, TryReserveError> {
     let n = block.xs.len();
     assert!(block.ys.len() == n && block.zs.len() == n && block.ids.len() == n);
     let room: usize = ranges.iter().map(|&(a, b)| (b - a) as usize + LANES).sum();
@@ -144,7 +153,7 @@ pub(crate) fn scan_ranges<R: Real>(
             "range end {b} not followed by padding ({n})"
         );
     }
-    out.reserve(room);
+    out.try_reserve(room)?;
     let before = out.len();
     // SAFETY: `out` has room for `room` more entries; a kernel writes at most LANES
     // entries past its count per step and at most (b − a) counted entries per range, so
@@ -154,7 +163,7 @@ pub(crate) fn scan_ranges<R: Real>(
         let dst = out.as_mut_ptr().add(before);
         let found = scan(p, block, ranges, skip, r2, dst);
         out.set_len(before + found);
-        found as u32
+        Ok(found as u32)
     }
 }
 
@@ -517,7 +526,7 @@ mod tests {
         let p = q.map(R::of_f64);
         let r2 = R::of_f64(r) * R::of_f64(r);
         let mut fast = vec![7];
-        scan_ranges(p, b, ranges, skip, r2, &mut fast);
+        scan_ranges(p, b, ranges, skip, r2, &mut fast).unwrap();
         let room: usize = ranges.iter().map(|&(a, b)| (b - a) as usize).sum();
         let mut slow = vec![0u32; room];
         let n = unsafe { scan_portable(p, b, ranges, skip, r2, slow.as_mut_ptr()) };

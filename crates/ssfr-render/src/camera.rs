@@ -55,9 +55,8 @@ impl Camera {
     /// image ([`SsfrError::ImageSize`]).
     pub fn frame(&self) -> Result<CameraFrame, SsfrError> {
         crate::check_image_size(self.width, self.height)?;
-        finite3("camera.eye", self.eye)?;
-        finite3("camera.target", self.target)?;
-        finite3("camera.up", self.up)?;
+        // The field of view first: a default eye is derived from it, and a bad one must
+        // be blamed, not the eye the caller never gave.
         positive("camera.fov_deg", self.fov_y_deg)?;
         if self.fov_y_deg >= 179.0 {
             return Err(SsfrError::invalid(
@@ -65,6 +64,9 @@ impl Camera {
                 format!("{}: must be < 179", self.fov_y_deg),
             ));
         }
+        finite3("camera.eye", self.eye)?;
+        finite3("camera.target", self.target)?;
+        finite3("camera.up", self.up)?;
         let eye = V3::from(self.eye);
         let d = V3::from(self.target) - eye;
         if d.norm() <= 0.0 {

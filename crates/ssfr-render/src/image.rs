@@ -1,8 +1,10 @@
 //! 8-bit RGB images: conversion from linear colour, PNG output (the `png` crate), and the
 //! image-difference measure used to check golden images.
 
-use std::io::BufWriter;
+use std::io::Write;
 use std::path::Path;
+
+use atomic_write_file::AtomicWriteFile;
 
 use crate::SsfrError;
 
@@ -76,22 +78,43 @@ impl RgbImage {
         })
     }
 
-    /// Writes a PNG.
+    /// Writes a PNG, atomically: the file appears complete or not at all (written to an
+    /// unnamed temporary file in the same directory, then linked into place), so that a
+    /// reader never sees half an image and a failed write leaves the old file.
     pub fn write_png(&self, path: &Path) -> Result<(), SsfrError> {
         let io = |e: String| SsfrError::Io {
             path: path.to_path_buf(),
             reason: e,
         };
-        let file = std::fs::File::create(path).map_err(|e| io(e.to_string()))?;
-        let mut enc =
-            png::Encoder::new(BufWriter::new(file), self.width as u32, self.height as u32);
-        enc.set_color(png::ColorType::Rgb);
-        enc.set_depth(png::BitDepth::Eight);
-        let mut writer = enc.write_header().map_err(|e| io(e.to_string()))?;
-        writer
-            .write_image_data(&self.data)
-            .map_err(|e| io(e.to_string()))?;
-        writer.finish().map_err(|e| io(e.to_string()))
+        if self.data.len() != 3 * self.width * self.height {
+            return Err(io(format!(
+                "{} bytes for a {}x{} RGB image ({} expected)",
+                self.data.len(),
+                self.width,
+                self.height,
+                3 * self.width * self.height
+            )));
+        }
+        let (width, height) = (u32::try_from(self.width), u32::try_from(self.height));
+        let (Ok(width), Ok(height)) = (width, height) else {
+            return Err(io("image too large for PNG".into()));
+        };
+        // Encoded in memory first, so that every write error reaches the caller (a buffered
+        // writer dropped by the encoder would swallow the last one).
+        let mut encoded = Vec::new();
+        {
+            let mut enc = png::Encoder::new(&mut encoded, width, height);
+            enc.set_color(png::ColorType::Rgb);
+            enc.set_depth(png::BitDepth::Eight);
+            let mut writer = enc.write_header().map_err(|e| io(e.to_string()))?;
+            writer
+                .write_image_data(&self.data)
+                .map_err(|e| io(e.to_string()))?;
+            writer.finish().map_err(|e| io(e.to_string()))?;
+        }
+        let mut file = AtomicWriteFile::open(path).map_err(|e| io(e.to_string()))?;
+        file.write_all(&encoded).map_err(|e| io(e.to_string()))?;
+        file.commit().map_err(|e| io(e.to_string()))
     }
 
     /// Reads an 8-bit RGB or RGBA PNG (alpha dropped).
@@ -104,7 +127,12 @@ impl RgbImage {
         let mut reader = png::Decoder::new(std::io::BufReader::new(file))
             .read_info()
             .map_err(|e| io(e.to_string()))?;
-        let mut buf = vec![0; reader.output_buffer_size()];
+        // Bounded by the decoder's default limit on decoded bytes (png::Limits).
+        let size = reader.output_buffer_size();
+        let mut buf = Vec::new();
+        buf.try_reserve_exact(size)
+            .map_err(|e| io(format!("{size} bytes for the decoded image: {e}")))?;
+        buf.resize(size, 0);
         let info = reader.next_frame(&mut buf).map_err(|e| io(e.to_string()))?;
         if info.bit_depth != png::BitDepth::Eight {
             return Err(io("not an 8-bit PNG".into()));
