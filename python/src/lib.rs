@@ -6,6 +6,7 @@
 mod arrays;
 mod comets;
 mod kernels;
+mod measure;
 mod neighbours;
 mod render;
 mod sim;
