@@ -431,6 +431,17 @@ impl Simulation {
         result.map_err(rust_err)
     }
 
+    /// A simulation built from `source`, before its first run.
+    fn new(sim: AnySim, source: SceneSource, cache_dir: Option<PathBuf>) -> Self {
+        Self {
+            sim: Mutex::new(sim),
+            record: None,
+            source,
+            cache_dir,
+            rest: None,
+        }
+    }
+
     fn scene_frames(&self) -> usize {
         each!(&*self.lock(), s => s.scene.frame_count())
     }
@@ -458,13 +469,7 @@ impl Simulation {
                 )
             })
             .map_err(rust_err)?;
-        Ok(Self {
-            sim: Mutex::new(sim),
-            record: None,
-            source,
-            cache_dir,
-            rest: None,
-        })
+        Ok(Self::new(sim, source, cache_dir))
     }
 }
 
@@ -514,13 +519,7 @@ impl Simulation {
             Ok((source, sim))
         });
         let (source, sim) = built.map_err(rust_err)?;
-        Ok(Self {
-            sim: Mutex::new(sim),
-            record: None,
-            source,
-            cache_dir,
-            rest: None,
-        })
+        Ok(Self::new(sim, source, cache_dir))
     }
 
     /// Writes the simulation to ``path``, atomically (a temporary file renamed into place:
