@@ -251,7 +251,7 @@ def test_run_shows_progress_through_partisim_progress(scene, monkeypatch):
 
 # A planar heap of known slope: a prism whose cross-section is an isosceles triangle with
 # base 1 m (x) and flanks at 30°, 0.2 m deep (z), filled with particles at 0.02 m.
-H = 0.5 * np.tan(np.radians(30.0))
+H = float(0.5 * np.tan(np.radians(30.0)))
 WEDGE_OBJ = f"""v 0 0 0
 v 1 0 0
 v 0.5 {H!r} 0
