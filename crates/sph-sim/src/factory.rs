@@ -82,6 +82,9 @@ pub fn build_boundary<R: Real>(
     build_boundary_reporting(scene, c, positions, cache).map(|(b, _)| b)
 }
 
+/// A boundary and how each solid's volume map was obtained.
+pub(crate) type BoundaryWithMaps<R> = (Box<dyn Boundary<R>>, Vec<CacheUse>);
+
 /// [`build_boundary`], with how each solid's volume map was obtained (built, loaded from
 /// the cache, ...; empty for the collision boundary).
 pub(crate) fn build_boundary_reporting<R: Real>(
@@ -89,7 +92,7 @@ pub(crate) fn build_boundary_reporting<R: Real>(
     c: &CommonParams<R>,
     positions: &[Vec3<R>],
     cache: Option<&VolumeMapCache>,
-) -> Result<(Box<dyn Boundary<R>>, Vec<CacheUse>), SimError> {
+) -> Result<BoundaryWithMaps<R>, SimError> {
     let solids = scene.build_solids::<R>()?;
     let setup = |source| setup_error(scene, source);
     match scene.boundary.model {
