@@ -172,7 +172,8 @@ fn overrides_of(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<Override>> {
                     type_name(&k)
                 ))
             })?;
-            Ok(Override::new(key.clone(), toml_value(&key, &v)?))
+            let value = toml_value(&key, &v)?;
+            Ok(Override::new(key, value))
         })
         .collect()
 }

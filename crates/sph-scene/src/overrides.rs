@@ -139,7 +139,7 @@ fn document_value(text: &str) -> Result<Spanned<DeValue<'_>>, String> {
 }
 
 /// `v` with its span and those of everything inside it set to [`override_span`].
-fn respan<'a>(v: DeValue<'a>) -> Spanned<DeValue<'a>> {
+fn respan(v: DeValue<'_>) -> Spanned<DeValue<'_>> {
     let v = match v {
         DeValue::Table(t) => {
             let mut out = DeTable::new();
