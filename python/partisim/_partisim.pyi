@@ -42,22 +42,68 @@ def kernel(name: str, support_radius: float) -> Kernel:
     """poly6, spiky, viscosity, cubic-spline or wendland-c2 with support radius h (m)."""
 
 class Simulation:
-    """A scene file run frame by frame (sph-sim's SceneSim and frame loop)."""
+    """A scene file run frame by frame (sph-sim's SceneSim and frame loop).
+
+    Units are SI (m, s, kg); arrays are in the scene's particle order and precision
+    (``precision``: float32 or float64). ``time`` is simulated time (s); wall-clock times
+    appear only in ``stats`` (``*_s`` phase timings). Picklable; ``save``/``load`` continue
+    bit for bit."""
     @staticmethod
-    def from_scene(path: _Path, quick: bool = False) -> Simulation:
-        """Loads, checks and builds a scene (quick: its [quick] overrides)."""
+    def from_scene(
+        path: _Path,
+        quick: bool = False,
+        overrides: Optional[Dict[str, Any]] = None,
+        volume_map_cache: Union[bool, _Path, None] = True,
+    ) -> Simulation:
+        """Loads, checks and builds a scene (quick: its [quick] overrides). `overrides`:
+        values of the file's keys by dotted path ({"solver.friction_angle_deg": 33.0,
+        "fluid[0].max": [...]}), checked as the file's ("given as an override" in messages).
+        `volume_map_cache`: True (default: the command line's target/cache/volume-maps under
+        the current directory), a directory, or None/False for none."""
+    @staticmethod
+    def load(path: _Path, volume_map_cache: Union[bool, _Path, None] = True) -> Simulation:
+        """The simulation saved by `save`, continuing bit for bit."""
+    def save(self, path: _Path) -> None:
+        """Writes the scene text, overrides, quick mode and the whole state, atomically."""
+    @staticmethod
+    def _from_bytes(data: bytes, volume_map_cache: Union[bool, _Path, None] = True) -> Simulation: ...
+    def __reduce__(self) -> Any: ...
     def step(self) -> Dict[str, Any]:
         """Advances one frame; returns its statistics (a blow-up raises PartisimError)."""
     def run(
         self,
-        frames: int,
-        progress: bool = True,
+        frames: Optional[int] = None,
+        progress: Optional[bool] = None,
         callback: Optional[Callable[[Dict[str, Any]], Any]] = None,
+        until_rest: Optional[Dict[str, Any]] = None,
     ) -> Dict[str, Any]:
-        """Advances `frames` frames (progress bar on stderr). `callback(stats)` after each
-        frame: False or a string (the reason) stops the run. Returns how it ended:
-        {"ending": "completed" | "stopped" | "diverged", "frame", "time_s", "reason"}.
+        """Runs to the scene's last frame (frames=None) or `frames` more (numpy integers
+        accepted), never past the scene's last frame (as `particles run --frames`); huge
+        counts are clamped. Progress through partisim.progress (None: on for a terminal or
+        Jupyter). `callback(stats)` after each frame: False or a string (the reason) stops
+        the run. `until_rest={"speed_m_s", "hold_s", "region"}` stops at rest. Returns
+        {"ending", "frame", "time_s", "reason", "frames_run", "scene_frames",
+        "at_scene_end"} (+ "at_rest", "rest_from_s", "max_speed_m_s" with until_rest).
         Ctrl-C stops between frames with KeyboardInterrupt (the frames done are kept)."""
+    def repose(
+        self,
+        shape: str = "planar",
+        floor_y: Optional[float] = None,
+        bin_width_m: Optional[float] = None,
+        fit_band: Tuple[float, float] = (0.2, 0.8),
+        min_fit_points: int = 4,
+        steepest_run_m: Optional[float] = None,
+    ) -> Dict[str, Any]:
+        """The angle of repose of the current particles (granular-measure), degrees, with
+        its resolution, flanks, profile and the at-rest verdict of the last run watched
+        with until_rest (None if none, or if frames were run since)."""
+    @property
+    def volume_maps(self) -> List[str]:
+        """Per solid: "built", "loaded", "stored", "replaced", "write-failed" or
+        "uncacheable" (empty for the collision boundary)."""
+    @property
+    def scene_frames(self) -> int:
+        """The scene's last frame, ceil(duration / frame_dt)."""
     @property
     def positions(self) -> _Float:
         """(N, 3) positions (m), in the scene's particle order and precision."""

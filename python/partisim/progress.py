@@ -43,8 +43,9 @@ def progress_wanted(enabled: Optional[bool]) -> bool:
     return tty or in_jupyter()
 
 
-class _Silent:
-    """The display when progress is off: every call does nothing."""
+class _Display:
+    """The display when progress is off (every call does nothing), and the context-manager
+    part every display shares."""
 
     def update(self, n: int = 1) -> None:
         pass
@@ -52,14 +53,14 @@ class _Silent:
     def close(self) -> None:
         pass
 
-    def __enter__(self) -> "_Silent":
+    def __enter__(self) -> "_Display":
         return self
 
     def __exit__(self, *exc: Any) -> None:
         self.close()
 
 
-class _PlainLine:
+class _PlainLine(_Display):
     """``desc: done/total`` on standard error, rewritten in place (``\\r``), throttled."""
 
     def __init__(self, total: Optional[int], desc: str) -> None:
@@ -98,14 +99,8 @@ class _PlainLine:
         except (AttributeError, ValueError, OSError):
             pass
 
-    def __enter__(self) -> "_PlainLine":
-        return self
 
-    def __exit__(self, *exc: Any) -> None:
-        self.close()
-
-
-class _Tqdm:
+class _Tqdm(_Display):
     """A ``tqdm.auto`` bar behind the same two calls."""
 
     def __init__(self, bar: Any) -> None:
@@ -116,12 +111,6 @@ class _Tqdm:
 
     def close(self) -> None:
         self._bar.close()
-
-    def __enter__(self) -> "_Tqdm":
-        return self
-
-    def __exit__(self, *exc: Any) -> None:
-        self.close()
 
 
 def make_progress(total: Optional[int], enabled: Optional[bool] = None, desc: str = "") -> Any:
@@ -142,7 +131,7 @@ def make_progress(total: Optional[int], enabled: Optional[bool] = None, desc: st
     An object with ``update(n=1)`` and ``close()``, usable as a context manager.
     """
     if not progress_wanted(enabled):
-        return _Silent()
+        return _Display()
     try:
         from tqdm.auto import tqdm
 

@@ -7,6 +7,7 @@ mod arrays;
 mod comets;
 mod interrupt;
 mod kernels;
+mod measure;
 mod neighbours;
 mod render;
 mod sim;

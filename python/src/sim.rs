@@ -1,19 +1,24 @@
 //! `sph-sim`: a scene run frame by frame through the workspace's one frame loop.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 use numpy::{IntoPyArray, PyArrayMethods};
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyString};
+use pyo3::types::{PyBool, PyBytes, PyDict, PyFloat, PyList, PyString, PyTuple};
 use sph_core::{Real, Vec3};
-use sph_sim::run::ProgressObserver;
+use sph_scene::Override;
+use sph_sim::saved::{decode_saved, encode_saved, read_saved, SceneSource};
 use sph_sim::{
-    run_frames, Ending, Flow, FrameObserver, FrameRecord, RunOutcome, RunPlan, Scene, SceneSim,
-    SimError,
+    run_frames, Ending, Flow, FrameObserver, FrameRecord, Precision, RunOutcome, RunPlan, Scene,
+    SceneSim, SimError,
 };
+use sph_solver::boundary::{CacheUse, VolumeMapCache};
 
+use crate::measure::{repose_dict, rest_criterion, ReposeArgs, RestVerdict};
 use crate::rust_err;
+use sph_sim::observe::RestObserver;
 
 /// A scene in either precision (the scene file's `precision`).
 enum AnySim {
@@ -35,6 +40,179 @@ macro_rules! each {
 struct Simulation {
     sim: Mutex<AnySim>,
     record: Option<FrameRecord>,
+    /// The scene file's text with the overrides and quick mode: what `save` keeps.
+    source: SceneSource,
+    /// The volume-map cache directory used, if any.
+    cache_dir: Option<PathBuf>,
+    /// The at-rest verdict of the last run watched with `until_rest`.
+    rest: Option<RestVerdict>,
+}
+
+/// The Python type name of `v`, for a message.
+fn type_name(v: &Bound<'_, PyAny>) -> String {
+    v.get_type()
+        .name()
+        .map(|n| n.to_string())
+        .unwrap_or_default()
+}
+
+/// The command line's default volume-map cache (`particles run`), relative to the current
+/// directory.
+fn default_cache_dir() -> PathBuf {
+    PathBuf::from("target").join("cache").join("volume-maps")
+}
+
+/// `volume_map_cache`: True (the default: the command line's directory), a directory, or
+/// None/False (no cache).
+enum CacheChoice {
+    Default,
+    Off,
+    Dir(PathBuf),
+}
+
+impl<'a, 'py> FromPyObject<'a, 'py> for CacheChoice {
+    type Error = PyErr;
+
+    fn extract(obj: pyo3::Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        if obj.is_none() {
+            return Ok(CacheChoice::Off);
+        }
+        if let Ok(b) = obj.cast::<PyBool>() {
+            return Ok(if b.is_true() {
+                CacheChoice::Default
+            } else {
+                CacheChoice::Off
+            });
+        }
+        obj.extract::<PathBuf>().map(CacheChoice::Dir).map_err(|_| {
+            PyTypeError::new_err(format!(
+                "volume_map_cache: expected a directory (str or os.PathLike), True or None, not {}",
+                type_name(&obj)
+            ))
+        })
+    }
+}
+
+impl CacheChoice {
+    fn dir(self) -> Option<PathBuf> {
+        match self {
+            CacheChoice::Default => Some(default_cache_dir()),
+            CacheChoice::Off => None,
+            CacheChoice::Dir(d) => Some(d),
+        }
+    }
+}
+
+/// A Python value as the TOML value of the override of `key`: bool, int (numpy integers
+/// too), float, str, a list or tuple (or an array, as its `tolist()`) of those, a dict of
+/// those.
+fn toml_value(key: &str, v: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
+    let py = v.py();
+    if let Ok(b) = v.cast::<PyBool>() {
+        return Ok(toml::Value::Boolean(b.is_true()));
+    }
+    if v.is_instance_of::<PyString>() {
+        return Ok(toml::Value::String(v.extract::<String>()?));
+    }
+    if let Ok(x) = v.cast::<PyFloat>() {
+        return Ok(toml::Value::Float(x.value()));
+    }
+    if let Ok(d) = v.cast::<PyDict>() {
+        let mut t = toml::Table::new();
+        for (k, item) in d.iter() {
+            let k: String = k.extract().map_err(|_| {
+                PyTypeError::new_err(format!("overrides[{key:?}]: table keys must be str"))
+            })?;
+            let value = toml_value(&format!("{key}.{k}"), &item)?;
+            t.insert(k, value);
+        }
+        return Ok(toml::Value::Table(t));
+    }
+    if v.is_instance_of::<PyList>() || v.is_instance_of::<PyTuple>() {
+        let items = v
+            .try_iter()?
+            .enumerate()
+            .map(|(i, item)| toml_value(&format!("{key}[{i}]"), &item?))
+            .collect::<PyResult<Vec<_>>>()?;
+        return Ok(toml::Value::Array(items));
+    }
+    // numpy scalars and arrays: their Python equivalents (int, float, bool, nested lists).
+    if v.hasattr("tolist")? {
+        let plain = v.call_method0("tolist")?;
+        if !plain.is(v) {
+            return toml_value(key, &plain);
+        }
+    }
+    if let Ok(i) = py.import("operator")?.call_method1("index", (v,)) {
+        return i.extract::<i64>().map(toml::Value::Integer).map_err(|_| {
+            PyValueError::new_err(format!(
+                "overrides[{key:?}]: {i} does not fit a TOML integer (64-bit signed)"
+            ))
+        });
+    }
+    Err(PyTypeError::new_err(format!(
+        "overrides[{key:?}]: a {} is not a scene value (give a bool, int, float, str, list or dict)",
+        type_name(v)
+    )))
+}
+
+/// The overrides dict as [`Override`]s, in the dict's order.
+fn overrides_of(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<Override>> {
+    let Some(arg) = arg.filter(|a| !a.is_none()) else {
+        return Ok(Vec::new());
+    };
+    let d = arg.cast::<PyDict>().map_err(|_| {
+        PyTypeError::new_err("overrides: expected a dict from a key's dotted path to its value")
+    })?;
+    d.iter()
+        .map(|(k, v)| {
+            let key: String = k.extract().map_err(|_| {
+                PyTypeError::new_err(format!(
+                    "overrides: the keys are dotted paths (str), not {}",
+                    type_name(&k)
+                ))
+            })?;
+            let value = toml_value(&key, &v)?;
+            Ok(Override::new(key, value))
+        })
+        .collect()
+}
+
+/// Builds the simulation of `scene` (with the volume maps from `cache_dir` when the scene
+/// has them), and restores `checkpoint` (bytes of the checkpoint format) if given.
+fn build(
+    scene: &Scene,
+    cache_dir: Option<&Path>,
+    checkpoint: Option<(&Path, &[u8])>,
+) -> Result<AnySim, SimError> {
+    let cache = match (cache_dir, scene.boundary.model) {
+        (Some(dir), sph_scene::BoundaryModel::VolumeMap) => {
+            Some(VolumeMapCache::new(dir).map_err(|e| SimError::output(dir, e))?)
+        }
+        _ => None,
+    };
+    fn restore<R: Real>(
+        mut sim: SceneSim<R>,
+        checkpoint: Option<(&Path, &[u8])>,
+    ) -> Result<SceneSim<R>, SimError> {
+        if let Some((file, bytes)) = checkpoint {
+            let c = sph_sim::checkpoint::decode::<R>(bytes)
+                .map_err(|reason| SimError::input(file, reason))?;
+            sim.restore(c)
+                .map_err(|reason| SimError::input(file, reason))?;
+        }
+        Ok(sim)
+    }
+    Ok(match scene.precision {
+        Precision::F32 => AnySim::F32(restore(
+            SceneSim::with_cache(scene, cache.as_ref())?,
+            checkpoint,
+        )?),
+        Precision::F64 => AnySim::F64(restore(
+            SceneSim::with_cache(scene, cache.as_ref())?,
+            checkpoint,
+        )?),
+    })
 }
 
 /// The frame record as a Python dict: its serde form (`phases_s` a dict by phase name).
@@ -48,6 +226,10 @@ fn record_dict<'py>(py: Python<'py>, r: &FrameRecord) -> PyResult<Bound<'py, PyA
 /// and ends the run.
 struct PythonSide {
     callback: Option<Py<PyAny>>,
+    /// The `partisim.progress` display (`update(n)`), if any.
+    progress: Option<Py<PyAny>>,
+    /// The rest criterion watched (`run(until_rest=...)`), if any.
+    rest: Option<RestObserver>,
     err: Option<PyErr>,
     last: Option<FrameRecord>,
 }
@@ -55,6 +237,9 @@ struct PythonSide {
 impl PythonSide {
     fn ask(&mut self, py: Python<'_>, record: &FrameRecord) -> PyResult<Flow> {
         py.check_signals()?;
+        if let Some(bar) = &self.progress {
+            bar.call_method1(py, "update", (1,))?;
+        }
         let Some(cb) = &self.callback else {
             return Ok(Flow::Continue);
         };
@@ -71,9 +256,14 @@ impl PythonSide {
 }
 
 impl<R: Real> FrameObserver<R> for PythonSide {
-    fn frame(&mut self, _: &SceneSim<R>, record: &FrameRecord) -> Result<Flow, SimError> {
+    fn frame(&mut self, sim: &SceneSim<R>, record: &FrameRecord) -> Result<Flow, SimError> {
         self.last = Some(*record);
+        let rest = match &mut self.rest {
+            Some(r) => r.frame(sim, record)?,
+            None => Flow::Continue,
+        };
         match Python::attach(|py| self.ask(py, record)) {
+            Ok(Flow::Continue) => Ok(rest),
             Ok(flow) => Ok(flow),
             Err(e) => {
                 self.err = Some(e);
@@ -85,23 +275,104 @@ impl<R: Real> FrameObserver<R> for PythonSide {
 
 fn run_in<R: Real>(
     sim: &mut SceneSim<R>,
-    frames: usize,
-    progress: bool,
+    last_frame: usize,
     side: &mut PythonSide,
 ) -> Result<RunOutcome, SimError> {
-    let plan = RunPlan::next(sim, frames);
-    let mut bar = ProgressObserver::new(progress);
-    run_frames(sim, &plan, &mut [&mut bar, side])
+    let plan = RunPlan {
+        first_frame: sim.frame,
+        last_frame: last_frame.max(sim.frame),
+        resumed: false,
+    };
+    run_frames(sim, &plan, &mut [side])
 }
 
-/// How a run ended, as a dict: `ending` ("completed", "stopped" or "diverged"), `frame`,
-/// `time_s`, `reason` (the stop's or the divergence's, else None).
-fn outcome_dict<'py>(py: Python<'py>, o: &RunOutcome) -> PyResult<Bound<'py, PyDict>> {
+/// What a call of `run` asked for and what it will do.
+struct FramePlan {
+    /// The frame the run stops at.
+    last_frame: usize,
+    /// The scene's last frame (`duration / frame_dt`, as the command line counts it).
+    scene_frames: usize,
+    /// Frames asked for (`None`: to the scene's end).
+    asked: Option<u128>,
+}
+
+impl FramePlan {
+    /// The plan of `run(frames)` from frame `now` of a scene of `scene_frames` frames: to
+    /// the scene's end, or `frames` more but never past it (the command line's `--frames`
+    /// stops there too).
+    fn new(frames: Option<&Bound<'_, PyAny>>, now: usize, scene_frames: usize) -> PyResult<Self> {
+        let asked = match frames.filter(|f| !f.is_none()) {
+            None => None,
+            Some(f) => {
+                if f.is_instance_of::<PyFloat>() || f.is_instance_of::<PyBool>() {
+                    return Err(PyTypeError::new_err(format!(
+                        "frames: expected a whole number of frames (int), not {}",
+                        type_name(f)
+                    )));
+                }
+                let n = f
+                    .py()
+                    .import("operator")?
+                    .call_method1("index", (f,))
+                    .map_err(|_| {
+                        PyTypeError::new_err(format!(
+                            "frames: expected a whole number of frames (int), not {}",
+                            type_name(f)
+                        ))
+                    })?;
+                if n.lt(1)? {
+                    return Err(PyValueError::new_err(format!(
+                        "frames = {n}: a run needs at least 1 frame (None runs to the scene's end)"
+                    )));
+                }
+                // Larger than any scene: clamped to the scene's end below, never wrapped.
+                Some(n.extract::<u128>().unwrap_or(u128::MAX))
+            }
+        };
+        let wanted = match asked {
+            None => scene_frames,
+            Some(n) => (now as u128).saturating_add(n).min(scene_frames as u128) as usize,
+        };
+        Ok(Self {
+            last_frame: wanted.max(now),
+            scene_frames,
+            asked,
+        })
+    }
+
+    /// Whether the run stops short of the frames asked for, at the scene's end.
+    fn clamped(&self, now: usize) -> bool {
+        self.asked
+            .is_some_and(|n| (now as u128).saturating_add(n) > self.scene_frames as u128)
+    }
+}
+
+/// How a run ended, as a dict: `ending` ("completed", "stopped", "interrupted" or
+/// "diverged"), `frame`, `time_s`, `reason` (the stop's or the divergence's, else None),
+/// `frames_run`, `scene_frames` and `at_scene_end`.
+fn outcome_dict<'py>(
+    py: Python<'py>,
+    o: &RunOutcome,
+    first: usize,
+    plan: &FramePlan,
+) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("ending", o.ending.name())?;
     d.set_item("frame", o.frame)?;
     d.set_item("time_s", o.time_s)?;
-    d.set_item("reason", o.ending.reason())?;
+    let mut reason = o.ending.reason();
+    if reason.is_none() && plan.clamped(first) && o.frame == plan.scene_frames {
+        reason = Some(format!(
+            "the scene ends at frame {} (duration / frame_dt): {} frames asked for from frame {first}, {} run",
+            plan.scene_frames,
+            plan.asked.unwrap_or_default(),
+            o.frame.saturating_sub(first)
+        ));
+    }
+    d.set_item("reason", reason)?;
+    d.set_item("frames_run", o.frame.saturating_sub(first))?;
+    d.set_item("scene_frames", plan.scene_frames)?;
+    d.set_item("at_scene_end", o.frame >= plan.scene_frames)?;
     Ok(d)
 }
 
@@ -124,60 +395,214 @@ impl Simulation {
         self.sim.lock().unwrap_or_else(|p| p.into_inner())
     }
 
-    /// Runs `frames` frames with the GIL released; a Python error (Ctrl-C, the callback's)
-    /// is raised after the frames done are kept.
+    /// Runs to frame `last_frame` with the GIL released; a Python error (Ctrl-C, the
+    /// callback's) is raised after the frames done are kept.
     fn run_frames(
         &mut self,
         py: Python<'_>,
-        frames: usize,
-        progress: bool,
+        last_frame: usize,
+        progress: Option<Py<PyAny>>,
         callback: Option<Py<PyAny>>,
+        rest: Option<RestObserver>,
     ) -> PyResult<RunOutcome> {
         let sim = &self.sim;
         let mut side = PythonSide {
             callback,
+            progress,
+            rest,
             err: None,
             last: None,
         };
         let result = py.detach(|| {
             let mut guard = sim.lock().unwrap_or_else(|p| p.into_inner());
-            each!(&mut *guard, s => run_in(s, frames, progress, &mut side))
+            each!(&mut *guard, s => run_in(s, last_frame, &mut side))
         });
+        if let Some(bar) = &side.progress {
+            bar.call_method0(py, "close")?;
+        }
         if side.last.is_some() {
             self.record = side.last;
+        }
+        if let Some(r) = &side.rest {
+            self.rest = Some(RestVerdict::of(r, self.frame()));
         }
         if let Some(e) = side.err {
             return Err(e);
         }
         result.map_err(rust_err)
     }
+
+    /// A simulation built from `source`, before its first run.
+    fn new(sim: AnySim, source: SceneSource, cache_dir: Option<PathBuf>) -> Self {
+        Self {
+            sim: Mutex::new(sim),
+            record: None,
+            source,
+            cache_dir,
+            rest: None,
+        }
+    }
+
+    fn scene_frames(&self) -> usize {
+        each!(&*self.lock(), s => s.scene.frame_count())
+    }
+
+    /// The bytes of `save` (the scene source and the checkpoint of the current frame).
+    fn to_bytes(&self) -> Vec<u8> {
+        each!(&*self.lock(), s => encode_saved(&self.source, s))
+    }
+
+    /// The simulation saved in `bytes` (read from `file`, named in messages).
+    fn from_saved(
+        py: Python<'_>,
+        file: &Path,
+        bytes: &[u8],
+        cache_dir: Option<PathBuf>,
+    ) -> PyResult<Self> {
+        let (source, checkpoint) =
+            decode_saved(bytes).map_err(|reason| rust_err(SimError::input(file, reason)))?;
+        let sim = py
+            .detach(|| {
+                build(
+                    &source.scene()?,
+                    cache_dir.as_deref(),
+                    Some((file, checkpoint)),
+                )
+            })
+            .map_err(rust_err)?;
+        Ok(Self::new(sim, source, cache_dir))
+    }
 }
 
 #[pymethods]
 impl Simulation {
-    /// Loads and checks a scene file and builds its particles, boundary and solver.
+    /// Loads and checks a scene file (TOML) and builds its particles, boundary and solver.
+    ///
+    /// Parameters
+    /// ----------
+    /// path : str or os.PathLike
+    ///     The scene file; mesh paths in it are relative to its directory.
+    /// quick : bool
+    ///     Apply the scene's ``[quick]`` overrides (coarser, shorter), as ``--quick`` does.
+    /// overrides : dict, optional
+    ///     Values of the scene file's keys by dotted path, e.g.
+    ///     ``{"solver.friction_angle_deg": 33.0, "simulation.duration": 2.0,
+    ///     "fluid[0].max": [0.3, 0.4, 0.3]}``, applied to the file's document before it is
+    ///     checked: a wrong type, an unknown key (named with the keys its table has) or an
+    ///     out-of-range value raises PartisimError at the key, "given as an override".
+    ///     Values: bool, int (numpy integers too), float, str, list/tuple/array, dict.
+    /// volume_map_cache : True, str, os.PathLike or None
+    ///     Where volume maps (``[boundary] model = "volume-map"``) are loaded from and stored:
+    ///     ``True`` (default) the command line's cache ``target/cache/volume-maps`` under the
+    ///     current directory (``particles run`` run from the same directory shares it), a
+    ///     directory, or ``None``/``False`` to build them afresh and keep none.
+    ///     ``volume_maps`` says what happened to each map.
+    ///
+    /// Raises
+    /// ------
+    /// PartisimError
+    ///     The scene is unreadable or refused (the message names the file, the key and the
+    ///     line, or "given as an override").
     #[staticmethod]
-    #[pyo3(signature = (path, quick = false))]
-    fn from_scene(py: Python<'_>, path: PathBuf, quick: bool) -> PyResult<Self> {
-        let sim = py.detach(|| -> Result<AnySim, SimError> {
-            let scene = Scene::load(&path)?;
-            let scene = if quick { scene.quick() } else { scene };
-            Ok(match scene.precision {
-                sph_sim::Precision::F32 => AnySim::F32(SceneSim::new(&scene)?),
-                sph_sim::Precision::F64 => AnySim::F64(SceneSim::new(&scene)?),
-            })
+    #[pyo3(signature = (path, quick = false, overrides = None, volume_map_cache = CacheChoice::Default))]
+    fn from_scene(
+        py: Python<'_>,
+        path: PathBuf,
+        quick: bool,
+        overrides: Option<&Bound<'_, PyAny>>,
+        volume_map_cache: CacheChoice,
+    ) -> PyResult<Self> {
+        let overrides = overrides_of(overrides)?;
+        let cache_dir = volume_map_cache.dir();
+        let built = py.detach(|| -> Result<(SceneSource, AnySim), SimError> {
+            let (source, scene) = SceneSource::load(&path, overrides, quick)?;
+            let sim = build(&scene, cache_dir.as_deref(), None)?;
+            Ok((source, sim))
         });
-        Ok(Self {
-            sim: Mutex::new(sim.map_err(rust_err)?),
-            record: None,
-        })
+        let (source, sim) = built.map_err(rust_err)?;
+        Ok(Self::new(sim, source, cache_dir))
+    }
+
+    /// Writes the simulation to ``path``, atomically (a temporary file renamed into place:
+    /// an interrupted save leaves the earlier file whole): the scene file's text, the
+    /// overrides and quick mode, and the whole state of the current frame (particles in the
+    /// scene's precision, the solver's carried state, frame and time). ``Simulation.load``
+    /// continues from it bit for bit as if the run had not stopped. Mesh files are read
+    /// again from their paths when loaded (a changed mesh is refused).
+    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        let bytes = self.to_bytes();
+        py.detach(|| sph_sim::checkpoint::write_atomically(&path, &bytes))
+            .map_err(rust_err)
+    }
+
+    /// The simulation saved by ``save`` at ``path``, continuing bit for bit from the frame
+    /// it was saved at. ``volume_map_cache`` as for ``from_scene``. A file that is not a
+    /// saved simulation, truncated, corrupt, or written by another version raises
+    /// PartisimError naming it.
+    #[staticmethod]
+    #[pyo3(signature = (path, volume_map_cache = CacheChoice::Default))]
+    fn load(py: Python<'_>, path: PathBuf, volume_map_cache: CacheChoice) -> PyResult<Self> {
+        let cache_dir = volume_map_cache.dir();
+        let bytes = py.detach(|| read_saved(&path)).map_err(rust_err)?;
+        Self::from_saved(py, &path, &bytes, cache_dir)
+    }
+
+    /// Pickling: the bytes of ``save`` (unpickled with the command line's default
+    /// volume-map cache directory when the simulation had a cache, else none).
+    #[allow(clippy::type_complexity)]
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyBytes>, bool))> {
+        let restore = py
+            .import("partisim.sim")?
+            .getattr("_simulation_from_bytes")?;
+        let bytes = PyBytes::new(py, &self.to_bytes());
+        Ok((restore, (bytes, self.cache_dir.is_some())))
+    }
+
+    /// The simulation of ``bytes`` (``save``'s format); used by pickle.
+    #[staticmethod]
+    #[pyo3(signature = (data, volume_map_cache = CacheChoice::Default))]
+    fn _from_bytes(py: Python<'_>, data: &[u8], volume_map_cache: CacheChoice) -> PyResult<Self> {
+        let cache_dir = volume_map_cache.dir();
+        Self::from_saved(py, Path::new("<pickle>"), data, cache_dir)
+    }
+
+    /// How each solid's volume map was obtained when the simulation was built, in solid
+    /// order: ``"built"`` (no cache), ``"loaded"`` (from the cache), ``"stored"`` (built and
+    /// written to the cache), ``"replaced"`` (a refused cache file rebuilt), ``"write-failed"``
+    /// or ``"uncacheable"``; empty for the collision boundary.
+    #[getter]
+    fn volume_maps(&self) -> Vec<&'static str> {
+        let uses = each!(&*self.lock(), s => s.volume_maps.clone());
+        uses.iter()
+            .map(|u| match u {
+                CacheUse::NoCache => "built",
+                CacheUse::Uncacheable => "uncacheable",
+                CacheUse::Hit => "loaded",
+                CacheUse::Stored => "stored",
+                CacheUse::Replaced => "replaced",
+                CacheUse::WriteFailed => "write-failed",
+                _ => "other",
+            })
+            .collect()
+    }
+
+    /// The scene's last frame, ``ceil(duration / frame_dt)``: where ``run()`` stops, as the
+    /// command line does.
+    #[getter(scene_frames)]
+    fn scene_frames_py(&self) -> usize {
+        self.scene_frames()
     }
 
     /// Advances one frame (the scene's frame interval) through the frame loop; returns the
     /// frame's statistics. A blow-up raises PartisimError naming the frame, step and
-    /// particle (the state keeps its last good substep).
+    /// particle (the state keeps its last good substep). Unlike ``run``, ``step`` may go
+    /// past the scene's last frame.
     fn step<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let outcome = self.run_frames(py, 1, false, None)?;
+        let next = self.frame().saturating_add(1);
+        let outcome = self.run_frames(py, next, None, None, None)?;
         if let Ending::Diverged(_) = outcome.ending {
             return Err(rust_err(outcome.ending.reason().unwrap_or_default()));
         }
@@ -187,39 +612,167 @@ impl Simulation {
         }
     }
 
-    /// Advances `frames` frames through the frame loop, with a progress bar on stderr if
-    /// `progress`. `callback(stats)`, if given, is called after each frame with its
-    /// statistics (the dict of `stats`); returning False or a string stops the run after
-    /// that frame (the string is the reason). Returns how the run ended, a dict with
-    /// `ending` ("completed", "stopped" or "diverged": a blow-up is a result, the state
-    /// keeps its last good substep), `frame`, `time_s` and `reason`. Ctrl-C stops it
-    /// between frames with KeyboardInterrupt, and an exception of the callback ends it
-    /// with that exception; the frames done are kept either way.
-    #[pyo3(signature = (frames, progress = true, callback = None))]
+    /// Runs frames through the frame loop, as the command line counts them.
+    ///
+    /// Parameters
+    /// ----------
+    /// frames : int or None
+    ///     ``None`` (default): to the scene's last frame (``scene_frames``, i.e.
+    ///     ``ceil(duration / frame_dt)``); an int ``>= 1`` (numpy integers too): that many
+    ///     more frames, but never past the scene's last frame (``particles run --frames``
+    ///     stops there too; the outcome's ``reason`` says so). A huge count is clamped,
+    ///     never wrapped.
+    /// progress : bool or None
+    ///     A progress display (``partisim.progress``: tqdm when installed, a widget in
+    ///     Jupyter); ``None`` (default) shows it when stderr is a terminal or in Jupyter.
+    /// callback : callable, optional
+    ///     ``callback(stats)`` after each frame with its statistics (the dict of ``stats``);
+    ///     returning False or a string stops the run after that frame (the string is the
+    ///     reason).
+    /// until_rest : dict, optional
+    ///     Stop once the material is at rest: ``{"speed_m_s": v, "hold_s": t}`` (and
+    ///     optionally ``"region": ((x0, y0, z0), (x1, y1, z1))``, m): the largest particle
+    ///     speed (in the region) has stayed below ``v`` m/s for ``t`` s of simulated time.
+    ///     The outcome then has ``at_rest`` and ``rest_from_s`` (s), and ``repose()``
+    ///     reports this verdict.
+    ///
+    /// Returns
+    /// -------
+    /// dict
+    ///     ``ending`` ("completed", "stopped" or "diverged": a blow-up is a result, the state
+    ///     keeps its last good substep), ``frame`` (frames done), ``time_s`` (simulated, s),
+    ///     ``reason`` (the stop's, the divergence's, or the scene's end when fewer frames
+    ///     than asked were run; else None), ``frames_run``, ``scene_frames`` and
+    ///     ``at_scene_end``; with ``until_rest``, ``at_rest`` (bool), ``rest_from_s``
+    ///     and ``max_speed_m_s`` (the last frame's, m/s).
+    ///
+    /// Ctrl-C stops the run between frames with KeyboardInterrupt, and an exception of the
+    /// callback ends it with that exception; the frames done are kept either way.
+    #[pyo3(signature = (frames = None, progress = None, callback = None, until_rest = None))]
     fn run<'py>(
         &mut self,
         py: Python<'py>,
-        frames: usize,
-        progress: bool,
+        frames: Option<&Bound<'py, PyAny>>,
+        progress: Option<bool>,
         callback: Option<Py<PyAny>>,
+        until_rest: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let outcome = self.run_frames(py, frames, progress, callback)?;
-        outcome_dict(py, &outcome)
+        let rest = until_rest
+            .filter(|r| !r.is_none())
+            .map(rest_criterion)
+            .transpose()?
+            .map(RestObserver::new);
+        let watched = rest.is_some();
+        let first = self.frame();
+        let plan = FramePlan::new(frames, first, self.scene_frames())?;
+        let total = plan.last_frame - first;
+        let bar = py
+            .import("partisim.progress")?
+            .call_method1("make_progress", (total, progress, "frames"))?;
+        let outcome = self.run_frames(py, plan.last_frame, Some(bar.unbind()), callback, rest)?;
+        let d = outcome_dict(py, &outcome, first, &plan)?;
+        if let Some(v) = self.rest.as_ref().filter(|_| watched) {
+            v.fill(&d)?;
+        }
+        Ok(d)
     }
 
-    /// Positions (m), shape (N, 3), in the scene's particle order and precision.
+    /// The angle of repose of the current particles (crate ``granular-measure``: the
+    /// free-surface profile binned along ``x`` (planar) or by distance from the axis
+    /// (conical), each flank fitted by least squares between ``fit_band`` fractions of the
+    /// pile height), with the at-rest verdict of the last ``run(until_rest=...)``.
+    ///
+    /// Parameters
+    /// ----------
+    /// shape : "planar" or "conical"
+    ///     A heap uniform along ``z`` (profile along ``x``), or a pile around the particles'
+    ///     centroid.
+    /// floor_y : float, optional
+    ///     Height of the floor (m); default the tank's bottom, else 0.
+    /// bin_width_m : float, optional
+    ///     Width of the profile's bins (m); default the particle spacing.
+    /// fit_band : (float, float)
+    ///     Fractions of the pile height between which the flanks are fitted.
+    /// min_fit_points : int
+    ///     Fewest surface points per fitted flank (>= 3).
+    /// steepest_run_m : float, optional
+    ///     Also report the steepest slope over runs of this length (m).
+    ///
+    /// Returns
+    /// -------
+    /// dict
+    ///     ``angle_deg`` (mean over the flanks), ``resolution_deg`` (the bound on the error
+    ///     from the sampling at this spacing), ``steepest_deg``, ``pile_height_m``,
+    ///     ``apex_d_m``, ``flanks`` (per flank: ``angle_deg``, ``points``, ``run_m``,
+    ///     ``rms_residual_m``, ``side``), ``profile_m`` (the surface points ``(d, y)``, m),
+    ///     ``particles``, ``frame``, ``time_s``, and the verdict: ``at_rest`` (True/False
+    ///     from the last run watched with ``until_rest``; None if none was, or if frames were
+    ///     run since it ended), with ``rest_from_s``, ``rest_speed_m_s``, ``rest_hold_s``,
+    ///     ``rest_checked_at_frame`` and ``max_speed_m_s``.
+    ///
+    /// Raises PartisimError for a pile that cannot be measured (flat layer, too few surface
+    /// points, options out of range).
+    #[pyo3(signature = (shape = "planar", floor_y = None, bin_width_m = None, fit_band = (0.2, 0.8), min_fit_points = 4, steepest_run_m = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn repose<'py>(
+        &self,
+        py: Python<'py>,
+        shape: &str,
+        floor_y: Option<f64>,
+        bin_width_m: Option<f64>,
+        fit_band: (f64, f64),
+        min_fit_points: usize,
+        steepest_run_m: Option<f64>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let args = ReposeArgs {
+            shape,
+            floor_y,
+            bin_width_m,
+            fit_band,
+            min_fit_points,
+            steepest_run_m,
+        };
+        let guard = self.lock();
+        let d = each!(&*guard, s => repose_dict(
+            py,
+            &s.state.positions,
+            s.scene.particle_spacing,
+            s.scene.tank.as_ref().map(|t| t.min.y),
+            &args,
+        ))?;
+        let (frame, time_s) = each!(&*guard, s => (s.frame, s.time_s));
+        drop(guard);
+        d.set_item("frame", frame)?;
+        d.set_item("time_s", time_s)?;
+        match &self.rest {
+            Some(v) => {
+                v.fill(&d)?;
+                if v.frame != frame {
+                    d.set_item("at_rest", py.None())?;
+                }
+            }
+            None => d.set_item("at_rest", py.None())?,
+        }
+        Ok(d)
+    }
+
+    /// Positions (m), a new array of shape (N, 3): float32 or float64 as the scene's
+    /// ``precision``, row ``k`` the particle the scene created ``k``-th (whatever order the
+    /// solver keeps them in), at simulated time ``time``.
     #[getter]
     fn positions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         each!(&*self.lock(), s => array2(py, s, &s.state.positions))
     }
 
-    /// Velocities (m/s), shape (N, 3), in the scene's particle order and precision.
+    /// Velocities (m/s), a new array of shape (N, 3), in the order and precision of
+    /// ``positions``.
     #[getter]
     fn velocities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         each!(&*self.lock(), s => array2(py, s, &s.state.velocities))
     }
 
-    /// Densities (kg/m³), shape (N,), in the scene's particle order and precision.
+    /// Densities (kg/m³) of the last solver step, a new array of shape (N,), in the order
+    /// and precision of ``positions``.
     #[getter]
     fn densities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         each!(&*self.lock(), s => Ok(s
@@ -229,19 +782,22 @@ impl Simulation {
             .into_any()))
     }
 
-    /// Simulated time (s).
+    /// Simulated time (s): ``frame * frame_dt`` of the scene (not wall-clock time; the
+    /// wall-clock cost of each frame is in ``stats``).
     #[getter]
     fn time(&self) -> f64 {
         each!(&*self.lock(), s => s.time_s)
     }
 
-    /// Frames done.
+    /// Frames done since the scene's start (a loaded simulation counts the frames done
+    /// before it was saved).
     #[getter]
     fn frame(&self) -> usize {
         each!(&*self.lock(), s => s.frame)
     }
 
-    /// The scene's precision, "f32" or "f64".
+    /// The scene's precision, "f32" or "f64": the dtype of every array (float32, float64)
+    /// and of the solver's arithmetic.
     #[getter]
     fn precision(&self) -> &'static str {
         match &*self.lock() {
@@ -251,13 +807,17 @@ impl Simulation {
     }
 
     /// The last frame's statistics (the frame loop's record) as a dict, or None before the
-    /// first frame.
+    /// first frame of this object: ``frame``, ``time_s`` (simulated), ``particles``, the
+    /// density ratios, ``iterations``, ``neighbour_pairs``, ``substeps``,
+    /// ``kinetic_energy_j``, ``max_speed_m_s``, ``reordered``, and the wall-clock costs
+    /// ``phases_s`` (a dict by solver phase) and ``total_s`` (s).
     #[getter]
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
         self.record.as_ref().map(|r| record_dict(py, r)).transpose()
     }
 
-    /// Writes the particles as a legacy VTK frame (the format of `cargo xtask run`).
+    /// Writes the particles as a legacy VTK frame (binary, the format of ``cargo xtask
+    /// run``: float32 points, velocity, density and id) to ``path``.
     fn write_vtk(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         let sim = &self.sim;
         py.detach(|| {
@@ -267,8 +827,9 @@ impl Simulation {
         .map_err(rust_err)
     }
 
-    /// The current particles rendered with the scene's `[render]` settings (the image
-    /// `cargo xtask run --render` writes), as an (H, W, 3) uint8 array.
+    /// The current particles rendered with the scene's ``[render]`` settings (the image
+    /// ``cargo xtask run --render`` writes), as an (H, W, 3) uint8 RGB array (H, W the
+    /// ``[render]`` table's ``height``, ``width``).
     fn render<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, numpy::PyArray3<u8>>> {
         let sim = &self.sim;
         let image = py.detach(|| {

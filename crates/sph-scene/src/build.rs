@@ -14,7 +14,7 @@ use sph_core::{
 
 use crate::error::Ctx;
 use crate::geom::{cast3, fmt3, v3, AXES};
-use crate::limits::{MAX_PARTICLES, MAX_SDF_NODES};
+use crate::limits::{MAX_PARTICLES, MAX_PASSIVE_POINTS, MAX_SDF_NODES};
 use crate::sample_cache::{FluidKey, FluidSample, SampleKey};
 use crate::{FluidSpec, Scene, SceneError, SolidSpec};
 
@@ -211,6 +211,18 @@ impl Scene {
                     format!(
                         "the fluids up to this one need about {total:.3e} particles at particle_spacing {} m, more than the maximum of {MAX_PARTICLES}",
                         self.particle_spacing
+                    ),
+                ));
+            }
+        }
+        if let Some(k) = self.solver.upscaling_factor() {
+            // Checked here, before the solver allocates them in its first step.
+            let points = total * k as f64;
+            if !(points <= MAX_PASSIVE_POINTS as f64) {
+                return Err(ctx.invalid(
+                    "solver.upscaling_factor",
+                    format!(
+                        "{k} passive points per particle for about {total:.3e} particles make about {points:.3e} points, more than the maximum of {MAX_PASSIVE_POINTS} (MAX_PASSIVE_POINTS)"
                     ),
                 ));
             }

@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use sph_core::Aabb;
 
 use crate::geom::{v3, AXES};
+use crate::overrides::is_override_span;
 
 /// Errors of scene loading and building. Every variant names the scene file, the field path
 /// and the reason.
@@ -97,8 +98,8 @@ impl<'a> Ctx<'a> {
     pub fn invalid(&self, field: impl Into<String>, reason: impl AsRef<str>) -> SceneError {
         let field = field.into();
         let mut reason = format!("{}{}", self.note, reason.as_ref());
-        if let Some(line) = self.lines.and_then(|l| l.line_of(&field)) {
-            let _ = write!(reason, " (line {line})");
+        if let Some(at) = self.lines.and_then(|l| l.location(&field)) {
+            let _ = write!(reason, " ({at})");
         }
         SceneError::Invalid {
             file: self.file.to_path_buf(),
@@ -154,7 +155,8 @@ impl<'a> Ctx<'a> {
 
 /// The 1-based line of every field path of a TOML document (`simulation.frame_dt`,
 /// `fluid[1]`, `fluid[1].min`, ...): the line of its key, or for an element of an array of
-/// tables the line where the element starts.
+/// tables the line where the element starts; 0 for a key set by an override
+/// ([`crate::Override`]), which has no line.
 #[derive(Debug, Default)]
 pub(crate) struct FieldLines(BTreeMap<String, usize>);
 
@@ -175,12 +177,15 @@ impl FieldLines {
         })
     }
 
-    /// The line of `field`, else of its closest parent path that has one.
-    pub fn line_of(&self, field: &str) -> Option<usize> {
+    /// Where `field` (else its closest parent path that is known) was given, for a message:
+    /// `line 7`, or `given as an override`.
+    pub fn location(&self, field: &str) -> Option<String> {
         let mut f = field;
         loop {
-            if let Some(&l) = self.0.get(f) {
-                return Some(l);
+            match self.0.get(f) {
+                Some(0) => return Some(OVERRIDE_LOCATION.into()),
+                Some(&l) => return Some(format!("line {l}")),
+                None => {}
             }
             let cut = f.rfind(['.', '['])?;
             f = &f[..cut];
@@ -201,20 +206,32 @@ fn collect_lines(
         } else {
             format!("{prefix}.{}", key.get_ref())
         };
-        out.insert(path.clone(), line_col(text, key.span().start).0);
+        out.insert(path.clone(), line_of_span(text, key.span().start));
         match value.get_ref() {
             DeValue::Table(t) => collect_lines(text, t, &path, out),
             DeValue::Array(items) => {
                 for (i, item) in items.iter().enumerate() {
                     if let DeValue::Table(t) = item.get_ref() {
                         let p = format!("{path}[{i}]");
-                        out.insert(p.clone(), line_col(text, item.span().start).0);
+                        out.insert(p.clone(), line_of_span(text, item.span().start));
                         collect_lines(text, t, &p, out);
                     }
                 }
             }
             _ => {}
         }
+    }
+}
+
+/// What messages say of a value given as an override instead of its line.
+pub(crate) const OVERRIDE_LOCATION: &str = "given as an override";
+
+/// The 1-based line of a span starting at `start`, 0 for an override's.
+fn line_of_span(text: &str, start: usize) -> usize {
+    if is_override_span(start) {
+        0
+    } else {
+        line_col(text, start).0
     }
 }
 
@@ -240,9 +257,15 @@ pub(crate) fn line_col(text: &str, offset: usize) -> (usize, usize) {
 /// The message of a TOML error with its line and column in `text`.
 pub(crate) fn toml_reason(text: &str, e: &toml::de::Error) -> String {
     let mut s = e.message().trim().to_string();
-    if let Some(span) = e.span() {
-        let (l, c) = line_col(text, span.start);
-        let _ = write!(s, " (line {l}, column {c})");
+    match e.span() {
+        Some(span) if is_override_span(span.start) => {
+            let _ = write!(s, " ({OVERRIDE_LOCATION})");
+        }
+        Some(span) => {
+            let (l, c) = line_col(text, span.start);
+            let _ = write!(s, " (line {l}, column {c})");
+        }
+        None => {}
     }
     s
 }

@@ -245,7 +245,8 @@
 //!   positive, every number finite, `min < max`, substeps/iterations ≥ 1, fluids inside the tank
 //!   (block or mesh bounds inside the tank box, every particle strictly inside it), blocks and cylinders at
 //!   least one spacing thick, no fluid particle inside (or on) a solid, at most
-//!   [`MAX_PARTICLES`] particles, mesh files that exist and are closed. The scene with its
+//!   [`MAX_PARTICLES`] particles and [`MAX_PASSIVE_POINTS`] passive points of granular
+//!   upscaling (`upscaling_factor` times the particles), mesh files that exist and are closed. The scene with its
 //!   `[quick]` overrides is validated too, so [`Scene::quick`] cannot fail.
 //! * The `[solver]` settings are range-checked once, by the solver's own checks of the
 //!   parameters made from them (`validate` of `PbfParams`, `PcisphParams`, `IisphParams`),
@@ -271,6 +272,11 @@
 //!   scene file. Mesh errors name the OBJ file and its line (a malformed number, a face
 //!   index that does not exist, a face with fewer than 3 corners, a file cut short before
 //!   its faces, the face an open edge belongs to). The library does not panic on any input.
+//! * [`Scene::load_with`] and [`Scene::parse_str_with`] apply [`Override`]s (a key by its
+//!   dotted path, `solver.friction_angle_deg`, and its value) to the parsed document before
+//!   serde reads it: an overridden value is checked as the file's would be, at the same
+//!   field path, its messages saying "given as an override" where a file's value gives its
+//!   line; an unknown key is refused with the keys its table has.
 //!
 //! # Modules
 //!
@@ -281,7 +287,7 @@
 //! serde input structs, `parse.rs` the reading from them to a [`Scene`] (`parse/solver.rs`
 //! for `[solver]`), `check.rs` the value checks (`check/time_step.rs`),
 //! `params.rs` the solver parameters (built once in `f64`, converted, checked), `render.rs` the renderer's view, `read.rs` the
-//! size-limited file reading, `mesh_io.rs` OBJ loading and mesh placement, `build.rs`
+//! size-limited file reading, `mesh_io.rs` OBJ loading and mesh placement, `overrides.rs` the overrides, `build.rs`
 //! particle sampling and the solids' signed distance fields, `limits.rs` the bounds. No two
 //! modules import each other.
 
@@ -292,6 +298,7 @@ mod geom;
 mod limits;
 mod mesh_io;
 mod obj;
+mod overrides;
 mod params;
 mod parse;
 mod raw;
@@ -304,8 +311,10 @@ mod spec;
 pub use build::FluidParticles;
 pub use error::SceneError;
 pub use limits::{
-    MAX_FRAMES, MAX_MESH_FILE_BYTES, MAX_PARTICLES, MAX_SCENE_FILE_BYTES, MAX_SDF_NODES,
+    MAX_FRAMES, MAX_MESH_FILE_BYTES, MAX_PARTICLES, MAX_PASSIVE_POINTS, MAX_SCENE_FILE_BYTES,
+    MAX_SDF_NODES,
 };
+pub use overrides::Override;
 pub use solver_spec::{SolverKind, SolverParams, SolverSpec};
 // The settings of each solver, owned by its crate (the variants of `SolverSpec`).
 pub use iisph_granular::{GranularSettings, IisphSettings, WaterSettings};

@@ -4,6 +4,11 @@
 /// Largest total number of fluid particles a scene may produce (20 M).
 pub const MAX_PARTICLES: usize = 20_000_000;
 
+/// Largest number of passive points of granular upscaling (`upscaling_factor` times the
+/// particles): 20 M, each carrying a position and a velocity (48 bytes in `f64`, about 1 GB
+/// in all, written whole into every checkpoint); beyond it the factor is a typing mistake.
+pub const MAX_PASSIVE_POINTS: usize = 20_000_000;
+
 /// Most frames (`duration / frame_dt`) a scene may have: 10 million, 44 hours of 16 ms
 /// frames; beyond it the frame length or the duration is a typing mistake.
 pub const MAX_FRAMES: f64 = 1e7;

@@ -15,6 +15,7 @@ use crate::error::{document_error, serde_error, Ctx, FieldLines};
 use crate::geom::v3;
 use crate::limits::MAX_SCENE_FILE_BYTES;
 use crate::mesh_io::{MeshFields, MeshLoader};
+use crate::overrides::{self, Override};
 use crate::raw::{
     RawBox, RawFluid, RawFluidKind, RawOutput, RawQuick, RawScene, RawSolid, RawSolidKind,
 };
@@ -34,6 +35,18 @@ impl Scene {
     /// Reads, parses and checks the scene file at `path` (mesh paths are relative to its
     /// directory). Only a regular file of at most [`MAX_SCENE_FILE_BYTES`] is read.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        Self::load_with(path, &[])
+    }
+
+    /// [`Scene::load`] with `overrides` applied to the file's document before it is read
+    /// (see [`Override`]): errors name the overridden keys as the file would.
+    pub fn load_with(path: &Path, overrides: &[Override]) -> Result<Scene, SceneError> {
+        Self::parse_str_with(&Self::read_text(path)?, path, overrides)
+    }
+
+    /// The text of the scene file at `path`, as [`Scene::load`] reads it: a regular file of
+    /// at most [`MAX_SCENE_FILE_BYTES`], UTF-8.
+    pub fn read_text(path: &Path) -> Result<String, SceneError> {
         let read_error = |reason: String| SceneError::Read {
             file: path.to_path_buf(),
             reason,
@@ -44,18 +57,29 @@ impl Scene {
             "scene file (MAX_SCENE_FILE_BYTES)",
         )
         .map_err(read_error)?;
-        let text = String::from_utf8(bytes).map_err(|e| {
+        String::from_utf8(bytes).map_err(|e| {
             let at = e.utf8_error().valid_up_to();
             let line = e.as_bytes()[..at].iter().filter(|&&b| b == b'\n').count() + 1;
             read_error(format!("line {line}: not UTF-8 text (is it a scene file?)"))
-        })?;
-        Self::parse_str(&text, path)
+        })
     }
 
     /// Parses and checks scene text ([`Scene::check`]); `path` names the file in messages and
     /// is the base of relative mesh paths (its directory).
     pub fn parse_str(text: &str, path: &Path) -> Result<Scene, SceneError> {
-        let doc = DeTable::parse(text).map_err(|e| document_error(path, text, &e))?;
+        Self::parse_str_with(text, path, &[])
+    }
+
+    /// [`Scene::parse_str`] with `overrides` applied, in order, to the parsed document
+    /// before serde reads it ([`Override`]).
+    pub fn parse_str_with(
+        text: &str,
+        path: &Path,
+        overrides: &[Override],
+    ) -> Result<Scene, SceneError> {
+        let value_docs = overrides::value_documents(path, overrides)?;
+        let mut doc = DeTable::parse(text).map_err(|e| document_error(path, text, &e))?;
+        overrides::apply(path, doc.get_mut(), overrides, &value_docs)?;
         let lines = FieldLines::new(text, doc.get_ref());
         let ctx = Ctx {
             lines: Some(&lines),

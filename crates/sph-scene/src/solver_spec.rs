@@ -251,6 +251,14 @@ impl SolverSpec {
         self.common().substeps
     }
 
+    /// Passive points per particle (granular upscaling), `None` when off or not granular.
+    pub fn upscaling_factor(&self) -> Option<usize> {
+        match self {
+            SolverSpec::Granular(g) => g.upscaling_factor,
+            _ => None,
+        }
+    }
+
     /// The density kernel of the solver.
     pub fn density_kernel(&self) -> KernelKind {
         self.kind().density_kernel()

@@ -53,14 +53,16 @@ pub enum SimError {
 }
 
 impl SimError {
-    pub(crate) fn output(path: impl Into<PathBuf>, reason: impl ToString) -> Self {
+    /// A [`SimError::Output`] for `path`.
+    pub fn output(path: impl Into<PathBuf>, reason: impl ToString) -> Self {
         SimError::Output {
             path: path.into(),
             reason: reason.to_string(),
         }
     }
 
-    pub(crate) fn input(path: impl Into<PathBuf>, reason: impl ToString) -> Self {
+    /// A [`SimError::Input`] for `path`.
+    pub fn input(path: impl Into<PathBuf>, reason: impl ToString) -> Self {
         SimError::Input {
             path: path.into(),
             reason: reason.to_string(),

@@ -8,7 +8,7 @@
 use sph_core::{Aabb, Real, Vec3};
 use sph_kernels::KernelKind;
 use sph_scene::{BoundaryModel, Scene, SolverParams};
-use sph_solver::boundary::{VolumeMapBoundary, VolumeMapCache, VolumeMapOptions};
+use sph_solver::boundary::{CacheUse, VolumeMapBoundary, VolumeMapCache, VolumeMapOptions};
 use sph_solver::{Boundary, CollisionBoundary, CommonParams, FluidSolver, SolverError};
 
 use crate::error::SimError;
@@ -79,11 +79,26 @@ pub fn build_boundary<R: Real>(
     positions: &[Vec3<R>],
     cache: Option<&VolumeMapCache>,
 ) -> Result<Box<dyn Boundary<R>>, SimError> {
+    build_boundary_reporting(scene, c, positions, cache).map(|(b, _)| b)
+}
+
+/// A boundary and how each solid's volume map was obtained.
+pub(crate) type BoundaryWithMaps<R> = (Box<dyn Boundary<R>>, Vec<CacheUse>);
+
+/// [`build_boundary`], with how each solid's volume map was obtained (built, loaded from
+/// the cache, ...; empty for the collision boundary).
+pub(crate) fn build_boundary_reporting<R: Real>(
+    scene: &Scene,
+    c: &CommonParams<R>,
+    positions: &[Vec3<R>],
+    cache: Option<&VolumeMapCache>,
+) -> Result<BoundaryWithMaps<R>, SimError> {
     let solids = scene.build_solids::<R>()?;
     let setup = |source| setup_error(scene, source);
     match scene.boundary.model {
-        BoundaryModel::Collision => Ok(Box::new(
-            CollisionBoundary::new(solids, c.particle_radius()).map_err(setup)?,
+        BoundaryModel::Collision => Ok((
+            Box::new(CollisionBoundary::new(solids, c.particle_radius()).map_err(setup)?),
+            Vec::new(),
         )),
         BoundaryModel::VolumeMap => {
             let b = VolumeMapBoundary::with_cache(
@@ -99,7 +114,8 @@ pub fn build_boundary<R: Real>(
             for w in b.cache_warnings() {
                 eprintln!("warning: {w} (the map was rebuilt)");
             }
-            Ok(Box::new(b))
+            let uses = b.maps().iter().map(|m| m.stats().cache).collect();
+            Ok((Box::new(b), uses))
         }
     }
 }

@@ -47,6 +47,7 @@ mod record;
 pub mod render;
 pub mod run;
 pub mod run_dir;
+pub mod saved;
 mod setup;
 mod sim;
 pub mod vtk;
@@ -57,6 +58,7 @@ pub use frame_loop::{run_frames, Divergence, Ending, Flow, FrameObserver, RunOut
 pub use record::{FrameRecord, STATS_COLUMNS, STATS_EXTRA_COLUMNS};
 pub use run::{run_scene, SceneRunOptions};
 pub use run_dir::RunDir;
+pub use saved::SceneSource;
 pub use setup::SceneSetup;
 pub use sim::SceneSim;
 pub use sph_scene::{Precision, Scene};

@@ -5,12 +5,12 @@
 
 use sph_core::{ParticleSet, Real};
 use sph_scene::{InitialMasses, Precision, Scene, SolverParams};
-use sph_solver::boundary::VolumeMapCache;
+use sph_solver::boundary::{CacheUse, VolumeMapCache};
 use sph_solver::initial::{calibrate_masses, MassCalibration};
 use sph_solver::Boundary;
 
 use crate::error::SimError;
-use crate::factory::{build_boundary, density_kernel};
+use crate::factory::{build_boundary_reporting, density_kernel};
 
 /// A scene built once in precision `R`: the parameters, the initial particles and the
 /// boundary. [`crate::SceneSim::from_setup`] builds the solver from it without sampling,
@@ -28,6 +28,9 @@ pub struct SceneSetup<R: Real> {
     pub boundary: Box<dyn Boundary<R>>,
     /// What the mass calibration did, `None` for lattice masses.
     pub calibration: Option<MassCalibration>,
+    /// How each solid's volume map was obtained (built, loaded from the cache, stored in
+    /// it, ...), in solid order; empty for the collision boundary.
+    pub volume_maps: Vec<CacheUse>,
 }
 
 impl<R: Real> std::fmt::Debug for SceneSetup<R> {
@@ -73,7 +76,8 @@ impl<R: Real> SceneSetup<R> {
         };
         let common = params.common().clone();
         let fluid = scene.fluid_particles::<R>()?;
-        let boundary = build_boundary(scene, &common, &fluid.positions, cache)?;
+        let (boundary, volume_maps) =
+            build_boundary_reporting(scene, &common, &fluid.positions, cache)?;
         let mut state = ParticleSet::from_positions(
             fluid.positions,
             common.particle_mass(),
@@ -97,6 +101,7 @@ impl<R: Real> SceneSetup<R> {
             state,
             boundary,
             calibration,
+            volume_maps,
         })
     }
 }

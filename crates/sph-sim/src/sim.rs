@@ -5,6 +5,7 @@ use std::path::Path;
 
 use sph_core::{apply_permutation, ParticleSet, Real};
 use sph_scene::Scene;
+use sph_solver::boundary::CacheUse;
 use sph_solver::initial::MassCalibration;
 use sph_solver::{FluidSolver, StepStats};
 
@@ -28,6 +29,9 @@ pub struct SceneSim<R: Real> {
     /// What the mass calibration did (`[boundary] initial_masses = "calibrated"`), `None`
     /// for lattice masses.
     pub calibration: Option<MassCalibration>,
+    /// How each solid's volume map was obtained (built, loaded from the cache, ...), in
+    /// solid order; empty for the collision boundary.
+    pub volume_maps: Vec<CacheUse>,
     solver: Box<dyn FluidSolver<R>>,
     id_scratch: Vec<u32>,
 }
@@ -70,6 +74,7 @@ impl<R: Real> SceneSim<R> {
             state,
             boundary,
             calibration,
+            volume_maps,
         } = setup;
         let solver = build_solver(params, boundary).map_err(|source| SimError::Setup {
             file: scene.source.display().to_string(),
@@ -83,6 +88,7 @@ impl<R: Real> SceneSim<R> {
             frame: 0,
             time_s: 0.0,
             calibration,
+            volume_maps,
             solver,
             id_scratch: Vec::new(),
         })

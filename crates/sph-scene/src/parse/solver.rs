@@ -81,8 +81,8 @@ fn variant<T: DeserializeOwned>(
         // field's own line instead.
         match err {
             SceneError::Syntax { file, field, .. } if e.path().iter().next().is_none() => {
-                let line = ctx.lines.and_then(|l| l.line_of(&field));
-                let at = line.map(|l| format!(" (line {l})")).unwrap_or_default();
+                let at = ctx.lines.and_then(|l| l.location(&field));
+                let at = at.map(|at| format!(" ({at})")).unwrap_or_default();
                 let message = e.inner().message().trim();
                 // The note explains an unknown field only; a missing one is not the kind's.
                 let reason = if message.starts_with("unknown field `") {

@@ -1,0 +1,313 @@
+"""Simulation as complete as a scene file run: overrides, save/load and pickle continuing
+bit for bit, the volume-map cache, and frame counts as the command line counts them."""
+
+import pickle
+
+import numpy as np
+import pytest
+
+import partisim
+import partisim.progress
+from partisim import PartisimError, Simulation
+
+# A scene of a few hundred particles and 5 frames (0.1 s of 0.02 s), walls as volume maps.
+PBF = """
+name = "tiny"
+[simulation]
+precision = "f64"
+particle_spacing = 0.05
+duration = 0.1
+frame_dt = 0.02
+[solver]
+kind = "pbf"
+substeps = 2
+solver_iterations = 3
+[boundary]
+model = "volume-map"
+[tank]
+min = [0.0, 0.0, 0.0]
+max = [0.5, 0.5, 0.5]
+[[fluid]]
+kind = "block"
+min = [0.0, 0.0, 0.0]
+max = [0.2, 0.3, 0.2]
+"""
+
+# The same column as granular matter (IISPH with friction: stresses and pressures carried
+# from frame to frame), in f32.
+GRANULAR = (
+    PBF.replace('"tiny"', '"tiny_granular"')
+    .replace('"f64"', '"f32"')
+    .replace('kind = "pbf"\nsubsteps = 2\nsolver_iterations = 3',
+             'kind = "granular"\nsubsteps = 4\nfriction_angle_deg = 30.0')
+    .replace('"volume-map"', '"collision"')
+)
+assert "granular" in GRANULAR and "solver_iterations" not in GRANULAR
+
+
+@pytest.fixture
+def scene(tmp_path):
+    def write(text=PBF, name="tiny.toml"):
+        path = tmp_path / name
+        path.write_text(text)
+        return path
+
+    return write
+
+
+def state(sim):
+    return sim.positions.copy(), sim.velocities.copy(), sim.densities.copy()
+
+
+# ---- overrides ----
+
+
+def test_overrides_set_keys_by_their_path_in_the_file(scene):
+    sim = Simulation.from_scene(scene(), volume_map_cache=None)
+    assert sim.scene_frames == 5
+    longer = Simulation.from_scene(
+        scene(),
+        overrides={"simulation.duration": 0.2, "fluid[0].max": [0.2, 0.2, 0.2]},
+        volume_map_cache=None,
+    )
+    assert longer.scene_frames == 10
+    assert len(longer.positions) == 4 * 4 * 4 < len(sim.positions)
+    # numpy scalars and arrays are values as their Python equivalents.
+    np_sim = Simulation.from_scene(
+        scene(),
+        overrides={"solver.substeps": np.int64(3), "fluid[0].max": np.array([0.2, 0.2, 0.2])},
+        volume_map_cache=None,
+    )
+    assert np_sim.step()["substeps"] == 3 and len(np_sim.positions) == 64
+
+
+def test_an_override_equals_the_edited_file(scene):
+    edited = Simulation.from_scene(
+        scene(PBF.replace("substeps = 2", "substeps = 3"), "edited.toml"), volume_map_cache=None
+    )
+    over = Simulation.from_scene(scene(), overrides={"solver.substeps": 3}, volume_map_cache=None)
+    edited.run(2, progress=False)
+    over.run(2, progress=False)
+    assert np.array_equal(edited.positions, over.positions)
+
+
+def test_override_errors_name_the_key_as_the_file_would(scene):
+    with pytest.raises(PartisimError, match=r"solver\.substeps.*given as an override"):
+        Simulation.from_scene(scene(), overrides={"solver.substeps": "eight"})
+    with pytest.raises(PartisimError, match=r"simulation\.particle_spacing.*given as an override"):
+        Simulation.from_scene(scene(), overrides={"simulation.particle_spacing": -0.05})
+    with pytest.raises(PartisimError) as e:
+        Simulation.from_scene(scene(), overrides={"simulation.durration": 1.0})
+    for known in ("particle_spacing", "duration", "frame_dt"):
+        assert f"`{known}`" in str(e.value)
+    with pytest.raises(PartisimError, match=r"friction_angle_deg.*given as an override"):
+        Simulation.from_scene(scene(GRANULAR), overrides={"solver.friction_angle_deg": 95.0})
+    with pytest.raises(PartisimError, match=r"fluid\[3\].*1 elements of `fluid`"):
+        Simulation.from_scene(scene(), overrides={"fluid[3].min": [0.0, 0.0, 0.0]})
+    with pytest.raises(TypeError, match="overrides"):
+        Simulation.from_scene(scene(), overrides={"solver.substeps": object()})
+    with pytest.raises(TypeError, match="overrides"):
+        Simulation.from_scene(scene(), overrides=[("solver.substeps", 2)])
+
+
+# ---- save / load / pickle ----
+
+
+@pytest.mark.parametrize("text", [PBF, GRANULAR], ids=["pbf", "granular"])
+def test_a_saved_run_continues_bit_for_bit(scene, tmp_path, text):
+    path = scene(text)
+    straight = Simulation.from_scene(path, volume_map_cache=None)
+    straight.run(4, progress=False)
+
+    first = Simulation.from_scene(path, volume_map_cache=None)
+    first.run(2, progress=False)
+    first.save(tmp_path / "run.sphsave")
+    path.unlink()  # self-contained: the scene's text is in the file
+    loaded = Simulation.load(tmp_path / "run.sphsave", volume_map_cache=None)
+    assert loaded.frame == 2 and loaded.time == first.time
+    for a, b in zip(state(loaded), state(first)):
+        assert np.array_equal(a, b)
+    loaded.run(2, progress=False)
+    assert loaded.frame == 4
+    for a, b in zip(state(loaded), state(straight)):
+        assert a.dtype == b.dtype and np.array_equal(a, b)
+
+
+def test_pickle_round_trips_and_continues_bit_for_bit(scene):
+    path = scene(GRANULAR)
+    straight = Simulation.from_scene(path, volume_map_cache=None)
+    straight.run(3, progress=False)
+    sim = Simulation.from_scene(path, volume_map_cache=None)
+    sim.run(1, progress=False)
+    copy = pickle.loads(pickle.dumps(sim))
+    assert copy.frame == 1 and copy.precision == "f32"
+    copy.run(2, progress=False)
+    for a, b in zip(state(copy), state(straight)):
+        assert np.array_equal(a, b)
+
+
+def test_saved_overrides_are_kept(scene, tmp_path):
+    sim = Simulation.from_scene(scene(), overrides={"simulation.duration": 0.2},
+                                volume_map_cache=None)
+    sim.save(tmp_path / "s.sphsave")
+    assert Simulation.load(tmp_path / "s.sphsave", volume_map_cache=None).scene_frames == 10
+
+
+def test_bad_saved_files_are_refused_by_name(scene, tmp_path):
+    sim = Simulation.from_scene(scene(), volume_map_cache=None)
+    good = tmp_path / "good.sphsave"
+    sim.save(good)
+    data = good.read_bytes()
+    (tmp_path / "cut.sphsave").write_bytes(data[: len(data) // 2])
+    with pytest.raises(PartisimError, match=r"cut\.sphsave.*(checksum|truncated)"):
+        Simulation.load(tmp_path / "cut.sphsave")
+    (tmp_path / "other.sphsave").write_bytes(b"not a simulation at all" * 4)
+    with pytest.raises(PartisimError, match=r"other\.sphsave.*not a saved simulation"):
+        Simulation.load(tmp_path / "other.sphsave")
+    with pytest.raises(PartisimError, match="missing.sphsave"):
+        Simulation.load(tmp_path / "missing.sphsave")
+
+
+# ---- the volume-map cache ----
+
+
+def test_the_second_from_scene_loads_the_volume_maps_from_the_cache(scene, tmp_path):
+    cache = tmp_path / "cache"
+    assert Simulation.from_scene(scene(), volume_map_cache=cache).volume_maps == ["stored"]
+    assert Simulation.from_scene(scene(), volume_map_cache=cache).volume_maps == ["loaded"]
+    assert Simulation.from_scene(scene(), volume_map_cache=None).volume_maps == ["built"]
+    # The same maps: a cached build runs exactly as a fresh one.
+    a = Simulation.from_scene(scene(), volume_map_cache=cache)
+    b = Simulation.from_scene(scene(), volume_map_cache=False)
+    a.run(1, progress=False)
+    b.run(1, progress=False)
+    assert np.array_equal(a.positions, b.positions)
+    assert Simulation.from_scene(scene(GRANULAR), volume_map_cache=cache).volume_maps == []
+
+
+# ---- frame counts ----
+
+
+def test_run_without_frames_runs_to_the_scenes_end(scene):
+    sim = Simulation.from_scene(scene(), volume_map_cache=None)
+    outcome = sim.run(progress=False)
+    assert outcome["ending"] == "completed" and outcome["frame"] == 5 and sim.frame == 5
+    assert outcome["at_scene_end"] and outcome["frames_run"] == 5
+
+
+def test_run_stops_at_the_scenes_end_as_the_command_line_does(scene):
+    sim = Simulation.from_scene(scene(), volume_map_cache=None)
+    sim.run(2, progress=False)
+    outcome = sim.run(200, progress=False)
+    assert outcome["frame"] == 5 and sim.frame == 5 and outcome["frames_run"] == 3
+    assert "ends at frame 5" in outcome["reason"]
+
+
+@pytest.mark.parametrize("frames", [2**64 - 1, 2**64, 2**200, np.uint64(2**64 - 1)])
+def test_huge_frame_counts_are_clamped_not_wrapped(scene, frames):
+    sim = Simulation.from_scene(scene(), volume_map_cache=None)
+    outcome = sim.run(frames, progress=False)
+    assert outcome["frame"] == 5 and sim.frame == 5
+
+
+def test_frame_counts_accept_numpy_integers_and_refuse_the_rest(scene):
+    sim = Simulation.from_scene(scene(), volume_map_cache=None)
+    assert sim.run(np.int64(2), progress=False)["frame"] == 2
+    assert sim.run(np.int32(1), progress=False)["frame"] == 3
+    with pytest.raises(ValueError, match="at least 1"):
+        sim.run(0, progress=False)
+    with pytest.raises(ValueError, match="at least 1"):
+        sim.run(-3, progress=False)
+    with pytest.raises(TypeError, match="whole number"):
+        sim.run(1.5, progress=False)
+    with pytest.raises(TypeError, match="whole number"):
+        sim.run("3", progress=False)
+    assert sim.frame == 3
+
+
+def test_run_shows_progress_through_partisim_progress(scene, monkeypatch):
+    calls = []
+
+    class Bar:
+        def update(self, n=1):
+            calls.append(n)
+
+        def close(self):
+            calls.append("closed")
+
+    made = []
+
+    def fake(total, enabled=None, desc=""):
+        made.append((total, enabled, desc))
+        return Bar()
+
+    monkeypatch.setattr(partisim.progress, "make_progress", fake)
+    sim = Simulation.from_scene(scene(), volume_map_cache=None)
+    sim.run(3)
+    assert made == [(3, None, "frames")] and calls == [1, 1, 1, "closed"]
+
+
+# ---- the angle of repose ----
+
+# A planar heap of known slope: a prism whose cross-section is an isosceles triangle with
+# base 1 m (x) and flanks at 30°, 0.2 m deep (z), filled with particles at 0.02 m.
+H = float(0.5 * np.tan(np.radians(30.0)))
+WEDGE_OBJ = f"""v 0 0 0
+v 1 0 0
+v 0.5 {H!r} 0
+v 0 0 0.2
+v 1 0 0.2
+v 0.5 {H!r} 0.2
+f 1 3 2
+f 4 5 6
+f 1 2 5
+f 1 5 4
+f 1 4 6
+f 1 6 3
+f 2 3 6
+f 2 6 5
+"""
+
+WEDGE = """
+name = "wedge"
+[simulation]
+particle_spacing = 0.02
+duration = 0.04
+frame_dt = 0.02
+gravity = [0.0, 0.0, 0.0]
+[solver]
+kind = "granular"
+substeps = 2
+friction_angle_deg = 30.0
+[boundary]
+model = "collision"
+[tank]
+min = [-0.01, -0.01, -0.01]
+max = [1.01, 0.5, 0.21]
+[[fluid]]
+kind = "mesh"
+path = "wedge.obj"
+"""
+
+
+def test_repose_measures_a_heap_of_known_slope_with_the_rest_verdict(scene, tmp_path):
+    (tmp_path / "wedge.obj").write_text(WEDGE_OBJ)
+    sim = Simulation.from_scene(scene(WEDGE, "wedge.toml"), volume_map_cache=None)
+    m = sim.repose("planar", floor_y=0.0)
+    # The sampled flanks are staircases of 0.02 m steps: the crate's resolution bounds
+    # the error of the fitted angle.
+    assert m["resolution_deg"] > 0
+    assert abs(m["angle_deg"] - 30.0) <= m["resolution_deg"], m
+    assert len(m["flanks"]) == 2 and m["particles"] == len(sim.positions)
+    assert m["at_rest"] is None  # no run watched the material yet
+    # No gravity: the particles stay put, so any speed bound above 0 holds at once.
+    out = sim.run(1, progress=False, until_rest={"speed_m_s": 1e3, "hold_s": 0.0})
+    assert out["ending"] == "stopped" and out["at_rest"] is True
+    assert sim.repose("planar", floor_y=0.0)["at_rest"] is True
+    out = sim.run(1, progress=False, until_rest={"speed_m_s": 1e-30, "hold_s": 1.0})
+    assert out["at_rest"] is False
+    assert sim.repose("planar", floor_y=0.0)["at_rest"] is False
+    with pytest.raises(ValueError, match="speed_m_s"):
+        sim.run(1, progress=False, until_rest={"speed_m_s": -1.0, "hold_s": 1.0})
+    with pytest.raises(ValueError, match="shape"):
+        sim.repose("round")
