@@ -9,10 +9,14 @@ sweep on a cluster would write them. Prints each round's wall times and the spee
 
 Run from the repository root in a virtual environment with the wheel and its dask extra:
 
-    flock /tmp/build.lock python benches/scripts/sweep_scaling.py
+    flock /tmp/build.lock python benches/scripts/sweep_scaling.py [--plain]
+
+`--plain`: RUNS copies of the scene as written, without checkpoints (what a build without
+scene overrides and `Simulation.save` can run).
 """
 
 import statistics
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -34,11 +38,17 @@ def _import_partisim() -> None:
     import partisim  # noqa: F401
 
 
+PLAIN = "--plain" in sys.argv[1:]
+
+
 def sweep(client: Client) -> float:
     with tempfile.TemporaryDirectory() as d:
         start = time.perf_counter()
-        table = run_scene_sweep(client, SCENE, ROWS, frames=FRAMES, quick=True,
-                                checkpoint_dir=d, checkpoint_every=EVERY)
+        if PLAIN:
+            table = run_scene_sweep(client, SCENE, [{}] * RUNS, frames=FRAMES, quick=True)
+        else:
+            table = run_scene_sweep(client, SCENE, ROWS, frames=FRAMES, quick=True,
+                                    checkpoint_dir=d, checkpoint_every=EVERY)
         wall = time.perf_counter() - start
     assert (table["ending"] == "completed").all() and (table["frame"] == FRAMES).all()
     return wall

@@ -200,7 +200,9 @@ def _run_scene(
                     "wall_s": time.perf_counter() - start,
                 }
     else:
-        sim = Simulation.from_scene(scene, quick=quick, overrides=row or None)
+        # An empty row is the scene as written (no overrides argument at all).
+        extra = {"overrides": row} if row else {}
+        sim = Simulation.from_scene(scene, quick=quick, **extra)
     resumed_from = sim.frame
 
     def every(rec: Dict[str, Any]) -> Any:
