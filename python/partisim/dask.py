@@ -145,11 +145,16 @@ def _write_json_atomic(path: Path, data: Any) -> None:
     os.replace(tmp, path)
 
 
+# The frame record's wall-clock fields: they depend on the machine, not on the run (the
+# table's ``wall_s`` is the run's).
+_WALL_CLOCK = ("phases_s", "total_s")
+
+
 def _stats_columns(record: Optional[Dict[str, Any]]) -> Dict[str, Any]:
-    """The final frame record's statistics, without its per-phase wall times."""
+    """The final frame record's statistics, without its wall-clock times."""
     if record is None:
         return {}
-    return {k: v for k, v in record.items() if k != "phases_s"}
+    return {k: v for k, v in record.items() if k not in _WALL_CLOCK}
 
 
 def _result(outcome: Dict[str, Any], record: Optional[Dict[str, Any]]) -> Dict[str, Any]:
@@ -288,7 +293,8 @@ def run_scene_sweep(
         (``ending``: "completed", "stopped" or "diverged", ``reason``, ``frame``,
         ``time_s``); the statistics of the final frame record (``particles``,
         ``max_density_ratio``, ``mean_density_ratio``, ``kinetic_energy_j``,
-        ``iterations``, ...); ``resumed_from_frame`` (0, or the checkpoint's frame the
+        ``iterations``, ...; not its wall-clock ``phases_s`` and ``total_s``);
+        ``resumed_from_frame`` (0, or the checkpoint's frame the
         finishing attempt started from), ``checkpoint`` (its path or None) and ``wall_s``
         (the finishing attempt's wall time, s).
     """

@@ -29,6 +29,8 @@ needs_scene_api = pytest.mark.skipif(
 
 # Columns that depend on the wall clock or on where the run went, not on the physics.
 NOT_PHYSICS = {"wall_s", "resumed_from_frame", "checkpoint"}
+# The frame record's wall-clock fields, left out of the table.
+WALL_CLOCK = {"phases_s", "total_s"}
 
 
 def test_override_tables_as_lists_and_dataframes():
@@ -63,6 +65,30 @@ def one_machine(row: dict):
     sim = partisim.Simulation.from_scene(SCENE, quick=True, overrides=row)
     outcome = sim.run(FRAMES, progress=False)
     return sim, outcome
+
+
+def test_sweep_of_the_scene_as_written_equals_one_machine():
+    """Rows without overrides and no checkpoints: the Dask path alone."""
+    distributed = pytest.importorskip("dask.distributed")
+    from partisim.dask import run_scene_sweep
+
+    frames = 3
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None,
+                                  env={"RAYON_NUM_THREADS": "1"}) as cluster, \
+            distributed.Client(cluster) as client:
+        table = run_scene_sweep(client, SCENE, [{}, {}], frames=frames, quick=True)
+    sim = partisim.Simulation.from_scene(SCENE, quick=True)
+    outcome = sim.run(frames, progress=False)
+    assert len(table) == 2
+    for i in range(2):
+        got = table.loc[i]
+        assert got["ending"] == outcome["ending"] == "completed" and got["frame"] == frames
+        assert got["resumed_from_frame"] == 0 and got["checkpoint"] is None
+        for key, value in sim.stats.items():
+            if key not in WALL_CLOCK:
+                assert got[key] == value, (i, key)
+        assert not WALL_CLOCK & set(table.columns)
 
 
 @needs_scene_api
@@ -116,9 +142,8 @@ def test_sweep_survives_a_killed_worker_and_equals_one_machine(tmp_path):
         assert got["frame"] == FRAMES == sim.frame
         # Every statistic of the final frame record, bit for bit (floats compared exactly).
         for key, value in sim.stats.items():
-            if key == "phases_s":
-                continue
-            assert got[key] == value, (i, key)
+            if key not in WALL_CLOCK:
+                assert got[key] == value, (i, key)
         # The final state kept in the run's checkpoint equals the one-machine run's.
         final = partisim.Simulation.load(got["checkpoint"])
         assert final.frame == FRAMES
