@@ -209,12 +209,26 @@ def _run_scene(
         extra = {"overrides": row} if row else {}
         sim = Simulation.from_scene(scene, quick=quick, **extra)
     resumed_from = sim.frame
+    # The run's last frame (frames asked for, never past the scene's end): no checkpoint stop
+    # there, so that the last call of `run` ends the run with its own outcome.
+    final = frames
+    scene_end = getattr(sim, "scene_frames", None)
+    if scene_end is not None:
+        final = scene_end if final is None else min(final, scene_end)
 
     def every(rec: Dict[str, Any]) -> Any:
-        return _CHECKPOINT_STOP if rec["frame"] % checkpoint_every == 0 else None
+        frame = rec["frame"]
+        if frame % checkpoint_every == 0 and (final is None or frame < final):
+            return _CHECKPOINT_STOP
+        return None
 
     while True:
-        todo = None if frames is None else max(frames - sim.frame, 0)
+        todo = None if frames is None else frames - sim.frame
+        if todo is not None and todo < 1:
+            raise RuntimeError(
+                f"{checkpoint}: resumed at frame {sim.frame}, not before the {frames} frames "
+                "asked for (a checkpoint of a finished run without its record)"
+            )
         outcome = sim.run(todo, progress=False, callback=every if ckpt is not None else None)
         if sim.stats is not None:
             record = sim.stats
