@@ -1,9 +1,14 @@
-"""Comet populations spread over a Dask cluster (optional: ``pip install "partisim[dask]"``).
+"""Work spread over a Dask cluster (optional: ``pip install "partisim[dask]"``).
 
-Each task receives the :class:`~partisim.PopulationSpec` settings and its shard's particles
-only, builds the planets itself from the same initial state, advances and returns its
-shard; the shards are merged in identifier order. A particle's trajectory depends only on
-its own initial state and the planet grid, so the result is bit-identical to one process.
+- :func:`run_population_dask`: one comet population split into shards. Each task receives
+  the :class:`~partisim.PopulationSpec` settings and its shard's particles only, builds the
+  planets itself from the same initial state, advances and returns its shard; the shards are
+  merged in identifier order. A particle's trajectory depends only on its own initial state
+  and the planet grid, so the result is bit-identical to one process.
+- :func:`run_scene_sweep`: a study of scene variants (a base scene file and a table of
+  overrides: a friction-angle sweep, a resolution study, a parameter scan), one task per
+  run, each run checkpointed into a shared directory and resumed from its latest
+  checkpoint when its worker dies; the results come back as one table.
 
 On one machine::
 
@@ -19,13 +24,19 @@ On a cluster, point the same call at a real scheduler, e.g. Slurm with ``dask-jo
 
 Every worker needs ``partisim`` installed (the same version). Each task uses all the
 threads of its worker process (rayon): give a worker process several cores, or set
-``RAYON_NUM_THREADS`` in the worker's environment.
+``RAYON_NUM_THREADS`` in the worker's environment. ``python/README.md`` has a complete
+Slurm and PBS recipe for scene sweeps.
 """
 
 from __future__ import annotations
 
+import hashlib
+import json
 import operator
-from typing import Any, List
+import os
+import time
+from pathlib import Path
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Union
 
 import numpy as np
 
@@ -83,3 +94,275 @@ def run_population_dask(
         )
         futures.append(client.submit(_run_shard, part, float(to_years), pure=False))
     return Population.merge(client.gather(futures))
+
+
+# The reason a sweep task gives when it stops a run to write a checkpoint (the frame loop's
+# "stopped" outcome carries it back); any other stop or ending is the run's own.
+_CHECKPOINT_STOP = "partisim.dask: checkpoint"
+
+
+def _plain(value: Any) -> Any:
+    """A table cell as a plain Python value (numpy scalars from a DataFrame become int,
+    float, bool or str; lists stay lists), so that the override is the TOML value it reads as."""
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    return value
+
+
+def _override_rows(overrides: Any) -> List[Dict[str, Any]]:
+    """The table of overrides as a list of dicts (dotted key path -> value)."""
+    if hasattr(overrides, "to_dict") and hasattr(overrides, "columns"):
+        rows = overrides.to_dict("records")  # a pandas DataFrame
+    elif isinstance(overrides, Mapping):
+        raise TypeError(
+            "overrides: a table of runs is expected (a list of dicts or a pandas DataFrame), "
+            "not one dict; wrap one run's overrides in a list"
+        )
+    else:
+        rows = list(overrides)
+    out = []
+    for i, row in enumerate(rows):
+        if not isinstance(row, Mapping):
+            raise TypeError(
+                f"overrides row {i}: a dict from dotted scene key to value is expected, "
+                f"not {type(row).__name__}"
+            )
+        for key in row:
+            if not isinstance(key, str):
+                raise TypeError(f"overrides row {i}: key {key!r} is not a string")
+        out.append({key: _plain(value) for key, value in row.items()})
+    return out
+
+
+def _run_key(scene: Path, row: Dict[str, Any], quick: bool, frames: Optional[int]) -> str:
+    """A digest of everything that defines a run (the scene file's bytes, its overrides,
+    quick, frames), naming its checkpoint: a checkpoint of another run is never resumed."""
+    h = hashlib.sha256()
+    h.update(scene.read_bytes())
+    h.update(json.dumps([str(scene), row, quick, frames], sort_keys=True, default=repr).encode())
+    return h.hexdigest()[:16]
+
+
+def _write_json_atomic(path: Path, data: Any) -> None:
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    tmp.write_text(json.dumps(data))
+    os.replace(tmp, path)
+
+
+# The frame record's wall-clock fields: they depend on the machine, not on the run (the
+# table's ``wall_s`` is the run's).
+_WALL_CLOCK = ("phases_s", "total_s")
+
+
+def _stats_columns(record: Optional[Dict[str, Any]]) -> Dict[str, Any]:
+    """The final frame record's statistics, without its wall-clock times."""
+    if record is None:
+        return {}
+    return {k: v for k, v in record.items() if k not in _WALL_CLOCK}
+
+
+def _result(outcome: Dict[str, Any], record: Optional[Dict[str, Any]]) -> Dict[str, Any]:
+    """A run's row: its outcome, then the final frame record's statistics."""
+    result: Dict[str, Any] = {
+        "ending": outcome["ending"],
+        "reason": outcome["reason"],
+        "frame": outcome["frame"],
+        "time_s": outcome["time_s"],
+    }
+    for key, value in _stats_columns(record).items():
+        result.setdefault(key, value)
+    return result
+
+
+def _run_scene(
+    scene: str,
+    row: Dict[str, Any],
+    quick: bool,
+    frames: Optional[int],
+    checkpoint: Optional[str],
+    checkpoint_every: int,
+) -> Dict[str, Any]:
+    """One run of a sweep (the Dask task): from its latest checkpoint if there is one, else
+    from the scene; a checkpoint every ``checkpoint_every`` frames; the result as a row.
+
+    Beside each checkpoint ``NAME`` a small ``NAME.json`` keeps the frame it was taken at,
+    that frame's record and, once the run has ended, its outcome. It is written before the
+    checkpoint, so it never lags behind it: a task that loads a checkpoint of the same frame
+    takes the record (and a finished run's outcome) from it, and one that loads an older
+    checkpoint (killed between the two writes) runs those frames again."""
+    from . import Simulation  # the worker imports the extension here, not at unpickling
+
+    start = time.perf_counter()
+    ckpt = Path(checkpoint) if checkpoint is not None else None
+    side = ckpt.with_name(ckpt.name + ".json") if ckpt is not None else None
+    record = None
+    if ckpt is not None and ckpt.exists():
+        sim = Simulation.load(ckpt)
+        saved = json.loads(side.read_text()) if side.exists() else {}
+        if saved.get("frame") == sim.frame:
+            record = saved["record"]
+            if saved.get("outcome") is not None:  # finished: its row, without running
+                return {
+                    **_result(saved["outcome"], record),
+                    "resumed_from_frame": sim.frame,
+                    "checkpoint": checkpoint,
+                    "wall_s": time.perf_counter() - start,
+                }
+    else:
+        # An empty row is the scene as written (no overrides argument at all).
+        extra = {"overrides": row} if row else {}
+        sim = Simulation.from_scene(scene, quick=quick, **extra)
+    resumed_from = sim.frame
+    # The run's last frame (frames asked for, never past the scene's end): no checkpoint stop
+    # there, so that the last call of `run` ends the run with its own outcome.
+    final = frames
+    scene_end = getattr(sim, "scene_frames", None)
+    if scene_end is not None:
+        final = scene_end if final is None else min(final, scene_end)
+
+    def every(rec: Dict[str, Any]) -> Any:
+        frame = rec["frame"]
+        if frame % checkpoint_every == 0 and (final is None or frame < final):
+            return _CHECKPOINT_STOP
+        return None
+
+    while True:
+        todo = None if frames is None else frames - sim.frame
+        if todo is not None and todo < 1:
+            raise RuntimeError(
+                f"{checkpoint}: resumed at frame {sim.frame}, not before the {frames} frames "
+                "asked for (a checkpoint of a finished run without its record)"
+            )
+        outcome = sim.run(todo, progress=False, callback=every if ckpt is not None else None)
+        if sim.stats is not None:
+            record = sim.stats
+        if ckpt is None:
+            break
+        pause = outcome["ending"] == "stopped" and outcome["reason"] == _CHECKPOINT_STOP
+        _write_json_atomic(
+            side, {"frame": sim.frame, "record": record, "outcome": None if pause else outcome}
+        )
+        sim.save(ckpt)
+        if not pause:
+            break
+    return {
+        **_result(outcome, record),
+        "resumed_from_frame": resumed_from,
+        "checkpoint": checkpoint,
+        "wall_s": time.perf_counter() - start,
+    }
+
+
+def run_scene_sweep(
+    client: Any,
+    scene: Union[str, os.PathLike],
+    overrides: Any,
+    frames: Optional[int] = None,
+    quick: bool = False,
+    checkpoint_dir: Optional[Union[str, os.PathLike]] = None,
+    checkpoint_every: int = 50,
+    retries: int = 0,
+) -> Any:
+    """Runs one scene file under each row of a table of overrides, one Dask task per run,
+    and gathers the results into one table.
+
+    Each task builds ``Simulation.from_scene(scene, quick=quick, overrides=row)`` and runs
+    it to ``frames`` (or to the scene's end, as the command line counts it). With
+    ``checkpoint_dir`` it stops every ``checkpoint_every`` frames to ``sim.save`` its
+    checkpoint there (an atomic write), and a task that starts again because its worker
+    died resumes with ``Simulation.load`` from the latest one. A loaded run continues bit
+    for bit, so every row is identical to the same run on one machine, interrupted or not.
+
+    Parameters
+    ----------
+    client : dask.distributed.Client
+        Any client: a ``LocalCluster``, a ``dask-jobqueue`` cluster, a remote scheduler.
+        The workers read ``scene`` (and the meshes it names) and ``checkpoint_dir`` at the
+        same paths as the caller: on a cluster, a shared file system.
+    scene : path
+        The base scene file (TOML).
+    overrides : list of dict or pandas.DataFrame
+        One row per run: dotted scene keys (``"solver.friction_angle_deg"``,
+        ``"simulation.particle_spacing"``, ...) to values, checked as the file's own values
+        are. An empty dict runs the scene as written.
+    frames : int, optional
+        Frames per run, counted from the scene's start; ``None`` runs to the scene's end.
+    quick : bool
+        The scene's ``[quick]`` settings.
+    checkpoint_dir : path, optional
+        A directory shared by the workers for the runs' checkpoints (created if missing),
+        named by the row and a digest of the scene file, its overrides, ``quick`` and
+        ``frames``; a checkpoint of any other run is never resumed. It is kept after the
+        sweep (the final state of each run: ``Simulation.load`` it), with a small JSON
+        file beside each (the frame record and, once finished, the outcome): the same sweep
+        run again resumes the unfinished runs and returns the finished ones without running
+        them. ``None``: no checkpoints, and a run whose worker dies starts again from
+        frame 0.
+    checkpoint_every : int
+        Frames between checkpoints (>= 1).
+    retries : int
+        Dask retries of a task that raised (a worker's death is rescheduled by Dask in any
+        case, up to its ``distributed.scheduler.allowed-failures``).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per run, in the order of ``overrides``: the override columns; the outcome
+        (``ending``: "completed", "stopped" or "diverged", ``reason``, ``frame``,
+        ``time_s``); the statistics of the final frame record (``particles``,
+        ``max_density_ratio``, ``mean_density_ratio``, ``kinetic_energy_j``,
+        ``iterations``, ...; not its wall-clock ``phases_s`` and ``total_s``);
+        ``resumed_from_frame`` (0, or the checkpoint's frame the
+        finishing attempt started from), ``checkpoint`` (its path or None) and ``wall_s``
+        (the finishing attempt's wall time, s).
+    """
+    try:
+        import pandas as pd
+    except ImportError as e:  # pragma: no cover - the dask extra installs pandas
+        raise ImportError(
+            'run_scene_sweep returns a pandas DataFrame: pip install "partisim[dask]"'
+        ) from e
+    scene_path = Path(scene).resolve()
+    if not scene_path.is_file():
+        raise FileNotFoundError(f"scene = {str(scene)!r}: no such file")
+    rows = _override_rows(overrides)
+    if frames is not None:
+        if isinstance(frames, (bool, np.bool_)) or not isinstance(frames, (int, np.integer)) or frames < 0:
+            raise ValueError(f"frames = {frames!r}: must be None or an integer >= 0")
+        frames = int(frames)
+    if (
+        isinstance(checkpoint_every, (bool, np.bool_))
+        or not isinstance(checkpoint_every, (int, np.integer))
+        or checkpoint_every < 1
+    ):
+        raise ValueError(f"checkpoint_every = {checkpoint_every!r}: must be an integer >= 1")
+    if isinstance(retries, (bool, np.bool_)) or not isinstance(retries, (int, np.integer)) or retries < 0:
+        raise ValueError(f"retries = {retries!r}: must be an integer >= 0")
+    ckpt_dir = None
+    if checkpoint_dir is not None:
+        ckpt_dir = Path(checkpoint_dir).resolve()
+        ckpt_dir.mkdir(parents=True, exist_ok=True)
+    quick = bool(quick)
+    futures: List[Any] = []
+    for i, row in enumerate(rows):
+        digest = _run_key(scene_path, row, quick, frames)
+        ckpt = None if ckpt_dir is None else str(ckpt_dir / f"run{i:04d}-{digest}.partisim")
+        futures.append(
+            client.submit(
+                _run_scene,
+                str(scene_path),
+                row,
+                quick,
+                frames,
+                ckpt,
+                int(checkpoint_every),
+                key=f"partisim-scene-run-{i:04d}-{digest}",
+                retries=int(retries),
+                pure=False,
+            )
+        )
+    results = client.gather(futures)
+    table = [{**row, **result} for row, result in zip(rows, results)]
+    return pd.DataFrame(table)
