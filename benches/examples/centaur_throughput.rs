@@ -1,9 +1,10 @@
 //! Throughput of `symplectic::Population` on Centaurs integrated through their close
 //! encounters, with the interface of `comet_throughput`:
 //!
-//! `cargo run --release -p benches --example centaur_throughput -- N YEARS [STEP_PER_AU_DAYS] [TOLERANCE] [SEED]`
+//! `cargo run --release -p benches --example centaur_throughput -- N YEARS [STEP_PER_AU_DAYS] [TOLERANCE] [SEED] [PLANET_STEP_DAYS]`
 //!
-//! builds `benches::centaur_population` (the four giants, S6 at 730.5 d; `N` comets with
+//! builds `benches::centaur_population` (the four giants, S6 at `PLANET_STEP_DAYS`, default
+//! 730.5 d; `N` comets with
 //! `a` 5.5–30 AU, `e` 0–0.2, `i` 0–10°; S2 barycentric with `B₁ = 4·10⁻⁶`, a first step of
 //! `STEP_PER_AU_DAYS` (default 2) days per AU of initial distance; encounters inside 3 Hill
 //! radii by Bulirsch–Stoer at `TOLERANCE` (default 10⁻¹²); removal below q = 2.5 AU, unbound
@@ -15,8 +16,9 @@
 //! with the counts of each end (labels as in the Parquet tables) and of each dynamical class
 //! of the active comets. The particle-years count each comet until its end. The clock covers
 //! `advance_to` only. `CENTAUR_THROUGHPUT_INITIAL=FILE` writes the initial barycentric states
-//! (as `comet_throughput` does) and `CENTAUR_THROUGHPUT_FINAL=FILE` each comet's end
-//! (`id,status,time_days`).
+//! (as `comet_throughput` does) and `CENTAUR_THROUGHPUT_FINAL=FILE` each comet's status
+//! and its own time and barycentric position then, its end's if it ended
+//! (`id,status,time_days,x,y,z`; days, AU).
 use std::collections::BTreeMap;
 use std::time::Instant;
 
@@ -34,7 +36,8 @@ fn main() {
 
 fn run() -> Result<(), String> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let usage = "usage: centaur_throughput N YEARS [STEP_PER_AU_DAYS] [TOLERANCE] [SEED]";
+    let usage =
+        "usage: centaur_throughput N YEARS [STEP_PER_AU_DAYS] [TOLERANCE] [SEED] [PLANET_STEP_DAYS]";
     let n: usize = args.first().and_then(|s| s.parse().ok()).ok_or(usage)?;
     let years: f64 = args.get(1).and_then(|s| s.parse().ok()).ok_or(usage)?;
     let arg = |i: usize, default: f64| -> Result<f64, String> {
@@ -44,7 +47,9 @@ fn run() -> Result<(), String> {
     let step_per_au = arg(2, 2.0)?;
     let tolerance = arg(3, symplectic::DEFAULT_ENCOUNTER_TOLERANCE)?;
     let seed = arg(4, benches::CENTAUR_SEED as f64)? as u64;
-    let (mut population, states) = benches::centaur_population(n, seed, step_per_au, tolerance)?;
+    let planet_step = arg(5, 730.5)?;
+    let (mut population, states) =
+        benches::centaur_population(n, seed, step_per_au, tolerance, planet_step)?;
     if let Ok(path) = std::env::var("CENTAUR_THROUGHPUT_INITIAL") {
         let planets = population.ephemeris().planets().clone();
         benches::write_comet_states(&path, &planets, &states)
@@ -59,11 +64,16 @@ fn run() -> Result<(), String> {
     let planets = population.ephemeris().planets().clone();
     let mut ends: BTreeMap<String, usize> = BTreeMap::new();
     let mut classes: BTreeMap<&str, usize> = BTreeMap::new();
-    let mut final_rows = String::from("id,status,time_days\n");
+    let mut final_rows = String::from("id,status,time_days,x,y,z\n");
     for (i, m) in population.members().iter().enumerate() {
         let (label, time) = status_label(&m.status, &planets);
         *ends.entry(label.clone()).or_default() += 1;
-        final_rows.push_str(&format!("{},{label},{time:e}\n", m.id));
+        let time = if time.is_nan() { m.particle.time } else { time };
+        let q = m.particle.position;
+        final_rows.push_str(&format!(
+            "{},{label},{time:e},{:e},{:e},{:e}\n",
+            m.id, q.x, q.y, q.z
+        ));
         if m.status == ParticleStatus::Active {
             let el = population.elements(i).map_err(|e| e.to_string())?;
             *classes.entry(classify(&el).label()).or_default() += 1;

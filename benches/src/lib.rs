@@ -146,9 +146,9 @@ pub const CENTAUR_SEED: u64 = 2027;
 /// outside the Sun-vicinity limit and the encounter spheres.
 pub const CENTAUR_B1: f64 = 4e-6;
 
-/// The Centaur population (the `centaur_throughput` example and the `centaur-population`
-/// validation experiment): the four giants of `outer_solar_system` (ecliptic J2000)
-/// integrated by S6 at 730.5 d; `n` comets with `a` 5.5–30 AU, `e` 0–0.2, `i` 0–10° and
+/// The Centaur population (the `centaur_throughput` example): the four giants of
+/// `outer_solar_system` (ecliptic J2000) integrated by S6 at `planet_step_days` (730.5 d in
+/// `populations/centaurs.toml`); `n` comets with `a` 5.5–30 AU, `e` 0–0.2, `i` 0–10° and
 /// random angles (`symplectic::samples::CENTAURS`, seed `seed`), S2 in the barycentric
 /// variant with `B₀ = 0`, `B₁ =` [`CENTAUR_B1`], a first step of `step_per_au_days` × the
 /// initial distance, integrated through close encounters (3 Hill radii, tolerance
@@ -160,6 +160,7 @@ pub fn centaur_population(
     seed: u64,
     step_per_au_days: f64,
     tolerance: f64,
+    planet_step_days: f64,
 ) -> Result<
     (
         symplectic::Population,
@@ -185,8 +186,13 @@ pub fn centaur_population(
         .map(|(q, _)| step_per_au_days * q.norm())
         .collect();
     let ids: Vec<u64> = (0..n as u64).collect();
-    let ephemeris =
-        Ephemeris::new(planets, Integrator::S6 { step: 730.5 }).map_err(|e| e.to_string())?;
+    let ephemeris = Ephemeris::new(
+        planets,
+        Integrator::S6 {
+            step: planet_step_days,
+        },
+    )
+    .map_err(|e| e.to_string())?;
     let integrator = ParticleIntegrator::new(Variant::Barycentric, Scheme::S2, 0.0, CENTAUR_B1)
         .map_err(|e| e.to_string())?;
     let rules = RemovalRules {

@@ -16,6 +16,8 @@ pub fn registry() -> Vec<Box<dyn Experiment>> {
         Box::new(chegodaeva_2004::symplectic_100myr::Symplectic100Myr),
         Box::new(chegodaeva_2004::symplectic_order::SymplecticOrder),
         Box::new(chegodaeva_2004::comet_population::CometPopulation),
+        Box::new(chegodaeva_2004::comet_encounters::CometEncounters),
+        Box::new(chegodaeva_2004::centaur_population::CentaurPopulation),
         Box::new(macklin_muller_2013::boundary_rest::BoundaryRest),
         Box::new(macklin_muller_2013::pbf_bunny_density::PbfBunnyDensity),
         Box::new(macklin_muller_2013::pbf_stability::PbfStability),

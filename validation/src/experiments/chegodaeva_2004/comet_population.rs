@@ -134,7 +134,7 @@ fn survivors(removals: &Removals, b: usize, t: f64) -> (usize, usize) {
 }
 
 /// Two-proportion z statistic (pooled variance); 0 when both fractions are 0 or 1.
-fn z_two_proportions((s1, n1): (usize, usize), (s2, n2): (usize, usize)) -> f64 {
+pub(crate) fn z_two_proportions((s1, n1): (usize, usize), (s2, n2): (usize, usize)) -> f64 {
     let (p1, p2) = (s1 as f64 / n1 as f64, s2 as f64 / n2 as f64);
     let p = (s1 + s2) as f64 / (n1 + n2) as f64;
     let var = p * (1.0 - p) * (1.0 / n1 as f64 + 1.0 / n2 as f64);

@@ -1,7 +1,9 @@
 //! Chegodaeva (2004), symplectic integration of the equations of motion of small Solar
-//! System bodies (crate `symplectic`): the paper's 100 Myr experiment, the maps' order, and
-//! populations of comets on their own clocks.
+//! System bodies (crate `symplectic`): the paper's 100 Myr experiment, the maps' order,
+//! populations of comets on their own clocks, and comets through close encounters.
 
+pub mod centaur_population;
+pub mod comet_encounters;
 pub mod comet_population;
 pub mod symplectic_100myr;
 pub mod symplectic_order;
