@@ -2,7 +2,6 @@
 //! needing more fails with `TooManyPairs`), an interrupt stops every method, and a searcher
 //! stopped either way gives correct lists on its next search.
 
-
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
