@@ -1,9 +1,6 @@
 //! [`SearchLimits`]: the pair limit is exact (a search needing `limit` pairs succeeds, one
 //! needing more fails with `TooManyPairs`), an interrupt stops every method, and a searcher
 //! stopped either way gives correct lists on its next search.
-//!
-//! Negative control (2026-11-27): with the comparison in `PairGuard::report` changed from
-//! `total > limit` to `total >= limit`, `the_pair_limit_is_exact` fails for every method.
 
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
