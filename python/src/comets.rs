@@ -13,6 +13,9 @@ use symplectic::Population as RustPopulation;
 use crate::arrays::{check_shape, is_f64, untyped};
 use crate::rust_err;
 
+/// States `(N, 6)` and their times `(N,)`, as returned to Python.
+type StatesAndTimes<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>);
+
 /// The planets of a population: the Sun (with the inner planets' masses) and the four
 /// giants at the epoch 1994-09-05 0h, heliocentric, in `frame`.
 #[pyfunction]
@@ -418,7 +421,7 @@ impl Population {
         &self,
         py: Python<'py>,
         at_days: Option<f64>,
-    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>)> {
+    ) -> PyResult<StatesAndTimes<'py>> {
         let (flat, times) = self.states_at(at_days)?;
         let n = times.len();
         Ok((

@@ -422,8 +422,8 @@ mod elements_of_states {
             q in 1.0f64..100.0,
             e in prop_oneof![0.01f64..0.95, 1.05f64..3.0],
             i in 0.01f64..3.13,
-            node in 0.0f64..6.28,
-            peri in 0.0f64..6.28,
+            node in 0.0f64..std::f64::consts::TAU,
+            peri in 0.0f64..std::f64::consts::TAU,
             m in -10.0f64..10.0,
         ) {
             let mu = 2.96e-4;

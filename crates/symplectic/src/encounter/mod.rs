@@ -32,7 +32,7 @@
 //! particle times (eqs. 33–34), the planets are advanced from the last grid state at or
 //! before the particle's time, here by the same integrator as the particle: the Sun, the
 //! planets and the particle are integrated together in barycentric coordinates (the
-//! particle massless) by the Bulirsch–Stoer method ([`bulirsch_stoer`]) with a relative
+//! particle massless) by the Bulirsch–Stoer method (module `bulirsch_stoer`) with a relative
 //! tolerance per step [`Encounters::tolerance`], steps fitted to the encounter by the error
 //! control. The particle keeps its own clock; nothing depends on the window or on the other
 //! particles, so the population stays bit-identical across threads, shards, checkpoints and
