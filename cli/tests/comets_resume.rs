@@ -118,6 +118,16 @@ fn a_killed_population_study_resumes_to_identical_files() {
         }
     }
     assert!(killed, "the study always ended before it could be killed");
+    // A kill between an atomic write's link and its rename leaves `.<name>.<6 characters>`
+    // behind (it happened in CI); plant such leftovers so that their removal on resume is
+    // checked every time, not only when the kill lands in that window.
+    std::fs::write(resumed.join(".checkpoint.json.Stale1"), b"{").unwrap();
+    std::fs::create_dir_all(resumed.join("snapshots")).unwrap();
+    std::fs::write(
+        resumed.join("snapshots/.snapshot_000003.parquet.Stale2"),
+        b"PAR1",
+    )
+    .unwrap();
 
     assert!(comets(&spec, &resumed).status().unwrap().success());
     let (a, b) = (files(&straight), files(&resumed));

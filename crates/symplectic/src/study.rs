@@ -94,6 +94,8 @@ pub fn run_study(
     };
     let snap_dir = out_dir.join(SNAPSHOT_DIR);
     std::fs::create_dir_all(&snap_dir).map_err(|e| output(e, &snap_dir))?;
+    remove_stale_temporaries(out_dir).map_err(|e| output(e, out_dir))?;
+    remove_stale_temporaries(&snap_dir).map_err(|e| output(e, &snap_dir))?;
     let epoch = spec.particles.epoch_days;
     let end = epoch + spec.span.years * DAYS_PER_YEAR;
     let snap_every = spec.span.snapshot_every_years * DAYS_PER_YEAR;
@@ -142,7 +144,68 @@ pub fn run_study(
     })
 }
 
+/// Removes what a killed run's atomic writes left in `dir`: a write is a temporary file,
+/// linked as `.<name>.<six letters or digits>` just before it is renamed to `<name>`, so a kill
+/// between the two leaves it behind (the renamed file is complete either way). Only names of
+/// files a study writes are touched.
+fn remove_stale_temporaries(dir: &Path) -> std::io::Result<()> {
+    for entry in std::fs::read_dir(dir)? {
+        let entry = entry?;
+        let name = entry.file_name();
+        let Some(name) = name.to_str() else { continue };
+        if is_study_temporary(name) && entry.file_type()?.is_file() {
+            std::fs::remove_file(entry.path())?;
+        }
+    }
+    Ok(())
+}
+
+/// Whether `name` is `.<target>.<6 alphanumerics>` for a file a study writes.
+fn is_study_temporary(name: &str) -> bool {
+    let Some(rest) = name.strip_prefix('.') else {
+        return false;
+    };
+    let Some((target, suffix)) = rest.rsplit_once('.') else {
+        return false;
+    };
+    let is_snapshot = target
+        .strip_prefix("snapshot_")
+        .and_then(|t| t.strip_suffix(".parquet"))
+        .is_some_and(|k| !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit()));
+    suffix.len() == 6
+        && suffix.bytes().all(|b| b.is_ascii_alphanumeric())
+        && (target == CHECKPOINT_FILE || target == FINAL_TABLE || is_snapshot)
+}
+
 /// Path of snapshot `k`.
 pub fn snapshot_path(dir: &Path, k: u64) -> PathBuf {
     dir.join(format!("snapshot_{k:06}.parquet"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::is_study_temporary;
+
+    #[test]
+    fn only_temporaries_of_the_study_files_are_recognised() {
+        for name in [
+            ".checkpoint.json.aW2s2a",
+            ".final.parquet.000000",
+            ".snapshot_000012.parquet.Zz9yQ1",
+        ] {
+            assert!(is_study_temporary(name), "{name}");
+        }
+        for name in [
+            "checkpoint.json",
+            ".checkpoint.json",
+            ".checkpoint.json.aW2s2",
+            ".checkpoint.json.aW2s2a7",
+            ".checkpoint.json.aW2-2a",
+            ".notes.txt.aW2s2a",
+            ".snapshot_.parquet.aW2s2a",
+            ".snapshot_00x.parquet.aW2s2a",
+        ] {
+            assert!(!is_study_temporary(name), "{name}");
+        }
+    }
 }
