@@ -16,7 +16,7 @@ use sph_sim::{
 };
 use sph_solver::boundary::{CacheUse, VolumeMapCache};
 
-use crate::measure::{repose_dict, rest_criterion, ReposeArgs, RestVerdict};
+use crate::measure::{repose_dict, rest_observer, ReposeArgs, RestVerdict};
 use crate::rust_err;
 use sph_sim::observe::RestObserver;
 
@@ -245,7 +245,9 @@ impl PythonSide {
         };
         let answer = cb.call1(py, (record_dict(py, record)?,))?;
         let answer = answer.bind(py);
-        if answer.is_none() || answer.is_truthy()? && !answer.is_instance_of::<PyString>() {
+        // The package's one rule (as `Population.advance`'s): something true stops the run,
+        // None or anything false goes on; a (non-empty) string is also the stop's reason.
+        if !answer.is_truthy()? {
             return Ok(Flow::Continue);
         }
         Ok(Flow::Stop(match answer.extract::<String>() {
@@ -263,8 +265,9 @@ impl<R: Real> FrameObserver<R> for PythonSide {
             None => Flow::Continue,
         };
         match Python::attach(|py| self.ask(py, record)) {
-            Ok(Flow::Continue) => Ok(rest),
-            Ok(flow) => Ok(flow),
+            // The rest criterion's stop is the run's result: it wins over the callback's.
+            Ok(flow) if matches!(rest, Flow::Continue) => Ok(flow),
+            Ok(_) => Ok(rest),
             Err(e) => {
                 self.err = Some(e);
                 Ok(Flow::Interrupt)
@@ -596,6 +599,13 @@ impl Simulation {
         self.scene_frames()
     }
 
+    /// The scene's solver (``[solver] kind``): ``"pbf"``, ``"pcisph"``, ``"iisph"`` or
+    /// ``"granular"`` (granular matter: ``repose()`` measures its heap).
+    #[getter]
+    fn solver(&self) -> &'static str {
+        each!(&*self.lock(), s => s.scene.solver.kind_name())
+    }
+
     /// Advances one frame (the scene's frame interval) through the frame loop; returns the
     /// frame's statistics. A blow-up raises PartisimError naming the frame, step and
     /// particle (the state keeps its last good substep). Unlike ``run``, ``step`` may go
@@ -627,14 +637,18 @@ impl Simulation {
     ///     Jupyter); ``None`` (default) shows it when stderr is a terminal or in Jupyter.
     /// callback : callable, optional
     ///     ``callback(stats)`` after each frame with its statistics (the dict of ``stats``);
-    ///     returning False or a string stops the run after that frame (the string is the
-    ///     reason).
+    ///     returning something true (``True``, a non-empty string, ...) stops the run after
+    ///     that frame, returning ``None`` or anything false goes on (the rule of
+    ///     ``Population.advance`` too). A returned string is the stop's ``reason``; on the
+    ///     frame where ``until_rest`` also stops the run, the rest's reason is kept.
     /// until_rest : dict, optional
     ///     Stop once the material is at rest: ``{"speed_m_s": v, "hold_s": t}`` (and
     ///     optionally ``"region": ((x0, y0, z0), (x1, y1, z1))``, m): the largest particle
     ///     speed (in the region) has stayed below ``v`` m/s for ``t`` s of simulated time.
     ///     The outcome then has ``at_rest`` and ``rest_from_s`` (s), and ``repose()``
-    ///     reports this verdict.
+    ///     reports this verdict. A run going on from an earlier one (after a stop, a
+    ///     ``save``/``load``) continues its hold with ``"below_since_s"``: the earlier
+    ///     outcome's ``rest_below_since_s`` (s); it then stops where one whole run would.
     ///
     /// Returns
     /// -------
@@ -643,8 +657,9 @@ impl Simulation {
     ///     keeps its last good substep), ``frame`` (frames done), ``time_s`` (simulated, s),
     ///     ``reason`` (the stop's, the divergence's, or the scene's end when fewer frames
     ///     than asked were run; else None), ``frames_run``, ``scene_frames`` and
-    ///     ``at_scene_end``; with ``until_rest``, ``at_rest`` (bool), ``rest_from_s``
-    ///     and ``max_speed_m_s`` (the last frame's, m/s).
+    ///     ``at_scene_end``; with ``until_rest``, ``at_rest`` (bool), ``rest_from_s``,
+    ///     ``rest_below_since_s`` (the start of the hold under way, s, or None) and
+    ///     ``max_speed_m_s`` (the last frame's, m/s).
     ///
     /// Ctrl-C stops the run between frames with KeyboardInterrupt, and an exception of the
     /// callback ends it with that exception; the frames done are kept either way.
@@ -657,11 +672,11 @@ impl Simulation {
         callback: Option<Py<PyAny>>,
         until_rest: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        let now_s = self.time();
         let rest = until_rest
             .filter(|r| !r.is_none())
-            .map(rest_criterion)
-            .transpose()?
-            .map(RestObserver::new);
+            .map(|r| rest_observer(r, now_s))
+            .transpose()?;
         let watched = rest.is_some();
         let first = self.frame();
         let plan = FramePlan::new(frames, first, self.scene_frames())?;
