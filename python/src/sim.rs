@@ -1,7 +1,8 @@
 //! `sph-sim`: a scene run frame by frame through the workspace's one frame loop.
 
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
 
 use numpy::{IntoPyArray, PyArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
@@ -14,8 +15,9 @@ use sph_sim::{
     run_frames, Ending, Flow, FrameObserver, FrameRecord, Precision, RunOutcome, RunPlan, Scene,
     SceneSim, SimError,
 };
-use sph_solver::boundary::{CacheUse, VolumeMapCache};
+use sph_solver::boundary::{CacheUse, VolumeMapBuild, VolumeMapCache};
 
+use crate::interrupt::{interruptible, OnSignal};
 use crate::measure::{repose_dict, rest_observer, ReposeArgs, RestVerdict};
 use crate::rust_err;
 use sph_sim::observe::RestObserver;
@@ -179,11 +181,13 @@ fn overrides_of(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<Override>> {
 }
 
 /// Builds the simulation of `scene` (with the volume maps from `cache_dir` when the scene
-/// has them), and restores `checkpoint` (bytes of the checkpoint format) if given.
+/// has them, the build stopped when `cancel` is set), and restores `checkpoint` (bytes of
+/// the checkpoint format) if given.
 fn build(
     scene: &Scene,
     cache_dir: Option<&Path>,
     checkpoint: Option<(&Path, &[u8])>,
+    cancel: &AtomicBool,
 ) -> Result<AnySim, SimError> {
     let cache = match (cache_dir, scene.boundary.model) {
         (Some(dir), sph_scene::BoundaryModel::VolumeMap) => {
@@ -203,16 +207,27 @@ fn build(
         }
         Ok(sim)
     }
+    let how = VolumeMapBuild {
+        cache: cache.as_ref(),
+        cancel: Some(cancel),
+    };
     Ok(match scene.precision {
-        Precision::F32 => AnySim::F32(restore(
-            SceneSim::with_cache(scene, cache.as_ref())?,
-            checkpoint,
-        )?),
-        Precision::F64 => AnySim::F64(restore(
-            SceneSim::with_cache(scene, cache.as_ref())?,
-            checkpoint,
-        )?),
+        Precision::F32 => AnySim::F32(restore(SceneSim::with_maps(scene, how)?, checkpoint)?),
+        Precision::F64 => AnySim::F64(restore(SceneSim::with_maps(scene, how)?, checkpoint)?),
     })
+}
+
+/// Runs `work` (a scene's build) on a thread of its own with a cancellation flag: Ctrl-C
+/// sets the flag, waits for the build to stop (within a row of volume-map nodes) and
+/// raises KeyboardInterrupt.
+fn cancellable<T: Send + 'static>(
+    py: Python<'_>,
+    work: impl FnOnce(&AtomicBool) -> T + Send + 'static,
+) -> PyResult<T> {
+    let cancel = Arc::new(AtomicBool::new(false));
+    let flag = cancel.clone();
+    let stop = move || flag.store(true, Ordering::Relaxed);
+    interruptible(py, OnSignal::Stop(&stop), move || work(&cancel))
 }
 
 /// The frame record as a Python dict: its serde form (`phases_s` a dict by phase name).
@@ -464,15 +479,13 @@ impl Simulation {
     ) -> PyResult<Self> {
         let (source, checkpoint) =
             decode_saved(bytes).map_err(|reason| rust_err(SimError::input(file, reason)))?;
-        let sim = py
-            .detach(|| {
-                build(
-                    &source.scene()?,
-                    cache_dir.as_deref(),
-                    Some((file, checkpoint)),
-                )
-            })
-            .map_err(rust_err)?;
+        let (file, dir, checkpoint) = (file.to_path_buf(), cache_dir.clone(), checkpoint.to_vec());
+        let (source, sim) = cancellable(py, move |cancel| -> Result<_, SimError> {
+            let scene = source.scene()?;
+            let sim = build(&scene, dir.as_deref(), Some((&file, &checkpoint)), cancel)?;
+            Ok((source, sim))
+        })?
+        .map_err(rust_err)?;
         Ok(Self::new(sim, source, cache_dir))
     }
 }
@@ -506,6 +519,9 @@ impl Simulation {
     /// PartisimError
     ///     The scene is unreadable or refused (the message names the file, the key and the
     ///     line, or "given as an override").
+    /// KeyboardInterrupt
+    ///     Ctrl-C while the scene is built (a volume map's build stops within a row of its
+    ///     nodes; nothing is kept, the cache included).
     #[staticmethod]
     #[pyo3(signature = (path, quick = false, overrides = None, volume_map_cache = CacheChoice::Default))]
     fn from_scene(
@@ -517,11 +533,12 @@ impl Simulation {
     ) -> PyResult<Self> {
         let overrides = overrides_of(overrides)?;
         let cache_dir = volume_map_cache.dir();
-        let built = py.detach(|| -> Result<(SceneSource, AnySim), SimError> {
+        let dir = cache_dir.clone();
+        let built = cancellable(py, move |cancel| -> Result<(SceneSource, AnySim), SimError> {
             let (source, scene) = SceneSource::load(&path, overrides, quick)?;
-            let sim = build(&scene, cache_dir.as_deref(), None)?;
+            let sim = build(&scene, dir.as_deref(), None, cancel)?;
             Ok((source, sim))
-        });
+        })?;
         let (source, sim) = built.map_err(rust_err)?;
         Ok(Self::new(sim, source, cache_dir))
     }
