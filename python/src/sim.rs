@@ -482,7 +482,8 @@ impl Simulation {
         let (file, dir, checkpoint) = (file.to_path_buf(), cache_dir.clone(), checkpoint.to_vec());
         let (source, sim) = cancellable(py, move |cancel| -> Result<_, SimError> {
             let scene = source.scene()?;
-            let sim = build(&scene, dir.as_deref(), Some((&file, &checkpoint)), cancel)?;
+            let saved = Some((file.as_path(), checkpoint.as_slice()));
+            let sim = build(&scene, dir.as_deref(), saved, cancel)?;
             Ok((source, sim))
         })?
         .map_err(rust_err)?;
@@ -521,7 +522,7 @@ impl Simulation {
     ///     line, or "given as an override").
     /// KeyboardInterrupt
     ///     Ctrl-C while the scene is built (a volume map's build stops within a row of its
-    ///     nodes; nothing is kept, the cache included).
+    ///     nodes; maps completed before it stay in the cache).
     #[staticmethod]
     #[pyo3(signature = (path, quick = false, overrides = None, volume_map_cache = CacheChoice::Default))]
     fn from_scene(

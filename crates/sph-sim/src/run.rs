@@ -290,9 +290,10 @@ fn run_scene_in<R: Real>(
     let mut checkpoints = CheckpointObserver::new(run, opts.checkpoint_every);
     let cancel = opts.cancel.clone();
     let mut ctrl_c = crate::observe::OnFrame(move |_: &SceneSim<R>, _: &FrameRecord| {
-        match cancel.as_deref().is_some_and(|c| c.load(Ordering::Relaxed)) {
-            true => Flow::Interrupt,
-            false => Flow::Continue,
+        if cancel.as_deref().is_some_and(|c| c.load(Ordering::Relaxed)) {
+            Flow::Interrupt
+        } else {
+            Flow::Continue
         }
     });
     let mut observers: Vec<&mut dyn FrameObserver<R>> = vec![&mut stats, &mut vtk];
