@@ -535,11 +535,14 @@ impl Simulation {
         let overrides = overrides_of(overrides)?;
         let cache_dir = volume_map_cache.dir();
         let dir = cache_dir.clone();
-        let built = cancellable(py, move |cancel| -> Result<(SceneSource, AnySim), SimError> {
-            let (source, scene) = SceneSource::load(&path, overrides, quick)?;
-            let sim = build(&scene, dir.as_deref(), None, cancel)?;
-            Ok((source, sim))
-        })?;
+        let built = cancellable(
+            py,
+            move |cancel| -> Result<(SceneSource, AnySim), SimError> {
+                let (source, scene) = SceneSource::load(&path, overrides, quick)?;
+                let sim = build(&scene, dir.as_deref(), None, cancel)?;
+                Ok((source, sim))
+            },
+        )?;
         let (source, sim) = built.map_err(rust_err)?;
         Ok(Self::new(sim, source, cache_dir))
     }

@@ -30,7 +30,9 @@ fn read_kib(file: &str, key: &str) -> Option<u64> {
 fn address_space_limit() -> Option<u64> {
     let text = std::fs::read_to_string("/proc/self/limits").ok()?;
     let line = text.lines().find(|l| l.starts_with("Max address space"))?;
-    let soft = line["Max address space".len()..].split_whitespace().next()?;
+    let soft = line["Max address space".len()..]
+        .split_whitespace()
+        .next()?;
     soft.parse().ok() // "unlimited" does not parse
 }
 
@@ -45,6 +47,9 @@ mod tests {
         }
         let total = read_kib("/proc/meminfo", "MemTotal:").unwrap() * 1024;
         let available = available_bytes().unwrap();
-        assert!(available > 0 && available <= total, "{available} of {total}");
+        assert!(
+            available > 0 && available <= total,
+            "{available} of {total}"
+        );
     }
 }

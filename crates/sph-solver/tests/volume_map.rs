@@ -632,14 +632,17 @@ fn report_build_times() {
 /// interpolation schemes; set before the build, no map is built at all.
 #[test]
 fn a_cancelled_build_stops_and_names_the_solid() {
+    use sph_solver::VolumeMapBuild;
     use std::sync::atomic::{AtomicBool, Ordering};
     use std::time::Duration;
-    use sph_solver::VolumeMapBuild;
 
     let h = 0.1;
     let sphere = || -> Box<dyn Sdf<f64>> { Box::new(Sphere::new(Vec3::repeat(0.5), 0.3).unwrap()) };
     let plane = || -> Box<dyn Sdf<f64>> { Box::new(Plane::new(Vec3::zeros(), Vec3::y()).unwrap()) };
-    for interpolation in [Interpolation::NodePlanes, Interpolation::TrilinearCorrection] {
+    for interpolation in [
+        Interpolation::NodePlanes,
+        Interpolation::TrilinearCorrection,
+    ] {
         let options = VolumeMapOptions {
             interpolation,
             ..VolumeMapOptions::default()
@@ -707,5 +710,8 @@ fn a_cancelled_build_stops_and_names_the_solid() {
         "{:?}",
         r.map(|_| ())
     );
-    assert!(flag.load(Ordering::Relaxed), "the build ended before the flag was set");
+    assert!(
+        flag.load(Ordering::Relaxed),
+        "the build ended before the flag was set"
+    );
 }

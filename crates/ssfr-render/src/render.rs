@@ -201,11 +201,7 @@ impl Renderer {
         params.material.validate()?;
         let pixels = cam.width.saturating_mul(cam.height);
         if pixels > self.checked_pixels {
-            crate::check_frame_memory(
-                cam.width,
-                cam.height,
-                sph_core::memory::available_bytes(),
-            )?;
+            crate::check_frame_memory(cam.width, cam.height, sph_core::memory::available_bytes())?;
             self.checked_pixels = pixels;
         }
         let mut times = StageTimes::default();
@@ -387,7 +383,8 @@ mod tests {
             seed: 1,
         });
         let mut r = Renderer::default();
-        r.render(&p, &ParticleView::spheres(&block(), 0.02)).unwrap();
+        r.render(&p, &ParticleView::spheres(&block(), 0.02))
+            .unwrap();
         let image = r.image();
         fn bytes<T>(v: &[T]) -> usize {
             std::mem::size_of_val(v)
@@ -427,7 +424,10 @@ mod tests {
             }
         );
         let text = e.to_string();
-        assert!(text.contains(&needed.to_string()) && text.contains("1073741824"), "{text}");
+        assert!(
+            text.contains(&needed.to_string()) && text.contains("1073741824"),
+            "{text}"
+        );
         assert!(crate::check_frame_memory(8192, 8192, Some(needed)).is_ok());
         assert!(crate::check_frame_memory(8192, 8192, None).is_ok());
     }
