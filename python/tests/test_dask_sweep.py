@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import partisim
-from conftest import REPO
+from conftest import PBF, REPO, WEDGE, WEDGE_OBJ
 
 SCENE = REPO / "scenes" / "dam_break.toml"
 # Two variants of the quick dam break (12,288 particles, about 0.2 s a frame on one core):
@@ -158,28 +158,8 @@ def test_sweep_survives_a_killed_worker_and_equals_one_machine(tmp_path):
 
 # ---- the at-rest verdict and the repose angle in the sweep's table ----
 
-# A scene of 96 particles and 5 frames of 0.02 s.
-TINY = """
-name = "tiny"
-[simulation]
-precision = "f64"
-particle_spacing = 0.05
-duration = 0.1
-frame_dt = 0.02
-[solver]
-kind = "pbf"
-substeps = 2
-solver_iterations = 3
-[boundary]
-model = "collision"
-[tank]
-min = [0.0, 0.0, 0.0]
-max = [0.5, 0.5, 0.5]
-[[fluid]]
-kind = "block"
-min = [0.0, 0.0, 0.0]
-max = [0.2, 0.3, 0.2]
-"""
+# The PBF column of 96 particles and 5 frames of 0.02 s, its walls as a collision boundary.
+TINY = PBF.replace('"volume-map"', '"collision"')
 
 
 class WorkerDied(Exception):
@@ -246,46 +226,6 @@ def test_the_at_rest_verdict_survives_checkpoints_and_a_death(tmp_path, monkeypa
                                    checkpoint_every=1, until_rest=rest)
     assert again.loc[0, "resumed_from_frame"] == 3 and bool(again.loc[0, "at_rest"])
     assert again.loc[0, "rest_from_s"] == 0.0
-
-
-# A planar heap with 30° flanks (a prism of isosceles cross-section, 1 m base), no gravity:
-# granular, so the sweep measures its angle of repose.
-H = float(0.5 * np.tan(np.radians(30.0)))
-WEDGE_OBJ = f"""v 0 0 0
-v 1 0 0
-v 0.5 {H!r} 0
-v 0 0 0.2
-v 1 0 0.2
-v 0.5 {H!r} 0.2
-f 1 3 2
-f 4 5 6
-f 1 2 5
-f 1 5 4
-f 1 4 6
-f 1 6 3
-f 2 3 6
-f 2 6 5
-"""
-WEDGE = """
-name = "wedge"
-[simulation]
-particle_spacing = 0.02
-duration = 0.04
-frame_dt = 0.02
-gravity = [0.0, 0.0, 0.0]
-[solver]
-kind = "granular"
-substeps = 2
-friction_angle_deg = 30.0
-[boundary]
-model = "collision"
-[tank]
-min = [-0.01, -0.01, -0.01]
-max = [1.01, 0.5, 0.21]
-[[fluid]]
-kind = "mesh"
-path = "wedge.obj"
-"""
 
 
 def test_granular_runs_get_their_repose_angle(tmp_path):

@@ -636,9 +636,29 @@ fn a_cancelled_build_stops_and_names_the_solid() {
     use std::sync::atomic::{AtomicBool, Ordering};
     use std::time::Duration;
 
-    let h = 0.1;
-    let sphere = || -> Box<dyn Sdf<f64>> { Box::new(Sphere::new(Vec3::repeat(0.5), 0.3).unwrap()) };
-    let plane = || -> Box<dyn Sdf<f64>> { Box::new(Plane::new(Vec3::zeros(), Vec3::y()).unwrap()) };
+    type Built = Result<VolumeMapBoundary<f64>, SolverError>;
+    fn sphere() -> Box<dyn Sdf<f64>> {
+        Box::new(Sphere::new(Vec3::repeat(0.5), 0.3).unwrap())
+    }
+    fn plane() -> Box<dyn Sdf<f64>> {
+        Box::new(Plane::new(Vec3::zeros(), Vec3::y()).unwrap())
+    }
+    fn build(
+        solids: Vec<Box<dyn Sdf<f64>>>,
+        h: f64,
+        options: VolumeMapOptions,
+        flag: &AtomicBool,
+    ) -> Built {
+        let how = VolumeMapBuild {
+            cache: None,
+            cancel: Some(flag),
+        };
+        let k = KernelKind::WendlandC2;
+        VolumeMapBoundary::build(solids, k, h, unit_domain(), 0.0, options, how)
+    }
+    fn cancelled(r: Built) -> bool {
+        matches!(&r, Err(SolverError::Cancelled { what }) if what == "solid 0: volume map")
+    }
     for interpolation in [
         Interpolation::NodePlanes,
         Interpolation::TrilinearCorrection,
@@ -648,35 +668,11 @@ fn a_cancelled_build_stops_and_names_the_solid() {
             ..VolumeMapOptions::default()
         };
         let flag = AtomicBool::new(true);
-        let how = VolumeMapBuild {
-            cache: None,
-            cancel: Some(&flag),
-        };
-        let r = VolumeMapBoundary::build(
-            vec![plane(), sphere()],
-            KernelKind::WendlandC2,
-            h,
-            unit_domain(),
-            0.0,
-            options,
-            how,
-        );
-        match r {
-            Err(SolverError::Cancelled { what }) => assert_eq!(what, "solid 0: volume map"),
-            other => panic!("{interpolation:?}: {:?}", other.map(|_| ())),
-        }
+        let r = build(vec![plane(), sphere()], 0.1, options, &flag);
+        assert!(cancelled(r), "{interpolation:?}");
         // Not set: the same build completes.
         flag.store(false, Ordering::Relaxed);
-        let b = VolumeMapBoundary::build(
-            vec![plane(), sphere()],
-            KernelKind::WendlandC2,
-            h,
-            unit_domain(),
-            0.0,
-            options,
-            how,
-        )
-        .unwrap();
+        let b = build(vec![plane(), sphere()], 0.1, options, &flag).unwrap();
         assert_eq!(b.maps().len(), 2);
     }
     // Set from another thread during a long build (16 cells per support: 1.1e7 nodes,
@@ -692,24 +688,9 @@ fn a_cancelled_build_stops_and_names_the_solid() {
             std::thread::sleep(Duration::from_millis(200));
             flag.store(true, Ordering::Relaxed);
         });
-        VolumeMapBoundary::build(
-            vec![sphere()],
-            KernelKind::WendlandC2,
-            0.05,
-            unit_domain(),
-            0.0,
-            fine,
-            VolumeMapBuild {
-                cache: None,
-                cancel: Some(&flag),
-            },
-        )
+        build(vec![sphere()], 0.05, fine, &flag)
     });
-    assert!(
-        matches!(&r, Err(SolverError::Cancelled { what }) if what == "solid 0: volume map"),
-        "{:?}",
-        r.map(|_| ())
-    );
+    assert!(cancelled(r));
     assert!(
         flag.load(Ordering::Relaxed),
         "the build ended before the flag was set"
