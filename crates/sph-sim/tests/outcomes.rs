@@ -152,23 +152,28 @@ fn a_resumed_rest_hold_stops_where_the_whole_run_does() {
     // Whole: at rest from t = 0, 0.048 s >= 0.04 s after frame 3.
     let mut whole = sim("rest-whole");
     let mut rest = RestObserver::new(criterion);
-    let out = run_frames(&mut whole, &RunPlan::next(&whole, 10), &mut [&mut rest]).unwrap();
+    let plan = RunPlan::next(&whole, 10);
+    let out = run_frames(&mut whole, &plan, &mut [&mut rest]).unwrap();
     assert_eq!((out.frame, rest.rest_from_s), (3, Some(0.0)));
     // Split after frame 1: the second run continues the first's hold.
     let mut split = sim("rest-split");
     let mut first = RestObserver::new(criterion);
-    let out = run_frames(&mut split, &RunPlan::next(&split, 1), &mut [&mut first]).unwrap();
+    let plan = RunPlan::next(&split, 1);
+    let out = run_frames(&mut split, &plan, &mut [&mut first]).unwrap();
     assert_eq!((out.frame, first.rest_from_s), (1, None));
     assert_eq!(first.below_since_s(), Some(0.0));
     let mut second = RestObserver::resumed(criterion, first.below_since_s());
-    let out = run_frames(&mut split, &RunPlan::next(&split, 10), &mut [&mut second]).unwrap();
+    let plan = RunPlan::next(&split, 10);
+    let out = run_frames(&mut split, &plan, &mut [&mut second]).unwrap();
     assert_eq!((out.frame, second.rest_from_s), (3, Some(0.0)));
     // A fresh observer starts the hold at the second run's first frame instead.
     let mut again = sim("rest-fresh");
     let mut first = RestObserver::new(criterion);
-    run_frames(&mut again, &RunPlan::next(&again, 1), &mut [&mut first]).unwrap();
+    let plan = RunPlan::next(&again, 1);
+    run_frames(&mut again, &plan, &mut [&mut first]).unwrap();
     let mut fresh = RestObserver::new(criterion);
-    let out = run_frames(&mut again, &RunPlan::next(&again, 10), &mut [&mut fresh]).unwrap();
+    let plan = RunPlan::next(&again, 10);
+    let out = run_frames(&mut again, &plan, &mut [&mut fresh]).unwrap();
     assert_eq!(out.frame, 4);
     let from = fresh.rest_from_s.unwrap();
     assert!((from - 0.016).abs() < 1e-12, "{from}");
