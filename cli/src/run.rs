@@ -1,8 +1,10 @@
 //! `particles run SCENE`: a scene run with its observers ([`sph_sim::run_scene`]).
 
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use sph_sim::{run_scene, SceneRunOptions};
 
 /// Arguments of `particles run`.
@@ -55,6 +57,16 @@ pub fn run(a: &RunArgs) -> Result<()> {
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "scene".into());
+    // Ctrl-C stops the volume maps' build, or the run after its frame (its checkpoint
+    // written: `--resume` goes on from it); a second one ends the process at once.
+    let cancel = Arc::new(AtomicBool::new(false));
+    let flag = cancel.clone();
+    ctrlc::set_handler(move || {
+        if flag.swap(true, Ordering::Relaxed) {
+            std::process::exit(130);
+        }
+    })
+    .context("installing the Ctrl-C handler")?;
     let opts = SceneRunOptions {
         quick: a.quick,
         out_dir: a
@@ -71,9 +83,18 @@ pub fn run(a: &RunArgs) -> Result<()> {
                 .clone()
                 .unwrap_or_else(|| PathBuf::from("target").join("cache").join("volume-maps"))
         }),
+        cancel: Some(cancel.clone()),
     };
     // A blow-up fails the command (exit status 1) with the solver's message naming the
     // frame, step and particle.
-    run_scene(&a.scene, &opts)?.diverged_as_error()?;
+    let outcome = run_scene(&a.scene, &opts)?;
+    if matches!(outcome.ending, sph_sim::Ending::Interrupted) {
+        let resume = match opts.checkpoint_every {
+            Some(_) => ": run the same command with --resume to go on from its checkpoint",
+            None => " (no checkpoint: --checkpoint-every 0)",
+        };
+        anyhow::bail!("interrupted (Ctrl-C) at frame {}{resume}", outcome.frame);
+    }
+    outcome.diverged_as_error()?;
     Ok(())
 }

@@ -80,10 +80,13 @@ class Simulation:
         """Runs to the scene's last frame (frames=None) or `frames` more (numpy integers
         accepted), never past the scene's last frame (as `particles run --frames`); huge
         counts are clamped. Progress through partisim.progress (None: on for a terminal or
-        Jupyter). `callback(stats)` after each frame: False or a string (the reason) stops
-        the run. `until_rest={"speed_m_s", "hold_s", "region"}` stops at rest. Returns
+        Jupyter). `callback(stats)` after each frame: something true (True, a non-empty
+        string: the reason) stops the run, None or anything false goes on.
+        `until_rest={"speed_m_s", "hold_s", "region", "below_since_s"}` stops at rest
+        (below_since_s: an earlier run's rest_below_since_s, continuing its hold). Returns
         {"ending", "frame", "time_s", "reason", "frames_run", "scene_frames",
-        "at_scene_end"} (+ "at_rest", "rest_from_s", "max_speed_m_s" with until_rest).
+        "at_scene_end"} (+ "at_rest", "rest_from_s", "rest_below_since_s",
+        "max_speed_m_s" with until_rest).
         Ctrl-C stops between frames with KeyboardInterrupt (the frames done are kept)."""
     def repose(
         self,
@@ -104,6 +107,9 @@ class Simulation:
     @property
     def scene_frames(self) -> int:
         """The scene's last frame, ceil(duration / frame_dt)."""
+    @property
+    def solver(self) -> str:
+        """The scene's solver kind: "pbf", "pcisph", "iisph" or "granular"."""
     @property
     def positions(self) -> _Float:
         """(N, 3) positions (m), in the scene's particle order and precision."""

@@ -280,8 +280,9 @@ class Population:
         callback : callable or None
             ``callback(info)`` after each window, ``info`` a dict: ``time_years``,
             ``time_days``, ``active``, ``removed``, ``particle_steps``. Returning something
-            true stops the run there (the population stays usable and goes on with the
-            next call).
+            true (``True``, a non-empty string, ...) stops the run there, ``None`` or
+            anything false goes on: the rule of ``Simulation.run``'s callback too. The
+            population stays usable and goes on with the next call.
 
         Ctrl-C stops within a window with ``KeyboardInterrupt``, each particle where it
         was; the population goes on from there with the next call, its trajectories the

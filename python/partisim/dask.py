@@ -136,12 +136,23 @@ def _override_rows(overrides: Any) -> List[Dict[str, Any]]:
     return out
 
 
-def _run_key(scene: Path, row: Dict[str, Any], quick: bool, frames: Optional[int]) -> str:
+def _run_key(
+    scene: Path,
+    row: Dict[str, Any],
+    quick: bool,
+    frames: Optional[int],
+    until_rest: Optional[Dict[str, Any]] = None,
+    repose: Any = None,
+) -> str:
     """A digest of everything that defines a run (the scene file's bytes, its overrides,
-    quick, frames), naming its checkpoint: a checkpoint of another run is never resumed."""
+    quick, frames, the rest criterion, the repose options), naming its checkpoint: a
+    checkpoint of another run is never resumed."""
     h = hashlib.sha256()
     h.update(scene.read_bytes())
-    h.update(json.dumps([str(scene), row, quick, frames], sort_keys=True, default=repr).encode())
+    defining = [str(scene), row, quick, frames]
+    if until_rest is not None or repose is not None:  # digests of earlier sweeps unchanged
+        defining += [until_rest, repose]
+    h.update(json.dumps(defining, sort_keys=True, default=repr).encode())
     return h.hexdigest()[:16]
 
 
@@ -163,17 +174,57 @@ def _stats_columns(record: Optional[Dict[str, Any]]) -> Dict[str, Any]:
     return {k: v for k, v in record.items() if k not in _WALL_CLOCK}
 
 
-def _result(outcome: Dict[str, Any], record: Optional[Dict[str, Any]]) -> Dict[str, Any]:
-    """A run's row: its outcome, then the final frame record's statistics."""
+def _result(
+    outcome: Dict[str, Any],
+    record: Optional[Dict[str, Any]],
+    measured: Optional[Dict[str, Any]] = None,
+) -> Dict[str, Any]:
+    """A run's row: its outcome (with the at-rest verdict when watched), the repose
+    columns when measured, then the final frame record's statistics."""
     result: Dict[str, Any] = {
         "ending": outcome["ending"],
         "reason": outcome["reason"],
         "frame": outcome["frame"],
         "time_s": outcome["time_s"],
     }
+    if "at_rest" in outcome:
+        result["at_rest"] = outcome["at_rest"]
+        result["rest_from_s"] = outcome["rest_from_s"]
+    result.update(measured or {})
     for key, value in _stats_columns(record).items():
         result.setdefault(key, value)
     return result
+
+
+# The repose measurement's scalar results, as the table's columns.
+_REPOSE_COLUMNS = {
+    "angle_deg": "repose_angle_deg",
+    "resolution_deg": "repose_resolution_deg",
+    "steepest_deg": "repose_steepest_deg",
+    "pile_height_m": "repose_pile_height_m",
+}
+
+
+def _measure_repose(sim: Any, repose: Any) -> Dict[str, Any]:
+    """The repose columns of a finished run: ``sim.repose(**options)`` when ``repose`` is a
+    dict, or with the defaults when it is None and the scene is granular; none when
+    ``repose`` is False or the scene is not granular. A heap that cannot be measured (a
+    flat layer, too few surface points) gives NaN angles and its message in
+    ``repose_error``, not a failed sweep."""
+    from . import PartisimError
+
+    if repose is False or (repose is None and getattr(sim, "solver", None) != "granular"):
+        return {}
+    options = dict(repose) if isinstance(repose, Mapping) else {}
+    try:
+        m = sim.repose(**options)
+    except PartisimError as e:
+        out: Dict[str, Any] = {column: float("nan") for column in _REPOSE_COLUMNS.values()}
+        out["repose_error"] = str(e)
+        return out
+    out = {column: m[key] for key, column in _REPOSE_COLUMNS.items()}
+    out["repose_error"] = None
+    return out
 
 
 def _run_scene(
@@ -183,29 +234,36 @@ def _run_scene(
     frames: Optional[int],
     checkpoint: Optional[str],
     checkpoint_every: int,
+    until_rest: Optional[Dict[str, Any]] = None,
+    repose: Any = None,
 ) -> Dict[str, Any]:
     """One run of a sweep (the Dask task): from its latest checkpoint if there is one, else
     from the scene; a checkpoint every ``checkpoint_every`` frames; the result as a row.
 
     Beside each checkpoint ``NAME`` a small ``NAME.json`` keeps the frame it was taken at,
-    that frame's record and, once the run has ended, its outcome. It is written before the
-    checkpoint, so it never lags behind it: a task that loads a checkpoint of the same frame
-    takes the record (and a finished run's outcome) from it, and one that loads an older
-    checkpoint (killed between the two writes) runs those frames again."""
+    that frame's record, the rest criterion's hold under way at each checkpoint frame
+    (``holds``: frame -> ``below_since_s``) and, once the run has ended, its outcome and
+    repose columns. It is written before the checkpoint, so it never lags behind it: a
+    task that loads a checkpoint of the same frame takes the record (and a finished run's
+    row) from it, one that loads an older checkpoint (killed between the two writes) runs
+    those frames again, and either continues the hold of its checkpoint's frame, so that
+    the at-rest verdict is the uninterrupted run's."""
     from . import Simulation  # the worker imports the extension here, not at unpickling
 
     start = time.perf_counter()
     ckpt = Path(checkpoint) if checkpoint is not None else None
     side = ckpt.with_name(ckpt.name + ".json") if ckpt is not None else None
     record = None
+    holds: Dict[str, Optional[float]] = {}
     if ckpt is not None and ckpt.exists():
         sim = Simulation.load(ckpt)
         saved = json.loads(side.read_text()) if side.exists() else {}
+        holds = dict(saved.get("holds") or {})
         if saved.get("frame") == sim.frame:
             record = saved["record"]
             if saved.get("outcome") is not None:  # finished: its row, without running
                 return {
-                    **_result(saved["outcome"], record),
+                    **_result(saved["outcome"], record, saved.get("measured")),
                     "resumed_from_frame": sim.frame,
                     "checkpoint": checkpoint,
                     "wall_s": time.perf_counter() - start,
@@ -215,6 +273,8 @@ def _run_scene(
         extra = {"overrides": row} if row else {}
         sim = Simulation.from_scene(scene, quick=quick, **extra)
     resumed_from = sim.frame
+    # The hold under way at the frame the run goes on from (none at frame 0).
+    below_since = holds.get(str(sim.frame))
     # The run's last frame (frames asked for, never past the scene's end): no checkpoint stop
     # there, so that the last call of `run` ends the run with its own outcome.
     final = frames
@@ -235,20 +295,33 @@ def _run_scene(
                 f"{checkpoint}: resumed at frame {sim.frame}, not before the {frames} frames "
                 "asked for (a checkpoint of a finished run without its record)"
             )
-        outcome = sim.run(todo, progress=False, callback=every if ckpt is not None else None)
+        watch = None if until_rest is None else {**until_rest, "below_since_s": below_since}
+        outcome = sim.run(todo, progress=False, callback=every if ckpt is not None else None,
+                          until_rest=watch)
         if sim.stats is not None:
             record = sim.stats
+        below_since = outcome.get("rest_below_since_s")
+        pause = outcome["ending"] == "stopped" and outcome["reason"] == _CHECKPOINT_STOP
+        measured = None if pause else _measure_repose(sim, repose)
         if ckpt is None:
             break
-        pause = outcome["ending"] == "stopped" and outcome["reason"] == _CHECKPOINT_STOP
+        if until_rest is not None:
+            holds[str(sim.frame)] = below_since
         _write_json_atomic(
-            side, {"frame": sim.frame, "record": record, "outcome": None if pause else outcome}
+            side,
+            {
+                "frame": sim.frame,
+                "record": record,
+                "holds": holds,
+                "outcome": None if pause else outcome,
+                "measured": measured,
+            },
         )
         sim.save(ckpt)
         if not pause:
             break
     return {
-        **_result(outcome, record),
+        **_result(outcome, record, measured),
         "resumed_from_frame": resumed_from,
         "checkpoint": checkpoint,
         "wall_s": time.perf_counter() - start,
@@ -264,6 +337,8 @@ def run_scene_sweep(
     checkpoint_dir: Optional[Union[str, os.PathLike]] = None,
     checkpoint_every: int = 50,
     retries: int = 0,
+    until_rest: Optional[Mapping[str, Any]] = None,
+    repose: Union[None, bool, Mapping[str, Any]] = None,
 ) -> Any:
     """Runs one scene file under each row of a table of overrides, one Dask task per run,
     and gathers the results into one table.
@@ -305,6 +380,16 @@ def run_scene_sweep(
     retries : int
         Dask retries of a task that raised (a worker's death is rescheduled by Dask in any
         case, up to its ``distributed.scheduler.allowed-failures``).
+    until_rest : dict, optional
+        Stop each run once its material is at rest, as ``Simulation.run(until_rest=...)``:
+        ``{"speed_m_s": v, "hold_s": t}`` and optionally ``"region"``. The hold under way
+        at each checkpoint is kept beside it, so a run resumed after its worker died
+        reaches the uninterrupted run's verdict at the same frame.
+    repose : None, False or dict
+        The angle of repose of each run's final particles (``Simulation.repose``): ``None``
+        (default) measures the runs whose scene is granular (``[solver] kind =
+        "granular"``) with ``repose()``'s defaults, a dict measures every run with those
+        options (``{"shape": "conical"}``, ...), ``False`` measures none.
 
     Returns
     -------
@@ -313,7 +398,11 @@ def run_scene_sweep(
         (``ending``: "completed", "stopped" or "diverged", ``reason``, ``frame``,
         ``time_s``); the statistics of the final frame record (``particles``,
         ``max_density_ratio``, ``mean_density_ratio``, ``kinetic_energy_j``,
-        ``iterations``, ...; not its wall-clock ``phases_s`` and ``total_s``);
+        ``iterations``, ...; not its wall-clock ``phases_s`` and ``total_s``); with
+        ``until_rest``, the verdict ``at_rest`` (bool) and ``rest_from_s`` (s, or None);
+        where measured, ``repose_angle_deg``, ``repose_resolution_deg``,
+        ``repose_steepest_deg``, ``repose_pile_height_m`` and ``repose_error`` (None, or
+        why the heap could not be measured, its angles then NaN);
         ``resumed_from_frame`` (0, or the checkpoint's frame the
         finishing attempt started from), ``checkpoint`` (its path or None) and ``wall_s``
         (the finishing attempt's wall time, s).
@@ -340,6 +429,20 @@ def run_scene_sweep(
         raise ValueError(f"checkpoint_every = {checkpoint_every!r}: must be an integer >= 1")
     if isinstance(retries, (bool, np.bool_)) or not isinstance(retries, (int, np.integer)) or retries < 0:
         raise ValueError(f"retries = {retries!r}: must be an integer >= 0")
+    if until_rest is not None:
+        if not isinstance(until_rest, Mapping):
+            raise TypeError(
+                f"until_rest: expected a dict (speed_m_s, hold_s, region), not {type(until_rest).__name__}"
+            )
+        if "below_since_s" in until_rest:
+            raise ValueError("until_rest: below_since_s is the sweep's to carry between checkpoints")
+        until_rest = {key: _plain(value) for key, value in until_rest.items()}
+    if repose is not None and repose is not False and not isinstance(repose, Mapping):
+        raise TypeError(
+            f"repose: expected None, False or a dict of Simulation.repose options, not {repose!r}"
+        )
+    if isinstance(repose, Mapping):
+        repose = {key: _plain(value) for key, value in repose.items()}
     ckpt_dir = None
     if checkpoint_dir is not None:
         ckpt_dir = Path(checkpoint_dir).resolve()
@@ -347,7 +450,7 @@ def run_scene_sweep(
     quick = bool(quick)
     futures: List[Any] = []
     for i, row in enumerate(rows):
-        digest = _run_key(scene_path, row, quick, frames)
+        digest = _run_key(scene_path, row, quick, frames, until_rest, repose)
         ckpt = None if ckpt_dir is None else str(ckpt_dir / f"run{i:04d}-{digest}.partisim")
         futures.append(
             client.submit(
@@ -358,6 +461,8 @@ def run_scene_sweep(
                 frames,
                 ckpt,
                 int(checkpoint_every),
+                until_rest,
+                repose,
                 key=f"partisim-scene-run-{i:04d}-{digest}",
                 retries=int(retries),
                 pure=False,

@@ -38,7 +38,9 @@ def render(
         (vertical field of view, degrees). Missing entries default to a view framing
         ``tank`` or else the particles' bounding box.
     width, height : int
-        Image size (pixels), each >= 1, at most 2**26 pixels in all.
+        Image size (pixels), each >= 1, at most 2**26 pixels in all, whose buffers (93
+        bytes a pixel: 6.2 GB at 2**26) must fit in the memory available (else
+        PartisimError with both sizes, before any is allocated).
     tank : (min, max), optional
         Corners of a tank (m) drawn as walls and framed by the default camera.
     **options

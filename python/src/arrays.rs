@@ -17,13 +17,11 @@ pub(crate) enum Points {
     F32(Vec<Vec3<f32>>),
 }
 
-/// Bytes of memory available to this process now: the kernel's estimate `MemAvailable`
-/// (Linux, `/proc/meminfo`), or `None` where it is not known.
+/// Bytes of memory this process may still allocate ([`sph_core::memory::available_bytes`]:
+/// the kernel's `MemAvailable`, within the address-space limit), or `None` where it is not
+/// known.
 pub(crate) fn available_memory_bytes() -> Option<usize> {
-    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kib: usize = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib.saturating_mul(1024))
+    sph_core::memory::available_bytes().map(|b| usize::try_from(b).unwrap_or(usize::MAX))
 }
 
 /// `bytes` as "1.2 GB" (decimal units).

@@ -11,19 +11,21 @@ use sph_sim::observe::{RestCriterion, RestObserver};
 
 use crate::rust_err;
 
-/// The rest criterion of `run(until_rest=...)`: a dict with `speed_m_s` (> 0), `hold_s`
-/// (>= 0) and optionally `region`, a pair of corners `((x0, y0, z0), (x1, y1, z1))` (m).
-pub(crate) fn rest_criterion(arg: &Bound<'_, PyAny>) -> PyResult<RestCriterion> {
+/// The rest observer of `run(until_rest=...)` at simulated time `now_s` (s): a dict with
+/// `speed_m_s` (> 0), `hold_s` (>= 0), optionally `region`, a pair of corners
+/// `((x0, y0, z0), (x1, y1, z1))` (m), and optionally `below_since_s`, the start of a hold
+/// under way (an earlier run's `rest_below_since_s`, at most `now_s`).
+pub(crate) fn rest_observer(arg: &Bound<'_, PyAny>, now_s: f64) -> PyResult<RestObserver> {
     let d = arg.cast::<PyDict>().map_err(|_| {
         PyTypeError::new_err(
-            "until_rest: expected a dict with speed_m_s, hold_s and optionally region",
+            "until_rest: expected a dict with speed_m_s, hold_s and optionally region, below_since_s",
         )
     })?;
     for key in d.keys() {
         let k: String = key.extract()?;
-        if !["speed_m_s", "hold_s", "region"].contains(&k.as_str()) {
+        if !["speed_m_s", "hold_s", "region", "below_since_s"].contains(&k.as_str()) {
             return Err(PyValueError::new_err(format!(
-                "until_rest: unknown key {k:?} (the keys are speed_m_s, hold_s, region)"
+                "until_rest: unknown key {k:?} (the keys are speed_m_s, hold_s, region, below_since_s)"
             )));
         }
     }
@@ -57,11 +59,27 @@ pub(crate) fn rest_criterion(arg: &Bound<'_, PyAny>) -> PyResult<RestCriterion> 
             Some(b)
         }
     };
-    Ok(RestCriterion {
+    let below_since_s = match d.get_item("below_since_s")?.filter(|v| !v.is_none()) {
+        None => None,
+        Some(v) => {
+            let t: f64 = v.extract().map_err(|_| {
+                PyTypeError::new_err("until_rest: below_since_s must be a number (s) or None")
+            })?;
+            if !(t.is_finite() && t <= now_s) {
+                return Err(PyValueError::new_err(format!(
+                    "until_rest: below_since_s = {t} s must be finite and at most the \
+                     simulation's time, {now_s} s (a hold that started before this run)"
+                )));
+            }
+            Some(t)
+        }
+    };
+    let criterion = RestCriterion {
         speed_m_s,
         hold_s,
         region,
-    })
+    };
+    Ok(RestObserver::resumed(criterion, below_since_s))
 }
 
 /// The at-rest verdict of the last run watched with a rest criterion.
@@ -73,6 +91,9 @@ pub(crate) struct RestVerdict {
     pub rest_from_s: Option<f64>,
     /// The largest speed in the region at the end of the run's last frame (m/s).
     pub last_speed_m_s: Option<f64>,
+    /// The start of the hold under way at the run's end (s), `None` if the last speed was
+    /// not below the bound: `until_rest`'s `below_since_s` for a run going on from here.
+    pub below_since_s: Option<f64>,
     /// The frame the run ended at.
     pub frame: usize,
 }
@@ -83,18 +104,20 @@ impl RestVerdict {
             criterion: observer.criterion,
             rest_from_s: observer.rest_from_s,
             last_speed_m_s: observer.speeds_m_s.last().copied(),
+            below_since_s: observer.below_since_s(),
             frame,
         }
     }
 
     /// Adds `at_rest`, `rest_from_s`, `rest_speed_m_s`, `rest_hold_s`, `rest_checked_at_frame`
-    /// and `max_speed_m_s` to `d`.
+    /// `rest_below_since_s` and `max_speed_m_s` to `d`.
     pub fn fill(&self, d: &Bound<'_, PyDict>) -> PyResult<()> {
         d.set_item("at_rest", self.rest_from_s.is_some())?;
         d.set_item("rest_from_s", self.rest_from_s)?;
         d.set_item("rest_speed_m_s", self.criterion.speed_m_s)?;
         d.set_item("rest_hold_s", self.criterion.hold_s)?;
         d.set_item("rest_checked_at_frame", self.frame)?;
+        d.set_item("rest_below_since_s", self.below_since_s)?;
         d.set_item("max_speed_m_s", self.last_speed_m_s)?;
         Ok(())
     }

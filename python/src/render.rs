@@ -237,6 +237,7 @@ fn write_png(py: Python<'_>, path: PathBuf, image: &Bound<'_, PyAny>) -> PyResul
             "image: expected uint8 (or integers in 0..=255), got dtype {dtype}"
         )));
     };
+    check_fits("image", width.saturating_mul(height), 3)?;
     let a: numpy::PyReadonlyArray3<'_, u8> = array.extract()?;
     let data: Vec<u8> = a.as_array().iter().copied().collect();
     let img = RgbImage {

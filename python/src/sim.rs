@@ -1,7 +1,8 @@
 //! `sph-sim`: a scene run frame by frame through the workspace's one frame loop.
 
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
 
 use numpy::{IntoPyArray, PyArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
@@ -14,9 +15,10 @@ use sph_sim::{
     run_frames, Ending, Flow, FrameObserver, FrameRecord, Precision, RunOutcome, RunPlan, Scene,
     SceneSim, SimError,
 };
-use sph_solver::boundary::{CacheUse, VolumeMapCache};
+use sph_solver::boundary::{CacheUse, VolumeMapBuild, VolumeMapCache};
 
-use crate::measure::{repose_dict, rest_criterion, ReposeArgs, RestVerdict};
+use crate::interrupt::{interruptible, OnSignal};
+use crate::measure::{repose_dict, rest_observer, ReposeArgs, RestVerdict};
 use crate::rust_err;
 use sph_sim::observe::RestObserver;
 
@@ -179,11 +181,13 @@ fn overrides_of(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<Override>> {
 }
 
 /// Builds the simulation of `scene` (with the volume maps from `cache_dir` when the scene
-/// has them), and restores `checkpoint` (bytes of the checkpoint format) if given.
+/// has them, the build stopped when `cancel` is set), and restores `checkpoint` (bytes of
+/// the checkpoint format) if given.
 fn build(
     scene: &Scene,
     cache_dir: Option<&Path>,
     checkpoint: Option<(&Path, &[u8])>,
+    cancel: &AtomicBool,
 ) -> Result<AnySim, SimError> {
     let cache = match (cache_dir, scene.boundary.model) {
         (Some(dir), sph_scene::BoundaryModel::VolumeMap) => {
@@ -203,16 +207,27 @@ fn build(
         }
         Ok(sim)
     }
+    let how = VolumeMapBuild {
+        cache: cache.as_ref(),
+        cancel: Some(cancel),
+    };
     Ok(match scene.precision {
-        Precision::F32 => AnySim::F32(restore(
-            SceneSim::with_cache(scene, cache.as_ref())?,
-            checkpoint,
-        )?),
-        Precision::F64 => AnySim::F64(restore(
-            SceneSim::with_cache(scene, cache.as_ref())?,
-            checkpoint,
-        )?),
+        Precision::F32 => AnySim::F32(restore(SceneSim::with_maps(scene, how)?, checkpoint)?),
+        Precision::F64 => AnySim::F64(restore(SceneSim::with_maps(scene, how)?, checkpoint)?),
     })
+}
+
+/// Runs `work` (a scene's build) on a thread of its own with a cancellation flag: Ctrl-C
+/// sets the flag, waits for the build to stop (within a row of volume-map nodes) and
+/// raises KeyboardInterrupt.
+fn cancellable<T: Send + 'static>(
+    py: Python<'_>,
+    work: impl FnOnce(&AtomicBool) -> T + Send + 'static,
+) -> PyResult<T> {
+    let cancel = Arc::new(AtomicBool::new(false));
+    let flag = cancel.clone();
+    let stop = move || flag.store(true, Ordering::Relaxed);
+    interruptible(py, OnSignal::Stop(&stop), move || work(&cancel))
 }
 
 /// The frame record as a Python dict: its serde form (`phases_s` a dict by phase name).
@@ -245,7 +260,9 @@ impl PythonSide {
         };
         let answer = cb.call1(py, (record_dict(py, record)?,))?;
         let answer = answer.bind(py);
-        if answer.is_none() || answer.is_truthy()? && !answer.is_instance_of::<PyString>() {
+        // The package's one rule (as `Population.advance`'s): something true stops the run,
+        // None or anything false goes on; a (non-empty) string is also the stop's reason.
+        if !answer.is_truthy()? {
             return Ok(Flow::Continue);
         }
         Ok(Flow::Stop(match answer.extract::<String>() {
@@ -263,8 +280,9 @@ impl<R: Real> FrameObserver<R> for PythonSide {
             None => Flow::Continue,
         };
         match Python::attach(|py| self.ask(py, record)) {
-            Ok(Flow::Continue) => Ok(rest),
-            Ok(flow) => Ok(flow),
+            // The rest criterion's stop is the run's result: it wins over the callback's.
+            Ok(flow) if matches!(rest, Flow::Continue) => Ok(flow),
+            Ok(_) => Ok(rest),
             Err(e) => {
                 self.err = Some(e);
                 Ok(Flow::Interrupt)
@@ -461,15 +479,14 @@ impl Simulation {
     ) -> PyResult<Self> {
         let (source, checkpoint) =
             decode_saved(bytes).map_err(|reason| rust_err(SimError::input(file, reason)))?;
-        let sim = py
-            .detach(|| {
-                build(
-                    &source.scene()?,
-                    cache_dir.as_deref(),
-                    Some((file, checkpoint)),
-                )
-            })
-            .map_err(rust_err)?;
+        let (file, dir, checkpoint) = (file.to_path_buf(), cache_dir.clone(), checkpoint.to_vec());
+        let (source, sim) = cancellable(py, move |cancel| -> Result<_, SimError> {
+            let scene = source.scene()?;
+            let saved = Some((file.as_path(), checkpoint.as_slice()));
+            let sim = build(&scene, dir.as_deref(), saved, cancel)?;
+            Ok((source, sim))
+        })?
+        .map_err(rust_err)?;
         Ok(Self::new(sim, source, cache_dir))
     }
 }
@@ -503,6 +520,9 @@ impl Simulation {
     /// PartisimError
     ///     The scene is unreadable or refused (the message names the file, the key and the
     ///     line, or "given as an override").
+    /// KeyboardInterrupt
+    ///     Ctrl-C while the scene is built (a volume map's build stops within a row of its
+    ///     nodes; maps completed before it stay in the cache).
     #[staticmethod]
     #[pyo3(signature = (path, quick = false, overrides = None, volume_map_cache = CacheChoice::Default))]
     fn from_scene(
@@ -514,11 +534,15 @@ impl Simulation {
     ) -> PyResult<Self> {
         let overrides = overrides_of(overrides)?;
         let cache_dir = volume_map_cache.dir();
-        let built = py.detach(|| -> Result<(SceneSource, AnySim), SimError> {
-            let (source, scene) = SceneSource::load(&path, overrides, quick)?;
-            let sim = build(&scene, cache_dir.as_deref(), None)?;
-            Ok((source, sim))
-        });
+        let dir = cache_dir.clone();
+        let built = cancellable(
+            py,
+            move |cancel| -> Result<(SceneSource, AnySim), SimError> {
+                let (source, scene) = SceneSource::load(&path, overrides, quick)?;
+                let sim = build(&scene, dir.as_deref(), None, cancel)?;
+                Ok((source, sim))
+            },
+        )?;
         let (source, sim) = built.map_err(rust_err)?;
         Ok(Self::new(sim, source, cache_dir))
     }
@@ -596,6 +620,13 @@ impl Simulation {
         self.scene_frames()
     }
 
+    /// The scene's solver (``[solver] kind``): ``"pbf"``, ``"pcisph"``, ``"iisph"`` or
+    /// ``"granular"`` (granular matter: ``repose()`` measures its heap).
+    #[getter]
+    fn solver(&self) -> &'static str {
+        each!(&*self.lock(), s => s.scene.solver.kind_name())
+    }
+
     /// Advances one frame (the scene's frame interval) through the frame loop; returns the
     /// frame's statistics. A blow-up raises PartisimError naming the frame, step and
     /// particle (the state keeps its last good substep). Unlike ``run``, ``step`` may go
@@ -627,14 +658,18 @@ impl Simulation {
     ///     Jupyter); ``None`` (default) shows it when stderr is a terminal or in Jupyter.
     /// callback : callable, optional
     ///     ``callback(stats)`` after each frame with its statistics (the dict of ``stats``);
-    ///     returning False or a string stops the run after that frame (the string is the
-    ///     reason).
+    ///     returning something true (``True``, a non-empty string, ...) stops the run after
+    ///     that frame, returning ``None`` or anything false goes on (the rule of
+    ///     ``Population.advance`` too). A returned string is the stop's ``reason``; on the
+    ///     frame where ``until_rest`` also stops the run, the rest's reason is kept.
     /// until_rest : dict, optional
     ///     Stop once the material is at rest: ``{"speed_m_s": v, "hold_s": t}`` (and
     ///     optionally ``"region": ((x0, y0, z0), (x1, y1, z1))``, m): the largest particle
     ///     speed (in the region) has stayed below ``v`` m/s for ``t`` s of simulated time.
     ///     The outcome then has ``at_rest`` and ``rest_from_s`` (s), and ``repose()``
-    ///     reports this verdict.
+    ///     reports this verdict. A run going on from an earlier one (after a stop, a
+    ///     ``save``/``load``) continues its hold with ``"below_since_s"``: the earlier
+    ///     outcome's ``rest_below_since_s`` (s); it then stops where one whole run would.
     ///
     /// Returns
     /// -------
@@ -643,8 +678,9 @@ impl Simulation {
     ///     keeps its last good substep), ``frame`` (frames done), ``time_s`` (simulated, s),
     ///     ``reason`` (the stop's, the divergence's, or the scene's end when fewer frames
     ///     than asked were run; else None), ``frames_run``, ``scene_frames`` and
-    ///     ``at_scene_end``; with ``until_rest``, ``at_rest`` (bool), ``rest_from_s``
-    ///     and ``max_speed_m_s`` (the last frame's, m/s).
+    ///     ``at_scene_end``; with ``until_rest``, ``at_rest`` (bool), ``rest_from_s``,
+    ///     ``rest_below_since_s`` (the start of the hold under way, s, or None) and
+    ///     ``max_speed_m_s`` (the last frame's, m/s).
     ///
     /// Ctrl-C stops the run between frames with KeyboardInterrupt, and an exception of the
     /// callback ends it with that exception; the frames done are kept either way.
@@ -657,11 +693,11 @@ impl Simulation {
         callback: Option<Py<PyAny>>,
         until_rest: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        let now_s = self.time();
         let rest = until_rest
             .filter(|r| !r.is_none())
-            .map(rest_criterion)
-            .transpose()?
-            .map(RestObserver::new);
+            .map(|r| rest_observer(r, now_s))
+            .transpose()?;
         let watched = rest.is_some();
         let first = self.frame();
         let plan = FramePlan::new(frames, first, self.scene_frames())?;

@@ -1,4 +1,5 @@
-"""Shared helpers: the repository root, `cargo xtask run` and a reader of its VTK frames."""
+"""Shared helpers: the repository root, two small scenes (a PBF column and a granular wedge
+of known slope), `cargo xtask run` and a reader of its VTK frames."""
 
 import os
 import re
@@ -10,6 +11,69 @@ import numpy as np
 import pytest
 
 REPO = Path(__file__).resolve().parents[2]
+
+# A scene of a few hundred particles and 5 frames (0.1 s of 0.02 s), walls as volume maps.
+PBF = """
+name = "tiny"
+[simulation]
+precision = "f64"
+particle_spacing = 0.05
+duration = 0.1
+frame_dt = 0.02
+[solver]
+kind = "pbf"
+substeps = 2
+solver_iterations = 3
+[boundary]
+model = "volume-map"
+[tank]
+min = [0.0, 0.0, 0.0]
+max = [0.5, 0.5, 0.5]
+[[fluid]]
+kind = "block"
+min = [0.0, 0.0, 0.0]
+max = [0.2, 0.3, 0.2]
+"""
+
+# A planar heap of known slope: a prism whose cross-section is an isosceles triangle with
+# base 1 m (x) and flanks at 30°, 0.2 m deep (z), filled with particles at 0.02 m.
+H = float(0.5 * np.tan(np.radians(30.0)))
+WEDGE_OBJ = f"""v 0 0 0
+v 1 0 0
+v 0.5 {H!r} 0
+v 0 0 0.2
+v 1 0 0.2
+v 0.5 {H!r} 0.2
+f 1 3 2
+f 4 5 6
+f 1 2 5
+f 1 5 4
+f 1 4 6
+f 1 6 3
+f 2 3 6
+f 2 6 5
+"""
+
+WEDGE = """
+name = "wedge"
+[simulation]
+particle_spacing = 0.02
+duration = 0.04
+frame_dt = 0.02
+gravity = [0.0, 0.0, 0.0]
+[solver]
+kind = "granular"
+substeps = 2
+friction_angle_deg = 30.0
+[boundary]
+model = "collision"
+[tank]
+min = [-0.01, -0.01, -0.01]
+max = [1.01, 0.5, 0.21]
+[[fluid]]
+kind = "mesh"
+path = "wedge.obj"
+"""
 
 
 def xtask_run(scene: Path, out: Path, frames: int, render: bool = False) -> Path:

@@ -83,6 +83,9 @@ RENDER = [
     BadInput("render height negative", f"{R}({BLOCK}, 0.01, width=32, height=-5)", words=("height", "-5")),
     BadInput("render width not a number", f"{R}({BLOCK}, 0.01, width='wide', height=32)", words=("width", "string")),
     BadInput("render image huge", f"{R}({BLOCK}, 0.01, width=10**6, height=10**6)", words=("image size", "2^26")),
+    # 2^26 pixels, the largest size accepted: 6.2 GB of buffers (93 bytes a pixel), more than
+    # the child's 1 GB: refused before any is allocated, naming both sizes.
+    BadInput("render image beyond memory", f"{R}({BLOCK}, 0.01, width=8192, height=8192)", words=("image size 8192 x 8192", "6241124352 bytes", "available")),
     BadInput("render unknown option", f"{R}({BLOCK}, 0.01, width=32, height=32, colour=1)", words=("colour",)),
     BadInput("render unknown background field", f"{R}({BLOCK}, 0.01, width=32, height=32, background={{'colour_of_sky': 1}})", words=("background", "colour_of_sky")),
     BadInput("render camera fov nan", f"{R}({BLOCK}, 0.01, camera={{'fov_deg': float('nan')}}, width=32, height=32)", words=("camera.fov_deg", "NaN")),

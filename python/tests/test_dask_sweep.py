@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import partisim
-from conftest import REPO
+from conftest import PBF, REPO, WEDGE, WEDGE_OBJ
 
 SCENE = REPO / "scenes" / "dam_break.toml"
 # Two variants of the quick dam break (12,288 particles, about 0.2 s a frame on one core):
@@ -154,3 +154,105 @@ def test_sweep_survives_a_killed_worker_and_equals_one_machine(tmp_path):
     assert again[physics].equals(table[physics])
     assert set(table.columns) >= {"ending", "reason", "time_s", "max_density_ratio",
                                   "kinetic_energy_j"} | NOT_PHYSICS
+
+
+# ---- the at-rest verdict and the repose angle in the sweep's table ----
+
+# The PBF column of 96 particles and 5 frames of 0.02 s, its walls as a collision boundary.
+TINY = PBF.replace('"volume-map"', '"collision"')
+
+
+class WorkerDied(Exception):
+    """A worker's death, as the inline client below sees it."""
+
+
+class InlineClient:
+    """Runs each task when submitted, in this process, and runs a task again when its
+    worker "died" (as Dask reschedules a dead worker's task): the sweep's checkpoint logic
+    without a cluster."""
+
+    def __init__(self):
+        self.attempts = 0
+
+    def submit(self, fn, *args, key=None, retries=0, pure=False):
+        while True:
+            self.attempts += 1
+            try:
+                return fn(*args)
+            except WorkerDied:
+                continue
+
+    def gather(self, futures):
+        return list(futures)
+
+
+def test_the_at_rest_verdict_survives_checkpoints_and_a_death(tmp_path, monkeypatch):
+    """Every speed is below 1 km/s: the whole run is at rest from t = 0 after 0.06 s (frame
+    3). With a checkpoint after every frame, and the worker dying while writing the third,
+    the verdict is still frame 3 from t = 0: the hold is carried beside each checkpoint."""
+    import partisim.dask as pd_mod
+
+    scene = tmp_path / "tiny.toml"
+    scene.write_text(TINY)
+    rest = {"speed_m_s": 1e3, "hold_s": 0.06}
+    whole = partisim.Simulation.from_scene(scene, volume_map_cache=None)
+    w = whole.run(progress=False, until_rest=rest)
+    assert w["at_rest"] is True and w["frame"] == 3 and w["rest_from_s"] == 0.0
+
+    writes = []
+    real_write = pd_mod._write_json_atomic
+
+    def dying_write(path, data):
+        writes.append(data["frame"])
+        if len(writes) == 3:  # the third checkpoint: the worker dies before writing it
+            raise WorkerDied()
+        real_write(path, data)
+
+    monkeypatch.setattr(pd_mod, "_write_json_atomic", dying_write)
+    client = InlineClient()
+    table = pd_mod.run_scene_sweep(client, scene, [{}], checkpoint_dir=tmp_path / "ckpt",
+                                   checkpoint_every=1, until_rest=rest)
+    assert client.attempts == 2 and writes == [1, 2, 3, 3]
+    got = table.loc[0]
+    assert got["resumed_from_frame"] == 2
+    assert got["at_rest"] and got["rest_from_s"] == 0.0 and got["frame"] == 3
+    assert got["ending"] == "stopped" and got["reason"] == w["reason"]
+    assert np.array_equal(partisim.Simulation.load(got["checkpoint"]).positions,
+                          whole.positions)
+    # No repose columns: the scene is not granular.
+    assert not any(c.startswith("repose_") for c in table.columns)
+    # The finished run again: its row from the side file, the verdict with it.
+    again = pd_mod.run_scene_sweep(client, scene, [{}], checkpoint_dir=tmp_path / "ckpt",
+                                   checkpoint_every=1, until_rest=rest)
+    assert again.loc[0, "resumed_from_frame"] == 3 and bool(again.loc[0, "at_rest"])
+    assert again.loc[0, "rest_from_s"] == 0.0
+
+
+def test_granular_runs_get_their_repose_angle(tmp_path):
+    import partisim.dask as pd_mod
+
+    (tmp_path / "wedge.obj").write_text(WEDGE_OBJ)
+    scene = tmp_path / "wedge.toml"
+    scene.write_text(WEDGE)
+    rows = [{}, {"solver.friction_angle_deg": 40.0}]
+    table = pd_mod.run_scene_sweep(InlineClient(), scene, rows, checkpoint_dir=tmp_path / "c",
+                                   checkpoint_every=1)
+    for i, row in enumerate(rows):
+        sim = partisim.Simulation.from_scene(scene, overrides=row or None,
+                                             volume_map_cache=None)
+        sim.run(progress=False)
+        m = sim.repose()
+        got = table.loc[i]
+        assert got["repose_error"] is None
+        assert got["repose_angle_deg"] == m["angle_deg"]
+        assert got["repose_resolution_deg"] == m["resolution_deg"]
+        assert got["repose_pile_height_m"] == m["pile_height_m"]
+        # The heap measured is the wedge's: 30° within the sampling's resolution.
+        assert abs(got["repose_angle_deg"] - 30.0) <= got["repose_resolution_deg"]
+    # repose=False: no measurement; options: passed to Simulation.repose.
+    off = pd_mod.run_scene_sweep(InlineClient(), scene, [{}], repose=False)
+    assert not any(c.startswith("repose_") for c in off.columns)
+    flat = pd_mod.run_scene_sweep(InlineClient(), scene, [{}], repose={"min_fit_points": 10**6})
+    assert np.isnan(flat.loc[0, "repose_angle_deg"]) and flat.loc[0, "repose_error"]
+    with pytest.raises(TypeError, match="repose"):
+        pd_mod.run_scene_sweep(InlineClient(), scene, [{}], repose="yes")

@@ -73,4 +73,52 @@ def test_a_callback_stop_and_an_interrupt_both_leave_the_simulation_usable():
     assert sim.run(1, progress=False)["ending"] == "completed"
     assert sim.frame == interrupted_at + 1 and np.isfinite(sim.positions).all()
     assert sim.step()["frame"] == interrupted_at + 2
-    assert sim.run(2, progress=False, callback=lambda s: False)["frame"] == interrupted_at + 3
+    # A false answer goes on (only a true one stops).
+    assert sim.run(2, progress=False, callback=lambda s: False)["frame"] == interrupted_at + 4
+
+
+# A sphere of 0.3 m as a volume-map solid at a 4 mm spacing: a map of millions of nodes,
+# hundreds of thousands of them in the sphere's band, each a quadrature of 16 x 32 rays.
+SPHERE_SCENE = """
+name = "sphere_map"
+[simulation]
+precision = "f32"
+particle_spacing = 0.004
+duration = 0.02
+frame_dt = 0.02
+[solver]
+kind = "pbf"
+substeps = 1
+solver_iterations = 1
+[boundary]
+model = "volume-map"
+[tank]
+min = [0.0, 0.0, 0.0]
+max = [0.8, 0.8, 0.8]
+[[solid]]
+kind = "sphere"
+center = [0.4, 0.4, 0.4]
+radius = 0.3
+[[fluid]]
+kind = "block"
+min = [0.0, 0.0, 0.0]
+max = [0.02, 0.02, 0.02]
+"""
+
+
+def test_a_volume_map_build_stops_on_ctrl_c(tmp_path):
+    """from_scene was deaf to Ctrl-C while it built volume maps; the build now checks a
+    cancellation flag per row of nodes."""
+    import time
+
+    path = tmp_path / "sphere.toml"
+    path.write_text(SPHERE_SCENE)
+    cache = tmp_path / "cache"
+    timer = interrupt_after(0.5)
+    start = time.monotonic()
+    with pytest.raises(KeyboardInterrupt):
+        partisim.Simulation.from_scene(path, volume_map_cache=cache)
+    stopped_after = time.monotonic() - start
+    timer.join()
+    # The bound of the bad-input suite's Ctrl-C cases (the build runs far longer whole).
+    assert stopped_after < 10.0

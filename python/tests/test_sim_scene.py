@@ -10,28 +10,7 @@ import partisim
 import partisim.progress
 from partisim import PartisimError, Simulation
 
-# A scene of a few hundred particles and 5 frames (0.1 s of 0.02 s), walls as volume maps.
-PBF = """
-name = "tiny"
-[simulation]
-precision = "f64"
-particle_spacing = 0.05
-duration = 0.1
-frame_dt = 0.02
-[solver]
-kind = "pbf"
-substeps = 2
-solver_iterations = 3
-[boundary]
-model = "volume-map"
-[tank]
-min = [0.0, 0.0, 0.0]
-max = [0.5, 0.5, 0.5]
-[[fluid]]
-kind = "block"
-min = [0.0, 0.0, 0.0]
-max = [0.2, 0.3, 0.2]
-"""
+from conftest import PBF, WEDGE, WEDGE_OBJ
 
 # The same column as granular matter (IISPH with friction: stresses and pressures carried
 # from frame to frame), in f32.
@@ -249,47 +228,6 @@ def test_run_shows_progress_through_partisim_progress(scene, monkeypatch):
 
 # ---- the angle of repose ----
 
-# A planar heap of known slope: a prism whose cross-section is an isosceles triangle with
-# base 1 m (x) and flanks at 30°, 0.2 m deep (z), filled with particles at 0.02 m.
-H = float(0.5 * np.tan(np.radians(30.0)))
-WEDGE_OBJ = f"""v 0 0 0
-v 1 0 0
-v 0.5 {H!r} 0
-v 0 0 0.2
-v 1 0 0.2
-v 0.5 {H!r} 0.2
-f 1 3 2
-f 4 5 6
-f 1 2 5
-f 1 5 4
-f 1 4 6
-f 1 6 3
-f 2 3 6
-f 2 6 5
-"""
-
-WEDGE = """
-name = "wedge"
-[simulation]
-particle_spacing = 0.02
-duration = 0.04
-frame_dt = 0.02
-gravity = [0.0, 0.0, 0.0]
-[solver]
-kind = "granular"
-substeps = 2
-friction_angle_deg = 30.0
-[boundary]
-model = "collision"
-[tank]
-min = [-0.01, -0.01, -0.01]
-max = [1.01, 0.5, 0.21]
-[[fluid]]
-kind = "mesh"
-path = "wedge.obj"
-"""
-
-
 def test_repose_measures_a_heap_of_known_slope_with_the_rest_verdict(scene, tmp_path):
     (tmp_path / "wedge.obj").write_text(WEDGE_OBJ)
     sim = Simulation.from_scene(scene(WEDGE, "wedge.toml"), volume_map_cache=None)
@@ -311,3 +249,54 @@ def test_repose_measures_a_heap_of_known_slope_with_the_rest_verdict(scene, tmp_
         sim.run(1, progress=False, until_rest={"speed_m_s": -1.0, "hold_s": 1.0})
     with pytest.raises(ValueError, match="shape"):
         sim.repose("round")
+
+
+# ---- the callback's rule and the rest hold carried across runs ----
+
+
+def test_callback_stops_on_anything_true_and_goes_on_on_anything_false(scene):
+    """One rule for Simulation.run and Population.advance: a true answer stops the run, None
+    or a false one goes on (today's code stopped on False and went on on True)."""
+    sim = Simulation.from_scene(scene(), volume_map_cache=None)
+    out = sim.run(3, progress=False, callback=lambda s: True)
+    assert out["ending"] == "stopped" and out["frames_run"] == 1
+    assert out["reason"] == "stopped by the callback"
+    for falsy in (None, False, 0, ""):
+        sim = Simulation.from_scene(scene(), volume_map_cache=None)
+        out = sim.run(3, progress=False, callback=lambda s, v=falsy: v)
+        assert out["ending"] == "completed" and out["frames_run"] == 3, falsy
+    sim = Simulation.from_scene(scene(), volume_map_cache=None)
+    out = sim.run(3, progress=False, callback=lambda s: "enough" if s["frame"] == 2 else None)
+    assert out["ending"] == "stopped" and out["reason"] == "enough" and out["frame"] == 2
+
+
+def test_the_rest_stop_wins_over_the_callback_on_the_same_frame(scene):
+    sim = Simulation.from_scene(scene(), volume_map_cache=None)
+    out = sim.run(3, progress=False, callback=lambda s: "callback",
+                  until_rest={"speed_m_s": 1e3, "hold_s": 0.0})
+    assert out["frame"] == 1 and out["at_rest"] is True
+    assert out["reason"].startswith("at rest"), out["reason"]
+
+
+def test_the_rest_hold_carries_across_runs(scene):
+    """A run split in two, the second given the first's ``rest_below_since_s``, stops at rest
+    where the uninterrupted run does (a fresh hold would stop two frames later)."""
+    rest = {"speed_m_s": 1e3, "hold_s": 0.06}  # every speed is below: at rest at t = 0.06 s
+    whole = Simulation.from_scene(scene(), volume_map_cache=None)
+    w = whole.run(progress=False, until_rest=rest)
+    assert w["at_rest"] is True and w["frame"] == 3 and w["rest_from_s"] == 0.0
+    split = Simulation.from_scene(scene(), volume_map_cache=None)
+    first = split.run(2, progress=False, until_rest=rest)
+    assert first["at_rest"] is False and first["rest_below_since_s"] == 0.0
+    second = split.run(progress=False,
+                       until_rest={**rest, "below_since_s": first["rest_below_since_s"]})
+    assert second["at_rest"] is True and second["frame"] == w["frame"]
+    assert second["rest_from_s"] == w["rest_from_s"]
+    assert np.array_equal(split.positions, whole.positions)
+    # Without the carry the hold starts afresh at the second run's first frame.
+    fresh = Simulation.from_scene(scene(), volume_map_cache=None)
+    fresh.run(2, progress=False, until_rest=rest)
+    f = fresh.run(progress=False, until_rest=rest)
+    assert f["frame"] == 5 and f["rest_from_s"] == pytest.approx(0.04)
+    with pytest.raises(ValueError, match="below_since_s"):
+        fresh.run(1, progress=False, until_rest={**rest, "below_since_s": 10.0})

@@ -18,12 +18,14 @@
 //!   (module [`grid`]),
 //! - [`TriangleMesh`] and its sampled signed distance [`GridSdf`] (module [`mesh`]),
 //! - [`random::SplitMix64`], a small seeded generator for reproducible point sets,
+//! - [`memory::available_bytes`], the memory a process may still allocate,
 //! - [`CoreError`], the crate's error enum.
 
 mod aabb;
 mod error;
 pub mod grid;
 pub mod input;
+pub mod memory;
 pub mod mesh;
 mod particles;
 pub mod random;

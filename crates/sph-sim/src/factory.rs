@@ -8,7 +8,9 @@
 use sph_core::{Aabb, Real, Vec3};
 use sph_kernels::KernelKind;
 use sph_scene::{BoundaryModel, Scene, SolverParams};
-use sph_solver::boundary::{CacheUse, VolumeMapBoundary, VolumeMapCache, VolumeMapOptions};
+use sph_solver::boundary::{
+    CacheUse, VolumeMapBoundary, VolumeMapBuild, VolumeMapCache, VolumeMapOptions,
+};
 use sph_solver::{Boundary, CollisionBoundary, CommonParams, FluidSolver, SolverError};
 
 use crate::error::SimError;
@@ -79,19 +81,24 @@ pub fn build_boundary<R: Real>(
     positions: &[Vec3<R>],
     cache: Option<&VolumeMapCache>,
 ) -> Result<Box<dyn Boundary<R>>, SimError> {
-    build_boundary_reporting(scene, c, positions, cache).map(|(b, _)| b)
+    let how = VolumeMapBuild {
+        cache,
+        cancel: None,
+    };
+    build_boundary_reporting(scene, c, positions, how).map(|(b, _)| b)
 }
 
 /// A boundary and how each solid's volume map was obtained.
 pub(crate) type BoundaryWithMaps<R> = (Box<dyn Boundary<R>>, Vec<CacheUse>);
 
-/// [`build_boundary`], with how each solid's volume map was obtained (built, loaded from
-/// the cache, ...; empty for the collision boundary).
+/// [`build_boundary`] with the volume maps obtained as `how` says (a cache, a cancellation
+/// flag), and how each solid's map was obtained (built, loaded from the cache, ...; empty
+/// for the collision boundary).
 pub(crate) fn build_boundary_reporting<R: Real>(
     scene: &Scene,
     c: &CommonParams<R>,
     positions: &[Vec3<R>],
-    cache: Option<&VolumeMapCache>,
+    how: VolumeMapBuild<'_>,
 ) -> Result<BoundaryWithMaps<R>, SimError> {
     let solids = scene.build_solids::<R>()?;
     let setup = |source| setup_error(scene, source);
@@ -101,14 +108,14 @@ pub(crate) fn build_boundary_reporting<R: Real>(
             Vec::new(),
         )),
         BoundaryModel::VolumeMap => {
-            let b = VolumeMapBoundary::with_cache(
+            let b = VolumeMapBoundary::build(
                 solids,
                 density_kernel(scene),
                 c.support_radius,
                 domain(scene, positions)?,
                 c.volume_map_contact_distance(),
                 VolumeMapOptions::default(),
-                cache,
+                how,
             )
             .map_err(setup)?;
             for w in b.cache_warnings() {

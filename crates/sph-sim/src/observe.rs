@@ -107,6 +107,22 @@ impl RestObserver {
             below_since_s: None,
         }
     }
+
+    /// An observer of `criterion` going on with a hold that started at `below_since_s` (s),
+    /// as [`RestObserver::below_since_s`] of an earlier run ending at this run's first
+    /// frame reported it: a run split in two then stops where the whole run does.
+    pub fn resumed(criterion: RestCriterion, below_since_s: Option<f64>) -> Self {
+        Self {
+            below_since_s,
+            ..Self::new(criterion)
+        }
+    }
+
+    /// The start (s) of the hold under way: the speed has stayed below the bound since
+    /// then (`None` if the last frame's speed was not below it).
+    pub fn below_since_s(&self) -> Option<f64> {
+        self.below_since_s
+    }
 }
 
 impl<R: Real> FrameObserver<R> for RestObserver {

@@ -6,6 +6,8 @@
 use std::fs::File;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
@@ -209,6 +211,11 @@ pub struct SceneRunOptions {
     pub render: bool,
     /// A directory of volume maps to load from and add to (`None`: build them, keep none).
     pub volume_map_cache: Option<PathBuf>,
+    /// A cancellation flag (set by a Ctrl-C handler): checked per row of nodes while the
+    /// volume maps are built (the run then fails with
+    /// [`sph_solver::SolverError::Cancelled`]) and after each frame (the run ends
+    /// [`crate::frame_loop::Ending::Interrupted`], its final checkpoint written).
+    pub cancel: Option<Arc<AtomicBool>>,
 }
 
 /// The frame a run of `scene` stops at with `max_frames`.
@@ -258,7 +265,11 @@ fn run_scene_in<R: Real>(
         ),
         _ => None,
     };
-    let mut sim = SceneSim::<R>::with_cache(scene, cache.as_ref())?;
+    let how = sph_solver::boundary::VolumeMapBuild {
+        cache: cache.as_ref(),
+        cancel: opts.cancel.as_deref(),
+    };
+    let mut sim = SceneSim::<R>::with_maps(scene, how)?;
     let resumed = opts.resume;
     if resumed {
         sim.resume_from(&run.checkpoint())?;
@@ -277,10 +288,19 @@ fn run_scene_in<R: Real>(
     let mut stats = StatsObserver::new(run);
     let mut bar = ProgressObserver::new(opts.progress);
     let mut checkpoints = CheckpointObserver::new(run, opts.checkpoint_every);
+    let cancel = opts.cancel.clone();
+    let mut ctrl_c = crate::observe::OnFrame(move |_: &SceneSim<R>, _: &FrameRecord| {
+        if cancel.as_deref().is_some_and(|c| c.load(Ordering::Relaxed)) {
+            Flow::Interrupt
+        } else {
+            Flow::Continue
+        }
+    });
     let mut observers: Vec<&mut dyn FrameObserver<R>> = vec![&mut stats, &mut vtk];
     if let Some(r) = render.as_mut() {
         observers.push(r);
     }
+    observers.push(&mut ctrl_c);
     observers.push(&mut checkpoints);
     observers.push(&mut bar);
     let result = run_frames(&mut sim, &plan, &mut observers);

@@ -5,7 +5,7 @@
 
 use sph_core::{ParticleSet, Real};
 use sph_scene::{InitialMasses, Precision, Scene, SolverParams};
-use sph_solver::boundary::{CacheUse, VolumeMapCache};
+use sph_solver::boundary::{CacheUse, VolumeMapBuild, VolumeMapCache};
 use sph_solver::initial::{calibrate_masses, MassCalibration};
 use sph_solver::Boundary;
 
@@ -68,6 +68,17 @@ impl<R: Real> SceneSetup<R> {
     /// With `cache`, the volume maps come from (or go into) that cache
     /// ([`sph_solver::boundary::VolumeMapCache`]).
     pub fn with_cache(scene: &Scene, cache: Option<&VolumeMapCache>) -> Result<Self, SimError> {
+        let how = VolumeMapBuild {
+            cache,
+            cancel: None,
+        };
+        Self::with_maps(scene, how)
+    }
+
+    /// [`SceneSetup::with_cache`] with the volume maps obtained as `how` says: from (or
+    /// into) `how.cache`, and stopped when `how.cancel` is set (Ctrl-C), the error then
+    /// [`sph_solver::SolverError::Cancelled`] within [`SimError::Setup`].
+    pub fn with_maps(scene: &Scene, how: VolumeMapBuild<'_>) -> Result<Self, SimError> {
         // Built once in f64 and converted to `R` (checked in `R` unless `Scene::check` did).
         let params = if is_scene_precision::<R>(scene) {
             scene.solver_params_unchecked::<R>()?
@@ -77,7 +88,7 @@ impl<R: Real> SceneSetup<R> {
         let common = params.common().clone();
         let fluid = scene.fluid_particles::<R>()?;
         let (boundary, volume_maps) =
-            build_boundary_reporting(scene, &common, &fluid.positions, cache)?;
+            build_boundary_reporting(scene, &common, &fluid.positions, how)?;
         let mut state = ParticleSet::from_positions(
             fluid.positions,
             common.particle_mass(),

@@ -64,6 +64,15 @@ impl<R: Real> SceneSim<R> {
         Self::from_setup(SceneSetup::with_cache(scene, cache)?)
     }
 
+    /// [`SceneSim::new`] with the volume maps obtained as `how` says (a cache, a
+    /// cancellation flag: [`SceneSetup::with_maps`]).
+    pub fn with_maps(
+        scene: &Scene,
+        how: sph_solver::boundary::VolumeMapBuild<'_>,
+    ) -> Result<Self, SimError> {
+        Self::from_setup(SceneSetup::with_maps(scene, how)?)
+    }
+
     /// The simulation of a scene built once: its solver made from the set-up's parameters
     /// and boundary ([`build_solver`]), its particles the set-up's. Nothing is sampled or
     /// built again.

@@ -141,3 +141,40 @@ fn rest_stops_the_run_once_the_speed_held_below_the_bound() {
     assert_eq!((out.frame, rest.speeds_m_s.len()), (2, 2));
     assert_eq!(rest.rest_from_s, Some(0.0));
 }
+
+#[test]
+fn a_resumed_rest_hold_stops_where_the_whole_run_does() {
+    let criterion = RestCriterion {
+        speed_m_s: 1e3,
+        hold_s: 0.04,
+        region: None,
+    };
+    // Whole: at rest from t = 0, 0.048 s >= 0.04 s after frame 3.
+    let mut whole = sim("rest-whole");
+    let mut rest = RestObserver::new(criterion);
+    let plan = RunPlan::next(&whole, 10);
+    let out = run_frames(&mut whole, &plan, &mut [&mut rest]).unwrap();
+    assert_eq!((out.frame, rest.rest_from_s), (3, Some(0.0)));
+    // Split after frame 1: the second run continues the first's hold.
+    let mut split = sim("rest-split");
+    let mut first = RestObserver::new(criterion);
+    let plan = RunPlan::next(&split, 1);
+    let out = run_frames(&mut split, &plan, &mut [&mut first]).unwrap();
+    assert_eq!((out.frame, first.rest_from_s), (1, None));
+    assert_eq!(first.below_since_s(), Some(0.0));
+    let mut second = RestObserver::resumed(criterion, first.below_since_s());
+    let plan = RunPlan::next(&split, 10);
+    let out = run_frames(&mut split, &plan, &mut [&mut second]).unwrap();
+    assert_eq!((out.frame, second.rest_from_s), (3, Some(0.0)));
+    // A fresh observer starts the hold at the second run's first frame instead.
+    let mut again = sim("rest-fresh");
+    let mut first = RestObserver::new(criterion);
+    let plan = RunPlan::next(&again, 1);
+    run_frames(&mut again, &plan, &mut [&mut first]).unwrap();
+    let mut fresh = RestObserver::new(criterion);
+    let plan = RunPlan::next(&again, 10);
+    let out = run_frames(&mut again, &plan, &mut [&mut fresh]).unwrap();
+    assert_eq!(out.frame, 4);
+    let from = fresh.rest_from_s.unwrap();
+    assert!((from - 0.016).abs() < 1e-12, "{from}");
+}

@@ -61,6 +61,7 @@ fn runs_a_scene_and_writes_frames_and_statistics() {
                 resume: false,
                 render: false,
                 volume_map_cache: None,
+                cancel: None,
             },
         )
         .unwrap();
@@ -126,6 +127,7 @@ fn runs_iisph_and_granular_scenes_with_passive_points() {
                 resume: false,
                 render: false,
                 volume_map_cache: None,
+                cancel: None,
             },
         )
         .unwrap();
@@ -175,6 +177,7 @@ fn malformed_scene_names_file_and_field() {
             resume: false,
             render: false,
             volume_map_cache: None,
+            cancel: None,
         },
     )
     .unwrap_err();
@@ -198,6 +201,7 @@ fn zero_frames_and_a_file_as_output_are_refused() {
         resume: false,
         render: false,
         volume_map_cache: None,
+        cancel: None,
     };
     let err = run_scene(&scene, &opts(dir.join("out"), Some(0))).unwrap_err();
     assert!(err.to_string().contains("--frames 0"), "{err}");

@@ -93,6 +93,13 @@ pub enum SolverError {
     /// A boundary could not be built (e.g. a volume map grid too large for the domain).
     #[error("boundary: {0}")]
     Boundary(String),
+    /// A long construction was cancelled through its cancellation flag (Ctrl-C): nothing
+    /// of it was kept.
+    #[error("{what}: cancelled")]
+    Cancelled {
+        /// What was being built (`"solid 1: volume map"`).
+        what: String,
+    },
     /// A volume-map file (see `boundary::volume_map::VolumeMapCache`) was refused: nothing
     /// of it was loaded.
     #[error("volume map file {}: {problem}", path.display())]

@@ -69,8 +69,8 @@ pub mod testing;
 
 pub use boundary::{
     half_space_volume, half_space_volume_derivative, Boundary, BoundarySample, ClosestPoint,
-    CollisionBoundary, Interpolation, VolumeMap, VolumeMapBoundary, VolumeMapOptions,
-    VolumeMapStats,
+    CollisionBoundary, Interpolation, VolumeMap, VolumeMapBoundary, VolumeMapBuild,
+    VolumeMapOptions, VolumeMapStats,
 };
 pub use error::{MapFileProblem, SolverError};
 pub use fluid_solver::{FluidSolver, Solids};

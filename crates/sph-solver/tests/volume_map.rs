@@ -627,3 +627,72 @@ fn report_build_times() {
     .unwrap();
     eprintln!("sphere r = 0.1, h = 0.025: {:?}", b.maps()[0].stats());
 }
+
+/// A cancellation flag stops a build within a row of nodes, naming the solid, for both
+/// interpolation schemes; set before the build, no map is built at all.
+#[test]
+fn a_cancelled_build_stops_and_names_the_solid() {
+    use sph_solver::VolumeMapBuild;
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::time::Duration;
+
+    type Built = Result<VolumeMapBoundary<f64>, SolverError>;
+    fn sphere() -> Box<dyn Sdf<f64>> {
+        Box::new(Sphere::new(Vec3::repeat(0.5), 0.3).unwrap())
+    }
+    fn plane() -> Box<dyn Sdf<f64>> {
+        Box::new(Plane::new(Vec3::zeros(), Vec3::y()).unwrap())
+    }
+    fn build(
+        solids: Vec<Box<dyn Sdf<f64>>>,
+        h: f64,
+        options: VolumeMapOptions,
+        flag: &AtomicBool,
+    ) -> Built {
+        let how = VolumeMapBuild {
+            cache: None,
+            cancel: Some(flag),
+        };
+        let k = KernelKind::WendlandC2;
+        VolumeMapBoundary::build(solids, k, h, unit_domain(), 0.0, options, how)
+    }
+    fn cancelled(r: Built) -> bool {
+        matches!(&r, Err(SolverError::Cancelled { what }) if what == "solid 0: volume map")
+    }
+    for interpolation in [
+        Interpolation::NodePlanes,
+        Interpolation::TrilinearCorrection,
+    ] {
+        let options = VolumeMapOptions {
+            interpolation,
+            ..VolumeMapOptions::default()
+        };
+        let flag = AtomicBool::new(true);
+        let r = build(vec![plane(), sphere()], 0.1, options, &flag);
+        assert!(cancelled(r), "{interpolation:?}");
+        // Not set: the same build completes.
+        flag.store(false, Ordering::Relaxed);
+        let b = build(vec![plane(), sphere()], 0.1, options, &flag).unwrap();
+        assert_eq!(b.maps().len(), 2);
+    }
+    // Set from another thread during a long build (16 cells per support: 1.1e7 nodes,
+    // 3.7e6 of them in the sphere's band, each a quadrature of 16 x 32 rays: minutes whole):
+    // the build stops with the error instead of completing.
+    let fine = VolumeMapOptions {
+        cells_per_support: 16,
+        ..VolumeMapOptions::default()
+    };
+    let flag = AtomicBool::new(false);
+    let r = std::thread::scope(|s| {
+        s.spawn(|| {
+            std::thread::sleep(Duration::from_millis(200));
+            flag.store(true, Ordering::Relaxed);
+        });
+        build(vec![sphere()], 0.05, fine, &flag)
+    });
+    assert!(cancelled(r));
+    assert!(
+        flag.load(Ordering::Relaxed),
+        "the build ended before the flag was set"
+    );
+}

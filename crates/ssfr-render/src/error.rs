@@ -16,6 +16,24 @@ pub enum SsfrError {
         /// Why it is refused.
         reason: &'static str,
     },
+    /// The image's buffers would take more memory than the process may allocate (checked
+    /// before they are allocated: [`crate::check_frame_memory`]).
+    #[error(
+        "image size {width} x {height}: its buffers need {needed_bytes} bytes \
+         ({bytes_per_pixel} per pixel) and {available_bytes} bytes of memory are available"
+    )]
+    OutOfMemory {
+        /// Width (pixels).
+        width: usize,
+        /// Height (pixels).
+        height: usize,
+        /// Bytes the renderer's buffers need at this size.
+        needed_bytes: u64,
+        /// Bytes per pixel of those buffers ([`crate::BYTES_PER_PIXEL`]).
+        bytes_per_pixel: usize,
+        /// Bytes the process may still allocate.
+        available_bytes: u64,
+    },
     /// A parameter is out of range (NaN, negative radius, degenerate camera, ...).
     #[error("{field}: {reason}")]
     Invalid {

@@ -136,6 +136,55 @@ pub const RADIUS_OVER_SPACING: f32 = 0.75;
 /// Largest image accepted (64 M pixels).
 pub const MAX_PIXELS: usize = 1 << 26;
 
+/// Bytes per pixel of a [`Renderer`]'s buffers and its image, all at their largest: depth
+/// and thickness, the camera's ray tables (`|d|²`, `|d|`), the raw depth, the normals, the
+/// scene buffer (colour, depth) and its depth pyramid (`1/z` over squares of 1, 4, 16, ...
+/// pixels: under 4·4/3 bytes, counted as 6), the colour, the refraction's sample
+/// coordinates, the smoothing and noise scratch buffers, and the 8-bit RGB image.
+pub const BYTES_PER_PIXEL: usize = {
+    use std::mem::size_of;
+    let f = size_of::<f32>();
+    2 * f // splat depth, thickness
+        + 2 * f // ray tables
+        + f // raw depth
+        + size_of::<[f32; 3]>() // normals
+        + size_of::<[f32; 3]>() + f // scene colour, depth
+        + 6 // scene depth pyramid
+        + size_of::<[f32; 3]>() // colour
+        + size_of::<[f32; 2]>() // refraction sample coordinates
+        + 2 * f + size_of::<[f32; 2]>() // scratch buffers
+        + 3 // the RGB image
+};
+
+/// Bytes a [`Renderer`]'s buffers take for an image of `width × height` pixels.
+pub fn frame_bytes(width: usize, height: usize) -> u64 {
+    (width as u64)
+        .saturating_mul(height as u64)
+        .saturating_mul(BYTES_PER_PIXEL as u64)
+}
+
+/// `Ok` when the buffers of a `width × height` image ([`frame_bytes`]) fit in
+/// `available_bytes` (the memory the process may still allocate; `None`: unknown, not
+/// checked), else [`SsfrError::OutOfMemory`] with both sizes. [`Renderer::render`] checks
+/// [`sph_core::memory::available_bytes`] this way before its buffers grow.
+pub fn check_frame_memory(
+    width: usize,
+    height: usize,
+    available_bytes: Option<u64>,
+) -> Result<(), SsfrError> {
+    let needed_bytes = frame_bytes(width, height);
+    match available_bytes {
+        Some(available_bytes) if needed_bytes > available_bytes => Err(SsfrError::OutOfMemory {
+            width,
+            height,
+            needed_bytes,
+            bytes_per_pixel: BYTES_PER_PIXEL,
+            available_bytes,
+        }),
+        _ => Ok(()),
+    }
+}
+
 /// 3-vector of `f32` (the renderer works in single precision).
 pub type V3 = nalgebra::Vector3<f32>;
 

@@ -177,6 +177,8 @@ pub struct Renderer {
     scratch_n: Vec<[f32; 2]>,
     scene_key: Option<(Camera, Light, Background)>,
     frame: Option<CameraFrame>,
+    /// The largest image (pixels) whose buffers were checked against the memory available.
+    checked_pixels: usize,
 }
 
 impl Renderer {
@@ -186,7 +188,9 @@ impl Renderer {
     }
 
     /// Renders one frame of `particles` (steps 1–8); the background is re-rendered only when
-    /// the camera, light or background changed. Errors: bad parameters or particles, and
+    /// the camera, light or background changed. Errors: bad parameters or particles,
+    /// [`SsfrError::OutOfMemory`] when the buffers of a larger image than before would not
+    /// fit in the memory available (checked before they grow), and
     /// [`SsfrError::NothingVisible`] when no particle is in view.
     pub fn render<R: Real>(
         &mut self,
@@ -195,6 +199,11 @@ impl Renderer {
     ) -> Result<FrameStats, SsfrError> {
         let cam = params.camera.frame()?;
         params.material.validate()?;
+        let pixels = cam.width.saturating_mul(cam.height);
+        if pixels > self.checked_pixels {
+            crate::check_frame_memory(cam.width, cam.height, sph_core::memory::available_bytes())?;
+            self.checked_pixels = pixels;
+        }
         let mut times = StageTimes::default();
         let key = (params.camera, params.light, params.background.clone());
         if self.scene_key.as_ref() != Some(&key) {
@@ -337,5 +346,89 @@ impl Renderer {
     pub fn image(&self) -> RgbImage {
         let (w, h) = (self.splats.width, self.splats.height);
         RgbImage::from_linear(w, h, &self.colour)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::smooth::NoiseParams;
+
+    fn params(width: usize, height: usize) -> RenderParams {
+        let camera = Camera {
+            eye: [0.5, 0.6, 1.5],
+            target: [0.5, 0.1, 0.0],
+            up: [0.0, 1.0, 0.0],
+            fov_y_deg: 45.0,
+            width,
+            height,
+        };
+        RenderParams::new(camera, Background::ground_only(0.0, 0.1), 0.02)
+    }
+
+    fn block() -> Vec<Vec3<f32>> {
+        (0..100)
+            .map(|k| Vec3::new(0.4 + 0.02 * (k % 10) as f32, 0.1, 0.02 * (k / 10) as f32))
+            .collect()
+    }
+
+    /// The buffers a frame filled, measured, never exceed what the memory check counts.
+    #[test]
+    fn bytes_per_pixel_bound_the_buffers_a_frame_fills() {
+        let (w, h) = (64, 48);
+        let mut p = params(w, h);
+        p.noise = Some(NoiseParams {
+            amplitude_m: 1e-3,
+            blur_px: 2,
+            seed: 1,
+        });
+        let mut r = Renderer::default();
+        r.render(&p, &ParticleView::spheres(&block(), 0.02))
+            .unwrap();
+        let image = r.image();
+        fn bytes<T>(v: &[T]) -> usize {
+            std::mem::size_of_val(v)
+        }
+        let measured = bytes(&r.splats.depth)
+            + bytes(&r.splats.thickness)
+            + bytes(&r.raw_depth)
+            + bytes(&r.normals)
+            + bytes(&r.scene.colour)
+            + bytes(&r.scene.depth)
+            + bytes(&r.colour)
+            + bytes(&r.refraction_sample_px)
+            + bytes(&r.scratch)
+            + bytes(&r.scratch2)
+            + bytes(&r.scratch_n)
+            + image.data.len();
+        assert!(measured > 0);
+        assert!(
+            measured as u64 <= crate::frame_bytes(w, h),
+            "{measured} bytes > {} counted",
+            crate::frame_bytes(w, h)
+        );
+    }
+
+    #[test]
+    fn an_image_larger_than_the_memory_is_refused_with_both_sizes() {
+        let e = crate::check_frame_memory(8192, 8192, Some(1 << 30)).unwrap_err();
+        let needed = (1u64 << 26) * crate::BYTES_PER_PIXEL as u64;
+        assert_eq!(
+            e,
+            SsfrError::OutOfMemory {
+                width: 8192,
+                height: 8192,
+                needed_bytes: needed,
+                bytes_per_pixel: crate::BYTES_PER_PIXEL,
+                available_bytes: 1 << 30,
+            }
+        );
+        let text = e.to_string();
+        assert!(
+            text.contains(&needed.to_string()) && text.contains("1073741824"),
+            "{text}"
+        );
+        assert!(crate::check_frame_memory(8192, 8192, Some(needed)).is_ok());
+        assert!(crate::check_frame_memory(8192, 8192, None).is_ok());
     }
 }

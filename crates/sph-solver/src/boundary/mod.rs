@@ -14,7 +14,8 @@ pub mod volume_map;
 pub use collision::CollisionBoundary;
 pub use volume_map::{
     half_space_volume, half_space_volume_derivative, CacheUse, Interpolation, VolumeMap,
-    VolumeMapBoundary, VolumeMapCache, VolumeMapKey, VolumeMapOptions, VolumeMapStats,
+    VolumeMapBoundary, VolumeMapBuild, VolumeMapCache, VolumeMapKey, VolumeMapOptions,
+    VolumeMapStats,
 };
 
 use sph_core::{Real, Sdf, Vec3};

@@ -1,6 +1,7 @@
 //! [`VolumeMapBoundary`]: one [`VolumeMap`] per solid behind the [`Boundary`] trait.
 
 use std::fmt;
+use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
 use sph_core::{Aabb, Real, Sdf, Vec3};
@@ -12,6 +13,19 @@ use super::options::{invalid, VolumeMapOptions};
 use super::quadrature::KernelTables;
 use crate::boundary::{project_out, Boundary, BoundarySample};
 use crate::SolverError;
+
+/// How the maps of a [`VolumeMapBoundary`] are obtained besides its inputs
+/// ([`VolumeMapBoundary::build`]): a cache to load them from and store them in, and a
+/// cancellation flag (set by a Ctrl-C handler or another thread) checked once per row of
+/// nodes of each map being built.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct VolumeMapBuild<'a> {
+    /// Load maps from (and store built ones into) this cache.
+    pub cache: Option<&'a VolumeMapCache>,
+    /// Once set, the build stops within a row of nodes and returns
+    /// [`SolverError::Cancelled`] naming the solid.
+    pub cancel: Option<&'a AtomicBool>,
+}
 
 /// Solids with volume maps (Bender et al. 2019; equations in the module docs of
 /// `volume_map`): [`Boundary::sample`] returns `Ψ(x) = Σ_k Ψ_k(x)` and
@@ -88,6 +102,36 @@ impl<R: Real> VolumeMapBoundary<R> {
         options: VolumeMapOptions,
         cache: Option<&VolumeMapCache>,
     ) -> Result<Self, SolverError> {
+        let how = VolumeMapBuild {
+            cache,
+            cancel: None,
+        };
+        Self::build(
+            solids,
+            kernel,
+            support_radius,
+            domain,
+            contact_distance,
+            options,
+            how,
+        )
+    }
+
+    /// As [`VolumeMapBoundary::with_cache`] with `how.cache`, stopping when `how.cancel`
+    /// is set (checked once per row of nodes while a map is built).
+    ///
+    /// Errors: those of [`VolumeMapBoundary::new`], and [`SolverError::Cancelled`] naming
+    /// the solid whose map was being built when the flag was set.
+    pub fn build(
+        solids: Vec<Box<dyn Sdf<R>>>,
+        kernel: KernelKind,
+        support_radius: R,
+        domain: Aabb<R>,
+        contact_distance: R,
+        options: VolumeMapOptions,
+        how: VolumeMapBuild<'_>,
+    ) -> Result<Self, SolverError> {
+        let cache = how.cache;
         options.validate()?;
         if !(contact_distance.is_finite_value() && contact_distance >= R::zero()) {
             return Err(invalid(
@@ -125,11 +169,17 @@ impl<R: Real> VolumeMapBoundary<R> {
         let mut maps = Vec::with_capacity(solids.len());
         for (i, s) in solids.iter().enumerate() {
             let build = || {
-                VolumeMap::build(s.as_ref(), tables.clone(), &domain, &options).map_err(|e| match e
-                {
-                    SolverError::Boundary(m) => SolverError::Boundary(format!("solid {i}: {m}")),
-                    e => e,
-                })
+                VolumeMap::build(s.as_ref(), tables.clone(), &domain, &options, how.cancel).map_err(
+                    |e| match e {
+                        SolverError::Boundary(m) => {
+                            SolverError::Boundary(format!("solid {i}: {m}"))
+                        }
+                        SolverError::Cancelled { what } => SolverError::Cancelled {
+                            what: format!("solid {i}: {what}"),
+                        },
+                        e => e,
+                    },
+                )
             };
             let Some(cache) = cache else {
                 maps.push(build()?);

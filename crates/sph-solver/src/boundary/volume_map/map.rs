@@ -1,6 +1,6 @@
 //! A volume map: its grid of node models, its construction and its sampling.
 
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -147,12 +147,20 @@ fn unit_normal<R: Real>(sdf: &dyn Sdf<R>, p: &Vec3<R>) -> Vec3<f64> {
 }
 
 impl<R: Real> VolumeMap<R> {
+    /// Builds the map of `solid`; `cancel`, when given, is checked once per row of nodes
+    /// (a slab of `nx` cells): once it is set the remaining rows are skipped and the build
+    /// returns [`SolverError::Cancelled`].
     pub(crate) fn build(
         solid: &dyn Sdf<R>,
         tables: Arc<KernelTables>,
         domain: &Aabb<R>,
         options: &VolumeMapOptions,
+        cancel: Option<&AtomicBool>,
     ) -> Result<Self, SolverError> {
+        let cancelled = || cancel.is_some_and(|c| c.load(Ordering::Relaxed));
+        let refuse = || SolverError::Cancelled {
+            what: "volume map".into(),
+        };
         let start = Instant::now();
         let h = tables.h;
         let cell = h / options.cells_per_support as f64;
@@ -237,9 +245,17 @@ impl<R: Real> VolumeMap<R> {
         };
         let reach = h + 3f64.sqrt() * cell;
         let storage = match options.interpolation {
+            // Checked per node here (the grid fills itself): a skipped node's value is
+            // never kept.
             Interpolation::TrilinearCorrection => Storage::Trilinear(
-                SampledGrid::from_fn(origin, cell, dims, |_, p| node(p).2.c)
-                    .map_err(|e| SolverError::Boundary(format!("volume map grid: {e}")))?,
+                SampledGrid::from_fn(origin, cell, dims, |_, p| {
+                    if cancelled() {
+                        0.0
+                    } else {
+                        node(p).2.c
+                    }
+                })
+                .map_err(|e| SolverError::Boundary(format!("volume map grid: {e}")))?,
             ),
             Interpolation::NodePlanes => {
                 let [nx, ny, nz] = dims;
@@ -248,6 +264,9 @@ impl<R: Real> VolumeMap<R> {
                 let slabs: Vec<(Vec<u32>, Vec<NodeModel>)> = (0..nz * ny)
                     .into_par_iter()
                     .map(|row| {
+                        if cancelled() {
+                            return (Vec::new(), Vec::new());
+                        }
                         let (j, k) = (row % ny, row / ny);
                         let mut index = Vec::with_capacity(nx);
                         let mut models = Vec::new();
@@ -288,6 +307,9 @@ impl<R: Real> VolumeMap<R> {
                         (index, models)
                     })
                     .collect();
+                if cancelled() {
+                    return Err(refuse());
+                }
                 let stored: usize = slabs.iter().map(|s| s.1.len()).sum();
                 if stored >= PLANE_BIT as usize {
                     return Err(SolverError::Boundary(format!(
@@ -309,6 +331,9 @@ impl<R: Real> VolumeMap<R> {
                 }
             }
         };
+        if cancelled() {
+            return Err(refuse());
+        }
         let stored_nodes = match &storage {
             Storage::NodePlanes { models, .. } => models.len(),
             _ => 0,

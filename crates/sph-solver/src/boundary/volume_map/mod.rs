@@ -134,7 +134,7 @@ mod map;
 mod options;
 mod quadrature;
 
-pub use boundary::VolumeMapBoundary;
+pub use boundary::{VolumeMapBoundary, VolumeMapBuild};
 pub use file::MAGIC;
 pub use key::{VolumeMapCache, VolumeMapKey, BUILD_VERSION, FORMAT_VERSION};
 pub use map::{CacheUse, VolumeMap, VolumeMapStats};
