@@ -83,7 +83,7 @@ SPHERE_SCENE = """
 name = "sphere_map"
 [simulation]
 precision = "f32"
-particle_spacing = 0.004
+particle_spacing = 0.006
 duration = 0.02
 frame_dt = 0.02
 [solver]
