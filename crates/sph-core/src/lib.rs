@@ -22,6 +22,7 @@
 //! - [`CoreError`], the crate's error enum.
 
 mod aabb;
+pub mod disk;
 mod error;
 pub mod grid;
 pub mod input;

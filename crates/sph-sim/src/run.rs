@@ -45,14 +45,50 @@ impl VtkObserver {
         sim.write_passive_vtk(&self.run.passive_vtk(sim.frame))?;
         Ok(())
     }
+
+    /// Bytes of the frame files of frame `f` (particles and passive points), if written.
+    fn frame_bytes(&self, f: usize) -> Option<u64> {
+        let size = |p: PathBuf| std::fs::metadata(p).ok().map(|m| m.len());
+        Some(size(self.run.frame_vtk(f))? + size(self.run.passive_vtk(f)).unwrap_or(0))
+    }
+
+    /// Refuses a run whose remaining frame files would not fit on the output's file system,
+    /// estimated from the size of the last frame written (particle counts do not change).
+    fn check_output_volume(&self, plan: &RunPlan) -> Result<(), SimError> {
+        let last_written = self.run.frames()?.last().map(|(f, _)| *f);
+        let Some(per_frame) = last_written.and_then(|f| self.frame_bytes(f)) else {
+            return Ok(());
+        };
+        let frames = frames_written_after(plan, self.every);
+        let bytes = per_frame.saturating_mul(frames);
+        let free = sph_core::disk::available_bytes(self.run.path());
+        match sph_core::disk::room_shortfall(self.run.path(), bytes, free) {
+            None => Ok(()),
+            Some(why) => Err(SimError::output(
+                self.run.path(),
+                format!(
+                    "the run's {frames} more frame files (output.every_frames = {}, about {} each) {why}: write fewer frames (a larger output.every_frames), run fewer frames, or choose another output directory",
+                    self.every,
+                    sph_core::disk::human(per_frame)
+                ),
+            )),
+        }
+    }
+}
+
+/// Frames after `plan.first_frame` up to `plan.last_frame` whose files a run writes every
+/// `every` frames.
+fn frames_written_after(plan: &RunPlan, every: usize) -> u64 {
+    let every = every.max(1);
+    (plan.last_frame / every).saturating_sub(plan.first_frame / every) as u64
 }
 
 impl<R: Real> FrameObserver<R> for VtkObserver {
     fn start(&mut self, sim: &SceneSim<R>, plan: &RunPlan) -> Result<(), SimError> {
-        if plan.resumed {
-            return Ok(());
+        if !plan.resumed {
+            self.write(sim)?;
         }
-        self.write(sim)
+        self.check_output_volume(plan)
     }
     fn frame(&mut self, sim: &SceneSim<R>, _: &FrameRecord) -> Result<Flow, SimError> {
         if sim.frame.is_multiple_of(self.every) {
@@ -356,7 +392,33 @@ fn announce<R: Real>(sim: &SceneSim<R>, scene: &Scene, plan: &RunPlan, run: &Run
 
 #[cfg(test)]
 mod tests {
-    use super::kept_stats_lines;
+    use super::{frames_written_after, kept_stats_lines};
+    use crate::frame_loop::RunPlan;
+
+    #[test]
+    fn frames_written_after_the_first_follow_the_cadence() {
+        let plan = |first_frame, last_frame| RunPlan {
+            first_frame,
+            last_frame,
+            resumed: first_frame > 0,
+        };
+        // Naive count: the frames f in (first, last] with f a multiple of `every`.
+        for (first, last, every) in [
+            (0, 94, 1),
+            (0, 94, 5),
+            (12, 94, 5),
+            (13, 14, 5),
+            (0, 0, 3),
+            (7, 7, 1),
+        ] {
+            let naive = (first + 1..=last).filter(|f| f % every == 0).count() as u64;
+            assert_eq!(
+                frames_written_after(&plan(first, last), every),
+                naive,
+                "{first} {last} {every}"
+            );
+        }
+    }
 
     #[test]
     fn resumed_statistics_keep_the_header_and_the_finished_rows() {
