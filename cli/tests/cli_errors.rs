@@ -95,3 +95,32 @@ fn command_line_error_messages() {
         assert!(!dir.join("target").exists(), "{name}: wrote output");
     }
 }
+
+/// A run whose frame files cannot fit on the disk is refused after its first frame file,
+/// naming both sizes, instead of running until the disk is full: 62,500 particles (2.75 MB a
+/// frame) over the 10⁷ frames the scene format allows is 27.5 TB.
+#[test]
+fn frame_files_that_cannot_fit_on_the_disk_are_refused() {
+    let dir = case_dir("output_volume");
+    let scene = GOOD
+        .replace("particle_spacing = 0.05", "particle_spacing = 0.02")
+        .replace("duration = 0.1", "duration = 2e5")
+        .replace("max = [0.2, 0.2, 0.2]", "max = [1.0, 0.5, 1.0]")
+        .replace("vtk = false", "vtk = true");
+    std::fs::write(dir.join("big.toml"), scene).unwrap();
+    let (code, stderr) = run(&dir, &["run", "big.toml", "--out", "out"]);
+    assert_eq!(code, 1, "{stderr}");
+    let error = stderr
+        .lines()
+        .find(|l| l.starts_with("error:"))
+        .unwrap_or("");
+    assert!(
+        error.contains("writing 10000000 more frame files (output.every_frames = 1, about 2.")
+            && error.contains("TB but out has only")
+            && error.contains("free"),
+        "{stderr}"
+    );
+    assert!(dir.join("out/frame_00000.vtk").is_file());
+    assert!(!dir.join("out/frame_00001.vtk").exists(), "the run went on");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -67,7 +67,7 @@ impl VtkObserver {
             Some(why) => Err(SimError::output(
                 self.run.path(),
                 format!(
-                    "the run's {frames} more frame files (output.every_frames = {}, about {} each) {why}: write fewer frames (a larger output.every_frames), run fewer frames, or choose another output directory",
+                    "writing {frames} more frame files (output.every_frames = {}, about {} each) {why}: write fewer frames (a larger output.every_frames), run fewer frames, or choose another output directory",
                     self.every,
                     sph_core::disk::human(per_frame)
                 ),
