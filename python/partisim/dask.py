@@ -35,6 +35,7 @@ import json
 import operator
 import os
 import time
+import uuid
 from pathlib import Path
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Union
 
@@ -449,6 +450,11 @@ def run_scene_sweep(
         ckpt_dir.mkdir(parents=True, exist_ok=True)
     quick = bool(quick)
     futures: List[Any] = []
+    # A token per call in each task's key: Dask hands back the result of a task whose key it
+    # still holds, so a second sweep over the same checkpoints submitted while the first's
+    # results were not yet released would return the first call's rows (resumed_from_frame
+    # and all) instead of reading the checkpoints again.
+    call = uuid.uuid4().hex[:8]
     for i, row in enumerate(rows):
         digest = _run_key(scene_path, row, quick, frames, until_rest, repose)
         ckpt = None if ckpt_dir is None else str(ckpt_dir / f"run{i:04d}-{digest}.partisim")
@@ -463,7 +469,7 @@ def run_scene_sweep(
                 int(checkpoint_every),
                 until_rest,
                 repose,
-                key=f"partisim-scene-run-{i:04d}-{digest}",
+                key=f"partisim-scene-run-{i:04d}-{digest}-{call}",
                 retries=int(retries),
                 pure=False,
             )

@@ -11,29 +11,19 @@ use crate::rust_err;
 /// How often the waiting thread looks for Ctrl-C.
 const SIGNAL_POLL: Duration = Duration::from_millis(50);
 
-/// What to do with the work when a signal's handler raises (Ctrl-C: `KeyboardInterrupt`).
-pub(crate) enum OnSignal<'a> {
-    /// Call this (it tells the work to stop, e.g. raises a flag the work checks) and wait
-    /// for the work to return before raising.
-    Stop(&'a dyn Fn()),
-    /// Raise at once; the work, which cannot be stopped, finishes on its thread and its
-    /// result is dropped.
-    Abandon,
-}
-
-/// Runs `work` on a new thread and returns its result; raises the exception of a Python
-/// signal handler (Ctrl-C) that fires meanwhile, after dealing with the work as
-/// `on_signal` says. The GIL is released while waiting.
+/// Runs `work` on a new thread and returns its result; when a Python signal handler
+/// raises meanwhile (Ctrl-C: `KeyboardInterrupt`), calls `stop` (which tells the work to
+/// stop, e.g. raises a flag the work checks), waits for the work to return, and raises.
+/// The GIL is released while waiting.
 pub(crate) fn interruptible<T: Send + 'static>(
     py: Python<'_>,
-    on_signal: OnSignal<'_>,
+    stop: &dyn Fn(),
     work: impl FnOnce() -> T + Send + 'static,
 ) -> PyResult<T> {
     let (tx, rx) = mpsc::channel();
     std::thread::Builder::new()
         .name("partisim-work".into())
         .spawn(move || {
-            // The receiver is gone only if the caller was interrupted and abandoned us.
             let _ = tx.send(work());
         })
         .map_err(|e| rust_err(format!("could not start a worker thread: {e}")))?;
@@ -47,10 +37,8 @@ pub(crate) fn interruptible<T: Send + 'static>(
             Ok(result) => return Ok(result),
             Err(mpsc::RecvTimeoutError::Timeout) => {
                 if let Err(e) = py.check_signals() {
-                    if let OnSignal::Stop(stop) = &on_signal {
-                        stop();
-                        let _ = py.detach(move || rx.recv());
-                    }
+                    stop();
+                    let _ = py.detach(move || rx.recv());
                     return Err(e);
                 }
             }

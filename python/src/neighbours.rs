@@ -10,7 +10,7 @@ use pyo3::prelude::*;
 use neighbour_search::{Method, NeighbourLists, SearchError, SearchLimits};
 
 use crate::arrays::{available_memory_bytes, points, try_vec, Points};
-use crate::interrupt::{interruptible, OnSignal};
+use crate::interrupt::interruptible;
 use crate::rust_err;
 
 /// CSR arrays: offsets (N + 1) and indices.
@@ -44,7 +44,7 @@ fn neighbour_lists<'py>(
         interrupt: Some(interrupt.clone()),
     };
     let stop = || interrupt.store(true, Ordering::Relaxed);
-    let lists = interruptible(py, OnSignal::Stop(&stop), move || {
+    let lists = interruptible(py, &stop, move || {
         let mut lists = NeighbourLists::with_limits(limits);
         match points {
             Points::F64(p) => method.build::<f64>().search(&p, radius, &mut lists),

@@ -1,6 +1,8 @@
 //! `ssfr-render`: screen-space fluid images of particles, and PNG files.
 
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 use numpy::{IntoPyArray, PyArray3, PyArrayDescrMethods, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
@@ -10,7 +12,7 @@ use sph_core::{Real, Vec3};
 use ssfr_render::{RenderConfig, RenderParams, Renderer, RgbImage, SceneInfo, SsfrError};
 
 use crate::arrays::{as_array, check_fits, check_shape, points, Points};
-use crate::interrupt::{interruptible, OnSignal};
+use crate::interrupt::interruptible;
 use crate::rust_err;
 
 /// Largest |coordinate| (m) the renderer frames: its arithmetic is float32, whose squares
@@ -22,8 +24,10 @@ const MAX_COORDINATE_M: f64 = 1e18;
 pub(crate) fn render_image<R: Real>(
     params: &RenderParams,
     positions: &[Vec3<R>],
+    cancel: Option<Arc<AtomicBool>>,
 ) -> Result<RgbImage, SsfrError> {
     let mut renderer = Renderer::default();
+    renderer.set_cancel(cancel);
     renderer.render_points(params, positions)?;
     Ok(renderer.image())
 }
@@ -179,7 +183,12 @@ fn render_options<'py>(
         Points::F64(p) => check_range(p)?,
         Points::F32(p) => check_range(p)?,
     }
-    let image = interruptible(py, OnSignal::Abandon, move || {
+    // Ctrl-C raises the flag the renderer checks per particle and per band of rows, and
+    // the call waits for it to stop before raising.
+    let cancel = Arc::new(AtomicBool::new(false));
+    let flag = cancel.clone();
+    let stop = move || flag.store(true, Ordering::Relaxed);
+    let image = interruptible(py, &stop, move || {
         let run = |liquid, f: &dyn Fn(&RenderParams) -> Result<RgbImage, SsfrError>| {
             let info = SceneInfo {
                 tank,
@@ -191,8 +200,12 @@ fn render_options<'py>(
             f(&config.resolve(&info)?)
         };
         match &points {
-            Points::F64(p) => run(bounds(p), &|params| render_image(params, p)),
-            Points::F32(p) => run(bounds(p), &|params| render_image(params, p)),
+            Points::F64(p) => run(bounds(p), &|params| {
+                render_image(params, p, Some(cancel.clone()))
+            }),
+            Points::F32(p) => run(bounds(p), &|params| {
+                render_image(params, p, Some(cancel.clone()))
+            }),
         }
     })?;
     to_numpy(py, image.map_err(render_err)?)

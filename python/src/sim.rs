@@ -17,7 +17,7 @@ use sph_sim::{
 };
 use sph_solver::boundary::{CacheUse, VolumeMapBuild, VolumeMapCache};
 
-use crate::interrupt::{interruptible, OnSignal};
+use crate::interrupt::interruptible;
 use crate::measure::{repose_dict, rest_observer, ReposeArgs, RestVerdict};
 use crate::rust_err;
 use sph_sim::observe::RestObserver;
@@ -227,7 +227,7 @@ fn cancellable<T: Send + 'static>(
     let cancel = Arc::new(AtomicBool::new(false));
     let flag = cancel.clone();
     let stop = move || flag.store(true, Ordering::Relaxed);
-    interruptible(py, OnSignal::Stop(&stop), move || work(&cancel))
+    interruptible(py, &stop, move || work(&cancel))
 }
 
 /// The frame record as a Python dict: its serde form (`phases_s` a dict by phase name).
@@ -871,7 +871,7 @@ impl Simulation {
         let image = py.detach(|| {
             let guard = sim.lock().unwrap_or_else(|p| p.into_inner());
             each!(&*guard, s => sph_sim::render::render_params(&s.scene)
-                .and_then(|params| crate::render::render_image(&params, &s.state.positions)
+                .and_then(|params| crate::render::render_image(&params, &s.state.positions, None)
                     .map_err(|e| SimError::Invalid(e.to_string()))))
         });
         crate::render::to_numpy(py, image.map_err(rust_err)?)

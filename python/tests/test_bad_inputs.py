@@ -97,7 +97,9 @@ RENDER = [
     BadInput("render dtype complex", f"{R}(np.zeros((5, 3), complex), 0.01, width=32, height=32)", raises="TypeError", words=("positions", "complex128")),
     BadInput("render empty", f"{R}(np.zeros((0, 3)), 0.01, width=32, height=32)", words=("none of the 0 particles",)),
     BadInput("render huge broadcast view", f"{R}({HUGE_VIEW}, 0.01, width=32, height=32)", words=("positions", "available")),
-    # 10⁶ ellipsoids of 0.01 m on 4096² pixels: seconds of work, stopped after 1 s.
+    # 10⁶ ellipsoids of 0.01 m on 4096² pixels: over two minutes of work (the ellipsoids'
+    # estimate about 100 s, the splatting about 35 s), stopped after 1 s through the
+    # renderer's cancellation flag (the interpreter's next call would otherwise wait for it).
     BadInput("render ctrl-c", "p = np.random.default_rng(5).random((10**6, 3))\npartisim.render(p, 0.01, width=4096, height=4096, anisotropy={'support': 0.03})", raises="KeyboardInterrupt", interrupt_after=1.0, seconds=10, memory_mb=2048),
 ]
 

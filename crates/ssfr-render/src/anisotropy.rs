@@ -22,6 +22,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use std::collections::HashMap;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use nalgebra::{Matrix3, SymmetricEigen};
 use rayon::prelude::*;
@@ -141,6 +142,17 @@ pub fn anisotropic_ellipsoids<R: Real>(
     positions: &[Vec3<R>],
     params: &AnisotropyParams,
 ) -> Result<Ellipsoids, SsfrError> {
+    anisotropic_ellipsoids_cancellable(positions, params, None)
+}
+
+/// [`anisotropic_ellipsoids`] that stops with [`SsfrError::Cancelled`] once `cancel` is set
+/// (checked per particle).
+pub fn anisotropic_ellipsoids_cancellable<R: Real>(
+    positions: &[Vec3<R>],
+    params: &AnisotropyParams,
+    cancel: Option<&AtomicBool>,
+) -> Result<Ellipsoids, SsfrError> {
+    let cancelled = || cancel.is_some_and(|c| c.load(Ordering::Relaxed));
     params.validate()?;
     let x: Vec<V3> = positions
         .iter()
@@ -169,6 +181,9 @@ pub fn anisotropic_ellipsoids<R: Real>(
     let out: Vec<(V3, Matrix3<f32>)> = x
         .par_iter()
         .map(|xi| {
+            if cancelled() {
+                return Err(SsfrError::Cancelled);
+            }
             let (ci, cj, ck) = cell_of(xi, r);
             let (grid, x) = (&grid, &x);
             let neighbours = move || {
@@ -183,9 +198,9 @@ pub fn anisotropic_ellipsoids<R: Real>(
                     })
                 })
             };
-            ellipsoid(xi, neighbours, params)
+            Ok(ellipsoid(xi, neighbours, params))
         })
-        .collect();
+        .collect::<Result<_, _>>()?;
     Ok(out.into_iter().unzip())
 }
 

@@ -34,6 +34,10 @@ pub enum SsfrError {
         /// Bytes the process may still allocate.
         available_bytes: u64,
     },
+    /// The render was cancelled through its flag ([`crate::Renderer::set_cancel`]) before
+    /// it finished; the renderer's buffers hold no complete frame.
+    #[error("cancelled before the frame was finished")]
+    Cancelled,
     /// A parameter is out of range (NaN, negative radius, degenerate camera, ...).
     #[error("{field}: {reason}")]
     Invalid {

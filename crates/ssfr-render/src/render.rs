@@ -1,6 +1,8 @@
 //! The pipeline: [`RenderParams`] (a value with every parameter) and the [`Renderer`] that
 //! owns the buffers and runs the steps, timing each.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::Instant;
 
 use sph_core::{Real, Vec3};
@@ -182,6 +184,21 @@ pub struct Renderer {
 }
 
 impl Renderer {
+    /// A flag that stops [`Renderer::render`] and [`Renderer::render_points`] with
+    /// [`SsfrError::Cancelled`] once set (from another thread: Ctrl-C, a closed window);
+    /// checked per particle in the ellipsoids' estimate, per band of rows in the splatting,
+    /// and between the stages. `None` (the default) renders to the end.
+    pub fn set_cancel(&mut self, cancel: Option<Arc<AtomicBool>>) {
+        self.splatter.cancel = cancel;
+    }
+
+    fn check_cancelled(&self) -> Result<(), SsfrError> {
+        match &self.splatter.cancel {
+            Some(c) if c.load(Ordering::Relaxed) => Err(SsfrError::Cancelled),
+            _ => Ok(()),
+        }
+    }
+
     /// The camera frame of the last render.
     pub fn camera_frame(&self) -> Option<&CameraFrame> {
         self.frame.as_ref()
@@ -204,6 +221,7 @@ impl Renderer {
             crate::check_frame_memory(cam.width, cam.height, sph_core::memory::available_bytes())?;
             self.checked_pixels = pixels;
         }
+        self.check_cancelled()?;
         let mut times = StageTimes::default();
         let key = (params.camera, params.light, params.background.clone());
         if self.scene_key.as_ref() != Some(&key) {
@@ -264,6 +282,7 @@ impl Renderer {
             }
         }
         times.smooth_s = t.elapsed().as_secs_f64();
+        self.check_cancelled()?;
 
         let t = Instant::now();
         gaussian_blur(
@@ -331,8 +350,11 @@ impl Renderer {
         match &params.anisotropy {
             None => self.render(params, &ParticleView::spheres(positions, radius)),
             Some(a) => {
-                let (centres, ellipsoids) =
-                    crate::anisotropy::anisotropic_ellipsoids(positions, a)?;
+                let (centres, ellipsoids) = crate::anisotropy::anisotropic_ellipsoids_cancellable(
+                    positions,
+                    a,
+                    self.splatter.cancel.as_deref(),
+                )?;
                 let view = ParticleView {
                     ellipsoids: Some(&ellipsoids),
                     ..ParticleView::spheres(&centres, radius)
@@ -406,6 +428,40 @@ mod tests {
             measured as u64 <= crate::frame_bytes(w, h),
             "{measured} bytes > {} counted",
             crate::frame_bytes(w, h)
+        );
+    }
+
+    #[test]
+    fn a_set_cancel_flag_stops_the_render_and_a_clear_one_changes_nothing() {
+        let p = params(64, 48);
+        let mut plain = Renderer::default();
+        plain.render_points(&p, &block()).unwrap();
+        let flag = Arc::new(AtomicBool::new(false));
+        let mut r = Renderer::default();
+        r.set_cancel(Some(flag.clone()));
+        r.render_points(&p, &block()).unwrap();
+        assert_eq!(r.image().data, plain.image().data);
+        flag.store(true, Ordering::Relaxed);
+        assert_eq!(r.render_points(&p, &block()), Err(SsfrError::Cancelled));
+        // The splatting alone (the check at the start of a frame bypassed).
+        let cam = p.camera.frame().unwrap();
+        let mut out = SplatBuffers::default();
+        assert_eq!(
+            r.splatter
+                .splat(&cam, &ParticleView::spheres(&block(), 0.02), &mut out),
+            Err(SsfrError::Cancelled)
+        );
+        // The ellipsoids' estimate alone.
+        let a = crate::anisotropy::AnisotropyParams::new(0.02, 0.06);
+        assert_eq!(
+            crate::anisotropy::anisotropic_ellipsoids_cancellable(&block(), &a, Some(&flag))
+                .map(|_| ()),
+            Err(SsfrError::Cancelled)
+        );
+        flag.store(false, Ordering::Relaxed);
+        assert_eq!(
+            crate::anisotropy::anisotropic_ellipsoids_cancellable(&block(), &a, Some(&flag)),
+            crate::anisotropy::anisotropic_ellipsoids(&block(), &a)
         );
     }
 

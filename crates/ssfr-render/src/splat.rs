@@ -20,6 +20,9 @@
 //! particle order, so the result does not depend on the thread count. Particles whose box
 //! reaches closer than [`NEAR_M`] to the camera plane are skipped.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
 use nalgebra::Matrix3;
 use rayon::prelude::*;
 use sph_core::{Real, Vec3};
@@ -262,6 +265,9 @@ pub struct Splatter {
     pub pixel_tests: u64,
     /// Particles drawn by the last call (inside the view).
     pub drawn: usize,
+    /// When set, [`Splatter::splat`] stops with [`SsfrError::Cancelled`] (checked per band
+    /// of rows).
+    pub cancel: Option<Arc<AtomicBool>>,
 }
 
 impl Splatter {
@@ -415,12 +421,17 @@ impl Splatter {
         let band_items = &self.band_items;
         self.rays.update(camera);
         let rays = &self.rays;
+        let cancel = self.cancel.as_deref();
+        let cancelled = || cancel.is_some_and(|c| c.load(Ordering::Relaxed));
         let tests: u64 = out
             .depth
             .par_chunks_mut(w * BAND_ROWS)
             .zip(out.thickness.par_chunks_mut(w * BAND_ROWS))
             .enumerate()
             .map(|(b, (depth, thick))| {
+                if cancelled() {
+                    return 0;
+                }
                 let row0 = b * BAND_ROWS;
                 let rows = depth.len() / w;
                 let mut tests = 0u64;
@@ -473,6 +484,9 @@ impl Splatter {
                 tests
             })
             .sum();
+        if cancelled() {
+            return Err(SsfrError::Cancelled);
+        }
         self.pixel_tests = tests;
         self.drawn = drawn;
         Ok(drawn)
