@@ -1,0 +1,133 @@
+//! The fixed-base heap of the shipped scene `granular_repose_30` built in Rust, and the
+//! rest criterion granular codes judge a heap by.
+//!
+//! Geometry (m): a tank `[0, 2.4] × [0, 0.8] × [0, 0.03]`, a base `[0.8, 1.6] × [0, 0.25]`
+//! across the slab, and a block `[0.8, 1.6] × [0.25, 0.55]` on it, on a cubic lattice half
+//! a spacing from its faces. Solids: 0 and 1 the slab's front and back walls (`z = 0`,
+//! `z = 0.03`), 2 the tank's floor and ends, 3 the base.
+
+use sph_core::sampling::cubic_lattice;
+use sph_core::{Aabb, BoxSdf, Inverted, ParticleSet, Plane, Real, Vec3};
+use sph_solver::{Solids, SolverError};
+
+use crate::params::{ElastoplasticParams, WallModel};
+use crate::solver::{Elastoplastic, ElastoplasticScheme};
+use crate::walls::volume_map_walls;
+
+/// The base's top (m): the heap's floor.
+pub const BASE_TOP_M: f64 = 0.25;
+/// The base's ends along `x` (m).
+pub const BASE_X_M: [f64; 2] = [0.8, 1.6];
+/// The slab's depth along `z` (m).
+pub const SLAB_DEPTH_M: f64 = 0.03;
+
+fn v<R: Real>(x: f64, y: f64, z: f64) -> Vec3<R> {
+    Vec3::new(R::of_f64(x), R::of_f64(y), R::of_f64(z))
+}
+
+fn aabb<R: Real>(lo: [f64; 3], hi: [f64; 3]) -> Result<Aabb<R>, SolverError> {
+    Ok(Aabb::new(v(lo[0], lo[1], lo[2]), v(hi[0], hi[1], hi[2]))?)
+}
+
+/// The solver and the block's particles at `t = 0` for `params` (its spacing sets the
+/// lattice): free-slip slab walls (solids 0, 1), no-slip tank and base (2, 3).
+pub fn fixed_base_heap<R: Real>(
+    mut params: ElastoplasticParams<R>,
+) -> Result<(Elastoplastic<R>, ParticleSet<R>), SolverError> {
+    let s = params.common.particle_spacing;
+    let d = SLAB_DEPTH_M;
+    let (far_lo, far_hi) = (-0.5, d + 0.5);
+    let solids: Solids<R> = vec![
+        Box::new(Plane::new(v(0.0, 0.0, 0.0), v(0.0, 0.0, 1.0))?),
+        Box::new(Plane::new(v(0.0, 0.0, d), v(0.0, 0.0, -1.0))?),
+        Box::new(Inverted(BoxSdf::new(aabb([0.0, 0.0, far_lo], [2.4, 0.8, far_hi])?)?)),
+        Box::new(BoxSdf::new(aabb(
+            [BASE_X_M[0], -0.5, far_lo],
+            [BASE_X_M[1], BASE_TOP_M, far_hi],
+        )?)?),
+    ];
+    params.wall_models = vec![
+        WallModel::FreeSlip,
+        WallModel::FreeSlip,
+        WallModel::NoSlip,
+        WallModel::NoSlip,
+    ];
+    let tank = aabb([0.0, 0.0, 0.0], [2.4, 0.8, d])?;
+    let walls = volume_map_walls(solids, &params, tank)?;
+    let block = aabb([BASE_X_M[0], BASE_TOP_M, 0.0], [BASE_X_M[1], 0.55, d])?;
+    let positions = cubic_lattice(&block, s, 1 << 22)?;
+    let state = ParticleSet::from_positions(
+        positions,
+        params.common.particle_mass(),
+        params.common.rest_density,
+    );
+    Ok((ElastoplasticScheme::solver(params, walls)?, state))
+}
+
+/// One frame's figures of the rest criterion.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RestSample {
+    /// Time (s).
+    pub time_s: f64,
+    /// 99th-percentile speed of the heap's particles (m/s).
+    pub p99_speed: f64,
+    /// Fastest particle at least two spacings below the surface of its column (m/s).
+    pub deep_max_speed: f64,
+    /// The heap's angle (degrees), if measurable.
+    pub angle_deg: Option<f64>,
+}
+
+/// The speeds of the rest criterion for the particles `(position, velocity)` of a heap:
+/// the 99th-percentile speed and the fastest particle at least two spacings below the
+/// highest particle of its column (bins of one spacing along `x`).
+pub fn rest_speeds<R: Real>(x: &[Vec3<R>], v: &[Vec3<R>], spacing: f64) -> (f64, f64) {
+    if x.is_empty() {
+        return (0.0, 0.0);
+    }
+    let mut speeds: Vec<f64> = v.iter().map(|u| u.norm().as_f64()).collect();
+    let lo = x.iter().map(|p| p.x.as_f64()).fold(f64::INFINITY, f64::min);
+    let bin = |p: &Vec3<R>| ((p.x.as_f64() - lo) / spacing).floor() as usize;
+    let bins = x.iter().map(bin).max().unwrap_or(0) + 1;
+    let mut top = vec![f64::NEG_INFINITY; bins];
+    for p in x {
+        let b = bin(p);
+        top[b] = top[b].max(p.y.as_f64());
+    }
+    let deep = x
+        .iter()
+        .zip(&speeds)
+        .filter(|(p, _)| top[bin(p)] - p.y.as_f64() >= 2.0 * spacing)
+        .map(|(_, &s)| s)
+        .fold(0.0, f64::max);
+    let k = ((speeds.len() as f64) * 0.99).floor() as usize;
+    let k = k.min(speeds.len() - 1);
+    let (_, p99, _) = speeds.select_nth_unstable_by(k, f64::total_cmp);
+    (*p99, deep)
+}
+
+/// Whether the heap is at rest by the criterion of granular codes, from one sample per
+/// frame (in time order): the 99th-percentile speed and the fastest particle two spacings
+/// deep below `0.05 √(g s)` over the last 0.5 s, and the angle moving less than 0.3° over
+/// the last second (at least one second of samples).
+pub fn at_rest(samples: &[RestSample], spacing: f64, gravity: f64) -> bool {
+    let Some(last) = samples.last() else {
+        return false;
+    };
+    if last.time_s < 1.0 {
+        return false;
+    }
+    let bound = 0.05 * (gravity * spacing).sqrt();
+    let slow = samples
+        .iter()
+        .filter(|s| s.time_s >= last.time_s - 0.5)
+        .all(|s| s.p99_speed < bound && s.deep_max_speed < bound);
+    let angles: Vec<f64> = samples
+        .iter()
+        .filter(|s| s.time_s >= last.time_s - 1.0)
+        .map(|s| s.angle_deg.unwrap_or(f64::NAN))
+        .collect();
+    let (lo, hi) = angles
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
+    slow && angles.iter().all(|a| a.is_finite()) && hi - lo < 0.3
+}
