@@ -3,7 +3,7 @@
 //! granular codes or a time cap, with the angle measured as the repose experiment does.
 //!
 //! ```sh
-//! cargo run --release --example heap_30 -p elastoplastic-granular [E_PA] [CAP_S] [PHI_DEG]
+//! cargo run --release --example heap_30 -p elastoplastic-granular [E_PA] [CAP_S] [PHI_DEG] [CFL]
 //! ```
 //!
 //! Prints every 0.1 s: time, 99th-percentile speed, fastest particle two spacings deep,
@@ -33,6 +33,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let phi = arg(3, 30.0)?;
     let mut params = ElastoplasticParams::<f64>::for_spacing(SPACING, phi);
     params.youngs_modulus = youngs;
+    params.cfl_number = arg(4, params.cfl_number)?;
     let (mut solver, mut state) = fixed_base_heap(params)?;
     let (steps, dt) = solver.params().explicit_steps();
     let predicted = (3.0 * plane_strain_alpha(phi)).asin().to_degrees();
@@ -65,6 +66,23 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         });
         let rest = at_rest(&samples, SPACING, 9.81);
         if frame % 6 == 0 || rest {
+            // The fastest particle anywhere: where it is, its density ratio and stress.
+            let (k, vmax) = state
+                .velocities
+                .iter()
+                .map(|u| u.norm())
+                .enumerate()
+                .fold((0, 0.0), |a, (k, s)| if s > a.1 { (k, s) } else { a });
+            let (i1, _, sq) = elastoplastic_granular::stress::invariants(&solver.stress()[k]);
+            let rho0 = solver.params().common.rest_density;
+            let (rmin, rmax) = state.densities.iter().fold((f64::MAX, 0.0f64), |a, &r| {
+                (a.0.min(r / rho0), a.1.max(r / rho0))
+            });
+            let p = state.positions[k];
+            println!(
+                "    fastest {vmax:.3} m/s at ({:.3}, {:.3}, {:.4}) rho/rho0 {:.3} I1 {i1:.0} Pa sqrtJ2 {sq:.0} Pa; rho/rho0 in [{rmin:.3}, {rmax:.3}]",
+                p.x, p.y, p.z, state.densities[k] / rho0
+            );
             println!(
                 "t {t:5.2} s  p99 {p99:.4} m/s  deep max {deep:.4} m/s  angle {}  on base {}  wall {:.1} s",
                 angle.map_or("-".into(), |a| format!("{a:.2}")),

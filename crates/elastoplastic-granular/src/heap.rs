@@ -40,7 +40,10 @@ pub fn fixed_base_heap<R: Real>(
     let solids: Solids<R> = vec![
         Box::new(Plane::new(v(0.0, 0.0, 0.0), v(0.0, 0.0, 1.0))?),
         Box::new(Plane::new(v(0.0, 0.0, d), v(0.0, 0.0, -1.0))?),
-        Box::new(Inverted(BoxSdf::new(aabb([0.0, 0.0, far_lo], [2.4, 0.8, far_hi])?)?)),
+        Box::new(Inverted(BoxSdf::new(aabb(
+            [0.0, 0.0, far_lo],
+            [2.4, 0.8, far_hi],
+        )?)?)),
         Box::new(BoxSdf::new(aabb(
             [BASE_X_M[0], -0.5, far_lo],
             [BASE_X_M[1], BASE_TOP_M, far_hi],
@@ -128,6 +131,8 @@ pub fn at_rest(samples: &[RestSample], spacing: f64, gravity: f64) -> bool {
         .collect();
     let (lo, hi) = angles
         .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        });
     slow && angles.iter().all(|a| a.is_finite()) && hi - lo < 0.3
 }

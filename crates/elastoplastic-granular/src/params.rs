@@ -173,7 +173,10 @@ impl<R: Real> ElastoplasticParams<R> {
 
     /// The wall model of solid `k`.
     pub fn wall_model(&self, k: usize) -> WallModel {
-        self.wall_models.get(k).copied().unwrap_or(self.default_wall)
+        self.wall_models
+            .get(k)
+            .copied()
+            .unwrap_or(self.default_wall)
     }
 
     /// The speed of sound `c = √(E/ρ0)` (m/s) of the time step and the viscosity.

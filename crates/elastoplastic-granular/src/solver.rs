@@ -167,10 +167,10 @@ impl<R: Real> ElastoplasticScheme<R> {
         s.rho.copy_from_slice(&state.densities);
         for _ in 0..steps {
             if !self.lists_valid || max_displacement(s) > skin * half {
-                let search =
-                    self.parts
-                        .neighbours
-                        .find_in_step(&s.x, h + skin, at, "position")?;
+                let search = self
+                    .parts
+                    .neighbours
+                    .find_in_step(&s.x, h + skin, at, "position")?;
                 stats.phases.add(CREATE_HASH_GRID, search.build_s());
                 stats.phases.add(DETECT_NEIGHBOURS, search.detect_s());
                 s.anchor.copy_from_slice(&s.x);
@@ -272,7 +272,16 @@ impl<R: Real> SubstepScheme<R> for ElastoplasticScheme<R> {
             "stress".into(),
             s.stress
                 .iter()
-                .flat_map(|m| [m[(0, 0)], m[(1, 1)], m[(2, 2)], m[(0, 1)], m[(1, 2)], m[(2, 0)]])
+                .flat_map(|m| {
+                    [
+                        m[(0, 0)],
+                        m[(1, 1)],
+                        m[(2, 2)],
+                        m[(0, 1)],
+                        m[(1, 2)],
+                        m[(2, 0)],
+                    ]
+                })
                 .collect(),
         ));
         arrays.push(("plastic_strain".into(), s.plastic_strain.clone()));

@@ -1,0 +1,131 @@
+//! The solver on small blocks: a settled layer against hydrostatics, determinism across
+//! thread counts, resuming from a checkpoint, parameter checks.
+
+use elastoplastic_granular::{
+    volume_map_walls, Aabb, BoxSdf, Elastoplastic, ElastoplasticParams, ElastoplasticScheme,
+    Inverted, ParticleSet, Solids, SolverError, Vec3, WallModel,
+};
+use sph_core::sampling::cubic_lattice;
+
+const S: f64 = 0.01;
+
+/// A block `[0, w] × [0, d] × [0, 0.03]` (m) in a box `[0, box_w] × [0, 0.5] × [0, 0.03]`
+/// whose faces are all one free-slip solid; `E` = 5.84e5 Pa.
+fn block(w: f64, d: f64, box_w: f64) -> (Elastoplastic<f64>, ParticleSet<f64>) {
+    let mut p = ElastoplasticParams::<f64>::for_spacing(S, 30.0);
+    p.youngs_modulus = 5.84e5;
+    p.wall_models = vec![WallModel::FreeSlip];
+    let tank = Aabb::new(Vec3::zeros(), Vec3::new(box_w, 0.5, 0.03)).unwrap();
+    let solids: Solids<f64> = vec![Box::new(Inverted(BoxSdf::new(tank).unwrap()))];
+    let walls = volume_map_walls(solids, &p, tank).unwrap();
+    let region = Aabb::new(Vec3::zeros(), Vec3::new(w, d, 0.03)).unwrap();
+    let x = cubic_lattice(&region, S, 100_000).unwrap();
+    let state = ParticleSet::from_positions(x, p.common.particle_mass(), p.common.rest_density);
+    (ElastoplasticScheme::solver(p, walls).unwrap(), state)
+}
+
+#[test]
+#[ignore = "fails today: the layer does not settle (bottom σ_yy 10.9× hydrostatic after 1 s, particles at 1.65 m/s; docs/elastoplastic-granular.md)"]
+fn a_settled_layer_carries_its_weight() {
+    // 20 layers (d = 0.2 m) between free-slip walls, settled for 1 s: the bottom layer's
+    // centres lie d − s/2 below the free surface (mass is conserved, so ρ g z in the
+    // deformed layer is ρ0 g z0 of the reference one). Hydrostatics: σ_yy = −ρ0 g (d − s/2);
+    // tolerance 3 % (a flat bed's vertical stress within 3 % of ρ g d).
+    let (mut solver, mut state) = block(0.08, 0.2, 0.08);
+    for _ in 0..63 {
+        solver.step(&mut state).unwrap();
+    }
+    let rho0 = solver.params().common.rest_density;
+    let expected = -rho0 * 9.81 * (0.2 - S / 2.0);
+    let bottom: Vec<f64> = state
+        .positions
+        .iter()
+        .zip(solver.stress())
+        .filter(|(x, _)| x.y < S)
+        .map(|(_, s)| s[(1, 1)])
+        .collect();
+    assert_eq!(bottom.len(), 8 * 3);
+    let mean = bottom.iter().sum::<f64>() / bottom.len() as f64;
+    let vmax = state
+        .velocities
+        .iter()
+        .map(|v| v.norm())
+        .fold(0.0, f64::max);
+    println!("bottom σ_yy {mean:.1} Pa, expected {expected:.1} Pa, fastest {vmax:.2e} m/s");
+    assert!(
+        (mean / expected - 1.0).abs() < 0.03,
+        "bottom σ_yy {mean} Pa against {expected} Pa"
+    );
+}
+
+fn run(threads: usize, frames: usize) -> (ParticleSet<f64>, Vec<f64>) {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(|| {
+        let (mut solver, mut state) = block(0.1, 0.1, 0.3);
+        for _ in 0..frames {
+            solver.step(&mut state).unwrap();
+        }
+        let stress = solver
+            .stress()
+            .iter()
+            .flat_map(|m| m.iter().copied())
+            .collect();
+        (state, stress)
+    })
+}
+
+#[test]
+fn one_and_two_threads_give_the_same_bits() {
+    let (a, sa) = run(1, 4);
+    let (b, sb) = run(2, 4);
+    assert_eq!(a.positions, b.positions);
+    assert_eq!(a.velocities, b.velocities);
+    assert_eq!(a.densities, b.densities);
+    assert_eq!(sa, sb);
+}
+
+#[test]
+fn a_resumed_run_repeats_the_uninterrupted_one() {
+    let (mut solver, mut state) = block(0.1, 0.1, 0.3);
+    for _ in 0..2 {
+        solver.step(&mut state).unwrap();
+    }
+    let (saved_particles, saved) = (state.clone(), solver.save_state());
+    assert!(solver.plastic_strain().iter().any(|&k| k > 0.0));
+    for _ in 0..2 {
+        solver.step(&mut state).unwrap();
+    }
+    let (mut resumed, _) = block(0.1, 0.1, 0.3);
+    let mut particles = saved_particles;
+    resumed.restore_state(&saved, particles.len()).unwrap();
+    for _ in 0..2 {
+        resumed.step(&mut particles).unwrap();
+    }
+    assert_eq!(particles.positions, state.positions);
+    assert_eq!(resumed.stress(), solver.stress());
+    assert_eq!(resumed.plastic_strain(), solver.plastic_strain());
+}
+
+#[test]
+fn invalid_parameters_are_named() {
+    let base = ElastoplasticParams::<f64>::for_spacing(S, 30.0);
+    let cases: [(&str, fn(&mut ElastoplasticParams<f64>)); 5] = [
+        ("poisson_ratio", |p| p.poisson_ratio = 0.5),
+        ("youngs_modulus", |p| p.youngs_modulus = -1.0),
+        ("dilatancy_angle_deg", |p| p.dilatancy_angle_deg = 40.0),
+        ("cfl_number", |p| p.cfl_number = 1e-9),
+        ("skin", |p| p.skin = f64::NAN),
+    ];
+    assert!(base.validate().is_ok());
+    for (name, change) in cases {
+        let mut p = base.clone();
+        change(&mut p);
+        match p.validate() {
+            Err(SolverError::InvalidParameter { name: n, .. }) => assert_eq!(n, name),
+            other => panic!("{name}: {other:?}"),
+        }
+    }
+}
