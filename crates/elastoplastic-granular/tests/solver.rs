@@ -112,7 +112,8 @@ fn a_resumed_run_repeats_the_uninterrupted_one() {
 #[test]
 fn invalid_parameters_are_named() {
     let base = ElastoplasticParams::<f64>::for_spacing(S, 30.0);
-    let cases: [(&str, fn(&mut ElastoplasticParams<f64>)); 5] = [
+    type Change = fn(&mut ElastoplasticParams<f64>);
+    let cases: [(&str, Change); 5] = [
         ("poisson_ratio", |p| p.poisson_ratio = 0.5),
         ("youngs_modulus", |p| p.youngs_modulus = -1.0),
         ("dilatancy_angle_deg", |p| p.dilatancy_angle_deg = 40.0),
