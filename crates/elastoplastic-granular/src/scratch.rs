@@ -50,6 +50,8 @@ impl<R: Real> Scratch<R> {
         self.x_new.resize(n, z);
         self.v_new.resize(n, z);
         self.anchor.resize(n, z);
-        self.wall_grad.resize(n * slots, z);
+        // At least one slot, so that the stress pass (which zips over chunks of it) sees
+        // every particle without walls too.
+        self.wall_grad.resize(n * slots.max(1), z);
     }
 }
