@@ -4,7 +4,7 @@
 //! discretisation keeps it bounded (the artificial viscosity lets it decay).
 //!
 //! ```sh
-//! cargo run --release --example perturbed_block -p elastoplastic-granular [FRAMES] [ALPHA_PI]
+//! cargo run --release --example perturbed_block -p elastoplastic-granular [FRAMES] [ALPHA_PI] [EPSILON]
 //! ```
 
 use elastoplastic_granular::{Aabb, Elastoplastic, ElastoplasticParams, ParticleSet, Vec3};
@@ -19,6 +19,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     p.cohesion = 1e6;
     p.common.gravity = Vec3::zeros();
     p.viscosity_alpha = args.get(2).map_or(Ok(p.viscosity_alpha), |a| a.parse())?;
+    p.artificial_stress_epsilon = args
+        .get(3)
+        .map_or(Ok(p.artificial_stress_epsilon), |a| a.parse())?;
     let region = Aabb::new(Vec3::zeros(), Vec3::new(0.1, 0.1, 0.1))?;
     let x = cubic_lattice(&region, s, 100_000)?;
     let mut state = ParticleSet::from_positions(x, p.common.particle_mass(), p.common.rest_density);
