@@ -3,7 +3,7 @@
 //! granular codes or a time cap, with the angle measured as the repose experiment does.
 //!
 //! ```sh
-//! cargo run --release --example heap_30 -p elastoplastic-granular [E_PA] [CAP_S] [PHI_DEG] [CFL]
+//! cargo run --release --example heap_30 -p elastoplastic-granular [E_PA] [CAP_S] [PHI_DEG] [CFL] [walls|periodic]
 //! ```
 //!
 //! Prints every 0.1 s: time, 99th-percentile speed, fastest particle two spacings deep,
@@ -13,7 +13,7 @@
 use std::time::Instant;
 
 use elastoplastic_granular::heap::{
-    at_rest, fixed_base_heap, rest_speeds, RestSample, BASE_TOP_M, BASE_X_M,
+    at_rest, fixed_base_heap, rest_speeds, RestSample, SlabSides, BASE_TOP_M, BASE_X_M,
 };
 use elastoplastic_granular::stress::plane_strain_alpha;
 use elastoplastic_granular::ElastoplasticParams;
@@ -34,7 +34,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut params = ElastoplasticParams::<f64>::for_spacing(SPACING, phi);
     params.youngs_modulus = youngs;
     params.cfl_number = arg(4, params.cfl_number)?;
-    let (mut solver, mut state) = fixed_base_heap(params)?;
+    let sides = match std::env::args().nth(5).as_deref() {
+        Some("periodic") => SlabSides::Periodic,
+        _ => SlabSides::FreeSlipWalls,
+    };
+    println!("slab sides: {sides:?}");
+    let (mut solver, mut state) = fixed_base_heap(params, sides)?;
     let (steps, dt) = solver.params().explicit_steps();
     let predicted = (3.0 * plane_strain_alpha(phi)).asin().to_degrees();
     println!(

@@ -3,14 +3,16 @@
 //!
 //! Geometry (m): a tank `[0, 2.4] × [0, 0.8] × [0, 0.03]`, a base `[0.8, 1.6] × [0, 0.25]`
 //! across the slab, and a block `[0.8, 1.6] × [0.25, 0.55]` on it, on a cubic lattice half
-//! a spacing from its faces. Solids: 0 and 1 the slab's front and back walls (`z = 0`,
-//! `z = 0.03`), 2 the tank's floor and ends, 3 the base.
+//! a spacing from its faces. Across the slab either free-slip walls (solids 0 and 1 the
+//! front and back walls `z = 0`, `z = 0.03`, then 2 the tank's floor and ends, 3 the base)
+//! or periodic ends (plane strain without walls: 0 the tank, 1 the base).
 
 use sph_core::sampling::cubic_lattice;
 use sph_core::{Aabb, BoxSdf, Inverted, ParticleSet, Plane, Real, Vec3};
 use sph_solver::{Solids, SolverError};
 
 use crate::params::{ElastoplasticParams, WallModel};
+use crate::periodic::PeriodicAxis;
 use crate::solver::{Elastoplastic, ElastoplasticScheme};
 use crate::walls::volume_map_walls;
 
@@ -29,34 +31,53 @@ fn aabb<R: Real>(lo: [f64; 3], hi: [f64; 3]) -> Result<Aabb<R>, SolverError> {
     Ok(Aabb::new(v(lo[0], lo[1], lo[2]), v(hi[0], hi[1], hi[2]))?)
 }
 
+/// What bounds the slab across `z`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum SlabSides {
+    /// Free-slip walls at `z = 0` and `z = SLAB_DEPTH_M`.
+    FreeSlipWalls,
+    /// Periodic ends: the slab repeats along `z` (plane strain without walls).
+    Periodic,
+}
+
 /// The solver and the block's particles at `t = 0` for `params` (its spacing sets the
-/// lattice): free-slip slab walls (solids 0, 1), no-slip tank and base (2, 3).
+/// lattice), the slab bounded by `sides`; the tank and the base are no-slip.
 pub fn fixed_base_heap<R: Real>(
     mut params: ElastoplasticParams<R>,
+    sides: SlabSides,
 ) -> Result<(Elastoplastic<R>, ParticleSet<R>), SolverError> {
     let s = params.common.particle_spacing;
     let d = SLAB_DEPTH_M;
     let (far_lo, far_hi) = (-0.5, d + 0.5);
-    let solids: Solids<R> = vec![
-        Box::new(Plane::new(v(0.0, 0.0, 0.0), v(0.0, 0.0, 1.0))?),
-        Box::new(Plane::new(v(0.0, 0.0, d), v(0.0, 0.0, -1.0))?),
-        Box::new(Inverted(BoxSdf::new(aabb(
-            [0.0, 0.0, far_lo],
-            [2.4, 0.8, far_hi],
-        )?)?)),
-        Box::new(BoxSdf::new(aabb(
-            [BASE_X_M[0], -0.5, far_lo],
-            [BASE_X_M[1], BASE_TOP_M, far_hi],
-        )?)?),
-    ];
-    params.wall_models = vec![
-        WallModel::FreeSlip,
-        WallModel::FreeSlip,
-        WallModel::NoSlip,
-        WallModel::NoSlip,
-    ];
-    let tank = aabb([0.0, 0.0, 0.0], [2.4, 0.8, d])?;
-    let walls = volume_map_walls(solids, &params, tank)?;
+    let mut solids: Solids<R> = Vec::new();
+    params.wall_models.clear();
+    params.periodic.clear();
+    match sides {
+        SlabSides::FreeSlipWalls => {
+            solids.push(Box::new(Plane::new(v(0.0, 0.0, 0.0), v(0.0, 0.0, 1.0))?));
+            solids.push(Box::new(Plane::new(v(0.0, 0.0, d), v(0.0, 0.0, -1.0))?));
+            params.wall_models = vec![WallModel::FreeSlip; 2];
+        }
+        SlabSides::Periodic => params.periodic.push(PeriodicAxis {
+            axis: 2,
+            lo: R::zero(),
+            hi: R::of_f64(d),
+        }),
+    }
+    solids.push(Box::new(Inverted(BoxSdf::new(aabb(
+        [0.0, 0.0, far_lo],
+        [2.4, 0.8, far_hi],
+    )?)?)));
+    solids.push(Box::new(BoxSdf::new(aabb(
+        [BASE_X_M[0], -0.5, far_lo],
+        [BASE_X_M[1], BASE_TOP_M, far_hi],
+    )?)?));
+    params
+        .wall_models
+        .extend([WallModel::NoSlip, WallModel::NoSlip]);
+    let domain = aabb([0.0, 0.0, -0.05], [2.4, 0.8, d + 0.05])?;
+    let walls = volume_map_walls(solids, &params, domain)?;
     let block = aabb([BASE_X_M[0], BASE_TOP_M, 0.0], [BASE_X_M[1], 0.55, d])?;
     let positions = cubic_lattice(&block, s, 1 << 22)?;
     let state = ParticleSet::from_positions(

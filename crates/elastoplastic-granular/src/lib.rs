@@ -61,15 +61,18 @@
 //!   (`E` = 5.84 MPa, `ν` = 0.3, `ρ0` = 2040 kg/m³), not checked against the paper here; the
 //!   speed of sound is `√(E/ρ0)` as in Bui (SPHinXsys uses `√(K/ρ0)`).
 
+pub mod boundary_particles;
 pub mod heap;
 mod kernels;
 mod params;
 mod passes;
+pub mod periodic;
 mod scratch;
 mod solver;
 pub mod stress;
 pub mod walls;
 
+pub use boundary_particles::{boundary_block, BoundaryParticle};
 pub use kernels::ELASTOPLASTIC_KERNEL;
 pub use params::{
     ElastoplasticParams, WallModel, DEFAULT_ARTIFICIAL_STRESS_EPSILON,
@@ -80,6 +83,7 @@ pub use params::{
     MAX_FRICTION_ANGLE_DEG, MAX_POISSON_RATIO, MAX_VISCOSITY_COEFFICIENT, MAX_WALL_MODELS,
     MAX_YOUNGS_MODULUS_PA,
 };
+pub use periodic::PeriodicAxis;
 pub use solver::{
     Elastoplastic, ElastoplasticScheme, ELASTOPLASTIC_PHASES, ELASTOPLASTIC_STATE_ARRAYS,
 };

@@ -3,6 +3,7 @@
 use sph_core::Real;
 use sph_solver::{CommonParams, SolverError};
 
+use crate::periodic::PeriodicAxis;
 use crate::stress::DruckerPrager;
 
 /// Largest Young's modulus accepted (Pa): 1 TPa, above any granular material's, so that the
@@ -59,6 +60,10 @@ pub enum WallModel {
     FreeSlip,
     /// The whole traction; the wall's velocity (zero) enters the velocity gradient.
     NoSlip,
+    /// The solid only keeps the particles out (projection to the contact distance); its
+    /// share of the sums comes from boundary particles
+    /// ([`ElastoplasticScheme::set_boundary_particles`](crate::ElastoplasticScheme::set_boundary_particles)).
+    ContactOnly,
 }
 
 /// Parameters of [`Elastoplastic`](crate::Elastoplastic).
@@ -78,6 +83,7 @@ pub enum WallModel {
 /// | `cfl_number` | 0.2 | [`DEFAULT_CFL_NUMBER`] |
 /// | `skin` | `0.3 s` | [`DEFAULT_SKIN_OVER_SPACING`] |
 /// | `default_wall`, `wall_models` | no-slip, none | |
+/// | `periodic` | none | |
 #[derive(Debug, Clone, PartialEq)]
 pub struct ElastoplasticParams<R: Real> {
     /// The parameters every solver has.
@@ -110,6 +116,9 @@ pub struct ElastoplasticParams<R: Real> {
     pub default_wall: WallModel,
     /// The wall model of each solid, by index in the boundary's solids.
     pub wall_models: Vec<WallModel>,
+    /// Periodic axes (at most one entry per axis; each period at least `support_radius +
+    /// skin`, so that one image on each side covers every neighbour).
+    pub periodic: Vec<PeriodicAxis<R>>,
 }
 
 fn invalid(name: &'static str, value: f64, reason: &'static str) -> SolverError {
@@ -157,6 +166,7 @@ impl<R: Real> ElastoplasticParams<R> {
             skin: s * R::of_f64(DEFAULT_SKIN_OVER_SPACING),
             default_wall: WallModel::NoSlip,
             wall_models: Vec::new(),
+            periodic: Vec::new(),
         }
     }
 
@@ -296,6 +306,26 @@ impl<R: Real> ElastoplasticParams<R> {
                 self.wall_models.len() as f64,
                 "at most MAX_WALL_MODELS = 64 solids have their own model",
             ));
+        }
+        let reach = f(self.common.support_radius + self.skin);
+        for (k, a) in self.periodic.iter().enumerate() {
+            if a.axis > 2 || self.periodic[..k].iter().any(|b| b.axis == a.axis) {
+                return Err(invalid(
+                    "periodic",
+                    a.axis as f64,
+                    "each periodic axis must be 0, 1 or 2 and appear once (value: the axis)",
+                ));
+            }
+            check_range(
+                "periodic",
+                f(a.period()),
+                reach,
+                f64::MAX,
+                "a period (hi − lo, m; the value) must be finite and at least support_radius + skin",
+            )?;
+            if !f(a.lo).is_finite() {
+                return Err(invalid("periodic", f(a.lo), "the lower end must be finite"));
+            }
         }
         let (n, _) = self.explicit_steps();
         if n > MAX_EXPLICIT_STEPS_PER_SUBSTEP {

@@ -26,6 +26,16 @@ pub(crate) struct StepInputs<'a, R: Real> {
     pub models: &'a [WallModel],
     pub gravity: Vec3<R>,
     pub dt: R,
+    /// Mass of a boundary particle (kg): neighbours `j ≥ masses.len()` are boundary
+    /// particles.
+    pub boundary_mass: R,
+}
+
+impl<R: Real> StepInputs<'_, R> {
+    #[inline]
+    fn mass(&self, j: usize) -> R {
+        self.masses.get(j).copied().unwrap_or(self.boundary_mass)
+    }
 }
 
 /// Pass 1: the wall gradients at `x`, the velocity gradient `L_i` and the continuity rate
@@ -34,13 +44,14 @@ pub(crate) struct StepInputs<'a, R: Real> {
 pub(crate) fn stress_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>) {
     let c = inp.c;
     let slots = inp.models.len();
-    let (x, v, rho, m) = (&s.x[..], &s.v[..], &s.rho[..], inp.masses);
-    let (stress, plastic) = (&s.stress[..], &s.plastic_strain[..]);
-    s.stress_new
+    let n = inp.masses.len();
+    let (x, v, rho) = (&s.x[..], &s.v[..], &s.rho[..]);
+    let (stress, plastic, images) = (&s.stress[..], &s.plastic_strain[..], &s.images);
+    s.stress_new[..n]
         .par_iter_mut()
-        .zip(s.rho_new.par_iter_mut())
+        .zip(s.rho_new[..n].par_iter_mut())
         .zip(s.plastic_new.par_iter_mut())
-        .zip(s.art.par_iter_mut())
+        .zip(s.art[..n].par_iter_mut())
         .zip(s.wall_grad.par_chunks_mut(slots.max(1)))
         .enumerate()
         .with_min_len(MIN_LEN)
@@ -49,16 +60,17 @@ pub(crate) fn stress_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>) 
             let mut grad_v = Matrix3::zeros();
             let mut drho = R::zero();
             for &j in inp.nb.neighbours(i) {
-                let j = j as usize;
-                let gw = c.kernel.gradient(&(xi - x[j]));
+                let (j, xj) = images.resolve(j as usize, x);
+                let gw = c.kernel.gradient(&(xi - xj));
                 let dv = v[j] - vi;
-                grad_v += dv * gw.transpose() * (m[j] / rho[j]);
-                drho -= m[j] * dv.dot(&gw);
+                let mj = inp.mass(j);
+                grad_v += dv * gw.transpose() * (mj / rho[j]);
+                drho -= mj * dv.dot(&gw);
             }
             if slots > 0 {
                 inp.walls.sample(inp.boundary, &xi, grads);
                 for (g, &model) in grads.iter().zip(inp.models) {
-                    if g.norm_squared() > R::zero() {
+                    if model != WallModel::ContactOnly && g.norm_squared() > R::zero() {
                         grad_v -= wall_part(model, g, &vi) * g.transpose();
                         drho += c.rho0 * vi.dot(g);
                     }
@@ -79,14 +91,16 @@ pub(crate) fn stress_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>) 
 pub(crate) fn momentum_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>) {
     let c = inp.c;
     let slots = inp.models.len();
-    let (x, v, m) = (&s.x[..], &s.v[..], inp.masses);
+    let n = inp.masses.len();
+    let (x, v) = (&s.x[..], &s.v[..]);
     let (sig, rho, art, grads) = (&s.stress_new[..], &s.rho_new[..], &s.art[..], &s.wall_grad);
+    let images = &s.images;
     let two = R::of_f64(2.0);
     let half = R::of_f64(0.5);
     let inv_dt = R::one() / inp.dt;
-    s.v_new
+    s.v_new[..n]
         .par_iter_mut()
-        .zip(s.x_new.par_iter_mut())
+        .zip(s.x_new[..n].par_iter_mut())
         .enumerate()
         .with_min_len(MIN_LEN)
         .for_each(|(i, (vn, xn))| {
@@ -96,8 +110,8 @@ pub(crate) fn momentum_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>
             let art_i_zero = art_i == Matrix3::zeros();
             let mut a = inp.gravity;
             for &j in inp.nb.neighbours(i) {
-                let j = j as usize;
-                let xij = xi - x[j];
+                let (j, xj) = images.resolve(j as usize, x);
+                let xij = xi - xj;
                 let gw = c.kernel.gradient(&xij);
                 if gw == Vec3::zeros() {
                     continue;
@@ -117,12 +131,12 @@ pub(crate) fn momentum_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>
                     let f = (c.kernel.value(xij.norm()) * c.inv_w_spacing).powf(c.exponent);
                     t += (art_i + art[j]) * f;
                 }
-                a += t * gw * m[j];
+                a += t * gw * inp.mass(j);
             }
             if slots > 0 {
                 let gi = &grads[i * slots..(i + 1) * slots];
                 for (g, &model) in gi.iter().zip(inp.models) {
-                    if g.norm_squared() > R::zero() {
+                    if model != WallModel::ContactOnly && g.norm_squared() > R::zero() {
                         a += wall_part(model, g, &(sig[i] * g)) * (two * c.rho0 / (ri * ri));
                     }
                 }
@@ -136,8 +150,9 @@ pub(crate) fn momentum_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>
 }
 
 /// The largest distance (m) any particle has moved since the last neighbour search.
-pub(crate) fn max_displacement<R: Real>(s: &Scratch<R>) -> R {
-    s.x.par_iter()
+pub(crate) fn max_displacement<R: Real>(s: &Scratch<R>, n: usize) -> R {
+    s.x[..n]
+        .par_iter()
         .zip(s.anchor.par_iter())
         .with_min_len(MIN_LEN)
         .map(|(a, b)| (a - b).norm())

@@ -4,6 +4,9 @@
 use nalgebra::Matrix3;
 use sph_core::{Real, Vec3};
 
+use crate::boundary_particles::BoundaryParticle;
+use crate::periodic::Images;
+
 /// Per-particle arrays (structure of arrays).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Scratch<R: Real> {
@@ -27,29 +30,49 @@ pub(crate) struct Scratch<R: Real> {
     pub anchor: Vec<Vec3<R>>,
     /// Wall gradients `∇Ψ_k`, `slots` per particle.
     pub wall_grad: Vec<Vec3<R>>,
+    /// Images of the particles near periodic ends, and the particles followed by them (the
+    /// array the neighbour lists index).
+    pub images: Images<R>,
+    pub x_ext: Vec<Vec3<R>>,
     /// Permutation scratch.
     pub permute_m: Vec<Matrix3<R>>,
     pub permute_r: Vec<R>,
 }
 
 impl<R: Real> Scratch<R> {
-    /// Sizes every array for `n` particles and `slots` wall gradients each; a new particle
-    /// starts unstressed.
-    pub(crate) fn resize(&mut self, n: usize, slots: usize) {
+    /// Sizes every array for `n` particles followed by the boundary particles `boundary`
+    /// (positions, velocities, stresses, densities; the particles' own arrays hold `n`)
+    /// and `slots` wall gradients each; a new particle starts unstressed. Writes the
+    /// boundary particles' positions and density `rho0`.
+    pub(crate) fn resize(
+        &mut self,
+        n: usize,
+        boundary: &[BoundaryParticle<R>],
+        rho0: R,
+        slots: usize,
+    ) {
         let z = Vec3::zeros();
         let zm = Matrix3::zeros();
-        self.stress.resize(n, zm);
+        let all = n + boundary.len();
+        self.stress.resize(all, zm);
         self.plastic_strain.resize(n, R::zero());
-        self.x.resize(n, z);
-        self.v.resize(n, z);
-        self.rho.resize(n, R::zero());
-        self.stress_new.resize(n, zm);
-        self.rho_new.resize(n, R::zero());
+        self.x.resize(all, z);
+        self.v.resize(all, z);
+        self.rho.resize(all, R::zero());
+        self.stress_new.resize(all, zm);
+        self.rho_new.resize(all, R::zero());
         self.plastic_new.resize(n, R::zero());
-        self.art.resize(n, zm);
-        self.x_new.resize(n, z);
-        self.v_new.resize(n, z);
-        self.anchor.resize(n, z);
+        self.art.resize(all, zm);
+        self.x_new.resize(all, z);
+        self.v_new.resize(all, z);
+        self.anchor.resize(all, z);
+        for (k, b) in boundary.iter().enumerate() {
+            for x in [&mut self.x, &mut self.x_new, &mut self.anchor] {
+                x[n + k] = b.position;
+            }
+            self.rho[n + k] = rho0;
+            self.rho_new[n + k] = rho0;
+        }
         // At least one slot, so that the stress pass (which zips over chunks of it) sees
         // every particle without walls too.
         self.wall_grad.resize(n * slots.max(1), z);

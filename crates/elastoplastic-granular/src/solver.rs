@@ -13,6 +13,7 @@ use sph_solver::state::{match_arrays, ArraySpec};
 use sph_solver::step::{check_divergence, FramePhases, StepAt};
 use sph_solver::{CommonParams, FrameSolver, SchemeParts, SolverError, StepStats, SubstepScheme};
 
+use crate::boundary_particles::{extrapolate, BoundaryParticle, Extrapolation};
 use crate::kernels::{Consts, ELASTOPLASTIC_KERNEL};
 use crate::params::{ElastoplasticParams, WallModel};
 use crate::passes::{max_displacement, momentum_pass, stress_pass, StepInputs};
@@ -52,6 +53,7 @@ pub struct ElastoplasticScheme<R: Real> {
     parts: SchemeParts<R>,
     walls: WallSampler<R>,
     models: Vec<WallModel>,
+    boundary_particles: Vec<BoundaryParticle<R>>,
     scratch: Scratch<R>,
     lists_valid: bool,
     explicit_steps: u64,
@@ -98,6 +100,7 @@ impl<R: Real> ElastoplasticScheme<R> {
             parts,
             walls,
             models,
+            boundary_particles: Vec::new(),
             scratch: Scratch::default(),
             lists_valid: false,
             explicit_steps: 0,
@@ -131,13 +134,83 @@ impl<R: Real> ElastoplasticScheme<R> {
 
     /// The stress `σ_i` of each particle (Pa, tension positive) after the last step.
     pub fn stress(&self) -> &[Matrix3<R>] {
-        &self.scratch.stress
+        &self.scratch.stress[..self.scratch.plastic_strain.len()]
     }
 
     /// The equivalent plastic shear strain accumulated by each particle
     /// ([`StressUpdate::plastic_strain`](crate::StressUpdate::plastic_strain) summed).
     pub fn plastic_strain(&self) -> &[R] {
         &self.scratch.plastic_strain
+    }
+
+    /// Sets the stress of each particle (Pa, tension positive; one per particle of the state
+    /// the next [`FrameSolver::step`] takes), e.g. a geostatic initial stress. Errors: a
+    /// non-finite or asymmetric stress, named by its index.
+    pub fn set_stress(&mut self, stress: &[Matrix3<R>]) -> Result<(), SolverError> {
+        for (i, m) in stress.iter().enumerate() {
+            if m.iter().any(|v| !v.is_finite()) || *m != m.transpose() {
+                return Err(SolverError::InvalidParameter {
+                    solver: NAME,
+                    name: "stress",
+                    value: i as f64,
+                    reason: "each stress must be finite and symmetric (value: the first particle whose stress is not)",
+                });
+            }
+        }
+        self.resize(stress.len());
+        self.scratch.stress[..stress.len()].copy_from_slice(stress);
+        Ok(())
+    }
+
+    /// Sets the fixed boundary particles (see [`crate::boundary_particles`]); they take
+    /// part in every sum from the next step on. Solids whose share they replace should
+    /// have the model [`WallModel::ContactOnly`]. Errors: a non-finite position or normal,
+    /// named by its index.
+    pub fn set_boundary_particles(
+        &mut self,
+        particles: Vec<BoundaryParticle<R>>,
+    ) -> Result<(), SolverError> {
+        for (k, b) in particles.iter().enumerate() {
+            let ok = b
+                .position
+                .iter()
+                .chain(b.normal.iter())
+                .all(|v| v.is_finite())
+                && b.normal.norm() > R::zero();
+            if !ok {
+                return Err(SolverError::InvalidParameter {
+                    solver: NAME,
+                    name: "boundary_particles",
+                    value: k as f64,
+                    reason: "each boundary particle needs a finite position and a finite non-zero normal (value: the first that has not)",
+                });
+            }
+        }
+        let n = self.scratch.plastic_strain.len();
+        self.boundary_particles = particles
+            .into_iter()
+            .map(|b| BoundaryParticle {
+                normal: b.normal / b.normal.norm(),
+                ..b
+            })
+            .collect();
+        self.resize(n);
+        self.lists_valid = false;
+        Ok(())
+    }
+
+    /// The boundary particles.
+    pub fn boundary_particles(&self) -> &[BoundaryParticle<R>] {
+        &self.boundary_particles
+    }
+
+    fn resize(&mut self, n: usize) {
+        self.scratch.resize(
+            n,
+            &self.boundary_particles,
+            self.params.common.rest_density,
+            self.models.len(),
+        );
     }
 
     /// Explicit steps taken so far, and neighbour searches made for them.
@@ -161,16 +234,25 @@ impl<R: Real> ElastoplasticScheme<R> {
         let h = self.params.common.support_radius;
         let skin = self.params.skin;
         let half = R::of_f64(0.5);
+        let n = state.len();
         let s = &mut self.scratch;
-        s.x.copy_from_slice(&state.positions);
-        s.v.copy_from_slice(&state.velocities);
-        s.rho.copy_from_slice(&state.densities);
+        s.x[..n].copy_from_slice(&state.positions);
+        s.v[..n].copy_from_slice(&state.velocities);
+        s.rho[..n].copy_from_slice(&state.densities);
+        let boundary_mass = self.params.common.particle_mass();
         for _ in 0..steps {
-            if !self.lists_valid || max_displacement(s) > skin * half {
-                let search = self
-                    .parts
-                    .neighbours
-                    .find_in_step(&s.x, h + skin, at, "position")?;
+            if !self.lists_valid || max_displacement(s, n) > skin * half {
+                let axes = &self.params.periodic;
+                let search = if axes.is_empty() {
+                    self.parts
+                        .neighbours
+                        .find_in_step(&s.x, h + skin, at, "position")?
+                } else {
+                    s.images.rebuild(&mut s.x, axes, h + skin, &mut s.x_ext);
+                    self.parts
+                        .neighbours
+                        .find_in_step(&s.x_ext, h + skin, at, "position")?
+                };
                 stats.phases.add(CREATE_HASH_GRID, search.build_s());
                 stats.phases.add(DETECT_NEIGHBOURS, search.detect_s());
                 s.anchor.copy_from_slice(&s.x);
@@ -186,9 +268,35 @@ impl<R: Real> ElastoplasticScheme<R> {
                 models: &self.models,
                 gravity: self.params.common.gravity,
                 dt,
+                boundary_mass,
             };
             let t = Instant::now();
+            let bp = &self.boundary_particles;
+            if !bp.is_empty() {
+                let e = Extrapolation {
+                    c: self.c,
+                    nb: self.parts.neighbours.lists(),
+                    images: &s.images,
+                    x: &s.x,
+                    rho: &s.rho,
+                    particles: bp,
+                    gravity: self.params.common.gravity,
+                };
+                extrapolate(&e, &mut s.stress, Some(&mut s.v), None);
+            }
             stress_pass(s, &inputs);
+            if !bp.is_empty() {
+                let e = Extrapolation {
+                    c: self.c,
+                    nb: self.parts.neighbours.lists(),
+                    images: &s.images,
+                    x: &s.x,
+                    rho: &s.rho,
+                    particles: bp,
+                    gravity: self.params.common.gravity,
+                };
+                extrapolate(&e, &mut s.stress_new, None, Some(&mut s.art));
+            }
             stats.phases.add(STRESS, t.elapsed().as_secs_f64());
             let t = Instant::now();
             momentum_pass(s, &inputs);
@@ -201,10 +309,10 @@ impl<R: Real> ElastoplasticScheme<R> {
             self.explicit_steps += 1;
             stats.iterations += 1;
         }
-        check_divergence(at, &s.x, &s.v, &*self.parts.boundary, h)?;
-        state.positions.copy_from_slice(&s.x);
-        state.velocities.copy_from_slice(&s.v);
-        state.densities.copy_from_slice(&s.rho);
+        check_divergence(at, &s.x[..n], &s.v[..n], &*self.parts.boundary, h)?;
+        state.positions.copy_from_slice(&s.x[..n]);
+        state.velocities.copy_from_slice(&s.v[..n]);
+        state.densities.copy_from_slice(&s.rho[..n]);
         stats.substeps += 1;
         stats.neighbour_pairs = self.parts.neighbours.lists().pair_count();
         Ok(())
@@ -246,11 +354,12 @@ impl<R: Real> SubstepScheme<R> for ElastoplasticScheme<R> {
         _stats: &mut StepStats,
     ) -> Result<(), SolverError> {
         let n = state.len();
-        let s = &mut self.scratch;
-        s.resize(n, self.models.len());
+        self.resize(n);
         if let Some(p) = permutation {
+            let s = &mut self.scratch;
             apply_permutation(&mut s.stress, p, &mut s.permute_m);
             apply_permutation(&mut s.plastic_strain, p, &mut s.permute_r);
+            self.resize(n);
         }
         // Every frame starts from fresh lists, so that a run resumed from a checkpoint
         // repeats the uninterrupted one bit for bit.
@@ -270,7 +379,7 @@ impl<R: Real> SubstepScheme<R> for ElastoplasticScheme<R> {
         let s = &self.scratch;
         arrays.push((
             "stress".into(),
-            s.stress
+            s.stress[..s.plastic_strain.len()]
                 .iter()
                 .flat_map(|m| {
                     [
@@ -306,15 +415,15 @@ impl<R: Real> SubstepScheme<R> for ElastoplasticScheme<R> {
                 },
             ],
         )?;
+        self.resize(n);
         let s = &mut self.scratch;
-        s.resize(n, self.models.len());
         match found[0] {
             Some(v) => {
-                for (m, c) in s.stress.iter_mut().zip(v.chunks_exact(6)) {
+                for (m, c) in s.stress[..n].iter_mut().zip(v.chunks_exact(6)) {
                     *m = Matrix3::new(c[0], c[3], c[5], c[3], c[1], c[4], c[5], c[4], c[2]);
                 }
             }
-            None => s.stress.fill(Matrix3::zeros()),
+            None => s.stress[..n].fill(Matrix3::zeros()),
         }
         match found[1] {
             Some(v) => s.plastic_strain.copy_from_slice(v),

@@ -114,6 +114,7 @@ impl<R: Real> WallSampler<R> {
 pub(crate) fn wall_part<R: Real>(model: WallModel, grad: &Vec3<R>, v: &Vec3<R>) -> Vec3<R> {
     match model {
         WallModel::NoSlip => *v,
+        WallModel::ContactOnly => Vec3::zeros(),
         WallModel::FreeSlip => {
             let g2 = grad.norm_squared();
             if g2 > R::zero() {
