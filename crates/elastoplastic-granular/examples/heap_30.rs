@@ -3,7 +3,7 @@
 //! granular codes or a time cap, with the angle measured as the repose experiment does.
 //!
 //! ```sh
-//! cargo run --release --example heap_30 -p elastoplastic-granular [E_PA] [CAP_S] [PHI_DEG] [CFL] [walls|periodic]
+//! cargo run --release --example heap_30 -p elastoplastic-granular [E_PA] [CAP_S] [PHI_DEG] [CFL] [walls|periodic] [particles|maps] [geo|zero] [WEDGE_DEG]
 //! ```
 //!
 //! Prints every 0.1 s: time, 99th-percentile speed, fastest particle two spacings deep,
@@ -13,7 +13,7 @@
 use std::time::Instant;
 
 use elastoplastic_granular::heap::{
-    at_rest, fixed_base_heap, rest_speeds, RestSample, SlabSides, BASE_TOP_M, BASE_X_M,
+    at_rest, fixed_base_heap, rest_speeds, HeapSetup, RestSample, SlabSides, BASE_TOP_M, BASE_X_M,
 };
 use elastoplastic_granular::stress::plane_strain_alpha;
 use elastoplastic_granular::ElastoplasticParams;
@@ -38,8 +38,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Some("periodic") => SlabSides::Periodic,
         _ => SlabSides::FreeSlipWalls,
     };
-    println!("slab sides: {sides:?}");
-    let (mut solver, mut state) = fixed_base_heap(params, sides)?;
+    let setup = HeapSetup {
+        sides,
+        particle_walls: std::env::args().nth(6).as_deref() == Some("particles"),
+        geostatic: std::env::args().nth(7).as_deref() == Some("geo"),
+        wedge_deg: std::env::args().nth(8).and_then(|a| a.parse().ok()),
+    };
+    println!("{setup:?}");
+    let (mut solver, mut state) = fixed_base_heap(params, setup)?;
     let (steps, dt) = solver.params().explicit_steps();
     let predicted = (3.0 * plane_strain_alpha(phi)).asin().to_degrees();
     println!(
@@ -49,10 +55,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let frame_dt = solver.params().common.dt;
     let options = ReposeOptions::planar(BASE_TOP_M, SPACING).with_spacing(SPACING);
     let mut samples: Vec<RestSample> = Vec::new();
+    let initial = state.positions.clone();
+    // ids[k]: the original index of the particle now at k (the solver reorders them).
+    let mut ids: Vec<usize> = (0..state.len()).collect();
     let start = Instant::now();
     let frames = (cap_s / frame_dt).ceil() as usize;
     for frame in 1..=frames {
         solver.step(&mut state)?;
+        if let Some(perm) = solver.last_permutation() {
+            ids = perm.iter().map(|&o| ids[o as usize]).collect();
+        }
         let t = frame as f64 * frame_dt;
         let (x, v): (Vec<_>, Vec<_>) = state
             .positions
@@ -88,6 +100,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 "    fastest {vmax:.3} m/s at ({:.3}, {:.3}, {:.4}) rho/rho0 {:.3} I1 {i1:.0} Pa sqrtJ2 {sq:.0} Pa; rho/rho0 in [{rmin:.3}, {rmax:.3}]",
                 p.x, p.y, p.z, state.densities[k] / rho0
             );
+            // Displacement from the start of the particles still on the base.
+            let mut disp: Vec<f64> = state
+                .positions
+                .iter()
+                .zip(&ids)
+                .filter(|(p, _)| p.x >= BASE_X_M[0] && p.x <= BASE_X_M[1] && p.y > BASE_TOP_M)
+                .map(|(p, &k)| {
+                    // In-plane displacement: z is periodic in one set-up.
+                    let d = p - initial[k];
+                    (d.x * d.x + d.y * d.y).sqrt()
+                })
+                .collect();
+            disp.sort_by(f64::total_cmp);
+            if let (Some(&med), Some(&max)) = (disp.get(disp.len() / 2), disp.last()) {
+                println!("    displacement on the base: median {med:.4} m, max {max:.4} m");
+            }
             println!(
                 "t {t:5.2} s  p99 {p99:.4} m/s  deep max {deep:.4} m/s  angle {}  on base {}  wall {:.1} s",
                 angle.map_or("-".into(), |a| format!("{a:.2}")),
@@ -95,7 +123,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 start.elapsed().as_secs_f64()
             );
         }
-        if rest {
+        if rest && setup.wedge_deg.is_none() {
             println!(
                 "AT REST at t = {t:.2} s: angle {} deg (predicted {predicted:.2}), wall time {:.1} s",
                 angle.map_or("-".into(), |a| format!("{a:.2}")),

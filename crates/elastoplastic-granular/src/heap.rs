@@ -5,12 +5,15 @@
 //! across the slab, and a block `[0.8, 1.6] × [0.25, 0.55]` on it, on a cubic lattice half
 //! a spacing from its faces. Across the slab either free-slip walls (solids 0 and 1 the
 //! front and back walls `z = 0`, `z = 0.03`, then 2 the tank's floor and ends, 3 the base)
-//! or periodic ends (plane strain without walls: 0 the tank, 1 the base).
+//! or periodic ends (plane strain without walls); then the tank's floor, its two ends, and
+//! the base.
 
+use nalgebra::Matrix3;
 use sph_core::sampling::cubic_lattice;
-use sph_core::{Aabb, BoxSdf, Inverted, ParticleSet, Plane, Real, Vec3};
+use sph_core::{Aabb, BoxSdf, ParticleSet, Plane, Real, Vec3};
 use sph_solver::{Solids, SolverError};
 
+use crate::boundary_particles::boundary_block;
 use crate::params::{ElastoplasticParams, WallModel};
 use crate::periodic::PeriodicAxis;
 use crate::solver::{Elastoplastic, ElastoplasticScheme};
@@ -41,11 +44,35 @@ pub enum SlabSides {
     Periodic,
 }
 
+/// How the heap is set up: what bounds the slab across `z`, whether the tank's floor and
+/// the base are rows of boundary particles ([`crate::boundary_particles`], no-slip; the
+/// solids then only keep particles out) or volume-map walls, and whether the block starts
+/// from the geostatic stress (`σ_yy = −ρ0 g (top − y)`, `σ_xx = σ_zz = K0 σ_yy`,
+/// `K0 = ν/(1 − ν)`) or unstressed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HeapSetup {
+    /// What bounds the slab across `z`.
+    pub sides: SlabSides,
+    /// Floor and base as boundary particles.
+    pub particle_walls: bool,
+    /// Start from the geostatic stress.
+    pub geostatic: bool,
+    /// `None`: the block `[0.8, 1.6] × [0.25, 0.55]`; `Some(θ)`: a symmetric wedge on the
+    /// base with flanks at `θ` degrees (`y ≤ 0.25 + tan θ · min(x − 0.8, 1.6 − x)`, the
+    /// particles of the block's lattice below it) and the geostatic stress measured from
+    /// its surface.
+    pub wedge_deg: Option<f64>,
+}
+
+/// Rows of boundary particles standing for a wall (three spacings thick: the support is
+/// 2.4 spacings).
+const BOUNDARY_ROWS: f64 = 3.0;
+
 /// The solver and the block's particles at `t = 0` for `params` (its spacing sets the
-/// lattice), the slab bounded by `sides`; the tank and the base are no-slip.
+/// lattice), set up as `setup` says; the tank (floor and ends) and the base are no-slip.
 pub fn fixed_base_heap<R: Real>(
     mut params: ElastoplasticParams<R>,
-    sides: SlabSides,
+    setup: HeapSetup,
 ) -> Result<(Elastoplastic<R>, ParticleSet<R>), SolverError> {
     let s = params.common.particle_spacing;
     let d = SLAB_DEPTH_M;
@@ -53,7 +80,7 @@ pub fn fixed_base_heap<R: Real>(
     let mut solids: Solids<R> = Vec::new();
     params.wall_models.clear();
     params.periodic.clear();
-    match sides {
+    match setup.sides {
         SlabSides::FreeSlipWalls => {
             solids.push(Box::new(Plane::new(v(0.0, 0.0, 0.0), v(0.0, 0.0, 1.0))?));
             solids.push(Box::new(Plane::new(v(0.0, 0.0, d), v(0.0, 0.0, -1.0))?));
@@ -65,27 +92,80 @@ pub fn fixed_base_heap<R: Real>(
             hi: R::of_f64(d),
         }),
     }
-    solids.push(Box::new(Inverted(BoxSdf::new(aabb(
-        [0.0, 0.0, far_lo],
-        [2.4, 0.8, far_hi],
-    )?)?)));
+    let floor_and_base = if setup.particle_walls {
+        WallModel::ContactOnly
+    } else {
+        WallModel::NoSlip
+    };
+    solids.push(Box::new(Plane::new(v(0.0, 0.0, 0.0), v(0.0, 1.0, 0.0))?));
+    solids.push(Box::new(Plane::new(v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0))?));
+    solids.push(Box::new(Plane::new(v(2.4, 0.0, 0.0), v(-1.0, 0.0, 0.0))?));
     solids.push(Box::new(BoxSdf::new(aabb(
         [BASE_X_M[0], -0.5, far_lo],
         [BASE_X_M[1], BASE_TOP_M, far_hi],
     )?)?));
-    params
-        .wall_models
-        .extend([WallModel::NoSlip, WallModel::NoSlip]);
+    params.wall_models.extend([
+        floor_and_base,
+        WallModel::NoSlip,
+        WallModel::NoSlip,
+        floor_and_base,
+    ]);
     let domain = aabb([0.0, 0.0, -0.05], [2.4, 0.8, d + 0.05])?;
     let walls = volume_map_walls(solids, &params, domain)?;
-    let block = aabb([BASE_X_M[0], BASE_TOP_M, 0.0], [BASE_X_M[1], 0.55, d])?;
-    let positions = cubic_lattice(&block, s, 1 << 22)?;
+    let top = 0.55;
+    let block = aabb([BASE_X_M[0], BASE_TOP_M, 0.0], [BASE_X_M[1], top, d])?;
+    let surface = |x: f64| match setup.wedge_deg {
+        Some(a) => BASE_TOP_M + a.to_radians().tan() * (x - BASE_X_M[0]).min(BASE_X_M[1] - x),
+        None => top,
+    };
+    let mut positions = cubic_lattice(&block, s, 1 << 22)?;
+    positions.retain(|p| p.y.as_f64() <= surface(p.x.as_f64()));
     let state = ParticleSet::from_positions(
         positions,
         params.common.particle_mass(),
         params.common.rest_density,
     );
-    Ok((ElastoplasticScheme::solver(params, walls)?, state))
+    let (rho0, g, nu) = (
+        params.common.rest_density,
+        -params.common.gravity.y,
+        params.poisson_ratio,
+    );
+    let mut solver = ElastoplasticScheme::solver(params, walls)?;
+    if setup.particle_walls {
+        let t = BOUNDARY_ROWS * s.as_f64();
+        let (x0, x1, yb) = (BASE_X_M[0], BASE_X_M[1], BASE_TOP_M);
+        let up = v(0.0, 1.0, 0.0);
+        let mut rows = Vec::new();
+        for (lo, hi, normal) in [
+            ([0.0, -t, 0.0], [x0, 0.0, d], up),
+            ([x1, -t, 0.0], [2.4, 0.0, d], up),
+            ([x0, yb - t, 0.0], [x1, yb, d], up),
+            ([x0, 0.0, 0.0], [x0 + t, yb - t, d], v(-1.0, 0.0, 0.0)),
+            ([x1 - t, 0.0, 0.0], [x1, yb - t, d], v(1.0, 0.0, 0.0)),
+        ] {
+            rows.extend(boundary_block(
+                &aabb(lo, hi)?,
+                s,
+                normal,
+                WallModel::NoSlip,
+                1 << 22,
+            )?);
+        }
+        solver.scheme_mut().set_boundary_particles(rows)?;
+    }
+    if setup.geostatic {
+        let k0 = nu / (R::one() - nu);
+        let stress: Vec<Matrix3<R>> = state
+            .positions
+            .iter()
+            .map(|x| {
+                let sv = -rho0 * g * (R::of_f64(surface(x.x.as_f64())) - x.y);
+                Matrix3::from_diagonal(&Vec3::new(k0 * sv, sv, k0 * sv))
+            })
+            .collect();
+        solver.scheme_mut().set_stress(&stress)?;
+    }
+    Ok((solver, state))
 }
 
 /// One frame's figures of the rest criterion.
