@@ -3,7 +3,7 @@
 //! granular codes or a time cap, with the angle measured as the repose experiment does.
 //!
 //! ```sh
-//! cargo run --release --example heap_30 -p elastoplastic-granular [E_PA] [CAP_S] [PHI_DEG] [CFL] [walls|periodic] [particles|maps] [geo|zero] [WEDGE_DEG]
+//! cargo run --release --example heap_30 -p elastoplastic-granular [E_PA] [CAP_S] [PHI_DEG] [CFL] [walls|periodic] [particles|maps] [geo|zero] [WEDGE_DEG|block] [NU]
 //! ```
 //!
 //! Prints every 0.1 s: time, 99th-percentile speed, fastest particle two spacings deep,
@@ -34,6 +34,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut params = ElastoplasticParams::<f64>::for_spacing(SPACING, phi);
     params.youngs_modulus = youngs;
     params.cfl_number = arg(4, params.cfl_number)?;
+    params.poisson_ratio = match std::env::args().nth(9) {
+        Some(a) => a.parse()?,
+        None => params.poisson_ratio,
+    };
     let sides = match std::env::args().nth(5).as_deref() {
         Some("periodic") => SlabSides::Periodic,
         _ => SlabSides::FreeSlipWalls,
@@ -133,8 +137,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     let last = samples.last().copied();
+    let rest = at_rest(&samples, SPACING, 9.81);
     println!(
-        "NOT AT REST by the cap {cap_s} s: last {last:?} (bound {:.4} m/s), wall time {:.1} s",
+        "{} at the cap {cap_s} s: last {last:?} (bound {:.4} m/s), wall time {:.1} s",
+        if rest { "AT REST" } else { "NOT AT REST" },
         0.05 * (9.81 * SPACING).sqrt(),
         start.elapsed().as_secs_f64()
     );

@@ -99,14 +99,14 @@ pub(crate) fn extrapolate<R: Real>(
 ) {
     let n = e.x.len() - e.particles.len();
     let (s_head, s_tail) = stress.split_at_mut(n);
-    let (v_head, mut v_tail) = match v {
+    let (v_head, v_tail) = match v {
         Some(v) => {
             let (h, t) = v.split_at_mut(n);
             (Some(&*h), Some(t))
         }
         None => (None, None),
     };
-    let mut art_tail = art.map(|a| &mut a[n..]);
+    let art_tail = art.map(|a| &mut a[n..]);
     let two = R::of_f64(2.0);
     let work =
         |k: usize, sig: &mut Matrix3<R>, vel: Option<&mut Vec3<R>>, a: Option<&mut Matrix3<R>>| {
@@ -149,7 +149,7 @@ pub(crate) fn extrapolate<R: Real>(
                 *a = artificial_stress(&s_b, e.c.rho0, e.c.eps_stress);
             }
         };
-    match (v_tail.as_deref_mut(), art_tail.as_deref_mut()) {
+    match (v_tail, art_tail) {
         (Some(vt), None) => s_tail
             .par_iter_mut()
             .zip(vt.par_iter_mut())
