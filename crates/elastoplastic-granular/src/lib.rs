@@ -48,11 +48,18 @@
 //!
 //! # Deviations
 //!
-//! - Walls: Bui et al. use rows of boundary particles; here the walls' share of each sum is
-//!   the volume map's `∇Ψ`, the wall's stress mirrors the particle's and its velocity is zero
-//!   (free-slip: normal components only). Particles are also projected out of the solids
-//!   to the contact distance, as in the workspace's other solvers.
+//! - Walls: Bui et al. use rows of boundary particles. Here either such rows
+//!   ([`boundary_particles`], stress and velocity extrapolated as Adami et al. 2012 do for
+//!   the pressure; the only walls with which a layer rests, see the docs page), or volume
+//!   maps: the walls' share of each sum is the volume map's `∇Ψ`, the wall's stress
+//!   mirrors the particle's and its velocity is zero (free-slip: normal components only).
+//!   Particles are also projected out of the solids to the contact distance, as in the
+//!   workspace's other solvers.
+//! - Periodic axes ([`periodic`]) by images of the particles near the ends.
 //! - Time integration: symplectic Euler instead of Bui's leap-frog.
+//! - A particle without any granular neighbour inside the kernel support (a grain out of
+//!   contact) carries no stress; otherwise its zero velocity gradient would keep the last
+//!   stress, which acts as a spring against walls.
 //! - The plastic rate applies when the stress lies within [`stress::YIELD_TOLERANCE`] of the
 //!   cone (Bui: exactly on it).
 //! - The equivalent plastic shear strain (the output) is this crate's measure:

@@ -39,8 +39,9 @@ impl<R: Real> StepInputs<'_, R> {
 }
 
 /// Pass 1: the wall gradients at `x`, the velocity gradient `L_i` and the continuity rate
-/// from `x`, `v`, `ρ`; the stress update (rate and return, [`crate::DruckerPrager::update`]),
-/// the density and plastic strain after `Δt`, and the artificial stress of the new stress.
+/// from `x`, `v`, `ρ`; the stress update (rate and return, [`crate::DruckerPrager::update`];
+/// zero for a particle without granular neighbours inside the support), the density and
+/// plastic strain after `Δt`, and the artificial stress of the new stress.
 pub(crate) fn stress_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>) {
     let c = inp.c;
     let slots = inp.models.len();
@@ -59,9 +60,11 @@ pub(crate) fn stress_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>) 
             let (xi, vi) = (x[i], v[i]);
             let mut grad_v = Matrix3::zeros();
             let mut drho = R::zero();
+            let mut in_contact = false;
             for &j in inp.nb.neighbours(i) {
                 let (j, xj) = images.resolve(j as usize, x);
                 let gw = c.kernel.gradient(&(xi - xj));
+                in_contact |= j < n && j != i && gw != Vec3::zeros();
                 let dv = v[j] - vi;
                 let mj = inp.mass(j);
                 grad_v += dv * gw.transpose() * (mj / rho[j]);
@@ -76,7 +79,13 @@ pub(crate) fn stress_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>) 
                     }
                 }
             }
-            let up = c.material.update(&stress[i], &grad_v, inp.dt);
+            let mut up = c.material.update(&stress[i], &grad_v, inp.dt);
+            if !in_contact {
+                // A grain without a granular neighbour is out of contact: it carries no
+                // stress (else it keeps the last one, its velocity gradient being zero).
+                up.stress = Matrix3::zeros();
+                up.plastic_strain = R::zero();
+            }
             let rho_next = rho[i] + drho * inp.dt;
             *sig = up.stress;
             *r = rho_next;
