@@ -178,6 +178,23 @@ fn periodic_layers_on_particle_floors_are_deterministic_and_resumable() {
     assert_eq!(state.positions, a.positions);
 }
 
+#[test]
+fn a_grain_out_of_contact_carries_no_stress() {
+    // One particle, no neighbours, no walls, no gravity, started under a compressive
+    // stress: a grain in the air has nothing to push against, so its stress is zero after
+    // one step (its velocity gradient is zero, so without the rule it would keep it).
+    let mut p = ElastoplasticParams::<f64>::for_spacing(S, 30.0);
+    p.youngs_modulus = 5.84e5;
+    p.common.gravity = Vec3::zeros();
+    let mut solver = Elastoplastic::new(p, Vec::new()).unwrap();
+    let mut state = ParticleSet::from_positions(vec![Vec3::new(0.1, 0.1, 0.1)], 2.04e-3, 2040.0);
+    let sigma = Matrix3::from_diagonal(&Vec3::new(-500.0, -1000.0, -500.0));
+    solver.scheme_mut().set_stress(&[sigma]).unwrap();
+    solver.step(&mut state).unwrap();
+    assert_eq!(solver.stress()[0], Matrix3::zeros());
+    assert_eq!(state.velocities[0], Vec3::zeros());
+}
+
 fn run(threads: usize, frames: usize) -> (ParticleSet<f64>, Vec<f64>) {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
