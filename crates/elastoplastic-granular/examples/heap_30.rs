@@ -150,6 +150,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             if let (Some(&med), Some(&max)) = (disp.get(disp.len() / 2), disp.last()) {
                 println!("    displacement on the base: median {med:.4} m, max {max:.4} m");
             }
+            if let Some(q) = x
+                .iter()
+                .zip(&v)
+                .find(|(_, u)| u.norm() == deep)
+                .map(|(q, _)| q)
+            {
+                println!(
+                    "    deepest-fastest at ({:.3}, {:.3}, {:.4})",
+                    q.x, q.y, q.z
+                );
+            }
             println!(
                 "t {t:5.2} s  p99 {p99:.4} m/s  deep max {deep:.4} m/s  angle {}  on base {}  wall {:.1} s",
                 angle.map_or("-".into(), |a| format!("{a:.2}")),
