@@ -3,7 +3,7 @@
 //! granular codes or a time cap, with the angle measured as the repose experiment does.
 //!
 //! ```sh
-//! cargo run --release --example heap_30 -p elastoplastic-granular [E_PA] [CAP_S] [PHI_DEG] [CFL] [walls|periodic] [particles|maps] [geo|zero] [WEDGE_DEG|block] [NU]
+//! cargo run --release --example heap_30 -p elastoplastic-granular [E_PA] [CAP_S] [PHI_DEG] [CFL] [walls|periodic] [particles|maps] [geo|zero] [WEDGE_DEG|block] [NU] [noslip|free (the base's sides)]
 //! ```
 //!
 //! `HEAP_RESUME=FILE` continues a run saved with `HEAP_SAVE=FILE` (written when the run
@@ -19,7 +19,7 @@ use elastoplastic_granular::heap::{
     at_rest, fixed_base_heap, rest_speeds, HeapSetup, RestSample, SlabSides, BASE_TOP_M, BASE_X_M,
 };
 use elastoplastic_granular::stress::plane_strain_alpha;
-use elastoplastic_granular::ElastoplasticParams;
+use elastoplastic_granular::{ElastoplasticParams, WallModel};
 use iisph_granular::measure::{angle_of_repose, ReposeOptions};
 
 const SPACING: f64 = 0.01;
@@ -50,6 +50,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         particle_walls: std::env::args().nth(6).as_deref() == Some("particles"),
         geostatic: std::env::args().nth(7).as_deref() == Some("geo"),
         wedge_deg: std::env::args().nth(8).and_then(|a| a.parse().ok()),
+        base_sides: match std::env::args().nth(10).as_deref() {
+            Some("free") => WallModel::FreeSlip,
+            _ => WallModel::NoSlip,
+        },
     };
     println!("{setup:?}");
     let (mut solver, mut state) = fixed_base_heap(params, setup)?;

@@ -55,6 +55,9 @@ pub struct HeapSetup {
     pub sides: SlabSides,
     /// Floor and base as boundary particles.
     pub particle_walls: bool,
+    /// The model of the base's vertical sides when they are boundary particles (the
+    /// base's top and the floor are no-slip).
+    pub base_sides: WallModel,
     /// Start from the geostatic stress.
     pub geostatic: bool,
     /// `None`: the block `[0.8, 1.6] × [0.25, 0.55]`; `Some(θ)`: a symmetric wedge on the
@@ -136,20 +139,15 @@ pub fn fixed_base_heap<R: Real>(
         let (x0, x1, yb) = (BASE_X_M[0], BASE_X_M[1], BASE_TOP_M);
         let up = v(0.0, 1.0, 0.0);
         let mut rows = Vec::new();
-        for (lo, hi, normal) in [
-            ([0.0, -t, 0.0], [x0, 0.0, d], up),
-            ([x1, -t, 0.0], [2.4, 0.0, d], up),
-            ([x0, yb - t, 0.0], [x1, yb, d], up),
-            ([x0, 0.0, 0.0], [x0 + t, yb - t, d], v(-1.0, 0.0, 0.0)),
-            ([x1 - t, 0.0, 0.0], [x1, yb - t, d], v(1.0, 0.0, 0.0)),
+        let (no, side) = (WallModel::NoSlip, setup.base_sides);
+        for (lo, hi, normal, model) in [
+            ([0.0, -t, 0.0], [x0, 0.0, d], up, no),
+            ([x1, -t, 0.0], [2.4, 0.0, d], up, no),
+            ([x0, yb - t, 0.0], [x1, yb, d], up, no),
+            ([x0, 0.0, 0.0], [x0 + t, yb - t, d], v(-1.0, 0.0, 0.0), side),
+            ([x1 - t, 0.0, 0.0], [x1, yb - t, d], v(1.0, 0.0, 0.0), side),
         ] {
-            rows.extend(boundary_block(
-                &aabb(lo, hi)?,
-                s,
-                normal,
-                WallModel::NoSlip,
-                1 << 22,
-            )?);
+            rows.extend(boundary_block(&aabb(lo, hi)?, s, normal, model, 1 << 22)?);
         }
         solver.scheme_mut().set_boundary_particles(rows)?;
     }
