@@ -3,7 +3,7 @@
 //! granular codes or a time cap, with the angle measured as the repose experiment does.
 //!
 //! ```sh
-//! cargo run --release --example heap_30 -p elastoplastic-granular [E_PA] [CAP_S] [PHI_DEG] [CFL] [walls|periodic] [particles|maps] [geo|zero] [WEDGE_DEG|block] [NU] [noslip|free (the base's sides)]
+//! cargo run --release --example heap_30 -p elastoplastic-granular [E_PA] [CAP_S] [PHI_DEG] [CFL] [walls|periodic] [particles|maps] [geo|zero] [WEDGE_DEG|block] [NU] [noslip|free (the base's sides)] [ALPHA_PI]
 //! ```
 //!
 //! `HEAP_RESUME=FILE` continues a run saved with `HEAP_SAVE=FILE` (written when the run
@@ -41,6 +41,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Some(a) => a.parse()?,
         None => params.poisson_ratio,
     };
+    params.viscosity_alpha = arg(11, params.viscosity_alpha)?;
     let sides = match std::env::args().nth(5).as_deref() {
         Some("periodic") => SlabSides::Periodic,
         _ => SlabSides::FreeSlipWalls,
