@@ -3,20 +3,22 @@
 //! granular codes or a time cap, with the angle measured as the repose experiment does.
 //!
 //! ```sh
-//! cargo run --release --example heap_30 -p elastoplastic-granular [E_PA] [CAP_S] [PHI_DEG] [CFL] [walls|periodic] [particles|maps] [geo|zero] [WEDGE_DEG|block] [NU] [noslip|free (the base's sides)] [ALPHA_PI]
+//! cargo run --release --example heap_30 -p elastoplastic-granular [E_PA] [CAP_S] [PHI_DEG] [CFL] [walls|periodic] [particles|maps] [geo|zero] [WEDGE_DEG|block] [NU] [noslip|free (the base's sides)] [ALPHA_PI] [scene|wide (the base)]
 //! ```
 //!
 //! `HEAP_RESUME=FILE` continues a run saved with `HEAP_SAVE=FILE` (written when the run
 //! stops; the same arguments must be given), so that a long run can be split into pieces.
 //!
 //! Prints every 0.1 s: time, 99th-percentile speed, fastest particle two spacings deep,
-//! angle, wall time; at the end whether the heap is at rest and its angle against the
+//! angle, wall time, the same two speeds without the five outermost columns at each foot,
+//! and the bottom grains at each foot (speed, stress, share of the cone); at the end whether the heap is at rest and its angle against the
 //! plane-strain prediction `asin(3 α_φ)` (docs/elastoplastic-granular.md).
 
 use std::time::Instant;
 
 use elastoplastic_granular::heap::{
     at_rest, fixed_base_heap, rest_speeds, HeapSetup, RestSample, SlabSides, BASE_TOP_M, BASE_X_M,
+    WIDE_BASE_X_M,
 };
 use elastoplastic_granular::stress::plane_strain_alpha;
 use elastoplastic_granular::{ElastoplasticParams, WallModel};
@@ -55,7 +57,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             Some("free") => WallModel::FreeSlip,
             _ => WallModel::NoSlip,
         },
+        base_x_m: match std::env::args().nth(12).as_deref() {
+            Some("wide") => WIDE_BASE_X_M,
+            _ => BASE_X_M,
+        },
     };
+    let [base_lo, base_hi] = setup.base_x_m;
     println!("{setup:?}");
     let (mut solver, mut state) = fixed_base_heap(params, setup)?;
     let (steps, dt) = solver.params().explicit_steps();
@@ -109,7 +116,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .positions
             .iter()
             .zip(&state.velocities)
-            .filter(|(p, _)| p.x >= BASE_X_M[0] && p.x <= BASE_X_M[1] && p.y > BASE_TOP_M)
+            .filter(|(p, _)| p.x >= base_lo && p.x <= base_hi && p.y > BASE_TOP_M)
             .map(|(p, u)| (*p, *u))
             .unzip();
         let (p99, deep) = rest_speeds(&x, &v, SPACING);
@@ -144,7 +151,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .positions
                 .iter()
                 .zip(&ids)
-                .filter(|(p, _)| p.x >= BASE_X_M[0] && p.x <= BASE_X_M[1] && p.y > BASE_TOP_M)
+                .filter(|(p, _)| p.x >= base_lo && p.x <= base_hi && p.y > BASE_TOP_M)
                 .map(|(p, &k)| {
                     // In-plane displacement: z is periodic in one set-up.
                     let d = p - initial[k];
@@ -166,6 +173,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     q.x, q.y, q.z
                 );
             }
+            feet(&solver, &state, &x, base_lo, base_hi);
             println!(
                 "t {t:5.2} s  p99 {p99:.4} m/s  deep max {deep:.4} m/s  angle {}  on base {}  wall {:.1} s",
                 angle.map_or("-".into(), |a| format!("{a:.2}")),
@@ -191,6 +199,72 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         start.elapsed().as_secs_f64()
     );
     save(&solver, &state, &ids, &samples)
+}
+
+/// The heap without its feet, and the bottom grains of each foot: the rest speeds of the
+/// particles more than five spacings inside the heap's ends, then, for the grains of the
+/// bottom row within three spacings of each end, their number, fastest speed, mean stress
+/// and the share of the cone they use, `√J2 / (−α_φ I1)` (1 on the cone).
+fn feet(
+    solver: &elastoplastic_granular::Elastoplastic<f64>,
+    state: &elastoplastic_granular::ParticleSet<f64>,
+    x: &[elastoplastic_granular::Vec3<f64>],
+    base_lo: f64,
+    base_hi: f64,
+) {
+    let (lo, hi) = x.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, p| {
+        (a.0.min(p.x), a.1.max(p.x))
+    });
+    let inner = |p: &elastoplastic_granular::Vec3<f64>| {
+        p.x > lo + 5.0 * SPACING && p.x < hi - 5.0 * SPACING
+    };
+    let on_base = |p: &elastoplastic_granular::Vec3<f64>| {
+        p.x >= base_lo && p.x <= base_hi && p.y > BASE_TOP_M
+    };
+    let (xi, vi): (Vec<_>, Vec<_>) = state
+        .positions
+        .iter()
+        .zip(&state.velocities)
+        .filter(|(p, _)| on_base(p) && inner(p))
+        .map(|(p, u)| (*p, *u))
+        .unzip();
+    let (p99, deep) = rest_speeds(&xi, &vi, SPACING);
+    println!(
+        "    without the feet (x in ({:.3}, {:.3})): p99 {p99:.4} m/s  deep max {deep:.4} m/s",
+        lo + 5.0 * SPACING,
+        hi - 5.0 * SPACING
+    );
+    let alpha = solver.params().material().alpha_phi;
+    for (name, end, sign) in [("left", lo, 1.0), ("right", hi, -1.0)] {
+        let grains: Vec<usize> = (0..state.len())
+            .filter(|&k| {
+                let p = state.positions[k];
+                on_base(&p)
+                    && p.y < BASE_TOP_M + 1.5 * SPACING
+                    && sign * (p.x - end) < 3.0 * SPACING
+            })
+            .collect();
+        let n = grains.len().max(1) as f64;
+        let mut sum = nalgebra::Matrix3::<f64>::zeros();
+        let (mut vmax, mut share) = (0.0f64, 0.0);
+        for &k in &grains {
+            let s = solver.stress()[k];
+            sum += s;
+            vmax = vmax.max(state.velocities[k].norm());
+            let (i1, _, sq) = elastoplastic_granular::stress::invariants(&s);
+            share += if i1 < 0.0 { sq / (-alpha * i1) } else { 0.0 };
+        }
+        let m = sum / n;
+        println!(
+            "    {name} foot ({end:.3} m): {} bottom grains, fastest {vmax:.4} m/s, mean sxx {:.0} syy {:.0} sxy {:.0} szz {:.0} Pa, mean cone share {:.2}",
+            grains.len(),
+            m[(0, 0)],
+            m[(1, 1)],
+            m[(0, 1)],
+            m[(2, 2)],
+            share / n
+        );
+    }
 }
 
 fn elapsed_over_budget(start: &Instant) -> bool {

@@ -21,8 +21,12 @@ use crate::walls::volume_map_walls;
 
 /// The base's top (m): the heap's floor.
 pub const BASE_TOP_M: f64 = 0.25;
-/// The base's ends along `x` (m).
+/// The base's ends along `x` (m) in the shipped scene; the block stands on `[0.8, 1.6]`
+/// whatever the base's width ([`HeapSetup::base_x_m`]).
 pub const BASE_X_M: [f64; 2] = [0.8, 1.6];
+/// A base wider than the block's runout (m): no grain reaches its edges, so the heap's feet
+/// rest on the base, as a repose test of a heap away from its feet is set up.
+pub const WIDE_BASE_X_M: [f64; 2] = [0.2, 2.2];
 /// The slab's depth along `z` (m).
 pub const SLAB_DEPTH_M: f64 = 0.03;
 
@@ -60,6 +64,9 @@ pub struct HeapSetup {
     pub base_sides: WallModel,
     /// Start from the geostatic stress.
     pub geostatic: bool,
+    /// The base's ends along `x` (m), inside the tank `(0, 2.4)`: [`BASE_X_M`] (the scene's)
+    /// or wider ([`WIDE_BASE_X_M`]); the block is `[0.8, 1.6]` along `x` either way.
+    pub base_x_m: [f64; 2],
     /// `None`: the block `[0.8, 1.6] × [0.25, 0.55]`; `Some(θ)`: a symmetric wedge on the
     /// base with flanks at `θ` degrees (`y ≤ 0.25 + tan θ · min(x − 0.8, 1.6 − x)`, the
     /// particles of the block's lattice below it) and the geostatic stress measured from
@@ -104,8 +111,8 @@ pub fn fixed_base_heap<R: Real>(
     solids.push(Box::new(Plane::new(v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0))?));
     solids.push(Box::new(Plane::new(v(2.4, 0.0, 0.0), v(-1.0, 0.0, 0.0))?));
     solids.push(Box::new(BoxSdf::new(aabb(
-        [BASE_X_M[0], -0.5, far_lo],
-        [BASE_X_M[1], BASE_TOP_M, far_hi],
+        [setup.base_x_m[0], -0.5, far_lo],
+        [setup.base_x_m[1], BASE_TOP_M, far_hi],
     )?)?));
     params.wall_models.extend([
         floor_and_base,
@@ -136,7 +143,7 @@ pub fn fixed_base_heap<R: Real>(
     let mut solver = ElastoplasticScheme::solver(params, walls)?;
     if setup.particle_walls {
         let t = BOUNDARY_ROWS * s.as_f64();
-        let (x0, x1, yb) = (BASE_X_M[0], BASE_X_M[1], BASE_TOP_M);
+        let ([x0, x1], yb) = (setup.base_x_m, BASE_TOP_M);
         let up = v(0.0, 1.0, 0.0);
         let mut rows = Vec::new();
         let (no, side) = (WallModel::NoSlip, setup.base_sides);
