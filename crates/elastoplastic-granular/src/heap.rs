@@ -26,7 +26,7 @@ pub const BASE_TOP_M: f64 = 0.25;
 pub const BASE_X_M: [f64; 2] = [0.8, 1.6];
 /// A base wider than the block's runout (m): no grain reaches its edges, so the heap's feet
 /// rest on the base, as a repose test of a heap away from its feet is set up.
-pub const WIDE_BASE_X_M: [f64; 2] = [0.2, 2.2];
+pub const WIDE_BASE_X_M: [f64; 2] = [0.05, 2.35];
 /// The slab's depth along `z` (m).
 pub const SLAB_DEPTH_M: f64 = 0.03;
 
