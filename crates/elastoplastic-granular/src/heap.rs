@@ -24,8 +24,9 @@ pub const BASE_TOP_M: f64 = 0.25;
 /// The base's ends along `x` (m) in the shipped scene; the block stands on `[0.8, 1.6]`
 /// whatever the base's width ([`HeapSetup::base_x_m`]).
 pub const BASE_X_M: [f64; 2] = [0.8, 1.6];
-/// A base wider than the block's runout (m): no grain reaches its edges, so the heap's feet
-/// rest on the base, as a repose test of a heap away from its feet is set up.
+/// A base nearly as wide as the tank (m), so that the block's runout ends on it: at the
+/// quick spacing only a tail one grain thick reaches its ends, and the heap's slope is
+/// measured away from its feet, as a repose test is set up.
 pub const WIDE_BASE_X_M: [f64; 2] = [0.05, 2.35];
 /// The slab's depth along `z` (m).
 pub const SLAB_DEPTH_M: f64 = 0.03;
