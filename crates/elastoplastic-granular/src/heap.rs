@@ -1,0 +1,245 @@
+//! The fixed-base heap of the shipped scene `granular_repose_30` built in Rust, and the
+//! rest criterion granular codes judge a heap by.
+//!
+//! Geometry (m): a tank `[0, 2.4] × [0, 0.8] × [0, 0.03]`, a base `[0.8, 1.6] × [0, 0.25]`
+//! across the slab, and a block `[0.8, 1.6] × [0.25, 0.55]` on it, on a cubic lattice half
+//! a spacing from its faces. Across the slab either free-slip walls (solids 0 and 1 the
+//! front and back walls `z = 0`, `z = 0.03`, then 2 the tank's floor and ends, 3 the base)
+//! or periodic ends (plane strain without walls); then the tank's floor, its two ends, and
+//! the base.
+
+use nalgebra::Matrix3;
+use sph_core::sampling::cubic_lattice;
+use sph_core::{Aabb, BoxSdf, ParticleSet, Plane, Real, Vec3};
+use sph_solver::{Solids, SolverError};
+
+use crate::boundary_particles::boundary_block;
+use crate::params::{ElastoplasticParams, WallModel};
+use crate::periodic::PeriodicAxis;
+use crate::solver::{Elastoplastic, ElastoplasticScheme};
+use crate::walls::volume_map_walls;
+
+/// The base's top (m): the heap's floor.
+pub const BASE_TOP_M: f64 = 0.25;
+/// The base's ends along `x` (m) in the shipped scene; the block stands on `[0.8, 1.6]`
+/// whatever the base's width ([`HeapSetup::base_x_m`]).
+pub const BASE_X_M: [f64; 2] = [0.8, 1.6];
+/// A base nearly as wide as the tank (m), so that the block's runout ends on it: at the
+/// quick spacing only a tail one grain thick reaches its ends, and the heap's slope is
+/// measured away from its feet, as a repose test is set up.
+pub const WIDE_BASE_X_M: [f64; 2] = [0.05, 2.35];
+/// The slab's depth along `z` (m).
+pub const SLAB_DEPTH_M: f64 = 0.03;
+
+fn v<R: Real>(x: f64, y: f64, z: f64) -> Vec3<R> {
+    Vec3::new(R::of_f64(x), R::of_f64(y), R::of_f64(z))
+}
+
+fn aabb<R: Real>(lo: [f64; 3], hi: [f64; 3]) -> Result<Aabb<R>, SolverError> {
+    Ok(Aabb::new(v(lo[0], lo[1], lo[2]), v(hi[0], hi[1], hi[2]))?)
+}
+
+/// What bounds the slab across `z`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum SlabSides {
+    /// Free-slip walls at `z = 0` and `z = SLAB_DEPTH_M`.
+    FreeSlipWalls,
+    /// Periodic ends: the slab repeats along `z` (plane strain without walls).
+    Periodic,
+}
+
+/// How the heap is set up: what bounds the slab across `z`, whether the tank's floor and
+/// the base are rows of boundary particles ([`crate::boundary_particles`], no-slip; the
+/// solids then only keep particles out) or volume-map walls, and whether the block starts
+/// from the geostatic stress (`σ_yy = −ρ0 g (top − y)`, `σ_xx = σ_zz = K0 σ_yy`,
+/// `K0 = ν/(1 − ν)`) or unstressed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HeapSetup {
+    /// What bounds the slab across `z`.
+    pub sides: SlabSides,
+    /// Floor and base as boundary particles.
+    pub particle_walls: bool,
+    /// The model of the base's vertical sides when they are boundary particles (the
+    /// base's top and the floor are no-slip).
+    pub base_sides: WallModel,
+    /// Start from the geostatic stress.
+    pub geostatic: bool,
+    /// The base's ends along `x` (m), inside the tank `(0, 2.4)`: [`BASE_X_M`] (the scene's)
+    /// or wider ([`WIDE_BASE_X_M`]); the block is `[0.8, 1.6]` along `x` either way.
+    pub base_x_m: [f64; 2],
+    /// `None`: the block `[0.8, 1.6] × [0.25, 0.55]`; `Some(θ)`: a symmetric wedge on the
+    /// base with flanks at `θ` degrees (`y ≤ 0.25 + tan θ · min(x − 0.8, 1.6 − x)`, the
+    /// particles of the block's lattice below it) and the geostatic stress measured from
+    /// its surface.
+    pub wedge_deg: Option<f64>,
+}
+
+/// Rows of boundary particles standing for a wall (three spacings thick: the support is
+/// 2.4 spacings).
+const BOUNDARY_ROWS: f64 = 3.0;
+
+/// The solver and the block's particles at `t = 0` for `params` (its spacing sets the
+/// lattice), set up as `setup` says; the tank (floor and ends) and the base are no-slip.
+pub fn fixed_base_heap<R: Real>(
+    mut params: ElastoplasticParams<R>,
+    setup: HeapSetup,
+) -> Result<(Elastoplastic<R>, ParticleSet<R>), SolverError> {
+    let s = params.common.particle_spacing;
+    let d = SLAB_DEPTH_M;
+    let (far_lo, far_hi) = (-0.5, d + 0.5);
+    let mut solids: Solids<R> = Vec::new();
+    params.wall_models.clear();
+    params.periodic.clear();
+    match setup.sides {
+        SlabSides::FreeSlipWalls => {
+            solids.push(Box::new(Plane::new(v(0.0, 0.0, 0.0), v(0.0, 0.0, 1.0))?));
+            solids.push(Box::new(Plane::new(v(0.0, 0.0, d), v(0.0, 0.0, -1.0))?));
+            params.wall_models = vec![WallModel::FreeSlip; 2];
+        }
+        SlabSides::Periodic => params.periodic.push(PeriodicAxis {
+            axis: 2,
+            lo: R::zero(),
+            hi: R::of_f64(d),
+        }),
+    }
+    let floor_and_base = if setup.particle_walls {
+        WallModel::ContactOnly
+    } else {
+        WallModel::NoSlip
+    };
+    solids.push(Box::new(Plane::new(v(0.0, 0.0, 0.0), v(0.0, 1.0, 0.0))?));
+    solids.push(Box::new(Plane::new(v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0))?));
+    solids.push(Box::new(Plane::new(v(2.4, 0.0, 0.0), v(-1.0, 0.0, 0.0))?));
+    solids.push(Box::new(BoxSdf::new(aabb(
+        [setup.base_x_m[0], -0.5, far_lo],
+        [setup.base_x_m[1], BASE_TOP_M, far_hi],
+    )?)?));
+    params.wall_models.extend([
+        floor_and_base,
+        WallModel::NoSlip,
+        WallModel::NoSlip,
+        floor_and_base,
+    ]);
+    let domain = aabb([0.0, 0.0, -0.05], [2.4, 0.8, d + 0.05])?;
+    let walls = volume_map_walls(solids, &params, domain)?;
+    let top = 0.55;
+    let block = aabb([BASE_X_M[0], BASE_TOP_M, 0.0], [BASE_X_M[1], top, d])?;
+    let surface = |x: f64| match setup.wedge_deg {
+        Some(a) => BASE_TOP_M + a.to_radians().tan() * (x - BASE_X_M[0]).min(BASE_X_M[1] - x),
+        None => top,
+    };
+    let mut positions = cubic_lattice(&block, s, 1 << 22)?;
+    positions.retain(|p| p.y.as_f64() <= surface(p.x.as_f64()));
+    let state = ParticleSet::from_positions(
+        positions,
+        params.common.particle_mass(),
+        params.common.rest_density,
+    );
+    let (rho0, g, nu) = (
+        params.common.rest_density,
+        -params.common.gravity.y,
+        params.poisson_ratio,
+    );
+    let mut solver = ElastoplasticScheme::solver(params, walls)?;
+    if setup.particle_walls {
+        let t = BOUNDARY_ROWS * s.as_f64();
+        let ([x0, x1], yb) = (setup.base_x_m, BASE_TOP_M);
+        let up = v(0.0, 1.0, 0.0);
+        let mut rows = Vec::new();
+        let (no, side) = (WallModel::NoSlip, setup.base_sides);
+        for (lo, hi, normal, model) in [
+            ([0.0, -t, 0.0], [x0, 0.0, d], up, no),
+            ([x1, -t, 0.0], [2.4, 0.0, d], up, no),
+            ([x0, yb - t, 0.0], [x1, yb, d], up, no),
+            ([x0, 0.0, 0.0], [x0 + t, yb - t, d], v(-1.0, 0.0, 0.0), side),
+            ([x1 - t, 0.0, 0.0], [x1, yb - t, d], v(1.0, 0.0, 0.0), side),
+        ] {
+            rows.extend(boundary_block(&aabb(lo, hi)?, s, normal, model, 1 << 22)?);
+        }
+        solver.scheme_mut().set_boundary_particles(rows)?;
+    }
+    if setup.geostatic {
+        let k0 = nu / (R::one() - nu);
+        let stress: Vec<Matrix3<R>> = state
+            .positions
+            .iter()
+            .map(|x| {
+                let sv = -rho0 * g * (R::of_f64(surface(x.x.as_f64())) - x.y);
+                Matrix3::from_diagonal(&Vec3::new(k0 * sv, sv, k0 * sv))
+            })
+            .collect();
+        solver.scheme_mut().set_stress(&stress)?;
+    }
+    Ok((solver, state))
+}
+
+/// One frame's figures of the rest criterion.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RestSample {
+    /// Time (s).
+    pub time_s: f64,
+    /// 99th-percentile speed of the heap's particles (m/s).
+    pub p99_speed: f64,
+    /// Fastest particle at least two spacings below the surface of its column (m/s).
+    pub deep_max_speed: f64,
+    /// The heap's angle (degrees), if measurable.
+    pub angle_deg: Option<f64>,
+}
+
+/// The speeds of the rest criterion for the particles `(position, velocity)` of a heap:
+/// the 99th-percentile speed and the fastest particle at least two spacings below the
+/// highest particle of its column (bins of one spacing along `x`).
+pub fn rest_speeds<R: Real>(x: &[Vec3<R>], v: &[Vec3<R>], spacing: f64) -> (f64, f64) {
+    if x.is_empty() {
+        return (0.0, 0.0);
+    }
+    let mut speeds: Vec<f64> = v.iter().map(|u| u.norm().as_f64()).collect();
+    let lo = x.iter().map(|p| p.x.as_f64()).fold(f64::INFINITY, f64::min);
+    let bin = |p: &Vec3<R>| ((p.x.as_f64() - lo) / spacing).floor() as usize;
+    let bins = x.iter().map(bin).max().unwrap_or(0) + 1;
+    let mut top = vec![f64::NEG_INFINITY; bins];
+    for p in x {
+        let b = bin(p);
+        top[b] = top[b].max(p.y.as_f64());
+    }
+    let deep = x
+        .iter()
+        .zip(&speeds)
+        .filter(|(p, _)| top[bin(p)] - p.y.as_f64() >= 2.0 * spacing)
+        .map(|(_, &s)| s)
+        .fold(0.0, f64::max);
+    let k = ((speeds.len() as f64) * 0.99).floor() as usize;
+    let k = k.min(speeds.len() - 1);
+    let (_, p99, _) = speeds.select_nth_unstable_by(k, f64::total_cmp);
+    (*p99, deep)
+}
+
+/// Whether the heap is at rest by the criterion of granular codes, from one sample per
+/// frame (in time order): the 99th-percentile speed and the fastest particle two spacings
+/// deep below `0.05 √(g s)` over the last 0.5 s, and the angle moving less than 0.3° over
+/// the last second (at least one second of samples).
+pub fn at_rest(samples: &[RestSample], spacing: f64, gravity: f64) -> bool {
+    let Some(last) = samples.last() else {
+        return false;
+    };
+    if last.time_s < 1.0 {
+        return false;
+    }
+    let bound = 0.05 * (gravity * spacing).sqrt();
+    let slow = samples
+        .iter()
+        .filter(|s| s.time_s >= last.time_s - 0.5)
+        .all(|s| s.p99_speed < bound && s.deep_max_speed < bound);
+    let angles: Vec<f64> = samples
+        .iter()
+        .filter(|s| s.time_s >= last.time_s - 1.0)
+        .map(|s| s.angle_deg.unwrap_or(f64::NAN))
+        .collect();
+    let (lo, hi) = angles
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        });
+    slow && angles.iter().all(|a| a.is_finite()) && hi - lo < 0.3
+}

@@ -1,0 +1,340 @@
+//! The parameters of [`Elastoplastic`](crate::Elastoplastic), their defaults and bounds.
+
+use sph_core::Real;
+use sph_solver::{CommonParams, SolverError};
+
+use crate::periodic::PeriodicAxis;
+use crate::stress::DruckerPrager;
+
+/// Largest Young's modulus accepted (Pa): 1 TPa, above any granular material's, so that the
+/// explicit step count stays finite.
+pub const MAX_YOUNGS_MODULUS_PA: f64 = 1e12;
+/// Largest Poisson's ratio accepted: `K = E/(3(1 − 2ν))` diverges at 0.5.
+pub const MAX_POISSON_RATIO: f64 = 0.49;
+/// Largest friction (and dilatancy) angle accepted (degrees).
+pub const MAX_FRICTION_ANGLE_DEG: f64 = 70.0;
+/// Largest cohesion accepted (Pa).
+pub const MAX_COHESION_PA: f64 = 1e9;
+/// Largest artificial viscosity coefficient (`α_Π`, `β_Π`) accepted.
+pub const MAX_VISCOSITY_COEFFICIENT: f64 = 10.0;
+/// Largest artificial stress exponent `n` accepted.
+pub const MAX_ARTIFICIAL_STRESS_EXPONENT: f64 = 10.0;
+/// Most explicit steps in one [`SubstepScheme::substep`](sph_solver::SubstepScheme) (one
+/// `dt / substeps`): a run must be able to finish; raise `common.substeps` instead.
+pub const MAX_EXPLICIT_STEPS_PER_SUBSTEP: usize = 100_000;
+/// Most solids with their own wall model.
+pub const MAX_WALL_MODELS: usize = 64;
+
+/// Young's modulus of the defaults (Pa): Bui et al. (2008)'s aluminium-bar test as
+/// SPHinXsys's `test_2d_column_collapse` transcribes it (5.84 MPa).
+pub const DEFAULT_YOUNGS_MODULUS_PA: f64 = 5.84e6;
+/// Poisson's ratio of the defaults: 0.3, the same source.
+pub const DEFAULT_POISSON_RATIO: f64 = 0.3;
+/// Rest density of the defaults (kg/m³): 2040, the same source.
+pub const DEFAULT_REST_DENSITY: f64 = 2040.0;
+/// Monaghan's artificial viscosity `α_Π` of the defaults (Monaghan 1992's solid-body
+/// value, the one Bui et al. 2008 use with it).
+pub const DEFAULT_VISCOSITY_ALPHA: f64 = 0.1;
+/// Monaghan's artificial viscosity `β_Π` of the defaults (0: no quadratic term).
+pub const DEFAULT_VISCOSITY_BETA: f64 = 0.0;
+/// Artificial stress `ε` of the defaults (Gray, Monaghan & Swift 2001, §5).
+pub const DEFAULT_ARTIFICIAL_STRESS_EPSILON: f64 = 0.5;
+/// Artificial stress exponent `n` of the defaults (Gray, Monaghan & Swift 2001, §5).
+pub const DEFAULT_ARTIFICIAL_STRESS_EXPONENT: f64 = 2.55;
+/// CFL number `C` of `Δt = C h / c` of the defaults (Bui et al. 2008 take 0.1–0.2; the upper
+/// end).
+pub const DEFAULT_CFL_NUMBER: f64 = 0.2;
+/// Neighbour-list skin of the defaults, as a fraction of the particle spacing.
+pub const DEFAULT_SKIN_OVER_SPACING: f64 = 0.3;
+/// Support radius of the defaults over the particle spacing: Bui et al. (2008)'s cubic
+/// B-spline with smoothing length `1.2 s` has support `2.4 s`.
+pub const DEFAULT_SUPPORT_OVER_SPACING: f64 = 2.4;
+
+/// How a solid acts on the particles next to it (the wall's share of each SPH sum is its
+/// volume-map gradient `∇Ψ`; the wall's stress mirrors the particle's, the wall is at rest).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum WallModel {
+    /// Only the normal part of the wall traction and of the velocity difference: grains
+    /// slide along the wall without resistance (plane-strain slab walls).
+    FreeSlip,
+    /// The whole traction; the wall's velocity (zero) enters the velocity gradient.
+    NoSlip,
+    /// The solid only keeps the particles out (projection to the contact distance); its
+    /// share of the sums comes from boundary particles
+    /// ([`ElastoplasticScheme::set_boundary_particles`](crate::ElastoplasticScheme::set_boundary_particles)).
+    ContactOnly,
+}
+
+/// Parameters of [`Elastoplastic`](crate::Elastoplastic).
+///
+/// | field | default | source |
+/// |---|---|---|
+/// | `common.rest_density` | 2040 kg/m³ | [`DEFAULT_REST_DENSITY`] |
+/// | `common.support_radius` | `2.4 s` | [`DEFAULT_SUPPORT_OVER_SPACING`] |
+/// | `common.substeps` | 1 (the explicit steps are sub-cycled inside it) | |
+/// | `youngs_modulus` | 5.84 MPa | [`DEFAULT_YOUNGS_MODULUS_PA`] |
+/// | `poisson_ratio` | 0.3 | [`DEFAULT_POISSON_RATIO`] |
+/// | `friction_angle_deg` | given | |
+/// | `dilatancy_angle_deg` | 0 (sand, Bui et al. 2008) | |
+/// | `cohesion` | 0 Pa (cohesionless) | |
+/// | `viscosity_alpha`, `viscosity_beta` | 0.1, 0 | [`DEFAULT_VISCOSITY_ALPHA`] |
+/// | `artificial_stress_epsilon`, `_exponent` | 0.5, 2.55 | Gray et al. 2001 |
+/// | `cfl_number` | 0.2 | [`DEFAULT_CFL_NUMBER`] |
+/// | `skin` | `0.3 s` | [`DEFAULT_SKIN_OVER_SPACING`] |
+/// | `default_wall`, `wall_models` | no-slip, none | |
+/// | `periodic` | none | |
+#[derive(Debug, Clone, PartialEq)]
+pub struct ElastoplasticParams<R: Real> {
+    /// The parameters every solver has.
+    pub common: CommonParams<R>,
+    /// Young's modulus `E` (Pa).
+    pub youngs_modulus: R,
+    /// Poisson's ratio `ν`.
+    pub poisson_ratio: R,
+    /// Friction angle `φ` (degrees).
+    pub friction_angle_deg: R,
+    /// Dilatancy angle `ψ` (degrees, `0 ≤ ψ ≤ φ`).
+    pub dilatancy_angle_deg: R,
+    /// Cohesion `c` (Pa).
+    pub cohesion: R,
+    /// Monaghan's artificial viscosity, linear coefficient `α_Π`.
+    pub viscosity_alpha: R,
+    /// Monaghan's artificial viscosity, quadratic coefficient `β_Π`.
+    pub viscosity_beta: R,
+    /// Gray et al. (2001)'s artificial stress coefficient `ε` (0 disables it).
+    pub artificial_stress_epsilon: R,
+    /// Gray et al. (2001)'s artificial stress exponent `n`.
+    pub artificial_stress_exponent: R,
+    /// CFL number `C` of the explicit step `Δt = C h / c`, `h` the smoothing length (half
+    /// the support radius) and `c = √(E/ρ0)`.
+    pub cfl_number: R,
+    /// Neighbour-list skin (m): lists are built with radius `support + skin` and kept while
+    /// no particle has moved more than `skin / 2` since.
+    pub skin: R,
+    /// The wall model of solids past the end of `wall_models`.
+    pub default_wall: WallModel,
+    /// The wall model of each solid, by index in the boundary's solids.
+    pub wall_models: Vec<WallModel>,
+    /// Periodic axes (at most one entry per axis; each period at least `support_radius +
+    /// skin`, so that one image on each side covers every neighbour).
+    pub periodic: Vec<PeriodicAxis<R>>,
+}
+
+fn invalid(name: &'static str, value: f64, reason: &'static str) -> SolverError {
+    SolverError::InvalidParameter {
+        solver: crate::solver::NAME,
+        name,
+        value,
+        reason,
+    }
+}
+
+fn check_range(
+    name: &'static str,
+    value: f64,
+    lo: f64,
+    hi: f64,
+    reason: &'static str,
+) -> Result<(), SolverError> {
+    if value.is_finite() && value >= lo && value <= hi {
+        Ok(())
+    } else {
+        Err(invalid(name, value, reason))
+    }
+}
+
+impl<R: Real> ElastoplasticParams<R> {
+    /// The defaults of the table above for spacing `s` (m) and friction angle `φ` (degrees).
+    /// Not validated here.
+    pub fn for_spacing(s: R, friction_angle_deg: R) -> Self {
+        let mut common = CommonParams::for_spacing(s);
+        common.rest_density = R::of_f64(DEFAULT_REST_DENSITY);
+        common.support_radius = s * R::of_f64(DEFAULT_SUPPORT_OVER_SPACING);
+        Self {
+            common,
+            youngs_modulus: R::of_f64(DEFAULT_YOUNGS_MODULUS_PA),
+            poisson_ratio: R::of_f64(DEFAULT_POISSON_RATIO),
+            friction_angle_deg,
+            dilatancy_angle_deg: R::zero(),
+            cohesion: R::zero(),
+            viscosity_alpha: R::of_f64(DEFAULT_VISCOSITY_ALPHA),
+            viscosity_beta: R::of_f64(DEFAULT_VISCOSITY_BETA),
+            artificial_stress_epsilon: R::of_f64(DEFAULT_ARTIFICIAL_STRESS_EPSILON),
+            artificial_stress_exponent: R::of_f64(DEFAULT_ARTIFICIAL_STRESS_EXPONENT),
+            cfl_number: R::of_f64(DEFAULT_CFL_NUMBER),
+            skin: s * R::of_f64(DEFAULT_SKIN_OVER_SPACING),
+            default_wall: WallModel::NoSlip,
+            wall_models: Vec::new(),
+            periodic: Vec::new(),
+        }
+    }
+
+    /// The material's moduli and cone.
+    pub fn material(&self) -> DruckerPrager<R> {
+        DruckerPrager::new(
+            self.youngs_modulus.as_f64(),
+            self.poisson_ratio.as_f64(),
+            self.friction_angle_deg.as_f64(),
+            self.dilatancy_angle_deg.as_f64(),
+            self.cohesion.as_f64(),
+        )
+    }
+
+    /// The wall model of solid `k`.
+    pub fn wall_model(&self, k: usize) -> WallModel {
+        self.wall_models
+            .get(k)
+            .copied()
+            .unwrap_or(self.default_wall)
+    }
+
+    /// The speed of sound `c = √(E/ρ0)` (m/s) of the time step and the viscosity.
+    pub fn sound_speed(&self) -> R {
+        (self.youngs_modulus / self.common.rest_density).sqrt()
+    }
+
+    /// The smoothing length `h` (m): half the support radius (cubic B-spline).
+    pub fn smoothing_length(&self) -> R {
+        self.common.support_radius * R::of_f64(0.5)
+    }
+
+    /// The explicit steps of one substep and their length (s): `n = ⌈(dt/substeps) / (C h/c)⌉`
+    /// steps of `(dt/substeps)/n`.
+    pub fn explicit_steps(&self) -> (usize, R) {
+        let limit = self.cfl_number * self.smoothing_length() / self.sound_speed();
+        let sub = self.common.substep_dt();
+        let n = (sub / limit).as_f64().ceil().max(1.0);
+        let n = if n.is_finite() && n < usize::MAX as f64 {
+            n as usize
+        } else {
+            usize::MAX
+        };
+        (n, sub / R::of_f64(n as f64))
+    }
+
+    /// Checks every field; the error ([`SolverError::InvalidParameter`]) names the first
+    /// invalid one.
+    pub fn validate(&self) -> Result<(), SolverError> {
+        self.common.validate(crate::solver::NAME)?;
+        let f = |v: R| v.as_f64();
+        check_range(
+            "youngs_modulus",
+            f(self.youngs_modulus),
+            f64::MIN_POSITIVE,
+            MAX_YOUNGS_MODULUS_PA,
+            "must be > 0 and at most MAX_YOUNGS_MODULUS_PA (1e12 Pa)",
+        )?;
+        check_range(
+            "poisson_ratio",
+            f(self.poisson_ratio),
+            0.0,
+            MAX_POISSON_RATIO,
+            "must be in [0, MAX_POISSON_RATIO = 0.49]",
+        )?;
+        check_range(
+            "friction_angle_deg",
+            f(self.friction_angle_deg),
+            0.0,
+            MAX_FRICTION_ANGLE_DEG,
+            "must be in [0, MAX_FRICTION_ANGLE_DEG = 70] degrees",
+        )?;
+        check_range(
+            "dilatancy_angle_deg",
+            f(self.dilatancy_angle_deg),
+            0.0,
+            f(self.friction_angle_deg),
+            "must be in [0, friction_angle_deg] degrees",
+        )?;
+        check_range(
+            "cohesion",
+            f(self.cohesion),
+            0.0,
+            MAX_COHESION_PA,
+            "must be in [0, MAX_COHESION_PA = 1e9] Pa",
+        )?;
+        if self.friction_angle_deg == R::zero() && self.cohesion == R::zero() {
+            return Err(invalid(
+                "friction_angle_deg",
+                0.0,
+                "a cohesionless material needs a friction angle > 0 (the cone would be a line)",
+            ));
+        }
+        for (name, v) in [
+            ("viscosity_alpha", self.viscosity_alpha),
+            ("viscosity_beta", self.viscosity_beta),
+        ] {
+            check_range(
+                name,
+                f(v),
+                0.0,
+                MAX_VISCOSITY_COEFFICIENT,
+                "must be in [0, MAX_VISCOSITY_COEFFICIENT = 10]",
+            )?;
+        }
+        check_range(
+            "artificial_stress_epsilon",
+            f(self.artificial_stress_epsilon),
+            0.0,
+            1.0,
+            "must be in [0, 1]",
+        )?;
+        check_range(
+            "artificial_stress_exponent",
+            f(self.artificial_stress_exponent),
+            1.0,
+            MAX_ARTIFICIAL_STRESS_EXPONENT,
+            "must be in [1, MAX_ARTIFICIAL_STRESS_EXPONENT = 10]",
+        )?;
+        check_range(
+            "cfl_number",
+            f(self.cfl_number),
+            f64::MIN_POSITIVE,
+            1.0,
+            "must be in (0, 1]",
+        )?;
+        check_range(
+            "skin",
+            f(self.skin),
+            0.0,
+            f(self.common.support_radius),
+            "must be in [0, support_radius] m",
+        )?;
+        if self.wall_models.len() > MAX_WALL_MODELS {
+            return Err(invalid(
+                "wall_models",
+                self.wall_models.len() as f64,
+                "at most MAX_WALL_MODELS = 64 solids have their own model",
+            ));
+        }
+        let reach = f(self.common.support_radius + self.skin);
+        for (k, a) in self.periodic.iter().enumerate() {
+            if a.axis > 2 || self.periodic[..k].iter().any(|b| b.axis == a.axis) {
+                return Err(invalid(
+                    "periodic",
+                    a.axis as f64,
+                    "each periodic axis must be 0, 1 or 2 and appear once (value: the axis)",
+                ));
+            }
+            check_range(
+                "periodic",
+                f(a.period()),
+                reach,
+                f64::MAX,
+                "a period (hi − lo, m; the value) must be finite and at least support_radius + skin",
+            )?;
+            if !f(a.lo).is_finite() {
+                return Err(invalid("periodic", f(a.lo), "the lower end must be finite"));
+            }
+        }
+        let (n, _) = self.explicit_steps();
+        if n > MAX_EXPLICIT_STEPS_PER_SUBSTEP {
+            return Err(invalid(
+                "cfl_number",
+                n as f64,
+                "the substep needs more than MAX_EXPLICIT_STEPS_PER_SUBSTEP = 100000 explicit steps (value: their count); raise common.substeps",
+            ));
+        }
+        Ok(())
+    }
+}

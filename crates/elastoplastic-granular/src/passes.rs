@@ -1,0 +1,169 @@
+//! The per-particle loops of one explicit step (see the crate docs for the equations). Each
+//! writes one particle's values from the previous arrays, so results do not depend on the
+//! thread count.
+
+use nalgebra::Matrix3;
+use rayon::prelude::*;
+use sph_core::{Real, Vec3};
+use sph_kernels::Kernel;
+use sph_solver::boundary::Boundary;
+use sph_solver::step::MIN_LEN;
+use sph_solver::NeighbourLists;
+
+use crate::kernels::Consts;
+use crate::params::WallModel;
+use crate::scratch::Scratch;
+use crate::stress::artificial_stress;
+use crate::walls::{wall_part, WallSampler};
+
+/// What the passes read besides the scratch arrays.
+pub(crate) struct StepInputs<'a, R: Real> {
+    pub c: Consts<R>,
+    pub masses: &'a [R],
+    pub nb: &'a NeighbourLists,
+    pub boundary: &'a dyn Boundary<R>,
+    pub walls: &'a WallSampler<R>,
+    pub models: &'a [WallModel],
+    pub gravity: Vec3<R>,
+    pub dt: R,
+    /// Mass of a boundary particle (kg): neighbours `j ≥ masses.len()` are boundary
+    /// particles.
+    pub boundary_mass: R,
+}
+
+impl<R: Real> StepInputs<'_, R> {
+    #[inline]
+    fn mass(&self, j: usize) -> R {
+        self.masses.get(j).copied().unwrap_or(self.boundary_mass)
+    }
+}
+
+/// Pass 1: the wall gradients at `x`, the velocity gradient `L_i` and the continuity rate
+/// from `x`, `v`, `ρ`; the stress update (rate and return, [`crate::DruckerPrager::update`];
+/// zero for a particle without granular neighbours inside the support), the density and
+/// plastic strain after `Δt`, and the artificial stress of the new stress.
+pub(crate) fn stress_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>) {
+    let c = inp.c;
+    let slots = inp.models.len();
+    let n = inp.masses.len();
+    let (x, v, rho) = (&s.x[..], &s.v[..], &s.rho[..]);
+    let (stress, plastic, images) = (&s.stress[..], &s.plastic_strain[..], &s.images);
+    s.stress_new[..n]
+        .par_iter_mut()
+        .zip(s.rho_new[..n].par_iter_mut())
+        .zip(s.plastic_new.par_iter_mut())
+        .zip(s.art[..n].par_iter_mut())
+        .zip(s.wall_grad.par_chunks_mut(slots.max(1)))
+        .enumerate()
+        .with_min_len(MIN_LEN)
+        .for_each(|(i, ((((sig, r), kappa), art), grads))| {
+            let (xi, vi) = (x[i], v[i]);
+            let mut grad_v = Matrix3::zeros();
+            let mut drho = R::zero();
+            let mut in_contact = false;
+            for &j in inp.nb.neighbours(i) {
+                let (j, xj) = images.resolve(j as usize, x);
+                let gw = c.kernel.gradient(&(xi - xj));
+                in_contact |= j < n && j != i && gw != Vec3::zeros();
+                let dv = v[j] - vi;
+                let mj = inp.mass(j);
+                grad_v += dv * gw.transpose() * (mj / rho[j]);
+                drho -= mj * dv.dot(&gw);
+            }
+            if slots > 0 {
+                inp.walls.sample(inp.boundary, &xi, grads);
+                for (g, &model) in grads.iter().zip(inp.models) {
+                    if model != WallModel::ContactOnly && g.norm_squared() > R::zero() {
+                        grad_v -= wall_part(model, g, &vi) * g.transpose();
+                        drho += c.rho0 * vi.dot(g);
+                    }
+                }
+            }
+            let mut up = c.material.update(&stress[i], &grad_v, inp.dt);
+            if !in_contact {
+                // A grain without a granular neighbour is out of contact: it carries no
+                // stress (else it keeps the last one, its velocity gradient being zero).
+                up.stress = Matrix3::zeros();
+                up.plastic_strain = R::zero();
+            }
+            let rho_next = rho[i] + drho * inp.dt;
+            *sig = up.stress;
+            *r = rho_next;
+            *kappa = plastic[i] + up.plastic_strain;
+            *art = artificial_stress(&up.stress, rho_next, c.eps_stress);
+        });
+}
+
+/// Pass 2: the acceleration from the new stresses (with the artificial viscosity and
+/// stress and the walls' share), the velocity and position after `Δt` (symplectic Euler),
+/// the position projected out of the solids and the velocity corrected by that projection.
+pub(crate) fn momentum_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>) {
+    let c = inp.c;
+    let slots = inp.models.len();
+    let n = inp.masses.len();
+    let (x, v) = (&s.x[..], &s.v[..]);
+    let (sig, rho, art, grads) = (&s.stress_new[..], &s.rho_new[..], &s.art[..], &s.wall_grad);
+    let images = &s.images;
+    let two = R::of_f64(2.0);
+    let half = R::of_f64(0.5);
+    let inv_dt = R::one() / inp.dt;
+    s.v_new[..n]
+        .par_iter_mut()
+        .zip(s.x_new[..n].par_iter_mut())
+        .enumerate()
+        .with_min_len(MIN_LEN)
+        .for_each(|(i, (vn, xn))| {
+            let (xi, vi, ri) = (x[i], v[i], rho[i]);
+            let si = sig[i] / (ri * ri);
+            let art_i = art[i];
+            let art_i_zero = art_i == Matrix3::zeros();
+            let mut a = inp.gravity;
+            for &j in inp.nb.neighbours(i) {
+                let (j, xj) = images.resolve(j as usize, x);
+                let xij = xi - xj;
+                let gw = c.kernel.gradient(&xij);
+                if gw == Vec3::zeros() {
+                    continue;
+                }
+                let rj = rho[j];
+                let mut t = si + sig[j] / (rj * rj);
+                // Monaghan's artificial viscosity, for approaching pairs.
+                let vij = vi - v[j];
+                let vx = vij.dot(&xij);
+                if vx < R::zero() {
+                    let phi = c.h * vx / (xij.norm_squared() + c.eta2);
+                    let pi = (-c.alpha * c.c0 * phi + c.beta * phi * phi) / ((ri + rj) * half);
+                    t -= Matrix3::identity() * pi;
+                }
+                // Gray, Monaghan & Swift's artificial stress.
+                if !(art_i_zero && art[j] == Matrix3::zeros()) {
+                    let f = (c.kernel.value(xij.norm()) * c.inv_w_spacing).powf(c.exponent);
+                    t += (art_i + art[j]) * f;
+                }
+                a += t * gw * inp.mass(j);
+            }
+            if slots > 0 {
+                let gi = &grads[i * slots..(i + 1) * slots];
+                for (g, &model) in gi.iter().zip(inp.models) {
+                    if model != WallModel::ContactOnly && g.norm_squared() > R::zero() {
+                        a += wall_part(model, g, &(sig[i] * g)) * (two * c.rho0 / (ri * ri));
+                    }
+                }
+            }
+            let v_star = vi + a * inp.dt;
+            let y = xi + v_star * inp.dt;
+            let p = inp.boundary.project(y);
+            *xn = p;
+            *vn = v_star + (p - y) * inv_dt;
+        });
+}
+
+/// The largest distance (m) any particle has moved since the last neighbour search.
+pub(crate) fn max_displacement<R: Real>(s: &Scratch<R>, n: usize) -> R {
+    s.x[..n]
+        .par_iter()
+        .zip(s.anchor.par_iter())
+        .with_min_len(MIN_LEN)
+        .map(|(a, b)| (a - b).norm())
+        .reduce(R::zero, |a, b| if b > a { b } else { a })
+}

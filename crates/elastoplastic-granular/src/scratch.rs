@@ -1,0 +1,80 @@
+//! The per-particle arrays of the solver: what it carries between frames (stress, plastic
+//! strain) and its working arrays.
+
+use nalgebra::Matrix3;
+use sph_core::{Real, Vec3};
+
+use crate::boundary_particles::BoundaryParticle;
+use crate::periodic::Images;
+
+/// Per-particle arrays (structure of arrays).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Scratch<R: Real> {
+    /// Cauchy stress `σ_i` (Pa), carried between frames.
+    pub stress: Vec<Matrix3<R>>,
+    /// Equivalent plastic shear strain, carried between frames.
+    pub plastic_strain: Vec<R>,
+    /// Working positions, velocities and densities of the explicit steps.
+    pub x: Vec<Vec3<R>>,
+    pub v: Vec<Vec3<R>>,
+    pub rho: Vec<R>,
+    /// The next step's stress, density, plastic strain.
+    pub stress_new: Vec<Matrix3<R>>,
+    pub rho_new: Vec<R>,
+    pub plastic_new: Vec<R>,
+    /// Gray et al.'s artificial stress `R_i`.
+    pub art: Vec<Matrix3<R>>,
+    pub x_new: Vec<Vec3<R>>,
+    pub v_new: Vec<Vec3<R>>,
+    /// Positions at the last neighbour search.
+    pub anchor: Vec<Vec3<R>>,
+    /// Wall gradients `∇Ψ_k`, `slots` per particle.
+    pub wall_grad: Vec<Vec3<R>>,
+    /// Images of the particles near periodic ends, and the particles followed by them (the
+    /// array the neighbour lists index).
+    pub images: Images<R>,
+    pub x_ext: Vec<Vec3<R>>,
+    /// Permutation scratch.
+    pub permute_m: Vec<Matrix3<R>>,
+    pub permute_r: Vec<R>,
+}
+
+impl<R: Real> Scratch<R> {
+    /// Sizes every array for `n` particles followed by the boundary particles `boundary`
+    /// (positions, velocities, stresses, densities; the particles' own arrays hold `n`)
+    /// and `slots` wall gradients each; a new particle starts unstressed. Writes the
+    /// boundary particles' positions and density `rho0`.
+    pub(crate) fn resize(
+        &mut self,
+        n: usize,
+        boundary: &[BoundaryParticle<R>],
+        rho0: R,
+        slots: usize,
+    ) {
+        let z = Vec3::zeros();
+        let zm = Matrix3::zeros();
+        let all = n + boundary.len();
+        self.stress.resize(all, zm);
+        self.plastic_strain.resize(n, R::zero());
+        self.x.resize(all, z);
+        self.v.resize(all, z);
+        self.rho.resize(all, R::zero());
+        self.stress_new.resize(all, zm);
+        self.rho_new.resize(all, R::zero());
+        self.plastic_new.resize(n, R::zero());
+        self.art.resize(all, zm);
+        self.x_new.resize(all, z);
+        self.v_new.resize(all, z);
+        self.anchor.resize(all, z);
+        for (k, b) in boundary.iter().enumerate() {
+            for x in [&mut self.x, &mut self.x_new, &mut self.anchor] {
+                x[n + k] = b.position;
+            }
+            self.rho[n + k] = rho0;
+            self.rho_new[n + k] = rho0;
+        }
+        // At least one slot, so that the stress pass (which zips over chunks of it) sees
+        // every particle without walls too.
+        self.wall_grad.resize(n * slots.max(1), z);
+    }
+}

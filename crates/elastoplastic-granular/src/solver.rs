@@ -1,0 +1,435 @@
+//! The scheme: explicit steps of Bui et al. (2008) sub-cycled inside each substep of the
+//! frame shell, neighbour lists kept across steps while particles move less than half the
+//! skin.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use nalgebra::Matrix3;
+use sph_core::{apply_permutation, ParticleSet, Real};
+use sph_kernels::KernelKind;
+use sph_solver::boundary::{check_volume_kernel, VolumeMapBoundary};
+use sph_solver::state::{match_arrays, ArraySpec};
+use sph_solver::step::{check_divergence, FramePhases, StepAt};
+use sph_solver::{CommonParams, FrameSolver, SchemeParts, SolverError, StepStats, SubstepScheme};
+
+use crate::boundary_particles::{extrapolate, BoundaryParticle, Extrapolation};
+use crate::kernels::{Consts, ELASTOPLASTIC_KERNEL};
+use crate::params::{ElastoplasticParams, WallModel};
+use crate::passes::{max_displacement, momentum_pass, stress_pass, StepInputs};
+use crate::scratch::Scratch;
+use crate::walls::{SharedWalls, WallSampler};
+
+pub(crate) const NAME: &str = "elastoplastic";
+
+/// The phases [`Elastoplastic::step`](FrameSolver::step) times.
+pub const ELASTOPLASTIC_PHASES: &[&str] = &[
+    "begin",
+    "create_hash_grid",
+    "detect_neighbours",
+    "stress",
+    "momentum",
+    "reorder",
+];
+const BEGIN: usize = 0;
+const CREATE_HASH_GRID: usize = 1;
+const DETECT_NEIGHBOURS: usize = 2;
+const STRESS: usize = 3;
+const MOMENTUM: usize = 4;
+const REORDER: usize = 5;
+
+/// What the solver carries between frames ([`SubstepScheme::save_arrays`]): the stress
+/// (`6 n` values per particle in the order xx, yy, zz, xy, yz, zx) and the equivalent
+/// plastic shear strain (`n` values). The density is the particles' own.
+pub const ELASTOPLASTIC_STATE_ARRAYS: &[&str] = &["stress", "plastic_strain"];
+
+/// The elastic–plastic granular solver of Bui et al. (2008); see the crate documentation.
+pub type Elastoplastic<R> = FrameSolver<R, ElastoplasticScheme<R>>;
+
+/// The time step of [`Elastoplastic`] as a [`SubstepScheme`].
+pub struct ElastoplasticScheme<R: Real> {
+    params: ElastoplasticParams<R>,
+    c: Consts<R>,
+    parts: SchemeParts<R>,
+    walls: WallSampler<R>,
+    models: Vec<WallModel>,
+    boundary_particles: Vec<BoundaryParticle<R>>,
+    scratch: Scratch<R>,
+    lists_valid: bool,
+    explicit_steps: u64,
+    searches: u64,
+}
+
+impl<R: Real> std::fmt::Debug for ElastoplasticScheme<R> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ElastoplasticScheme")
+            .field("params", &self.params)
+            .field("parts", &self.parts)
+            .field("explicit_steps", &self.explicit_steps)
+            .finish()
+    }
+}
+
+impl<R: Real> ElastoplasticScheme<R> {
+    fn build(
+        params: ElastoplasticParams<R>,
+        parts: SchemeParts<R>,
+        walls: WallSampler<R>,
+    ) -> Result<Self, SolverError> {
+        let models = match &walls {
+            WallSampler::PerSolid(w) => (0..w.maps().len()).map(|k| params.wall_model(k)).collect(),
+            WallSampler::Combined => {
+                if params.wall_models.iter().any(|&m| m != params.default_wall) {
+                    return Err(SolverError::InvalidParameter {
+                        solver: NAME,
+                        name: "wall_models",
+                        value: params.wall_models.len() as f64,
+                        reason: "a wall model per solid needs the walls of `volume_map_walls` given to `ElastoplasticScheme::solver`",
+                    });
+                }
+                if parts.boundary.has_volume() {
+                    vec![params.default_wall]
+                } else {
+                    Vec::new()
+                }
+            }
+        };
+        Ok(Self {
+            c: Consts::new(&params)?,
+            params,
+            parts,
+            walls,
+            models,
+            boundary_particles: Vec::new(),
+            scratch: Scratch::default(),
+            lists_valid: false,
+            explicit_steps: 0,
+            searches: 0,
+        })
+    }
+
+    /// The solver with `params` and volume-map `walls` (from
+    /// [`volume_map_walls`](crate::volume_map_walls)), each solid taking its wall model
+    /// ([`ElastoplasticParams::wall_model`]). Errors: invalid parameters, or walls
+    /// integrated with another kernel or support radius.
+    pub fn solver(
+        params: ElastoplasticParams<R>,
+        walls: VolumeMapBoundary<R>,
+    ) -> Result<Elastoplastic<R>, SolverError> {
+        params.validate()?;
+        check_volume_kernel(
+            &walls,
+            NAME,
+            ELASTOPLASTIC_KERNEL,
+            params.common.support_radius,
+        )?;
+        let walls = Arc::new(walls);
+        let parts = SchemeParts::new(
+            Box::new(SharedWalls(Arc::clone(&walls))),
+            params.common.neighbour_method,
+        );
+        let scheme = Self::build(params, parts, WallSampler::PerSolid(walls))?;
+        Ok(FrameSolver::from_scheme(scheme))
+    }
+
+    /// The stress `σ_i` of each particle (Pa, tension positive) after the last step.
+    pub fn stress(&self) -> &[Matrix3<R>] {
+        &self.scratch.stress[..self.scratch.plastic_strain.len()]
+    }
+
+    /// The equivalent plastic shear strain accumulated by each particle
+    /// ([`StressUpdate::plastic_strain`](crate::StressUpdate::plastic_strain) summed).
+    pub fn plastic_strain(&self) -> &[R] {
+        &self.scratch.plastic_strain
+    }
+
+    /// Sets the stress of each particle (Pa, tension positive; one per particle of the state
+    /// the next [`FrameSolver::step`] takes), e.g. a geostatic initial stress. Errors: a
+    /// non-finite or asymmetric stress, named by its index.
+    pub fn set_stress(&mut self, stress: &[Matrix3<R>]) -> Result<(), SolverError> {
+        for (i, m) in stress.iter().enumerate() {
+            if m.iter().any(|v| !v.is_finite()) || *m != m.transpose() {
+                return Err(SolverError::InvalidParameter {
+                    solver: NAME,
+                    name: "stress",
+                    value: i as f64,
+                    reason: "each stress must be finite and symmetric (value: the first particle whose stress is not)",
+                });
+            }
+        }
+        self.resize(stress.len());
+        self.scratch.stress[..stress.len()].copy_from_slice(stress);
+        Ok(())
+    }
+
+    /// Sets the fixed boundary particles (see [`crate::boundary_particles`]); they take
+    /// part in every sum from the next step on. Solids whose share they replace should
+    /// have the model [`WallModel::ContactOnly`]. Errors: a non-finite position or normal,
+    /// named by its index.
+    pub fn set_boundary_particles(
+        &mut self,
+        particles: Vec<BoundaryParticle<R>>,
+    ) -> Result<(), SolverError> {
+        for (k, b) in particles.iter().enumerate() {
+            let ok = b
+                .position
+                .iter()
+                .chain(b.normal.iter())
+                .all(|v| v.is_finite())
+                && b.normal.norm() > R::zero();
+            if !ok {
+                return Err(SolverError::InvalidParameter {
+                    solver: NAME,
+                    name: "boundary_particles",
+                    value: k as f64,
+                    reason: "each boundary particle needs a finite position and a finite non-zero normal (value: the first that has not)",
+                });
+            }
+        }
+        let n = self.scratch.plastic_strain.len();
+        self.boundary_particles = particles
+            .into_iter()
+            .map(|b| BoundaryParticle {
+                normal: b.normal / b.normal.norm(),
+                ..b
+            })
+            .collect();
+        self.resize(n);
+        self.lists_valid = false;
+        Ok(())
+    }
+
+    /// The boundary particles.
+    pub fn boundary_particles(&self) -> &[BoundaryParticle<R>] {
+        &self.boundary_particles
+    }
+
+    fn resize(&mut self, n: usize) {
+        self.scratch.resize(
+            n,
+            &self.boundary_particles,
+            self.params.common.rest_density,
+            self.models.len(),
+        );
+    }
+
+    /// Explicit steps taken so far, and neighbour searches made for them.
+    pub fn counts(&self) -> (u64, u64) {
+        (self.explicit_steps, self.searches)
+    }
+
+    /// The wall model each wall gradient of the scheme takes (one per solid with per-solid
+    /// walls, one for a combined boundary with volume, none otherwise).
+    pub fn wall_models(&self) -> &[WallModel] {
+        &self.models
+    }
+
+    fn time_step(
+        &mut self,
+        state: &mut ParticleSet<R>,
+        at: StepAt,
+        stats: &mut StepStats,
+    ) -> Result<(), SolverError> {
+        let (steps, dt) = self.params.explicit_steps();
+        let h = self.params.common.support_radius;
+        let skin = self.params.skin;
+        let half = R::of_f64(0.5);
+        let n = state.len();
+        let s = &mut self.scratch;
+        s.x[..n].copy_from_slice(&state.positions);
+        s.v[..n].copy_from_slice(&state.velocities);
+        s.rho[..n].copy_from_slice(&state.densities);
+        let boundary_mass = self.params.common.particle_mass();
+        for _ in 0..steps {
+            if !self.lists_valid || max_displacement(s, n) > skin * half {
+                let axes = &self.params.periodic;
+                let search = if axes.is_empty() {
+                    self.parts
+                        .neighbours
+                        .find_in_step(&s.x, h + skin, at, "position")?
+                } else {
+                    s.images.rebuild(&mut s.x, axes, h + skin, &mut s.x_ext);
+                    self.parts
+                        .neighbours
+                        .find_in_step(&s.x_ext, h + skin, at, "position")?
+                };
+                stats.phases.add(CREATE_HASH_GRID, search.build_s());
+                stats.phases.add(DETECT_NEIGHBOURS, search.detect_s());
+                s.anchor.copy_from_slice(&s.x);
+                self.lists_valid = true;
+                self.searches += 1;
+            }
+            let inputs = StepInputs {
+                c: self.c,
+                masses: &state.masses,
+                nb: self.parts.neighbours.lists(),
+                boundary: &*self.parts.boundary,
+                walls: &self.walls,
+                models: &self.models,
+                gravity: self.params.common.gravity,
+                dt,
+                boundary_mass,
+            };
+            let t = Instant::now();
+            let bp = &self.boundary_particles;
+            if !bp.is_empty() {
+                let e = Extrapolation {
+                    c: self.c,
+                    nb: self.parts.neighbours.lists(),
+                    images: &s.images,
+                    x: &s.x,
+                    rho: &s.rho,
+                    particles: bp,
+                    gravity: self.params.common.gravity,
+                };
+                extrapolate(&e, &mut s.stress, Some(&mut s.v), None);
+            }
+            stress_pass(s, &inputs);
+            if !bp.is_empty() {
+                let e = Extrapolation {
+                    c: self.c,
+                    nb: self.parts.neighbours.lists(),
+                    images: &s.images,
+                    x: &s.x,
+                    rho: &s.rho,
+                    particles: bp,
+                    gravity: self.params.common.gravity,
+                };
+                extrapolate(&e, &mut s.stress_new, None, Some(&mut s.art));
+            }
+            stats.phases.add(STRESS, t.elapsed().as_secs_f64());
+            let t = Instant::now();
+            momentum_pass(s, &inputs);
+            stats.phases.add(MOMENTUM, t.elapsed().as_secs_f64());
+            std::mem::swap(&mut s.x, &mut s.x_new);
+            std::mem::swap(&mut s.v, &mut s.v_new);
+            std::mem::swap(&mut s.rho, &mut s.rho_new);
+            std::mem::swap(&mut s.stress, &mut s.stress_new);
+            std::mem::swap(&mut s.plastic_strain, &mut s.plastic_new);
+            self.explicit_steps += 1;
+            stats.iterations += 1;
+        }
+        check_divergence(at, &s.x[..n], &s.v[..n], &*self.parts.boundary, h)?;
+        state.positions.copy_from_slice(&s.x[..n]);
+        state.velocities.copy_from_slice(&s.v[..n]);
+        state.densities.copy_from_slice(&s.rho[..n]);
+        stats.substeps += 1;
+        stats.neighbour_pairs = self.parts.neighbours.lists().pair_count();
+        Ok(())
+    }
+}
+
+impl<R: Real> SubstepScheme<R> for ElastoplasticScheme<R> {
+    type Params = ElastoplasticParams<R>;
+    const NAME: &'static str = NAME;
+    const PHASES: &'static [&'static str] = ELASTOPLASTIC_PHASES;
+    const FRAME_PHASES: FramePhases = FramePhases {
+        checks: BEGIN,
+        reorder: REORDER,
+        statistics: MOMENTUM,
+    };
+    const DENSITY_KERNEL: KernelKind = ELASTOPLASTIC_KERNEL;
+
+    fn validate(params: &ElastoplasticParams<R>) -> Result<(), SolverError> {
+        params.validate()
+    }
+    fn common_of(params: &ElastoplasticParams<R>) -> &CommonParams<R> {
+        &params.common
+    }
+    /// Any boundary: its summed `∇Ψ` (if it has volume) takes `default_wall`; per-solid
+    /// models need [`ElastoplasticScheme::solver`].
+    fn new(params: ElastoplasticParams<R>, parts: SchemeParts<R>) -> Result<Self, SolverError> {
+        Self::build(params, parts, WallSampler::Combined)
+    }
+    fn params(&self) -> &ElastoplasticParams<R> {
+        &self.params
+    }
+    fn parts(&self) -> &SchemeParts<R> {
+        &self.parts
+    }
+    fn begin_frame(
+        &mut self,
+        state: &mut ParticleSet<R>,
+        permutation: Option<&[u32]>,
+        _stats: &mut StepStats,
+    ) -> Result<(), SolverError> {
+        let n = state.len();
+        self.resize(n);
+        if let Some(p) = permutation {
+            let s = &mut self.scratch;
+            apply_permutation(&mut s.stress, p, &mut s.permute_m);
+            apply_permutation(&mut s.plastic_strain, p, &mut s.permute_r);
+            self.resize(n);
+        }
+        // Every frame starts from fresh lists, so that a run resumed from a checkpoint
+        // repeats the uninterrupted one bit for bit.
+        self.lists_valid = false;
+        Ok(())
+    }
+    fn substep(
+        &mut self,
+        state: &mut ParticleSet<R>,
+        at: StepAt,
+        _last: bool,
+        stats: &mut StepStats,
+    ) -> Result<(), SolverError> {
+        self.time_step(state, at, stats)
+    }
+    fn save_arrays(&self, arrays: &mut Vec<(String, Vec<R>)>) {
+        let s = &self.scratch;
+        arrays.push((
+            "stress".into(),
+            s.stress[..s.plastic_strain.len()]
+                .iter()
+                .flat_map(|m| {
+                    [
+                        m[(0, 0)],
+                        m[(1, 1)],
+                        m[(2, 2)],
+                        m[(0, 1)],
+                        m[(1, 2)],
+                        m[(2, 0)],
+                    ]
+                })
+                .collect(),
+        ));
+        arrays.push(("plastic_strain".into(), s.plastic_strain.clone()));
+    }
+    fn restore_arrays(
+        &mut self,
+        arrays: &[(String, Vec<R>)],
+        particles: usize,
+    ) -> Result<(), SolverError> {
+        let n = particles;
+        let found = match_arrays(
+            NAME,
+            arrays,
+            &[
+                ArraySpec {
+                    name: "stress",
+                    len: 6 * n,
+                },
+                ArraySpec {
+                    name: "plastic_strain",
+                    len: n,
+                },
+            ],
+        )?;
+        self.resize(n);
+        let s = &mut self.scratch;
+        match found[0] {
+            Some(v) => {
+                for (m, c) in s.stress[..n].iter_mut().zip(v.chunks_exact(6)) {
+                    *m = Matrix3::new(c[0], c[3], c[5], c[3], c[1], c[4], c[5], c[4], c[2]);
+                }
+            }
+            None => s.stress[..n].fill(Matrix3::zeros()),
+        }
+        match found[1] {
+            Some(v) => s.plastic_strain.copy_from_slice(v),
+            None => s.plastic_strain.fill(R::zero()),
+        }
+        self.lists_valid = false;
+        Ok(())
+    }
+}

@@ -1,0 +1,283 @@
+//! The solver on small blocks: a settled layer against hydrostatics, determinism across
+//! thread counts, resuming from a checkpoint, parameter checks.
+
+use elastoplastic_granular::{
+    boundary_block, volume_map_walls, Aabb, BoxSdf, Elastoplastic, ElastoplasticParams,
+    ElastoplasticScheme, Inverted, ParticleSet, PeriodicAxis, Plane, Solids, SolverError, Vec3,
+    WallModel,
+};
+use nalgebra::Matrix3;
+use sph_core::sampling::cubic_lattice;
+
+const S: f64 = 0.01;
+
+/// A block `[0, w] × [0, d] × [0, 0.03]` (m) in a box `[0, box_w] × [0, 0.5] × [0, 0.03]`
+/// whose faces are all one free-slip solid; `E` = 5.84e5 Pa.
+fn block(w: f64, d: f64, box_w: f64) -> (Elastoplastic<f64>, ParticleSet<f64>) {
+    let mut p = ElastoplasticParams::<f64>::for_spacing(S, 30.0);
+    p.youngs_modulus = 5.84e5;
+    p.wall_models = vec![WallModel::FreeSlip];
+    let tank = Aabb::new(Vec3::zeros(), Vec3::new(box_w, 0.5, 0.03)).unwrap();
+    let solids: Solids<f64> = vec![Box::new(Inverted(BoxSdf::new(tank).unwrap()))];
+    let walls = volume_map_walls(solids, &p, tank).unwrap();
+    let region = Aabb::new(Vec3::zeros(), Vec3::new(w, d, 0.03)).unwrap();
+    let x = cubic_lattice(&region, S, 100_000).unwrap();
+    let state = ParticleSet::from_positions(x, p.common.particle_mass(), p.common.rest_density);
+    (ElastoplasticScheme::solver(p, walls).unwrap(), state)
+}
+
+#[test]
+#[ignore = "fails today: the layer does not settle (bottom σ_yy 10.9× hydrostatic after 1 s, particles at 1.65 m/s; docs/elastoplastic-granular.md)"]
+fn a_settled_layer_carries_its_weight() {
+    // 20 layers (d = 0.2 m) between free-slip walls, settled for 1 s: the bottom layer's
+    // centres lie d − s/2 below the free surface (mass is conserved, so ρ g z in the
+    // deformed layer is ρ0 g z0 of the reference one). Hydrostatics: σ_yy = −ρ0 g (d − s/2);
+    // tolerance 3 % (a flat bed's vertical stress within 3 % of ρ g d).
+    let (mut solver, mut state) = block(0.08, 0.2, 0.08);
+    for _ in 0..63 {
+        solver.step(&mut state).unwrap();
+    }
+    let rho0 = solver.params().common.rest_density;
+    let expected = -rho0 * 9.81 * (0.2 - S / 2.0);
+    let bottom: Vec<f64> = state
+        .positions
+        .iter()
+        .zip(solver.stress())
+        .filter(|(x, _)| x.y < S)
+        .map(|(_, s)| s[(1, 1)])
+        .collect();
+    assert_eq!(bottom.len(), 8 * 3);
+    let mean = bottom.iter().sum::<f64>() / bottom.len() as f64;
+    let vmax = state
+        .velocities
+        .iter()
+        .map(|v| v.norm())
+        .fold(0.0, f64::max);
+    println!("bottom σ_yy {mean:.1} Pa, expected {expected:.1} Pa, fastest {vmax:.2e} m/s");
+    assert!(
+        (mean / expected - 1.0).abs() < 0.03,
+        "bottom σ_yy {mean} Pa against {expected} Pa"
+    );
+}
+
+/// A layer `[0, 0.08] × [0, d] × [0, 0.03]` (m), periodic along `x` and `z`, on a floor of
+/// three rows of free-slip boundary particles (the floor plane only keeps particles out);
+/// `E` = 5.84e5 Pa, c = 0, φ = 30°. `geostatic`: it starts from `σ_yy = −ρ0 g (d − y)`,
+/// `σ_xx = σ_zz = K0 σ_yy`, `K0 = ν/(1 − ν)`.
+fn periodic_layer(d: f64, geostatic: bool) -> (Elastoplastic<f64>, ParticleSet<f64>) {
+    let mut p = ElastoplasticParams::<f64>::for_spacing(S, 30.0);
+    p.youngs_modulus = 5.84e5;
+    p.wall_models = vec![WallModel::ContactOnly];
+    let hi = Vec3::new(0.08, d, 0.03);
+    for axis in [0, 2] {
+        p.periodic.push(PeriodicAxis {
+            axis,
+            lo: 0.0,
+            hi: hi[axis],
+        });
+    }
+    let solids: Solids<f64> = vec![Box::new(Plane::new(Vec3::zeros(), Vec3::y()).unwrap())];
+    let domain = Aabb::new(
+        Vec3::new(-0.05, 0.0, -0.05),
+        hi + Vec3::new(0.05, 0.3, 0.05),
+    )
+    .unwrap();
+    let walls = volume_map_walls(solids, &p, domain).unwrap();
+    let x = cubic_lattice(&Aabb::new(Vec3::zeros(), hi).unwrap(), S, 100_000).unwrap();
+    let state = ParticleSet::from_positions(x, p.common.particle_mass(), p.common.rest_density);
+    let (rho0, nu) = (p.common.rest_density, p.poisson_ratio);
+    let mut solver = ElastoplasticScheme::solver(p, walls).unwrap();
+    let rows = Aabb::new(Vec3::new(0.0, -3.0 * S, 0.0), Vec3::new(hi.x, 0.0, hi.z)).unwrap();
+    let floor = boundary_block(&rows, S, Vec3::y(), WallModel::FreeSlip, 10_000).unwrap();
+    solver.scheme_mut().set_boundary_particles(floor).unwrap();
+    if geostatic {
+        let k0 = nu / (1.0 - nu);
+        let stress: Vec<Matrix3<f64>> = state
+            .positions
+            .iter()
+            .map(|x| {
+                let v = -rho0 * 9.81 * (d - x.y);
+                Matrix3::from_diagonal(&Vec3::new(k0 * v, v, k0 * v))
+            })
+            .collect();
+        solver.scheme_mut().set_stress(&stress).unwrap();
+    }
+    (solver, state)
+}
+
+#[test]
+fn a_geostatic_layer_on_a_particle_floor_rests_and_carries_its_weight() {
+    // 20 layers (d = 0.2 m), periodic sideways, for 1 s. Checks: the bottom layer's mean
+    // σ_yy within 3 % of −ρ0 g (d − s/2) (its centres lie d − s/2 below the surface; a flat
+    // bed's vertical stress within 3 % of ρ g d), and at rest by the criterion of granular
+    // codes over the last 0.5 s: the 99th-percentile speed below 0.05 √(g s).
+    // (With volume-map walls the same layer does not rest: docs/elastoplastic-granular.md.)
+    let d = 0.2;
+    let (mut solver, mut state) = periodic_layer(d, true);
+    let bound = 0.05 * (9.81 * S).sqrt();
+    let frames = 60;
+    for frame in 1..=frames {
+        solver.step(&mut state).unwrap();
+        if frame > frames / 2 {
+            let mut speeds: Vec<f64> = state.velocities.iter().map(|v| v.norm()).collect();
+            let k = (speeds.len() as f64 * 0.99) as usize;
+            let (_, p99, _) = speeds.select_nth_unstable_by(k, f64::total_cmp);
+            assert!(*p99 < bound, "frame {frame}: p99 speed {p99} m/s");
+        }
+    }
+    let rho0 = solver.params().common.rest_density;
+    let expected = -rho0 * 9.81 * (d - S / 2.0);
+    let bottom: Vec<f64> = state
+        .positions
+        .iter()
+        .zip(solver.stress())
+        .filter(|(x, _)| x.y < S)
+        .map(|(_, s)| s[(1, 1)])
+        .collect();
+    assert_eq!(bottom.len(), 8 * 3);
+    let mean = bottom.iter().sum::<f64>() / bottom.len() as f64;
+    assert!(
+        (mean / expected - 1.0).abs() < 0.03,
+        "bottom σ_yy {mean} Pa against {expected} Pa"
+    );
+}
+
+#[test]
+fn periodic_layers_on_particle_floors_are_deterministic_and_resumable() {
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| {
+                let (mut solver, mut state) = periodic_layer(0.05, false);
+                for _ in 0..3 {
+                    solver.step(&mut state).unwrap();
+                }
+                (state, solver.stress().to_vec())
+            })
+    };
+    let (a, sa) = run(1);
+    let (b, sb) = run(2);
+    assert_eq!(a.positions, b.positions);
+    assert_eq!(sa, sb);
+    let (mut solver, mut state) = periodic_layer(0.05, false);
+    solver.step(&mut state).unwrap();
+    let (saved_particles, saved) = (state.clone(), solver.save_state());
+    for _ in 0..2 {
+        solver.step(&mut state).unwrap();
+    }
+    let (mut resumed, _) = periodic_layer(0.05, false);
+    let mut particles = saved_particles;
+    resumed.restore_state(&saved, particles.len()).unwrap();
+    for _ in 0..2 {
+        resumed.step(&mut particles).unwrap();
+    }
+    assert_eq!(particles.positions, state.positions);
+    assert_eq!(resumed.stress(), solver.stress());
+    assert_eq!(state.positions, a.positions);
+}
+
+#[test]
+fn a_grain_out_of_contact_carries_no_stress() {
+    // One particle, no neighbours, no walls, no gravity, started under a compressive
+    // stress: a grain in the air has nothing to push against, so its stress is zero after
+    // one step (its velocity gradient is zero, so without the rule it would keep it).
+    let mut p = ElastoplasticParams::<f64>::for_spacing(S, 30.0);
+    p.youngs_modulus = 5.84e5;
+    p.common.gravity = Vec3::zeros();
+    let mut solver = Elastoplastic::new(p, Vec::new()).unwrap();
+    let mut state = ParticleSet::from_positions(vec![Vec3::new(0.1, 0.1, 0.1)], 2.04e-3, 2040.0);
+    let sigma = Matrix3::from_diagonal(&Vec3::new(-500.0, -1000.0, -500.0));
+    solver.scheme_mut().set_stress(&[sigma]).unwrap();
+    solver.step(&mut state).unwrap();
+    assert_eq!(solver.stress()[0], Matrix3::zeros());
+    assert_eq!(state.velocities[0], Vec3::zeros());
+}
+
+fn run(threads: usize, frames: usize) -> (ParticleSet<f64>, Vec<f64>) {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(|| {
+        let (mut solver, mut state) = block(0.1, 0.1, 0.3);
+        for _ in 0..frames {
+            solver.step(&mut state).unwrap();
+        }
+        let stress = solver
+            .stress()
+            .iter()
+            .flat_map(|m| m.iter().copied())
+            .collect();
+        (state, stress)
+    })
+}
+
+#[test]
+fn one_and_two_threads_give_the_same_bits() {
+    let (a, sa) = run(1, 4);
+    let (b, sb) = run(2, 4);
+    assert_eq!(a.positions, b.positions);
+    assert_eq!(a.velocities, b.velocities);
+    assert_eq!(a.densities, b.densities);
+    assert_eq!(sa, sb);
+}
+
+#[test]
+fn a_resumed_run_repeats_the_uninterrupted_one() {
+    let (mut solver, mut state) = block(0.1, 0.1, 0.3);
+    for _ in 0..2 {
+        solver.step(&mut state).unwrap();
+    }
+    let (saved_particles, saved) = (state.clone(), solver.save_state());
+    assert!(solver.plastic_strain().iter().any(|&k| k > 0.0));
+    for _ in 0..2 {
+        solver.step(&mut state).unwrap();
+    }
+    let (mut resumed, _) = block(0.1, 0.1, 0.3);
+    let mut particles = saved_particles;
+    resumed.restore_state(&saved, particles.len()).unwrap();
+    for _ in 0..2 {
+        resumed.step(&mut particles).unwrap();
+    }
+    assert_eq!(particles.positions, state.positions);
+    assert_eq!(resumed.stress(), solver.stress());
+    assert_eq!(resumed.plastic_strain(), solver.plastic_strain());
+}
+
+#[test]
+fn invalid_parameters_are_named() {
+    let base = ElastoplasticParams::<f64>::for_spacing(S, 30.0);
+    type Change = fn(&mut ElastoplasticParams<f64>);
+    let cases: [(&str, Change); 7] = [
+        ("periodic", |p| {
+            p.periodic.push(PeriodicAxis {
+                axis: 2,
+                lo: 0.0,
+                hi: 0.02,
+            })
+        }),
+        ("periodic", |p| {
+            p.periodic.push(PeriodicAxis {
+                axis: 3,
+                lo: 0.0,
+                hi: 1.0,
+            })
+        }),
+        ("poisson_ratio", |p| p.poisson_ratio = 0.5),
+        ("youngs_modulus", |p| p.youngs_modulus = -1.0),
+        ("dilatancy_angle_deg", |p| p.dilatancy_angle_deg = 40.0),
+        ("cfl_number", |p| p.cfl_number = 1e-9),
+        ("skin", |p| p.skin = f64::NAN),
+    ];
+    assert!(base.validate().is_ok());
+    for (name, change) in cases {
+        let mut p = base.clone();
+        change(&mut p);
+        match p.validate() {
+            Err(SolverError::InvalidParameter { name: n, .. }) => assert_eq!(n, name),
+            other => panic!("{name}: {other:?}"),
+        }
+    }
+}
