@@ -9,7 +9,9 @@
 //!
 //! Keys (defaults): `s` spacing (0.02 m), `E` (5.84e5 Pa), `alpha` (α_Π, 0.1), `phi`
 //! (30°), `C` (0.2), `cap` (6 s), `L` period (1.2 m), `H` bed height (0.2 m), `w` slot
-//! width (0.12 m), `sump` (0.6 m), `geo` (1: geostatic start; 0: unstressed).
+//! width (0.12 m), `sump` (0.6 m), `geo` (1: geostatic start; 0: unstressed), `u` the
+//! viscosity's fixed velocity scale (m/s; 0, the default: the speed of sound), `psi` the
+//! dilatancy angle (0°).
 //! `HEAP_BUDGET_S`, `HEAP_SAVE`, `HEAP_RESUME` split a long run into pieces (see
 //! `examples/pieces`).
 //!
@@ -45,6 +47,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     params.youngs_modulus = num("E", 5.84e5)?;
     params.viscosity_alpha = num("alpha", params.viscosity_alpha)?;
     params.cfl_number = num("C", params.cfl_number)?;
+    params.dilatancy_angle_deg = num("psi", 0.0)?;
+    let u = num("u", 0.0)?;
+    params.viscosity_speed_m_s = (u > 0.0).then_some(u);
     let cap_s = num("cap", 6.0)?;
     let mut setup = DrainedSetup::for_spacing(s);
     setup.period_x_m = num("L", setup.period_x_m)?;
@@ -52,7 +57,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     setup.slot_width_m = num("w", setup.slot_width_m)?;
     setup.sump_depth_m = num("sump", setup.sump_depth_m)?;
     setup.geostatic = num("geo", 1.0)? != 0.0;
-    println!("{setup:?}, alpha_Pi {}", params.viscosity_alpha);
+    println!(
+        "{setup:?}, alpha_Pi {}, viscosity speed {:?}, psi {} deg",
+        params.viscosity_alpha, params.viscosity_speed_m_s, params.dilatancy_angle_deg
+    );
     let youngs = params.youngs_modulus;
     let (mut solver, mut state) = drained_bed(params, setup)?;
     let (steps, dt) = solver.params().explicit_steps();
@@ -158,12 +166,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 /// The surface height (mm) of the grains on the floor in bins of 5 cm along `x`.
 fn profile(x: &[elastoplastic_granular::Vec3<f64>], s: f64) {
     let bins = 200;
-    let mut top = vec![f64::NAN; bins];
+    let mut top = vec![f64::NEG_INFINITY; bins];
     for p in x {
         let b = ((p.x / 0.05) as usize).min(bins - 1);
-        if !(top[b] >= p.y) {
-            top[b] = p.y + 0.5 * s;
-        }
+        top[b] = top[b].max(p.y + 0.5 * s);
     }
     let shown: Vec<String> = top
         .iter()

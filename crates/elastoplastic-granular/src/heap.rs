@@ -334,11 +334,17 @@ pub fn drained_bed<R: Real>(
     // The solids only keep grains out of the plate and under the sump's floor.
     let (far_lo, far_hi) = (-0.5, d + 0.5);
     let solids: Solids<R> = vec![
-        Box::new(BoxSdf::new(aabb([half, -plate, far_lo], [l - half, 0.0, far_hi])?)?),
+        Box::new(BoxSdf::new(aabb(
+            [half, -plate, far_lo],
+            [l - half, 0.0, far_hi],
+        )?)?),
         Box::new(Plane::new(v(0.0, sump_floor, 0.0), v(0.0, 1.0, 0.0))?),
     ];
     params.wall_models = vec![WallModel::ContactOnly; 2];
-    let domain = aabb([-0.05, sump_floor - 0.05, -0.05], [l + 0.05, h + 0.1, d + 0.05])?;
+    let domain = aabb(
+        [-0.05, sump_floor - 0.05, -0.05],
+        [l + 0.05, h + 0.1, d + 0.05],
+    )?;
     let walls = volume_map_walls(solids, &params, domain)?;
     let bed = aabb([0.0, 0.0, 0.0], [l, h, d])?;
     let positions = cubic_lattice(&bed, params.common.particle_spacing, 1 << 22)?;
@@ -362,7 +368,10 @@ pub fn drained_bed<R: Real>(
         1 << 22,
     )?;
     rows.extend(boundary_block(
-        &aabb([0.0, sump_floor - BOUNDARY_ROWS * s, 0.0], [l, sump_floor, d])?,
+        &aabb(
+            [0.0, sump_floor - BOUNDARY_ROWS * s, 0.0],
+            [l, sump_floor, d],
+        )?,
         R::of_f64(s),
         up,
         WallModel::NoSlip,
