@@ -246,17 +246,17 @@ pub fn at_rest(samples: &[RestSample], spacing: f64, gravity: f64) -> bool {
 
 /// A drained bed: a layer of grains on a perforated floor, drained through a slot into a
 /// sump below, so that the two slopes left beside the slot form quasi-statically (the
-/// drained angle of repose, e.g. Nedderman 1992, *Statics and Kinematics of Granular
-/// Materials*, §1.3).
+/// drained angle of repose; Nedderman 1992, *Statics and Kinematics of Granular
+/// Materials*, Cambridge University Press, ch. 1).
 ///
 /// Geometry (m): periodic along `x` with period `period_x_m` and along `z` with
 /// `slab_depth_m` (plane strain without walls); the slot `|x| < slot_width_m / 2` (mod the
 /// period) is centred on the periodic seam, so that the grains left on the floor
 /// `[slot/2, period − slot/2]` form one mound whose two flanks descend to the slot's edges
-/// (a planar heap for [`granular_measure`]-style angle measures, floor `y = 0`). The floor is
-/// a plate of [`DRAINED_PLATE_ROWS`] rows of no-slip boundary particles under `y = 0`, thick
-/// enough that none of them sees both the bed and the sump (support 2.4 spacings); the sump
-/// is the space `sump_depth_m` deep under the plate, closed by three rows of no-slip boundary
+/// (a planar heap for the angle-of-repose measure of `granular-measure`, floor `y = 0`).
+/// The floor is a plate of [`DRAINED_PLATE_ROWS`] rows of no-slip boundary particles under
+/// `y = 0`, thick enough that none of them sees both the bed and the sump (support 2.4
+/// spacings); the sump is the space `sump_depth_m` deep under the plate, closed by three rows of no-slip boundary
 /// particles. At `t = 0` the bed `[0, period) × [0, bed_height_m]` is at rest, with the
 /// geostatic stress if asked, and the grains over the slot start to fall.
 #[derive(Debug, Clone, Copy, PartialEq)]
