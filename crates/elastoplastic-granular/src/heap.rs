@@ -243,3 +243,152 @@ pub fn at_rest(samples: &[RestSample], spacing: f64, gravity: f64) -> bool {
         });
     slow && angles.iter().all(|a| a.is_finite()) && hi - lo < 0.3
 }
+
+/// A drained bed: a layer of grains on a perforated floor, drained through a slot into a
+/// sump below, so that the two slopes left beside the slot form quasi-statically (the
+/// drained angle of repose; Nedderman 1992, *Statics and Kinematics of Granular
+/// Materials*, Cambridge University Press, ch. 1).
+///
+/// Geometry (m): periodic along `x` with period `period_x_m` and along `z` with
+/// `slab_depth_m` (plane strain without walls); the slot `|x| < slot_width_m / 2` (mod the
+/// period) is centred on the periodic seam, so that the grains left on the floor
+/// `[slot/2, period − slot/2]` form one mound whose two flanks descend to the slot's edges
+/// (a planar heap for the angle-of-repose measure of `granular-measure`, floor `y = 0`).
+/// The floor is a plate of [`DRAINED_PLATE_ROWS`] rows of no-slip boundary particles under
+/// `y = 0`, thick enough that none of them sees both the bed and the sump (support 2.4
+/// spacings); the sump is the space `sump_depth_m` deep under the plate, closed by three rows of no-slip boundary
+/// particles. At `t = 0` the bed `[0, period) × [0, bed_height_m]` is at rest, with the
+/// geostatic stress if asked, and the grains over the slot start to fall.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DrainedSetup {
+    /// The period along `x` (m; a multiple of the spacing).
+    pub period_x_m: f64,
+    /// The bed's initial height (m).
+    pub bed_height_m: f64,
+    /// The slot's width (m; an even multiple of the spacing).
+    pub slot_width_m: f64,
+    /// The sump's depth under the plate (m).
+    pub sump_depth_m: f64,
+    /// The slab's depth along `z` (m; a multiple of the spacing).
+    pub slab_depth_m: f64,
+    /// Start from the geostatic stress (`σ_yy = −ρ0 g (H − y)`, `σ_xx = σ_zz = K0 σ_yy`,
+    /// `K0 = ν/(1 − ν)`) rather than unstressed.
+    pub geostatic: bool,
+}
+
+/// Rows of boundary particles in the drained bed's floor plate: with the support 2.4
+/// spacings, a plate four or more rows thick has no boundary particle within the support of
+/// both the bed above and the sump below (their stresses would mix in its Shepard average).
+pub const DRAINED_PLATE_ROWS: f64 = 5.0;
+
+impl DrainedSetup {
+    /// The bed of the runs in `docs/elastoplastic-granular.md` at spacing `s` (m): period
+    /// 1.2 m, bed 0.2 m high, slot 0.12 m wide, sump 0.6 m deep, slab three spacings deep,
+    /// geostatic start.
+    pub fn for_spacing(s: f64) -> Self {
+        Self {
+            period_x_m: 1.2,
+            bed_height_m: 0.2,
+            slot_width_m: 0.12,
+            sump_depth_m: 0.6,
+            slab_depth_m: 3.0 * s,
+            geostatic: true,
+        }
+    }
+
+    /// Whether a grain at `p` is on the floor beside the slot (part of the drained heap).
+    pub fn on_floor<R: Real>(&self, p: &Vec3<R>) -> bool {
+        let (x, y) = (p.x.as_f64(), p.y.as_f64());
+        let half = 0.5 * self.slot_width_m;
+        y > 0.0 && x >= half && x <= self.period_x_m - half
+    }
+}
+
+/// The solver and the bed's particles at `t = 0` for `params` (its spacing sets the
+/// lattice), set up as `setup` says ([`DrainedSetup`]).
+pub fn drained_bed<R: Real>(
+    mut params: ElastoplasticParams<R>,
+    setup: DrainedSetup,
+) -> Result<(Elastoplastic<R>, ParticleSet<R>), SolverError> {
+    let s = params.common.particle_spacing.as_f64();
+    let (l, h, half, d) = (
+        setup.period_x_m,
+        setup.bed_height_m,
+        0.5 * setup.slot_width_m,
+        setup.slab_depth_m,
+    );
+    let plate = DRAINED_PLATE_ROWS * s;
+    let sump_floor = -plate - setup.sump_depth_m;
+    params.periodic = vec![
+        PeriodicAxis {
+            axis: 0,
+            lo: R::zero(),
+            hi: R::of_f64(l),
+        },
+        PeriodicAxis {
+            axis: 2,
+            lo: R::zero(),
+            hi: R::of_f64(d),
+        },
+    ];
+    // The solids only keep grains out of the plate and under the sump's floor.
+    let (far_lo, far_hi) = (-0.5, d + 0.5);
+    let solids: Solids<R> = vec![
+        Box::new(BoxSdf::new(aabb(
+            [half, -plate, far_lo],
+            [l - half, 0.0, far_hi],
+        )?)?),
+        Box::new(Plane::new(v(0.0, sump_floor, 0.0), v(0.0, 1.0, 0.0))?),
+    ];
+    params.wall_models = vec![WallModel::ContactOnly; 2];
+    let domain = aabb(
+        [-0.05, sump_floor - 0.05, -0.05],
+        [l + 0.05, h + 0.1, d + 0.05],
+    )?;
+    let walls = volume_map_walls(solids, &params, domain)?;
+    let bed = aabb([0.0, 0.0, 0.0], [l, h, d])?;
+    let positions = cubic_lattice(&bed, params.common.particle_spacing, 1 << 22)?;
+    let state = ParticleSet::from_positions(
+        positions,
+        params.common.particle_mass(),
+        params.common.rest_density,
+    );
+    let (rho0, g, nu) = (
+        params.common.rest_density,
+        -params.common.gravity.y,
+        params.poisson_ratio,
+    );
+    let mut solver = ElastoplasticScheme::solver(params, walls)?;
+    let up = v(0.0, 1.0, 0.0);
+    let mut rows = boundary_block(
+        &aabb([half, -plate, 0.0], [l - half, 0.0, d])?,
+        R::of_f64(s),
+        up,
+        WallModel::NoSlip,
+        1 << 22,
+    )?;
+    rows.extend(boundary_block(
+        &aabb(
+            [0.0, sump_floor - BOUNDARY_ROWS * s, 0.0],
+            [l, sump_floor, d],
+        )?,
+        R::of_f64(s),
+        up,
+        WallModel::NoSlip,
+        1 << 22,
+    )?);
+    solver.scheme_mut().set_boundary_particles(rows)?;
+    if setup.geostatic {
+        let k0 = nu / (R::one() - nu);
+        let stress: Vec<Matrix3<R>> = state
+            .positions
+            .iter()
+            .map(|x| {
+                let sv = -rho0 * g * (R::of_f64(h) - x.y);
+                Matrix3::from_diagonal(&Vec3::new(k0 * sv, sv, k0 * sv))
+            })
+            .collect();
+        solver.scheme_mut().set_stress(&stress)?;
+    }
+    Ok((solver, state))
+}

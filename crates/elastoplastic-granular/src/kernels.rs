@@ -21,7 +21,8 @@ pub(crate) struct Consts<R: Real> {
     pub h: R,
     /// `0.01 h²` of the viscosity's denominator.
     pub eta2: R,
-    /// Speed of sound `c = √(E/ρ0)` (m/s).
+    /// The viscosity's velocity scale (m/s): the speed of sound `c = √(E/ρ0)` unless
+    /// `viscosity_speed_m_s` fixes it.
     pub c0: R,
     pub alpha: R,
     pub beta: R,
@@ -41,7 +42,7 @@ impl<R: Real> Consts<R> {
             rho0: p.common.rest_density,
             h,
             eta2: h * h * R::of_f64(0.01),
-            c0: p.sound_speed(),
+            c0: p.viscosity_speed(),
             alpha: p.viscosity_alpha,
             beta: p.viscosity_beta,
             eps_stress: p.artificial_stress_epsilon,

@@ -15,6 +15,8 @@ pub const MAX_POISSON_RATIO: f64 = 0.49;
 pub const MAX_FRICTION_ANGLE_DEG: f64 = 70.0;
 /// Largest cohesion accepted (Pa).
 pub const MAX_COHESION_PA: f64 = 1e9;
+/// Largest fixed velocity scale of the artificial viscosity accepted (m/s).
+pub const MAX_VISCOSITY_SPEED_M_S: f64 = 1e6;
 /// Largest artificial viscosity coefficient (`α_Π`, `β_Π`) accepted.
 pub const MAX_VISCOSITY_COEFFICIENT: f64 = 10.0;
 /// Largest artificial stress exponent `n` accepted.
@@ -79,6 +81,7 @@ pub enum WallModel {
 /// | `dilatancy_angle_deg` | 0 (sand, Bui et al. 2008) | |
 /// | `cohesion` | 0 Pa (cohesionless) | |
 /// | `viscosity_alpha`, `viscosity_beta` | 0.1, 0 | [`DEFAULT_VISCOSITY_ALPHA`] |
+/// | `viscosity_speed_m_s` | `None` (the speed of sound) | Monaghan 1992 |
 /// | `artificial_stress_epsilon`, `_exponent` | 0.5, 2.55 | Gray et al. 2001 |
 /// | `cfl_number` | 0.2 | [`DEFAULT_CFL_NUMBER`] |
 /// | `skin` | `0.3 s` | [`DEFAULT_SKIN_OVER_SPACING`] |
@@ -102,6 +105,11 @@ pub struct ElastoplasticParams<R: Real> {
     pub viscosity_alpha: R,
     /// Monaghan's artificial viscosity, quadratic coefficient `β_Π`.
     pub viscosity_beta: R,
+    /// The velocity scale of the viscosity's linear term (m/s): `None` uses the speed of
+    /// sound `c = √(E/ρ0)` (Monaghan 1992); `Some(u)` a fixed scale, so that the damping
+    /// does not grow with the modulus (its shear viscosity is of order `α_Π u h / 10`
+    /// whatever `E`). See [`ElastoplasticParams::viscosity_speed`].
+    pub viscosity_speed_m_s: Option<R>,
     /// Gray et al. (2001)'s artificial stress coefficient `ε` (0 disables it).
     pub artificial_stress_epsilon: R,
     /// Gray et al. (2001)'s artificial stress exponent `n`.
@@ -160,6 +168,7 @@ impl<R: Real> ElastoplasticParams<R> {
             cohesion: R::zero(),
             viscosity_alpha: R::of_f64(DEFAULT_VISCOSITY_ALPHA),
             viscosity_beta: R::of_f64(DEFAULT_VISCOSITY_BETA),
+            viscosity_speed_m_s: None,
             artificial_stress_epsilon: R::of_f64(DEFAULT_ARTIFICIAL_STRESS_EPSILON),
             artificial_stress_exponent: R::of_f64(DEFAULT_ARTIFICIAL_STRESS_EXPONENT),
             cfl_number: R::of_f64(DEFAULT_CFL_NUMBER),
@@ -192,6 +201,13 @@ impl<R: Real> ElastoplasticParams<R> {
     /// The speed of sound `c = √(E/ρ0)` (m/s) of the time step and the viscosity.
     pub fn sound_speed(&self) -> R {
         (self.youngs_modulus / self.common.rest_density).sqrt()
+    }
+
+    /// The velocity scale of the artificial viscosity's linear term (m/s):
+    /// [`Self::viscosity_speed_m_s`] if set, else the speed of sound.
+    pub fn viscosity_speed(&self) -> R {
+        self.viscosity_speed_m_s
+            .unwrap_or_else(|| self.sound_speed())
     }
 
     /// The smoothing length `h` (m): half the support radius (cubic B-spline).
@@ -270,6 +286,15 @@ impl<R: Real> ElastoplasticParams<R> {
                 0.0,
                 MAX_VISCOSITY_COEFFICIENT,
                 "must be in [0, MAX_VISCOSITY_COEFFICIENT = 10]",
+            )?;
+        }
+        if let Some(u) = self.viscosity_speed_m_s {
+            check_range(
+                "viscosity_speed_m_s",
+                f(u),
+                f64::MIN_POSITIVE,
+                MAX_VISCOSITY_SPEED_M_S,
+                "must be > 0 and at most MAX_VISCOSITY_SPEED_M_S (1e6 m/s) when set",
             )?;
         }
         check_range(

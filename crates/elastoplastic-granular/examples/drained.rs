@@ -1,0 +1,181 @@
+//! A drained heap: a bed of grains on a floor with a slot in its middle, drained into a
+//! sump below (`heap::drained_bed`), run until the two slopes left beside the slot are at
+//! rest by the criterion of granular codes or a time cap, with their angle measured as
+//! the repose experiment measures a planar heap (floor `y = 0`, the grains on the floor).
+//!
+//! ```sh
+//! cargo run --release --example drained -p elastoplastic-granular [key=value …]
+//! ```
+//!
+//! Keys (defaults): `s` spacing (0.02 m), `E` (5.84e5 Pa), `alpha` (α_Π, 0.1), `phi`
+//! (30°), `C` (0.2), `cap` (6 s), `L` period (1.2 m), `H` bed height (0.2 m), `w` slot
+//! width (0.12 m), `sump` (0.6 m), `geo` (1: geostatic start; 0: unstressed), `u` the
+//! viscosity's fixed velocity scale (m/s; 0, the default: the speed of sound), `psi` the
+//! dilatancy angle (0°).
+//! `HEAP_BUDGET_S`, `HEAP_SAVE`, `HEAP_RESUME` split a long run into pieces (see
+//! `examples/pieces`).
+//!
+//! Prints every 0.1 s: time, 99th-percentile speed and fastest particle two spacings deep
+//! of the grains on the floor, the angle (mean of the flanks) and each flank's, the grains
+//! on the floor, wall time; at the end whether the heap is at rest and its angle against
+//! the plane-strain prediction `asin(3 α_φ)` (docs/elastoplastic-granular.md).
+
+use std::time::Instant;
+
+use elastoplastic_granular::heap::{at_rest, drained_bed, rest_speeds, DrainedSetup, RestSample};
+use elastoplastic_granular::stress::plane_strain_alpha;
+use elastoplastic_granular::ElastoplasticParams;
+use granular_measure::{angle_of_repose, ReposeOptions};
+
+mod pieces;
+use pieces::{elapsed_over_budget, resume, save_run};
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let num = |key: &str, d: f64| -> Result<f64, Box<dyn std::error::Error>> {
+        match args
+            .iter()
+            .find_map(|a| a.strip_prefix(key).and_then(|r| r.strip_prefix('=')))
+        {
+            Some(a) => Ok(a.parse()?),
+            None => Ok(d),
+        }
+    };
+    let s = num("s", 0.02)?;
+    let phi = num("phi", 30.0)?;
+    let mut params = ElastoplasticParams::<f64>::for_spacing(s, phi);
+    params.youngs_modulus = num("E", 5.84e5)?;
+    params.viscosity_alpha = num("alpha", params.viscosity_alpha)?;
+    params.cfl_number = num("C", params.cfl_number)?;
+    params.dilatancy_angle_deg = num("psi", 0.0)?;
+    let u = num("u", 0.0)?;
+    params.viscosity_speed_m_s = (u > 0.0).then_some(u);
+    let cap_s = num("cap", 6.0)?;
+    let mut setup = DrainedSetup::for_spacing(s);
+    setup.period_x_m = num("L", setup.period_x_m)?;
+    setup.bed_height_m = num("H", setup.bed_height_m)?;
+    setup.slot_width_m = num("w", setup.slot_width_m)?;
+    setup.sump_depth_m = num("sump", setup.sump_depth_m)?;
+    setup.geostatic = num("geo", 1.0)? != 0.0;
+    println!(
+        "{setup:?}, alpha_Pi {}, viscosity speed {:?}, psi {} deg",
+        params.viscosity_alpha, params.viscosity_speed_m_s, params.dilatancy_angle_deg
+    );
+    let youngs = params.youngs_modulus;
+    let (mut solver, mut state) = drained_bed(params, setup)?;
+    let (steps, dt) = solver.params().explicit_steps();
+    let predicted = (3.0 * plane_strain_alpha(phi)).asin().to_degrees();
+    println!(
+        "{} particles, s = {s} m, E = {youngs:.3e} Pa, phi = {phi} deg, {steps} explicit steps of {dt:.3e} s per frame; predicted slope {predicted:.2} deg",
+        state.len()
+    );
+    let frame_dt = solver.params().common.dt;
+    let options = ReposeOptions::planar(0.0, s).with_spacing(s);
+    let mut samples: Vec<RestSample> = Vec::new();
+    let mut initial = state.positions.clone();
+    let mut ids: Vec<usize> = (0..state.len()).collect();
+    let mut first = 1;
+    if let Ok(path) = std::env::var("HEAP_RESUME") {
+        first = resume(
+            &path,
+            &mut solver,
+            &mut state,
+            &mut initial,
+            &mut ids,
+            &mut samples,
+        )?;
+        println!("resumed {path} at frame {first}");
+    }
+    let start = Instant::now();
+    let frames = (cap_s / frame_dt).ceil() as usize;
+    let save = |solver: &elastoplastic_granular::Elastoplastic<f64>,
+                state: &elastoplastic_granular::ParticleSet<f64>,
+                ids: &[usize],
+                samples: &[RestSample]|
+     -> Result<(), Box<dyn std::error::Error>> {
+        if let Ok(path) = std::env::var("HEAP_SAVE") {
+            save_run(&path, solver, state, &initial, ids, samples)?;
+            println!("saved {path}");
+        }
+        Ok(())
+    };
+    for frame in first..=frames {
+        if elapsed_over_budget(&start) {
+            println!("stopping at frame {frame} (HEAP_BUDGET_S)");
+            return save(&solver, &state, &ids, &samples);
+        }
+        solver.step(&mut state)?;
+        if let Some(perm) = solver.last_permutation() {
+            ids = perm.iter().map(|&o| ids[o as usize]).collect();
+        }
+        let t = frame as f64 * frame_dt;
+        let (x, v): (Vec<_>, Vec<_>) = state
+            .positions
+            .iter()
+            .zip(&state.velocities)
+            .filter(|(p, _)| setup.on_floor(p))
+            .map(|(p, u)| (*p, *u))
+            .unzip();
+        let (p99, deep) = rest_speeds(&x, &v, s);
+        let measured = angle_of_repose(&x, &options).ok();
+        let angle = measured.as_ref().map(|m| m.angle_deg);
+        samples.push(RestSample {
+            time_s: t,
+            p99_speed: p99,
+            deep_max_speed: deep,
+            angle_deg: angle,
+        });
+        let rest = at_rest(&samples, s, 9.81);
+        if frame % 6 == 0 || rest {
+            let flanks = measured.as_ref().map_or(String::new(), |m| {
+                m.flanks
+                    .iter()
+                    .map(|f| format!("{:.2}", f.angle_deg))
+                    .collect::<Vec<_>>()
+                    .join("/")
+            });
+            let height = measured.as_ref().map_or(0.0, |m| m.pile_height_m);
+            println!(
+                "t {t:5.2} s  p99 {p99:.4} m/s  deep max {deep:.4} m/s  angle {} (flanks {flanks}, height {height:.3} m)  on floor {}  wall {:.1} s",
+                angle.map_or("-".into(), |a| format!("{a:.2}")),
+                x.len(),
+                start.elapsed().as_secs_f64()
+            );
+        }
+        if rest {
+            println!(
+                "AT REST at t = {t:.2} s: angle {} deg (predicted {predicted:.2}), wall time {:.1} s",
+                angle.map_or("-".into(), |a| format!("{a:.2}")),
+                start.elapsed().as_secs_f64()
+            );
+            profile(&x, s);
+            return save(&solver, &state, &ids, &samples);
+        }
+    }
+    let last = samples.last().copied();
+    let rest = at_rest(&samples, s, 9.81);
+    println!(
+        "{} at the cap {cap_s} s: last {last:?} (bound {:.4} m/s), wall time {:.1} s",
+        if rest { "AT REST" } else { "NOT AT REST" },
+        0.05 * (9.81 * s).sqrt(),
+        start.elapsed().as_secs_f64()
+    );
+    save(&solver, &state, &ids, &samples)
+}
+
+/// The surface height (mm) of the grains on the floor in bins of 5 cm along `x`.
+fn profile(x: &[elastoplastic_granular::Vec3<f64>], s: f64) {
+    let bins = 200;
+    let mut top = vec![f64::NEG_INFINITY; bins];
+    for p in x {
+        let b = ((p.x / 0.05) as usize).min(bins - 1);
+        top[b] = top[b].max(p.y + 0.5 * s);
+    }
+    let shown: Vec<String> = top
+        .iter()
+        .enumerate()
+        .filter(|(_, h)| h.is_finite())
+        .map(|(b, h)| format!("{:.3}:{:.0}", (b as f64 + 0.5) * 0.05, 1000.0 * h))
+        .collect();
+    println!("profile (x m: top mm): {}", shown.join(" "));
+}
