@@ -77,8 +77,9 @@ pub struct RestSettings {
     /// (default 1).
     pub angle_window_s: f64,
     /// The largest change (degrees, max − min) of the angle over its window, exclusive
-    /// (default 0.3).
-    pub angle_drift_deg: f64,
+    /// (default 0.3); `None` judges the speeds only (a material that is not a heap: a
+    /// liquid, a column that has not collapsed).
+    pub angle_drift_deg: Option<f64>,
 }
 
 impl Default for RestSettings {
@@ -89,7 +90,7 @@ impl Default for RestSettings {
             deep_spacings: 2.0,
             speed_hold_s: 0.5,
             angle_window_s: 1.0,
-            angle_drift_deg: 0.3,
+            angle_drift_deg: Some(0.3),
         }
     }
 }
@@ -109,7 +110,7 @@ impl RestSettings {
         for (name, v) in [
             ("speed_scale", self.speed_scale),
             ("deep_spacings", self.deep_spacings),
-            ("angle_drift_deg", self.angle_drift_deg),
+            ("angle_drift_deg", self.angle_drift_deg.unwrap_or(1.0)),
         ] {
             if !(v.is_finite() && v > 0.0) {
                 return bad(name, v, "must be finite and > 0");
@@ -338,8 +339,9 @@ pub struct RestVerdict {
     pub percentile_speed: RestMargin,
     /// The deep particles' largest speed over the hold window.
     pub deep_speed: RestMargin,
-    /// The angle's change over its window (degrees).
-    pub angle_drift: RestMargin,
+    /// The angle's change over its window (degrees); `None` when the settings do not
+    /// judge the angle.
+    pub angle_drift: Option<RestMargin>,
     /// The angle (degrees) at the last sample, if measured.
     pub angle_deg: Option<f64>,
     /// How long (s) both speeds have stayed below the bound, up to the last sample, against
@@ -423,12 +425,15 @@ pub fn judge_rest(
         value: d_max,
         bound: speed_bound_m_s,
     };
-    let angle_drift = RestMargin {
+    let angle_drift = settings.angle_drift_deg.map(|bound| RestMargin {
         value: drift,
-        bound: settings.angle_drift_deg,
-    };
+        bound,
+    });
     let held = speeds_held_s >= settings.speed_hold_s - 1e-9 && first_slow < samples.len();
-    let at_rest = held && percentile_speed.passes() && deep_speed.passes() && angle_drift.passes();
+    let at_rest = held
+        && percentile_speed.passes()
+        && deep_speed.passes()
+        && angle_drift.is_none_or(|a| a.passes());
     Ok(RestVerdict {
         at_rest,
         rest_from_s: at_rest.then(|| samples[first_slow].time_s),
@@ -443,55 +448,57 @@ pub fn judge_rest(
 }
 
 impl RestVerdict {
+    /// Every quantity judged: `(name, unit, margin)` (the angle's drift only when judged).
+    pub fn margins(&self) -> Vec<(&'static str, &'static str, RestMargin)> {
+        let mut out = vec![
+            ("percentile_speed", "m/s", self.percentile_speed),
+            ("deep_speed", "m/s", self.deep_speed),
+        ];
+        if let Some(a) = self.angle_drift {
+            out.push(("angle_drift", "deg", a));
+        }
+        out
+    }
+
     /// One line saying the verdict and, when not at rest, what misses and by how much.
     pub fn summary(&self, settings: &RestSettings) -> String {
         let mut misses = Vec::new();
-        let m = |name: &str, r: &RestMargin, unit: &str| {
+        for (name, unit, r) in self.margins() {
             if r.value.is_nan() {
-                format!(
-                    "{name} not measured over the window (bound {:.4} {unit})",
+                misses.push(format!(
+                    "{name} not measured over its window (bound {:.4} {unit})",
                     r.bound
-                )
-            } else {
-                format!(
-                    "{name} {:.4} {unit} {} {:.4} {unit}",
+                ));
+            } else if !r.passes() {
+                misses.push(format!(
+                    "{name} {:.4} {unit} >= {:.4} {unit} (misses by {:.4} {unit})",
                     r.value,
-                    if r.passes() { "<" } else { ">=" },
-                    r.bound
-                )
-            }
-        };
-        for (r, line) in [
-            (
-                &self.percentile_speed,
-                m("percentile speed", &self.percentile_speed, "m/s"),
-            ),
-            (&self.deep_speed, m("deep speed", &self.deep_speed, "m/s")),
-            (
-                &self.angle_drift,
-                m("angle drift", &self.angle_drift, "deg"),
-            ),
-        ] {
-            if !r.passes() {
-                misses.push(format!("{line} (misses by {:.4})", r.misses_by()));
+                    r.bound,
+                    r.misses_by()
+                ));
             }
         }
         if self.speeds_held_s < settings.speed_hold_s - 1e-9 {
             misses.push(format!(
-                "speeds held {:.3} s of {} s",
+                "speeds below the bound for {:.3} s of {} s",
                 self.speeds_held_s, settings.speed_hold_s
             ));
         }
-        if self.angle_window_covered_s < settings.angle_window_s - 1e-9 {
+        if self.angle_drift.is_some()
+            && self.angle_window_covered_s < settings.angle_window_s - 1e-9
+        {
             misses.push(format!(
                 "angle window covered {:.3} s of {} s",
                 self.angle_window_covered_s, settings.angle_window_s
             ));
         }
+        let drift = self.angle_drift.map_or(String::new(), |a| {
+            format!(", angle drift {:.3} deg", a.value)
+        });
         match (self.at_rest, self.rest_from_s) {
             (true, Some(t)) => format!(
-                "at rest at t = {:.3} s (speeds below {:.4} m/s since t = {t:.3} s, angle drift {:.3} deg)",
-                self.judged_at_s, self.percentile_speed.bound, self.angle_drift.value
+                "at rest at t = {:.3} s (speeds below {:.4} m/s since t = {t:.3} s{drift})",
+                self.judged_at_s, self.percentile_speed.bound
             ),
             _ => format!(
                 "not at rest at t = {:.3} s: {}",
@@ -536,7 +543,7 @@ mod tests {
         );
         assert_eq!(
             (s.speed_hold_s, s.angle_window_s, s.angle_drift_deg),
-            (0.5, 1.0, 0.3)
+            (0.5, 1.0, Some(0.3))
         );
         let b = s.speed_bound_m_s(9.81, 0.01).unwrap();
         assert!((b - 0.05 * (0.0981f64).sqrt()).abs() < 1e-15);
@@ -546,7 +553,9 @@ mod tests {
     fn settings_parse_with_defaults_and_reject_unknown_keys() {
         let s: RestSettings = serde_json::from_str(r#"{"speed_hold_s": 0.25}"#).unwrap();
         assert_eq!(s.speed_hold_s, 0.25);
-        assert_eq!(s.angle_drift_deg, 0.3);
+        assert_eq!(s.angle_drift_deg, Some(0.3));
+        let s: RestSettings = serde_json::from_str(r#"{"angle_drift_deg": null}"#).unwrap();
+        assert_eq!(s.angle_drift_deg, None);
         assert!(serde_json::from_str::<RestSettings>(r#"{"hold": 1}"#).is_err());
         let bad = RestSettings {
             percentile: 1.5,
@@ -581,7 +590,11 @@ mod tests {
         assert!(!v.at_rest);
         assert!((v.percentile_speed.misses_by() - (0.02 - 0.0157)).abs() < 1e-12);
         assert!((v.speeds_held_s - 0.25).abs() < 1e-9, "{}", v.speeds_held_s);
-        assert!(v.summary(&s).contains("percentile speed"));
+        assert!(
+            v.summary(&s).contains("percentile_speed 0.0200 m/s"),
+            "{}",
+            v.summary(&s)
+        );
         // Later, the hold has lasted 0.5 s again: at rest from the first slow sample.
         let samples = series(1.75, |t| {
             let p = if (t - 1.2).abs() < 1e-9 { 0.02 } else { 0.001 };
@@ -612,8 +625,14 @@ mod tests {
         )
         .unwrap();
         assert!(!v.at_rest);
-        assert!((v.angle_drift.value - 0.4).abs() < 1e-9);
-        assert!((v.angle_drift.misses_by() - 0.1).abs() < 1e-9);
+        let a = v.angle_drift.unwrap();
+        assert!((a.value - 0.4).abs() < 1e-9);
+        assert!((a.misses_by() - 0.1).abs() < 1e-9);
+        assert!(
+            v.summary(&s).contains("angle_drift 0.4000 deg"),
+            "{}",
+            v.summary(&s)
+        );
         // 0.2°/s passes.
         let v = judge_rest(
             &series(2.0, |t| (0.001, 0.001, Some(30.0 + 0.2 * t))),
@@ -624,9 +643,16 @@ mod tests {
         assert!(v.at_rest);
         // Less than a second of samples.
         let v = judge_rest(&series(0.9, |_| (0.0, 0.0, Some(30.0))), 0.0157, &s).unwrap();
-        assert!(!v.at_rest && v.angle_drift.value.is_nan());
+        assert!(!v.at_rest && v.angle_drift.unwrap().value.is_nan());
         assert!((v.angle_window_covered_s - 0.9).abs() < 1e-9);
-        assert_eq!(v.angle_drift.misses_by(), f64::INFINITY);
+        assert_eq!(v.angle_drift.unwrap().misses_by(), f64::INFINITY);
+        // Without the angle judged, the speeds alone decide.
+        let speeds_only = RestSettings {
+            angle_drift_deg: None,
+            ..s
+        };
+        let v = judge_rest(&series(0.9, |_| (0.0, 0.0, None)), 0.0157, &speeds_only).unwrap();
+        assert!(v.at_rest && v.angle_drift.is_none());
         // An angle missing in the window.
         let v = judge_rest(
             &series(2.0, |t| (0.0, 0.0, (t < 1.5).then_some(30.0))),
