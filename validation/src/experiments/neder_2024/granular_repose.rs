@@ -150,12 +150,10 @@ fn scene_for(theta_deg: f64, cone: ConeMatch, shift_m: f64, ctx: &Context) -> Re
 /// must come to rest everywhere and leaves no heap).
 fn rest_criterion(scene: &Scene, theta_deg: f64) -> RestCriterion {
     let base = base_of(scene).ok();
-    let region = base
-        .filter(|_| theta_deg > 0.0)
-        .map(|b| sph_core::Aabb {
-            min: Vec3::new(b.x0, b.top_y, f64::NEG_INFINITY),
-            max: Vec3::new(b.x1, f64::INFINITY, f64::INFINITY),
-        });
+    let region = base.filter(|_| theta_deg > 0.0).map(|b| sph_core::Aabb {
+        min: Vec3::new(b.x0, b.top_y, f64::NEG_INFINITY),
+        max: Vec3::new(b.x1, f64::INFINITY, f64::INFINITY),
+    });
     let settings = RestSettings {
         angle_drift_deg: RestSettings::default()
             .angle_drift_deg
