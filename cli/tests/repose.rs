@@ -20,7 +20,7 @@ duration = 1.2
 frame_dt = 0.05
 [solver]
 kind = "pbf"
-substeps = 1
+substeps = 4
 iterations = 2
 [tank]
 min = [0.0, 0.0, 0.0]
