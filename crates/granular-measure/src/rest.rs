@@ -160,14 +160,22 @@ pub struct RestSample {
     /// Time (s).
     pub time_s: f64,
     /// The percentile speed of the heap's particles (m/s).
+    #[serde(deserialize_with = "f64_or_nan")]
     pub percentile_speed_m_s: f64,
     /// The largest speed of the particles at least `deep_spacings` below their column's
     /// surface (m/s); 0 if there is none.
+    #[serde(deserialize_with = "f64_or_nan")]
     pub deep_max_speed_m_s: f64,
     /// How many particles are that deep.
     pub deep_particles: usize,
     /// The heap's angle (degrees), `None` if it could not be measured.
     pub angle_deg: Option<f64>,
+}
+
+/// A number, or `NaN` for `null` (JSON writes a non-finite number as `null`: the sample
+/// of a diverged state reads back as not at rest).
+fn f64_or_nan<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Ok(<Option<f64> as serde::Deserialize>::deserialize(d)?.unwrap_or(f64::NAN))
 }
 
 /// The rest criterion's sample of a heap at `time_s` (module documentation): its particles
@@ -568,6 +576,14 @@ mod tests {
                 ..
             })
         ));
+    }
+
+    #[test]
+    fn a_sample_of_a_diverged_state_reads_back_as_not_slow() {
+        let s = sample(0.5, f64::NAN, 0.0, None);
+        let json = serde_json::to_string(&s).unwrap();
+        let back: RestSample = serde_json::from_str(&json).unwrap();
+        assert!(back.percentile_speed_m_s.is_nan() && back.time_s == 0.5);
     }
 
     #[test]
