@@ -1,12 +1,15 @@
 //! `particles repose DIR`: the angle of repose of the last (or a given) frame of a scene
-//! run, measured with [`granular_measure::angle_of_repose`], so that any granular
+//! run, measured with [`granular_measure::angle_of_repose`], and whether the heap is at rest
+//! by [`granular_measure::rest`]'s criterion judged over the run's frames up to it (the last
+//! second of them and the speeds' hold under way), with by how much it misses; any granular
 //! scene's output can be measured, not only the experiment's.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use granular_measure::{angle_of_repose, ReposeOptions};
-use sph_sim::RunDir;
+use granular_measure::{angle_of_repose, PileShape, ReposeOptions};
+use sph_sim::observe::RestCriterion;
+use sph_sim::{RunDir, Scene};
 
 use crate::render::scene_of_run;
 
@@ -38,22 +41,27 @@ pub struct ReposeArgs {
     quick: bool,
 }
 
-/// Measures the frame and prints the angle, the flanks and the resolution. The floor is the
-/// scene tank's bottom (or y = 0 without a tank); the bins are one particle spacing wide.
+/// Measures the frame and prints the angle, the flanks and the resolution, then the rest
+/// verdict. The floor is the scene tank's bottom (or y = 0 without a tank); the bins are
+/// one particle spacing wide.
 pub fn run(a: &ReposeArgs) -> Result<()> {
     let run = RunDir::new(&a.dir);
     let scene = scene_of_run(&run, a.scene.as_deref(), a.quick)?;
+    let frames = run.frames()?;
     let file = match &a.frame {
         Some(f) => f.clone(),
-        None => run
-            .frames()?
-            .pop()
-            .map(|(_, p)| p)
+        None => frames
+            .last()
+            .map(|(_, p)| p.clone())
             .with_context(|| format!("{}: no frame_*.vtk to measure", a.dir.display()))?,
     };
     let positions = sph_sim::vtk::read_positions(&file)?;
     let s = scene.particle_spacing;
     let floor = scene.tank.map_or(0.0, |t| t.min.y);
+    let shape = match a.shape {
+        Shape::Planar => PileShape::Planar,
+        Shape::Conical => PileShape::Conical { axis_xz: None },
+    };
     let opts = match a.shape {
         Shape::Planar => ReposeOptions::planar(floor, s),
         Shape::Conical => ReposeOptions::conical(floor, s),
@@ -79,5 +87,89 @@ pub fn run(a: &ReposeArgs) -> Result<()> {
             f.rms_residual_m
         );
     }
+    // The frames of DIR up to the measured one.
+    let upto = frames.iter().position(|(_, p)| same_file(p, &file));
+    match upto {
+        Some(i) => print_rest(&scene, shape, &frames[..=i])?,
+        None => println!(
+            "rest: not judged ({} is not one of {}'s frames)",
+            file.display(),
+            a.dir.display()
+        ),
+    }
+    Ok(())
+}
+
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => a == b,
+    }
+}
+
+/// Judges the rest criterion over `frames` (the last one the measured frame): the frames of
+/// the criterion's windows and of the speeds' hold under way, read from the last back, and
+/// prints the verdict with each quantity's bound and miss.
+fn print_rest(scene: &Scene, shape: PileShape, frames: &[(usize, PathBuf)]) -> Result<()> {
+    let criterion = RestCriterion {
+        shape,
+        ..RestCriterion::default()
+    };
+    let settings = criterion.settings;
+    let window = settings.speed_hold_s.max(settings.angle_window_s);
+    let tank_floor = scene.tank.as_ref().map(|t| t.min.y);
+    let bound = criterion.speed_bound_m_s(scene.gravity, scene.particle_spacing)?;
+    // Read back from the last frame: every frame of the windows and one before (which says
+    // they are covered), then on while the speeds stay below the bound (the hold under way).
+    let mut samples = Vec::new();
+    let mut t_last = None;
+    for (n, path) in frames.iter().rev() {
+        let f = sph_sim::vtk::read_particle_frame(path)?;
+        let velocities = f.velocities.with_context(|| {
+            format!(
+                "{}: the frame has no velocities, so the rest criterion cannot be judged",
+                path.display()
+            )
+        })?;
+        let t = f.time_s.unwrap_or(*n as f64 * scene.frame_dt_s);
+        let sample = criterion.sample(
+            &f.positions,
+            &velocities,
+            scene.particle_spacing,
+            tank_floor,
+            t,
+        )?;
+        let t_end = *t_last.get_or_insert(t);
+        let in_window = t >= t_end - window - 1e-9;
+        let slow = sample.percentile_speed_m_s < bound && sample.deep_max_speed_m_s < bound;
+        samples.push(sample);
+        if !in_window && !slow {
+            break;
+        }
+    }
+    samples.reverse();
+    let v = granular_measure::judge_rest(&samples, bound, &settings)?;
+    println!(
+        "rest: {} (judged over {} frames from t = {:.3} s)",
+        v.summary(&settings),
+        samples.len(),
+        samples.first().map_or(f64::NAN, |s| s.time_s)
+    );
+    for (name, unit, margin) in v.margins() {
+        println!(
+            "  {name}: {:.4} {unit} against {:.4} {unit}: {}",
+            margin.value,
+            margin.bound,
+            if margin.passes() {
+                "passes".to_string()
+            } else {
+                format!("misses by {:.4} {unit}", margin.misses_by())
+            }
+        );
+    }
+    println!(
+        "  speeds held {:.3} s of {} s; angle window covered {:.3} s of {} s",
+        v.speeds_held_s, settings.speed_hold_s, v.angle_window_covered_s, settings.angle_window_s
+    );
     Ok(())
 }

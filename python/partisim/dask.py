@@ -191,6 +191,11 @@ def _result(
     if "at_rest" in outcome:
         result["at_rest"] = outcome["at_rest"]
         result["rest_from_s"] = outcome["rest_from_s"]
+        result["rest_summary"] = outcome.get("rest_summary")
+        # Each quantity of the verdict with by how much it misses its bound (0 when within).
+        for name, margin in (outcome.get("rest_margins") or {}).items():
+            result[f"rest_{name}"] = margin["value"]
+            result[f"rest_{name}_misses_by"] = margin["misses_by"]
     result.update(measured or {})
     for key, value in _stats_columns(record).items():
         result.setdefault(key, value)
@@ -242,12 +247,12 @@ def _run_scene(
     from the scene; a checkpoint every ``checkpoint_every`` frames; the result as a row.
 
     Beside each checkpoint ``NAME`` a small ``NAME.json`` keeps the frame it was taken at,
-    that frame's record, the rest criterion's hold under way at each checkpoint frame
-    (``holds``: frame -> ``below_since_s``) and, once the run has ended, its outcome and
+    that frame's record, the rest criterion's samples carried at each checkpoint frame
+    (``holds``: frame -> the outcome's ``rest_state``) and, once the run has ended, its outcome and
     repose columns. It is written before the checkpoint, so it never lags behind it: a
     task that loads a checkpoint of the same frame takes the record (and a finished run's
     row) from it, one that loads an older checkpoint (killed between the two writes) runs
-    those frames again, and either continues the hold of its checkpoint's frame, so that
+    those frames again, and either continues from the samples of its checkpoint's frame, so that
     the at-rest verdict is the uninterrupted run's."""
     from . import Simulation  # the worker imports the extension here, not at unpickling
 
@@ -255,7 +260,7 @@ def _run_scene(
     ckpt = Path(checkpoint) if checkpoint is not None else None
     side = ckpt.with_name(ckpt.name + ".json") if ckpt is not None else None
     record = None
-    holds: Dict[str, Optional[float]] = {}
+    holds: Dict[str, Any] = {}
     if ckpt is not None and ckpt.exists():
         sim = Simulation.load(ckpt)
         saved = json.loads(side.read_text()) if side.exists() else {}
@@ -274,8 +279,8 @@ def _run_scene(
         extra = {"overrides": row} if row else {}
         sim = Simulation.from_scene(scene, quick=quick, **extra)
     resumed_from = sim.frame
-    # The hold under way at the frame the run goes on from (none at frame 0).
-    below_since = holds.get(str(sim.frame))
+    # The rest criterion's samples at the frame the run goes on from (none at frame 0).
+    carried = holds.get(str(sim.frame))
     # The run's last frame (frames asked for, never past the scene's end): no checkpoint stop
     # there, so that the last call of `run` ends the run with its own outcome.
     final = frames
@@ -296,18 +301,18 @@ def _run_scene(
                 f"{checkpoint}: resumed at frame {sim.frame}, not before the {frames} frames "
                 "asked for (a checkpoint of a finished run without its record)"
             )
-        watch = None if until_rest is None else {**until_rest, "below_since_s": below_since}
+        watch = None if until_rest is None else {**until_rest, "resume": carried}
         outcome = sim.run(todo, progress=False, callback=every if ckpt is not None else None,
                           until_rest=watch)
         if sim.stats is not None:
             record = sim.stats
-        below_since = outcome.get("rest_below_since_s")
+        carried = outcome.get("rest_state")
         pause = outcome["ending"] == "stopped" and outcome["reason"] == _CHECKPOINT_STOP
         measured = None if pause else _measure_repose(sim, repose)
         if ckpt is None:
             break
         if until_rest is not None:
-            holds[str(sim.frame)] = below_since
+            holds[str(sim.frame)] = carried
         _write_json_atomic(
             side,
             {
@@ -383,9 +388,10 @@ def run_scene_sweep(
         case, up to its ``distributed.scheduler.allowed-failures``).
     until_rest : dict, optional
         Stop each run once its material is at rest, as ``Simulation.run(until_rest=...)``:
-        ``{"speed_m_s": v, "hold_s": t}`` and optionally ``"region"``. The hold under way
-        at each checkpoint is kept beside it, so a run resumed after its worker died
-        reaches the uninterrupted run's verdict at the same frame.
+        ``{}`` for granular codes' criterion with its default figures, or a dict changing
+        them and giving ``region``, ``shape``, ``floor_y`` (see ``Simulation.run``). The
+        criterion's samples at each checkpoint are kept beside it, so a run resumed after
+        its worker died reaches the uninterrupted run's verdict at the same frame.
     repose : None, False or dict
         The angle of repose of each run's final particles (``Simulation.repose``): ``None``
         (default) measures the runs whose scene is granular (``[solver] kind =
@@ -400,7 +406,10 @@ def run_scene_sweep(
         ``time_s``); the statistics of the final frame record (``particles``,
         ``max_density_ratio``, ``mean_density_ratio``, ``kinetic_energy_j``,
         ``iterations``, ...; not its wall-clock ``phases_s`` and ``total_s``); with
-        ``until_rest``, the verdict ``at_rest`` (bool) and ``rest_from_s`` (s, or None);
+        ``until_rest``, the verdict ``at_rest`` (bool), ``rest_from_s`` (s, or None),
+        ``rest_summary`` (what misses and by how much) and, per quantity judged
+        (``percentile_speed``, ``deep_speed``, ``angle_drift``), ``rest_<name>`` (its value
+        over the window) and ``rest_<name>_misses_by`` (0 when within its bound);
         where measured, ``repose_angle_deg``, ``repose_resolution_deg``,
         ``repose_steepest_deg``, ``repose_pile_height_m`` and ``repose_error`` (None, or
         why the heap could not be measured, its angles then NaN);
@@ -433,10 +442,10 @@ def run_scene_sweep(
     if until_rest is not None:
         if not isinstance(until_rest, Mapping):
             raise TypeError(
-                f"until_rest: expected a dict (speed_m_s, hold_s, region), not {type(until_rest).__name__}"
+                f"until_rest: expected a dict (the rest criterion's figures, region, shape, floor_y), not {type(until_rest).__name__}"
             )
-        if "below_since_s" in until_rest:
-            raise ValueError("until_rest: below_since_s is the sweep's to carry between checkpoints")
+        if "resume" in until_rest:
+            raise ValueError("until_rest: resume is the sweep's to carry between checkpoints")
         until_rest = {key: _plain(value) for key, value in until_rest.items()}
     if repose is not None and repose is not False and not isinstance(repose, Mapping):
         raise TypeError(

@@ -18,7 +18,7 @@ use sph_sim::{
 use sph_solver::boundary::{CacheUse, VolumeMapBuild, VolumeMapCache};
 
 use crate::interrupt::interruptible;
-use crate::measure::{repose_dict, rest_observer, ReposeArgs, RestVerdict};
+use crate::measure::{repose_dict, rest_observer, ReposeArgs, RestOutcome};
 use crate::rust_err;
 use sph_sim::observe::RestObserver;
 
@@ -47,7 +47,7 @@ struct Simulation {
     /// The volume-map cache directory used, if any.
     cache_dir: Option<PathBuf>,
     /// The at-rest verdict of the last run watched with `until_rest`.
-    rest: Option<RestVerdict>,
+    rest: Option<RestOutcome>,
 }
 
 /// The Python type name of `v`, for a message.
@@ -273,6 +273,13 @@ impl PythonSide {
 }
 
 impl<R: Real> FrameObserver<R> for PythonSide {
+    fn start(&mut self, sim: &SceneSim<R>, plan: &RunPlan) -> Result<(), SimError> {
+        match &mut self.rest {
+            Some(r) => r.start(sim, plan),
+            None => Ok(()),
+        }
+    }
+
     fn frame(&mut self, sim: &SceneSim<R>, record: &FrameRecord) -> Result<Flow, SimError> {
         self.last = Some(*record);
         let rest = match &mut self.rest {
@@ -442,7 +449,7 @@ impl Simulation {
             self.record = side.last;
         }
         if let Some(r) = &side.rest {
-            self.rest = Some(RestVerdict::of(r, self.frame()));
+            self.rest = Some(RestOutcome::of(r, self.frame()));
         }
         if let Some(e) = side.err {
             return Err(e);
@@ -662,14 +669,22 @@ impl Simulation {
     ///     that frame, returning ``None`` or anything false goes on (the rule of
     ///     ``Population.advance`` too). A returned string is the stop's ``reason``; on the
     ///     frame where ``until_rest`` also stops the run, the rest's reason is kept.
-    /// until_rest : dict, optional
-    ///     Stop once the material is at rest: ``{"speed_m_s": v, "hold_s": t}`` (and
-    ///     optionally ``"region": ((x0, y0, z0), (x1, y1, z1))``, m): the largest particle
-    ///     speed (in the region) has stayed below ``v`` m/s for ``t`` s of simulated time.
-    ///     The outcome then has ``at_rest`` and ``rest_from_s`` (s), and ``repose()``
-    ///     reports this verdict. A run going on from an earlier one (after a stop, a
-    ///     ``save``/``load``) continues its hold with ``"below_since_s"``: the earlier
-    ///     outcome's ``rest_below_since_s`` (s); it then stops where one whole run would.
+    /// until_rest : True or dict, optional
+    ///     Stop once the heap is at rest by granular codes' criterion (crate
+    ///     ``granular-measure``, module ``rest``): the 99th-percentile speed of its particles
+    ///     and the fastest particle two spacings below the local surface under
+    ///     ``0.05 sqrt(g s)`` for 0.5 s, and its angle of repose moving less than 0.3° over
+    ///     the last second (judged after each frame, and on the run's first state). ``True``
+    ///     takes these figures; a dict may change them (``speed_scale``, ``percentile``,
+    ///     ``deep_spacings``, ``speed_hold_s``, ``angle_window_s``, ``angle_drift_deg``;
+    ///     ``angle_drift_deg=None`` judges the speeds only, for a material that is not a
+    ///     heap) and give ``region`` (``((x0, y0, z0), (x1, y1, z1))``, m: the heap's
+    ///     particles; default all), ``shape`` ("planar", default, or "conical") and
+    ///     ``floor_y`` (m; default the tank's bottom). The outcome then has the verdict,
+    ///     and ``repose()`` reports it. A run going on from an earlier one (after a stop, a
+    ///     ``save``/``load``) gives ``"resume"``: the earlier outcome's ``rest_state``; it
+    ///     then stops where one whole run would. (The old ``speed_m_s``/``hold_s``/
+    ///     ``below_since_s`` keys are refused with a message.)
     ///
     /// Returns
     /// -------
@@ -678,9 +693,14 @@ impl Simulation {
     ///     keeps its last good substep), ``frame`` (frames done), ``time_s`` (simulated, s),
     ///     ``reason`` (the stop's, the divergence's, or the scene's end when fewer frames
     ///     than asked were run; else None), ``frames_run``, ``scene_frames`` and
-    ///     ``at_scene_end``; with ``until_rest``, ``at_rest`` (bool), ``rest_from_s``,
-    ///     ``rest_below_since_s`` (the start of the hold under way, s, or None) and
-    ///     ``max_speed_m_s`` (the last frame's, m/s).
+    ///     ``at_scene_end``; with ``until_rest``, the verdict: ``at_rest`` (bool),
+    ///     ``rest_from_s`` (the start of the speeds' hold when at rest, s), ``rest_summary``
+    ///     (one line: what misses and by how much), ``rest_margins`` (per quantity,
+    ///     ``percentile_speed``, ``deep_speed`` and ``angle_drift``: ``value``, ``bound``,
+    ///     ``unit``, ``passes``, ``misses_by``), ``rest_speed_m_s`` (the speed bound),
+    ///     ``rest_hold_s``, ``rest_speeds_held_s``, ``rest_angle_deg``,
+    ///     ``rest_below_since_s`` (the start of the speeds' hold under way, s, or None),
+    ///     ``rest_checked_at_frame`` and ``rest_state`` (for ``resume``).
     ///
     /// Ctrl-C stops the run between frames with KeyboardInterrupt, and an exception of the
     /// callback ends it with that exception; the frames done are kept either way.
@@ -743,8 +763,8 @@ impl Simulation {
     ///     ``rms_residual_m``, ``side``), ``profile_m`` (the surface points ``(d, y)``, m),
     ///     ``particles``, ``frame``, ``time_s``, and the verdict: ``at_rest`` (True/False
     ///     from the last run watched with ``until_rest``; None if none was, or if frames were
-    ///     run since it ended), with ``rest_from_s``, ``rest_speed_m_s``, ``rest_hold_s``,
-    ///     ``rest_checked_at_frame`` and ``max_speed_m_s``.
+    ///     run since it ended), with the rest of that run's verdict as ``run`` returns it
+    ///     (``rest_summary``, ``rest_margins``: by how much each quantity misses, ...).
     ///
     /// Raises PartisimError for a pile that cannot be measured (flat layer, too few surface
     /// points, options out of range).

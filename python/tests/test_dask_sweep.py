@@ -187,14 +187,15 @@ class InlineClient:
 
 
 def test_the_at_rest_verdict_survives_checkpoints_and_a_death(tmp_path, monkeypatch):
-    """Every speed is below 1 km/s: the whole run is at rest from t = 0 after 0.06 s (frame
-    3). With a checkpoint after every frame, and the worker dying while writing the third,
-    the verdict is still frame 3 from t = 0: the hold is carried beside each checkpoint."""
+    """Every speed is below the bound (1e4 sqrt(g s), 7 km/s; the speeds only): the whole
+    run is at rest from t = 0 after 0.06 s (frame 3). With a checkpoint after every frame,
+    and the worker dying while writing the third, the verdict is still frame 3 from t = 0:
+    the criterion's samples are carried beside each checkpoint."""
     import partisim.dask as pd_mod
 
     scene = tmp_path / "tiny.toml"
     scene.write_text(TINY)
-    rest = {"speed_m_s": 1e3, "hold_s": 0.06}
+    rest = {"speed_scale": 1e4, "speed_hold_s": 0.06, "angle_drift_deg": None}
     whole = partisim.Simulation.from_scene(scene, volume_map_cache=None)
     w = whole.run(progress=False, until_rest=rest)
     assert w["at_rest"] is True and w["frame"] == 3 and w["rest_from_s"] == 0.0
@@ -216,6 +217,9 @@ def test_the_at_rest_verdict_survives_checkpoints_and_a_death(tmp_path, monkeypa
     got = table.loc[0]
     assert got["resumed_from_frame"] == 2
     assert got["at_rest"] and got["rest_from_s"] == 0.0 and got["frame"] == 3
+    assert got["rest_summary"] == w["rest_summary"]
+    assert got["rest_percentile_speed_misses_by"] == 0.0 and got["rest_deep_speed_misses_by"] == 0.0
+    assert got["rest_percentile_speed"] == w["rest_margins"]["percentile_speed"]["value"]
     assert got["ending"] == "stopped" and got["reason"] == w["reason"]
     assert np.array_equal(partisim.Simulation.load(got["checkpoint"]).positions,
                           whole.positions)

@@ -24,6 +24,30 @@ pub enum MeasureError {
         /// Its coordinates.
         z: f64,
     },
+    /// A particle velocity is NaN or infinite.
+    #[error("{what}: particle {index} has a non-finite velocity ({x}, {y}, {z})")]
+    NonFiniteVelocity {
+        /// The measurement.
+        what: &'static str,
+        /// Index of the particle in the input.
+        index: usize,
+        /// Its components.
+        x: f64,
+        /// Its components.
+        y: f64,
+        /// Its components.
+        z: f64,
+    },
+    /// Positions and velocities of different lengths.
+    #[error("{what}: {positions} positions but {velocities} velocities")]
+    LengthMismatch {
+        /// The measurement.
+        what: &'static str,
+        /// How many positions.
+        positions: usize,
+        /// How many velocities.
+        velocities: usize,
+    },
     /// An option is out of range.
     #[error("{what}: option {option} = {value}: {reason}")]
     InvalidOption {

@@ -5,8 +5,9 @@
 //! Measurements of granular heaps and deposits on particle output, usable on any scene's
 //! positions (a VTK frame read back, a simulation state, an experiment's run): the **angle of
 //! repose** of a settled pile ([`repose`]) and the **runout** of a collapsed column, planar
-//! ([`runout()`]) or axisymmetric ([`radial_runout`]) ([`mod@runout`]). They depend on the
-//! particle positions only, not on the solver that made them.
+//! ([`runout()`]) or axisymmetric ([`radial_runout`]) ([`mod@runout`]), and whether a heap is
+//! **at rest** ([`rest`]: robust speeds and the angle's drift over time, with the margins). They depend on the
+//! particle positions (and, for rest, velocities) only, not on the solver that made them.
 //!
 //! Conventions: SI units (m, degrees for angles); gravity along −y, so "up" is +y and the
 //! floor is the plane `y = floor_y`. Heights and distances are those of particle **centres**
@@ -24,6 +25,7 @@
 
 mod error;
 pub mod repose;
+pub mod rest;
 pub mod runout;
 
 pub use error::MeasureError;
@@ -31,6 +33,7 @@ pub use repose::{
     angle_of_repose, surface_profile, FlankFit, PileShape, ReposeMeasurement, ReposeOptions,
     SurfacePoint,
 };
+pub use rest::{judge_rest, rest_sample, RestMargin, RestSample, RestSettings, RestVerdict};
 pub use runout::{
     normalised_runout, radial_runout, runout, FrontMethod, RadialRunout, RadialRunoutOptions,
     RunoutOptions,

@@ -1,10 +1,14 @@
 //! Observers of the frame loop that measure rather than write files: [`Recorder`] keeps
 //! every [`FrameRecord`], [`DensityLimit`] ends a run whose density has left any liquid's
-//! range, [`RestObserver`] ends it when the material has come to rest, [`Snapshots`] keeps
+//! range, [`RestObserver`] ends it when the material has come to rest (by
+//! [`granular_measure::rest`]), [`Snapshots`] keeps
 //! the positions at chosen frames, [`FrameTimer`] times the frames, and [`OnFrame`] runs a closure after each frame (a
 //! measurement of the experiment's own). The observers writing files are in [`crate::run`],
 //! [`crate::checkpoint`] and [`crate::render`].
 
+use granular_measure::rest::{judge_rest, rest_sample};
+use granular_measure::{angle_of_repose, MeasureError, ReposeOptions};
+pub use granular_measure::{PileShape, RestMargin, RestSample, RestSettings, RestVerdict};
 use sph_core::{Aabb, Real, Vec3};
 
 use crate::error::SimError;
@@ -53,100 +57,214 @@ impl<R: Real> FrameObserver<R> for DensityLimit {
     }
 }
 
-/// When a run counts as at rest: the largest speed of the particles in `region` has stayed
-/// below `speed_m_s` for `hold_s` (checked at the end of each frame).
-#[derive(Debug, Clone, Copy)]
+/// When a run counts as at rest: [`granular_measure::rest`]'s criterion (the percentile
+/// speed and the fastest particle two spacings below the surface under `0.05 √(g s)` for
+/// 0.5 s, the heap's angle moving less than 0.3° over the last second, by default) on the
+/// particles inside `region`, the scene's spacing and gravity setting the speed bound.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RestCriterion {
-    /// Speed bound (m/s).
-    pub speed_m_s: f64,
-    /// How long every particle must stay below it (s).
-    pub hold_s: f64,
-    /// The particles that count: those inside this box (m); `None` = all.
+    /// The criterion's figures.
+    pub settings: RestSettings,
+    /// The heap's particles: those inside this box (m); `None` = all.
     pub region: Option<Aabb<f64>>,
+    /// How the heap's angle is measured and its columns taken: a planar (2.5D) heap or a
+    /// conical pile.
+    pub shape: PileShape,
+    /// The floor the heap stands on (m); `None` = the scene tank's bottom, else `y = 0`.
+    pub floor_y: Option<f64>,
+}
+
+impl Default for RestCriterion {
+    /// The default criterion on a planar heap of all the particles on the tank's floor.
+    fn default() -> Self {
+        Self {
+            settings: RestSettings::default(),
+            region: None,
+            shape: PileShape::Planar,
+            floor_y: None,
+        }
+    }
 }
 
 impl RestCriterion {
-    /// The largest speed (m/s) of the particles at `positions` with `velocities` inside the
-    /// criterion's region.
-    pub fn max_speed<R: Real>(&self, positions: &[Vec3<R>], velocities: &[Vec3<R>]) -> f64 {
+    /// The criterion's sample of the particles at `positions` with `velocities` at
+    /// `time_s` (s) for a scene of spacing `spacing_m` whose tank's bottom is `tank_floor`:
+    /// the angle is measured with [`angle_of_repose`] (bins of one spacing, `None` when
+    /// the heap cannot be measured). A non-finite velocity or position gives a sample that
+    /// is not at rest (its speeds `NaN`: a diverged run is [`DensityLimit`]'s to report);
+    /// a region holding no particle is an error.
+    pub fn sample<R: Real>(
+        &self,
+        positions: &[Vec3<R>],
+        velocities: &[Vec3<R>],
+        spacing_m: f64,
+        tank_floor: Option<f64>,
+        time_s: f64,
+    ) -> Result<RestSample, SimError> {
         let inside = |p: &Vec3<R>| {
             self.region.is_none_or(|b| {
                 (0..3).all(|a| p[a].as_f64() >= b.min[a] && p[a].as_f64() <= b.max[a])
             })
         };
-        positions
+        let (x, v): (Vec<Vec3<R>>, Vec<Vec3<R>>) = positions
             .iter()
             .zip(velocities)
             .filter(|(p, _)| inside(p))
-            .map(|(_, v)| v.norm().as_f64())
-            .fold(0.0, f64::max)
+            .map(|(p, u)| (*p, *u))
+            .unzip();
+        if x.is_empty() {
+            return Err(SimError::Invalid(format!(
+                "rest criterion: no particle inside the region {:?} at t = {time_s} s",
+                self.region
+            )));
+        }
+        let angle = self.settings.angle_drift_deg.and_then(|_| {
+            let floor = self.floor_y.or(tank_floor).unwrap_or(0.0);
+            let opts = match self.shape {
+                PileShape::Planar => ReposeOptions::planar(floor, spacing_m),
+                shape => ReposeOptions {
+                    shape,
+                    ..ReposeOptions::conical(floor, spacing_m)
+                },
+            };
+            angle_of_repose(&x, &opts).ok().map(|m| m.angle_deg)
+        });
+        match rest_sample(&x, &v, spacing_m, self.shape, time_s, angle, &self.settings) {
+            Ok(s) => Ok(s),
+            Err(MeasureError::NonFinite { .. } | MeasureError::NonFiniteVelocity { .. }) => {
+                Ok(RestSample {
+                    time_s,
+                    percentile_speed_m_s: f64::NAN,
+                    deep_max_speed_m_s: f64::NAN,
+                    deep_particles: 0,
+                    angle_deg: None,
+                })
+            }
+            Err(e) => Err(SimError::Invalid(e.to_string())),
+        }
+    }
+
+    /// The speed bound `c √(g s)` (m/s) of a scene with `gravity` (m/s²) and spacing
+    /// `spacing_m`.
+    pub fn speed_bound_m_s(&self, gravity: [f64; 3], spacing_m: f64) -> Result<f64, SimError> {
+        let g = gravity.iter().map(|c| c * c).sum::<f64>().sqrt();
+        self.settings
+            .speed_bound_m_s(g, spacing_m)
+            .map_err(|e| SimError::Invalid(e.to_string()))
     }
 }
 
-/// Stops a run ([`Flow::Stop`]) once its [`RestCriterion`] holds; the scene's duration is
-/// then a cap.
+/// Stops a run ([`Flow::Stop`]) once its [`RestCriterion`] holds (judged with
+/// [`judge_rest`] after each frame, on one sample per frame and one of the run's first
+/// state); the scene's duration is then a cap.
 #[derive(Debug, Clone)]
 pub struct RestObserver {
     /// The criterion.
     pub criterion: RestCriterion,
-    /// The largest speed in the criterion's region at the end of each frame (m/s).
-    pub speeds_m_s: Vec<f64>,
-    /// The time (s) from which the speed stayed below the bound for the hold time, once
-    /// it has (the run stopped then).
+    /// The samples, one per frame (and one of the first state), in time order; a resumed
+    /// observer starts with the earlier run's [`RestObserver::carried`] samples.
+    pub samples: Vec<RestSample>,
+    /// The verdict at the last sample (`None` before the first frame).
+    pub verdict: Option<RestVerdict>,
+    /// The time (s) from which the criterion held (the run stopped then), once it has.
     pub rest_from_s: Option<f64>,
-    below_since_s: Option<f64>,
 }
 
 impl RestObserver {
     /// An observer of `criterion`.
     pub fn new(criterion: RestCriterion) -> Self {
+        Self::resumed(criterion, Vec::new())
+    }
+
+    /// An observer of `criterion` going on from the samples `carried` by an earlier run
+    /// ending at this run's first frame ([`RestObserver::carried`]): a run split in two
+    /// then stops where the whole run does.
+    pub fn resumed(criterion: RestCriterion, carried: Vec<RestSample>) -> Self {
         Self {
             criterion,
-            speeds_m_s: Vec::new(),
+            samples: carried,
+            verdict: None,
             rest_from_s: None,
-            below_since_s: None,
         }
     }
 
-    /// An observer of `criterion` going on with a hold that started at `below_since_s` (s),
-    /// as [`RestObserver::below_since_s`] of an earlier run ending at this run's first
-    /// frame reported it: a run split in two then stops where the whole run does.
-    pub fn resumed(criterion: RestCriterion, below_since_s: Option<f64>) -> Self {
-        Self {
-            below_since_s,
-            ..Self::new(criterion)
-        }
+    /// The index of the first sample of the trailing run below the speed bound (the
+    /// samples' length when the last is not below it).
+    fn hold_start(&self) -> usize {
+        let Some(v) = self.verdict else {
+            return self.samples.len();
+        };
+        let slow = |r: &RestSample| {
+            r.percentile_speed_m_s < v.percentile_speed.bound
+                && r.deep_max_speed_m_s < v.deep_speed.bound
+        };
+        self.samples
+            .iter()
+            .rposition(|r| !slow(r))
+            .map_or(0, |i| i + 1)
     }
 
-    /// The start (s) of the hold under way: the speed has stayed below the bound since
-    /// then (`None` if the last frame's speed was not below it).
+    /// The samples a run going on from here needs for the same verdicts: those of the
+    /// angle's and the speeds' windows (and one before, which says the window is covered),
+    /// and those of the speeds' hold under way.
+    pub fn carried(&self) -> Vec<RestSample> {
+        let Some(last) = self.samples.last() else {
+            return Vec::new();
+        };
+        let s = &self.criterion.settings;
+        let window = s.speed_hold_s.max(s.angle_window_s);
+        let window_start = self
+            .samples
+            .iter()
+            .position(|r| r.time_s >= last.time_s - window - 1e-9)
+            .unwrap_or(0);
+        let from = self.hold_start().min(window_start.saturating_sub(1));
+        self.samples[from..].to_vec()
+    }
+
+    /// The start (s) of the speeds' hold under way: the time of the first sample of the
+    /// trailing run of samples below the bound (`None` if the last sample is not below it).
     pub fn below_since_s(&self) -> Option<f64> {
-        self.below_since_s
+        self.samples.get(self.hold_start()).map(|r| r.time_s)
+    }
+
+    fn take<R: Real>(&mut self, sim: &SceneSim<R>) -> Result<(), SimError> {
+        if self.samples.last().is_some_and(|s| s.time_s >= sim.time_s) {
+            return Ok(()); // the carried samples end at this state
+        }
+        let sample = self.criterion.sample(
+            &sim.state.positions,
+            &sim.state.velocities,
+            sim.scene.particle_spacing,
+            sim.scene.tank.as_ref().map(|t| t.min.y),
+            sim.time_s,
+        )?;
+        self.samples.push(sample);
+        let bound = self
+            .criterion
+            .speed_bound_m_s(sim.scene.gravity, sim.scene.particle_spacing)?;
+        self.verdict = Some(
+            judge_rest(&self.samples, bound, &self.criterion.settings)
+                .map_err(|e| SimError::Invalid(e.to_string()))?,
+        );
+        Ok(())
     }
 }
 
 impl<R: Real> FrameObserver<R> for RestObserver {
+    fn start(&mut self, sim: &SceneSim<R>, _: &RunPlan) -> Result<(), SimError> {
+        self.take(sim)
+    }
+
     fn frame(&mut self, sim: &SceneSim<R>, _: &FrameRecord) -> Result<Flow, SimError> {
-        let c = self.criterion;
-        let speed = c.max_speed(&sim.state.positions, &sim.state.velocities);
-        self.speeds_m_s.push(speed);
-        // A speed at or above the bound (or not a number) starts the hold afresh.
-        let below = speed < c.speed_m_s;
-        if !below {
-            self.below_since_s = None;
-            return Ok(Flow::Continue);
+        self.take(sim)?;
+        match self.verdict {
+            Some(v) if v.at_rest => {
+                self.rest_from_s = v.rest_from_s;
+                Ok(Flow::Stop(v.summary(&self.criterion.settings)))
+            }
+            _ => Ok(Flow::Continue),
         }
-        // The frame's start time: the speeds of the previous frame's end held since then.
-        let t_start = sim.time_s - sim.scene.frame_dt_s;
-        let since = *self.below_since_s.get_or_insert(t_start);
-        if sim.time_s - since < c.hold_s - 1e-9 {
-            return Ok(Flow::Continue);
-        }
-        self.rest_from_s = Some(since);
-        Ok(Flow::Stop(format!(
-            "at rest: the largest speed below {} m/s for {} s from t = {since:.3} s",
-            c.speed_m_s, c.hold_s
-        )))
     }
 }
 

@@ -140,11 +140,30 @@ fn write_points<R: Real>(
 /// 10⁶-particle frame this crate writes (about 40 bytes per particle).
 pub const MAX_FRAME_BYTES: u64 = 4 << 30;
 
+/// One particle frame read back ([`read_particle_frame`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrameRead {
+    /// The simulated time (s) in the frame's title (`particles t = … s`), if there.
+    pub time_s: Option<f64>,
+    /// Positions (m).
+    pub positions: Vec<Vec3<f32>>,
+    /// Velocities (m/s): the `velocity` point data, `None` if the frame has none (passive
+    /// points).
+    pub velocities: Option<Vec<Vec3<f32>>>,
+}
+
 /// Reads the particle positions (m) of one frame written by [`write_particle_frame`] or
 /// [`write_point_frame`]. A missing file, a file that is not a regular file or is larger
 /// than [`MAX_FRAME_BYTES`], or anything that is not such a frame is a
 /// [`SimError::Input`] naming the file and what is wrong.
 pub fn read_positions(path: &Path) -> Result<Vec<Vec3<f32>>, SimError> {
+    Ok(read_particle_frame(path)?.positions)
+}
+
+/// Reads one frame written by [`write_particle_frame`] (or [`write_point_frame`]): its
+/// time, positions and velocities, with the errors of [`read_positions`]; a `velocity`
+/// array of the wrong length or with a non-finite component is an error too.
+pub fn read_particle_frame(path: &Path) -> Result<FrameRead, SimError> {
     let bytes = sph_core::input::read_bytes_limited(path, MAX_FRAME_BYTES, "VTK frame")
         .map_err(SimError::from)?;
     let corrupt = |reason: String| SimError::input(path, format!("not a particle frame: {reason}"));
@@ -159,10 +178,16 @@ pub fn read_positions(path: &Path) -> Result<Vec<Vec3<f32>>, SimError> {
             "the legacy VTK parser stopped before the end of the data: the file is truncated or was not written by this crate (vtkio: {e})"
         ))
     })?;
+    let time_s = vtk
+        .title
+        .strip_prefix("particles t = ")
+        .and_then(|t| t.strip_suffix(" s"))
+        .and_then(|t| t.trim().parse::<f64>().ok());
     let DataSet::PolyData { pieces, .. } = vtk.data else {
         return Err(corrupt("not POLYDATA".into()));
     };
     let mut out = Vec::new();
+    let mut vel: Option<Vec<Vec3<f32>>> = Some(Vec::new());
     for piece in pieces {
         let vtkio::model::Piece::Inline(p) = piece else {
             return Err(corrupt("a piece is not inline".into()));
@@ -179,18 +204,47 @@ pub fn read_positions(path: &Path) -> Result<Vec<Vec3<f32>>, SimError> {
             )));
         }
         out.extend(pts.chunks(3).map(|c| Vec3::new(c[0], c[1], c[2])));
+        let v = p.data.point.iter().find_map(|a| match a {
+            Attribute::DataArray(d) if d.name == "velocity" => Some(d.data.clone()),
+            _ => None,
+        });
+        match (v, vel.as_mut()) {
+            (Some(data), Some(acc)) => {
+                let v: Vec<f32> = data
+                    .cast_into()
+                    .ok_or_else(|| corrupt("the velocities are not numbers".into()))?;
+                if v.len() != pts.len() {
+                    return Err(corrupt(format!(
+                        "{} velocity components for {} coordinates",
+                        v.len(),
+                        pts.len()
+                    )));
+                }
+                acc.extend(v.chunks(3).map(|c| Vec3::new(c[0], c[1], c[2])));
+            }
+            _ => vel = None,
+        }
     }
-    if let Some((i, p)) = out
-        .iter()
-        .enumerate()
-        .find(|(_, p)| !p.iter().all(|x| x.is_finite()))
-    {
-        return Err(corrupt(format!(
-            "particle {i} at {:?} is not finite",
-            p.as_slice()
-        )));
+    for (what, arr) in [
+        ("particle", Some(&out)),
+        ("velocity of particle", vel.as_ref()),
+    ] {
+        if let Some((i, p)) = arr.and_then(|a| {
+            a.iter()
+                .enumerate()
+                .find(|(_, p)| !p.iter().all(|x| x.is_finite()))
+        }) {
+            return Err(corrupt(format!(
+                "{what} {i}: {:?} is not finite",
+                p.as_slice()
+            )));
+        }
     }
-    Ok(out)
+    Ok(FrameRead {
+        time_s,
+        positions: out,
+        velocities: vel,
+    })
 }
 
 #[cfg(test)]
@@ -229,6 +283,19 @@ mod tests {
         assert_eq!(p.num_verts(), 2);
         let names: Vec<&str> = p.data.point.iter().map(|a| a.name()).collect();
         assert_eq!(names, ["velocity", "speed", "density", "id"]);
+        let read = read_particle_frame(&path).unwrap();
+        assert_eq!(read.time_s, Some(0.5));
+        assert_eq!(
+            read.positions,
+            vec![Vec3::new(1.0f32, 2.0, 3.0), Vec3::new(-1.0, 0.5, 0.25)]
+        );
+        assert_eq!(
+            read.velocities,
+            Some(vec![Vec3::new(0.0f32, -1.0, 0.0), Vec3::new(3.0, 4.0, 0.0)])
+        );
+        write_point_frame(&dir.join("p.vtk"), 0.25, &pos).unwrap();
+        let passive = read_particle_frame(&dir.join("p.vtk")).unwrap();
+        assert_eq!((passive.time_s, passive.velocities), (None, None));
         std::fs::remove_dir_all(&dir).ok();
         let short = write_particle_frame(
             &dir.join("g.vtk"),

@@ -4,6 +4,7 @@
 
 use std::path::PathBuf;
 
+use granular_measure::RestSettings;
 use sph_core::Vec3;
 use sph_scene::Scene;
 use sph_sim::observe::{DensityLimit, OnFrame, Recorder, RestCriterion, RestObserver, Snapshots};
@@ -125,48 +126,77 @@ fn a_blow_up_is_kept_as_an_outcome_naming_the_step_and_particle() {
     assert!(err.to_string().contains("blow-up"), "{err}");
 }
 
+/// The speeds only (the water block has no slope), under a bound of about 5 km/s that every
+/// particle is below, held `hold_s`.
+fn speeds_only(hold_s: f64) -> RestCriterion {
+    RestCriterion {
+        settings: RestSettings {
+            speed_scale: 1e4,
+            speed_hold_s: hold_s,
+            angle_drift_deg: None,
+            ..RestSettings::default()
+        },
+        ..RestCriterion::default()
+    }
+}
+
 #[test]
-fn rest_stops_the_run_once_the_speed_held_below_the_bound() {
+fn rest_stops_the_run_once_the_speeds_held_below_the_bound() {
     let mut sim = sim("rest");
-    // Every speed is below 1 km/s: at rest from the first frame's start, held 0.03 s.
-    let mut rest = RestObserver::new(RestCriterion {
-        speed_m_s: 1e3,
-        hold_s: 0.03,
-        region: None,
-    });
+    // Sampled at t = 0 and after each frame: at rest from t = 0, held 0.03 s.
+    let mut rest = RestObserver::new(speeds_only(0.03));
     let plan = RunPlan::next(&sim, 10);
     let out = run_frames(&mut sim, &plan, &mut [&mut rest]).unwrap();
     assert!(matches!(out.ending, Ending::Stopped { .. }), "{out:?}");
     // 0.032 s >= 0.03 s after frame 2.
-    assert_eq!((out.frame, rest.speeds_m_s.len()), (2, 2));
+    assert_eq!((out.frame, rest.samples.len()), (2, 3));
     assert_eq!(rest.rest_from_s, Some(0.0));
+    let v = rest.verdict.unwrap();
+    assert!(v.at_rest && v.angle_drift.is_none());
+    assert!((v.percentile_speed.bound - 1e4 * (9.81f64 * 0.025).sqrt()).abs() < 1e-9);
+}
+
+#[test]
+fn a_block_of_water_is_never_a_heap_at_rest() {
+    // The angle judged: a flat block has no flank to measure, so the angle's drift is
+    // never measured and the verdict says so, however slow the particles.
+    let mut sim = sim("rest-angle");
+    let mut criterion = speeds_only(0.03);
+    criterion.settings.angle_drift_deg = Some(0.3);
+    criterion.settings.angle_window_s = 0.05;
+    let mut rest = RestObserver::new(criterion);
+    let plan = RunPlan::next(&sim, 5);
+    let out = run_frames(&mut sim, &plan, &mut [&mut rest]).unwrap();
+    assert!(matches!(out.ending, Ending::Completed), "{out:?}");
+    let v = rest.verdict.unwrap();
+    assert!(!v.at_rest && v.angle_drift.unwrap().value.is_nan());
+    assert!(v
+        .summary(&criterion.settings)
+        .contains("angle_drift not measured"));
 }
 
 #[test]
 fn a_resumed_rest_hold_stops_where_the_whole_run_does() {
-    let criterion = RestCriterion {
-        speed_m_s: 1e3,
-        hold_s: 0.04,
-        region: None,
-    };
+    let criterion = speeds_only(0.04);
     // Whole: at rest from t = 0, 0.048 s >= 0.04 s after frame 3.
     let mut whole = sim("rest-whole");
     let mut rest = RestObserver::new(criterion);
     let plan = RunPlan::next(&whole, 10);
     let out = run_frames(&mut whole, &plan, &mut [&mut rest]).unwrap();
     assert_eq!((out.frame, rest.rest_from_s), (3, Some(0.0)));
-    // Split after frame 1: the second run continues the first's hold.
+    // Split after frame 1: the second run continues from the first's samples.
     let mut split = sim("rest-split");
     let mut first = RestObserver::new(criterion);
     let plan = RunPlan::next(&split, 1);
     let out = run_frames(&mut split, &plan, &mut [&mut first]).unwrap();
     assert_eq!((out.frame, first.rest_from_s), (1, None));
     assert_eq!(first.below_since_s(), Some(0.0));
-    let mut second = RestObserver::resumed(criterion, first.below_since_s());
+    let mut second = RestObserver::resumed(criterion, first.carried());
     let plan = RunPlan::next(&split, 10);
     let out = run_frames(&mut split, &plan, &mut [&mut second]).unwrap();
     assert_eq!((out.frame, second.rest_from_s), (3, Some(0.0)));
-    // A fresh observer starts the hold at the second run's first frame instead.
+    assert_eq!(second.verdict, rest.verdict);
+    // A fresh observer starts the hold at the second run's first state instead.
     let mut again = sim("rest-fresh");
     let mut first = RestObserver::new(criterion);
     let plan = RunPlan::next(&again, 1);

@@ -21,7 +21,7 @@ use sph_sim::{FrameObserver, FrameRecord};
 use crate::sim::{run_frames, scene_sim};
 use crate::{Check, Context};
 
-pub use sph_sim::observe::RestCriterion;
+pub use sph_sim::observe::{RestCriterion, RestSettings, RestVerdict};
 
 /// A scene run to its end (or to a blow-up).
 #[derive(Debug, Clone)]
@@ -30,9 +30,9 @@ pub struct SceneRun {
     pub particles: usize,
     /// The record of each completed frame.
     pub frames: Vec<FrameRecord>,
-    /// With a [`RestCriterion`]: the largest speed of the particles in its region at the
-    /// end of each frame (m/s).
-    pub rest_speeds_m_s: Vec<f64>,
+    /// With a [`RestCriterion`]: its verdict at the end of the run (every quantity judged
+    /// with its bound and by how much it misses).
+    pub rest_verdict: Option<RestVerdict>,
     /// Positions (m) at the requested frames, `(frame, positions)`; frame 0 = initial.
     pub snapshots: Vec<(usize, Vec<Vec3<f64>>)>,
     /// Positions at the end of the run.
@@ -41,9 +41,8 @@ pub struct SceneRun {
     pub initial_potential_energy_j: f64,
     /// The solver's blow-up that ended the run early, if any.
     pub blow_up: Option<String>,
-    /// With a [`RestCriterion`]: the time (s) from which the largest speed stayed below its
-    /// bound for its hold time (the run stopped then); `None` if that did not happen before
-    /// the scene's duration.
+    /// With a [`RestCriterion`]: the time (s) from which the heap was at rest by it (the run
+    /// stopped once it was); `None` if that did not happen before the scene's duration.
     pub rest_from_s: Option<f64>,
 }
 
@@ -67,9 +66,7 @@ fn run_in<R: Real>(
     Ok(SceneRun {
         particles: sim.state.len(),
         frames: recorder.records,
-        rest_speeds_m_s: rest
-            .as_ref()
-            .map_or_else(Vec::new, |r| r.speeds_m_s.clone()),
+        rest_verdict: rest.as_ref().and_then(|r| r.verdict),
         snapshots: snapshots.taken,
         final_positions: positions_f64(&sim.state.positions),
         initial_potential_energy_j,
