@@ -22,13 +22,13 @@
 
 use std::time::Instant;
 
-use elastoplastic_granular::heap::{at_rest, drained_bed, rest_speeds, DrainedSetup, RestSample};
+use elastoplastic_granular::heap::{drained_bed, DrainedSetup};
 use elastoplastic_granular::stress::plane_strain_alpha;
 use elastoplastic_granular::ElastoplasticParams;
-use granular_measure::{angle_of_repose, ReposeOptions};
+use granular_measure::{angle_of_repose, ReposeOptions, RestSample};
 
 mod pieces;
-use pieces::{elapsed_over_budget, resume, save_run};
+use pieces::{at_rest, elapsed_over_budget, resume, sample, save_run};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -116,16 +116,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .filter(|(p, _)| setup.on_floor(p))
             .map(|(p, u)| (*p, *u))
             .unzip();
-        let (p99, deep) = rest_speeds(&x, &v, s);
         let measured = angle_of_repose(&x, &options).ok();
         let angle = measured.as_ref().map(|m| m.angle_deg);
-        samples.push(RestSample {
-            time_s: t,
-            p99_speed: p99,
-            deep_max_speed: deep,
-            angle_deg: angle,
-        });
-        let rest = at_rest(&samples, s, 9.81);
+        let now = sample(&x, &v, s, t, angle)?;
+        let (p99, deep) = (now.percentile_speed_m_s, now.deep_max_speed_m_s);
+        samples.push(now);
+        let rest = at_rest(&samples, s)?;
         if frame % 6 == 0 || rest {
             let flanks = measured.as_ref().map_or(String::new(), |m| {
                 m.flanks
@@ -153,11 +149,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     let last = samples.last().copied();
-    let rest = at_rest(&samples, s, 9.81);
+    let rest = at_rest(&samples, s)?;
     println!(
         "{} at the cap {cap_s} s: last {last:?} (bound {:.4} m/s), wall time {:.1} s",
         if rest { "AT REST" } else { "NOT AT REST" },
-        0.05 * (9.81 * s).sqrt(),
+        granular_measure::RestSettings::default().speed_bound_m_s(pieces::GRAVITY_M_S2, s)?,
         start.elapsed().as_secs_f64()
     );
     save(&solver, &state, &ids, &samples)

@@ -17,15 +17,14 @@
 use std::time::Instant;
 
 use elastoplastic_granular::heap::{
-    at_rest, fixed_base_heap, rest_speeds, HeapSetup, RestSample, SlabSides, BASE_TOP_M, BASE_X_M,
-    WIDE_BASE_X_M,
+    fixed_base_heap, HeapSetup, SlabSides, BASE_TOP_M, BASE_X_M, WIDE_BASE_X_M,
 };
 use elastoplastic_granular::stress::plane_strain_alpha;
 use elastoplastic_granular::{ElastoplasticParams, WallModel};
-use granular_measure::{angle_of_repose, ReposeOptions};
+use granular_measure::{angle_of_repose, ReposeOptions, RestSample};
 
 mod pieces;
-use pieces::{elapsed_over_budget, resume, save_run};
+use pieces::{at_rest, elapsed_over_budget, resume, sample, save_run};
 
 const SPACING: f64 = 0.01;
 
@@ -122,15 +121,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .filter(|(p, _)| p.x >= base_lo && p.x <= base_hi && p.y > BASE_TOP_M)
             .map(|(p, u)| (*p, *u))
             .unzip();
-        let (p99, deep) = rest_speeds(&x, &v, SPACING);
         let angle = angle_of_repose(&x, &options).ok().map(|m| m.angle_deg);
-        samples.push(RestSample {
-            time_s: t,
-            p99_speed: p99,
-            deep_max_speed: deep,
-            angle_deg: angle,
-        });
-        let rest = at_rest(&samples, SPACING, 9.81);
+        let now = sample(&x, &v, SPACING, t, angle)?;
+        let (p99, deep) = (now.percentile_speed_m_s, now.deep_max_speed_m_s);
+        samples.push(now);
+        let rest = at_rest(&samples, SPACING)?;
         if frame % 6 == 0 || rest {
             // The fastest particle anywhere: where it is, its density ratio and stress.
             let (k, vmax) = state
@@ -194,11 +189,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     let last = samples.last().copied();
-    let rest = at_rest(&samples, SPACING, 9.81);
+    let rest = at_rest(&samples, SPACING)?;
     println!(
         "{} at the cap {cap_s} s: last {last:?} (bound {:.4} m/s), wall time {:.1} s",
         if rest { "AT REST" } else { "NOT AT REST" },
-        0.05 * (9.81 * SPACING).sqrt(),
+        granular_measure::RestSettings::default().speed_bound_m_s(pieces::GRAVITY_M_S2, SPACING)?,
         start.elapsed().as_secs_f64()
     );
     save(&solver, &state, &ids, &samples)
@@ -231,7 +226,9 @@ fn feet(
         .filter(|(p, _)| on_base(p) && inner(p))
         .map(|(p, u)| (*p, *u))
         .unzip();
-    let (p99, deep) = rest_speeds(&xi, &vi, SPACING);
+    let (p99, deep) = sample(&xi, &vi, SPACING, 0.0, None).map_or((f64::NAN, f64::NAN), |r| {
+        (r.percentile_speed_m_s, r.deep_max_speed_m_s)
+    });
     println!(
         "    without the feet (x in ({:.3}, {:.3})): p99 {p99:.4} m/s  deep max {deep:.4} m/s",
         lo + 5.0 * SPACING,

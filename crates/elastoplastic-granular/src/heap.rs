@@ -1,5 +1,6 @@
-//! The fixed-base heap of the shipped scene `granular_repose_30` built in Rust, and the
-//! rest criterion granular codes judge a heap by.
+//! The fixed-base heap of the shipped scene `granular_repose_30` built in Rust, and a
+//! drained bed ([`drained_bed`]). Whether a heap is at rest is judged by
+//! `granular_measure::rest` (the examples `heap_30` and `drained` do).
 //!
 //! Geometry (m): a tank `[0, 2.4] × [0, 0.8] × [0, 0.03]`, a base `[0.8, 1.6] × [0, 0.25]`
 //! across the slab, and a block `[0.8, 1.6] × [0.25, 0.55]` on it, on a cubic lattice half
@@ -172,76 +173,6 @@ pub fn fixed_base_heap<R: Real>(
         solver.scheme_mut().set_stress(&stress)?;
     }
     Ok((solver, state))
-}
-
-/// One frame's figures of the rest criterion.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct RestSample {
-    /// Time (s).
-    pub time_s: f64,
-    /// 99th-percentile speed of the heap's particles (m/s).
-    pub p99_speed: f64,
-    /// Fastest particle at least two spacings below the surface of its column (m/s).
-    pub deep_max_speed: f64,
-    /// The heap's angle (degrees), if measurable.
-    pub angle_deg: Option<f64>,
-}
-
-/// The speeds of the rest criterion for the particles `(position, velocity)` of a heap:
-/// the 99th-percentile speed and the fastest particle at least two spacings below the
-/// highest particle of its column (bins of one spacing along `x`).
-pub fn rest_speeds<R: Real>(x: &[Vec3<R>], v: &[Vec3<R>], spacing: f64) -> (f64, f64) {
-    if x.is_empty() {
-        return (0.0, 0.0);
-    }
-    let mut speeds: Vec<f64> = v.iter().map(|u| u.norm().as_f64()).collect();
-    let lo = x.iter().map(|p| p.x.as_f64()).fold(f64::INFINITY, f64::min);
-    let bin = |p: &Vec3<R>| ((p.x.as_f64() - lo) / spacing).floor() as usize;
-    let bins = x.iter().map(bin).max().unwrap_or(0) + 1;
-    let mut top = vec![f64::NEG_INFINITY; bins];
-    for p in x {
-        let b = bin(p);
-        top[b] = top[b].max(p.y.as_f64());
-    }
-    let deep = x
-        .iter()
-        .zip(&speeds)
-        .filter(|(p, _)| top[bin(p)] - p.y.as_f64() >= 2.0 * spacing)
-        .map(|(_, &s)| s)
-        .fold(0.0, f64::max);
-    let k = ((speeds.len() as f64) * 0.99).floor() as usize;
-    let k = k.min(speeds.len() - 1);
-    let (_, p99, _) = speeds.select_nth_unstable_by(k, f64::total_cmp);
-    (*p99, deep)
-}
-
-/// Whether the heap is at rest by the criterion of granular codes, from one sample per
-/// frame (in time order): the 99th-percentile speed and the fastest particle two spacings
-/// deep below `0.05 √(g s)` over the last 0.5 s, and the angle moving less than 0.3° over
-/// the last second (at least one second of samples).
-pub fn at_rest(samples: &[RestSample], spacing: f64, gravity: f64) -> bool {
-    let Some(last) = samples.last() else {
-        return false;
-    };
-    if last.time_s < 1.0 {
-        return false;
-    }
-    let bound = 0.05 * (gravity * spacing).sqrt();
-    let slow = samples
-        .iter()
-        .filter(|s| s.time_s >= last.time_s - 0.5)
-        .all(|s| s.p99_speed < bound && s.deep_max_speed < bound);
-    let angles: Vec<f64> = samples
-        .iter()
-        .filter(|s| s.time_s >= last.time_s - 1.0)
-        .map(|s| s.angle_deg.unwrap_or(f64::NAN))
-        .collect();
-    let (lo, hi) = angles
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
-            (a.min(x), b.max(x))
-        });
-    slow && angles.iter().all(|a| a.is_finite()) && hi - lo < 0.3
 }
 
 /// A drained bed: a layer of grains on a perforated floor, drained through a slot into a

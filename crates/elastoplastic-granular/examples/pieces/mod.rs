@@ -3,7 +3,40 @@
 //! `HEAP_RESUME=FILE` (continue a saved run; the same arguments must be given). Shared by
 //! the `heap_30` and `drained` examples.
 
-use elastoplastic_granular::heap::RestSample;
+use granular_measure::{judge_rest, rest_sample, PileShape, RestSample, RestSettings, Vec3};
+
+/// Standard gravity (m/s²) of the examples' set-ups.
+pub const GRAVITY_M_S2: f64 = 9.81;
+
+/// The rest criterion's sample of the heap's grains `x`, `v` at `time_s`
+/// (`granular_measure::rest` with its default settings, a planar heap; `angle_deg` measured
+/// by the caller).
+pub fn sample(
+    x: &[Vec3<f64>],
+    v: &[Vec3<f64>],
+    spacing_m: f64,
+    time_s: f64,
+    angle_deg: Option<f64>,
+) -> Result<RestSample, Box<dyn std::error::Error>> {
+    let settings = RestSettings::default();
+    Ok(rest_sample(
+        x,
+        v,
+        spacing_m,
+        PileShape::Planar,
+        time_s,
+        angle_deg,
+        &settings,
+    )?)
+}
+
+/// Whether the heap is at rest at the last of `samples` by the rest criterion (default
+/// settings).
+pub fn at_rest(samples: &[RestSample], spacing_m: f64) -> Result<bool, Box<dyn std::error::Error>> {
+    let settings = RestSettings::default();
+    let bound = settings.speed_bound_m_s(GRAVITY_M_S2, spacing_m)?;
+    Ok(judge_rest(samples, bound, &settings)?.at_rest)
+}
 
 pub fn elapsed_over_budget(start: &std::time::Instant) -> bool {
     std::env::var("HEAP_BUDGET_S")
@@ -49,8 +82,9 @@ pub fn save_run(
         samples.iter().flat_map(|s| {
             [
                 s.time_s,
-                s.p99_speed,
-                s.deep_max_speed,
+                s.percentile_speed_m_s,
+                s.deep_max_speed_m_s,
+                s.deep_particles as f64,
                 s.angle_deg.unwrap_or(f64::NAN),
             ]
         }),
@@ -98,11 +132,12 @@ pub fn resume(
         plastic.push(next()?);
     }
     for _ in 0..count {
-        let (t, p, d, a) = (next()?, next()?, next()?, next()?);
+        let (t, p, d, k, a) = (next()?, next()?, next()?, next()?, next()?);
         samples.push(RestSample {
             time_s: t,
-            p99_speed: p,
-            deep_max_speed: d,
+            percentile_speed_m_s: p,
+            deep_max_speed_m_s: d,
+            deep_particles: k as usize,
             angle_deg: (!a.is_nan()).then_some(a),
         });
     }
