@@ -308,7 +308,7 @@ mod sample_cache;
 mod solver_spec;
 mod spec;
 
-pub use build::FluidParticles;
+pub use build::{FluidParticles, OPEN_TANK_REACH};
 pub use error::SceneError;
 pub use limits::{
     MAX_FRAMES, MAX_MESH_FILE_BYTES, MAX_PARTICLES, MAX_PASSIVE_POINTS, MAX_SCENE_FILE_BYTES,
@@ -318,10 +318,11 @@ pub use overrides::Override;
 pub use solver_spec::{SolverKind, SolverParams, SolverSpec};
 // The settings of each solver, owned by its crate (the variants of `SolverSpec`).
 pub use iisph_granular::{GranularSettings, IisphSettings, WaterSettings};
+pub use elastoplastic_granular::ElastoplasticSettings;
 pub use pbf::PbfSettings;
 pub use pcisph::PcisphSettings;
 pub use spec::{
     BoundaryModel, BoundarySpec, FluidSpec, InitialMasses, MeshPlacement, MeshSpec, OutputSpec,
-    Precision, QuickSpec, Scene, SolidSpec,
+    Precision, QuickSpec, Scene, SceneWalls, SolidSpec, WallModel,
 };
 pub use sph_solver::CommonSettings;
