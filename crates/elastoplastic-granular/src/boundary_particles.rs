@@ -283,7 +283,11 @@ pub fn sample_solids<R: Real>(
         for j in 0..counts[1] {
             for k in 0..counts[2] {
                 node += 1;
-                let idx: Vec3<R> = Vec3::new(R::of_f64(i as f64), R::of_f64(j as f64), R::of_f64(k as f64));
+                let idx: Vec3<R> = Vec3::new(
+                    R::of_f64(i as f64),
+                    R::of_f64(j as f64),
+                    R::of_f64(k as f64),
+                );
                 let x: Vec3<R> = lo + (idx + Vec3::repeat(half)) * s;
                 let mut deepest = R::zero();
                 let mut nearest: Option<(usize, R)> = None;

@@ -56,7 +56,8 @@ pub fn geostatic<R: Real>(
         (u as i64, v as i64)
     };
     let mut top: HashMap<(i64, i64), R> = HashMap::new();
-    top.try_reserve(n.min(1 << 20)).map_err(|_| alloc_error(n))?;
+    top.try_reserve(n.min(1 << 20))
+        .map_err(|_| alloc_error(n))?;
     for x in positions {
         let h = -down.dot(x);
         top.entry(column(x))

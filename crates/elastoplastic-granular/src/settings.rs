@@ -146,7 +146,8 @@ impl SolverSettings for ElastoplasticSettings {
     fn set_iterations(&mut self, _n: usize) {}
 
     fn params(&self, scene: &SceneValues) -> ElastoplasticParams<f64> {
-        let mut p = ElastoplasticParams::for_spacing(scene.particle_spacing, self.friction_angle_deg);
+        let mut p =
+            ElastoplasticParams::for_spacing(scene.particle_spacing, self.friction_angle_deg);
         self.common.apply(scene, &mut p.common);
         let set = |target: &mut f64, v: Option<f64>| {
             if let Some(v) = v {
@@ -159,8 +160,14 @@ impl SolverSettings for ElastoplasticSettings {
         set(&mut p.cohesion, self.cohesion);
         set(&mut p.viscosity_alpha, self.viscosity_alpha);
         set(&mut p.viscosity_beta, self.viscosity_beta);
-        set(&mut p.artificial_stress_epsilon, self.artificial_stress_epsilon);
-        set(&mut p.artificial_stress_exponent, self.artificial_stress_exponent);
+        set(
+            &mut p.artificial_stress_epsilon,
+            self.artificial_stress_epsilon,
+        );
+        set(
+            &mut p.artificial_stress_exponent,
+            self.artificial_stress_exponent,
+        );
         set(&mut p.cfl_number, self.cfl_number);
         set(&mut p.skin, self.skin);
         p.periodic = self
@@ -217,7 +224,10 @@ impl<R: Real> ElastoplasticParams<R> {
             cohesion: c("cohesion", self.cohesion)?,
             viscosity_alpha: c("viscosity_alpha", self.viscosity_alpha)?,
             viscosity_beta: c("viscosity_beta", self.viscosity_beta)?,
-            artificial_stress_epsilon: c("artificial_stress_epsilon", self.artificial_stress_epsilon)?,
+            artificial_stress_epsilon: c(
+                "artificial_stress_epsilon",
+                self.artificial_stress_epsilon,
+            )?,
             artificial_stress_exponent: c(
                 "artificial_stress_exponent",
                 self.artificial_stress_exponent,

@@ -89,7 +89,8 @@ impl<R: Real> ElastoplasticScheme<R> {
                 solver: NAME,
                 name: "wall_models",
                 value: params.wall_models.len() as f64,
-                reason: "Coulomb walls are walls of boundary particles: set boundary_particle_region",
+                reason:
+                    "Coulomb walls are walls of boundary particles: set boundary_particle_region",
             });
         }
         let models = match &walls {
@@ -129,11 +130,8 @@ impl<R: Real> ElastoplasticScheme<R> {
                 }
             }
         };
-        let boundary_particles = sample_solids(
-            parts.boundary.solids(),
-            &params,
-            MAX_BOUNDARY_PARTICLES,
-        )?;
+        let boundary_particles =
+            sample_solids(parts.boundary.solids(), &params, MAX_BOUNDARY_PARTICLES)?;
         let mut scheme = Self {
             c: Consts::new(&params)?,
             initial_stress_pending: params.initial_stress == InitialStress::Geostatic,

@@ -19,8 +19,7 @@ fn a_floor_gives_three_rows_with_its_normal_and_model() {
         lo: 0.0,
         hi: 0.4,
     }];
-    p.boundary_particle_region =
-        Some(Aabb::new(Vec3::zeros(), Vec3::new(0.5, 0.2, 0.4)).unwrap());
+    p.boundary_particle_region = Some(Aabb::new(Vec3::zeros(), Vec3::new(0.5, 0.2, 0.4)).unwrap());
     let solids: Solids<f64> = vec![Box::new(Plane::new(Vec3::zeros(), Vec3::y()).unwrap())];
     let b = sample_solids(&solids, &p, 1_000).unwrap();
     // Along x: 5 + 2·3 nodes (not periodic, extended by three rows each side); along z:
@@ -130,9 +129,8 @@ fn slab_on_tilted_floor(wall: WallModel, tilt_deg: f64, t_s: f64) -> (f64, f64, 
     solver.restore_state(&settled, state.len()).unwrap();
     assert_eq!(solver.scheme().boundary_particles().len(), 8 * 3 * 4);
     let frames = (t_s / 0.02).round() as usize;
-    let mean_vx = |st: &ParticleSet<f64>| {
-        st.velocities.iter().map(|v| v.x).sum::<f64>() / st.len() as f64
-    };
+    let mean_vx =
+        |st: &ParticleSet<f64>| st.velocities.iter().map(|v| v.x).sum::<f64>() / st.len() as f64;
     let mut travelled = 0.0;
     let mut v_early = 0.0;
     for f in 0..frames {

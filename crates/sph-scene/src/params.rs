@@ -43,13 +43,10 @@ impl Scene {
                 .chain(self.walls.solids.iter().map(|w| w.unwrap_or(default)))
                 .collect();
             e.boundary_particle_region = self.tank.or_else(|| {
-                self.fluids
-                    .iter()
-                    .map(|f| f.bounds())
-                    .reduce(|a, b| Aabb {
-                        min: a.min.inf(&b.min),
-                        max: a.max.sup(&b.max),
-                    })
+                self.fluids.iter().map(|f| f.bounds()).reduce(|a, b| Aabb {
+                    min: a.min.inf(&b.min),
+                    max: a.max.sup(&b.max),
+                })
             });
         }
         p

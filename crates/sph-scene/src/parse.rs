@@ -22,7 +22,8 @@ use crate::raw::{
 use crate::read::read_limited;
 use crate::sample_cache::FluidSampleCache;
 use crate::{
-    FluidSpec, OutputSpec, Precision, QuickSpec, Scene, SceneWalls, SceneError, SolidSpec, SolverSpec,
+    FluidSpec, OutputSpec, Precision, QuickSpec, Scene, SceneError, SceneWalls, SolidSpec,
+    SolverSpec,
 };
 
 /// The `[solver]` table as parsed (with spans), for [`solver::parse`].

@@ -68,7 +68,10 @@ fn a_resumed_elastoplastic_scene_repeats_the_uninterrupted_run() {
     let n = first.state.len();
     let stress = c.solver.array("stress").expect("stress saved");
     assert_eq!(stress.len(), 6 * n);
-    assert!(stress.iter().any(|&s| s < 0.0), "a geostatic block is compressed");
+    assert!(
+        stress.iter().any(|&s| s < 0.0),
+        "a geostatic block is compressed"
+    );
     assert_eq!(c.solver.array("plastic_strain").map(<[f64]>::len), Some(n));
     let mut resumed = SceneSim::<f64>::new(&scene).unwrap();
     resumed.restore(c).unwrap();
