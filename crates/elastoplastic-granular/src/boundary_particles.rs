@@ -274,7 +274,7 @@ pub fn sample_solids<R: Real>(
         counts[a] = (c + 1e-9_f64).floor().max(1.0) as usize;
     }
     let total: f64 = counts.iter().map(|&c| c as f64).product();
-    if !(total <= MAX_BOUNDARY_LATTICE_NODES) {
+    if total > MAX_BOUNDARY_LATTICE_NODES {
         return Err(sampling_error(
             "boundary_particle_region",
             total,

@@ -36,7 +36,7 @@ pub fn geostatic<R: Real>(
     out.try_reserve_exact(n).map_err(|_| alloc_error(n))?;
     let g = params.common.gravity;
     let g_norm = g.norm();
-    if !(g_norm > R::zero()) {
+    if g_norm <= R::zero() {
         out.resize(n, Matrix3::zeros());
         return Ok(out);
     }
