@@ -113,7 +113,7 @@ impl Scene {
                 ));
             }
             if let WallModel::Coulomb(mu) = wall {
-                if !(mu >= 0.0 && mu <= MAX_WALL_FRICTION) {
+                if !(0.0..=MAX_WALL_FRICTION).contains(&mu) {
                     return Err(ctx.invalid(
                         field,
                         format!("the Coulomb friction coefficient must be in [0, MAX_WALL_FRICTION = {MAX_WALL_FRICTION}], got {mu}"),
