@@ -43,8 +43,12 @@
 //! sub-cycled inside each substep of the frame shell; the neighbour lists are built with
 //! radius `support + skin` and kept while no particle has moved more than `skin/2`.
 //!
-//! Walls are volume maps sampled solid by solid, each solid with its [`WallModel`]
-//! (free-slip or no-slip; see [`walls`] for the terms).
+//! Walls are rows of fixed boundary particles ([`boundary_particles`]; from a scene's solids
+//! with [`ElastoplasticParams::boundary_particle_region`], [`sample_solids`]) or volume maps
+//! sampled solid by solid, each solid with its [`WallModel`] (free-slip, no-slip, or, for
+//! boundary particles, Coulomb with a wall friction coefficient; see [`boundary_particles`]
+//! and [`walls`] for the terms). In scene files the solver is `[solver] kind =
+//! "elastoplastic"` ([`ElastoplasticSettings`]) with `[boundary] model = "particles"`.
 //!
 //! # Deviations
 //!
@@ -70,27 +74,33 @@
 
 pub mod boundary_particles;
 pub mod heap;
+pub mod initial;
 mod kernels;
 mod params;
 mod passes;
 pub mod periodic;
 mod scratch;
+mod settings;
 mod solver;
 pub mod stress;
 pub mod walls;
 
-pub use boundary_particles::{boundary_block, BoundaryParticle};
+pub use boundary_particles::{
+    boundary_block, sample_solids, BoundaryParticle, MAX_BOUNDARY_LATTICE_NODES,
+    MAX_BOUNDARY_PARTICLES,
+};
 pub use kernels::ELASTOPLASTIC_KERNEL;
 pub use params::{
-    ElastoplasticParams, WallModel, DEFAULT_ARTIFICIAL_STRESS_EPSILON,
-    DEFAULT_ARTIFICIAL_STRESS_EXPONENT, DEFAULT_CFL_NUMBER, DEFAULT_POISSON_RATIO,
-    DEFAULT_REST_DENSITY, DEFAULT_SKIN_OVER_SPACING, DEFAULT_SUPPORT_OVER_SPACING,
-    DEFAULT_VISCOSITY_ALPHA, DEFAULT_VISCOSITY_BETA, DEFAULT_YOUNGS_MODULUS_PA,
-    MAX_ARTIFICIAL_STRESS_EXPONENT, MAX_COHESION_PA, MAX_EXPLICIT_STEPS_PER_SUBSTEP,
-    MAX_FRICTION_ANGLE_DEG, MAX_POISSON_RATIO, MAX_VISCOSITY_COEFFICIENT, MAX_WALL_MODELS,
-    MAX_YOUNGS_MODULUS_PA,
+    ElastoplasticParams, InitialStress, WallModel, BOUNDARY_PARTICLE_ROWS,
+    DEFAULT_ARTIFICIAL_STRESS_EPSILON, DEFAULT_ARTIFICIAL_STRESS_EXPONENT, DEFAULT_CFL_NUMBER,
+    DEFAULT_POISSON_RATIO, DEFAULT_REST_DENSITY, DEFAULT_SKIN_OVER_SPACING,
+    DEFAULT_SUPPORT_OVER_SPACING, DEFAULT_VISCOSITY_ALPHA, DEFAULT_VISCOSITY_BETA,
+    DEFAULT_YOUNGS_MODULUS_PA, MAX_ARTIFICIAL_STRESS_EXPONENT, MAX_COHESION_PA,
+    MAX_EXPLICIT_STEPS_PER_SUBSTEP, MAX_FRICTION_ANGLE_DEG, MAX_POISSON_RATIO,
+    MAX_VISCOSITY_COEFFICIENT, MAX_WALL_FRICTION, MAX_WALL_MODELS, MAX_YOUNGS_MODULUS_PA,
 };
 pub use periodic::PeriodicAxis;
+pub use settings::{Axis, ElastoplasticSettings, PeriodicSetting, WITH_COMMON_FRICTION_ANGLE_DEG};
 pub use solver::{
     Elastoplastic, ElastoplasticScheme, ELASTOPLASTIC_PHASES, ELASTOPLASTIC_STATE_ARRAYS,
 };

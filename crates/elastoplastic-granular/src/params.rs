@@ -1,6 +1,6 @@
 //! The parameters of [`Elastoplastic`](crate::Elastoplastic), their defaults and bounds.
 
-use sph_core::Real;
+use sph_core::{Aabb, Real};
 use sph_solver::{CommonParams, SolverError};
 
 use crate::periodic::PeriodicAxis;
@@ -26,6 +26,13 @@ pub const MAX_ARTIFICIAL_STRESS_EXPONENT: f64 = 10.0;
 pub const MAX_EXPLICIT_STEPS_PER_SUBSTEP: usize = 100_000;
 /// Most solids with their own wall model.
 pub const MAX_WALL_MODELS: usize = 64;
+/// Largest wall friction coefficient `μ_w` of [`WallModel::Coulomb`] accepted: 10, a wall
+/// friction angle of 84°, past any measured wall–grain pair (a rough wall is `NoSlip`).
+pub const MAX_WALL_FRICTION: f64 = 10.0;
+/// Rows of boundary particles standing for a wall
+/// ([`ElastoplasticParams::boundary_particle_region`]): three, so that a particle at the
+/// wall sees a full support (2.4 spacings) of boundary particles behind it.
+pub const BOUNDARY_PARTICLE_ROWS: f64 = 3.0;
 
 /// Young's modulus of the defaults (Pa): Bui et al. (2008)'s aluminium-bar test as
 /// SPHinXsys's `test_2d_column_collapse` transcribes it (5.84 MPa).
@@ -52,9 +59,16 @@ pub const DEFAULT_SKIN_OVER_SPACING: f64 = 0.3;
 /// B-spline with smoothing length `1.2 s` has support `2.4 s`.
 pub const DEFAULT_SUPPORT_OVER_SPACING: f64 = 2.4;
 
-/// How a solid acts on the particles next to it (the wall's share of each SPH sum is its
-/// volume-map gradient `∇Ψ`; the wall's stress mirrors the particle's, the wall is at rest).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// How a solid acts on the particles next to it.
+///
+/// With volume-map walls ([`crate::walls`]) the wall's share of each SPH sum is its
+/// volume-map gradient `∇Ψ`, its stress mirrors the particle's and it is at rest; with
+/// boundary particles ([`crate::boundary_particles`]) each particle carries its solid's
+/// model and the stress and velocity extrapolated from the grains are mirrored, kept, or
+/// (Coulomb) mirrored in part. In scene files: `wall = "free-slip"`, `"no-slip"` or
+/// `{ coulomb = 0.4 }`.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[serde(rename_all = "kebab-case", deny_unknown_fields)]
 #[non_exhaustive]
 pub enum WallModel {
     /// Only the normal part of the wall traction and of the velocity difference: grains
@@ -62,10 +76,32 @@ pub enum WallModel {
     FreeSlip,
     /// The whole traction; the wall's velocity (zero) enters the velocity gradient.
     NoSlip,
+    /// Coulomb friction with coefficient `μ_w` (the value, `0 ≤ μ_w ≤`
+    /// [`MAX_WALL_FRICTION`]): the tangential traction the wall takes is at most `μ_w`
+    /// times the compressive normal one (boundary particles only; see
+    /// [`crate::boundary_particles`] for the terms).
+    Coulomb(f64),
     /// The solid only keeps the particles out (projection to the contact distance); its
     /// share of the sums comes from boundary particles
     /// ([`ElastoplasticScheme::set_boundary_particles`](crate::ElastoplasticScheme::set_boundary_particles)).
+    #[serde(skip)]
     ContactOnly,
+}
+
+/// The stress the particles start from (in scene files `initial_stress = "geostatic"` or
+/// `"none"`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+#[non_exhaustive]
+pub enum InitialStress {
+    /// Unstressed: the grains settle under gravity from zero stress (the default).
+    #[default]
+    None,
+    /// At rest under gravity in each column (Jaky's `K0 = ν/(1 − ν)` of the elastic
+    /// oedometer): `σ_v = −ρ0 |g| d` along gravity, `K0 σ_v` across it, `d` the depth below
+    /// the column's top particle plus half a spacing (columns one spacing wide across
+    /// gravity), applied to the state the first frame starts from.
+    Geostatic,
 }
 
 /// Parameters of [`Elastoplastic`](crate::Elastoplastic).
@@ -87,6 +123,8 @@ pub enum WallModel {
 /// | `skin` | `0.3 s` | [`DEFAULT_SKIN_OVER_SPACING`] |
 /// | `default_wall`, `wall_models` | no-slip, none | |
 /// | `periodic` | none | |
+/// | `boundary_particle_region` | none (walls from the boundary) | |
+/// | `initial_stress` | none | |
 #[derive(Debug, Clone, PartialEq)]
 pub struct ElastoplasticParams<R: Real> {
     /// The parameters every solver has.
@@ -127,6 +165,15 @@ pub struct ElastoplasticParams<R: Real> {
     /// Periodic axes (at most one entry per axis; each period at least `support_radius +
     /// skin`, so that one image on each side covers every neighbour).
     pub periodic: Vec<PeriodicAxis<R>>,
+    /// `Some(region)`: the solids of the solver's boundary become walls of fixed boundary
+    /// particles ([`crate::boundary_particles::sample_solids`]): the nodes of the particle
+    /// lattice over `region` (the fluid's lattice: half a spacing from its faces), extended
+    /// by [`BOUNDARY_PARTICLE_ROWS`] spacings, that lie inside a solid within that many
+    /// spacings of its surface, each with its solid's model (`wall_models`); the solids
+    /// then only keep the particles out. `None`: the boundary's volume (if any) is the wall.
+    pub boundary_particle_region: Option<Aabb<R>>,
+    /// The stress the particles start from.
+    pub initial_stress: InitialStress,
 }
 
 fn invalid(name: &'static str, value: f64, reason: &'static str) -> SolverError {
@@ -176,6 +223,8 @@ impl<R: Real> ElastoplasticParams<R> {
             default_wall: WallModel::NoSlip,
             wall_models: Vec::new(),
             periodic: Vec::new(),
+            boundary_particle_region: None,
+            initial_stress: InitialStress::None,
         }
     }
 
@@ -331,6 +380,17 @@ impl<R: Real> ElastoplasticParams<R> {
                 self.wall_models.len() as f64,
                 "at most MAX_WALL_MODELS = 64 solids have their own model",
             ));
+        }
+        for m in std::iter::once(&self.default_wall).chain(&self.wall_models) {
+            if let WallModel::Coulomb(mu) = *m {
+                check_range(
+                    "wall_friction",
+                    mu,
+                    0.0,
+                    MAX_WALL_FRICTION,
+                    "a Coulomb wall's friction coefficient must be in [0, MAX_WALL_FRICTION = 10]",
+                )?;
+            }
         }
         let reach = f(self.common.support_radius + self.skin);
         for (k, a) in self.periodic.iter().enumerate() {

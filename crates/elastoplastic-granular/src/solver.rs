@@ -13,9 +13,11 @@ use sph_solver::state::{match_arrays, ArraySpec};
 use sph_solver::step::{check_divergence, FramePhases, StepAt};
 use sph_solver::{CommonParams, FrameSolver, SchemeParts, SolverError, StepStats, SubstepScheme};
 
-use crate::boundary_particles::{extrapolate, BoundaryParticle, Extrapolation};
+use crate::boundary_particles::{
+    extrapolate, sample_solids, BoundaryParticle, Extrapolation, MAX_BOUNDARY_PARTICLES,
+};
 use crate::kernels::{Consts, ELASTOPLASTIC_KERNEL};
-use crate::params::{ElastoplasticParams, WallModel};
+use crate::params::{ElastoplasticParams, InitialStress, WallModel};
 use crate::passes::{max_displacement, momentum_pass, stress_pass, StepInputs};
 use crate::scratch::Scratch;
 use crate::walls::{SharedWalls, WallSampler};
@@ -58,6 +60,8 @@ pub struct ElastoplasticScheme<R: Real> {
     lists_valid: bool,
     explicit_steps: u64,
     searches: u64,
+    /// The initial stress is still to be applied (at the first frame's start).
+    initial_stress_pending: bool,
 }
 
 impl<R: Real> std::fmt::Debug for ElastoplasticScheme<R> {
@@ -76,15 +80,47 @@ impl<R: Real> ElastoplasticScheme<R> {
         parts: SchemeParts<R>,
         walls: WallSampler<R>,
     ) -> Result<Self, SolverError> {
+        let coulomb = std::iter::once(&params.default_wall)
+            .chain(&params.wall_models)
+            .any(|m| matches!(m, WallModel::Coulomb(_)));
+        let particle_walls = params.boundary_particle_region.is_some();
+        if coulomb && !particle_walls {
+            return Err(SolverError::InvalidParameter {
+                solver: NAME,
+                name: "wall_models",
+                value: params.wall_models.len() as f64,
+                reason:
+                    "Coulomb walls are walls of boundary particles: set boundary_particle_region",
+            });
+        }
         let models = match &walls {
+            WallSampler::PerSolid(_) if particle_walls => {
+                return Err(SolverError::InvalidParameter {
+                    solver: NAME,
+                    name: "boundary_particle_region",
+                    value: 0.0,
+                    reason: "walls of boundary particles take a boundary without volume (e.g. a collision boundary), not volume-map walls",
+                });
+            }
             WallSampler::PerSolid(w) => (0..w.maps().len()).map(|k| params.wall_model(k)).collect(),
+            WallSampler::Combined if particle_walls => {
+                if parts.boundary.has_volume() {
+                    return Err(SolverError::InvalidParameter {
+                        solver: NAME,
+                        name: "boundary_particle_region",
+                        value: 0.0,
+                        reason: "walls of boundary particles take a boundary without volume (e.g. a collision boundary): a volume map would count the walls twice",
+                    });
+                }
+                Vec::new()
+            }
             WallSampler::Combined => {
                 if params.wall_models.iter().any(|&m| m != params.default_wall) {
                     return Err(SolverError::InvalidParameter {
                         solver: NAME,
                         name: "wall_models",
                         value: params.wall_models.len() as f64,
-                        reason: "a wall model per solid needs the walls of `volume_map_walls` given to `ElastoplasticScheme::solver`",
+                        reason: "a wall model per solid needs the walls of `volume_map_walls` given to `ElastoplasticScheme::solver`, or boundary particles",
                     });
                 }
                 if parts.boundary.has_volume() {
@@ -94,8 +130,11 @@ impl<R: Real> ElastoplasticScheme<R> {
                 }
             }
         };
-        Ok(Self {
+        let boundary_particles =
+            sample_solids(parts.boundary.solids(), &params, MAX_BOUNDARY_PARTICLES)?;
+        let mut scheme = Self {
             c: Consts::new(&params)?,
+            initial_stress_pending: params.initial_stress == InitialStress::Geostatic,
             params,
             parts,
             walls,
@@ -105,7 +144,11 @@ impl<R: Real> ElastoplasticScheme<R> {
             lists_valid: false,
             explicit_steps: 0,
             searches: 0,
-        })
+        };
+        if !boundary_particles.is_empty() {
+            scheme.set_boundary_particles(boundary_particles)?;
+        }
+        Ok(scheme)
     }
 
     /// The solver with `params` and volume-map `walls` (from
@@ -144,7 +187,8 @@ impl<R: Real> ElastoplasticScheme<R> {
     }
 
     /// Sets the stress of each particle (Pa, tension positive; one per particle of the state
-    /// the next [`FrameSolver::step`] takes), e.g. a geostatic initial stress. Errors: a
+    /// the next [`FrameSolver::step`] takes), e.g. a geostatic initial stress; it replaces
+    /// the parameters' `initial_stress`. Errors: a
     /// non-finite or asymmetric stress, named by its index.
     pub fn set_stress(&mut self, stress: &[Matrix3<R>]) -> Result<(), SolverError> {
         for (i, m) in stress.iter().enumerate() {
@@ -159,6 +203,7 @@ impl<R: Real> ElastoplasticScheme<R> {
         }
         self.resize(stress.len());
         self.scratch.stress[..stress.len()].copy_from_slice(stress);
+        self.initial_stress_pending = false;
         Ok(())
     }
 
@@ -361,6 +406,11 @@ impl<R: Real> SubstepScheme<R> for ElastoplasticScheme<R> {
             apply_permutation(&mut s.plastic_strain, p, &mut s.permute_r);
             self.resize(n);
         }
+        if self.initial_stress_pending {
+            let stress = crate::initial::geostatic(&self.params, &state.positions)?;
+            self.scratch.stress[..n].copy_from_slice(&stress);
+            self.initial_stress_pending = false;
+        }
         // Every frame starts from fresh lists, so that a run resumed from a checkpoint
         // repeats the uninterrupted one bit for bit.
         self.lists_valid = false;
@@ -430,6 +480,7 @@ impl<R: Real> SubstepScheme<R> for ElastoplasticScheme<R> {
             None => s.plastic_strain.fill(R::zero()),
         }
         self.lists_valid = false;
+        self.initial_stress_pending = false;
         Ok(())
     }
 }

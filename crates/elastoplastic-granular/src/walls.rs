@@ -113,7 +113,9 @@ impl<R: Real> WallSampler<R> {
 #[inline]
 pub(crate) fn wall_part<R: Real>(model: WallModel, grad: &Vec3<R>, v: &Vec3<R>) -> Vec3<R> {
     match model {
-        WallModel::NoSlip => *v,
+        // Coulomb walls are boundary particles only (the scheme refuses them with volume
+        // maps); the full traction if one reaches here.
+        WallModel::NoSlip | WallModel::Coulomb(_) => *v,
         WallModel::ContactOnly => Vec3::zeros(),
         WallModel::FreeSlip => {
             let g2 = grad.norm_squared();

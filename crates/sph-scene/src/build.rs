@@ -27,6 +27,11 @@ pub struct FluidParticles<R: Real> {
     pub velocities: Vec<Vec3<R>>,
 }
 
+/// How far the tank reaches past each end of a periodic axis, in tank extents (at least
+/// 1 m): the particles are wrapped into the period at each neighbour search and move less
+/// than the support radius between searches, far less than this.
+pub const OPEN_TANK_REACH: f64 = 100.0;
+
 impl Scene {
     /// Initial fluid particle positions (m), fluid by fluid in file order (see the crate
     /// documentation for the sampling rules).
@@ -181,7 +186,11 @@ impl Scene {
     }
 
     /// The boundary signed distance fields in precision `R`: the tank first (as
-    /// `Inverted<BoxSdf>`, when there is one), then the solids in file order (meshes as
+    /// `Inverted<BoxSdf>`, when there is one; open along the solver's periodic axes,
+    /// [`SolverSpec::periodic_axes`](crate::SolverSpec::periodic_axes): its box reaches
+    /// [`OPEN_TANK_REACH`] times its extent (at least 1 m) past each end there, so that
+    /// particles crossing a periodic end, which the solver wraps, meet no wall), then the
+    /// solids in file order (meshes as
     /// [`GridSdf`] with cell `sdf_cell`, default `particle_spacing / 2`, and margin
     /// `2 · particle_spacing + 2 · cell`). Errors only when a value does not fit in `R`
     /// (e.g. a box too thin for `f32`).
@@ -189,7 +198,15 @@ impl Scene {
         let ctx = Ctx::new(&self.source);
         let mut out: Vec<Box<dyn Sdf<R>>> = Vec::with_capacity(self.solids.len() + 1);
         if let Some(t) = &self.tank {
-            let b = Aabb::new(cast3::<R>(&t.min), cast3::<R>(&t.max))
+            let (mut lo, mut hi) = (t.min, t.max);
+            for (axis, _, _) in self.solver.periodic_axes() {
+                if axis < 3 {
+                    let reach = OPEN_TANK_REACH * (hi[axis] - lo[axis]).max(1.0);
+                    lo[axis] -= reach;
+                    hi[axis] += reach;
+                }
+            }
+            let b = Aabb::new(cast3::<R>(&lo), cast3::<R>(&hi))
                 .and_then(BoxSdf::new)
                 .map_err(|e| ctx.invalid("tank.min", format!("in {}: {e}", R::NAME)))?;
             out.push(Box::new(Inverted(b)));

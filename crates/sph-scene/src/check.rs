@@ -16,7 +16,10 @@ use sph_core::Aabb;
 use crate::error::Ctx;
 use crate::geom::{fmt3, v3, AXES};
 use crate::mesh_io::placement_field;
-use crate::{FluidSpec, QuickSpec, Scene, SceneError, SolidSpec};
+use crate::{
+    BoundaryModel, FluidSpec, QuickSpec, Scene, SceneError, SolidSpec, SolverKind, WallModel,
+};
+use elastoplastic_granular::MAX_WALL_FRICTION;
 
 impl Scene {
     /// Checks every value of the scene, as [`Scene::load`] does: after editing a loaded
@@ -64,11 +67,75 @@ impl Scene {
         for (j, s) in self.solids.iter().enumerate() {
             check_solid(ctx, &format!("solid[{j}]"), s)?;
         }
+        self.check_walls(ctx)?;
         if self.output.every_frames == 0 {
             return Err(ctx.invalid("output.every_frames", "must be >= 1, got 0"));
         }
         if let Some(q) = &self.quick_overrides {
             self.check_quick(ctx, q)?;
+        }
+        Ok(())
+    }
+
+    /// The boundary model against the solver, the walls' models, and the periodic axes
+    /// against the tank.
+    fn check_walls(&self, ctx: &Ctx) -> Result<(), SceneError> {
+        let particles = self.boundary.model == BoundaryModel::Particles;
+        let elastoplastic = self.solver.kind() == SolverKind::Elastoplastic;
+        if elastoplastic && !particles {
+            return Err(ctx.invalid(
+                "boundary.model",
+                "solver kind = \"elastoplastic\" needs model = \"particles\" (walls of boundary particles): with volume maps or collisions alone a granular layer does not come to rest on its walls (docs/elastoplastic-granular.md)",
+            ));
+        }
+        if particles && !elastoplastic {
+            return Err(ctx.invalid(
+                "boundary.model",
+                format!(
+                    "model = \"particles\" is the elastoplastic solver's; solver kind = \"{}\" takes \"volume-map\" or \"collision\"",
+                    self.solver.kind_name()
+                ),
+            ));
+        }
+        let walls = std::iter::once(("tank.wall".to_string(), self.walls.tank)).chain(
+            self.walls
+                .solids
+                .iter()
+                .enumerate()
+                .map(|(j, w)| (format!("solid[{j}].wall"), *w)),
+        );
+        for (field, wall) in walls {
+            let Some(wall) = wall else { continue };
+            if !particles {
+                return Err(ctx.invalid(
+                    field,
+                    "a wall model applies to walls of boundary particles: set [boundary] model = \"particles\"",
+                ));
+            }
+            if let WallModel::Coulomb(mu) = wall {
+                if !(0.0..=MAX_WALL_FRICTION).contains(&mu) {
+                    return Err(ctx.invalid(
+                        field,
+                        format!("the Coulomb friction coefficient must be in [0, MAX_WALL_FRICTION = {MAX_WALL_FRICTION}], got {mu}"),
+                    ));
+                }
+            }
+        }
+        if self.walls.tank.is_some() && self.tank.is_none() {
+            return Err(ctx.invalid("tank.wall", "a wall model without a tank"));
+        }
+        if let Some(t) = &self.tank {
+            for (axis, lo, hi) in self.solver.periodic_axes() {
+                if axis < 3 && (lo != t.min[axis] || hi != t.max[axis]) {
+                    return Err(ctx.invalid(
+                        "solver.periodic",
+                        format!(
+                            "the period along {} must be the tank's extent [{}, {}] (the tank is open along a periodic axis), got [{lo}, {hi}]",
+                            AXES[axis], t.min[axis], t.max[axis]
+                        ),
+                    ));
+                }
+            }
         }
         Ok(())
     }

@@ -100,7 +100,7 @@
 //!                                  # WaterSettings, GranularSettings); each key is the name
 //!                                  # of the parameter it sets; the keys of another solver
 //!                                  # are refused (unknown field)
-//! kind = "pbf"                     # "pbf" | "pcisph" | "iisph" | "granular"
+//! kind = "pbf"                     # "pbf" | "pcisph" | "iisph" | "granular" | "elastoplastic"
 //! substeps = 4                     # solver steps per frame (>= 1)
 //! solver_iterations = 3            # PBF: constraint iterations per step (>= 1; formerly
 //!                                  # `iterations`, still accepted)
@@ -156,10 +156,46 @@
 //! #                                # bound; the thesis's eq. 9 implies 0.5, outside it)
 //! ```
 //!
+//! The elastic–plastic granular solver (crate `elastoplastic-granular`, Bui, Fukagawa, Sako
+//! & Ohno 2008: a per-particle stress, elastic and capped by the Drucker–Prager cone matched
+//! to Mohr–Coulomb in plane strain; explicit steps sub-cycled inside each frame) requires
+//! `[boundary] model = "particles"`; each key is an `ElastoplasticParams` field, defaults
+//! its `for_spacing`'s:
+//!
+//! ```toml
+//! [solver]
+//! kind = "elastoplastic"
+//! substeps = 1                     # (>= 1; the explicit steps, Δt = C h / √(E/ρ0), are
+//!                                  # sub-cycled inside each)
+//! friction_angle_deg = 30.0        # required, in [0, 70]: φ
+//! # youngs_modulus = 5.84e6        # Pa, E (> 0)
+//! # poisson_ratio = 0.3            # ν, in [0, 0.49]
+//! # dilatancy_angle_deg = 0.0      # ψ, in [0, φ]
+//! # cohesion = 0.0                 # Pa, c (>= 0; φ > 0 when 0)
+//! # viscosity_alpha = 0.1          # Monaghan's α_Π, in [0, 10]
+//! # viscosity_beta = 0.0           # Monaghan's β_Π, in [0, 10]
+//! # artificial_stress_epsilon = 0.5 # Gray et al.'s ε, in [0, 1]
+//! # artificial_stress_exponent = 2.55 # Gray et al.'s n, in [1, 10]
+//! # cfl_number = 0.2               # C, in (0, 1]
+//! # skin = 0.003                   # m, neighbour-list skin, in [0, support radius]
+//! #                                # (default 0.3 particle_spacing)
+//! # initial_stress = "none"        # "none" | "geostatic" (σ_v = −ρ0 g depth along gravity,
+//! #                                # K0 σ_v across it, K0 = ν/(1 − ν), per column)
+//! # periodic = [{ axis = "z", lo = 0.0, hi = 0.03 }] # m: periodic axes; with a tank, the
+//! #                                # period is its extent along the axis and the tank is
+//! #                                # open there
+//! # rest_density, support_over_spacing (default 2.4), reorder_every as above
+//! ```
+//!
 //! ```toml
 //! [boundary]                       # optional
-//! model = "volume-map"             # "volume-map" | "collision" (default: BoundaryModel's
-//!                                  # Default, "volume-map")
+//! model = "volume-map"             # "volume-map" | "collision" | "particles" (default:
+//!                                  # BoundaryModel's Default, "volume-map"); "particles":
+//!                                  # walls of fixed boundary particles, the elastoplastic
+//!                                  # solver's (and required by it): the lattice nodes inside
+//!                                  # the tank's walls and the solids within three spacings
+//!                                  # of their surfaces (over the tank, or the fluids' box),
+//!                                  # each with its solid's `wall` model
 //! initial_masses = "lattice"       # "lattice" (default): every particle ρ0 s³;
 //!                                  # "calibrated": those masses lowered where the lattice
 //!                                  # plus the walls' share ρ0 Ψ would start above ρ0 (see
@@ -168,6 +204,9 @@
 //! [tank]                           # optional: the container, a closed box (particles inside)
 //! min = [0.0, 0.0, 0.0]            # m
 //! max = [1.6, 1.0, 0.6]            # m, > min on every axis
+//! # wall = "no-slip"               # with model = "particles" only: "no-slip" (default),
+//! #                                # "free-slip" or { coulomb = 0.4 } (wall friction
+//! #                                # coefficient μ_w in [0, 10]); also on each [[solid]]
 //!
 //! [[fluid]]                        # any number of fluid bodies, sampled in file order
 //! kind = "block"
@@ -308,7 +347,7 @@ mod sample_cache;
 mod solver_spec;
 mod spec;
 
-pub use build::FluidParticles;
+pub use build::{FluidParticles, OPEN_TANK_REACH};
 pub use error::SceneError;
 pub use limits::{
     MAX_FRAMES, MAX_MESH_FILE_BYTES, MAX_PARTICLES, MAX_PASSIVE_POINTS, MAX_SCENE_FILE_BYTES,
@@ -317,11 +356,12 @@ pub use limits::{
 pub use overrides::Override;
 pub use solver_spec::{SolverKind, SolverParams, SolverSpec};
 // The settings of each solver, owned by its crate (the variants of `SolverSpec`).
+pub use elastoplastic_granular::ElastoplasticSettings;
 pub use iisph_granular::{GranularSettings, IisphSettings, WaterSettings};
 pub use pbf::PbfSettings;
 pub use pcisph::PcisphSettings;
 pub use spec::{
     BoundaryModel, BoundarySpec, FluidSpec, InitialMasses, MeshPlacement, MeshSpec, OutputSpec,
-    Precision, QuickSpec, Scene, SolidSpec,
+    Precision, QuickSpec, Scene, SceneWalls, SolidSpec, WallModel,
 };
 pub use sph_solver::CommonSettings;

@@ -10,11 +10,11 @@
 //! is set as `support_over_spacing`, PBF's `cfm_epsilon` as `relative_cfm`, `dt`, `gravity`
 //! and `particle_spacing` in `[simulation]`).
 
-use sph_core::Real;
+use sph_core::{Aabb, Real};
 use sph_solver::{CommonSettings, SceneValues, SolverError};
 
 use crate::error::Ctx;
-use crate::{Precision, Scene, SceneError, SolverParams};
+use crate::{Precision, Scene, SceneError, SceneWalls, SolverParams};
 
 impl Scene {
     /// The scene's values every solver's parameters take: spacing, frame length, gravity.
@@ -24,6 +24,32 @@ impl Scene {
             frame_dt: self.frame_dt_s,
             gravity: self.gravity,
         }
+    }
+
+    /// The solver's parameters in `f64` from the `[solver]` settings and the scene's values,
+    /// with the walls of a solver that takes them from the scene: for `elastoplastic`, each
+    /// solid's wall model (the tank first, as in [`Scene::build_solids`]; unstated walls
+    /// [`SceneWalls::DEFAULT`](crate::SceneWalls::DEFAULT)) and the region whose walls
+    /// become boundary particles (the tank, or else the box of the fluids).
+    fn solver_params_f64(&self) -> SolverParams<f64> {
+        let mut p = self.solver.params(&self.scene_values());
+        if let SolverParams::Elastoplastic(e) = &mut p {
+            let default = SceneWalls::DEFAULT;
+            e.default_wall = default;
+            e.wall_models = self
+                .tank
+                .iter()
+                .map(|_| self.walls.tank.unwrap_or(default))
+                .chain(self.walls.solids.iter().map(|w| w.unwrap_or(default)))
+                .collect();
+            e.boundary_particle_region = self.tank.or_else(|| {
+                self.fluids.iter().map(|f| f.bounds()).reduce(|a, b| Aabb {
+                    min: a.min.inf(&b.min),
+                    max: a.max.sup(&b.max),
+                })
+            });
+        }
+        p
     }
 
     /// The solver parameters the scene asks for, in precision `R`, checked (the settings as
@@ -46,7 +72,7 @@ impl Scene {
             lines: Some(&self.lines),
             ..Ctx::new(&self.source)
         };
-        let p = self.solver.params(&self.scene_values());
+        let p = self.solver_params_f64();
         p.try_convert::<R>()
             .map_err(|e| self.param_error(&ctx, &p, Some(R::NAME), e))
     }
@@ -66,7 +92,7 @@ impl Scene {
         self.solver
             .check_written(&key)
             .map_err(|(name, reason)| ctx.invalid(self.key(name), reason))?;
-        let p = self.solver.params(&self.scene_values());
+        let p = self.solver_params_f64();
         p.validate()
             .map_err(|e| self.param_error(ctx, &p, None, e))?;
         let converted = p

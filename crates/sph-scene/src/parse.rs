@@ -22,7 +22,8 @@ use crate::raw::{
 use crate::read::read_limited;
 use crate::sample_cache::FluidSampleCache;
 use crate::{
-    FluidSpec, OutputSpec, Precision, QuickSpec, Scene, SceneError, SolidSpec, SolverSpec,
+    FluidSpec, OutputSpec, Precision, QuickSpec, Scene, SceneError, SceneWalls, SolidSpec,
+    SolverSpec,
 };
 
 /// The `[solver]` table as parsed (with spans), for [`solver::parse`].
@@ -125,6 +126,10 @@ fn from_raw(
         .enumerate()
         .map(|(i, s)| solid(ctx, &format!("solid[{i}]"), s, &mut meshes))
         .collect::<Result<Vec<_>, _>>()?;
+    let walls = SceneWalls {
+        tank: raw.tank.and_then(|t| t.wall),
+        solids: raw.solid.iter().map(|s| s.wall).collect(),
+    };
     let sim = raw.simulation;
     Ok(Scene {
         name: raw.name,
@@ -140,6 +145,7 @@ fn from_raw(
         }),
         fluids,
         solids,
+        walls,
         solver,
         boundary: raw.boundary,
         output: output(raw.output.as_ref()),

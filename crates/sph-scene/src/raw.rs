@@ -4,7 +4,7 @@ use serde::Deserialize;
 
 use ssfr_render::RenderConfig;
 
-use crate::{BoundarySpec, Precision, SolverKind};
+use crate::{BoundarySpec, Precision, SolverKind, WallModel};
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -15,7 +15,7 @@ pub(crate) struct RawScene {
     pub solver: RawSolverTag,
     #[serde(default)]
     pub boundary: BoundarySpec,
-    pub tank: Option<RawBox>,
+    pub tank: Option<RawTank>,
     #[serde(default)]
     pub fluid: Vec<RawFluid>,
     #[serde(default)]
@@ -49,6 +49,14 @@ pub(crate) struct RawSolverTag {
 pub(crate) struct RawBox {
     pub min: [f64; 3],
     pub max: [f64; 3],
+}
+
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawTank {
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+    pub wall: Option<WallModel>,
 }
 
 #[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]
@@ -102,6 +110,7 @@ pub(crate) struct RawSolid {
     pub sdf_cell: Option<f64>,
     pub base_center: Option<[f64; 3]>,
     pub height: Option<f64>,
+    pub wall: Option<WallModel>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -238,6 +238,10 @@ solvers! {
     /// IISPH with Drucker–Prager friction, drag and upscaling for granular matter (Neder
     /// 2024), crate `iisph-granular`.
     Granular = "granular", iisph_granular::GranularSettings [iisph_granular::IisphSettings];
+    /// Elastic–plastic Drucker–Prager SPH for granular matter (Bui, Fukagawa, Sako & Ohno
+    /// 2008), crate `elastoplastic-granular`: walls of boundary particles
+    /// (`[boundary] model = "particles"`).
+    Elastoplastic = "elastoplastic", elastoplastic_granular::ElastoplasticSettings [];
 }
 
 impl SolverSpec {
@@ -262,6 +266,15 @@ impl SolverSpec {
     /// The density kernel of the solver.
     pub fn density_kernel(&self) -> KernelKind {
         self.kind().density_kernel()
+    }
+
+    /// The periodic axes `(axis, lo, hi)` (0 = x, 1 = y, 2 = z; m) of a solver that has
+    /// them (`elastoplastic`'s `periodic`), empty otherwise: the tank is open along them.
+    pub fn periodic_axes(&self) -> Vec<(usize, f64, f64)> {
+        match self {
+            SolverSpec::Elastoplastic(e) => e.periodic_axes(),
+            _ => Vec::new(),
+        }
     }
 
     /// These settings for solver `kind`: a copy when `kind` is this solver's; otherwise the

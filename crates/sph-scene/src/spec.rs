@@ -9,6 +9,8 @@ use serde::Deserialize;
 use sph_core::{Aabb, TriangleMesh};
 use ssfr_render::RenderConfig;
 
+pub use elastoplastic_granular::WallModel;
+
 use crate::error::FieldLines;
 use crate::sample_cache::FluidSampleCache;
 use crate::SolverSpec;
@@ -37,6 +39,11 @@ pub enum BoundaryModel {
     /// Collision handling only: particles entering a solid are projected back to its
     /// surface (`model = "collision"`).
     Collision,
+    /// Walls of fixed boundary particles (`model = "particles"`; the elastoplastic solver's,
+    /// which requires it): the lattice nodes inside the tank's walls and the solids within
+    /// three spacings of their surfaces, each with its solid's `wall` model; the solids
+    /// also keep particles out as `collision` does.
+    Particles,
 }
 
 /// Boundary settings: the `[boundary]` table (optional; [`BoundarySpec::default`] when
@@ -220,6 +227,28 @@ pub enum SolidSpec {
     },
 }
 
+/// The wall model of the tank and of each solid as written (`wall = "free-slip"`,
+/// `"no-slip"` or `{ coulomb = μ_w }`; absent = [`SceneWalls::DEFAULT`]). Only walls of
+/// boundary particles (`[boundary] model = "particles"`) have models.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SceneWalls {
+    /// The tank's (`[tank] wall`).
+    pub tank: Option<WallModel>,
+    /// Each solid's (`[[solid]] wall`), in file order.
+    pub solids: Vec<Option<WallModel>>,
+}
+
+impl SceneWalls {
+    /// The model of a wall that does not say: no-slip (Bui et al. 2008's rows of fixed
+    /// boundary particles).
+    pub const DEFAULT: WallModel = WallModel::NoSlip;
+
+    /// Whether any wall states a model.
+    pub fn any_given(&self) -> bool {
+        self.tank.is_some() || self.solids.iter().any(Option::is_some)
+    }
+}
+
 /// The `[quick]` overrides (all optional).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct QuickSpec {
@@ -260,6 +289,9 @@ pub struct Scene {
     pub fluids: Vec<FluidSpec>,
     /// Solid obstacles, in file order.
     pub solids: Vec<SolidSpec>,
+    /// The wall model of the tank and of each solid (`wall` of `[tank]` and of each
+    /// `[[solid]]`), for boundary particles.
+    pub walls: SceneWalls,
     /// Solver settings.
     pub solver: SolverSpec,
     /// Boundary settings.

@@ -223,3 +223,28 @@ fn cylinder_fluid_of_the_axisymmetric_collapse() {
         assert!(v.iter().all(|v| v.norm() == 0.0));
     }
 }
+
+/// The elastoplastic heap: the block of `granular_repose_30` in a slab periodic across `z`
+/// (0.06 m: at least the support plus skin, 2.7 spacings, at the quick spacing), walls of
+/// boundary particles (the tank free-slip, the base no-slip); its stated particle counts.
+#[test]
+fn granular_heap_elastoplastic_is_a_periodic_slab_with_particle_walls() {
+    let s = Scene::load(&scene_path("granular_heap_elastoplastic.toml")).unwrap();
+    assert_eq!(s.solver.kind(), sph_scene::SolverKind::Elastoplastic);
+    assert_eq!(s.boundary.model, BoundaryModel::Particles);
+    assert_eq!(s.solver.periodic_axes(), vec![(2, 0.0, 0.06)]);
+    assert_eq!(s.walls.tank, Some(sph_scene::WallModel::FreeSlip));
+    assert_eq!(s.walls.solids, vec![Some(sph_scene::WallModel::NoSlip)]);
+    assert_eq!(counts(&s), (80 * 30 * 6, 40 * 15 * 3));
+    check_inside(&s);
+    let sph_scene::SolverParams::Elastoplastic(p) = s.solver_params::<f64>().unwrap() else {
+        panic!("not elastoplastic")
+    };
+    assert_eq!(
+        p.wall_models,
+        vec![sph_scene::WallModel::FreeSlip, sph_scene::WallModel::NoSlip]
+    );
+    assert_eq!(p.boundary_particle_region, s.tank);
+    assert_eq!(p.friction_angle_deg, 30.0);
+    assert_eq!(p.viscosity_alpha, 0.5);
+}

@@ -284,7 +284,7 @@ fn bad_boundary_model_lists_the_allowed_values() {
         &e,
         "bad_boundary",
         "boundary.model",
-        "unknown variant `volume_map`, expected `volume-map` or `collision`",
+        "unknown variant `volume_map`, expected one of `volume-map`, `collision`, `particles`",
     );
     let line = format!("(line {}, column 9)", lines + 3);
     assert!(e.to_string().contains(&line), "no {line} in: {e}");
@@ -330,7 +330,7 @@ fn old_keys_still_load() {
     // A table of each kind giving every renamed key under its new name.
     let table = |kind: SolverKind| -> String {
         let mut t = format!("kind = \"{}\"\nsubsteps = 2\n", kind.name());
-        if kind == SolverKind::Granular {
+        if kind == SolverKind::Granular || kind == SolverKind::Elastoplastic {
             t.push_str("friction_angle_deg = 30.0\n");
         }
         if kind == SolverKind::Pbf {

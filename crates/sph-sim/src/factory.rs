@@ -70,7 +70,8 @@ fn domain<R: Real>(scene: &Scene, positions: &[Vec3<R>]) -> Result<Aabb<R>, SimE
 /// `c`, the density kernel of the scene's solver ([`density_kernel`]) and the fluid's
 /// initial `positions` (they bound the volume maps when there is no tank): the tank and
 /// solids ([`Scene::build_solids`], built once here) as a [`CollisionBoundary`] at the
-/// particle radius, or as a [`VolumeMapBoundary`] of the kernel at the support radius with
+/// particle radius (`collision`, and `particles`, whose boundary particles the solver
+/// samples from these solids), or as a [`VolumeMapBoundary`] of the kernel at the support radius with
 /// contact distance [`VOLUME_MAP_CONTACT_FRACTION`] of the particle radius.
 ///
 /// With `cache`, volume maps are loaded from (or built into) that cache
@@ -103,7 +104,9 @@ pub(crate) fn build_boundary_reporting<R: Real>(
     let solids = scene.build_solids::<R>()?;
     let setup = |source| setup_error(scene, source);
     match scene.boundary.model {
-        BoundaryModel::Collision => Ok((
+        // Boundary particles are sampled from these solids by the solver (the parameters
+        // carry the region and each solid's model); the solids keep particles out.
+        BoundaryModel::Collision | BoundaryModel::Particles => Ok((
             Box::new(CollisionBoundary::new(solids, c.particle_radius()).map_err(setup)?),
             Vec::new(),
         )),

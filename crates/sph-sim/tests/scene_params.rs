@@ -77,6 +77,7 @@ fn edited(scene: &Scene) -> Vec<(String, Scene)> {
             g.cone_match = Some(iisph_granular::ConeMatch::PlaneStrain);
             g.iisph.density_error_tolerance = Some(1e-4);
         }
+        SolverSpec::Elastoplastic(e) => e.friction_angle_deg = 35.0,
     }
     out.push(("edited settings".to_string(), s));
     out

@@ -127,10 +127,12 @@ pub fn run_fluid(
         SolverKind::Pcisph => "PCISPH",
         SolverKind::Iisph => "IISPH",
         SolverKind::Granular => "IISPH-granular",
+        SolverKind::Elastoplastic => "elastoplastic",
     };
     let walls = match scene.boundary.model {
         sph_scene::BoundaryModel::VolumeMap => "volume maps",
         sph_scene::BoundaryModel::Collision => "collision walls",
+        sph_scene::BoundaryModel::Particles => "boundary particles",
     };
     let label = format!("{name} {substeps}×{iterations}, {walls}");
     sph_sim::with_precision!(scene.precision, R => run_in::<R>(ctx, &scene, label))

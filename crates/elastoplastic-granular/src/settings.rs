@@ -1,0 +1,254 @@
+//! The scene-facing settings (`[solver] kind = "elastoplastic"`): each key is the name of
+//! the [`ElastoplasticParams`] field it sets, defaults are
+//! [`ElastoplasticParams::for_spacing`]'s, the range checks [`ElastoplasticParams::validate`]'s.
+//! The walls (each solid's [`WallModel`] and the region whose solids become boundary
+//! particles) come from the scene's solids, not from this table.
+
+use serde::Deserialize;
+use sph_core::{Aabb, Real};
+use sph_solver::settings::convert;
+use sph_solver::{
+    Boundary, CommonParams, CommonSettings, FluidSolver, KernelKind, SceneValues, SolverError,
+    SolverSettings,
+};
+
+use crate::kernels::ELASTOPLASTIC_KERNEL;
+use crate::params::{ElastoplasticParams, InitialStress};
+use crate::periodic::PeriodicAxis;
+use crate::solver::{Elastoplastic, NAME};
+
+/// The friction angle (degrees) of settings made for this kind from another solver's
+/// ([`SolverSettings::with_common`]): 30°, the shipped heaps' (a cohesionless material
+/// needs one; the other solvers have none).
+pub const WITH_COMMON_FRICTION_ANGLE_DEG: f64 = 30.0;
+
+/// An axis in scene files: `"x"`, `"y"` or `"z"`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Axis {
+    /// `x` (0).
+    X,
+    /// `y` (1).
+    Y,
+    /// `z` (2).
+    Z,
+}
+
+impl Axis {
+    /// The coordinate index (0, 1, 2).
+    pub fn index(self) -> usize {
+        match self {
+            Axis::X => 0,
+            Axis::Y => 1,
+            Axis::Z => 2,
+        }
+    }
+}
+
+/// One periodic axis as a scene writes it: `{ axis = "z", lo = 0.0, hi = 0.03 }` (m),
+/// [`PeriodicAxis`].
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PeriodicSetting {
+    /// The axis.
+    pub axis: Axis,
+    /// Lower end of the period (m).
+    pub lo: f64,
+    /// Upper end of the period (m).
+    pub hi: f64,
+}
+
+/// The `[solver]` settings of `kind = "elastoplastic"`; `None` = the default of
+/// [`ElastoplasticParams::for_spacing`]. Units and ranges as in [`ElastoplasticParams`].
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ElastoplasticSettings {
+    /// The settings every solver has.
+    #[serde(flatten)]
+    pub common: CommonSettings,
+    /// [`ElastoplasticParams::friction_angle_deg`] (degrees, required).
+    pub friction_angle_deg: f64,
+    /// [`ElastoplasticParams::youngs_modulus`] (Pa).
+    pub youngs_modulus: Option<f64>,
+    /// [`ElastoplasticParams::poisson_ratio`].
+    pub poisson_ratio: Option<f64>,
+    /// [`ElastoplasticParams::dilatancy_angle_deg`] (degrees).
+    pub dilatancy_angle_deg: Option<f64>,
+    /// [`ElastoplasticParams::cohesion`] (Pa).
+    pub cohesion: Option<f64>,
+    /// [`ElastoplasticParams::viscosity_alpha`].
+    pub viscosity_alpha: Option<f64>,
+    /// [`ElastoplasticParams::viscosity_beta`].
+    pub viscosity_beta: Option<f64>,
+    /// [`ElastoplasticParams::artificial_stress_epsilon`].
+    pub artificial_stress_epsilon: Option<f64>,
+    /// [`ElastoplasticParams::artificial_stress_exponent`].
+    pub artificial_stress_exponent: Option<f64>,
+    /// [`ElastoplasticParams::cfl_number`].
+    pub cfl_number: Option<f64>,
+    /// [`ElastoplasticParams::skin`] (m).
+    pub skin: Option<f64>,
+    /// [`ElastoplasticParams::periodic`] (absent = none).
+    pub periodic: Option<Vec<PeriodicSetting>>,
+    /// [`ElastoplasticParams::initial_stress`]: `"none"` (the default) or `"geostatic"`.
+    pub initial_stress: Option<InitialStress>,
+}
+
+impl ElastoplasticSettings {
+    /// The periodic axes as `(axis index, lo, hi)` (m).
+    pub fn periodic_axes(&self) -> Vec<(usize, f64, f64)> {
+        self.periodic
+            .iter()
+            .flatten()
+            .map(|p| (p.axis.index(), p.lo, p.hi))
+            .collect()
+    }
+}
+
+impl SolverSettings for ElastoplasticSettings {
+    type Params<R: Real> = ElastoplasticParams<R>;
+
+    const DENSITY_KERNEL: KernelKind = ELASTOPLASTIC_KERNEL;
+
+    /// Friction angle [`WITH_COMMON_FRICTION_ANGLE_DEG`], every other setting the default.
+    fn with_common(common: CommonSettings, _iterations: usize) -> Self {
+        Self {
+            common,
+            friction_angle_deg: WITH_COMMON_FRICTION_ANGLE_DEG,
+            youngs_modulus: None,
+            poisson_ratio: None,
+            dilatancy_angle_deg: None,
+            cohesion: None,
+            viscosity_alpha: None,
+            viscosity_beta: None,
+            artificial_stress_epsilon: None,
+            artificial_stress_exponent: None,
+            cfl_number: None,
+            skin: None,
+            periodic: None,
+            initial_stress: None,
+        }
+    }
+
+    fn common(&self) -> &CommonSettings {
+        &self.common
+    }
+
+    fn common_mut(&mut self) -> &mut CommonSettings {
+        &mut self.common
+    }
+
+    /// Explicit steps are sub-cycled to the CFL limit: no iteration count (1).
+    fn iterations(&self) -> usize {
+        1
+    }
+
+    fn set_iterations(&mut self, _n: usize) {}
+
+    fn params(&self, scene: &SceneValues) -> ElastoplasticParams<f64> {
+        let mut p =
+            ElastoplasticParams::for_spacing(scene.particle_spacing, self.friction_angle_deg);
+        self.common.apply(scene, &mut p.common);
+        let set = |target: &mut f64, v: Option<f64>| {
+            if let Some(v) = v {
+                *target = v;
+            }
+        };
+        set(&mut p.youngs_modulus, self.youngs_modulus);
+        set(&mut p.poisson_ratio, self.poisson_ratio);
+        set(&mut p.dilatancy_angle_deg, self.dilatancy_angle_deg);
+        set(&mut p.cohesion, self.cohesion);
+        set(&mut p.viscosity_alpha, self.viscosity_alpha);
+        set(&mut p.viscosity_beta, self.viscosity_beta);
+        set(
+            &mut p.artificial_stress_epsilon,
+            self.artificial_stress_epsilon,
+        );
+        set(
+            &mut p.artificial_stress_exponent,
+            self.artificial_stress_exponent,
+        );
+        set(&mut p.cfl_number, self.cfl_number);
+        set(&mut p.skin, self.skin);
+        p.periodic = self
+            .periodic_axes()
+            .into_iter()
+            .map(|(axis, lo, hi)| PeriodicAxis { axis, lo, hi })
+            .collect();
+        if let Some(s) = self.initial_stress {
+            p.initial_stress = s;
+        }
+        p
+    }
+
+    fn common_params<R: Real>(params: &ElastoplasticParams<R>) -> &CommonParams<R> {
+        &params.common
+    }
+
+    fn convert<S: Real>(
+        params: &ElastoplasticParams<f64>,
+    ) -> Result<ElastoplasticParams<S>, SolverError> {
+        params.try_convert()
+    }
+
+    fn validate<R: Real>(params: &ElastoplasticParams<R>) -> Result<(), SolverError> {
+        params.validate()
+    }
+
+    fn build<R: Real>(
+        params: ElastoplasticParams<R>,
+        boundary: Box<dyn Boundary<R>>,
+    ) -> Result<Box<dyn FluidSolver<R>>, SolverError> {
+        Ok(Box::new(Elastoplastic::with_boundary(params, boundary)?))
+    }
+}
+
+impl<R: Real> ElastoplasticParams<R> {
+    /// These parameters in precision `S`, each value rounded to nearest (an error names the
+    /// first finite value that does not fit).
+    pub fn try_convert<S: Real>(&self) -> Result<ElastoplasticParams<S>, SolverError> {
+        let c = |name: &'static str, v: R| convert::<R, S>(NAME, name, v);
+        let region = match &self.boundary_particle_region {
+            Some(a) => Some(Aabb {
+                min: sph_solver::settings::convert3(NAME, "boundary_particle_region", &a.min)?,
+                max: sph_solver::settings::convert3(NAME, "boundary_particle_region", &a.max)?,
+            }),
+            None => None,
+        };
+        Ok(ElastoplasticParams {
+            common: self.common.try_convert(NAME)?,
+            youngs_modulus: c("youngs_modulus", self.youngs_modulus)?,
+            poisson_ratio: c("poisson_ratio", self.poisson_ratio)?,
+            friction_angle_deg: c("friction_angle_deg", self.friction_angle_deg)?,
+            dilatancy_angle_deg: c("dilatancy_angle_deg", self.dilatancy_angle_deg)?,
+            cohesion: c("cohesion", self.cohesion)?,
+            viscosity_alpha: c("viscosity_alpha", self.viscosity_alpha)?,
+            viscosity_beta: c("viscosity_beta", self.viscosity_beta)?,
+            artificial_stress_epsilon: c(
+                "artificial_stress_epsilon",
+                self.artificial_stress_epsilon,
+            )?,
+            artificial_stress_exponent: c(
+                "artificial_stress_exponent",
+                self.artificial_stress_exponent,
+            )?,
+            cfl_number: c("cfl_number", self.cfl_number)?,
+            skin: c("skin", self.skin)?,
+            default_wall: self.default_wall,
+            wall_models: self.wall_models.clone(),
+            periodic: self
+                .periodic
+                .iter()
+                .map(|a| {
+                    Ok(PeriodicAxis {
+                        axis: a.axis,
+                        lo: c("periodic", a.lo)?,
+                        hi: c("periodic", a.hi)?,
+                    })
+                })
+                .collect::<Result<_, SolverError>>()?,
+            boundary_particle_region: region,
+            initial_stress: self.initial_stress,
+        })
+    }
+}

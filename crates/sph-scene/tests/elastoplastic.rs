@@ -1,0 +1,198 @@
+//! `[solver] kind = "elastoplastic"`: its settings, the walls of boundary particles it
+//! requires, each wall's model, periodic axes against the tank; each refusal names its key.
+
+use std::path::Path;
+
+use sph_scene::{BoundaryModel, Scene, SolverParams, WallModel};
+
+const BASE: &str = r#"
+name = "ep"
+[simulation]
+precision = "f64"
+particle_spacing = 0.02
+duration = 0.1
+frame_dt = 0.016
+[solver]
+kind = "elastoplastic"
+substeps = 1
+friction_angle_deg = 30.0
+youngs_modulus = 1e6
+poisson_ratio = 0.25
+dilatancy_angle_deg = 5.0
+cohesion = 10.0
+viscosity_alpha = 0.2
+viscosity_beta = 0.1
+artificial_stress_epsilon = 0.3
+artificial_stress_exponent = 3.0
+cfl_number = 0.15
+skin = 0.004
+initial_stress = "geostatic"
+periodic = [{ axis = "z", lo = 0.0, hi = 0.06 }]
+[boundary]
+model = "particles"
+[tank]
+min = [0.0, 0.0, 0.0]
+max = [0.6, 0.4, 0.06]
+wall = { coulomb = 0.4 }
+[[solid]]
+kind = "box"
+min = [0.2, -0.5, -0.5]
+max = [0.4, 0.1, 0.56]
+wall = "free-slip"
+[[solid]]
+kind = "sphere"
+center = [0.5, 0.3, 0.03]
+radius = 0.03
+[[fluid]]
+kind = "block"
+min = [0.2, 0.1, 0.0]
+max = [0.4, 0.2, 0.06]
+"#;
+
+fn parse(text: &str) -> Result<Scene, String> {
+    Scene::parse_str(text, Path::new("ep.toml")).map_err(|e| e.to_string())
+}
+
+/// Every key reaches its parameter; unstated walls are no-slip; the region is the tank.
+#[test]
+fn every_setting_reaches_the_parameters() {
+    let s = parse(BASE).unwrap();
+    assert_eq!(s.boundary.model, BoundaryModel::Particles);
+    let SolverParams::Elastoplastic(p) = s.solver_params::<f64>().unwrap() else {
+        panic!("not elastoplastic")
+    };
+    assert_eq!(p.youngs_modulus, 1e6);
+    assert_eq!(p.poisson_ratio, 0.25);
+    assert_eq!(p.dilatancy_angle_deg, 5.0);
+    assert_eq!(p.cohesion, 10.0);
+    assert_eq!((p.viscosity_alpha, p.viscosity_beta), (0.2, 0.1));
+    assert_eq!(
+        (p.artificial_stress_epsilon, p.artificial_stress_exponent),
+        (0.3, 3.0)
+    );
+    assert_eq!((p.cfl_number, p.skin), (0.15, 0.004));
+    assert_eq!(
+        p.initial_stress,
+        elastoplastic_granular::InitialStress::Geostatic
+    );
+    assert_eq!(p.periodic.len(), 1);
+    assert_eq!((p.periodic[0].axis, p.periodic[0].hi), (2, 0.06));
+    assert_eq!(
+        p.wall_models,
+        vec![
+            WallModel::Coulomb(0.4),
+            WallModel::FreeSlip,
+            WallModel::NoSlip
+        ]
+    );
+    assert_eq!(p.boundary_particle_region, s.tank);
+    // The defaults are `for_spacing`'s.
+    let minimal = BASE
+        .lines()
+        .filter(|l| {
+            ![
+                "youngs",
+                "poisson",
+                "dilatancy",
+                "cohesion",
+                "viscosity",
+                "artificial",
+                "cfl",
+                "skin",
+                "initial",
+            ]
+            .iter()
+            .any(|k| l.starts_with(k))
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let SolverParams::Elastoplastic(d) = parse(&minimal).unwrap().solver_params::<f64>().unwrap()
+    else {
+        panic!("not elastoplastic")
+    };
+    let mut expected = elastoplastic_granular::ElastoplasticParams::<f64>::for_spacing(0.02, 30.0);
+    expected.common.dt = 0.016;
+    expected.common.substeps = 1;
+    expected.periodic = d.periodic.clone();
+    expected.wall_models = d.wall_models.clone();
+    expected.boundary_particle_region = d.boundary_particle_region;
+    assert_eq!(d, expected);
+}
+
+/// Each refusal names its key.
+#[test]
+fn refusals_name_their_key() {
+    let cases: &[(&str, &str, &str)] = &[
+        (
+            "model = \"particles\"",
+            "model = \"volume-map\"",
+            "boundary.model",
+        ),
+        (
+            "model = \"particles\"",
+            "model = \"collision\"",
+            "boundary.model",
+        ),
+        (
+            "wall = { coulomb = 0.4 }",
+            "wall = { coulomb = -0.1 }",
+            "tank.wall",
+        ),
+        (
+            "wall = \"free-slip\"",
+            "wall = { coulomb = 11.0 }",
+            "solid[0].wall",
+        ),
+        ("wall = \"free-slip\"", "wall = \"sticky\"", "wall"),
+        ("hi = 0.06 }", "hi = 0.05 }", "solver.periodic"),
+        (
+            "youngs_modulus = 1e6",
+            "youngs_modulus = -1.0",
+            "solver.youngs_modulus",
+        ),
+        (
+            "skin = 0.004",
+            "skin = 0.004\nrestitution = 0.5",
+            "restitution",
+        ),
+    ];
+    for (from, to, key) in cases {
+        assert!(BASE.contains(from), "{from}");
+        let e = parse(&BASE.replacen(from, to, 1)).unwrap_err();
+        assert!(e.contains(key), "{to}: {e}");
+    }
+    // Boundary particles are the elastoplastic solver's only.
+    let pbf = BASE
+        .replace("kind = \"elastoplastic\"", "kind = \"pbf\"\niterations = 2")
+        .lines()
+        .filter(|l| {
+            !l.contains("friction_angle") && !l.contains("periodic") && !l.starts_with("initial")
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let pbf: String = pbf
+        .lines()
+        .filter(|l| {
+            ![
+                "youngs",
+                "poisson",
+                "dilatancy",
+                "cohesion",
+                "viscosity",
+                "artificial",
+                "cfl",
+                "skin",
+            ]
+            .iter()
+            .any(|k| l.starts_with(k))
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let e = parse(&pbf).unwrap_err();
+    assert!(
+        e.contains("boundary.model") && e.contains("elastoplastic"),
+        "{e}"
+    );
+    let e = parse(&pbf.replace("model = \"particles\"", "model = \"collision\"")).unwrap_err();
+    assert!(e.contains("tank.wall"), "{e}");
+}
