@@ -1,4 +1,6 @@
-//! Elastic–plastic Drucker–Prager SPH for granular matter.
+#![doc = include_str!("../README.md")]
+//!
+//! ## In detail
 //!
 //! Bui, H. H., Fukagawa, R., Sako, K. & Ohno, S. (2008). "Lagrangian meshfree particles
 //! method (SPH) for large deformation and failure flows of geomaterial using
@@ -107,5 +109,6 @@ pub use solver::{
 pub use stress::{DruckerPrager, StressUpdate};
 pub use walls::volume_map_walls;
 
+pub use sph_core::sampling::cubic_lattice;
 pub use sph_core::{Aabb, BoxSdf, Inverted, ParticleSet, Plane, Vec3};
 pub use sph_solver::{Solids, SolverError};

@@ -80,6 +80,8 @@ pub struct ElastoplasticSettings {
     pub viscosity_alpha: Option<f64>,
     /// [`ElastoplasticParams::viscosity_beta`].
     pub viscosity_beta: Option<f64>,
+    /// [`ElastoplasticParams::viscosity_speed_m_s`] (m/s; absent = the speed of sound).
+    pub viscosity_speed_m_s: Option<f64>,
     /// [`ElastoplasticParams::artificial_stress_epsilon`].
     pub artificial_stress_epsilon: Option<f64>,
     /// [`ElastoplasticParams::artificial_stress_exponent`].
@@ -121,6 +123,7 @@ impl SolverSettings for ElastoplasticSettings {
             cohesion: None,
             viscosity_alpha: None,
             viscosity_beta: None,
+            viscosity_speed_m_s: None,
             artificial_stress_epsilon: None,
             artificial_stress_exponent: None,
             cfl_number: None,
@@ -160,6 +163,9 @@ impl SolverSettings for ElastoplasticSettings {
         set(&mut p.cohesion, self.cohesion);
         set(&mut p.viscosity_alpha, self.viscosity_alpha);
         set(&mut p.viscosity_beta, self.viscosity_beta);
+        if self.viscosity_speed_m_s.is_some() {
+            p.viscosity_speed_m_s = self.viscosity_speed_m_s;
+        }
         set(
             &mut p.artificial_stress_epsilon,
             self.artificial_stress_epsilon,
@@ -224,6 +230,10 @@ impl<R: Real> ElastoplasticParams<R> {
             cohesion: c("cohesion", self.cohesion)?,
             viscosity_alpha: c("viscosity_alpha", self.viscosity_alpha)?,
             viscosity_beta: c("viscosity_beta", self.viscosity_beta)?,
+            viscosity_speed_m_s: self
+                .viscosity_speed_m_s
+                .map(|u| c("viscosity_speed_m_s", u))
+                .transpose()?,
             artificial_stress_epsilon: c(
                 "artificial_stress_epsilon",
                 self.artificial_stress_epsilon,

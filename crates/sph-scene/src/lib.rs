@@ -174,6 +174,9 @@
 //! # cohesion = 0.0                 # Pa, c (>= 0; φ > 0 when 0)
 //! # viscosity_alpha = 0.1          # Monaghan's α_Π, in [0, 10]
 //! # viscosity_beta = 0.0           # Monaghan's β_Π, in [0, 10]
+//! # viscosity_speed_m_s = 2.0      # m/s: a fixed velocity scale for the viscosity's linear
+//! #                                # term (absent: the speed of sound √(E/ρ0), which makes
+//! #                                # the damping grow with E)
 //! # artificial_stress_epsilon = 0.5 # Gray et al.'s ε, in [0, 1]
 //! # artificial_stress_exponent = 2.55 # Gray et al.'s n, in [1, 10]
 //! # cfl_number = 0.2               # C, in (0, 1]

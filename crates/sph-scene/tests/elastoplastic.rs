@@ -22,6 +22,7 @@ dilatancy_angle_deg = 5.0
 cohesion = 10.0
 viscosity_alpha = 0.2
 viscosity_beta = 0.1
+viscosity_speed_m_s = 2.5
 artificial_stress_epsilon = 0.3
 artificial_stress_exponent = 3.0
 cfl_number = 0.15
@@ -66,6 +67,7 @@ fn every_setting_reaches_the_parameters() {
     assert_eq!(p.dilatancy_angle_deg, 5.0);
     assert_eq!(p.cohesion, 10.0);
     assert_eq!((p.viscosity_alpha, p.viscosity_beta), (0.2, 0.1));
+    assert_eq!(p.viscosity_speed_m_s, Some(2.5));
     assert_eq!(
         (p.artificial_stress_epsilon, p.artificial_stress_exponent),
         (0.3, 3.0)
