@@ -53,6 +53,7 @@ fn model_name(m: BoundaryModel) -> &'static str {
     match m {
         BoundaryModel::VolumeMap => "volume-map",
         BoundaryModel::Collision => "collision",
+        BoundaryModel::Particles => "particles",
     }
 }
 
@@ -393,7 +394,7 @@ fn write_summary(ctx: &mut Context, rows: Vec<Vec<String>>) -> Result<()> {
 fn run_style(r: &RestRun) -> (SeriesStyle, usize) {
     let style = match r.model {
         BoundaryModel::VolumeMap => SeriesStyle::Line,
-        BoundaryModel::Collision => SeriesStyle::Dashed,
+        BoundaryModel::Collision | BoundaryModel::Particles => SeriesStyle::Dashed,
     };
     let color = match (r.solver, r.model) {
         ("PBF", BoundaryModel::VolumeMap) => 2,
