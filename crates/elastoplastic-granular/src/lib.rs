@@ -52,6 +52,9 @@
 //! and [`walls`] for the terms). In scene files the solver is `[solver] kind =
 //! "elastoplastic"` ([`ElastoplasticSettings`]) with `[boundary] model = "particles"`.
 //!
+//! A particle faster than `c` stops the run with a blow-up error naming the step and the
+//! particle: the explicit step's Courant bound holds only below it.
+//!
 //! # Deviations
 //!
 //! - Walls: Bui et al. use rows of boundary particles. Here either such rows

@@ -6,11 +6,11 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use nalgebra::Matrix3;
-use sph_core::{apply_permutation, ParticleSet, Real};
+use sph_core::{apply_permutation, ParticleSet, Real, Vec3};
 use sph_kernels::KernelKind;
 use sph_solver::boundary::{check_volume_kernel, VolumeMapBoundary};
 use sph_solver::state::{match_arrays, ArraySpec};
-use sph_solver::step::{check_divergence, FramePhases, StepAt};
+use sph_solver::step::{blow_up, check_divergence, FramePhases, StepAt};
 use sph_solver::{CommonParams, FrameSolver, SchemeParts, SolverError, StepStats, SubstepScheme};
 
 use crate::boundary_particles::{
@@ -355,6 +355,7 @@ impl<R: Real> ElastoplasticScheme<R> {
             stats.iterations += 1;
         }
         check_divergence(at, &s.x[..n], &s.v[..n], &*self.parts.boundary, h)?;
+        check_sound_barrier(at, &s.v[..n], self.params.sound_speed())?;
         state.positions.copy_from_slice(&s.x[..n]);
         state.velocities.copy_from_slice(&s.v[..n]);
         state.densities.copy_from_slice(&s.rho[..n]);
@@ -482,5 +483,29 @@ impl<R: Real> SubstepScheme<R> for ElastoplasticScheme<R> {
         self.lists_valid = false;
         self.initial_stress_pending = false;
         Ok(())
+    }
+}
+
+/// A blow-up when a particle moves faster than the sound speed `c = √(E/ρ0)`: the explicit
+/// step `Δt ≤ C h / c` keeps the elastic waves within the Courant condition only while the
+/// particles themselves are slower than `c` (else `|v| Δt > C h` as well), so a faster particle
+/// means the scheme has left its stability bound. Needs no closed domain (an open or
+/// periodic set-up has no solid to find a runaway particle in). Errors: the first such
+/// particle, with its speed and `c`.
+fn check_sound_barrier<R: Real>(at: StepAt, v: &[Vec3<R>], c: R) -> Result<(), SolverError> {
+    let c2 = c * c;
+    match v.iter().position(|u| u.norm_squared() > c2) {
+        None => Ok(()),
+        Some(i) => Err(blow_up(
+            at.solver,
+            at.step,
+            i,
+            format!(
+                "substep {}: speed {:.3e} m/s above the sound speed {:.3e} m/s (the explicit step's stability bound)",
+                at.substep,
+                v[i].norm().as_f64(),
+                c.as_f64()
+            ),
+        )),
     }
 }

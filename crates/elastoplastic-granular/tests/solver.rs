@@ -281,3 +281,39 @@ fn invalid_parameters_are_named() {
         }
     }
 }
+
+/// A block `[0, 0.04]² × [0, 0.03]` (m) over a floor, moving as a whole along `x` at
+/// `fraction` of the sound speed `√(E/ρ0)` (no relative velocity: no viscosity, no stress).
+fn sliding_block(fraction: f64) -> (Elastoplastic<f64>, ParticleSet<f64>) {
+    let mut p = ElastoplasticParams::<f64>::for_spacing(S, 30.0);
+    p.youngs_modulus = 5.84e5;
+    let c = p.sound_speed();
+    let solids: Solids<f64> = vec![Box::new(Plane::new(Vec3::zeros(), Vec3::y()).unwrap())];
+    let region = Aabb::new(Vec3::zeros(), Vec3::new(0.04, 0.04, 0.03)).unwrap();
+    let x = cubic_lattice(&region, S, 1000).unwrap();
+    let mut state = ParticleSet::from_positions(x, p.common.particle_mass(), p.common.rest_density);
+    state
+        .velocities
+        .iter_mut()
+        .for_each(|v| *v = Vec3::new(fraction * c, 0.0, 0.0));
+    (Elastoplastic::new(p, solids).unwrap(), state)
+}
+
+#[test]
+fn a_particle_faster_than_sound_is_a_blow_up_without_a_solid_to_catch_it() {
+    // The explicit step Δt ≤ C h / c holds the scheme within its Courant condition only
+    // while the particles are slower than c; nothing encloses this block, so only the
+    // speed can tell. At half the sound speed the frame runs.
+    let (mut solver, mut state) = sliding_block(0.5);
+    solver.step(&mut state).unwrap();
+    let (mut solver, mut state) = sliding_block(2.0);
+    match solver.step(&mut state) {
+        Err(SolverError::BlowUp {
+            particle, reason, ..
+        }) => {
+            assert!(particle < state.len());
+            assert!(reason.contains("above the sound speed"), "{reason}");
+        }
+        other => panic!("expected a blow-up, got {other:?}"),
+    }
+}
