@@ -11,20 +11,21 @@
 //! (30°), `C` (0.2), `cap` (6 s), `L` period (1.2 m), `H` bed height (0.2 m), `w` slot
 //! width (0.12 m), `sump` (0.6 m), `geo` (1: geostatic start; 0: unstressed), `u` the
 //! viscosity's fixed velocity scale (m/s; 0, the default: the speed of sound), `psi` the
-//! dilatancy angle (0°).
+//! dilatancy angle (0°), `match` the cone's match (`psa` plane strain associated, the
+//! default; `ps` plane strain; `ss` simple shear: `ConeMatch`).
 //! `HEAP_BUDGET_S`, `HEAP_SAVE`, `HEAP_RESUME` split a long run into pieces (see
 //! `examples/pieces`).
 //!
 //! Prints every 0.1 s: time, 99th-percentile speed and fastest particle two spacings deep
 //! of the grains on the floor, the angle (mean of the flanks) and each flank's, the grains
 //! on the floor, wall time; at the end whether the heap is at rest and its angle against
-//! the plane-strain prediction `asin(3 α_φ)` (docs/elastoplastic-granular.md).
+//! the prediction for a heap formed by flowing, `atan(3 α_φ)`
+//! (`ConeMatch::predicted_repose_angle_deg`; docs/elastoplastic-granular.md).
 
 use std::time::Instant;
 
 use elastoplastic_granular::heap::{drained_bed, DrainedSetup};
-use elastoplastic_granular::stress::plane_strain_alpha;
-use elastoplastic_granular::ElastoplasticParams;
+use elastoplastic_granular::{ConeMatch, ElastoplasticParams};
 use granular_measure::{angle_of_repose, ReposeOptions, RestSample};
 
 mod pieces;
@@ -48,6 +49,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     params.viscosity_alpha = num("alpha", params.viscosity_alpha)?;
     params.cfl_number = num("C", params.cfl_number)?;
     params.dilatancy_angle_deg = num("psi", 0.0)?;
+    params.cone_match = match args.iter().find_map(|a| a.strip_prefix("match=")) {
+        None | Some("psa") => ConeMatch::PlaneStrainAssociated,
+        Some("ps") => ConeMatch::PlaneStrain,
+        Some("ss") => ConeMatch::SimpleShear,
+        Some(other) => return Err(format!("match={other}: expected psa, ps or ss").into()),
+    };
+    let cone_match = params.cone_match;
     let u = num("u", 0.0)?;
     params.viscosity_speed_m_s = (u > 0.0).then_some(u);
     let cap_s = num("cap", 6.0)?;
@@ -64,10 +72,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let youngs = params.youngs_modulus;
     let (mut solver, mut state) = drained_bed(params, setup)?;
     let (steps, dt) = solver.params().explicit_steps();
-    let predicted = (3.0 * plane_strain_alpha(phi)).asin().to_degrees();
+    let predicted = cone_match.predicted_repose_angle_deg(phi);
     println!(
-        "{} particles, s = {s} m, E = {youngs:.3e} Pa, phi = {phi} deg, {steps} explicit steps of {dt:.3e} s per frame; predicted slope {predicted:.2} deg",
-        state.len()
+        "{} particles, s = {s} m, E = {youngs:.3e} Pa, phi = {phi} deg ({cone_match:?}), {steps} explicit steps of {dt:.3e} s per frame; predicted repose {predicted:.2} deg (a settled wedge holds to {:.2})",
+        state.len(),
+        cone_match.max_stable_slope_deg(phi)
     );
     let frame_dt = solver.params().common.dt;
     let options = ReposeOptions::planar(0.0, s).with_spacing(s);

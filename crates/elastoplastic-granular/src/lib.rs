@@ -109,7 +109,7 @@ pub use settings::{Axis, ElastoplasticSettings, PeriodicSetting, WITH_COMMON_FRI
 pub use solver::{
     Elastoplastic, ElastoplasticScheme, ELASTOPLASTIC_PHASES, ELASTOPLASTIC_STATE_ARRAYS,
 };
-pub use stress::{DruckerPrager, StressUpdate};
+pub use stress::{ConeMatch, DruckerPrager, StressUpdate};
 pub use walls::volume_map_walls;
 
 pub use sph_core::sampling::cubic_lattice;

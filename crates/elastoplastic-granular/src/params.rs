@@ -4,7 +4,7 @@ use sph_core::{Aabb, Real};
 use sph_solver::{CommonParams, SolverError};
 
 use crate::periodic::PeriodicAxis;
-use crate::stress::DruckerPrager;
+use crate::stress::{ConeMatch, DruckerPrager};
 
 /// Largest Young's modulus accepted (Pa): 1 TPa, above any granular material's, so that the
 /// explicit step count stays finite.
@@ -114,6 +114,7 @@ pub enum InitialStress {
 /// | `youngs_modulus` | 5.84 MPa | [`DEFAULT_YOUNGS_MODULUS_PA`] |
 /// | `poisson_ratio` | 0.3 | [`DEFAULT_POISSON_RATIO`] |
 /// | `friction_angle_deg` | given | |
+/// | `cone_match` | plane strain, associated (Bui et al. 2008) | [`ConeMatch`] |
 /// | `dilatancy_angle_deg` | 0 (sand, Bui et al. 2008) | |
 /// | `cohesion` | 0 Pa (cohesionless) | |
 /// | `viscosity_alpha`, `viscosity_beta` | 0.1, 0 | [`DEFAULT_VISCOSITY_ALPHA`] |
@@ -135,6 +136,9 @@ pub struct ElastoplasticParams<R: Real> {
     pub poisson_ratio: R,
     /// Friction angle `φ` (degrees).
     pub friction_angle_deg: R,
+    /// How the friction angle (and dilatancy angle, cohesion) fix the cone: under
+    /// [`ConeMatch::SimpleShear`] a heap comes to rest at `friction_angle_deg`.
+    pub cone_match: ConeMatch,
     /// Dilatancy angle `ψ` (degrees, `0 ≤ ψ ≤ φ`).
     pub dilatancy_angle_deg: R,
     /// Cohesion `c` (Pa).
@@ -211,6 +215,7 @@ impl<R: Real> ElastoplasticParams<R> {
             youngs_modulus: R::of_f64(DEFAULT_YOUNGS_MODULUS_PA),
             poisson_ratio: R::of_f64(DEFAULT_POISSON_RATIO),
             friction_angle_deg,
+            cone_match: ConeMatch::default(),
             dilatancy_angle_deg: R::zero(),
             cohesion: R::zero(),
             viscosity_alpha: R::of_f64(DEFAULT_VISCOSITY_ALPHA),
@@ -230,12 +235,13 @@ impl<R: Real> ElastoplasticParams<R> {
 
     /// The material's moduli and cone.
     pub fn material(&self) -> DruckerPrager<R> {
-        DruckerPrager::new(
+        DruckerPrager::matched(
             self.youngs_modulus.as_f64(),
             self.poisson_ratio.as_f64(),
             self.friction_angle_deg.as_f64(),
             self.dilatancy_angle_deg.as_f64(),
             self.cohesion.as_f64(),
+            self.cone_match,
         )
     }
 
@@ -318,13 +324,6 @@ impl<R: Real> ElastoplasticParams<R> {
             MAX_COHESION_PA,
             "must be in [0, MAX_COHESION_PA = 1e9] Pa",
         )?;
-        if self.friction_angle_deg == R::zero() && self.cohesion == R::zero() {
-            return Err(invalid(
-                "friction_angle_deg",
-                0.0,
-                "a cohesionless material needs a friction angle > 0 (the cone would be a line)",
-            ));
-        }
         for (name, v) in [
             ("viscosity_alpha", self.viscosity_alpha),
             ("viscosity_beta", self.viscosity_beta),

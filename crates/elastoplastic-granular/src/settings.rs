@@ -14,6 +14,7 @@ use sph_solver::{
 
 use crate::kernels::ELASTOPLASTIC_KERNEL;
 use crate::params::{ElastoplasticParams, InitialStress};
+use crate::stress::ConeMatch;
 use crate::periodic::PeriodicAxis;
 use crate::solver::{Elastoplastic, NAME};
 
@@ -68,6 +69,9 @@ pub struct ElastoplasticSettings {
     pub common: CommonSettings,
     /// [`ElastoplasticParams::friction_angle_deg`] (degrees, required).
     pub friction_angle_deg: f64,
+    /// [`ElastoplasticParams::cone_match`]: `"plane-strain-associated"` (the default),
+    /// `"plane-strain"` or `"simple-shear"` (the heap stands at `friction_angle_deg`).
+    pub cone_match: Option<ConeMatch>,
     /// [`ElastoplasticParams::youngs_modulus`] (Pa).
     pub youngs_modulus: Option<f64>,
     /// [`ElastoplasticParams::poisson_ratio`].
@@ -117,6 +121,7 @@ impl SolverSettings for ElastoplasticSettings {
         Self {
             common,
             friction_angle_deg: WITH_COMMON_FRICTION_ANGLE_DEG,
+            cone_match: None,
             youngs_modulus: None,
             poisson_ratio: None,
             dilatancy_angle_deg: None,
@@ -157,6 +162,9 @@ impl SolverSettings for ElastoplasticSettings {
                 *target = v;
             }
         };
+        if let Some(m) = self.cone_match {
+            p.cone_match = m;
+        }
         set(&mut p.youngs_modulus, self.youngs_modulus);
         set(&mut p.poisson_ratio, self.poisson_ratio);
         set(&mut p.dilatancy_angle_deg, self.dilatancy_angle_deg);
@@ -226,6 +234,7 @@ impl<R: Real> ElastoplasticParams<R> {
             youngs_modulus: c("youngs_modulus", self.youngs_modulus)?,
             poisson_ratio: c("poisson_ratio", self.poisson_ratio)?,
             friction_angle_deg: c("friction_angle_deg", self.friction_angle_deg)?,
+            cone_match: self.cone_match,
             dilatancy_angle_deg: c("dilatancy_angle_deg", self.dilatancy_angle_deg)?,
             cohesion: c("cohesion", self.cohesion)?,
             viscosity_alpha: c("viscosity_alpha", self.viscosity_alpha)?,

@@ -12,9 +12,24 @@
 //! λ̇     = (3 α_φ K tr(ε̇) + (G/√J2) s:ε̇) / (9 α_φ α_ψ K + G)   if f(σ) = 0 and λ̇ > 0, else 0
 //! ```
 //!
-//! with `ė = ε̇ − tr(ε̇)/3 I`, `K = E/(3(1 − 2ν))`, `G = E/(2(1 + ν))`, and the plane-strain
-//! match of the cone to Mohr–Coulomb, `α_φ = tan φ/√(9 + 12 tan² φ)`,
-//! `k_c = 3c/√(9 + 12 tan² φ)`, `α_ψ = tan ψ/√(9 + 12 tan² ψ)`.
+//! with `ė = ε̇ − tr(ε̇)/3 I`, `K = E/(3(1 − 2ν))`, `G = E/(2(1 + ν))`, and `α_φ`, `k_c`,
+//! `α_ψ` from the friction angle `φ`, the cohesion `c` and the dilatancy angle `ψ` by the
+//! cone's match to Mohr–Coulomb ([`ConeMatch`]; Bui et al. 2008's plane-strain match of an
+//! associated material, `α_φ = tan φ/√(9 + 12 tan² φ)`, `k_c = 3c/√(9 + 12 tan² φ)`, by
+//! default).
+//!
+//! # The slope a heap comes to rest at
+//!
+//! A flank that has flowed and stopped is in steady shear parallel to its surface; with
+//! zero dilatancy the plastic flow is deviatoric and coaxial with `s`, so the stress that
+//! shears a layer without changing its thickness has `s` of pure shear on the slope planes
+//! and equal normal stresses, `√J2 = |τ|`, `I1 = −3σ_n`; the cone then reads
+//! `|τ| ≤ 3 α_φ σ_n + k_c` and a cohesionless infinite slope (`τ/σ_n = tan β`) stops at
+//! **`tan β = 3 α_φ`** ([`ConeMatch::predicted_repose_angle_deg`]). A settled wedge that has
+//! not flowed fails later, at the cone's Mohr–Coulomb angle in plane strain,
+//! `sin φ_m = 3 α_φ` ([`ConeMatch::max_stable_slope_deg`]): Davis (1968)'s reduced
+//! strength. The derivation, and the runs that confirm it, are in the workspace's
+//! `docs/elastoplastic-granular.md`.
 
 use nalgebra::{Matrix3, SymmetricEigen};
 use sph_core::Real;
@@ -31,19 +46,95 @@ pub struct DruckerPrager<R: Real> {
     pub shear_modulus: R,
     /// Bulk modulus `K = E/(3(1 − 2ν))` (Pa).
     pub bulk_modulus: R,
-    /// `α_φ = tan φ/√(9 + 12 tan² φ)` (dimensionless).
+    /// `α_φ` of the friction angle ([`ConeMatch::alpha`], dimensionless).
     pub alpha_phi: R,
-    /// `α_ψ = tan ψ/√(9 + 12 tan² ψ)` (dimensionless).
+    /// `α_ψ` of the dilatancy angle ([`ConeMatch::alpha`], dimensionless).
     pub alpha_psi: R,
-    /// `k_c = 3c/√(9 + 12 tan² φ)` (Pa).
+    /// `k_c` of the cohesion ([`ConeMatch::k_c`], Pa).
     pub k_c: R,
 }
 
 /// `tan a/√(9 + 12 tan² a)` for an angle `a` in degrees: the plane-strain Drucker–Prager
-/// coefficient of Bui et al. (2008).
+/// coefficient of Bui et al. (2008) ([`ConeMatch::PlaneStrainAssociated`]).
 pub fn plane_strain_alpha(angle_deg: f64) -> f64 {
     let t = angle_deg.to_radians().tan();
     t / (9.0 + 12.0 * t * t).sqrt()
+}
+
+/// Where the Drucker–Prager cone `√J2 + α_φ I1 ≤ k_c` meets Mohr–Coulomb's
+/// `|τ| ≤ c + σ_n tan φ`: the state of stress in which a friction angle `φ` and a cohesion
+/// `c` fix `α_φ` and `k_c` (and the dilatancy angle `ψ` fixes `α_ψ` the same way). In scene
+/// files `cone_match = "plane-strain-associated"` (the default), `"plane-strain"` or
+/// `"simple-shear"`. In the thesis's notation of crate `iisph-granular` (`‖s‖_F ≤ α p`),
+/// `α = 3√2 α_φ`, and the two crates' `plane-strain` and `simple-shear` are the same cones.
+///
+/// | match | `α_φ` | `k_c` | repose `β` at φ = 20°, 30°, 40° |
+/// |---|---|---|---|
+/// | `PlaneStrainAssociated` | `tan φ/√(9 + 12 tan² φ)` | `3c/√(9 + 12 tan² φ)` | 18.5°, 25.7°, 31.1° |
+/// | `PlaneStrain` | `sin φ / 3` | `c cos φ` | 18.9°, 26.6°, 32.7° |
+/// | `SimpleShear` | `tan φ / 3` | `c` | 20°, 30°, 40° |
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+#[non_exhaustive]
+pub enum ConeMatch {
+    /// Bui et al. (2008)'s match: the cone through Mohr–Coulomb in plane strain for an
+    /// associated material (`ψ = φ`), the match of their column collapse.
+    #[default]
+    PlaneStrainAssociated,
+    /// Plane strain at zero dilatancy: the plastic strain rate has no out-of-plane part, so
+    /// `s_zz = 0`, `√J2` is the Mohr circle's radius and `−I1/3` its centre, and
+    /// Mohr–Coulomb is `√J2 ≤ −(I1/3) sin φ + c cos φ` exactly (the thesis's eq. 14 match).
+    PlaneStrain,
+    /// Simple shear on the planes of slip (the stress of a flank that flowed and stopped,
+    /// see the module docs): `√J2 = |τ|`, `−I1/3 = σ_n`, so Coulomb's law on the slip planes
+    /// is `√J2 ≤ −(I1/3) tan φ + c`. Under it the friction angle is the angle of repose.
+    SimpleShear,
+}
+
+impl ConeMatch {
+    /// `α` for an angle `a` (degrees): `α_φ` of a friction angle, `α_ψ` of a dilatancy angle.
+    pub fn alpha(self, angle_deg: f64) -> f64 {
+        let a = angle_deg.to_radians();
+        match self {
+            ConeMatch::PlaneStrainAssociated => plane_strain_alpha(angle_deg),
+            ConeMatch::PlaneStrain => a.sin() / 3.0,
+            ConeMatch::SimpleShear => a.tan() / 3.0,
+        }
+    }
+
+    /// The name in scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            ConeMatch::PlaneStrainAssociated => "plane-strain-associated",
+            ConeMatch::PlaneStrain => "plane-strain",
+            ConeMatch::SimpleShear => "simple-shear",
+        }
+    }
+
+    /// `k_c` (Pa) of cohesion `c` (Pa) at friction angle `φ` (degrees).
+    pub fn k_c(self, cohesion: f64, friction_angle_deg: f64) -> f64 {
+        let t = friction_angle_deg.to_radians().tan();
+        match self {
+            ConeMatch::PlaneStrainAssociated => 3.0 * cohesion / (9.0 + 12.0 * t * t).sqrt(),
+            ConeMatch::PlaneStrain => cohesion * friction_angle_deg.to_radians().cos(),
+            ConeMatch::SimpleShear => cohesion,
+        }
+    }
+
+    /// The slope (degrees) a cohesionless heap of zero dilatancy that formed by flowing
+    /// comes to rest at: `atan(3 α_φ)` (module docs).
+    pub fn predicted_repose_angle_deg(self, friction_angle_deg: f64) -> f64 {
+        (3.0 * self.alpha(friction_angle_deg)).atan().to_degrees()
+    }
+
+    /// The steepest slope (degrees) a settled cohesionless wedge holds: the cone's
+    /// Mohr–Coulomb angle in plane strain, `asin(3 α_φ)` (90° when `3 α_φ ≥ 1`; module docs).
+    pub fn max_stable_slope_deg(self, friction_angle_deg: f64) -> f64 {
+        (3.0 * self.alpha(friction_angle_deg))
+            .min(1.0)
+            .asin()
+            .to_degrees()
+    }
 }
 
 /// The stress increment of one explicit step and what it did plastically.
@@ -68,7 +159,8 @@ pub fn invariants<R: Real>(sigma: &Matrix3<R>) -> (R, Matrix3<R>, R) {
 
 impl<R: Real> DruckerPrager<R> {
     /// The material of Young's modulus `E` (Pa), Poisson's ratio `ν`, friction angle `φ`,
-    /// dilatancy angle `ψ` (degrees) and cohesion `c` (Pa), the cone matched in plane strain.
+    /// dilatancy angle `ψ` (degrees) and cohesion `c` (Pa), the cone matched as Bui et al.
+    /// (2008) match it ([`ConeMatch::PlaneStrainAssociated`]).
     pub fn new(
         youngs_modulus: f64,
         poisson_ratio: f64,
@@ -76,13 +168,31 @@ impl<R: Real> DruckerPrager<R> {
         dilatancy_angle_deg: f64,
         cohesion: f64,
     ) -> Self {
-        let t = friction_angle_deg.to_radians().tan();
+        Self::matched(
+            youngs_modulus,
+            poisson_ratio,
+            friction_angle_deg,
+            dilatancy_angle_deg,
+            cohesion,
+            ConeMatch::PlaneStrainAssociated,
+        )
+    }
+
+    /// [`Self::new`] with the cone matched by `cone_match`.
+    pub fn matched(
+        youngs_modulus: f64,
+        poisson_ratio: f64,
+        friction_angle_deg: f64,
+        dilatancy_angle_deg: f64,
+        cohesion: f64,
+        cone_match: ConeMatch,
+    ) -> Self {
         Self {
             shear_modulus: R::of_f64(youngs_modulus / (2.0 * (1.0 + poisson_ratio))),
             bulk_modulus: R::of_f64(youngs_modulus / (3.0 * (1.0 - 2.0 * poisson_ratio))),
-            alpha_phi: R::of_f64(plane_strain_alpha(friction_angle_deg)),
-            alpha_psi: R::of_f64(plane_strain_alpha(dilatancy_angle_deg)),
-            k_c: R::of_f64(3.0 * cohesion / (9.0 + 12.0 * t * t).sqrt()),
+            alpha_phi: R::of_f64(cone_match.alpha(friction_angle_deg)),
+            alpha_psi: R::of_f64(cone_match.alpha(dilatancy_angle_deg)),
+            k_c: R::of_f64(cone_match.k_c(cohesion, friction_angle_deg)),
         }
     }
 
@@ -134,12 +244,21 @@ impl<R: Real> DruckerPrager<R> {
     /// `−α_φ I1 + k_c < 0`, the mean stress is moved back to the apex `I1 = k_c/α_φ`), then
     /// the deviator scaled by `r = (−α_φ I1 + k_c)/√J2` when `r < 1`. Returns the stress and
     /// the equivalent plastic shear strain of the scaling, `(1 − r)√J2/G`.
+    ///
+    /// A material without friction or cohesion (`α_φ = k_c = 0`: a granular liquid, the
+    /// θ = 0 limit) has its apex at `I1 = 0`: it carries no tension and no deviator.
     pub fn return_to_cone(&self, sigma: &Matrix3<R>) -> (Matrix3<R>, R) {
         let three = R::of_f64(3.0);
         let mut out = *sigma;
         let (mut i1, _, _) = invariants(&out);
-        if self.alpha_phi > R::zero() && -self.alpha_phi * i1 + self.k_c < R::zero() {
-            let apex = self.k_c / self.alpha_phi;
+        let apex = if self.alpha_phi > R::zero() {
+            Some(self.k_c / self.alpha_phi)
+        } else if self.k_c == R::zero() {
+            Some(R::zero())
+        } else {
+            None
+        };
+        if let Some(apex) = apex.filter(|&apex| i1 > apex) {
             out -= Matrix3::identity() * ((i1 - apex) / three);
             i1 = apex;
         }

@@ -184,3 +184,80 @@ proptest! {
         prop_assert!(close(&back.stress, &sig, 1e-12), "{} vs {}", back.stress, sig);
     }
 }
+
+/// Mohr–Coulomb stress states on the failure line, built from the mechanics (not from the
+/// crate's coefficients), lie on the cone of the match made for them.
+mod cone_match {
+    use super::*;
+    use elastoplastic_granular::ConeMatch;
+
+    const P: f64 = 1.0e4; // mean compressive stress (Pa)
+
+    fn matched(phi: f64, c: f64, m: ConeMatch) -> DruckerPrager<f64> {
+        DruckerPrager::matched(E, NU, phi, 0.0, c, m)
+    }
+
+    /// Simple shear on the x–y planes with equal normal stresses `σ_n = P` and
+    /// `τ = c + P tan φ`: Coulomb's law at failure on the slip planes.
+    #[test]
+    fn simple_shear_at_coulomb_failure_is_on_the_simple_shear_cone() {
+        for (phi, c) in [(20.0, 0.0), (30.0, 0.0), (40.0, 0.0), (30.0, 500.0)] {
+            let tau = c + P * f64::to_radians(phi).tan();
+            let sig = Matrix3::new(-P, tau, 0.0, tau, -P, 0.0, 0.0, 0.0, -P);
+            let f = matched(phi, c, ConeMatch::SimpleShear).yield_function(&sig);
+            assert!(f.abs() < 1e-9 * P, "phi {phi}, c {c}: f = {f}");
+        }
+    }
+
+    /// Plane strain at zero dilatancy: `σ_zz` the mean of the in-plane principal stresses,
+    /// the Mohr circle of centre `P` tangent to `τ = c + σ tan φ` (radius `P sin φ + c cos φ`).
+    #[test]
+    fn a_mohr_circle_tangent_to_the_coulomb_line_is_on_the_plane_strain_cone() {
+        for (phi, c) in [(20.0, 0.0), (30.0, 0.0), (40.0, 0.0), (30.0, 500.0)] {
+            let a = f64::to_radians(phi);
+            let r = P * a.sin() + c * a.cos();
+            let sig = Matrix3::new(-P + r, 0.0, 0.0, 0.0, -P - r, 0.0, 0.0, 0.0, -P);
+            let f = matched(phi, c, ConeMatch::PlaneStrain).yield_function(&sig);
+            assert!(f.abs() < 1e-9 * P, "phi {phi}, c {c}: f = {f}");
+        }
+    }
+
+    /// The repose angles of the match table, from `tan β = 3 α_φ` written out per match
+    /// (Bui et al. 2008's `α_φ`, `sin φ / 3`, `tan φ / 3`).
+    #[test]
+    fn predicted_repose_angles_are_the_tables() {
+        let cases = [
+            (ConeMatch::PlaneStrainAssociated, [18.5, 25.7, 31.1]),
+            (ConeMatch::PlaneStrain, [18.9, 26.6, 32.7]),
+            (ConeMatch::SimpleShear, [20.0, 30.0, 40.0]),
+        ];
+        for (m, expected) in cases {
+            for (phi, want) in [20.0, 30.0, 40.0].into_iter().zip(expected) {
+                let got = m.predicted_repose_angle_deg(phi);
+                // the table is rounded to 0.1°
+                assert!((got - want).abs() < 0.05, "{m:?} {phi}: {got}");
+            }
+        }
+        assert_eq!(
+            ConeMatch::PlaneStrainAssociated.alpha(30.0),
+            plane_strain_alpha(30.0)
+        );
+        // a settled wedge of the default match holds to asin(3 α_φ) = 28.71° at φ = 30°
+        // (docs/elastoplastic-granular.md, the wedge runs)
+        let m = ConeMatch::PlaneStrainAssociated.max_stable_slope_deg(30.0);
+        assert!((m - 28.71).abs() < 0.01, "{m}");
+    }
+
+    /// θ = 0 without cohesion: a granular liquid; tension and deviator are removed.
+    #[test]
+    fn a_frictionless_cohesionless_material_carries_no_tension_and_no_shear() {
+        let m = matched(0.0, 0.0, ConeMatch::SimpleShear);
+        let sig = Matrix3::new(200.0, 50.0, 0.0, 50.0, -100.0, 0.0, 0.0, 0.0, 10.0);
+        let (out, _) = m.return_to_cone(&sig);
+        assert!(out.abs().max() < 1e-12, "{out}");
+        let compressed = Matrix3::new(-300.0, 50.0, 0.0, 50.0, -100.0, 0.0, 0.0, 0.0, -200.0);
+        let (out, _) = m.return_to_cone(&compressed);
+        let want = Matrix3::identity() * -200.0;
+        assert!(close(&out, &want, 1e-12), "{out}");
+    }
+}
