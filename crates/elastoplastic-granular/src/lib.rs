@@ -26,7 +26,7 @@
 //! L_i  = Σ_j (m_j/ρ_j) (v_j − v_i) ⊗ ∇_i W_ij                            (velocity gradient)
 //! σ̇    = σ ωᵀ + ω σ + 2G ė + K tr(ε̇) I − λ̇ [3 α_ψ K I + (G/√J2) s]      (Jaumann rate)
 //! λ̇    = (3 α_φ K tr ε̇ + (G/√J2) s:ε̇) / (9 α_φ α_ψ K + G)   on the cone, if > 0
-//! f    = √J2 + α_φ I1 − k_c,  α_φ = tan φ/√(9 + 12 tan²φ),  k_c = 3c/√(9 + 12 tan²φ)
+//! f    = √J2 + α_φ I1 − k_c,  α_φ, α_ψ, k_c from φ, ψ, c by the cone's match (below)
 //! dv_i/dt = Σ_j m_j (σ_i/ρ_i² + σ_j/ρ_j² − Π_ij I + (R_i + R_j) f_ij^n)·∇_i W_ij + g
 //! Π_ij = (−α_Π c φ_ij + β_Π φ_ij²)/ρ̄_ij if v_ij·x_ij < 0,  φ_ij = h v_ij·x_ij/(|x_ij|² + 0.01 h²)
 //! R_i  = Σ_a R^a e_a e_aᵀ,  R^a = −ε σ^a/ρ_i² for σ^a > 0;  f_ij = W(r_ij)/W(s)
@@ -34,9 +34,20 @@
 //!
 //! After each stress step, Bui's return: tension cracking (if `−α_φ I1 + k_c < 0` the mean
 //! stress moves back to the apex), then the deviator scaled by `r = (−α_φ I1 + k_c)/√J2` when
-//! `r < 1` ([`DruckerPrager::return_to_cone`]). The cone is matched to Mohr–Coulomb in plane
-//! strain; with `ψ = 0` a heap in plane strain should stand near `φ` itself (the docs page
-//! `docs/elastoplastic-granular.md` derives the slope).
+//! `r < 1` ([`DruckerPrager::return_to_cone`]).
+//!
+//! # The cone's match and the angle of repose
+//!
+//! [`ConeMatch`] says in which state of stress the cone meets Mohr–Coulomb:
+//! `PlaneStrainAssociated` (Bui et al. 2008's `α_φ = tan φ/√(9 + 12 tan²φ)`,
+//! `k_c = 3c/√(9 + 12 tan²φ)`, the default), `PlaneStrain` (`α_φ = sin φ/3`, `k_c = c cos φ`)
+//! or `SimpleShear` (`α_φ = tan φ/3`, `k_c = c`). With `ψ = 0` a flank that formed by
+//! flowing comes to rest at `tan β = 3 α_φ` (steady shear parallel to the slope, stress
+//! coaxial with the plastic flow: [`ConeMatch::predicted_repose_angle_deg`]), so under
+//! `SimpleShear` the friction angle is the angle of repose; a settled wedge that has not
+//! flowed holds up to `sin β = 3 α_φ` ([`ConeMatch::max_stable_slope_deg`]; Davis 1968's
+//! reduced strength). The workspace's `docs/elastoplastic-granular.md` derives both and
+//! records the runs that measure them.
 //!
 //! One explicit step (symplectic Euler): `L`, `ρ̇` and the stress update from `(x, v, σ, ρ)`,
 //! then the acceleration from the new `σ`, `ρ`; `v ← v + Δt a`, `x ← x + Δt v`, projected out

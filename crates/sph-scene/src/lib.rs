@@ -158,7 +158,7 @@
 //!
 //! The elastic–plastic granular solver (crate `elastoplastic-granular`, Bui, Fukagawa, Sako
 //! & Ohno 2008: a per-particle stress, elastic and capped by the Drucker–Prager cone matched
-//! to Mohr–Coulomb in plane strain; explicit steps sub-cycled inside each frame) requires
+//! to Mohr–Coulomb; explicit steps sub-cycled inside each frame) requires
 //! `[boundary] model = "particles"`; each key is an `ElastoplasticParams` field, defaults
 //! its `for_spacing`'s:
 //!
@@ -167,11 +167,15 @@
 //! kind = "elastoplastic"
 //! substeps = 1                     # (>= 1; the explicit steps, Δt = C h / √(E/ρ0), are
 //!                                  # sub-cycled inside each)
-//! friction_angle_deg = 30.0        # required, in [0, 70]: φ
+//! friction_angle_deg = 30.0        # required, in [0, 70]: φ (0 with cohesion 0: a
+//!                                  # granular liquid, no shear stress and no tension)
+//! # cone_match = "plane-strain-associated" # how φ, ψ, c fix the cone (ConeMatch):
+//! #                                # "plane-strain-associated" (Bui 2008's), "plane-strain"
+//! #                                # or "simple-shear" (a heap comes to rest at φ)
 //! # youngs_modulus = 5.84e6        # Pa, E (> 0)
 //! # poisson_ratio = 0.3            # ν, in [0, 0.49]
 //! # dilatancy_angle_deg = 0.0      # ψ, in [0, φ]
-//! # cohesion = 0.0                 # Pa, c (>= 0; φ > 0 when 0)
+//! # cohesion = 0.0                 # Pa, c (>= 0)
 //! # viscosity_alpha = 0.1          # Monaghan's α_Π, in [0, 10]
 //! # viscosity_beta = 0.0           # Monaghan's β_Π, in [0, 10]
 //! # viscosity_speed_m_s = 2.0      # m/s: a fixed velocity scale for the viscosity's linear

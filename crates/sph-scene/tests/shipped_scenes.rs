@@ -246,5 +246,7 @@ fn granular_heap_elastoplastic_is_a_periodic_slab_with_particle_walls() {
     );
     assert_eq!(p.boundary_particle_region, s.tank);
     assert_eq!(p.friction_angle_deg, 30.0);
+    // the friction angle is the angle of repose under this match
+    assert_eq!(p.cone_match, elastoplastic_granular::ConeMatch::SimpleShear);
     assert_eq!(p.viscosity_alpha, 0.5);
 }
