@@ -77,6 +77,7 @@ fn write_run(dir: &Path, deep_speed: impl Fn(f64) -> f32) -> PathBuf {
             velocities: &velocities,
             densities: &densities,
             ids: &ids,
+            fields: &[],
         };
         write_particle_frame(&dir.join(format!("frame_{f:05}.vtk")), &frame).unwrap();
     }

@@ -426,6 +426,11 @@ impl<R: Real> SubstepScheme<R> for ElastoplasticScheme<R> {
     ) -> Result<(), SolverError> {
         self.time_step(state, at, stats)
     }
+    /// The stress (Pa, `xx, yy, zz, xy, yz, zx`) and the equivalent plastic shear strain:
+    /// the arrays a checkpoint carries.
+    fn particle_fields(&self, fields: &mut Vec<(String, Vec<R>)>) {
+        self.save_arrays(fields);
+    }
     fn save_arrays(&self, arrays: &mut Vec<(String, Vec<R>)>) {
         let s = &self.scratch;
         arrays.push((

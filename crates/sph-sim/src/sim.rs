@@ -166,8 +166,10 @@ impl<R: Real> SceneSim<R> {
         }
     }
 
-    /// Writes the current frame to `path` (legacy VTK).
+    /// Writes the current frame to `path` (legacy VTK), with the solver's per-particle
+    /// fields (`FluidSolver::particle_fields`).
     pub fn write_vtk(&self, path: &Path) -> Result<(), SimError> {
+        let fields = self.solver.particle_fields();
         write_particle_frame(
             path,
             &ParticleFrame {
@@ -176,6 +178,7 @@ impl<R: Real> SceneSim<R> {
                 velocities: &self.state.velocities,
                 densities: &self.state.densities,
                 ids: &self.ids,
+                fields: &fields,
             },
         )
     }

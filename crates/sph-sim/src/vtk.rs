@@ -7,7 +7,8 @@ use sph_core::{Real, Vec3};
 
 use crate::error::SimError;
 use vtkio::model::{
-    Attribute, Attributes, ByteOrder, DataSet, PolyDataPiece, Version, VertexNumbers, Vtk,
+    Attribute, Attributes, ByteOrder, DataSet, FieldArray, PolyDataPiece, Version,
+    VertexNumbers, Vtk,
 };
 
 /// One particle frame: positions (m), velocities (m/s), densities (kg/m³) and a stable
@@ -25,6 +26,9 @@ pub struct ParticleFrame<'a, R: Real> {
     pub densities: &'a [R],
     /// Particle ids.
     pub ids: &'a [u32],
+    /// The solver's per-particle fields (`sph_solver::FluidSolver::particle_fields`):
+    /// `(name, values)`, `k` values per particle.
+    pub fields: &'a [(String, Vec<R>)],
 }
 
 fn flat(v: &[Vec3<impl Real>]) -> Vec<f32> {
@@ -40,8 +44,11 @@ fn flat(v: &[Vec3<impl Real>]) -> Vec<f32> {
 }
 
 /// Writes `frame` to `path` (`.vtk`): points with one vertex cell each, and the point data
-/// `velocity` (vectors), `speed`, `density` and `id` (scalars). Coordinates are stored in
-/// single precision (ParaView's default).
+/// `velocity` (vectors), `speed`, `density` and `id` (scalars), then each solver field: one
+/// value per particle as scalars, three as vectors, six (a symmetric tensor `xx, yy, zz, xy,
+/// yz, zx`) as a full 3×3 tensor, any other count as an array of that many components in the
+/// field `solver_fields`. Coordinates and data are stored in single precision (ParaView's
+/// default). A field whose length is not a multiple of the particle count is an error.
 pub fn write_particle_frame<R: Real>(
     path: &Path,
     frame: &ParticleFrame<'_, R>,
@@ -72,12 +79,60 @@ pub fn write_particle_frame<R: Real>(
         Attribute::scalars("id", 1)
             .with_data(frame.ids.iter().map(|&i| i as i32).collect::<Vec<i32>>()),
     ];
+    let mut point = point;
+    point.extend(field_attributes(path, n, frame.fields)?);
     write_points(
         path,
         frame.positions,
         point,
         format!("particles t = {} s", frame.time_s),
     )
+}
+
+/// The point attributes of the solver's fields (see [`write_particle_frame`]).
+fn field_attributes<R: Real>(
+    path: &Path,
+    n: usize,
+    fields: &[(String, Vec<R>)],
+) -> Result<Vec<Attribute>, SimError> {
+    let mut out = Vec::new();
+    let mut other = Vec::new();
+    for (name, values) in fields {
+        let k = match values.len().checked_div(n) {
+            Some(k) if k * n == values.len() && k > 0 => k,
+            _ if values.is_empty() && n == 0 => continue,
+            _ => {
+                return Err(SimError::output(
+                    path,
+                    format!(
+                        "solver field {name:?} has {} values, not a positive multiple of the {n} particles",
+                        values.len()
+                    ),
+                ))
+            }
+        };
+        let data: Vec<f32> = values.iter().map(|v| v.as_f64() as f32).collect();
+        match k {
+            1 => out.push(Attribute::scalars(name.as_str(), 1).with_data(data)),
+            3 => out.push(Attribute::vectors(name.as_str()).with_data(data)),
+            6 => {
+                let full: Vec<f32> = data
+                    .chunks_exact(6)
+                    .flat_map(|c| [c[0], c[3], c[5], c[3], c[1], c[4], c[5], c[4], c[2]])
+                    .collect();
+                out.push(Attribute::tensors(name.as_str()).with_data(full));
+            }
+            _ => other.push(FieldArray {
+                name: name.clone(),
+                elem: k as u32,
+                data: data.into(),
+            }),
+        }
+    }
+    if !other.is_empty() {
+        out.push(Attribute::field("solver_fields").with_field_data(other));
+    }
+    Ok(out)
 }
 
 /// Writes passive points (e.g. the high-resolution points of an upscaling) to `path`
@@ -268,6 +323,7 @@ mod tests {
                 velocities: &vel,
                 densities: &rho,
                 ids: &ids,
+                fields: &[],
             },
         )
         .unwrap();
@@ -305,8 +361,81 @@ mod tests {
                 velocities: &vel[..1],
                 densities: &rho,
                 ids: &ids,
+                fields: &[],
             },
         );
         assert!(short.unwrap_err().to_string().contains("differ in length"));
+    }
+
+    /// Solver fields: a scalar, a symmetric tensor (written as the full 3×3), a two-component
+    /// array (in the `solver_fields` field); a field of the wrong length is refused.
+    #[test]
+    fn solver_fields_are_written_by_their_component_count() {
+        let dir = std::env::temp_dir().join(format!("vtk-fields-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let pos = [Vec3::new(0.0f64, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0)];
+        let zeros = [Vec3::zeros(); 2];
+        let fields = vec![
+            ("plastic_strain".to_string(), vec![0.5f64, 0.25]),
+            (
+                "stress".to_string(),
+                vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0, -1.0, -2.0, -3.0, -4.0, -5.0, -6.0],
+            ),
+            ("pair".to_string(), vec![1.0, 2.0, 3.0, 4.0]),
+        ];
+        let frame = |fields: &[(String, Vec<f64>)], path: &Path| {
+            write_particle_frame(
+                path,
+                &ParticleFrame {
+                    time_s: 0.0,
+                    positions: &pos,
+                    velocities: &zeros,
+                    densities: &[1.0, 1.0],
+                    ids: &[0, 1],
+                    fields,
+                },
+            )
+        };
+        let path = dir.join("f.vtk");
+        frame(&fields, &path).unwrap();
+        let back = Vtk::import(&path).unwrap();
+        let DataSet::PolyData { pieces, .. } = back.data else {
+            panic!("not poly data")
+        };
+        let vtkio::model::Piece::Inline(p) = &pieces[0] else {
+            panic!("not inline")
+        };
+        let get = |name: &str| -> Vec<f32> {
+            p.data
+                .point
+                .iter()
+                .find_map(|a| match a {
+                    Attribute::DataArray(d) if d.name == name => {
+                        d.data.clone().cast_into::<f32>()
+                    }
+                    _ => None,
+                })
+                .unwrap()
+        };
+        assert_eq!(get("plastic_strain"), vec![0.5, 0.25]);
+        // xx, yy, zz, xy, yz, zx = 1..6 → rows (1 4 6), (4 2 5), (6 5 3)
+        assert_eq!(
+            get("stress")[..9],
+            [1.0, 4.0, 6.0, 4.0, 2.0, 5.0, 6.0, 5.0, 3.0]
+        );
+        let pair = p.data.point.iter().find_map(|a| match a {
+            Attribute::Field { name, data_array } if name == "solver_fields" => {
+                Some(data_array[0].clone())
+            }
+            _ => None,
+        });
+        let pair = pair.unwrap();
+        assert_eq!((pair.name.as_str(), pair.elem), ("pair", 2));
+        // the reader of the frame still reads it
+        assert_eq!(read_particle_frame(&path).unwrap().positions.len(), 2);
+        let bad = vec![("short".to_string(), vec![1.0f64, 2.0, 3.0])];
+        let err = frame(&bad, &dir.join("g.vtk")).unwrap_err().to_string();
+        assert!(err.contains("\"short\" has 3 values"), "{err}");
+        std::fs::remove_dir_all(&dir).ok();
     }
 }

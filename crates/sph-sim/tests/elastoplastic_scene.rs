@@ -96,4 +96,36 @@ fn a_resumed_elastoplastic_scene_repeats_the_uninterrupted_run() {
         );
     }
     assert_eq!(whole.ids, resumed.ids);
+    // The output frame carries the stress (as a full tensor) and the plastic strain.
+    let path = std::env::temp_dir().join(format!("sph-sim-ep-frame-{}.vtk", std::process::id()));
+    whole.write_vtk(&path).unwrap();
+    let vtk = vtkio::Vtk::import(&path).unwrap();
+    std::fs::remove_file(&path).ok();
+    let vtkio::model::DataSet::PolyData { pieces, .. } = vtk.data else {
+        panic!("not poly data")
+    };
+    let vtkio::model::Piece::Inline(p) = &pieces[0] else {
+        panic!("not inline")
+    };
+    let field = |name: &str| -> Vec<f32> {
+        p.data
+            .point
+            .iter()
+            .find_map(|x| match x {
+                vtkio::model::Attribute::DataArray(d) if d.name == name => {
+                    d.data.clone().cast_into::<f32>()
+                }
+                _ => None,
+            })
+            .unwrap_or_else(|| panic!("no {name} in the frame"))
+    };
+    let n = whole.state.len();
+    let (tensor, eps) = (field("stress"), field("plastic_strain"));
+    assert_eq!((tensor.len(), eps.len()), (9 * n, n));
+    let stress = a.array("stress").unwrap();
+    for i in [0, n / 2, n - 1] {
+        // σ_yy is the tensor's centre entry
+        assert_eq!(tensor[9 * i + 4], stress[6 * i + 1] as f32, "particle {i}");
+        assert_eq!(eps[i], a.array("plastic_strain").unwrap()[i] as f32);
+    }
 }

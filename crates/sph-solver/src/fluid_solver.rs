@@ -42,6 +42,14 @@ pub trait FluidSolver<R: Real>: Send {
     fn passive_points(&self) -> Option<&[Vec3<R>]> {
         None
     }
+    /// Per-particle fields the solver carries beside the [`ParticleSet`], for output frames:
+    /// `(name, values)` in the particles' current order, `values.len()` a multiple `k` of the
+    /// particle count (`k` values per particle: 1 a scalar, 3 a vector, 6 a symmetric tensor
+    /// `xx, yy, zz, xy, yz, zx`). None by default; e.g. the elastic–plastic solver's
+    /// `stress` (Pa) and `plastic_strain`.
+    fn particle_fields(&self) -> Vec<(String, Vec<R>)> {
+        Vec::new()
+    }
     /// The kernel of the solver's density sum (a volume-map boundary must have been
     /// integrated with it).
     fn density_kernel(&self) -> KernelKind;

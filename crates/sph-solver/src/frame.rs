@@ -131,6 +131,11 @@ pub trait SubstepScheme<R: Real>: Send + Sized {
     fn passive_points(&self) -> Option<&[Vec3<R>]> {
         None
     }
+    /// Appends the per-particle fields written with each output frame
+    /// ([`FluidSolver::particle_fields`]); nothing by default.
+    fn particle_fields(&self, fields: &mut Vec<(String, Vec<R>)>) {
+        let _ = fields;
+    }
 }
 
 /// A particle solver: a [`SubstepScheme`] run frame by frame (see the module docs). Every
@@ -365,6 +370,11 @@ impl<R: Real, S: SubstepScheme<R>> FluidSolver<R> for FrameSolver<R, S> {
     }
     fn passive_points(&self) -> Option<&[Vec3<R>]> {
         self.scheme.passive_points()
+    }
+    fn particle_fields(&self) -> Vec<(String, Vec<R>)> {
+        let mut fields = Vec::new();
+        self.scheme.particle_fields(&mut fields);
+        fields
     }
     fn save_state(&self) -> SolverState<R> {
         FrameSolver::save_state(self)
