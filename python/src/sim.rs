@@ -838,6 +838,29 @@ impl Simulation {
             .into_any()))
     }
 
+    /// The solver's per-particle fields beside positions, velocities and densities, a new
+    /// dict of arrays in the order and precision of ``positions``: for the elastoplastic
+    /// solver ``"stress"`` (Pa, shape (N, 6): xx, yy, zz, xy, yz, zx; tension positive) and
+    /// ``"plastic_strain"`` (the equivalent plastic shear strain, shape (N,)); empty for
+    /// solvers that carry none.
+    #[getter]
+    fn fields<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        each!(&*self.lock(), s => {
+            for (name, k, values) in s.particle_fields().map_err(rust_err)? {
+                let n = values.len() / k;
+                let a = values.into_pyarray(py);
+                if k == 1 {
+                    d.set_item(name, a)?;
+                } else {
+                    d.set_item(name, a.reshape([n, k])?)?;
+                }
+            }
+            Ok::<(), PyErr>(())
+        })?;
+        Ok(d)
+    }
+
     /// Simulated time (s): ``frame * frame_dt`` of the scene (not wall-clock time; the
     /// wall-clock cost of each frame is in ``stats``).
     #[getter]

@@ -334,3 +334,53 @@ def test_the_rest_hold_carries_across_runs(scene):
         fresh.run(1, progress=False, until_rest={**rest, "resume": late})
     with pytest.raises(ValueError, match="old rule"):
         fresh.run(1, progress=False, until_rest={**rest, "below_since_s": 0.0})
+
+
+# ---- solver fields ----
+
+# A geostatic block of the elastic–plastic solver on a floor of boundary particles, periodic
+# across z (the scene of crates/sph-sim/tests/elastoplastic_scene.rs, without the solid).
+ELASTOPLASTIC = """
+name = "tiny_elastoplastic"
+[simulation]
+precision = "f64"
+particle_spacing = 0.02
+duration = 0.032
+frame_dt = 0.016
+[solver]
+kind = "elastoplastic"
+substeps = 1
+friction_angle_deg = 30.0
+cone_match = "simple-shear"
+youngs_modulus = 5.84e5
+initial_stress = "geostatic"
+periodic = [{ axis = "z", lo = 0.0, hi = 0.06 }]
+[boundary]
+model = "particles"
+[tank]
+min = [0.0, 0.0, 0.0]
+max = [0.3, 0.3, 0.06]
+[[fluid]]
+kind = "block"
+min = [0.0, 0.0, 0.0]
+max = [0.3, 0.12, 0.06]
+"""
+
+
+def test_fields_give_the_elastoplastic_stress_and_plastic_strain(scene):
+    sim = Simulation.from_scene(scene(ELASTOPLASTIC, "ep.toml"), volume_map_cache=None)
+    sim.run(frames=1)
+    fields = sim.fields
+    n = len(sim.positions)
+    assert sorted(fields) == ["plastic_strain", "stress"]
+    assert fields["stress"].shape == (n, 6) and fields["plastic_strain"].shape == (n,)
+    assert fields["stress"].dtype == np.float64
+    # Geostatic: the vertical stress grows with depth, rho0 g (top - y) within a particle's
+    # weight (the block is 0.12 m deep; the stress is compressive, tension positive).
+    y = sim.positions[:, 1]
+    deep, shallow = np.argmin(y), np.argmax(y)
+    assert fields["stress"][deep, 1] < fields["stress"][shallow, 1] <= 0.0
+    expected = -2040.0 * 9.81 * (0.12 - y[deep])
+    assert abs(fields["stress"][deep, 1] - expected) < 2040.0 * 9.81 * 0.02
+    # Solvers without carried fields give an empty dict.
+    assert Simulation.from_scene(scene(), volume_map_cache=None).fields == {}

@@ -152,6 +152,33 @@ impl<R: Real> SceneSim<R> {
         Ok(out)
     }
 
+    /// The solver's per-particle fields (`FluidSolver::particle_fields`, e.g. the
+    /// elastic–plastic stress and plastic strain) in the scene's original particle order:
+    /// `(name, k, values)` with `k` values per particle, particle `i`'s at `k i .. k (i + 1)`.
+    /// A field whose length is not a multiple of the particle count is an error.
+    pub fn particle_fields(&self) -> Result<Vec<(String, usize, Vec<R>)>, SimError> {
+        let n = self.ids.len();
+        let mut out = Vec::new();
+        for (name, values) in self.solver.particle_fields() {
+            let k = match values.len().checked_div(n) {
+                Some(k) if k > 0 && k * n == values.len() => k,
+                _ => {
+                    return Err(SimError::Invalid(format!(
+                        "solver field {name:?} has {} values, not a positive multiple of the {n} particles",
+                        values.len()
+                    )))
+                }
+            };
+            let mut ordered = values.clone();
+            for (&id, chunk) in self.ids.iter().zip(values.chunks_exact(k)) {
+                let at = id as usize * k;
+                ordered[at..at + k].copy_from_slice(chunk);
+            }
+            out.push((name, k, ordered));
+        }
+        Ok(out)
+    }
+
     /// Writes the solver's passive points (upscaling) of the current frame to `path` (legacy
     /// VTK, the format of [`SceneSim::write_vtk`]); returns `false` and writes nothing when
     /// the solver has none ([`FluidSolver::passive_points`]; an upscaling solver seeds them

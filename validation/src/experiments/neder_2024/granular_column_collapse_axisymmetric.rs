@@ -278,7 +278,7 @@ impl Experiment for GranularColumnCollapseAxisymmetric {
         plot_runout(
             ctx,
             &laws,
-            &simulated,
+            &[("IISPH granular (θ = 30°)", &simulated)],
             &RunoutPlot {
                 title: "Axisymmetric granular column collapse: runout",
                 x_label: "aspect ratio a = H0/R0",
