@@ -35,9 +35,10 @@
 //! **Cases.** Quick mode (20 mm) runs the three simple-shear heaps (the match under which the
 //! friction angle is the angle of repose, the experiment's point) and θ = 0. It leaves out
 //! the plane-strain heaps: they drain for 13–14 s of simulated time (the 30° one came to rest
-//! at about 13.5 s, 2026-11-28), about 170 s of wall time each on an idle 2-core machine,
-//! which quick mode's budget (330 s for the experiment, CI) cannot hold next to the 20°
-//! simple-shear heap (about 140 s). Full mode (10 mm) runs both matches at all three angles and θ = 0, and
+//! at about 13.5 s, 2026-11-28), about 170 s of wall time each at run 16's 12 s per
+//! simulated second on an idle 2-core machine (an estimate), which quick mode's budget (330 s
+//! for the experiment, CI) cannot hold next to the four runs it has (485–519 s of CPU time on
+//! two threads, measured on a shared machine). Full mode (10 mm) runs both matches at all three angles and θ = 0, and
 //! adds, on the 30° simple-shear heap at 20 mm: the spacing check (20 mm against the 10 mm
 //! heap, within [`SPACING_MODULUS_DEG`]) and the modulus check (`E` and `10 E` with
 //! `viscosity_speed_m_s` held at the speed of sound of `E`, within [`SPACING_MODULUS_DEG`]:
