@@ -1,4 +1,4 @@
-//! The 30° fixed-base heap (the geometry of `scenes/granular_repose_30.toml`, quick
+//! The 30° fixed-base heap (the geometry of `scenes/granular_repose_thesis_30.toml`, quick
 //! spacing 10 mm) between free-slip slab walls, run until at rest by the criterion of
 //! granular codes or a time cap, with the angle measured as the repose experiment does.
 //!

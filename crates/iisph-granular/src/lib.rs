@@ -156,7 +156,7 @@
 //! [`ConeMatch::predicted_repose_angle_deg`] returns `atan(α/√2)`. The Coulomb friction at
 //! walls (see the deviations) uses `μ = tan θ` under either match. The thesis's match is the
 //! default so that its experiments run as printed; the workspace's repose scenes
-//! (`scenes/granular_repose_*.toml`) choose `cone_match = "simple-shear"`, so that
+//! (`scenes/granular_repose_thesis_*.toml`) choose `cone_match = "simple-shear"`, so that
 //! `friction_angle_deg` is the angle a heap stands at, and the `granular-repose` experiment
 //! measures both matches against these predictions.
 //!

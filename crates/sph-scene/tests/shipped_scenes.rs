@@ -224,7 +224,7 @@ fn cylinder_fluid_of_the_axisymmetric_collapse() {
     }
 }
 
-/// The elastoplastic heap: the block of `granular_repose_30` in a slab periodic across `z`
+/// The elastoplastic heap: the block of `granular_repose_thesis_30` in a slab periodic across `z`
 /// (0.06 m: at least the support plus skin, 2.7 spacings, at the quick spacing), walls of
 /// boundary particles (the tank free-slip, the base no-slip); its stated particle counts.
 #[test]
@@ -249,4 +249,43 @@ fn granular_heap_elastoplastic_is_a_periodic_slab_with_particle_walls() {
     // the friction angle is the angle of repose under this match
     assert_eq!(p.cone_match, elastoplastic_granular::ConeMatch::SimpleShear);
     assert_eq!(p.viscosity_alpha, 0.5);
+}
+
+/// The drained heaps of `granular-repose` (run 16 of `docs/elastoplastic-granular.md`): a
+/// bed 0.2 m high, periodic along `x` (the period per θ) and `z` (0.06 m), on a no-slip plate
+/// with a slot 0.12 m wide centred on the seam, the sump's floor 0.6 m below the plate; the
+/// particle counts their comments state.
+#[test]
+fn granular_repose_scenes_are_drained_beds() {
+    for (theta, period) in [(20.0, 1.6), (30.0, 1.2), (40.0, 1.0)] {
+        let s = Scene::load(&scene_path(&format!("granular_repose_{theta:.0}.toml"))).unwrap();
+        assert_eq!(s.solver.kind(), sph_scene::SolverKind::Elastoplastic);
+        assert_eq!(s.boundary.model, BoundaryModel::Particles);
+        assert_eq!(
+            s.solver.periodic_axes(),
+            vec![(0, 0.0, period), (2, 0.0, 0.06)]
+        );
+        let SolverSpec::Elastoplastic(e) = &s.solver else {
+            panic!("not elastoplastic")
+        };
+        assert_eq!(e.friction_angle_deg, theta);
+        assert_eq!(
+            e.cone_match,
+            Some(elastoplastic_granular::ConeMatch::SimpleShear)
+        );
+        let Some(sph_scene::SolidSpec::Box { min, max }) = s.solids.first() else {
+            panic!("the plate is a box")
+        };
+        assert_eq!((min[0], max[0]), (0.06, period - 0.06), "slot 0.12 m wide");
+        assert_eq!(max[1], 0.0, "the plate's top is the floor y = 0");
+        assert_eq!(s.walls.solids, vec![Some(sph_scene::WallModel::NoSlip)]);
+        let tank = s.tank.unwrap();
+        assert!((min[1] - 0.6 - tank.min.y).abs() < 1e-12, "sump 0.6 m deep");
+        let cells = |sp: f64| (period / sp).round() as usize;
+        assert_eq!(
+            counts(&s),
+            (cells(0.01) * 20 * 6, cells(0.02) * 10 * 3),
+            "θ = {theta}"
+        );
+    }
 }

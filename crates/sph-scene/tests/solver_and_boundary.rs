@@ -105,7 +105,7 @@ fn pcisph_field_under_pbf_is_refused_with_path_and_line() {
 fn missing_field_of_a_flattened_part_is_not_called_unknown() {
     let shipped = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../../scenes/granular_repose_30.toml"
+        "/../../scenes/granular_repose_thesis_30.toml"
     ))
     .unwrap();
     let text = shipped.replacen("substeps = 16", "", 1);

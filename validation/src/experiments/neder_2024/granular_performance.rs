@@ -1,7 +1,7 @@
 //! `granular-performance`: time per step and per particle of the IISPH granular solver
 //! (Neder 2024) on a 100,000-particle pile, per phase, on 2 threads (and, in full mode, on 1).
 //!
-//! The pile: the 30° repose scene (`scenes/granular_repose_30.toml`) without its base (the
+//! The pile: the 30° repose scene (`scenes/granular_repose_thesis_30.toml`) without its base (the
 //! solid) and with the thesis's cone (`cone_match` plane strain, as when the figures in
 //! `docs/performance.md` were taken), with a block of 0.4 × 0.25 × 0.125 m at a spacing of 5 mm (80 × 50 × 25 = 100,000 particles) resting on the
 //! floor of a 1.2 m long tank, 1 ms steps, one step per frame. [`WARM_UP_STEPS`] steps are run
@@ -38,7 +38,7 @@ pub const WARM_UP_STEPS: usize = 3;
 const PARTICLES: usize = 100_000;
 
 fn pile_scene(mode: Mode, measured_steps: usize) -> Result<Scene> {
-    let mut scene = shipped("granular_repose_30", mode)?;
+    let mut scene = shipped("granular_repose_thesis_30", mode)?;
     scene.particle_spacing = 0.005;
     scene.frame_dt_s = 0.001;
     scene.duration_s = 0.001 * (WARM_UP_STEPS + measured_steps) as f64;
@@ -122,7 +122,7 @@ impl Experiment for GranularPerformance {
         &["iisph-granular"]
     }
     fn scenes(&self) -> &'static [&'static str] {
-        &["granular_repose_30"]
+        &["granular_repose_thesis_30"]
     }
 
     fn source(&self) -> &'static str {
