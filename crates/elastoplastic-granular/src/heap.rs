@@ -15,7 +15,7 @@ use sph_core::{Aabb, BoxSdf, ParticleSet, Plane, Real, Vec3};
 use sph_solver::{Solids, SolverError};
 
 use crate::boundary_particles::boundary_block;
-use crate::params::{ElastoplasticParams, WallModel};
+use crate::params::{ElastoplasticParams, InitialStress, WallModel};
 use crate::periodic::PeriodicAxis;
 use crate::solver::{Elastoplastic, ElastoplasticScheme};
 use crate::walls::volume_map_walls;
@@ -321,5 +321,88 @@ pub fn drained_bed<R: Real>(
             .collect();
         solver.scheme_mut().set_stress(&stress)?;
     }
+    Ok((solver, state))
+}
+
+/// A slope cut in a settled layer: a mound of grains on a flat no-slip floor, periodic
+/// along `x` (period `period_x_m`) and along `z` (`slab_depth_m`: plane strain without
+/// walls), its cross-section the trapezoid
+/// `y ≤ min(H, tan θ · min(x − x0, x0 + W − x))`, `x0 = (period − W)/2`, `W` its base
+/// width: two flanks at `θ` rising from the floor to a flat top `H` high. The floor is
+/// three rows of no-slip boundary particles under `y = 0` across the whole period (the
+/// floor plane only keeps grains out); the grains start at rest on the lattice under the
+/// surface with the geostatic stress of their columns
+/// ([`InitialStress::Geostatic`](crate::InitialStress::Geostatic),
+/// [`crate::initial::geostatic`]), the static bracket's set-up (a slope formed without
+/// flowing).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SlopeSetup {
+    /// The period along `x` (m; a multiple of the spacing, wide enough for a failing
+    /// flank's runout).
+    pub period_x_m: f64,
+    /// The mound's base width `W` (m).
+    pub base_width_m: f64,
+    /// The mound's height `H` (m).
+    pub height_m: f64,
+    /// The flanks' angle `θ` (degrees, in `(0, 90)`).
+    pub slope_deg: f64,
+    /// The slab's depth along `z` (m; a multiple of the spacing).
+    pub slab_depth_m: f64,
+}
+
+impl SlopeSetup {
+    /// The surface's height (m) over `x` (m).
+    pub fn surface_m(&self, x: f64) -> f64 {
+        let x0 = 0.5 * (self.period_x_m - self.base_width_m);
+        let rise = (x - x0).min(x0 + self.base_width_m - x).max(0.0);
+        (self.slope_deg.to_radians().tan() * rise).min(self.height_m)
+    }
+}
+
+/// The solver and the mound's particles at `t = 0` for `params` (its spacing sets the
+/// lattice; its `periodic`, `wall_models` and `initial_stress` are replaced), set up as
+/// `setup` says ([`SlopeSetup`]).
+pub fn cut_slope<R: Real>(
+    mut params: ElastoplasticParams<R>,
+    setup: SlopeSetup,
+) -> Result<(Elastoplastic<R>, ParticleSet<R>), SolverError> {
+    let s = params.common.particle_spacing;
+    let (l, d) = (setup.period_x_m, setup.slab_depth_m);
+    if !(setup.slope_deg > 0.0 && setup.slope_deg < 90.0) {
+        return Err(SolverError::InvalidParameter {
+            solver: crate::solver::NAME,
+            name: "slope_deg",
+            value: setup.slope_deg,
+            reason: "a slope's angle must lie in (0, 90) degrees",
+        });
+    }
+    params.periodic = [(0, l), (2, d)]
+        .into_iter()
+        .map(|(axis, hi)| PeriodicAxis {
+            axis,
+            lo: R::zero(),
+            hi: R::of_f64(hi),
+        })
+        .collect();
+    params.wall_models = vec![WallModel::ContactOnly];
+    params.initial_stress = InitialStress::Geostatic;
+    let solids: Solids<R> = vec![Box::new(Plane::new(v(0.0, 0.0, 0.0), v(0.0, 1.0, 0.0))?)];
+    let domain = aabb(
+        [-0.05, -0.05, -0.05],
+        [l + 0.05, setup.height_m + 0.1, d + 0.05],
+    )?;
+    let walls = volume_map_walls(solids, &params, domain)?;
+    let region = aabb([0.0, 0.0, 0.0], [l, setup.height_m, d])?;
+    let mut positions = cubic_lattice(&region, s, 1 << 22)?;
+    positions.retain(|p| p.y.as_f64() <= setup.surface_m(p.x.as_f64()));
+    let state = ParticleSet::from_positions(
+        positions,
+        params.common.particle_mass(),
+        params.common.rest_density,
+    );
+    let mut solver = ElastoplasticScheme::solver(params, walls)?;
+    let rows = aabb([0.0, -BOUNDARY_ROWS * s.as_f64(), 0.0], [l, 0.0, d])?;
+    let floor = boundary_block(&rows, s, v(0.0, 1.0, 0.0), WallModel::NoSlip, 1 << 22)?;
+    solver.scheme_mut().set_boundary_particles(floor)?;
     Ok((solver, state))
 }
