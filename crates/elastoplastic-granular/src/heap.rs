@@ -9,7 +9,6 @@
 //! or periodic ends (plane strain without walls); then the tank's floor, its two ends, and
 //! the base.
 
-use nalgebra::Matrix3;
 use sph_core::sampling::cubic_lattice;
 use sph_core::{Aabb, BoxSdf, ParticleSet, Plane, Real, Vec3};
 use sph_solver::{Solids, SolverError};
@@ -53,8 +52,9 @@ pub enum SlabSides {
 /// How the heap is set up: what bounds the slab across `z`, whether the tank's floor and
 /// the base are rows of boundary particles ([`crate::boundary_particles`], no-slip; the
 /// solids then only keep particles out) or volume-map walls, and whether the block starts
-/// from the geostatic stress (`σ_yy = −ρ0 g (top − y)`, `σ_xx = σ_zz = K0 σ_yy`,
-/// `K0 = ν/(1 − ν)`) or unstressed.
+/// from the geostatic stress of its columns ([`crate::initial::geostatic`]: `σ_yy = −ρ0 g
+/// d`, `σ_xx = σ_zz = K0 σ_yy`, `K0 = ν/(1 − ν)`, `d` the depth below the column's top
+/// grain plus half a spacing) or unstressed.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HeapSetup {
     /// What bounds the slab across `z`.
@@ -71,9 +71,18 @@ pub struct HeapSetup {
     pub base_x_m: [f64; 2],
     /// `None`: the block `[0.8, 1.6] × [0.25, 0.55]`; `Some(θ)`: a symmetric wedge on the
     /// base with flanks at `θ` degrees (`y ≤ 0.25 + tan θ · min(x − 0.8, 1.6 − x)`, the
-    /// particles of the block's lattice below it) and the geostatic stress measured from
-    /// its surface.
+    /// particles of the block's lattice below it), the geostatic stress measured from
+    /// the top grain of each column (half a spacing above it).
     pub wedge_deg: Option<f64>,
+}
+
+/// The initial stress of a set-up that starts from the geostatic stress or unstressed.
+fn geostatic_or_none(geostatic: bool) -> InitialStress {
+    if geostatic {
+        InitialStress::Geostatic
+    } else {
+        InitialStress::None
+    }
 }
 
 /// Rows of boundary particles standing for a wall (three spacings thick: the support is
@@ -137,11 +146,7 @@ pub fn fixed_base_heap<R: Real>(
         params.common.particle_mass(),
         params.common.rest_density,
     );
-    let (rho0, g, nu) = (
-        params.common.rest_density,
-        -params.common.gravity.y,
-        params.poisson_ratio,
-    );
+    params.initial_stress = geostatic_or_none(setup.geostatic);
     let mut solver = ElastoplasticScheme::solver(params, walls)?;
     if setup.particle_walls {
         let t = BOUNDARY_ROWS * s.as_f64();
@@ -159,18 +164,6 @@ pub fn fixed_base_heap<R: Real>(
             rows.extend(boundary_block(&aabb(lo, hi)?, s, normal, model, 1 << 22)?);
         }
         solver.scheme_mut().set_boundary_particles(rows)?;
-    }
-    if setup.geostatic {
-        let k0 = nu / (R::one() - nu);
-        let stress: Vec<Matrix3<R>> = state
-            .positions
-            .iter()
-            .map(|x| {
-                let sv = -rho0 * g * (R::of_f64(surface(x.x.as_f64())) - x.y);
-                Matrix3::from_diagonal(&Vec3::new(k0 * sv, sv, k0 * sv))
-            })
-            .collect();
-        solver.scheme_mut().set_stress(&stress)?;
     }
     Ok((solver, state))
 }
@@ -202,8 +195,8 @@ pub struct DrainedSetup {
     pub sump_depth_m: f64,
     /// The slab's depth along `z` (m; a multiple of the spacing).
     pub slab_depth_m: f64,
-    /// Start from the geostatic stress (`σ_yy = −ρ0 g (H − y)`, `σ_xx = σ_zz = K0 σ_yy`,
-    /// `K0 = ν/(1 − ν)`) rather than unstressed.
+    /// Start from the geostatic stress ([`crate::initial::geostatic`]: `σ_yy = −ρ0 g
+    /// (H − y)`, `σ_xx = σ_zz = K0 σ_yy`, `K0 = ν/(1 − ν)`) rather than unstressed.
     pub geostatic: bool,
 }
 
@@ -284,11 +277,7 @@ pub fn drained_bed<R: Real>(
         params.common.particle_mass(),
         params.common.rest_density,
     );
-    let (rho0, g, nu) = (
-        params.common.rest_density,
-        -params.common.gravity.y,
-        params.poisson_ratio,
-    );
+    params.initial_stress = geostatic_or_none(setup.geostatic);
     let mut solver = ElastoplasticScheme::solver(params, walls)?;
     let up = v(0.0, 1.0, 0.0);
     let mut rows = boundary_block(
@@ -309,18 +298,6 @@ pub fn drained_bed<R: Real>(
         1 << 22,
     )?);
     solver.scheme_mut().set_boundary_particles(rows)?;
-    if setup.geostatic {
-        let k0 = nu / (R::one() - nu);
-        let stress: Vec<Matrix3<R>> = state
-            .positions
-            .iter()
-            .map(|x| {
-                let sv = -rho0 * g * (R::of_f64(h) - x.y);
-                Matrix3::from_diagonal(&Vec3::new(k0 * sv, sv, k0 * sv))
-            })
-            .collect();
-        solver.scheme_mut().set_stress(&stress)?;
-    }
     Ok((solver, state))
 }
 
