@@ -309,7 +309,7 @@ pub fn drained_bed<R: Real>(
 /// three rows of no-slip boundary particles under `y = 0` across the whole period (the
 /// floor plane only keeps grains out); the grains start at rest on the lattice under the
 /// surface with the geostatic stress of their columns
-/// ([`InitialStress::Geostatic`](crate::InitialStress::Geostatic),
+/// ([`InitialStress::Geostatic`],
 /// [`crate::initial::geostatic`]), the static bracket's set-up (a slope formed without
 /// flowing).
 #[derive(Debug, Clone, Copy, PartialEq)]
