@@ -9,13 +9,12 @@
 //! or periodic ends (plane strain without walls); then the tank's floor, its two ends, and
 //! the base.
 
-use nalgebra::Matrix3;
 use sph_core::sampling::cubic_lattice;
 use sph_core::{Aabb, BoxSdf, ParticleSet, Plane, Real, Vec3};
 use sph_solver::{Solids, SolverError};
 
 use crate::boundary_particles::boundary_block;
-use crate::params::{ElastoplasticParams, WallModel};
+use crate::params::{ElastoplasticParams, InitialStress, WallModel};
 use crate::periodic::PeriodicAxis;
 use crate::solver::{Elastoplastic, ElastoplasticScheme};
 use crate::walls::volume_map_walls;
@@ -53,8 +52,9 @@ pub enum SlabSides {
 /// How the heap is set up: what bounds the slab across `z`, whether the tank's floor and
 /// the base are rows of boundary particles ([`crate::boundary_particles`], no-slip; the
 /// solids then only keep particles out) or volume-map walls, and whether the block starts
-/// from the geostatic stress (`σ_yy = −ρ0 g (top − y)`, `σ_xx = σ_zz = K0 σ_yy`,
-/// `K0 = ν/(1 − ν)`) or unstressed.
+/// from the geostatic stress of its columns ([`crate::initial::geostatic`]: `σ_yy = −ρ0 g
+/// d`, `σ_xx = σ_zz = K0 σ_yy`, `K0 = ν/(1 − ν)`, `d` the depth below the column's top
+/// grain plus half a spacing) or unstressed.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HeapSetup {
     /// What bounds the slab across `z`.
@@ -71,9 +71,18 @@ pub struct HeapSetup {
     pub base_x_m: [f64; 2],
     /// `None`: the block `[0.8, 1.6] × [0.25, 0.55]`; `Some(θ)`: a symmetric wedge on the
     /// base with flanks at `θ` degrees (`y ≤ 0.25 + tan θ · min(x − 0.8, 1.6 − x)`, the
-    /// particles of the block's lattice below it) and the geostatic stress measured from
-    /// its surface.
+    /// particles of the block's lattice below it), the geostatic stress measured from
+    /// the top grain of each column (half a spacing above it).
     pub wedge_deg: Option<f64>,
+}
+
+/// The initial stress of a set-up that starts from the geostatic stress or unstressed.
+fn geostatic_or_none(geostatic: bool) -> InitialStress {
+    if geostatic {
+        InitialStress::Geostatic
+    } else {
+        InitialStress::None
+    }
 }
 
 /// Rows of boundary particles standing for a wall (three spacings thick: the support is
@@ -137,11 +146,7 @@ pub fn fixed_base_heap<R: Real>(
         params.common.particle_mass(),
         params.common.rest_density,
     );
-    let (rho0, g, nu) = (
-        params.common.rest_density,
-        -params.common.gravity.y,
-        params.poisson_ratio,
-    );
+    params.initial_stress = geostatic_or_none(setup.geostatic);
     let mut solver = ElastoplasticScheme::solver(params, walls)?;
     if setup.particle_walls {
         let t = BOUNDARY_ROWS * s.as_f64();
@@ -159,18 +164,6 @@ pub fn fixed_base_heap<R: Real>(
             rows.extend(boundary_block(&aabb(lo, hi)?, s, normal, model, 1 << 22)?);
         }
         solver.scheme_mut().set_boundary_particles(rows)?;
-    }
-    if setup.geostatic {
-        let k0 = nu / (R::one() - nu);
-        let stress: Vec<Matrix3<R>> = state
-            .positions
-            .iter()
-            .map(|x| {
-                let sv = -rho0 * g * (R::of_f64(surface(x.x.as_f64())) - x.y);
-                Matrix3::from_diagonal(&Vec3::new(k0 * sv, sv, k0 * sv))
-            })
-            .collect();
-        solver.scheme_mut().set_stress(&stress)?;
     }
     Ok((solver, state))
 }
@@ -202,8 +195,8 @@ pub struct DrainedSetup {
     pub sump_depth_m: f64,
     /// The slab's depth along `z` (m; a multiple of the spacing).
     pub slab_depth_m: f64,
-    /// Start from the geostatic stress (`σ_yy = −ρ0 g (H − y)`, `σ_xx = σ_zz = K0 σ_yy`,
-    /// `K0 = ν/(1 − ν)`) rather than unstressed.
+    /// Start from the geostatic stress ([`crate::initial::geostatic`]: `σ_yy = −ρ0 g
+    /// (H − y)`, `σ_xx = σ_zz = K0 σ_yy`, `K0 = ν/(1 − ν)`) rather than unstressed.
     pub geostatic: bool,
 }
 
@@ -284,11 +277,7 @@ pub fn drained_bed<R: Real>(
         params.common.particle_mass(),
         params.common.rest_density,
     );
-    let (rho0, g, nu) = (
-        params.common.rest_density,
-        -params.common.gravity.y,
-        params.poisson_ratio,
-    );
+    params.initial_stress = geostatic_or_none(setup.geostatic);
     let mut solver = ElastoplasticScheme::solver(params, walls)?;
     let up = v(0.0, 1.0, 0.0);
     let mut rows = boundary_block(
@@ -309,17 +298,88 @@ pub fn drained_bed<R: Real>(
         1 << 22,
     )?);
     solver.scheme_mut().set_boundary_particles(rows)?;
-    if setup.geostatic {
-        let k0 = nu / (R::one() - nu);
-        let stress: Vec<Matrix3<R>> = state
-            .positions
-            .iter()
-            .map(|x| {
-                let sv = -rho0 * g * (R::of_f64(h) - x.y);
-                Matrix3::from_diagonal(&Vec3::new(k0 * sv, sv, k0 * sv))
-            })
-            .collect();
-        solver.scheme_mut().set_stress(&stress)?;
+    Ok((solver, state))
+}
+
+/// A slope cut in a settled layer: a mound of grains on a flat no-slip floor, periodic
+/// along `x` (period `period_x_m`) and along `z` (`slab_depth_m`: plane strain without
+/// walls), its cross-section the trapezoid
+/// `y ≤ min(H, tan θ · min(x − x0, x0 + W − x))`, `x0 = (period − W)/2`, `W` its base
+/// width: two flanks at `θ` rising from the floor to a flat top `H` high. The floor is
+/// three rows of no-slip boundary particles under `y = 0` across the whole period (the
+/// floor plane only keeps grains out); the grains start at rest on the lattice under the
+/// surface with the geostatic stress of their columns
+/// ([`InitialStress::Geostatic`],
+/// [`crate::initial::geostatic`]), the static bracket's set-up (a slope formed without
+/// flowing).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SlopeSetup {
+    /// The period along `x` (m; a multiple of the spacing, wide enough for a failing
+    /// flank's runout).
+    pub period_x_m: f64,
+    /// The mound's base width `W` (m).
+    pub base_width_m: f64,
+    /// The mound's height `H` (m).
+    pub height_m: f64,
+    /// The flanks' angle `θ` (degrees, in `(0, 90)`).
+    pub slope_deg: f64,
+    /// The slab's depth along `z` (m; a multiple of the spacing).
+    pub slab_depth_m: f64,
+}
+
+impl SlopeSetup {
+    /// The surface's height (m) over `x` (m).
+    pub fn surface_m(&self, x: f64) -> f64 {
+        let x0 = 0.5 * (self.period_x_m - self.base_width_m);
+        let rise = (x - x0).min(x0 + self.base_width_m - x).max(0.0);
+        (self.slope_deg.to_radians().tan() * rise).min(self.height_m)
     }
+}
+
+/// The solver and the mound's particles at `t = 0` for `params` (its spacing sets the
+/// lattice; its `periodic`, `wall_models` and `initial_stress` are replaced), set up as
+/// `setup` says ([`SlopeSetup`]).
+pub fn cut_slope<R: Real>(
+    mut params: ElastoplasticParams<R>,
+    setup: SlopeSetup,
+) -> Result<(Elastoplastic<R>, ParticleSet<R>), SolverError> {
+    let s = params.common.particle_spacing;
+    let (l, d) = (setup.period_x_m, setup.slab_depth_m);
+    if !(setup.slope_deg > 0.0 && setup.slope_deg < 90.0) {
+        return Err(SolverError::InvalidParameter {
+            solver: crate::solver::NAME,
+            name: "slope_deg",
+            value: setup.slope_deg,
+            reason: "a slope's angle must lie in (0, 90) degrees",
+        });
+    }
+    params.periodic = [(0, l), (2, d)]
+        .into_iter()
+        .map(|(axis, hi)| PeriodicAxis {
+            axis,
+            lo: R::zero(),
+            hi: R::of_f64(hi),
+        })
+        .collect();
+    params.wall_models = vec![WallModel::ContactOnly];
+    params.initial_stress = InitialStress::Geostatic;
+    let solids: Solids<R> = vec![Box::new(Plane::new(v(0.0, 0.0, 0.0), v(0.0, 1.0, 0.0))?)];
+    let domain = aabb(
+        [-0.05, -0.05, -0.05],
+        [l + 0.05, setup.height_m + 0.1, d + 0.05],
+    )?;
+    let walls = volume_map_walls(solids, &params, domain)?;
+    let region = aabb([0.0, 0.0, 0.0], [l, setup.height_m, d])?;
+    let mut positions = cubic_lattice(&region, s, 1 << 22)?;
+    positions.retain(|p| p.y.as_f64() <= setup.surface_m(p.x.as_f64()));
+    let state = ParticleSet::from_positions(
+        positions,
+        params.common.particle_mass(),
+        params.common.rest_density,
+    );
+    let mut solver = ElastoplasticScheme::solver(params, walls)?;
+    let rows = aabb([0.0, -BOUNDARY_ROWS * s.as_f64(), 0.0], [l, 0.0, d])?;
+    let floor = boundary_block(&rows, s, v(0.0, 1.0, 0.0), WallModel::NoSlip, 1 << 22)?;
+    solver.scheme_mut().set_boundary_particles(floor)?;
     Ok((solver, state))
 }

@@ -14,9 +14,9 @@ use sph_solver::{
 
 use crate::kernels::ELASTOPLASTIC_KERNEL;
 use crate::params::{ElastoplasticParams, InitialStress};
-use crate::stress::ConeMatch;
 use crate::periodic::PeriodicAxis;
 use crate::solver::{Elastoplastic, NAME};
+use crate::stress::ConeMatch;
 
 /// The friction angle (degrees) of settings made for this kind from another solver's
 /// ([`SolverSettings::with_common`]): 30°, the shipped heaps' (a cohesionless material

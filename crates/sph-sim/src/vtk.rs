@@ -7,8 +7,8 @@ use sph_core::{Real, Vec3};
 
 use crate::error::SimError;
 use vtkio::model::{
-    Attribute, Attributes, ByteOrder, DataSet, FieldArray, PolyDataPiece, Version,
-    VertexNumbers, Vtk,
+    Attribute, Attributes, ByteOrder, DataSet, FieldArray, PolyDataPiece, Version, VertexNumbers,
+    Vtk,
 };
 
 /// One particle frame: positions (m), velocities (m/s), densities (kg/m³) and a stable
@@ -379,7 +379,9 @@ mod tests {
             ("plastic_strain".to_string(), vec![0.5f64, 0.25]),
             (
                 "stress".to_string(),
-                vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0, -1.0, -2.0, -3.0, -4.0, -5.0, -6.0],
+                vec![
+                    1.0, 2.0, 3.0, 4.0, 5.0, 6.0, -1.0, -2.0, -3.0, -4.0, -5.0, -6.0,
+                ],
             ),
             ("pair".to_string(), vec![1.0, 2.0, 3.0, 4.0]),
         ];
@@ -410,9 +412,7 @@ mod tests {
                 .point
                 .iter()
                 .find_map(|a| match a {
-                    Attribute::DataArray(d) if d.name == name => {
-                        d.data.clone().cast_into::<f32>()
-                    }
+                    Attribute::DataArray(d) if d.name == name => d.data.clone().cast_into::<f32>(),
                     _ => None,
                 })
                 .unwrap()

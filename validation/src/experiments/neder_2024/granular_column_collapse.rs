@@ -37,8 +37,10 @@
 //! 3.92 (docs/elastoplastic-granular.md).
 
 use anyhow::{bail, Result};
+use elastoplastic_granular::{
+    Axis, ConeMatch, ElastoplasticSettings, InitialStress, PeriodicSetting,
+};
 use granular_measure::{normalised_runout, runout, RunoutOptions};
-use elastoplastic_granular::{Axis, ConeMatch, ElastoplasticSettings, InitialStress, PeriodicSetting};
 use sph_scene::{BoundaryModel, FluidSpec, InitialMasses, Scene, SolverSpec, WallModel};
 
 use super::scene_edit::{set_block_and_tank, shipped};
@@ -143,7 +145,8 @@ fn elastoplastic_column(column: &Scene) -> Result<Scene> {
     let theta = granular.friction_angle_deg;
     let mut common = granular.common.clone();
     common.substeps = 1;
-    let mut settings = <ElastoplasticSettings as sph_solver::SolverSettings>::with_common(common, 1);
+    let mut settings =
+        <ElastoplasticSettings as sph_solver::SolverSettings>::with_common(common, 1);
     settings.friction_angle_deg = theta;
     settings.cone_match = Some(ConeMatch::PlaneStrain);
     settings.youngs_modulus = Some(ELASTOPLASTIC_YOUNGS_MODULUS_PA);
@@ -188,7 +191,11 @@ impl Experiment for GranularColumnCollapse {
         "granular-column-collapse"
     }
     fn crates(&self) -> &'static [&'static str] {
-        &["iisph-granular", "elastoplastic-granular", "granular-measure"]
+        &[
+            "iisph-granular",
+            "elastoplastic-granular",
+            "granular-measure",
+        ]
     }
     fn scenes(&self) -> &'static [&'static str] {
         &["granular_column_collapse"]
@@ -416,7 +423,11 @@ pub(super) fn plot_runout(
     ];
     let markers = [Marker::Circle, Marker::Triangle];
     let mut series = series;
-    for (k, (label, points)) in models.iter().enumerate().filter(|(_, (_, p))| !p.is_empty()) {
+    for (k, (label, points)) in models
+        .iter()
+        .enumerate()
+        .filter(|(_, (_, p))| !p.is_empty())
+    {
         series.push(Series::markers(
             *label,
             points.to_vec(),
