@@ -280,8 +280,7 @@ impl Experiment for GranularColumnBui {
             "normalised_runout",
             normalised_runout(runout_m, column.length)?,
         );
-        let height_sum =
-            |ps: &[Vec3<f64>]| ps.iter().map(|p| p.y - column.floor_y).sum::<f64>();
+        let height_sum = |ps: &[Vec3<f64>]| ps.iter().map(|p| p.y - column.floor_y).sum::<f64>();
         let kept = height_sum(&run.final_positions) / height_sum(&initial);
         out.metric("potential_energy_kept", kept);
         out.metric("sphinxsys_potential_energy_kept", peer_kept);
