@@ -5,7 +5,7 @@
 //! `elastoplastic-granular`, against Rankine's active wedge.
 //!
 //! **Set-up** (`scenes/granular_column_bui.toml`): a column `L0 × H0` = 0.2 m × 0.1 m on the
-//! floor of a tank 0.5 m long, a fixed wall behind it (`x = 0`), released at `t = 0` (the
+//! floor of a tank 0.8 m long, a fixed wall behind it (`x = 0`), released at `t = 0` (the
 //! plate in front removed) from its geostatic stress; plane strain as a slab three spacings
 //! deep, periodic across `z` (the experiment sets the tank's depth, the block's and the
 //! period to `3 s` in either mode); `E` = 5.84 MPa, `ν` = 0.3, `ρ0` = 2040 kg/m³, `c` = 0,
@@ -39,7 +39,7 @@
 //!   radius, from the back wall).
 //! - *Potential energy kept*: `Σ y_final / Σ y_initial` over the grains (equal masses).
 //!
-//! **Checks**: at rest by [`REST_BY_S`]; the back keeps its height within one spacing (the
+//! **Checks**: the deposit's front clear of the far wall (validity); at rest by [`REST_BY_S`]; the back keeps its height within one spacing (the
 //! wall holds the material behind the failure line, which does not move); the failure line
 //! at Rankine's `45° + φ/2` within `1.5 sin²β s/H0` rad (see [`failure_line_tolerance_deg`]);
 //! the energy kept against SPHinXsys's 0.690 within [`ENERGY_BAND`]. The deposit slope and
@@ -276,6 +276,13 @@ impl Experiment for GranularColumnBui {
             &RunoutOptions::connected(column.back_x, s),
         )?;
         out.metric("runout_m", runout_m);
+        let far_wall = scene.tank.map_or(f64::NAN, |t| t.max.x);
+        out.check(Check::greater_than(
+            "deposit's front clear of the far wall (m)",
+            far_wall - (column.back_x + runout_m),
+            2.0 * s,
+            "validity: a front at the far wall was stopped by it",
+        ));
         out.metric(
             "normalised_runout",
             normalised_runout(runout_m, column.length)?,
@@ -383,10 +390,15 @@ fn plot_deposit(
             1,
         ),
     ];
+    let x_end = run
+        .final_positions
+        .iter()
+        .map(|p| p.x)
+        .fold(x0 + 2.0 * l, f64::max);
     let spec = PlotSpec {
         legend: Legend::UpperRight,
         series,
-        x_range: Some((x0, x0 + 0.5)),
+        x_range: Some((x0, x_end + 0.02)),
         y_range: Some((y0, y0 + 0.25)),
         ..PlotSpec::new(
             "Column of Bui et al. (2008): deposit and failure line",
