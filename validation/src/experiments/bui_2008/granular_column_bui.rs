@@ -35,7 +35,7 @@
 //!   the deposit's height), next to the model's angle of repose `atan(3 α_φ)` (a heap formed
 //!   by flowing, ψ = 0) and its largest stable slope `asin(3 α_φ)` (a wedge that has not
 //!   flowed), `ConeMatch::predicted_repose_angle_deg` and `max_stable_slope_deg`.
-//! - *Runout*: [`granular_measure::runout`] (the connected deposit's front plus the grain's
+//! - *Runout*: [`granular_measure::runout()`] (the connected deposit's front plus the grain's
 //!   radius, from the back wall).
 //! - *Potential energy kept*: `Σ y_final / Σ y_initial` over the grains (equal masses).
 //!
