@@ -1,5 +1,7 @@
-//! The four papers the workspace implements, as `docs/papers.md` rows them, and the
-//! paper → crates → experiments → scenes → reference-data table generated from the registry.
+//! The four papers the workspace implements, as `docs/papers.md` rows them, and Bui et al.
+//! (2008), whose model the crate `elastoplastic-granular` implements (listed among the other
+//! works there); and the paper → crates → experiments → scenes → reference-data table
+//! generated from the registry.
 //!
 //! Each experiment lives in the folder of the paper whose crates it validates
 //! (`src/experiments/<folder>/<id>.rs`, or `<id>/mod.rs` for a large one), and its reference
@@ -11,7 +13,8 @@ use std::path::Path;
 
 use crate::Experiment;
 
-/// One of the four papers of `docs/papers.md` (full citations there).
+/// One of the papers of `docs/papers.md` whose crates have experiments (full citations
+/// there).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Paper {
     /// Macklin & Müller 2013, "Position Based Fluids".
@@ -22,15 +25,18 @@ pub enum Paper {
     ImChan2016,
     /// Chegodaeva 2004, symplectic integration of small Solar System bodies.
     Chegodaeva2004,
+    /// Bui, Fukagawa, Sako & Ohno 2008, elastic–plastic SPH for geomaterials.
+    Bui2008,
 }
 
 impl Paper {
-    /// The four papers, in `docs/papers.md`'s order.
-    pub const ALL: [Paper; 4] = [
+    /// The papers, in `docs/papers.md`'s order (the four, then Bui et al. 2008).
+    pub const ALL: [Paper; 5] = [
         Paper::MacklinMuller2013,
         Paper::Neder2024,
         Paper::ImChan2016,
         Paper::Chegodaeva2004,
+        Paper::Bui2008,
     ];
 
     /// The folder of its experiments under `src/experiments/`.
@@ -40,6 +46,7 @@ impl Paper {
             Paper::Neder2024 => "neder_2024",
             Paper::ImChan2016 => "im_chan_2016",
             Paper::Chegodaeva2004 => "chegodaeva_2004",
+            Paper::Bui2008 => "bui_2008",
         }
     }
 
@@ -50,6 +57,7 @@ impl Paper {
             Paper::Neder2024 => "Neder 2024",
             Paper::ImChan2016 => "Im & Chan 2016",
             Paper::Chegodaeva2004 => "Chegodaeva 2004",
+            Paper::Bui2008 => "Bui et al. 2008",
         }
     }
 

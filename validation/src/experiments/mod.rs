@@ -3,6 +3,7 @@
 
 use crate::Experiment;
 
+pub mod bui_2008;
 pub mod chegodaeva_2004;
 pub mod im_chan_2016;
 pub mod macklin_muller_2013;
@@ -32,6 +33,7 @@ pub fn registry() -> Vec<Box<dyn Experiment>> {
         ),
         Box::new(neder_2024::iisph_convergence::IisphConvergence),
         Box::new(neder_2024::granular_performance::GranularPerformance),
+        Box::new(bui_2008::granular_column_bui::GranularColumnBui),
         Box::new(im_chan_2016::ssfr_depth_accuracy::SsfrDepthAccuracy),
         Box::new(im_chan_2016::ssfr_refraction::SsfrRefraction),
         Box::new(im_chan_2016::ssfr_performance::SsfrPerformance),

@@ -37,6 +37,9 @@ pub struct SceneRun {
     pub snapshots: Vec<(usize, Vec<Vec3<f64>>)>,
     /// Positions at the end of the run.
     pub final_positions: Vec<Vec3<f64>>,
+    /// For each of [`SceneRun::final_positions`], the particle's index in the scene's
+    /// initial order (the solver reorders particles by cell).
+    pub final_ids: Vec<u32>,
     /// Potential energy of the initial state above the tank floor (J).
     pub initial_potential_energy_j: f64,
     /// The solver's blow-up that ended the run early, if any.
@@ -69,6 +72,7 @@ fn run_in<R: Real>(
         rest_verdict: rest.as_ref().and_then(|r| r.verdict),
         snapshots: snapshots.taken,
         final_positions: positions_f64(&sim.state.positions),
+        final_ids: sim.ids.clone(),
         initial_potential_energy_j,
         blow_up: outcome.divergence().map(|d| d.to_string()),
         rest_from_s: rest.and_then(|r| r.rest_from_s),

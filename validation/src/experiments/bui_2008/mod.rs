@@ -1,0 +1,6 @@
+//! Bui, Fukagawa, Sako & Ohno (2008), elastic–plastic SPH for geomaterials (crate
+//! `elastoplastic-granular`: a per-particle stress, elastic and capped by the
+//! Drucker–Prager cone matched to Mohr–Coulomb in plane strain): the collapse of their
+//! column of aluminium bars against Rankine's active wedge.
+
+pub mod granular_column_bui;
