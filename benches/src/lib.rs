@@ -80,6 +80,49 @@ pub fn dam_break_fluid<R: Real>() -> (Vec<Vec3<R>>, Aabb<R>) {
     (p, tank)
 }
 
+/// The elastic–plastic granular solver (Bui et al. 2008, `elastoplastic-granular`, its
+/// defaults for spacing 0.025 m and φ = 30°) on the grains of [`dam_break_fluid`] (59,319
+/// particles) held at rest: the block stands in a box that fits it (an inverted box, open
+/// above it), whose floor and sides are three rows of no-slip boundary particles
+/// (`boundary_particle_region` = the block), from the geostatic stress, frames of `frame_dt`
+/// seconds (one substep; the solver sub-cycles its explicit steps inside). Returns the solver
+/// and the grains.
+pub fn settled_block_elastoplastic<R: Real>(
+    frame_dt: f64,
+) -> Result<
+    (
+        elastoplastic_granular::Elastoplastic<R>,
+        sph_core::ParticleSet<R>,
+    ),
+    sph_solver::SolverError,
+> {
+    use elastoplastic_granular::{ElastoplasticParams, InitialStress};
+    use sph_core::{BoxSdf, Inverted};
+    let s = 0.025;
+    let (p, _) = dam_break_fluid::<R>();
+    let v = |x: f64, y: f64, z: f64| Vec3::new(R::of_f64(x), R::of_f64(y), R::of_f64(z));
+    let lo = (-1.95, 0.05, -0.5);
+    let side = 39.0 * s;
+    let block = Aabb::new(
+        v(lo.0, lo.1, lo.2),
+        v(lo.0 + side, lo.1 + side, lo.2 + side),
+    )?;
+    let container = Aabb::new(
+        v(lo.0, lo.1, lo.2),
+        v(lo.0 + side, lo.1 + 2.0 * side, lo.2 + side),
+    )?;
+    let mut params = ElastoplasticParams::<R>::for_spacing(R::of_f64(s), R::of_f64(30.0));
+    params.common.dt = R::of_f64(frame_dt);
+    params.common.substeps = 1;
+    params.initial_stress = InitialStress::Geostatic;
+    params.boundary_particle_region = Some(block);
+    let mass = params.common.particle_mass();
+    let rho0 = params.common.rest_density;
+    let solids: sph_solver::Solids<R> = vec![Box::new(Inverted(BoxSdf::new(container)?))];
+    let solver = elastoplastic_granular::Elastoplastic::new(params, solids)?;
+    Ok((solver, sph_core::ParticleSet::from_positions(p, mass, rho0)))
+}
+
 /// Seed of the scattered-disk comet population.
 pub const COMET_SEED: u64 = 2026;
 

@@ -128,7 +128,6 @@ pub fn coulomb<R: Real>(
 /// What [`extrapolate`] reads.
 pub(crate) struct Extrapolation<'a, R: Real> {
     pub c: Consts<R>,
-    pub nb: &'a NeighbourLists,
     pub images: &'a Images<R>,
     /// Positions of the particles then the boundary particles.
     pub x: &'a [Vec3<R>],
@@ -138,11 +137,82 @@ pub(crate) struct Extrapolation<'a, R: Real> {
     pub gravity: Vec3<R>,
 }
 
+/// The grain neighbours of each boundary particle (from the neighbour lists, in their
+/// order: the extrapolation's sums add in the same order as over the whole lists, whose
+/// other entries are boundary particles), rebuilt at each neighbour search, and their
+/// Shepard weights `W_bf` and gravity terms `ρ_f (g·r_bf) W_bf`, computed once per step for
+/// both extrapolations of the step.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct BoundaryLists<R: Real> {
+    /// CSR offsets: boundary particle `k`'s entries are `start[k]..start[k + 1]`.
+    start: Vec<usize>,
+    /// The lists' entry (a particle or an image of one).
+    entry: Vec<u32>,
+    /// The grain it resolves to.
+    grain: Vec<u32>,
+    /// The boundary particle (`0..`) whose entry it is.
+    owner: Vec<u32>,
+    weight: Vec<R>,
+    weighted_gravity: Vec<R>,
+}
+
+impl<R: Real> BoundaryLists<R> {
+    /// Keeps, for each of the `count` boundary particles `n..n + count` of `nb`, the entries
+    /// that resolve to a grain (`< n`). Grows its arrays to the pair count (reusing them).
+    pub(crate) fn rebuild(
+        &mut self,
+        nb: &NeighbourLists,
+        images: &Images<R>,
+        x: &[Vec3<R>],
+        n: usize,
+        count: usize,
+    ) {
+        self.start.clear();
+        self.entry.clear();
+        self.grain.clear();
+        self.owner.clear();
+        self.start.push(0);
+        for k in 0..count {
+            for &j in nb.neighbours(n + k) {
+                let (f, _) = images.resolve(j as usize, x);
+                if f < n {
+                    self.entry.push(j);
+                    self.grain.push(f as u32);
+                    self.owner.push(k as u32);
+                }
+            }
+            self.start.push(self.entry.len());
+        }
+        let len = self.entry.len();
+        self.weight.resize(len, R::zero());
+        self.weighted_gravity.resize(len, R::zero());
+    }
+
+    /// The weights and gravity terms at the positions `e.x` (boundary particles from `n =
+    /// e.x.len() − e.particles.len()` on).
+    pub(crate) fn weigh(&mut self, e: &Extrapolation<'_, R>) {
+        let n = e.x.len() - e.particles.len();
+        let (entry, owner) = (&self.entry, &self.owner);
+        self.weight
+            .par_iter_mut()
+            .zip(self.weighted_gravity.par_iter_mut())
+            .enumerate()
+            .with_min_len(MIN_LEN)
+            .for_each(|(m, (w, wg))| {
+                let (j, xj) = e.images.resolve(entry[m] as usize, e.x);
+                let r = e.x[n + owner[m] as usize] - xj;
+                *w = e.c.kernel.value(r.norm());
+                *wg = e.rho[j] * e.gravity.dot(&r) * *w;
+            });
+    }
+}
+
 /// Writes the boundary particles' stress into `stress[n..]` from the particles' `stress[..n]`
 /// (module docs), their artificial stress into `art[n..]` if given, and their velocity into
-/// `v[n..]` if given (from `v[..n]`).
+/// `v[n..]` if given (from `v[..n]`), with the weights of the last [`BoundaryLists::weigh`].
 pub(crate) fn extrapolate<R: Real>(
     e: &Extrapolation<'_, R>,
+    lists: &BoundaryLists<R>,
     stress: &mut [Matrix3<R>],
     v: Option<&mut [Vec3<R>]>,
     art: Option<&mut [Matrix3<R>]>,
@@ -160,21 +230,15 @@ pub(crate) fn extrapolate<R: Real>(
     let two = R::of_f64(2.0);
     let work =
         |k: usize, sig: &mut Matrix3<R>, vel: Option<&mut Vec3<R>>, a: Option<&mut Matrix3<R>>| {
-            let b = n + k;
-            let xb = e.x[b];
             let mut sum_s = Matrix3::zeros();
             let mut sum_g = R::zero();
             let mut sum_v = Vec3::zeros();
             let mut sum_w = R::zero();
-            for &j in e.nb.neighbours(b) {
-                let (j, xj) = e.images.resolve(j as usize, e.x);
-                if j >= n {
-                    continue;
-                }
-                let r = xb - xj;
-                let w = e.c.kernel.value(r.norm());
+            for m in lists.start[k]..lists.start[k + 1] {
+                let j = lists.grain[m] as usize;
+                let w = lists.weight[m];
                 sum_s += s_head[j] * w;
-                sum_g += e.rho[j] * e.gravity.dot(&r) * w;
+                sum_g += lists.weighted_gravity[m];
                 if let Some(vh) = v_head {
                     sum_v += vh[j] * w;
                 }

@@ -30,6 +30,10 @@ pub(crate) struct Consts<R: Real> {
     pub exponent: R,
     /// `1 / W(s)`: the artificial stress's `f_ij = (W(r_ij)/W(s))^n`.
     pub inv_w_spacing: R,
+    /// A squared distance (m²) a little above the support radius squared: a pair farther
+    /// apart has a zero kernel and gradient (the relative margin `1e-4` covers the
+    /// rounding of the squares, so that the exact test stays the kernel's own).
+    pub support2_above: R,
 }
 
 impl<R: Real> Consts<R> {
@@ -48,6 +52,9 @@ impl<R: Real> Consts<R> {
             eps_stress: p.artificial_stress_epsilon,
             exponent: p.artificial_stress_exponent,
             inv_w_spacing: R::one() / kernel.value(p.common.particle_spacing),
+            support2_above: p.common.support_radius
+                * p.common.support_radius
+                * R::of_f64(1.0 + 1e-4),
         })
     }
 }

@@ -46,7 +46,15 @@ pub(crate) fn stress_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>) 
     let c = inp.c;
     let slots = inp.models.len();
     let n = inp.masses.len();
-    let (x, v, rho) = (&s.x[..], &s.v[..], &s.rho[..]);
+    let h2 = c.support2_above;
+    // `m_j / ρ_j` of every neighbour, once per particle rather than once per pair (the
+    // boundary particles' stays `m_b / ρ0` from `Scratch::resize`).
+    s.volume[..n]
+        .par_iter_mut()
+        .zip(inp.masses.par_iter().zip(s.rho[..n].par_iter()))
+        .with_min_len(MIN_LEN)
+        .for_each(|(vol, (&m, &r))| *vol = m / r);
+    let (x, v, rho, volume) = (&s.x[..], &s.v[..], &s.rho[..], &s.volume[..]);
     let (stress, plastic, images) = (&s.stress[..], &s.plastic_strain[..], &s.images);
     s.stress_new[..n]
         .par_iter_mut()
@@ -54,44 +62,58 @@ pub(crate) fn stress_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>) 
         .zip(s.plastic_new.par_iter_mut())
         .zip(s.art[..n].par_iter_mut())
         .zip(s.wall_grad.par_chunks_mut(slots.max(1)))
+        .zip(s.stress_over_rho2[..n].par_iter_mut())
+        .zip(s.art_on[..n].par_iter_mut())
         .enumerate()
         .with_min_len(MIN_LEN)
-        .for_each(|(i, ((((sig, r), kappa), art), grads))| {
-            let (xi, vi) = (x[i], v[i]);
-            let mut grad_v = Matrix3::zeros();
-            let mut drho = R::zero();
-            let mut in_contact = false;
-            for &j in inp.nb.neighbours(i) {
-                let (j, xj) = images.resolve(j as usize, x);
-                let gw = c.kernel.gradient(&(xi - xj));
-                in_contact |= j < n && j != i && gw != Vec3::zeros();
-                let dv = v[j] - vi;
-                let mj = inp.mass(j);
-                grad_v += dv * gw.transpose() * (mj / rho[j]);
-                drho -= mj * dv.dot(&gw);
-            }
-            if slots > 0 {
-                inp.walls.sample(inp.boundary, &xi, grads);
-                for (g, &model) in grads.iter().zip(inp.models) {
-                    if model != WallModel::ContactOnly && g.norm_squared() > R::zero() {
-                        grad_v -= wall_part(model, g, &vi) * g.transpose();
-                        drho += c.rho0 * vi.dot(g);
+        .for_each(
+            |(i, ((((((sig, r), kappa), art), grads), sig_rho2), art_on))| {
+                let (xi, vi) = (x[i], v[i]);
+                let mut grad_v = Matrix3::zeros();
+                let mut drho = R::zero();
+                let mut in_contact = false;
+                for &j in inp.nb.neighbours(i) {
+                    let (j, xj) = images.resolve(j as usize, x);
+                    let xij = xi - xj;
+                    // Beyond the support (the lists' skin): a zero gradient, whose terms
+                    // would add zeros.
+                    if xij.norm_squared() > h2 {
+                        continue;
+                    }
+                    let gw = c.kernel.gradient(&xij);
+                    if gw == Vec3::zeros() {
+                        continue;
+                    }
+                    in_contact |= j < n && j != i;
+                    let dv = v[j] - vi;
+                    grad_v += dv * gw.transpose() * volume[j];
+                    drho -= inp.mass(j) * dv.dot(&gw);
+                }
+                if slots > 0 {
+                    inp.walls.sample(inp.boundary, &xi, grads);
+                    for (g, &model) in grads.iter().zip(inp.models) {
+                        if model != WallModel::ContactOnly && g.norm_squared() > R::zero() {
+                            grad_v -= wall_part(model, g, &vi) * g.transpose();
+                            drho += c.rho0 * vi.dot(g);
+                        }
                     }
                 }
-            }
-            let mut up = c.material.update(&stress[i], &grad_v, inp.dt);
-            if !in_contact {
-                // A grain without a granular neighbour is out of contact: it carries no
-                // stress (else it keeps the last one, its velocity gradient being zero).
-                up.stress = Matrix3::zeros();
-                up.plastic_strain = R::zero();
-            }
-            let rho_next = rho[i] + drho * inp.dt;
-            *sig = up.stress;
-            *r = rho_next;
-            *kappa = plastic[i] + up.plastic_strain;
-            *art = artificial_stress(&up.stress, rho_next, c.eps_stress);
-        });
+                let mut up = c.material.update(&stress[i], &grad_v, inp.dt);
+                if !in_contact {
+                    // A grain without a granular neighbour is out of contact: it carries no
+                    // stress (else it keeps the last one, its velocity gradient being zero).
+                    up.stress = Matrix3::zeros();
+                    up.plastic_strain = R::zero();
+                }
+                let rho_next = rho[i] + drho * inp.dt;
+                *sig = up.stress;
+                *r = rho_next;
+                *kappa = plastic[i] + up.plastic_strain;
+                *art = artificial_stress(&up.stress, rho_next, c.eps_stress);
+                *sig_rho2 = up.stress / (rho_next * rho_next);
+                *art_on = *art != Matrix3::zeros();
+            },
+        );
 }
 
 /// Pass 2: the acceleration from the new stresses (with the artificial viscosity and
@@ -101,8 +123,10 @@ pub(crate) fn momentum_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>
     let c = inp.c;
     let slots = inp.models.len();
     let n = inp.masses.len();
+    let h2 = c.support2_above;
     let (x, v) = (&s.x[..], &s.v[..]);
     let (sig, rho, art, grads) = (&s.stress_new[..], &s.rho_new[..], &s.art[..], &s.wall_grad);
+    let (sig_rho2, art_on) = (&s.stress_over_rho2[..], &s.art_on[..]);
     let images = &s.images;
     let two = R::of_f64(2.0);
     let half = R::of_f64(0.5);
@@ -114,29 +138,35 @@ pub(crate) fn momentum_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>
         .with_min_len(MIN_LEN)
         .for_each(|(i, (vn, xn))| {
             let (xi, vi, ri) = (x[i], v[i], rho[i]);
-            let si = sig[i] / (ri * ri);
+            let si = sig_rho2[i];
             let art_i = art[i];
-            let art_i_zero = art_i == Matrix3::zeros();
+            let art_i_on = art_on[i];
             let mut a = inp.gravity;
             for &j in inp.nb.neighbours(i) {
                 let (j, xj) = images.resolve(j as usize, x);
                 let xij = xi - xj;
+                if xij.norm_squared() > h2 {
+                    continue;
+                }
                 let gw = c.kernel.gradient(&xij);
                 if gw == Vec3::zeros() {
                     continue;
                 }
                 let rj = rho[j];
-                let mut t = si + sig[j] / (rj * rj);
-                // Monaghan's artificial viscosity, for approaching pairs.
+                let mut t = si + sig_rho2[j];
+                // Monaghan's artificial viscosity, for approaching pairs (`Π_ij > 0`: only
+                // the diagonal changes).
                 let vij = vi - v[j];
                 let vx = vij.dot(&xij);
                 if vx < R::zero() {
                     let phi = c.h * vx / (xij.norm_squared() + c.eta2);
                     let pi = (-c.alpha * c.c0 * phi + c.beta * phi * phi) / ((ri + rj) * half);
-                    t -= Matrix3::identity() * pi;
+                    for k in 0..3 {
+                        t[(k, k)] -= pi;
+                    }
                 }
                 // Gray, Monaghan & Swift's artificial stress.
-                if !(art_i_zero && art[j] == Matrix3::zeros()) {
+                if art_i_on || art_on[j] {
                     let f = (c.kernel.value(xij.norm()) * c.inv_w_spacing).powf(c.exponent);
                     t += (art_i + art[j]) * f;
                 }
@@ -155,6 +185,22 @@ pub(crate) fn momentum_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>
             let p = inp.boundary.project(y);
             *xn = p;
             *vn = v_star + (p - y) * inv_dt;
+        });
+}
+
+/// `σ_b/ρ_b²` and whether the artificial stress is non-zero, for the boundary particles
+/// `n..` (after their stress and artificial stress are extrapolated), as the stress pass
+/// writes them for the grains.
+pub(crate) fn boundary_pair_terms<R: Real>(s: &mut Scratch<R>, n: usize) {
+    let (sig, rho, art) = (&s.stress_new[n..], &s.rho_new[n..], &s.art[n..]);
+    s.stress_over_rho2[n..]
+        .par_iter_mut()
+        .zip(s.art_on[n..].par_iter_mut())
+        .enumerate()
+        .with_min_len(MIN_LEN)
+        .for_each(|(k, (sr, on))| {
+            *sr = sig[k] / (rho[k] * rho[k]);
+            *on = art[k] != Matrix3::zeros();
         });
 }
 

@@ -4,7 +4,7 @@
 use nalgebra::Matrix3;
 use sph_core::{Real, Vec3};
 
-use crate::boundary_particles::BoundaryParticle;
+use crate::boundary_particles::{BoundaryLists, BoundaryParticle};
 use crate::periodic::Images;
 
 /// Per-particle arrays (structure of arrays).
@@ -24,6 +24,14 @@ pub(crate) struct Scratch<R: Real> {
     pub plastic_new: Vec<R>,
     /// Gray et al.'s artificial stress `R_i`.
     pub art: Vec<Matrix3<R>>,
+    /// The pair terms of the momentum pass, once per particle: `σ_i/ρ_i²` of the next
+    /// step's stress and density, and whether `R_i` is non-zero.
+    pub stress_over_rho2: Vec<Matrix3<R>>,
+    pub art_on: Vec<bool>,
+    /// `m_j/ρ_j` of the step's densities (the velocity gradient's volume).
+    pub volume: Vec<R>,
+    /// The boundary particles' grain neighbours and Shepard weights.
+    pub boundary_lists: BoundaryLists<R>,
     pub x_new: Vec<Vec3<R>>,
     pub v_new: Vec<Vec3<R>>,
     /// Positions at the last neighbour search.
@@ -44,11 +52,13 @@ impl<R: Real> Scratch<R> {
     /// (positions, velocities, stresses, densities; the particles' own arrays hold `n`)
     /// and `slots` wall gradients each; a new particle starts unstressed. Writes the
     /// boundary particles' positions and density `rho0`.
+    /// The boundary particles' mass is `boundary_mass` (their volume `boundary_mass/ρ0`).
     pub(crate) fn resize(
         &mut self,
         n: usize,
         boundary: &[BoundaryParticle<R>],
         rho0: R,
+        boundary_mass: R,
         slots: usize,
     ) {
         let z = Vec3::zeros();
@@ -63,6 +73,9 @@ impl<R: Real> Scratch<R> {
         self.rho_new.resize(all, R::zero());
         self.plastic_new.resize(n, R::zero());
         self.art.resize(all, zm);
+        self.stress_over_rho2.resize(all, zm);
+        self.art_on.resize(all, false);
+        self.volume.resize(all, R::zero());
         self.x_new.resize(all, z);
         self.v_new.resize(all, z);
         self.anchor.resize(all, z);
@@ -72,6 +85,7 @@ impl<R: Real> Scratch<R> {
             }
             self.rho[n + k] = rho0;
             self.rho_new[n + k] = rho0;
+            self.volume[n + k] = boundary_mass / rho0;
         }
         // At least one slot, so that the stress pass (which zips over chunks of it) sees
         // every particle without walls too.

@@ -18,7 +18,9 @@ use crate::boundary_particles::{
 };
 use crate::kernels::{Consts, ELASTOPLASTIC_KERNEL};
 use crate::params::{ElastoplasticParams, InitialStress, WallModel};
-use crate::passes::{max_displacement, momentum_pass, stress_pass, StepInputs};
+use crate::passes::{
+    boundary_pair_terms, max_displacement, momentum_pass, stress_pass, StepInputs,
+};
 use crate::scratch::Scratch;
 use crate::walls::{SharedWalls, WallSampler};
 
@@ -254,6 +256,7 @@ impl<R: Real> ElastoplasticScheme<R> {
             n,
             &self.boundary_particles,
             self.params.common.rest_density,
+            self.params.common.particle_mass(),
             self.models.len(),
         );
     }
@@ -301,6 +304,13 @@ impl<R: Real> ElastoplasticScheme<R> {
                 stats.phases.add(CREATE_HASH_GRID, search.build_s());
                 stats.phases.add(DETECT_NEIGHBOURS, search.detect_s());
                 s.anchor.copy_from_slice(&s.x);
+                s.boundary_lists.rebuild(
+                    self.parts.neighbours.lists(),
+                    &s.images,
+                    &s.x,
+                    n,
+                    self.boundary_particles.len(),
+                );
                 self.lists_valid = true;
                 self.searches += 1;
             }
@@ -320,27 +330,33 @@ impl<R: Real> ElastoplasticScheme<R> {
             if !bp.is_empty() {
                 let e = Extrapolation {
                     c: self.c,
-                    nb: self.parts.neighbours.lists(),
                     images: &s.images,
                     x: &s.x,
                     rho: &s.rho,
                     particles: bp,
                     gravity: self.params.common.gravity,
                 };
-                extrapolate(&e, &mut s.stress, Some(&mut s.v), None);
+                s.boundary_lists.weigh(&e);
+                extrapolate(&e, &s.boundary_lists, &mut s.stress, Some(&mut s.v), None);
             }
             stress_pass(s, &inputs);
             if !bp.is_empty() {
                 let e = Extrapolation {
                     c: self.c,
-                    nb: self.parts.neighbours.lists(),
                     images: &s.images,
                     x: &s.x,
                     rho: &s.rho,
                     particles: bp,
                     gravity: self.params.common.gravity,
                 };
-                extrapolate(&e, &mut s.stress_new, None, Some(&mut s.art));
+                extrapolate(
+                    &e,
+                    &s.boundary_lists,
+                    &mut s.stress_new,
+                    None,
+                    Some(&mut s.art),
+                );
+                boundary_pair_terms(s, n);
             }
             stats.phases.add(STRESS, t.elapsed().as_secs_f64());
             let t = Instant::now();
