@@ -1,4 +1,4 @@
-//! The fixed-base heap of the shipped scene `granular_repose_30` built in Rust, and a
+//! The fixed-base heap of the shipped scene `granular_repose_thesis_30` built in Rust, and a
 //! drained bed ([`drained_bed`]). Whether a heap is at rest is judged by
 //! `granular_measure::rest` (the examples `heap_30` and `drained` do).
 //!
