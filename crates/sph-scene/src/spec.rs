@@ -42,7 +42,9 @@ pub enum BoundaryModel {
     /// Walls of fixed boundary particles (`model = "particles"`; the elastoplastic solver's,
     /// which requires it): the lattice nodes inside the tank's walls and the solids within
     /// three spacings of their surfaces, each with its solid's `wall` model; the solids
-    /// also keep particles out as `collision` does.
+    /// also keep particles out as `collision` does, at a quarter spacing from their surfaces
+    /// (the volume maps' contact distance) rather than half: the boundary particles carry
+    /// the wall, the contact only catches a particle that would pass through it.
     Particles,
 }
 
