@@ -9,7 +9,7 @@
 //!
 //! Keys (defaults): `s` spacing (0.02 m), `E` (5.84e5 Pa), `alpha` (α_Π, 0.1), `phi`
 //! (30°), `C` (0.2), `cap` (6 s), `L` period (1.2 m), `H` bed height (0.2 m), `w` slot
-//! width (0.12 m), `sump` (0.6 m), `geo` (1: geostatic start; 0: unstressed), `u` the
+//! width (0.24 m), `sump` (0.6 m), `geo` (1: geostatic start; 0: unstressed), `u` the
 //! viscosity's fixed velocity scale (m/s; 0, the default: the speed of sound), `psi` the
 //! dilatancy angle (0°), `match` the cone's match (`psa` plane strain associated, the
 //! default; `ps` plane strain; `ss` simple shear: `ConeMatch`).

@@ -206,14 +206,15 @@ pub struct DrainedSetup {
 pub const DRAINED_PLATE_ROWS: f64 = 5.0;
 
 impl DrainedSetup {
-    /// The bed of the runs in `docs/elastoplastic-granular.md` at spacing `s` (m): period
-    /// 1.2 m, bed 0.2 m high, slot 0.12 m wide, sump 0.6 m deep, slab three spacings deep,
-    /// geostatic start.
+    /// The bed of the shipped scenes `scenes/granular_repose_30.toml` at spacing `s` (m):
+    /// period 1.2 m, bed 0.2 m high, slot 0.24 m wide (twelve grains at 20 mm: a narrower
+    /// one jams, run 30 of `docs/elastoplastic-granular.md`; runs 16–29 took 0.12 m), sump
+    /// 0.6 m deep, slab three spacings deep, geostatic start.
     pub fn for_spacing(s: f64) -> Self {
         Self {
             period_x_m: 1.2,
             bed_height_m: 0.2,
-            slot_width_m: 0.12,
+            slot_width_m: 0.24,
             sump_depth_m: 0.6,
             slab_depth_m: 3.0 * s,
             geostatic: true,

@@ -12,7 +12,7 @@
 //!
 //! **Formation** (the shipped scenes `scenes/granular_repose_{20,30,40}.toml`, run 16 of
 //! `docs/elastoplastic-granular.md`): a bed 0.2 m high at rest under its geostatic stress,
-//! periodic along `x` and `z`, on a floor plate with a slot 0.12 m wide centred on the
+//! periodic along `x` and `z`, on a floor plate with a slot 0.24 m wide centred on the
 //! periodic seam; the grains over the slot fall into a sump 0.6 m deep and the crater's
 //! flanks drain until they stop, leaving a mound whose flanks end at the slot's edges (the
 //! drained angle of repose). The period grows as θ falls so that both flanks reach the bed's
@@ -532,7 +532,7 @@ impl Experiment for GranularRepose {
         plot_angles(ctx, &measured)?;
         plot_profiles(ctx, &profiles)?;
         out.note(format!(
-            "drained heaps of the elastic-plastic model (plate with a 0.12 m slot, periodic bed 0.2 m high); rest = 99th-percentile and deep (2 spacings) speeds < 0.05 sqrt(g s) for 0.5 s and the angle moving < 0.3 deg over 1 s; angle = mean of both flanks' least-squares slopes between 20 % and 80 % of the heap height, steepest over {STEEPEST_RUN_M} m; {}",
+            "drained heaps of the elastic-plastic model (plate with a 0.24 m slot, periodic bed 0.2 m high); rest = 99th-percentile and deep (2 spacings) speeds < 0.05 sqrt(g s) for 0.5 s and the angle moving < 0.3 deg over 1 s; angle = mean of both flanks' least-squares slopes between 20 % and 80 % of the heap height, steepest over {STEEPEST_RUN_M} m; {}",
             match ctx.mode {
                 Mode::Quick => "spacing 20 mm (quick)",
                 Mode::Full => "spacing 10 mm (full), the thesis replay at 5 mm",
