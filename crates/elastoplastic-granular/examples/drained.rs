@@ -16,7 +16,7 @@
 //! `HEAP_BUDGET_S`, `HEAP_SAVE`, `HEAP_RESUME` split a long run into pieces (see
 //! `examples/pieces`).
 //!
-//! Prints every 0.1 s: time, 99th-percentile speed and fastest particle two spacings deep
+//! At rest, also the stress state of the flanks (`flank_stress`). Prints every 0.1 s: time, 99th-percentile speed and fastest particle two spacings deep
 //! of the grains on the floor, the angle (mean of the flanks) and each flank's, the grains
 //! on the floor, wall time; at the end whether the heap is at rest and its angle against
 //! the prediction for a heap formed by flowing, `atan(3 α_φ)`
@@ -70,6 +70,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         params.viscosity_alpha, params.viscosity_speed_m_s, params.dilatancy_angle_deg
     );
     let youngs = params.youngs_modulus;
+    let alpha_phi = cone_match.alpha(phi);
     let (mut solver, mut state) = drained_bed(params, setup)?;
     let (steps, dt) = solver.params().explicit_steps();
     let predicted = cone_match.predicted_repose_angle_deg(phi);
@@ -154,6 +155,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 start.elapsed().as_secs_f64()
             );
             profile(&x, s);
+            if let Some(m) = &measured {
+                flank_stress(&solver, &state, &setup, s, m.angle_deg, alpha_phi);
+            }
             return save(&solver, &state, &ids, &samples);
         }
     }
@@ -183,4 +187,94 @@ fn profile(x: &[elastoplastic_granular::Vec3<f64>], s: f64) {
         .map(|(b, h)| format!("{:.3}:{:.0}", (b as f64 + 0.5) * 0.05, 1000.0 * h))
         .collect();
     println!("profile (x m: top mm): {}", shown.join(" "));
+}
+
+/// The stress state of each flank at rest: over the grains on the floor two to five
+/// spacings below the surface, between 20 % and 80 % of the bed's height, the medians of
+/// the friction mobilised on planes parallel to the flank (`τ/σ_n`, to compare with the
+/// flank's `tan β`), of the in-plane Mohr circle's `R/p_in` (`sin` of the in-plane
+/// mobilised friction; at yield with `s_zz = 0` it is `3 α_φ`), of the Drucker–Prager
+/// yield ratio `√J2 / (3 α_φ p)`, of `s_zz/p`, and of the angle of the major (most
+/// compressive) principal stress from the horizontal (degrees, measured toward the crest).
+/// A flank that stopped in steady simple shear parallel to itself is at yield (ratio 1)
+/// with the principal stresses at 45° to its plane and `τ/σ_n = tan β = R/p_in = 3 α_φ`.
+fn flank_stress(
+    solver: &elastoplastic_granular::Elastoplastic<f64>,
+    state: &elastoplastic_granular::ParticleSet<f64>,
+    setup: &DrainedSetup,
+    s: f64,
+    beta_deg: f64,
+    alpha_phi: f64,
+) {
+    let stress = solver.scheme().stress();
+    let bins = (setup.period_x_m / s).ceil() as usize + 1;
+    let mut top = vec![f64::NEG_INFINITY; bins];
+    for p in &state.positions {
+        if setup.on_floor(p) {
+            let b = ((p.x / s) as usize).min(bins - 1);
+            top[b] = top[b].max(p.y);
+        }
+    }
+    let h = setup.bed_height_m;
+    let beta = beta_deg.to_radians();
+    for (name, left) in [("left", true), ("right", false)] {
+        let mut rows: Vec<[f64; 6]> = Vec::new();
+        for (p, sg) in state.positions.iter().zip(stress) {
+            if !setup.on_floor(p) || (p.x < 0.5 * setup.period_x_m) != left {
+                continue;
+            }
+            let b = ((p.x / s) as usize).min(bins - 1);
+            let depth = top[b] - p.y;
+            if !(depth >= 1.9 * s && depth <= 5.1 * s && p.y > 0.2 * h && p.y < 0.8 * h) {
+                continue;
+            }
+            let n = if left {
+                elastoplastic_granular::Vec3::new(-beta.sin(), beta.cos(), 0.0)
+            } else {
+                elastoplastic_granular::Vec3::new(beta.sin(), beta.cos(), 0.0)
+            };
+            let t = sg * n;
+            let sn = n.dot(&t);
+            let tau = (t - n * sn).norm();
+            let (sxx, syy, sxy, szz) = (sg[(0, 0)], sg[(1, 1)], sg[(0, 1)], sg[(2, 2)]);
+            let p3 = -(sxx + syy + szz) / 3.0;
+            let p_in = -(sxx + syy) / 2.0;
+            let r = (((sxx - syy) / 2.0).powi(2) + sxy * sxy).sqrt();
+            let dev = sg - nalgebra::Matrix3::identity() * (-p3);
+            let j2 = 0.5 * (dev * dev).trace();
+            // Major compressive principal direction: the eigenvector of the most negative
+            // in-plane principal stress.
+            let theta = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+            let major = if sxx + syy - 2.0 * r < 0.0 {
+                theta + std::f64::consts::FRAC_PI_2
+            } else {
+                theta
+            };
+            let mut ang = major.to_degrees().rem_euclid(180.0);
+            if !left {
+                ang = 180.0 - ang;
+            }
+            rows.push([
+                tau / -sn,
+                r / p_in,
+                j2.sqrt() / (3.0 * alpha_phi * p3),
+                dev[(2, 2)] / p3,
+                ang,
+                p3,
+            ]);
+        }
+        let med = |k: usize| {
+            let mut v: Vec<f64> = rows
+                .iter()
+                .map(|r| r[k])
+                .filter(|x| x.is_finite())
+                .collect();
+            v.sort_by(f64::total_cmp);
+            v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+        };
+        println!(
+            "{name} flank ({} grains, 2-5 spacings deep): tau/sigma_n {:.3} (tan beta {:.3}), R/p_in {:.3} (3 alpha {:.3}), yield ratio {:.3}, s_zz/p {:.3}, major principal stress at {:.1} deg from the horizontal (toward the crest), p {:.0} Pa",
+            rows.len(), med(0), beta.tan(), med(1), 3.0 * alpha_phi, med(2), med(3), med(4), med(5)
+        );
+    }
 }
