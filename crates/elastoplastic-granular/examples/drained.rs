@@ -11,7 +11,8 @@
 //! (30°), `C` (0.2), `cap` (6 s), `L` period (1.2 m), `H` bed height (0.2 m), `w` slot
 //! width (0.24 m), `sump` (0.6 m), `geo` (1: geostatic start; 0: unstressed), `u` the
 //! viscosity's fixed velocity scale (m/s; 0, the default: the speed of sound), `psi` the
-//! dilatancy angle (0°), `match` the cone's match (`psa` plane strain associated, the
+//! dilatancy angle (0°), `door` a trapdoor's speed (m/s; 0, the default: an open slot over
+//! the sump; `DrainedSetup::trapdoor_speed_m_s`), `match` the cone's match (`psa` plane strain associated, the
 //! default; `ps` plane strain; `ss` simple shear: `ConeMatch`).
 //! `HEAP_BUDGET_S`, `HEAP_SAVE`, `HEAP_RESUME` split a long run into pieces (see
 //! `examples/pieces`).
@@ -24,7 +25,7 @@
 
 use std::time::Instant;
 
-use elastoplastic_granular::heap::{drained_bed, DrainedSetup};
+use elastoplastic_granular::heap::{drained_bed, trapdoor_update, DrainedSetup};
 use elastoplastic_granular::{ConeMatch, ElastoplasticParams};
 use granular_measure::{angle_of_repose, ReposeOptions, RestSample};
 
@@ -65,6 +66,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     setup.slot_width_m = num("w", setup.slot_width_m)?;
     setup.sump_depth_m = num("sump", setup.sump_depth_m)?;
     setup.geostatic = num("geo", 1.0)? != 0.0;
+    let door = num("door", 0.0)?;
+    setup.trapdoor_speed_m_s = (door > 0.0).then_some(door);
     println!(
         "{setup:?}, alpha_Pi {}, viscosity speed {:?}, psi {} deg",
         params.viscosity_alpha, params.viscosity_speed_m_s, params.dilatancy_angle_deg
@@ -115,10 +118,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             return save(&solver, &state, &ids, &samples);
         }
         solver.step(&mut state)?;
+        let t = frame as f64 * frame_dt;
+        trapdoor_update(&mut solver, &setup, t)?;
         if let Some(perm) = solver.last_permutation() {
             ids = perm.iter().map(|&o| ids[o as usize]).collect();
         }
-        let t = frame as f64 * frame_dt;
         let (x, v): (Vec<_>, Vec<_>) = state
             .positions
             .iter()
@@ -131,7 +135,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let now = sample(&x, &v, s, t, angle)?;
         let (p99, deep) = (now.percentile_speed_m_s, now.deep_max_speed_m_s);
         samples.push(now);
-        let rest = at_rest(&samples, s)?;
+        // Not at rest while the trapdoor still moves.
+        let rest = at_rest(&samples, s)? && setup.trapdoor_travel_s().is_none_or(|d| t > d);
         if frame % 6 == 0 || rest {
             let flanks = measured.as_ref().map_or(String::new(), |m| {
                 m.flanks

@@ -44,6 +44,12 @@
 //! 0.17 m): `μ_w |t_n|` caps the traction the wall takes, and the grains' own shear stress
 //! next to a sliding wall, which the wall's share cannot exceed, stays below that cap.
 //!
+//! **Moving walls.** A boundary particle with a wall velocity `v_w` moves with it (`x_b +=
+//! v_w Δt` each explicit step) and its model acts on the relative velocity: `v_b = v_w +
+//! f(ṽ − v_w)` with `f` the fixed wall's rule above (`−u`, the mirror `P u`, or Coulomb's
+//! blend). The wall's acceleration is taken as zero (Adami et al. 2012, eq. 27, has
+//! `g − a_w`): a wall moves at constant velocity between the changes its owner makes.
+//!
 //! Their density is `ρ0` and their mass that of a particle; they enter every sum (velocity
 //! gradient, continuity, momentum, artificial viscosity and stress) as neighbours. The
 //! isotropic gravity term carries the hydrostatic gradient of the normal stress across the
@@ -72,6 +78,9 @@ pub struct BoundaryParticle<R: Real> {
     pub normal: Vec3<R>,
     /// Free-slip (mirrored), no-slip (opposite velocity) or Coulomb (module docs).
     pub model: WallModel,
+    /// The wall's velocity (m/s; zero for a fixed wall): the particle moves with it, and
+    /// the models act on the grains' velocity relative to it (module docs).
+    pub velocity: Vec3<R>,
 }
 
 /// Boundary particles on the cubic lattice of spacing `spacing` filling `region` (half a
@@ -100,6 +109,7 @@ pub fn boundary_block<R: Real>(
             position,
             normal,
             model,
+            velocity: Vec3::zeros(),
         })
         .collect())
 }
@@ -251,11 +261,15 @@ pub(crate) fn extrapolate<R: Real>(
             } else {
                 (Matrix3::zeros(), Vec3::zeros())
             };
+            // A moving wall: its models act on the velocity relative to it.
+            let moving = p.velocity != Vec3::zeros();
+            let v_rel = if moving { v_bar - p.velocity } else { v_bar };
             let (s_b, v_b) = match p.model {
-                WallModel::NoSlip => (s_bar, -v_bar),
-                WallModel::Coulomb(mu) => coulomb(&s_bar, &v_bar, &p.normal, R::of_f64(mu)),
-                _ => (mirror * s_bar * mirror, mirror * v_bar),
+                WallModel::NoSlip => (s_bar, -v_rel),
+                WallModel::Coulomb(mu) => coulomb(&s_bar, &v_rel, &p.normal, R::of_f64(mu)),
+                _ => (mirror * s_bar * mirror, mirror * v_rel),
             };
+            let v_b = if moving { v_b + p.velocity } else { v_b };
             *sig = s_b;
             if let Some(vel) = vel {
                 *vel = v_b;
@@ -405,6 +419,7 @@ pub fn sample_solids<R: Real>(
                     position: x,
                     normal: g / len,
                     model,
+                    velocity: Vec3::zeros(),
                 });
             }
         }

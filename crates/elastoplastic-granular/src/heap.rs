@@ -13,7 +13,7 @@ use sph_core::sampling::cubic_lattice;
 use sph_core::{Aabb, BoxSdf, ParticleSet, Plane, Real, Vec3};
 use sph_solver::{Solids, SolverError};
 
-use crate::boundary_particles::boundary_block;
+use crate::boundary_particles::{boundary_block, BoundaryParticle};
 use crate::params::{ElastoplasticParams, InitialStress, WallModel};
 use crate::periodic::PeriodicAxis;
 use crate::solver::{Elastoplastic, ElastoplasticScheme};
@@ -198,6 +198,12 @@ pub struct DrainedSetup {
     /// Start from the geostatic stress ([`crate::initial::geostatic`]: `σ_yy = −ρ0 g
     /// (H − y)`, `σ_xx = σ_zz = K0 σ_yy`, `K0 = ν/(1 − ν)`) rather than unstressed.
     pub geostatic: bool,
+    /// `None`: the slot is open over the sump (the grains fall through it). `Some(v)`: a
+    /// slow drain. The slot is a channel `sump_depth_m` deep with free-slip walls, closed at
+    /// the plate's top by a trapdoor (three rows of no-slip boundary particles) that is
+    /// lowered at `v` m/s ([`trapdoor_update`] stops it at the channel's floor): the grains
+    /// over the slot descend with it and the flanks form by slow flows.
+    pub trapdoor_speed_m_s: Option<f64>,
 }
 
 /// Rows of boundary particles in the drained bed's floor plate: with the support 2.4
@@ -218,7 +224,13 @@ impl DrainedSetup {
             sump_depth_m: 0.6,
             slab_depth_m: 3.0 * s,
             geostatic: true,
+            trapdoor_speed_m_s: None,
         }
+    }
+
+    /// How long the trapdoor takes to reach the channel's floor (s; `None` without one).
+    pub fn trapdoor_travel_s(&self) -> Option<f64> {
+        self.trapdoor_speed_m_s.map(|v| self.sump_depth_m / v)
     }
 
     /// Whether a grain at `p` is on the floor beside the slot (part of the drained heap).
@@ -256,11 +268,17 @@ pub fn drained_bed<R: Real>(
             hi: R::of_f64(d),
         },
     ];
-    // The solids only keep grains out of the plate and under the sump's floor.
+    // The solids only keep grains out of the plate (down to the channel's floor with a
+    // trapdoor: its sides are the channel's walls) and under the sump's floor.
     let (far_lo, far_hi) = (-0.5, d + 0.5);
+    let plate_bottom = if setup.trapdoor_speed_m_s.is_some() {
+        sump_floor
+    } else {
+        -plate
+    };
     let solids: Solids<R> = vec![
         Box::new(BoxSdf::new(aabb(
-            [half, -plate, far_lo],
+            [half, plate_bottom, far_lo],
             [l - half, 0.0, far_hi],
         )?)?),
         Box::new(Plane::new(v(0.0, sump_floor, 0.0), v(0.0, 1.0, 0.0))?),
@@ -298,8 +316,58 @@ pub fn drained_bed<R: Real>(
         WallModel::NoSlip,
         1 << 22,
     )?);
+    if let Some(speed) = setup.trapdoor_speed_m_s {
+        let wall = BOUNDARY_ROWS * s;
+        for (x0, x1, nx) in [(half, half + wall, -1.0), (l - half - wall, l - half, 1.0)] {
+            rows.extend(boundary_block(
+                &aabb([x0, sump_floor, 0.0], [x1, -plate, d])?,
+                R::of_f64(s),
+                v(nx, 0.0, 0.0),
+                WallModel::FreeSlip,
+                1 << 22,
+            )?);
+        }
+        let down = v(0.0, -speed, 0.0);
+        for (x0, x1) in [(0.0, half), (l - half, l)] {
+            let door = boundary_block(
+                &aabb([x0, -wall, 0.0], [x1, 0.0, d])?,
+                R::of_f64(s),
+                up,
+                WallModel::NoSlip,
+                1 << 22,
+            )?;
+            rows.extend(door.into_iter().map(|b| BoundaryParticle {
+                velocity: down,
+                ..b
+            }));
+        }
+    }
     solver.scheme_mut().set_boundary_particles(rows)?;
     Ok((solver, state))
+}
+
+/// Stops the drained bed's trapdoor ([`DrainedSetup::trapdoor_speed_m_s`]) once it has
+/// reached the channel's floor, at `time_s` (s) from the start: call it after each frame.
+/// Without a trapdoor, or once stopped, it does nothing.
+pub fn trapdoor_update<R: Real>(
+    solver: &mut Elastoplastic<R>,
+    setup: &DrainedSetup,
+    time_s: f64,
+) -> Result<(), SolverError> {
+    let Some(travel_s) = setup.trapdoor_travel_s() else {
+        return Ok(());
+    };
+    let bp = solver.scheme().boundary_particles();
+    let moving = bp.iter().position(|b| b.velocity != Vec3::zeros());
+    match moving {
+        Some(first) if time_s >= travel_s => {
+            let end = bp.len();
+            solver
+                .scheme_mut()
+                .set_boundary_velocity(first..end, Vec3::zeros())
+        }
+        _ => Ok(()),
+    }
 }
 
 /// A slope cut in a settled layer: a mound of grains on a flat no-slip floor, periodic

@@ -54,9 +54,11 @@
 //! of the solids. `Δt = (dt/substeps)/n` with the smallest `n` such that `Δt ≤ C h / c`,
 //! `c = √(E/ρ0)`, `h` the smoothing length (half the support radius). The steps are
 //! sub-cycled inside each substep of the frame shell; the neighbour lists are built with
-//! radius `support + skin` and kept while no particle has moved more than `skin/2`.
+//! radius `support + skin` and kept while no particle has moved more than `skin/2` (and no
+//! grain and moving wall together more than `skin`).
 //!
-//! Walls are rows of fixed boundary particles ([`boundary_particles`]; from a scene's solids
+//! Walls are rows of boundary particles, fixed or moving at a velocity
+//! ([`ElastoplasticScheme::set_boundary_velocity`]) ([`boundary_particles`]; from a scene's solids
 //! with [`ElastoplasticParams::boundary_particle_region`], [`sample_solids`]) or volume maps
 //! sampled solid by solid, each solid with its [`WallModel`] (free-slip, no-slip, or, for
 //! boundary particles, Coulomb with a wall friction coefficient; see [`boundary_particles`]

@@ -58,6 +58,10 @@ pub struct ElastoplasticScheme<R: Real> {
     walls: WallSampler<R>,
     models: Vec<WallModel>,
     boundary_particles: Vec<BoundaryParticle<R>>,
+    /// The fastest boundary particle's speed (m/s; zero: all fixed).
+    boundary_speed: R,
+    /// How far the boundary particles moved since the last neighbour search (m).
+    boundary_shift: R,
     scratch: Scratch<R>,
     lists_valid: bool,
     explicit_steps: u64,
@@ -142,6 +146,8 @@ impl<R: Real> ElastoplasticScheme<R> {
             walls,
             models,
             boundary_particles: Vec::new(),
+            boundary_speed: R::zero(),
+            boundary_shift: R::zero(),
             scratch: Scratch::default(),
             lists_valid: false,
             explicit_steps: 0,
@@ -209,10 +215,10 @@ impl<R: Real> ElastoplasticScheme<R> {
         Ok(())
     }
 
-    /// Sets the fixed boundary particles (see [`crate::boundary_particles`]); they take
-    /// part in every sum from the next step on. Solids whose share they replace should
-    /// have the model [`WallModel::ContactOnly`]. Errors: a non-finite position or normal,
-    /// named by its index.
+    /// Sets the boundary particles (see [`crate::boundary_particles`]); they take part in
+    /// every sum from the next step on, and those with a velocity move with it. Solids
+    /// whose share they replace should have the model [`WallModel::ContactOnly`]. Errors: a
+    /// non-finite position, normal or velocity, named by its index.
     pub fn set_boundary_particles(
         &mut self,
         particles: Vec<BoundaryParticle<R>>,
@@ -222,6 +228,7 @@ impl<R: Real> ElastoplasticScheme<R> {
                 .position
                 .iter()
                 .chain(b.normal.iter())
+                .chain(b.velocity.iter())
                 .all(|v| v.is_finite())
                 && b.normal.norm() > R::zero();
             if !ok {
@@ -229,7 +236,7 @@ impl<R: Real> ElastoplasticScheme<R> {
                     solver: NAME,
                     name: "boundary_particles",
                     value: k as f64,
-                    reason: "each boundary particle needs a finite position and a finite non-zero normal (value: the first that has not)",
+                    reason: "each boundary particle needs a finite position and velocity and a finite non-zero normal (value: the first that has not)",
                 });
             }
         }
@@ -241,9 +248,65 @@ impl<R: Real> ElastoplasticScheme<R> {
                 ..b
             })
             .collect();
+        self.boundary_speed = self.fastest_boundary();
         self.resize(n);
         self.lists_valid = false;
         Ok(())
+    }
+
+    /// Sets the wall velocity (m/s) of the boundary particles `range` (indices into
+    /// [`ElastoplasticScheme::boundary_particles`]), e.g. to start or stop a wall: they
+    /// move with it from the next step on. Errors: a range past the boundary particles or
+    /// a non-finite velocity.
+    pub fn set_boundary_velocity(
+        &mut self,
+        range: std::ops::Range<usize>,
+        velocity: Vec3<R>,
+    ) -> Result<(), SolverError> {
+        let error = |value: f64, reason: &'static str| SolverError::InvalidParameter {
+            solver: NAME,
+            name: "boundary_velocity",
+            value,
+            reason,
+        };
+        if range.end > self.boundary_particles.len() || range.start > range.end {
+            return Err(error(
+                range.end as f64,
+                "the range must lie within the boundary particles (value: its end)",
+            ));
+        }
+        if !velocity.iter().all(|v| v.is_finite()) {
+            return Err(error(
+                velocity.norm().as_f64(),
+                "a wall velocity must be finite (value: its norm)",
+            ));
+        }
+        for b in &mut self.boundary_particles[range] {
+            b.velocity = velocity;
+        }
+        self.boundary_speed = self.fastest_boundary();
+        Ok(())
+    }
+
+    fn fastest_boundary(&self) -> R {
+        self.boundary_particles
+            .iter()
+            .map(|b| b.velocity.norm())
+            .fold(R::zero(), |a, b| if b > a { b } else { a })
+    }
+
+    /// Moves the boundary particles that have a velocity by `dt` (their positions, and the
+    /// scratch's of this step and the next).
+    fn move_boundary(&mut self, n: usize, dt: R) {
+        let s = &mut self.scratch;
+        for (k, b) in self.boundary_particles.iter_mut().enumerate() {
+            if b.velocity != Vec3::zeros() {
+                b.position += b.velocity * dt;
+                s.x[n + k] = b.position;
+                s.x_new[n + k] = b.position;
+            }
+        }
+        self.boundary_shift += self.boundary_speed * dt;
     }
 
     /// The boundary particles.
@@ -283,13 +346,19 @@ impl<R: Real> ElastoplasticScheme<R> {
         let skin = self.params.skin;
         let half = R::of_f64(0.5);
         let n = state.len();
-        let s = &mut self.scratch;
-        s.x[..n].copy_from_slice(&state.positions);
-        s.v[..n].copy_from_slice(&state.velocities);
-        s.rho[..n].copy_from_slice(&state.densities);
+        self.scratch.x[..n].copy_from_slice(&state.positions);
+        self.scratch.v[..n].copy_from_slice(&state.velocities);
+        self.scratch.rho[..n].copy_from_slice(&state.densities);
         let boundary_mass = self.params.common.particle_mass();
         for _ in 0..steps {
-            if !self.lists_valid || max_displacement(s, n) > skin * half {
+            if self.boundary_speed > R::zero() {
+                self.move_boundary(n, dt);
+            }
+            let s = &mut self.scratch;
+            let moved = max_displacement(s, n);
+            // A pair stays within the lists' reach `h + skin` while the two together moved
+            // less than the skin: grains `2 × moved`, a grain and a wall `moved + shift`.
+            if !self.lists_valid || moved > skin * half || moved + self.boundary_shift > skin {
                 let axes = &self.params.periodic;
                 let search = if axes.is_empty() {
                     self.parts
@@ -311,7 +380,14 @@ impl<R: Real> ElastoplasticScheme<R> {
                     n,
                     self.boundary_particles.len(),
                 );
+                if self.boundary_speed > R::zero() {
+                    // The search wrapped the positions into the periods.
+                    for (k, b) in self.boundary_particles.iter_mut().enumerate() {
+                        b.position = s.x[n + k];
+                    }
+                }
                 self.lists_valid = true;
+                self.boundary_shift = R::zero();
                 self.searches += 1;
             }
             let inputs = StepInputs {
@@ -370,6 +446,7 @@ impl<R: Real> ElastoplasticScheme<R> {
             self.explicit_steps += 1;
             stats.iterations += 1;
         }
+        let s = &self.scratch;
         check_divergence(at, &s.x[..n], &s.v[..n], &*self.parts.boundary, h)?;
         check_sound_barrier(at, &s.v[..n], self.params.sound_speed())?;
         state.positions.copy_from_slice(&s.x[..n]);

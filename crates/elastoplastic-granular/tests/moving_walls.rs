@@ -1,0 +1,156 @@
+//! Moving walls of boundary particles: a floor that moves carries the grains on it (no-slip
+//! along it, any model across it) and a free-slip floor sliding under them does not drag
+//! them; the wall velocity is checked when set.
+
+use elastoplastic_granular::{
+    boundary_block, cubic_lattice, Aabb, Elastoplastic, ElastoplasticParams, InitialStress,
+    ParticleSet, PeriodicAxis, Solids, SolverError, Vec3, WallModel,
+};
+
+const S: f64 = 0.02;
+
+/// An elastic slab `8s × 5s × 4s`, periodic along `x` and `z`, at rest under its geostatic
+/// stress on a floor of three rows of boundary particles of model `wall` under `y = 0`
+/// (no contact solid: the floor's particles alone hold the slab), the floor moving at
+/// `velocity` from the start. Cohesion 100 kPa keeps the slab inside its cone (elastic).
+/// Returns the slab's mean displacement and the floor's after `t_s` seconds.
+fn slab_on_moving_floor(wall: WallModel, velocity: Vec3<f64>, t_s: f64) -> (Vec3<f64>, Vec3<f64>) {
+    let mut p = ElastoplasticParams::<f64>::for_spacing(S, 30.0);
+    p.cohesion = 1e5;
+    p.common.dt = 0.02;
+    let hi = Vec3::new(8.0 * S, 5.0 * S, 4.0 * S);
+    for axis in [0, 2] {
+        p.periodic.push(PeriodicAxis {
+            axis,
+            lo: 0.0,
+            hi: hi[axis],
+        });
+    }
+    p.initial_stress = InitialStress::Geostatic;
+    let region = Aabb::new(Vec3::zeros(), hi).unwrap();
+    let x = cubic_lattice(&region, S, 10_000).unwrap();
+    let mut state = ParticleSet::from_positions(x, p.common.particle_mass(), p.common.rest_density);
+    let solids: Solids<f64> = Vec::new();
+    let mut solver = Elastoplastic::new(p, solids).unwrap();
+    let rows = Aabb::new(Vec3::new(0.0, -3.0 * S, 0.0), Vec3::new(hi.x, 0.0, hi.z)).unwrap();
+    let floor = boundary_block(&rows, S, Vec3::y(), wall, 10_000).unwrap();
+    let count = floor.len();
+    solver.scheme_mut().set_boundary_particles(floor).unwrap();
+    let floor_start = solver.scheme().boundary_particles()[0].position;
+    solver
+        .scheme_mut()
+        .set_boundary_velocity(0..count, velocity)
+        .unwrap();
+    let start = state.positions.clone();
+    let frames = (t_s / 0.02).round() as usize;
+    let mut travelled = vec![Vec3::zeros(); state.len()];
+    let mut before = start;
+    for _ in 0..frames {
+        solver.step(&mut state).unwrap();
+        if let Some(perm) = solver.last_permutation() {
+            // The step reordered the particles first: follow them.
+            before = perm.iter().map(|&o| before[o as usize]).collect();
+            travelled = perm.iter().map(|&o| travelled[o as usize]).collect();
+        }
+        for (k, (x, b)) in state.positions.iter().zip(&before).enumerate() {
+            let mut d = x - b;
+            for a in [0, 2] {
+                // Unwrapped: a periodic wrap moves a particle by one period.
+                if d[a] > 0.5 * hi[a] {
+                    d[a] -= hi[a];
+                } else if d[a] < -0.5 * hi[a] {
+                    d[a] += hi[a];
+                }
+            }
+            travelled[k] += d;
+        }
+        before = state.positions.clone();
+    }
+    let mean = travelled.iter().sum::<Vec3<f64>>() / state.len() as f64;
+    let mut floor_moved = solver.scheme().boundary_particles()[0].position - floor_start;
+    for a in [0, 2] {
+        floor_moved[a] = floor_moved[a].rem_euclid(hi[a]);
+        if floor_moved[a] > 0.5 * hi[a] {
+            floor_moved[a] -= hi[a];
+        }
+    }
+    (mean, floor_moved)
+}
+
+/// A floor lowered at 5 cm/s (a tenth of `√(g s)`): the slab descends with it, by the
+/// floor's travel within 10 % (the slab starts at rest and catches up within its elastic
+/// wave's crossing time, `5 s / √(E/ρ0)` ≈ 0.6 ms, plus the damping of its bounce), and
+/// does not move sideways.
+#[test]
+fn a_lowered_floor_carries_the_slab_down() {
+    let w = 0.05;
+    let t = 0.3;
+    let (slab, floor) = slab_on_moving_floor(WallModel::NoSlip, Vec3::new(0.0, -w, 0.0), t);
+    eprintln!("slab {slab:?}, floor {floor:?}");
+    // The floor's particles move exactly with the wall: w t (rounding only).
+    assert!((floor.y + w * t).abs() < 1e-9, "floor moved {floor:?}");
+    assert!(
+        (slab.y + w * t).abs() < 0.1 * w * t,
+        "slab moved {:?} against the floor's {}",
+        slab,
+        -w * t
+    );
+    assert!(slab.x.abs() < 0.1 * S && slab.z.abs() < 0.1 * S);
+}
+
+/// A no-slip floor sliding along `x` at 0.1 m/s drags the (elastic, cohesive) slab with
+/// it: its mean travel is the floor's within 10 % (it lags by the shear wave's crossing
+/// time and its damped oscillation); a free-slip floor sliding the same way leaves it in
+/// place (under a tenth of a spacing): the mirrored relative velocity shears nothing.
+#[test]
+fn a_sliding_floor_drags_the_slab_only_if_no_slip() {
+    let u = 0.1;
+    let t = 0.3;
+    let (dragged, floor) = slab_on_moving_floor(WallModel::NoSlip, Vec3::new(u, 0.0, 0.0), t);
+    let (left, _) = slab_on_moving_floor(WallModel::FreeSlip, Vec3::new(u, 0.0, 0.0), t);
+    eprintln!("no-slip: slab {dragged:?}, floor {floor:?}; free-slip: slab {left:?}");
+    assert!((floor.x - u * t).abs() < 1e-9, "floor moved {floor:?}");
+    assert!(
+        (dragged.x - u * t).abs() < 0.1 * u * t,
+        "no-slip floor: slab moved {dragged:?}"
+    );
+    assert!(
+        left.x.abs() < 0.1 * S,
+        "free-slip floor: slab moved {left:?}"
+    );
+}
+
+/// The wall velocity is checked: a range past the boundary particles and a non-finite
+/// velocity are refused, by name.
+#[test]
+fn a_wall_velocity_out_of_range_or_not_finite_is_refused() {
+    let p = ElastoplasticParams::<f64>::for_spacing(S, 30.0);
+    let mut solver = Elastoplastic::new(p, Vec::new()).unwrap();
+    let rows = Aabb::new(Vec3::new(0.0, -3.0 * S, 0.0), Vec3::new(0.1, 0.0, 0.1)).unwrap();
+    let floor = boundary_block(&rows, S, Vec3::y(), WallModel::NoSlip, 10_000).unwrap();
+    let n = floor.len();
+    solver.scheme_mut().set_boundary_particles(floor).unwrap();
+    let named = |e: SolverError| {
+        matches!(
+            e,
+            SolverError::InvalidParameter {
+                name: "boundary_velocity",
+                ..
+            }
+        )
+    };
+    let past = solver
+        .scheme_mut()
+        .set_boundary_velocity(0..n + 1, Vec3::zeros())
+        .unwrap_err();
+    assert!(named(past));
+    let nan = solver
+        .scheme_mut()
+        .set_boundary_velocity(0..n, Vec3::new(f64::NAN, 0.0, 0.0))
+        .unwrap_err();
+    assert!(named(nan));
+    solver
+        .scheme_mut()
+        .set_boundary_velocity(0..n, Vec3::new(0.0, -1.0, 0.0))
+        .unwrap();
+}
