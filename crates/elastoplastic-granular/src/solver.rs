@@ -44,8 +44,10 @@ const REORDER: usize = 5;
 
 /// What the solver carries between frames ([`SubstepScheme::save_arrays`]): the stress
 /// (`6 n` values per particle in the order xx, yy, zz, xy, yz, zx) and the equivalent
-/// plastic shear strain (`n` values). The density is the particles' own.
-pub const ELASTOPLASTIC_STATE_ARRAYS: &[&str] = &["stress", "plastic_strain"];
+/// plastic shear strain (`n` values). The density is the particles' own. Once a wall of
+/// boundary particles has moved, also `boundary_motion`: each boundary particle's position
+/// and wall velocity (6 values per boundary particle, m and m/s).
+pub const ELASTOPLASTIC_STATE_ARRAYS: &[&str] = &["stress", "plastic_strain", "boundary_motion"];
 
 /// The elastic–plastic granular solver of Bui et al. (2008); see the crate documentation.
 pub type Elastoplastic<R> = FrameSolver<R, ElastoplasticScheme<R>>;
@@ -62,6 +64,8 @@ pub struct ElastoplasticScheme<R: Real> {
     boundary_speed: R,
     /// How far the boundary particles moved since the last neighbour search (m).
     boundary_shift: R,
+    /// A boundary particle has moved: checkpoints carry their positions and velocities.
+    boundary_moved: bool,
     scratch: Scratch<R>,
     lists_valid: bool,
     explicit_steps: u64,
@@ -148,6 +152,7 @@ impl<R: Real> ElastoplasticScheme<R> {
             boundary_particles: Vec::new(),
             boundary_speed: R::zero(),
             boundary_shift: R::zero(),
+            boundary_moved: false,
             scratch: Scratch::default(),
             lists_valid: false,
             explicit_steps: 0,
@@ -307,6 +312,29 @@ impl<R: Real> ElastoplasticScheme<R> {
             }
         }
         self.boundary_shift += self.boundary_speed * dt;
+        self.boundary_moved = true;
+    }
+
+    /// The per-particle arrays: stress (`xx, yy, zz, xy, yz, zx`) and plastic strain.
+    fn particle_arrays(&self, arrays: &mut Vec<(String, Vec<R>)>) {
+        let s = &self.scratch;
+        arrays.push((
+            "stress".into(),
+            s.stress[..s.plastic_strain.len()]
+                .iter()
+                .flat_map(|m| {
+                    [
+                        m[(0, 0)],
+                        m[(1, 1)],
+                        m[(2, 2)],
+                        m[(0, 1)],
+                        m[(1, 2)],
+                        m[(2, 0)],
+                    ]
+                })
+                .collect(),
+        ));
+        arrays.push(("plastic_strain".into(), s.plastic_strain.clone()));
     }
 
     /// The boundary particles.
@@ -522,27 +550,22 @@ impl<R: Real> SubstepScheme<R> for ElastoplasticScheme<R> {
     /// The stress (Pa, `xx, yy, zz, xy, yz, zx`) and the equivalent plastic shear strain:
     /// the arrays a checkpoint carries.
     fn particle_fields(&self, fields: &mut Vec<(String, Vec<R>)>) {
-        self.save_arrays(fields);
+        self.particle_arrays(fields);
     }
     fn save_arrays(&self, arrays: &mut Vec<(String, Vec<R>)>) {
-        let s = &self.scratch;
-        arrays.push((
-            "stress".into(),
-            s.stress[..s.plastic_strain.len()]
-                .iter()
-                .flat_map(|m| {
-                    [
-                        m[(0, 0)],
-                        m[(1, 1)],
-                        m[(2, 2)],
-                        m[(0, 1)],
-                        m[(1, 2)],
-                        m[(2, 0)],
-                    ]
-                })
-                .collect(),
-        ));
-        arrays.push(("plastic_strain".into(), s.plastic_strain.clone()));
+        self.particle_arrays(arrays);
+        if self.boundary_moved {
+            arrays.push((
+                "boundary_motion".into(),
+                self.boundary_particles
+                    .iter()
+                    .flat_map(|b| {
+                        let (x, v) = (b.position, b.velocity);
+                        [x.x, x.y, x.z, v.x, v.y, v.z]
+                    })
+                    .collect(),
+            ));
+        }
     }
     fn restore_arrays(
         &mut self,
@@ -562,8 +585,27 @@ impl<R: Real> SubstepScheme<R> for ElastoplasticScheme<R> {
                     name: "plastic_strain",
                     len: n,
                 },
+                ArraySpec {
+                    name: "boundary_motion",
+                    len: 6 * self.boundary_particles.len(),
+                },
             ],
         )?;
+        if let Some(v) = found[2] {
+            if v.iter().any(|x| !x.is_finite()) {
+                return Err(SolverError::InvalidSolverState {
+                    solver: NAME.to_owned(),
+                    reason: "the boundary particles' positions and velocities must be finite"
+                        .into(),
+                });
+            }
+            for (b, c) in self.boundary_particles.iter_mut().zip(v.chunks_exact(6)) {
+                b.position = Vec3::new(c[0], c[1], c[2]);
+                b.velocity = Vec3::new(c[3], c[4], c[5]);
+            }
+            self.boundary_speed = self.fastest_boundary();
+            self.boundary_moved = true;
+        }
         self.resize(n);
         let s = &mut self.scratch;
         match found[0] {

@@ -12,9 +12,9 @@ const S: f64 = 0.02;
 /// An elastic slab `8s × 5s × 4s`, periodic along `x` and `z`, at rest under its geostatic
 /// stress on a floor of three rows of boundary particles of model `wall` under `y = 0`
 /// (no contact solid: the floor's particles alone hold the slab), the floor moving at
-/// `velocity` from the start. Cohesion 100 kPa keeps the slab inside its cone (elastic).
-/// Returns the slab's mean displacement and the floor's after `t_s` seconds.
-fn slab_on_moving_floor(wall: WallModel, velocity: Vec3<f64>, t_s: f64) -> (Vec3<f64>, Vec3<f64>) {
+/// `velocity`. Cohesion 100 kPa keeps the slab inside its cone (elastic). Returns the
+/// solver, the slab and the period along `x` and `z`.
+fn slab(wall: WallModel, velocity: Vec3<f64>) -> (Elastoplastic<f64>, ParticleSet<f64>, Vec3<f64>) {
     let mut p = ElastoplasticParams::<f64>::for_spacing(S, 30.0);
     p.cohesion = 1e5;
     p.common.dt = 0.02;
@@ -29,18 +29,25 @@ fn slab_on_moving_floor(wall: WallModel, velocity: Vec3<f64>, t_s: f64) -> (Vec3
     p.initial_stress = InitialStress::Geostatic;
     let region = Aabb::new(Vec3::zeros(), hi).unwrap();
     let x = cubic_lattice(&region, S, 10_000).unwrap();
-    let mut state = ParticleSet::from_positions(x, p.common.particle_mass(), p.common.rest_density);
+    let state = ParticleSet::from_positions(x, p.common.particle_mass(), p.common.rest_density);
     let solids: Solids<f64> = Vec::new();
     let mut solver = Elastoplastic::new(p, solids).unwrap();
     let rows = Aabb::new(Vec3::new(0.0, -3.0 * S, 0.0), Vec3::new(hi.x, 0.0, hi.z)).unwrap();
     let floor = boundary_block(&rows, S, Vec3::y(), wall, 10_000).unwrap();
     let count = floor.len();
     solver.scheme_mut().set_boundary_particles(floor).unwrap();
-    let floor_start = solver.scheme().boundary_particles()[0].position;
     solver
         .scheme_mut()
         .set_boundary_velocity(0..count, velocity)
         .unwrap();
+    (solver, state, hi)
+}
+
+/// The slab of [`slab`] with its floor moving at `velocity` from the start: the slab's mean
+/// displacement and the floor's after `t_s` seconds.
+fn slab_on_moving_floor(wall: WallModel, velocity: Vec3<f64>, t_s: f64) -> (Vec3<f64>, Vec3<f64>) {
+    let (mut solver, mut state, hi) = slab(wall, velocity);
+    let floor_start = solver.scheme().boundary_particles()[0].position;
     let start = state.positions.clone();
     let frames = (t_s / 0.02).round() as usize;
     let mut travelled = vec![Vec3::zeros(); state.len()];
@@ -153,4 +160,42 @@ fn a_wall_velocity_out_of_range_or_not_finite_is_refused() {
         .scheme_mut()
         .set_boundary_velocity(0..n, Vec3::new(0.0, -1.0, 0.0))
         .unwrap();
+}
+
+/// A run with a moving floor resumes bit for bit from a saved state: the floor's positions
+/// and velocity travel in the state (`boundary_motion`), and a state from before the floor
+/// moved carries none.
+#[test]
+fn a_moving_floor_resumes_bit_for_bit() {
+    let down = Vec3::new(0.0, -0.05, 0.0);
+    let (mut first, mut state, _) = slab(WallModel::NoSlip, down);
+    for _ in 0..3 {
+        first.step(&mut state).unwrap();
+    }
+    let saved = first.save_state();
+    assert!(saved
+        .arrays
+        .iter()
+        .any(|(name, _)| name == "boundary_motion"));
+    let mut resumed_state = state.clone();
+    for _ in 0..4 {
+        first.step(&mut state).unwrap();
+    }
+    // A fresh solver, its floor where the set-up puts it and at rest until restored.
+    let (mut second, _, _) = slab(WallModel::NoSlip, Vec3::zeros());
+    assert!(!second
+        .save_state()
+        .arrays
+        .iter()
+        .any(|(name, _)| name == "boundary_motion"));
+    second.restore_state(&saved, resumed_state.len()).unwrap();
+    for _ in 0..4 {
+        second.step(&mut resumed_state).unwrap();
+    }
+    assert_eq!(state.positions, resumed_state.positions);
+    assert_eq!(state.velocities, resumed_state.velocities);
+    assert_eq!(
+        first.scheme().boundary_particles(),
+        second.scheme().boundary_particles()
+    );
 }
