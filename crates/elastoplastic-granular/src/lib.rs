@@ -82,15 +82,6 @@
 //! - A particle without any granular neighbour inside the kernel support (a grain out of
 //!   contact) carries no stress; otherwise its zero velocity gradient would keep the last
 //!   stress, which acts as a spring against walls.
-//! - The density of a particle whose stress after the step is zero (a cohesionless grain
-//!   returned to the apex, or one out of contact) does not fall below `ρ0`: `ρ ←
-//!   max(ρ, ρ0)`. Such a grain carries no contact force, so a continuity density below `ρ0`
-//!   records its separation from its neighbours, not an elastic strain; left in place, the
-//!   pressure its next contact builds from zero by the stress rate meets a density that no
-//!   longer matches it (`σ/ρ²` amplified by `(ρ0/ρ)²`), which creates energy and, as grains
-//!   splash and separate again, drives `ρ` to zero (docs page, run 34). A stressed grain
-//!   (the geostatic bed unloading, or with cohesion a grain at the apex) keeps its
-//!   continuity density.
 //! - The plastic rate applies when the stress lies within [`stress::YIELD_TOLERANCE`] of the
 //!   cone (Bui: exactly on it).
 //! - The equivalent plastic shear strain (the output) is this crate's measure:

@@ -40,9 +40,8 @@ impl<R: Real> StepInputs<'_, R> {
 
 /// Pass 1: the wall gradients at `x`, the velocity gradient `L_i` and the continuity rate
 /// from `x`, `v`, `ρ`; the stress update (rate and return, [`crate::DruckerPrager::update`];
-/// zero for a particle without granular neighbours inside the support), the density
-/// (at least `ρ0` for a particle whose new stress is zero) and plastic strain after `Δt`,
-/// and the artificial stress of the new stress.
+/// zero for a particle without granular neighbours inside the support), the density and
+/// plastic strain after `Δt`, and the artificial stress of the new stress.
 pub(crate) fn stress_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>) {
     let c = inp.c;
     let slots = inp.models.len();
@@ -106,13 +105,7 @@ pub(crate) fn stress_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>) 
                     up.stress = Matrix3::zeros();
                     up.plastic_strain = R::zero();
                 }
-                let mut rho_next = rho[i] + drho * inp.dt;
-                if up.stress == Matrix3::zeros() && rho_next < c.rho0 {
-                    // A stress-free grain (cohesionless apex, or out of contact) is not
-                    // dilated but separated: it keeps its own density, from which the next
-                    // contact builds its pressure (crate docs, deviations).
-                    rho_next = c.rho0;
-                }
+                let rho_next = rho[i] + drho * inp.dt;
                 *sig = up.stress;
                 *r = rho_next;
                 *kappa = plastic[i] + up.plastic_strain;
