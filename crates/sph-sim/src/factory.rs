@@ -104,23 +104,24 @@ pub(crate) fn build_boundary_reporting<R: Real>(
     let solids = scene.build_solids::<R>()?;
     let setup = |source| setup_error(scene, source);
     match scene.boundary.model {
-        BoundaryModel::Collision => Ok((
-            Box::new(CollisionBoundary::new(solids, c.particle_radius()).map_err(setup)?),
-            Vec::new(),
-        )),
         // Boundary particles are sampled from these solids by the solver (the parameters
-        // carry the region and each solid's model); the solids keep particles out at the
-        // volume maps' contact distance, a quarter spacing: a net under the wall the
-        // boundary particles carry. At the particle radius (the `collision` model's) it
-        // would hold the first layer, which rests half a spacing above the wall, rigidly
-        // in place of the boundary particles' stress and round the solids' edges by half a
-        // spacing (docs/elastoplastic-granular.md, run 31).
-        BoundaryModel::Particles => Ok((
-            Box::new(
-                CollisionBoundary::new(solids, c.volume_map_contact_distance()).map_err(setup)?,
-            ),
-            Vec::new(),
-        )),
+        // carry the region and each solid's model); the solids keep particles out, with
+        // boundary particles at the volume maps' contact distance, a quarter spacing: a net
+        // under the wall the boundary particles carry. At the particle radius (the
+        // `collision` model's) it would hold the first layer, which rests half a spacing
+        // above the wall, rigidly in place of the boundary particles' stress and round the
+        // solids' edges by half a spacing (docs/elastoplastic-granular.md, run 31).
+        BoundaryModel::Collision | BoundaryModel::Particles => {
+            let contact = if scene.boundary.model == BoundaryModel::Particles {
+                c.volume_map_contact_distance()
+            } else {
+                c.particle_radius()
+            };
+            Ok((
+                Box::new(CollisionBoundary::new(solids, contact).map_err(setup)?),
+                Vec::new(),
+            ))
+        }
         BoundaryModel::VolumeMap => {
             let b = VolumeMapBoundary::build(
                 solids,
