@@ -25,7 +25,7 @@
 
 use std::time::Instant;
 
-use elastoplastic_granular::heap::{drained_bed, trapdoor_update, DrainedSetup};
+use elastoplastic_granular::heap::{drained_bed, DrainedSetup};
 use elastoplastic_granular::{ConeMatch, ElastoplasticParams};
 use granular_measure::{angle_of_repose, ReposeOptions, RestSample};
 
@@ -119,7 +119,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         solver.step(&mut state)?;
         let t = frame as f64 * frame_dt;
-        trapdoor_update(&mut solver, &setup, t)?;
         if let Some(perm) = solver.last_permutation() {
             ids = perm.iter().map(|&o| ids[o as usize]).collect();
         }

@@ -59,14 +59,14 @@
 use nalgebra::Matrix3;
 use rayon::prelude::*;
 use sph_core::sampling::cubic_lattice;
-use sph_core::{Aabb, Real, Sdf, Vec3};
+use sph_core::{Aabb, BoxSdf, Real, Sdf, Vec3};
 use sph_kernels::Kernel;
 use sph_solver::step::MIN_LEN;
 use sph_solver::{NeighbourLists, SolverError};
 
 use crate::kernels::Consts;
-use crate::params::{ElastoplasticParams, WallModel, BOUNDARY_PARTICLE_ROWS};
-use crate::periodic::Images;
+use crate::params::{ElastoplasticParams, MovingWall, WallModel, BOUNDARY_PARTICLE_ROWS};
+use crate::periodic::{Images, PeriodicAxis};
 use crate::stress::artificial_stress;
 
 /// One fixed boundary particle.
@@ -336,93 +336,206 @@ pub fn sample_solids<R: Real>(
     params: &ElastoplasticParams<R>,
     max_count: usize,
 ) -> Result<Vec<BoundaryParticle<R>>, SolverError> {
-    let Some(region) = &params.boundary_particle_region else {
+    let Some(lattice) = WallLattice::of(params)? else {
         return Ok(Vec::new());
     };
-    let s = params.common.particle_spacing;
-    let rows = R::of_f64(BOUNDARY_PARTICLE_ROWS);
-    let depth_limit = rows * s;
-    let mut lo: Vec3<R> = Vec3::zeros();
-    let mut counts = [0usize; 3];
-    for a in 0..3 {
-        let periodic = params.periodic.iter().any(|p| p.axis == a);
-        let pad = if periodic { R::zero() } else { depth_limit };
-        lo[a] = region.min[a] - pad;
-        let c: f64 = ((region.max[a] - region.min[a] + pad + pad) / s).as_f64();
-        counts[a] = (c + 1e-9_f64).floor().max(1.0) as usize;
-    }
-    let total: f64 = counts.iter().map(|&c| c as f64).product();
-    if total > MAX_BOUNDARY_LATTICE_NODES {
-        return Err(sampling_error(
-            "boundary_particle_region",
-            total,
-            "the wall lattice would have more than MAX_BOUNDARY_LATTICE_NODES = 2^28 nodes (value: their count); coarsen the spacing or shrink the region",
-        ));
-    }
-    let max = max_count.min(MAX_BOUNDARY_PARTICLES);
-    let half = R::of_f64(0.5);
-    let mut out: Vec<BoundaryParticle<R>> = Vec::new();
-    let mut node = 0usize;
-    for i in 0..counts[0] {
-        for j in 0..counts[1] {
-            for k in 0..counts[2] {
-                node += 1;
-                let idx: Vec3<R> = Vec3::new(
-                    R::of_f64(i as f64),
-                    R::of_f64(j as f64),
-                    R::of_f64(k as f64),
-                );
-                let x: Vec3<R> = lo + (idx + Vec3::repeat(half)) * s;
-                let mut deepest = R::zero();
-                let mut nearest: Option<(usize, R)> = None;
-                for (m, solid) in solids.iter().enumerate() {
-                    let d = solid.signed_distance(&x);
-                    if d < R::zero() {
-                        deepest = deepest.max(-d);
-                        if nearest.is_none_or(|(_, b)| -d < b) {
-                            nearest = Some((m, -d));
-                        }
-                    }
+    let mut out = Particles::new(max_count);
+    for (node, x) in lattice.nodes().enumerate() {
+        let mut deepest = R::zero();
+        let mut nearest: Option<(usize, R)> = None;
+        for (m, solid) in solids.iter().enumerate() {
+            let d = solid.signed_distance(&x);
+            if d < R::zero() {
+                deepest = deepest.max(-d);
+                if nearest.is_none_or(|(_, b)| -d < b) {
+                    nearest = Some((m, -d));
                 }
-                let Some((m, _)) = nearest else { continue };
-                let model = params.wall_model(m);
-                if deepest > depth_limit || model == WallModel::ContactOnly {
-                    continue;
-                }
-                let g = solids[m].gradient(&x);
-                let len = g.norm();
-                if !(len.is_finite() && len > R::zero()) {
-                    return Err(sampling_error(
-                        "boundary_particles",
-                        (node - 1) as f64,
-                        "a solid's signed distance has no finite non-zero gradient at a wall node (value: the node's index in the wall lattice)",
-                    ));
-                }
-                if out.len() >= max {
-                    return Err(sampling_error(
-                        "boundary_particles",
-                        max as f64,
-                        "the walls need more than this many boundary particles (MAX_BOUNDARY_PARTICLES = 2^22, or the caller's limit); coarsen the spacing",
-                    ));
-                }
-                if out.len() == out.capacity() {
-                    let more = out.capacity().max(1024).min(max - out.len());
-                    out.try_reserve(more).map_err(|_| {
-                        sampling_error(
-                            "boundary_particles",
-                            (out.len() + more) as f64,
-                            "could not allocate the boundary particles (value: their count)",
-                        )
-                    })?;
-                }
-                out.push(BoundaryParticle {
-                    position: x,
-                    normal: g / len,
-                    model,
-                    velocity: Vec3::zeros(),
-                });
             }
         }
+        let Some((m, _)) = nearest else { continue };
+        let model = params.wall_model(m);
+        if deepest > lattice.depth_limit || model == WallModel::ContactOnly {
+            continue;
+        }
+        let normal = unit_gradient(&*solids[m], &x, node)?;
+        out.push(BoundaryParticle {
+            position: x,
+            normal,
+            model,
+            velocity: Vec3::zeros(),
+        })?;
     }
-    Ok(out)
+    Ok(out.0)
+}
+
+/// The particles of the moving wall `wall` ([`MovingWall`]) on the lattice of
+/// [`sample_solids`] (that of `params.boundary_particle_region`): the nodes inside its box no
+/// deeper than [`BOUNDARY_PARTICLE_ROWS`] spacings, a node taking the periodic image of
+/// itself that lies deepest in the box (so that a box across a periodic axis's ends gives
+/// particles on both sides of the seam), each with the wall's model and velocity and the
+/// outward normal of the box's nearest face. In lattice order; no region: none.
+///
+/// Errors: those of [`sample_solids`] (counts against `max_count` and
+/// [`MAX_BOUNDARY_PARTICLES`], the lattice's size, an allocation).
+pub fn sample_moving_wall<R: Real>(
+    wall: &MovingWall<R>,
+    params: &ElastoplasticParams<R>,
+    max_count: usize,
+) -> Result<Vec<BoundaryParticle<R>>, SolverError> {
+    let Some(lattice) = WallLattice::of(params)? else {
+        return Ok(Vec::new());
+    };
+    let solid = BoxSdf::new(wall.region)?;
+    let images = periodic_images(&params.periodic);
+    let mut out = Particles::new(max_count);
+    for (node, x) in lattice.nodes().enumerate() {
+        let deepest = images
+            .iter()
+            .map(|o| (x + o, solid.signed_distance(&(x + o))))
+            .fold(None, |best: Option<(Vec3<R>, R)>, (y, d)| match best {
+                Some((_, b)) if b <= d => best,
+                _ => Some((y, d)),
+            });
+        let Some((y, d)) = deepest else { continue };
+        if d >= R::zero() || -d > lattice.depth_limit {
+            continue;
+        }
+        out.push(BoundaryParticle {
+            position: x,
+            normal: unit_gradient(&solid, &y, node)?,
+            model: wall.model,
+            velocity: wall.velocity,
+        })?;
+    }
+    Ok(out.0)
+}
+
+/// The offsets of a point's periodic images: zero and `±period` along each periodic axis
+/// and their combinations (1, 3, 9 or 27 offsets).
+fn periodic_images<R: Real>(axes: &[PeriodicAxis<R>]) -> Vec<Vec3<R>> {
+    let mut out = vec![Vec3::zeros()];
+    for a in axes {
+        let shift = |sign: R| {
+            let mut e: Vec3<R> = Vec3::zeros();
+            e[a.axis] = sign * a.period();
+            e
+        };
+        let ends = [shift(R::one()), shift(-R::one())];
+        let more: Vec<Vec3<R>> = out.iter().flat_map(|o| ends.map(|e| o + e)).collect();
+        out.extend(more);
+    }
+    out
+}
+
+/// The unit outward normal of `solid` at the wall lattice's node `x` (number `node`).
+fn unit_gradient<R: Real>(
+    solid: &dyn Sdf<R>,
+    x: &Vec3<R>,
+    node: usize,
+) -> Result<Vec3<R>, SolverError> {
+    let g = solid.gradient(x);
+    let len = g.norm();
+    if len.is_finite() && len > R::zero() {
+        Ok(g / len)
+    } else {
+        Err(sampling_error(
+            "boundary_particles",
+            node as f64,
+            "a solid's signed distance has no finite non-zero gradient at a wall node (value: the node's index in the wall lattice)",
+        ))
+    }
+}
+
+/// The wall lattice of [`sample_solids`]: the fluid's lattice over the region, extended by
+/// the wall rows on each non-periodic axis.
+struct WallLattice<R: Real> {
+    lo: Vec3<R>,
+    counts: [usize; 3],
+    spacing: R,
+    depth_limit: R,
+}
+
+impl<R: Real> WallLattice<R> {
+    /// The lattice of `params` (`None` without a region). Errors: more than
+    /// [`MAX_BOUNDARY_LATTICE_NODES`] nodes.
+    fn of(params: &ElastoplasticParams<R>) -> Result<Option<Self>, SolverError> {
+        let Some(region) = &params.boundary_particle_region else {
+            return Ok(None);
+        };
+        let s = params.common.particle_spacing;
+        let depth_limit = R::of_f64(BOUNDARY_PARTICLE_ROWS) * s;
+        let mut lo: Vec3<R> = Vec3::zeros();
+        let mut counts = [0usize; 3];
+        for a in 0..3 {
+            let periodic = params.periodic.iter().any(|p| p.axis == a);
+            let pad = if periodic { R::zero() } else { depth_limit };
+            lo[a] = region.min[a] - pad;
+            let c: f64 = ((region.max[a] - region.min[a] + pad + pad) / s).as_f64();
+            counts[a] = (c + 1e-9_f64).floor().max(1.0) as usize;
+        }
+        let total: f64 = counts.iter().map(|&c| c as f64).product();
+        if total > MAX_BOUNDARY_LATTICE_NODES {
+            return Err(sampling_error(
+                "boundary_particle_region",
+                total,
+                "the wall lattice would have more than MAX_BOUNDARY_LATTICE_NODES = 2^28 nodes (value: their count); coarsen the spacing or shrink the region",
+            ));
+        }
+        Ok(Some(Self {
+            lo,
+            counts,
+            spacing: s,
+            depth_limit,
+        }))
+    }
+
+    /// The nodes in lattice order (`x` slowest, `z` fastest).
+    fn nodes(&self) -> impl Iterator<Item = Vec3<R>> + '_ {
+        let [nx, ny, nz] = self.counts;
+        let half = R::of_f64(0.5);
+        (0..nx).flat_map(move |i| {
+            (0..ny).flat_map(move |j| {
+                (0..nz).map(move |k| {
+                    let idx: Vec3<R> = Vec3::new(
+                        R::of_f64(i as f64),
+                        R::of_f64(j as f64),
+                        R::of_f64(k as f64),
+                    );
+                    self.lo + (idx + Vec3::repeat(half)) * self.spacing
+                })
+            })
+        })
+    }
+}
+
+/// Boundary particles collected up to a limit, with fallible growth.
+struct Particles<R: Real>(Vec<BoundaryParticle<R>>, usize);
+
+impl<R: Real> Particles<R> {
+    fn new(max_count: usize) -> Self {
+        Self(Vec::new(), max_count.min(MAX_BOUNDARY_PARTICLES))
+    }
+
+    fn push(&mut self, b: BoundaryParticle<R>) -> Result<(), SolverError> {
+        let (out, max) = (&mut self.0, self.1);
+        if out.len() >= max {
+            return Err(sampling_error(
+                "boundary_particles",
+                max as f64,
+                "the walls need more than this many boundary particles (MAX_BOUNDARY_PARTICLES = 2^22, or the caller's limit); coarsen the spacing",
+            ));
+        }
+        if out.len() == out.capacity() {
+            let more = out.capacity().max(1024).min(max - out.len());
+            out.try_reserve(more).map_err(|_| {
+                sampling_error(
+                    "boundary_particles",
+                    (out.len() + more) as f64,
+                    "could not allocate the boundary particles (value: their count)",
+                )
+            })?;
+        }
+        out.push(b);
+        Ok(())
+    }
 }

@@ -13,8 +13,8 @@ use sph_core::sampling::cubic_lattice;
 use sph_core::{Aabb, BoxSdf, ParticleSet, Plane, Real, Vec3};
 use sph_solver::{Solids, SolverError};
 
-use crate::boundary_particles::{boundary_block, BoundaryParticle};
-use crate::params::{ElastoplasticParams, InitialStress, WallModel};
+use crate::boundary_particles::boundary_block;
+use crate::params::{ElastoplasticParams, InitialStress, MovingWall, WallModel};
 use crate::periodic::PeriodicAxis;
 use crate::solver::{Elastoplastic, ElastoplasticScheme};
 use crate::walls::volume_map_walls;
@@ -201,7 +201,7 @@ pub struct DrainedSetup {
     /// `None`: the slot is open over the sump (the grains fall through it). `Some(v)`: a
     /// slow drain. The slot is a channel `sump_depth_m` deep with free-slip walls, closed at
     /// the plate's top by a trapdoor (three rows of no-slip boundary particles) that is
-    /// lowered at `v` m/s ([`trapdoor_update`] stops it at the channel's floor): the grains
+    /// lowered at `v` m/s until it reaches the channel's floor (a [`MovingWall`]): the grains
     /// over the slot descend with it and the flanks form by slow flows.
     pub trapdoor_speed_m_s: Option<f64>,
 }
@@ -297,6 +297,17 @@ pub fn drained_bed<R: Real>(
         params.common.rest_density,
     );
     params.initial_stress = geostatic_or_none(setup.geostatic);
+    if let (Some(speed), Some(travel_s)) = (setup.trapdoor_speed_m_s, setup.trapdoor_travel_s()) {
+        // The door: three rows under the slot, across the periodic seam (the wall's box
+        // wraps), on the bed's lattice.
+        params.boundary_particle_region = Some(bed);
+        params.moving_walls = vec![MovingWall {
+            region: aabb([-half, -BOUNDARY_ROWS * s, far_lo], [half, 0.0, far_hi])?,
+            model: WallModel::NoSlip,
+            velocity: v(0.0, -speed, 0.0),
+            duration_s: R::of_f64(travel_s),
+        }];
+    }
     let mut solver = ElastoplasticScheme::solver(params, walls)?;
     let up = v(0.0, 1.0, 0.0);
     let mut rows = boundary_block(
@@ -316,7 +327,7 @@ pub fn drained_bed<R: Real>(
         WallModel::NoSlip,
         1 << 22,
     )?);
-    if let Some(speed) = setup.trapdoor_speed_m_s {
+    if setup.trapdoor_speed_m_s.is_some() {
         let wall = BOUNDARY_ROWS * s;
         for (x0, x1, nx) in [(half, half + wall, -1.0), (l - half - wall, l - half, 1.0)] {
             rows.extend(boundary_block(
@@ -327,47 +338,9 @@ pub fn drained_bed<R: Real>(
                 1 << 22,
             )?);
         }
-        let down = v(0.0, -speed, 0.0);
-        for (x0, x1) in [(0.0, half), (l - half, l)] {
-            let door = boundary_block(
-                &aabb([x0, -wall, 0.0], [x1, 0.0, d])?,
-                R::of_f64(s),
-                up,
-                WallModel::NoSlip,
-                1 << 22,
-            )?;
-            rows.extend(door.into_iter().map(|b| BoundaryParticle {
-                velocity: down,
-                ..b
-            }));
-        }
     }
     solver.scheme_mut().set_boundary_particles(rows)?;
     Ok((solver, state))
-}
-
-/// Stops the drained bed's trapdoor ([`DrainedSetup::trapdoor_speed_m_s`]) once it has
-/// reached the channel's floor, at `time_s` (s) from the start: call it after each frame.
-/// Without a trapdoor, or once stopped, it does nothing.
-pub fn trapdoor_update<R: Real>(
-    solver: &mut Elastoplastic<R>,
-    setup: &DrainedSetup,
-    time_s: f64,
-) -> Result<(), SolverError> {
-    let Some(travel_s) = setup.trapdoor_travel_s() else {
-        return Ok(());
-    };
-    let bp = solver.scheme().boundary_particles();
-    let moving = bp.iter().position(|b| b.velocity != Vec3::zeros());
-    match moving {
-        Some(first) if time_s >= travel_s => {
-            let end = bp.len();
-            solver
-                .scheme_mut()
-                .set_boundary_velocity(first..end, Vec3::zeros())
-        }
-        _ => Ok(()),
-    }
 }
 
 /// A slope cut in a settled layer: a mound of grains on a flat no-slip floor, periodic

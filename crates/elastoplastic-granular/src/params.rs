@@ -1,6 +1,6 @@
 //! The parameters of [`Elastoplastic`](crate::Elastoplastic), their defaults and bounds.
 
-use sph_core::{Aabb, Real};
+use sph_core::{Aabb, Real, Vec3};
 use sph_solver::{CommonParams, SolverError};
 
 use crate::periodic::PeriodicAxis;
@@ -26,6 +26,10 @@ pub const MAX_ARTIFICIAL_STRESS_EXPONENT: f64 = 10.0;
 pub const MAX_EXPLICIT_STEPS_PER_SUBSTEP: usize = 100_000;
 /// Most solids with their own wall model.
 pub const MAX_WALL_MODELS: usize = 64;
+/// Most moving walls ([`ElastoplasticParams::moving_walls`]).
+pub const MAX_MOVING_WALLS: usize = 64;
+/// Longest motion of a moving wall accepted (s): a year, past any run.
+pub const MAX_WALL_MOTION_S: f64 = 3.2e7;
 /// Largest wall friction coefficient `μ_w` of [`WallModel::Coulomb`] accepted: 10, a wall
 /// friction angle of 84°, past any measured wall–grain pair (a rough wall is `NoSlip`).
 pub const MAX_WALL_FRICTION: f64 = 10.0;
@@ -125,6 +129,7 @@ pub enum InitialStress {
 /// | `default_wall`, `wall_models` | no-slip, none | |
 /// | `periodic` | none | |
 /// | `boundary_particle_region` | none (walls from the boundary) | |
+/// | `moving_walls` | none | |
 /// | `initial_stress` | none | |
 #[derive(Debug, Clone, PartialEq)]
 pub struct ElastoplasticParams<R: Real> {
@@ -176,8 +181,38 @@ pub struct ElastoplasticParams<R: Real> {
     /// spacings of its surface, each with its solid's model (`wall_models`); the solids
     /// then only keep the particles out. `None`: the boundary's volume (if any) is the wall.
     pub boundary_particle_region: Option<Aabb<R>>,
+    /// Walls of boundary particles that move for a while and then stand still (a trapdoor
+    /// lowered under a bed, a gate lifted), sampled on the same lattice as the solids'
+    /// walls (they need `boundary_particle_region`); see [`MovingWall`].
+    pub moving_walls: Vec<MovingWall<R>>,
     /// The stress the particles start from.
     pub initial_stress: InitialStress,
+}
+
+/// A wall of boundary particles that moves at a constant velocity from the start of the run
+/// for `duration_s` and then stands still: the nodes of the particle lattice (that of
+/// [`ElastoplasticParams::boundary_particle_region`]) inside the box `region` and within
+/// [`BOUNDARY_PARTICLE_ROWS`] spacings of its faces, a box across a periodic axis's ends
+/// wrapped into the period. Each particle takes the model `model`, the outward normal of
+/// the box's nearest face, and the wall velocity `velocity` while the wall moves (the wall
+/// models act on the grains' velocity relative to it: module
+/// [`crate::boundary_particles`]). The solver stops the wall at the explicit step nearest
+/// `duration_s` from the run's start (its clock is the frame count, which checkpoints
+/// carry, so a resumed run stops it at the same step).
+///
+/// A moving wall is not a solid of the solver's boundary: nothing but its particles'
+/// stress keeps grains out of it (the collision boundary's contact projection is for
+/// solids that stand still), as for Bui et al. (2008)'s rows of boundary particles.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MovingWall<R: Real> {
+    /// The box the wall's particles fill at the start (m).
+    pub region: Aabb<R>,
+    /// Its wall model (not [`WallModel::ContactOnly`]).
+    pub model: WallModel,
+    /// Its velocity while it moves (m/s).
+    pub velocity: Vec3<R>,
+    /// How long it moves from the run's start (s, ≥ 0).
+    pub duration_s: R,
 }
 
 fn invalid(name: &'static str, value: f64, reason: &'static str) -> SolverError {
@@ -229,6 +264,7 @@ impl<R: Real> ElastoplasticParams<R> {
             wall_models: Vec::new(),
             periodic: Vec::new(),
             boundary_particle_region: None,
+            moving_walls: Vec::new(),
             initial_stress: InitialStress::None,
         }
     }
@@ -391,6 +427,7 @@ impl<R: Real> ElastoplasticParams<R> {
                 )?;
             }
         }
+        self.validate_moving_walls()?;
         let reach = f(self.common.support_radius + self.skin);
         for (k, a) in self.periodic.iter().enumerate() {
             if a.axis > 2 || self.periodic[..k].iter().any(|b| b.axis == a.axis) {
@@ -418,6 +455,77 @@ impl<R: Real> ElastoplasticParams<R> {
                 n as f64,
                 "the substep needs more than MAX_EXPLICIT_STEPS_PER_SUBSTEP = 100000 explicit steps (value: their count); raise common.substeps",
             ));
+        }
+        Ok(())
+    }
+}
+
+impl<R: Real> ElastoplasticParams<R> {
+    /// The moving walls' checks: at most [`MAX_MOVING_WALLS`], each a proper box with a
+    /// finite velocity, a duration in `[0, MAX_WALL_MOTION_S]`, a model that makes particles,
+    /// and a lattice to sample it on (`boundary_particle_region`).
+    fn validate_moving_walls(&self) -> Result<(), SolverError> {
+        let walls = &self.moving_walls;
+        if walls.is_empty() {
+            return Ok(());
+        }
+        if walls.len() > MAX_MOVING_WALLS {
+            return Err(invalid(
+                "moving_walls",
+                walls.len() as f64,
+                "at most MAX_MOVING_WALLS = 64 moving walls",
+            ));
+        }
+        if self.boundary_particle_region.is_none() {
+            return Err(invalid(
+                "moving_walls",
+                walls.len() as f64,
+                "moving walls are walls of boundary particles: set boundary_particle_region (the lattice they are sampled on)",
+            ));
+        }
+        for (k, w) in walls.iter().enumerate() {
+            let finite = |v: &Vec3<R>| v.iter().all(|x| x.is_finite());
+            let proper = finite(&w.region.min)
+                && finite(&w.region.max)
+                && (0..3).all(|a| w.region.min[a] < w.region.max[a]);
+            if !proper {
+                return Err(invalid(
+                    "moving_walls",
+                    k as f64,
+                    "each moving wall's box needs finite corners with min < max on every axis (value: the wall's index)",
+                ));
+            }
+            if !finite(&w.velocity) {
+                return Err(invalid(
+                    "moving_walls",
+                    k as f64,
+                    "each moving wall's velocity must be finite (value: the wall's index)",
+                ));
+            }
+            check_range(
+                "moving_walls",
+                w.duration_s.as_f64(),
+                0.0,
+                MAX_WALL_MOTION_S,
+                "a moving wall's duration (s; the value) must be in [0, MAX_WALL_MOTION_S = 3.2e7]",
+            )?;
+            match w.model {
+                WallModel::ContactOnly => {
+                    return Err(invalid(
+                        "moving_walls",
+                        k as f64,
+                        "a moving wall is made of boundary particles: its model cannot be contact-only (value: the wall's index)",
+                    ))
+                }
+                WallModel::Coulomb(mu) => check_range(
+                    "wall_friction",
+                    mu,
+                    0.0,
+                    MAX_WALL_FRICTION,
+                    "a Coulomb wall's friction coefficient must be in [0, MAX_WALL_FRICTION = 10]",
+                )?,
+                _ => {}
+            }
         }
         Ok(())
     }

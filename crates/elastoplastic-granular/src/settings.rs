@@ -13,7 +13,7 @@ use sph_solver::{
 };
 
 use crate::kernels::ELASTOPLASTIC_KERNEL;
-use crate::params::{ElastoplasticParams, InitialStress};
+use crate::params::{ElastoplasticParams, InitialStress, MovingWall};
 use crate::periodic::PeriodicAxis;
 use crate::solver::{Elastoplastic, NAME};
 use crate::stress::ConeMatch;
@@ -267,6 +267,22 @@ impl<R: Real> ElastoplasticParams<R> {
                 })
                 .collect::<Result<_, SolverError>>()?,
             boundary_particle_region: region,
+            moving_walls: self
+                .moving_walls
+                .iter()
+                .map(|w| {
+                    let v3 = |v| sph_solver::settings::convert3(NAME, "moving_walls", v);
+                    Ok(MovingWall {
+                        region: Aabb {
+                            min: v3(&w.region.min)?,
+                            max: v3(&w.region.max)?,
+                        },
+                        model: w.model,
+                        velocity: v3(&w.velocity)?,
+                        duration_s: c("moving_walls", w.duration_s)?,
+                    })
+                })
+                .collect::<Result<_, SolverError>>()?,
             initial_stress: self.initial_stress,
         })
     }

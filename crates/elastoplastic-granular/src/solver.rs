@@ -14,7 +14,8 @@ use sph_solver::step::{blow_up, check_divergence, FramePhases, StepAt};
 use sph_solver::{CommonParams, FrameSolver, SchemeParts, SolverError, StepStats, SubstepScheme};
 
 use crate::boundary_particles::{
-    extrapolate, sample_solids, BoundaryParticle, Extrapolation, MAX_BOUNDARY_PARTICLES,
+    extrapolate, sample_moving_wall, sample_solids, BoundaryParticle, Extrapolation,
+    MAX_BOUNDARY_PARTICLES,
 };
 use crate::kernels::{Consts, ELASTOPLASTIC_KERNEL};
 use crate::params::{ElastoplasticParams, InitialStress, WallModel};
@@ -59,19 +60,33 @@ pub struct ElastoplasticScheme<R: Real> {
     parts: SchemeParts<R>,
     walls: WallSampler<R>,
     models: Vec<WallModel>,
+    /// The fixed (or caller-moved) boundary particles, then the moving walls' of the
+    /// parameters.
     boundary_particles: Vec<BoundaryParticle<R>>,
+    /// How many of `boundary_particles` are not the parameters' moving walls'.
+    fixed_boundary: usize,
     /// The fastest boundary particle's speed (m/s; zero: all fixed).
     boundary_speed: R,
     /// How far the boundary particles moved since the last neighbour search (m).
     boundary_shift: R,
     /// A boundary particle has moved: checkpoints carry their positions and velocities.
     boundary_moved: bool,
+    /// The moving walls of the parameters still to stop: their particles and when.
+    schedule: Vec<WallStop>,
     scratch: Scratch<R>,
     lists_valid: bool,
     explicit_steps: u64,
     searches: u64,
     /// The initial stress is still to be applied (at the first frame's start).
     initial_stress_pending: bool,
+}
+
+/// A moving wall ([`crate::MovingWall`]) to stop: its boundary particles and the time (s
+/// from the run's start) its motion ends.
+#[derive(Debug, Clone)]
+struct WallStop {
+    particles: std::ops::Range<usize>,
+    stop_s: f64,
 }
 
 impl<R: Real> std::fmt::Debug for ElastoplasticScheme<R> {
@@ -104,12 +119,18 @@ impl<R: Real> ElastoplasticScheme<R> {
             });
         }
         let models = match &walls {
-            WallSampler::PerSolid(_) if particle_walls => {
+            // Volume-map walls sampled into boundary particles as well would count twice;
+            // contact-only ones (a moving wall's lattice) do not.
+            WallSampler::PerSolid(w)
+                if particle_walls
+                    && (0..w.maps().len())
+                        .any(|k| params.wall_model(k) != WallModel::ContactOnly) =>
+            {
                 return Err(SolverError::InvalidParameter {
                     solver: NAME,
                     name: "boundary_particle_region",
                     value: 0.0,
-                    reason: "walls of boundary particles take a boundary without volume (e.g. a collision boundary), not volume-map walls",
+                    reason: "walls of boundary particles take a boundary without volume (e.g. a collision boundary), not volume-map walls (unless every solid is contact-only)",
                 });
             }
             WallSampler::PerSolid(w) => (0..w.maps().len()).map(|k| params.wall_model(k)).collect(),
@@ -140,8 +161,22 @@ impl<R: Real> ElastoplasticScheme<R> {
                 }
             }
         };
-        let boundary_particles =
-            sample_solids(parts.boundary.solids(), &params, MAX_BOUNDARY_PARTICLES)?;
+        let fixed = sample_solids(parts.boundary.solids(), &params, MAX_BOUNDARY_PARTICLES)?;
+        let mut moving: Vec<BoundaryParticle<R>> = Vec::new();
+        let mut schedule = Vec::with_capacity(params.moving_walls.len());
+        for wall in &params.moving_walls {
+            let room = MAX_BOUNDARY_PARTICLES - fixed.len() - moving.len();
+            let mut sampled = sample_moving_wall(wall, &params, room)?;
+            if wall.duration_s == R::zero() {
+                sampled.iter_mut().for_each(|b| b.velocity = Vec3::zeros());
+            }
+            let first = moving.len();
+            moving.append(&mut sampled);
+            schedule.push(WallStop {
+                particles: first..moving.len(),
+                stop_s: wall.duration_s.as_f64(),
+            });
+        }
         let mut scheme = Self {
             c: Consts::new(&params)?,
             initial_stress_pending: params.initial_stress == InitialStress::Geostatic,
@@ -149,17 +184,19 @@ impl<R: Real> ElastoplasticScheme<R> {
             parts,
             walls,
             models,
-            boundary_particles: Vec::new(),
+            boundary_particles: moving,
+            fixed_boundary: 0,
             boundary_speed: R::zero(),
             boundary_shift: R::zero(),
             boundary_moved: false,
+            schedule,
             scratch: Scratch::default(),
             lists_valid: false,
             explicit_steps: 0,
             searches: 0,
         };
-        if !boundary_particles.is_empty() {
-            scheme.set_boundary_particles(boundary_particles)?;
+        if !(fixed.is_empty() && scheme.boundary_particles.is_empty()) {
+            scheme.set_boundary_particles(fixed)?;
         }
         Ok(scheme)
     }
@@ -221,9 +258,12 @@ impl<R: Real> ElastoplasticScheme<R> {
     }
 
     /// Sets the boundary particles (see [`crate::boundary_particles`]); they take part in
-    /// every sum from the next step on, and those with a velocity move with it. Solids
-    /// whose share they replace should have the model [`WallModel::ContactOnly`]. Errors: a
-    /// non-finite position, normal or velocity, named by its index.
+    /// every sum from the next step on, and those with a velocity move with it until
+    /// [`ElastoplasticScheme::set_boundary_velocity`] stops them. They replace those the
+    /// solver sampled from the solids; the parameters' moving walls ([`crate::MovingWall`])
+    /// stay, after them in [`ElastoplasticScheme::boundary_particles`]. Solids whose share
+    /// they replace should have the model [`WallModel::ContactOnly`]. Errors: a non-finite
+    /// position, normal or velocity, named by its index.
     pub fn set_boundary_particles(
         &mut self,
         particles: Vec<BoundaryParticle<R>>,
@@ -246,13 +286,21 @@ impl<R: Real> ElastoplasticScheme<R> {
             }
         }
         let n = self.scratch.plastic_strain.len();
+        let moving = self.boundary_particles.split_off(self.fixed_boundary);
+        let fixed = particles.len();
         self.boundary_particles = particles
             .into_iter()
             .map(|b| BoundaryParticle {
                 normal: b.normal / b.normal.norm(),
                 ..b
             })
+            .chain(moving)
             .collect();
+        for w in &mut self.schedule {
+            w.particles = w.particles.start - self.fixed_boundary + fixed
+                ..w.particles.end - self.fixed_boundary + fixed;
+        }
+        self.fixed_boundary = fixed;
         self.boundary_speed = self.fastest_boundary();
         self.resize(n);
         self.lists_valid = false;
@@ -298,6 +346,25 @@ impl<R: Real> ElastoplasticScheme<R> {
             .iter()
             .map(|b| b.velocity.norm())
             .fold(R::zero(), |a, b| if b > a { b } else { a })
+    }
+
+    /// Stops the moving walls whose motion has ended by `time_s` (s from the run's start;
+    /// the step from `time_s` to `time_s + dt` is the first they do not move in if it
+    /// starts past their end less half a step): the explicit step nearest the end is the
+    /// last one that moves them.
+    fn stop_walls(&mut self, time_s: f64, dt: f64) {
+        let mut stopped = false;
+        for w in &self.schedule {
+            if time_s + 0.5 * dt >= w.stop_s {
+                let still = &mut self.boundary_particles[w.particles.clone()];
+                still.iter_mut().for_each(|b| b.velocity = Vec3::zeros());
+                stopped = true;
+            }
+        }
+        if stopped {
+            self.schedule.retain(|w| time_s + 0.5 * dt < w.stop_s);
+            self.boundary_speed = self.fastest_boundary();
+        }
     }
 
     /// Moves the boundary particles that have a velocity by `dt` (their positions, and the
@@ -378,7 +445,15 @@ impl<R: Real> ElastoplasticScheme<R> {
         self.scratch.v[..n].copy_from_slice(&state.velocities);
         self.scratch.rho[..n].copy_from_slice(&state.densities);
         let boundary_mass = self.params.common.particle_mass();
-        for _ in 0..steps {
+        // The clock of the moving walls: the frame count (checkpointed) and the substep.
+        let substeps = self.params.common.substeps as f64;
+        let substep_start_s = (at.step as f64 * substeps + at.substep as f64)
+            * self.params.common.substep_dt().as_f64();
+        for k in 0..steps {
+            if !self.schedule.is_empty() {
+                let dt = dt.as_f64();
+                self.stop_walls(substep_start_s + k as f64 * dt, dt);
+            }
             if self.boundary_speed > R::zero() {
                 self.move_boundary(n, dt);
             }

@@ -1,10 +1,13 @@
 //! Moving walls of boundary particles: a floor that moves carries the grains on it (no-slip
 //! along it, any model across it) and a free-slip floor sliding under them does not drag
-//! them; the wall velocity is checked when set.
+//! them; the wall velocity is checked when set; a moving wall of the parameters
+//! (`MovingWall`) stops by itself, resumes bit for bit, wraps across a periodic seam and is
+//! checked.
 
+use elastoplastic_granular::boundary_particles::sample_moving_wall;
 use elastoplastic_granular::{
     boundary_block, cubic_lattice, Aabb, Elastoplastic, ElastoplasticParams, InitialStress,
-    ParticleSet, PeriodicAxis, Solids, SolverError, Vec3, WallModel,
+    MovingWall, ParticleSet, PeriodicAxis, Solids, SolverError, Vec3, WallModel,
 };
 
 const S: f64 = 0.02;
@@ -15,6 +18,22 @@ const S: f64 = 0.02;
 /// `velocity`. Cohesion 100 kPa keeps the slab inside its cone (elastic). Returns the
 /// solver, the slab and the period along `x` and `z`.
 fn slab(wall: WallModel, velocity: Vec3<f64>) -> (Elastoplastic<f64>, ParticleSet<f64>, Vec3<f64>) {
+    let (p, state, hi) = slab_params();
+    let solids: Solids<f64> = Vec::new();
+    let mut solver = Elastoplastic::new(p, solids).unwrap();
+    let rows = Aabb::new(Vec3::new(0.0, -3.0 * S, 0.0), Vec3::new(hi.x, 0.0, hi.z)).unwrap();
+    let floor = boundary_block(&rows, S, Vec3::y(), wall, 10_000).unwrap();
+    let count = floor.len();
+    solver.scheme_mut().set_boundary_particles(floor).unwrap();
+    solver
+        .scheme_mut()
+        .set_boundary_velocity(0..count, velocity)
+        .unwrap();
+    (solver, state, hi)
+}
+
+/// The parameters and particles of [`slab`], and the periods.
+fn slab_params() -> (ElastoplasticParams<f64>, ParticleSet<f64>, Vec3<f64>) {
     let mut p = ElastoplasticParams::<f64>::for_spacing(S, 30.0);
     p.cohesion = 1e5;
     p.common.dt = 0.02;
@@ -30,17 +49,7 @@ fn slab(wall: WallModel, velocity: Vec3<f64>) -> (Elastoplastic<f64>, ParticleSe
     let region = Aabb::new(Vec3::zeros(), hi).unwrap();
     let x = cubic_lattice(&region, S, 10_000).unwrap();
     let state = ParticleSet::from_positions(x, p.common.particle_mass(), p.common.rest_density);
-    let solids: Solids<f64> = Vec::new();
-    let mut solver = Elastoplastic::new(p, solids).unwrap();
-    let rows = Aabb::new(Vec3::new(0.0, -3.0 * S, 0.0), Vec3::new(hi.x, 0.0, hi.z)).unwrap();
-    let floor = boundary_block(&rows, S, Vec3::y(), wall, 10_000).unwrap();
-    let count = floor.len();
-    solver.scheme_mut().set_boundary_particles(floor).unwrap();
-    solver
-        .scheme_mut()
-        .set_boundary_velocity(0..count, velocity)
-        .unwrap();
-    (solver, state, hi)
+    (p, state, hi)
 }
 
 /// The slab of [`slab`] with its floor moving at `velocity` from the start: the slab's mean
@@ -177,19 +186,32 @@ fn a_moving_floor_resumes_bit_for_bit() {
         .arrays
         .iter()
         .any(|(name, _)| name == "boundary_motion"));
-    let mut resumed_state = state.clone();
-    for _ in 0..4 {
-        first.step(&mut state).unwrap();
-    }
     // A fresh solver, its floor where the set-up puts it and at rest until restored.
-    let (mut second, _, _) = slab(WallModel::NoSlip, Vec3::zeros());
+    let (second, _, _) = slab(WallModel::NoSlip, Vec3::zeros());
     assert!(!second
         .save_state()
         .arrays
         .iter()
         .any(|(name, _)| name == "boundary_motion"));
+    assert_resumes_bit_for_bit(first, state, second, 4);
+}
+
+/// Saves `first`'s state, steps it `frames` more frames from `state`, restores the saved
+/// state into the fresh solver `second`, steps it as many from the same particles, and
+/// asserts the two runs' particles and boundary particles equal bit for bit.
+fn assert_resumes_bit_for_bit(
+    mut first: Elastoplastic<f64>,
+    mut state: ParticleSet<f64>,
+    mut second: Elastoplastic<f64>,
+    frames: usize,
+) {
+    let saved = first.save_state();
+    let mut resumed_state = state.clone();
+    for _ in 0..frames {
+        first.step(&mut state).unwrap();
+    }
     second.restore_state(&saved, resumed_state.len()).unwrap();
-    for _ in 0..4 {
+    for _ in 0..frames {
         second.step(&mut resumed_state).unwrap();
     }
     assert_eq!(state.positions, resumed_state.positions);
@@ -198,4 +220,124 @@ fn a_moving_floor_resumes_bit_for_bit() {
         first.scheme().boundary_particles(),
         second.scheme().boundary_particles()
     );
+}
+
+/// The slab of [`slab`] on a floor that is a moving wall of the parameters
+/// ([`MovingWall`]: three rows under `y = 0` across the periods, lowered at 5 cm/s for
+/// `duration_s`), sampled by the solver on the slab's lattice.
+fn slab_on_scheduled_floor(duration_s: f64) -> (Elastoplastic<f64>, ParticleSet<f64>) {
+    let (mut p, state, hi) = slab_params();
+    p.boundary_particle_region = Some(Aabb::new(Vec3::zeros(), hi).unwrap());
+    p.moving_walls = vec![MovingWall {
+        region: Aabb::new(Vec3::new(-1.0, -3.0 * S, -1.0), Vec3::new(1.0, 0.0, 1.0)).unwrap(),
+        model: WallModel::NoSlip,
+        velocity: Vec3::new(0.0, -0.05, 0.0),
+        duration_s,
+    }];
+    (Elastoplastic::new(p, Vec::new()).unwrap(), state)
+}
+
+/// A moving wall of the parameters moves from the start and stops by itself at the
+/// explicit step nearest its duration: after 0.2 s of motion and 0.2 s at rest, each of
+/// its particles has travelled `0.05 × 0.2 = 10 mm` to within half an explicit step's
+/// travel (the stop's rounding), stands still, and the slab it carried followed it down
+/// (within 10 %, as for the lowered floor above).
+#[test]
+fn a_moving_wall_of_the_parameters_stops_after_its_duration() {
+    let (mut solver, mut state) = slab_on_scheduled_floor(0.2);
+    let start = solver.scheme().boundary_particles().to_vec();
+    assert_eq!(start.len(), 8 * 3 * 4, "three rows across the periods");
+    assert!(start.iter().all(|b| b.velocity == Vec3::new(0.0, -0.05, 0.0)));
+    let y0 = state.positions.iter().map(|x| x.y).sum::<f64>() / state.len() as f64;
+    for _ in 0..20 {
+        solver.step(&mut state).unwrap();
+    }
+    let (_, dt) = slab_params().0.explicit_steps();
+    for (b, a) in solver.scheme().boundary_particles().iter().zip(&start) {
+        let moved = b.position.y - a.position.y;
+        assert!((moved + 0.01).abs() <= 0.5 * 0.05 * dt + 1e-12, "moved {moved}");
+        assert_eq!(b.velocity, Vec3::zeros());
+    }
+    let y1 = state.positions.iter().map(|x| x.y).sum::<f64>() / state.len() as f64;
+    assert!((y1 - y0 + 0.01).abs() < 0.001, "slab moved {}", y1 - y0);
+}
+
+/// A run resumed from a state saved while the wall moved stops it at the same step and
+/// repeats the uninterrupted run bit for bit (the clock is the frame count the state
+/// carries).
+#[test]
+fn a_scheduled_wall_resumes_bit_for_bit_across_its_stop() {
+    let (mut first, mut state) = slab_on_scheduled_floor(0.2);
+    for _ in 0..8 {
+        first.step(&mut state).unwrap();
+    }
+    let (second, _) = slab_on_scheduled_floor(0.2);
+    assert_resumes_bit_for_bit(first, state, second, 6);
+}
+
+/// A moving wall's box across a periodic axis's ends gives particles on both sides of the
+/// seam: a box `|x| < 2 s` on the period `8 s` holds the lattice columns `x = s/2, 3s/2`
+/// and `8s − s/2, 8s − 3s/2`, each three rows and four layers deep.
+#[test]
+fn a_moving_wall_across_the_seam_wraps() {
+    let (mut p, _, hi) = slab_params();
+    p.boundary_particle_region = Some(Aabb::new(Vec3::zeros(), hi).unwrap());
+    let wall = MovingWall {
+        region: Aabb::new(Vec3::new(-2.0 * S, -3.0 * S, -1.0), Vec3::new(2.0 * S, 0.0, 1.0))
+            .unwrap(),
+        model: WallModel::NoSlip,
+        velocity: Vec3::zeros(),
+        duration_s: 1.0,
+    };
+    let b = sample_moving_wall(&wall, &p, 10_000).unwrap();
+    assert_eq!(b.len(), 4 * 3 * 4);
+    let mut columns: Vec<i64> = b.iter().map(|b| (b.position.x / S * 2.0).round() as i64).collect();
+    columns.sort_unstable();
+    columns.dedup();
+    assert_eq!(columns, vec![1, 3, 13, 15], "x in half spacings");
+    assert!(b.iter().all(|b| (b.normal.norm() - 1.0).abs() < 1e-12));
+}
+
+/// A moving wall is checked with the parameters: one without a lattice to sample it on
+/// (`boundary_particle_region`), with the model contact-only, a non-finite velocity or a
+/// negative duration is refused, by name.
+#[test]
+fn a_moving_wall_without_a_lattice_or_with_bad_values_is_refused() {
+    let (mut p, _, hi) = slab_params();
+    let good = MovingWall {
+        region: Aabb::new(Vec3::new(0.0, -3.0 * S, 0.0), hi).unwrap(),
+        model: WallModel::NoSlip,
+        velocity: Vec3::new(0.0, -0.05, 0.0),
+        duration_s: 1.0,
+    };
+    p.moving_walls = vec![good];
+    let refused = |p: &ElastoplasticParams<f64>| {
+        matches!(
+            p.validate(),
+            Err(SolverError::InvalidParameter {
+                name: "moving_walls",
+                ..
+            })
+        )
+    };
+    assert!(refused(&p), "no boundary_particle_region");
+    p.boundary_particle_region = Some(Aabb::new(Vec3::zeros(), hi).unwrap());
+    p.validate().unwrap();
+    for bad in [
+        MovingWall {
+            model: WallModel::ContactOnly,
+            ..good
+        },
+        MovingWall {
+            velocity: Vec3::new(f64::NAN, 0.0, 0.0),
+            ..good
+        },
+        MovingWall {
+            duration_s: -1.0,
+            ..good
+        },
+    ] {
+        p.moving_walls = vec![bad];
+        assert!(refused(&p), "{bad:?}");
+    }
 }

@@ -190,10 +190,11 @@ impl Scene {
     /// [`SolverSpec::periodic_axes`](crate::SolverSpec::periodic_axes): its box reaches
     /// [`OPEN_TANK_REACH`] times its extent (at least 1 m) past each end there, so that
     /// particles crossing a periodic end, which the solver wraps, meet no wall), then the
-    /// solids in file order (meshes as
+    /// solids that stand still in file order ([`Scene::standing_solids`]; meshes as
     /// [`GridSdf`] with cell `sdf_cell`, default `particle_spacing / 2`, and margin
-    /// `2 · particle_spacing + 2 · cell`). Errors only when a value does not fit in `R`
-    /// (e.g. a box too thin for `f32`).
+    /// `2 · particle_spacing + 2 · cell`). A moving solid (`motion`) is not among them: it
+    /// is a wall of boundary particles the solver moves ([`crate::SolidMotion`]). Errors
+    /// only when a value does not fit in `R` (e.g. a box too thin for `f32`).
     pub fn build_solids<R: Real>(&self) -> Result<Vec<Box<dyn Sdf<R>>>, SceneError> {
         let ctx = Ctx::new(&self.source);
         let mut out: Vec<Box<dyn Sdf<R>>> = Vec::with_capacity(self.solids.len() + 1);
@@ -211,10 +212,25 @@ impl Scene {
                 .map_err(|e| ctx.invalid("tank.min", format!("in {}: {e}", R::NAME)))?;
             out.push(Box::new(Inverted(b)));
         }
-        for j in 0..self.solids.len() {
+        for j in self.standing_solids() {
             out.push(self.solid_sdf::<R>(&ctx, j)?);
         }
         Ok(out)
+    }
+
+    /// The indices (in file order) of the solids without a `motion`: those
+    /// [`Scene::build_solids`] builds.
+    pub fn standing_solids(&self) -> impl Iterator<Item = usize> + '_ {
+        (0..self.solids.len()).filter(|&j| self.motions.get(j).is_none_or(Option::is_none))
+    }
+
+    /// When the last moving solid stops (s from the start; 0 without one).
+    pub fn motion_end_s(&self) -> f64 {
+        self.motions
+            .iter()
+            .flatten()
+            .map(|m| m.duration_s)
+            .fold(0.0, f64::max)
     }
 
     /// Particle-level checks: count limit, non-empty fluids, inside the tank, outside solids.

@@ -19,7 +19,7 @@ use crate::mesh_io::placement_field;
 use crate::{
     BoundaryModel, FluidSpec, QuickSpec, Scene, SceneError, SolidSpec, SolverKind, WallModel,
 };
-use elastoplastic_granular::MAX_WALL_FRICTION;
+use elastoplastic_granular::{MAX_WALL_FRICTION, MAX_WALL_MOTION_S};
 
 impl Scene {
     /// Checks every value of the scene, as [`Scene::load`] does: after editing a loaded
@@ -120,6 +120,37 @@ impl Scene {
                     ));
                 }
             }
+        }
+        for (j, m) in self.motions.iter().enumerate() {
+            let Some(m) = m else { continue };
+            let field = format!("solid[{j}].motion");
+            if !particles {
+                return Err(ctx.invalid(
+                    field,
+                    "a moving solid is a wall of boundary particles: set [boundary] model = \"particles\" (the elastoplastic solver)",
+                ));
+            }
+            if !matches!(self.solids.get(j), Some(SolidSpec::Box { .. })) {
+                return Err(ctx.invalid(field, "only a solid of kind = \"box\" moves"));
+            }
+            ctx.finite3(&format!("{field}.velocity"), &m.velocity)?;
+            ctx.positive(&format!("{field}.duration"), m.duration_s)?;
+            if m.duration_s > MAX_WALL_MOTION_S {
+                return Err(ctx.invalid(
+                    format!("{field}.duration"),
+                    format!("at most MAX_WALL_MOTION_S = {MAX_WALL_MOTION_S} s, got {}", m.duration_s),
+                ));
+            }
+        }
+        if self.motions.len() != self.solids.len() {
+            return Err(ctx.invalid(
+                "solid",
+                format!(
+                    "{} motions for {} solids (Scene::motions has one entry per solid)",
+                    self.motions.len(),
+                    self.solids.len()
+                ),
+            ));
         }
         if self.walls.tank.is_some() && self.tank.is_none() {
             return Err(ctx.invalid("tank.wall", "a wall model without a tank"));

@@ -242,7 +242,9 @@
 //! kind = "sphere"                  # center (m), radius (m, > 0)
 //! center = [0.8, 0.2, 0.3]
 //! radius = 0.1
-//! # kind = "box":   min, max (m)
+//! # kind = "box":   min, max (m); with model = "particles" a box may move:
+//! #   motion = { velocity = [0.0, -0.05, 0.0], duration = 12.0 }  # m/s, s (> 0): it
+//! #   moves from the start for `duration`, then stands still (SolidMotion; a trapdoor)
 //! # kind = "plane": point (m), normal (points into the free side, normalised)
 //! # kind = "cylinder": base_center (m), radius (m, > 0), height (m, > 0): vertical axis
 //! # kind = "mesh":  path, scale/translate or fit (as for fluids), sdf_cell (m, grid spacing of
@@ -369,6 +371,6 @@ pub use pbf::PbfSettings;
 pub use pcisph::PcisphSettings;
 pub use spec::{
     BoundaryModel, BoundarySpec, FluidSpec, InitialMasses, MeshPlacement, MeshSpec, OutputSpec,
-    Precision, QuickSpec, Scene, SceneWalls, SolidSpec, WallModel,
+    Precision, QuickSpec, Scene, SceneWalls, SolidMotion, SolidSpec, WallModel,
 };
 pub use sph_solver::CommonSettings;

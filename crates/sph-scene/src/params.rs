@@ -14,7 +14,10 @@ use sph_core::{Aabb, Real};
 use sph_solver::{CommonSettings, SceneValues, SolverError};
 
 use crate::error::Ctx;
-use crate::{Precision, Scene, SceneError, SceneWalls, SolverParams};
+use elastoplastic_granular::MovingWall;
+
+use crate::geom::v3;
+use crate::{Precision, Scene, SceneError, SceneWalls, SolidSpec, SolverParams, WallModel};
 
 impl Scene {
     /// The scene's values every solver's parameters take: spacing, frame length, gravity.
@@ -29,8 +32,9 @@ impl Scene {
     /// The solver's parameters in `f64` from the `[solver]` settings and the scene's values,
     /// with the walls of a solver that takes them from the scene: for `elastoplastic`, each
     /// solid's wall model (the tank first, as in [`Scene::build_solids`]; unstated walls
-    /// [`SceneWalls::DEFAULT`](crate::SceneWalls::DEFAULT)) and the region whose walls
-    /// become boundary particles (the tank, or else the box of the fluids).
+    /// [`SceneWalls::DEFAULT`](crate::SceneWalls::DEFAULT)), the region whose walls
+    /// become boundary particles (the tank, or else the box of the fluids) and the moving
+    /// solids as moving walls ([`crate::SolidMotion`]).
     fn solver_params_f64(&self) -> SolverParams<f64> {
         let mut p = self.solver.params(&self.scene_values());
         if let SolverParams::Elastoplastic(e) = &mut p {
@@ -40,8 +44,12 @@ impl Scene {
                 .tank
                 .iter()
                 .map(|_| self.walls.tank.unwrap_or(default))
-                .chain(self.walls.solids.iter().map(|w| w.unwrap_or(default)))
+                .chain(
+                    self.standing_solids()
+                        .map(|j| self.walls.solids[j].unwrap_or(default)),
+                )
                 .collect();
+            e.moving_walls = self.moving_walls(default);
             e.boundary_particle_region = self.tank.or_else(|| {
                 self.fluids.iter().map(|f| f.bounds()).reduce(|a, b| Aabb {
                     min: a.min.inf(&b.min),
@@ -50,6 +58,28 @@ impl Scene {
             });
         }
         p
+    }
+
+    /// The moving solids as the elastoplastic solver's moving walls: each a box (the parser
+    /// refuses a motion on another kind) with its wall model.
+    fn moving_walls(&self, default: WallModel) -> Vec<MovingWall<f64>> {
+        self.solids
+            .iter()
+            .zip(&self.motions)
+            .zip(&self.walls.solids)
+            .filter_map(|((solid, motion), wall)| match (solid, motion) {
+                (SolidSpec::Box { min, max }, Some(m)) => Some(MovingWall {
+                    region: Aabb {
+                        min: v3(*min),
+                        max: v3(*max),
+                    },
+                    model: wall.unwrap_or(default),
+                    velocity: v3(m.velocity),
+                    duration_s: m.duration_s,
+                }),
+                _ => None,
+            })
+            .collect()
     }
 
     /// The solver parameters the scene asks for, in precision `R`, checked (the settings as

@@ -130,6 +130,7 @@ fn from_raw(
         tank: raw.tank.and_then(|t| t.wall),
         solids: raw.solid.iter().map(|s| s.wall).collect(),
     };
+    let motions = raw.solid.iter().map(|s| s.motion).collect();
     let sim = raw.simulation;
     Ok(Scene {
         name: raw.name,
@@ -146,6 +147,7 @@ fn from_raw(
         fluids,
         solids,
         walls,
+        motions,
         solver,
         boundary: raw.boundary,
         output: output(raw.output.as_ref()),
@@ -282,6 +284,12 @@ fn solid(
             let center = vector("center", "sphere", s.center)?;
             let radius = require(ctx, &format!("{field}.radius"), "sphere", s.radius)?;
             SolidSpec::Sphere { center, radius }
+        }
+        _ if s.motion.is_some() && s.kind != RawSolidKind::Box => {
+            return Err(ctx.invalid(
+                format!("{field}.motion"),
+                "only a solid of kind = \"box\" moves (a wall of boundary particles)",
+            ))
         }
         RawSolidKind::Box => {
             forbid(ctx, field, "box", &present, &["min", "max"])?;

@@ -4,7 +4,7 @@ use serde::Deserialize;
 
 use ssfr_render::RenderConfig;
 
-use crate::{BoundarySpec, Precision, SolverKind, WallModel};
+use crate::{BoundarySpec, Precision, SolidMotion, SolverKind, WallModel};
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -111,6 +111,7 @@ pub(crate) struct RawSolid {
     pub base_center: Option<[f64; 3]>,
     pub height: Option<f64>,
     pub wall: Option<WallModel>,
+    pub motion: Option<SolidMotion>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -31,10 +31,10 @@ impl Scene {
                 ),
             });
         }
+        // A moving solid (a wall of boundary particles) is not drawn where it started.
         let obstacles = self
-            .solids
-            .iter()
-            .filter_map(|s| match s {
+            .standing_solids()
+            .filter_map(|j| match &self.solids[j] {
                 SolidSpec::Box { min, max } => Some(Obstacle::Box {
                     min: f3(*min),
                     max: f3(*max),

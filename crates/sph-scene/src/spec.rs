@@ -229,6 +229,22 @@ pub enum SolidSpec {
     },
 }
 
+/// A solid's motion (`[[solid]] motion = { velocity = [0.0, -0.05, 0.0], duration = 12.0 }`):
+/// it moves at `velocity` from the run's start for `duration` seconds, then stands still.
+/// Only a box moves, and only as a wall of boundary particles (`[boundary] model =
+/// "particles"`, the elastoplastic solver's: a [`elastoplastic_granular::MovingWall`]); a
+/// moving solid is not one of the boundary's solids ([`Scene::build_solids`]), so nothing
+/// but its particles keeps the grains out of it.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolidMotion {
+    /// Velocity while it moves (m/s).
+    pub velocity: [f64; 3],
+    /// How long it moves from the start (s, > 0).
+    #[serde(rename = "duration")]
+    pub duration_s: f64,
+}
+
 /// The wall model of the tank and of each solid as written (`wall = "free-slip"`,
 /// `"no-slip"` or `{ coulomb = μ_w }`; absent = [`SceneWalls::DEFAULT`]). Only walls of
 /// boundary particles (`[boundary] model = "particles"`) have models.
@@ -294,6 +310,8 @@ pub struct Scene {
     /// The wall model of the tank and of each solid (`wall` of `[tank]` and of each
     /// `[[solid]]`), for boundary particles.
     pub walls: SceneWalls,
+    /// Each solid's motion (`[[solid]] motion`), in file order; `None`: it stands still.
+    pub motions: Vec<Option<SolidMotion>>,
     /// Solver settings.
     pub solver: SolverSpec,
     /// Boundary settings.

@@ -198,3 +198,65 @@ fn refusals_name_their_key() {
     let e = parse(&pbf.replace("model = \"particles\"", "model = \"collision\"")).unwrap_err();
     assert!(e.contains("tank.wall"), "{e}");
 }
+
+/// A moving box (`motion`): it becomes a moving wall of the parameters with its model,
+/// velocity and duration, leaves the boundary's solids (it is not a contact solid) and
+/// the wall models of the standing ones, and the rest criterion waits for it
+/// (`motion_end_s`).
+#[test]
+fn a_moving_box_becomes_a_moving_wall() {
+    let moving = BASE.replacen(
+        "wall = \"free-slip\"",
+        "wall = \"free-slip\"\nmotion = { velocity = [0.0, -0.05, 0.0], duration = 2.0 }",
+        1,
+    );
+    let s = parse(&moving).unwrap();
+    assert_eq!(s.motion_end_s(), 2.0);
+    assert_eq!(s.standing_solids().collect::<Vec<_>>(), vec![1]);
+    assert_eq!(s.build_solids::<f64>().unwrap().len(), 2, "the tank and the sphere");
+    let SolverParams::Elastoplastic(p) = s.solver_params::<f64>().unwrap() else {
+        panic!("not elastoplastic")
+    };
+    assert_eq!(p.wall_models, vec![WallModel::Coulomb(0.4), WallModel::NoSlip]);
+    assert_eq!(p.moving_walls.len(), 1);
+    let w = &p.moving_walls[0];
+    assert_eq!((w.region.min.x, w.region.max.y), (0.2, 0.1));
+    assert_eq!(w.model, WallModel::FreeSlip);
+    assert_eq!((w.velocity.y, w.duration_s), (-0.05, 2.0));
+    assert_eq!(parse(BASE).unwrap().motion_end_s(), 0.0);
+}
+
+/// A motion is refused, at its key, on a solid that is not a box, without walls of
+/// boundary particles, with a non-finite velocity, a duration that is not positive or an
+/// unknown field.
+#[test]
+fn bad_motions_name_their_key() {
+    let motion = "motion = { velocity = [0.0, -0.05, 0.0], duration = 2.0 }";
+    let sphere = BASE.replacen("radius = 0.03", &format!("radius = 0.03\n{motion}"), 1);
+    let e = parse(&sphere).unwrap_err();
+    assert!(e.contains("solid[1].motion") && e.contains("box"), "{e}");
+    let on_box = |m: &str| BASE.replacen("wall = \"free-slip\"", &format!("wall = \"free-slip\"\n{m}"), 1);
+    for (m, key) in [
+        (
+            "motion = { velocity = [0.0, nan, 0.0], duration = 2.0 }",
+            "solid[0].motion.velocity",
+        ),
+        (
+            "motion = { velocity = [0.0, -0.05, 0.0], duration = 0.0 }",
+            "solid[0].motion.duration",
+        ),
+        (
+            "motion = { velocity = [0.0, -0.05, 0.0], duration = 2.0, spin = 1.0 }",
+            "spin",
+        ),
+        ("motion = { velocity = [0.0, -0.05, 0.0] }", "duration"),
+    ] {
+        let e = parse(&on_box(m)).unwrap_err();
+        assert!(e.contains(key), "{m}: {e}");
+    }
+    // Only walls of boundary particles move: with the collision boundary (and a solver
+    // that takes it), the motion is refused at its key.
+    let collision = on_box(motion).replacen("model = \"particles\"", "model = \"collision\"", 1);
+    let e = parse(&collision).unwrap_err();
+    assert!(e.contains("boundary.model") || e.contains("motion"), "{e}");
+}

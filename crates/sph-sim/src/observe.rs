@@ -156,7 +156,10 @@ impl RestCriterion {
 
 /// Stops a run ([`Flow::Stop`]) once its [`RestCriterion`] holds (judged with
 /// [`judge_rest`] after each frame, on one sample per frame and one of the run's first
-/// state); the scene's duration is then a cap.
+/// state) and the scene's moving solids have stopped ([`Scene::motion_end_s`]: a heap
+/// is not at rest on a trapdoor still being lowered); the scene's duration is then a cap.
+///
+/// [`Scene::motion_end_s`]: sph_scene::Scene::motion_end_s
 #[derive(Debug, Clone)]
 pub struct RestObserver {
     /// The criterion.
@@ -259,8 +262,9 @@ impl<R: Real> FrameObserver<R> for RestObserver {
     fn frame(&mut self, sim: &SceneSim<R>, _: &FrameRecord) -> Result<Flow, SimError> {
         self.take(sim)?;
         match self.verdict {
-            Some(v) if v.at_rest => {
-                self.rest_from_s = v.rest_from_s;
+            Some(v) if v.at_rest && sim.time_s >= sim.scene.motion_end_s() => {
+                let still_from = sim.scene.motion_end_s();
+                self.rest_from_s = v.rest_from_s.map(|t| t.max(still_from));
                 Ok(Flow::Stop(v.summary(&self.criterion.settings)))
             }
             _ => Ok(Flow::Continue),
