@@ -130,8 +130,10 @@ impl Scene {
                     "a moving solid is a wall of boundary particles: set [boundary] model = \"particles\" (the elastoplastic solver)",
                 ));
             }
-            if !matches!(self.solids.get(j), Some(SolidSpec::Box { .. })) {
-                return Err(ctx.invalid(field, "only a solid of kind = \"box\" moves"));
+            match self.solids.get(j) {
+                Some(SolidSpec::Box { .. }) => {}
+                Some(_) => return Err(ctx.invalid(field, "only a solid of kind = \"box\" moves")),
+                None => return Err(ctx.invalid(field, "a motion without its solid")),
             }
             ctx.finite3(&format!("{field}.velocity"), &m.velocity)?;
             ctx.positive(&format!("{field}.duration"), m.duration_s)?;
@@ -141,16 +143,6 @@ impl Scene {
                     format!("at most MAX_WALL_MOTION_S = {MAX_WALL_MOTION_S} s, got {}", m.duration_s),
                 ));
             }
-        }
-        if self.motions.len() != self.solids.len() {
-            return Err(ctx.invalid(
-                "solid",
-                format!(
-                    "{} motions for {} solids (Scene::motions has one entry per solid)",
-                    self.motions.len(),
-                    self.solids.len()
-                ),
-            ));
         }
         if self.walls.tank.is_some() && self.tank.is_none() {
             return Err(ctx.invalid("tank.wall", "a wall model without a tank"));

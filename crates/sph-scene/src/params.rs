@@ -44,10 +44,7 @@ impl Scene {
                 .tank
                 .iter()
                 .map(|_| self.walls.tank.unwrap_or(default))
-                .chain(
-                    self.standing_solids()
-                        .map(|j| self.walls.solids[j].unwrap_or(default)),
-                )
+                .chain(self.standing_solids().map(|j| self.wall_of(j).unwrap_or(default)))
                 .collect();
             e.moving_walls = self.moving_walls(default);
             e.boundary_particle_region = self.tank.or_else(|| {
@@ -65,21 +62,25 @@ impl Scene {
     fn moving_walls(&self, default: WallModel) -> Vec<MovingWall<f64>> {
         self.solids
             .iter()
-            .zip(&self.motions)
-            .zip(&self.walls.solids)
-            .filter_map(|((solid, motion), wall)| match (solid, motion) {
-                (SolidSpec::Box { min, max }, Some(m)) => Some(MovingWall {
+            .enumerate()
+            .filter_map(|(j, solid)| match (solid, self.motions.get(j)) {
+                (SolidSpec::Box { min, max }, Some(Some(m))) => Some(MovingWall {
                     region: Aabb {
                         min: v3(*min),
                         max: v3(*max),
                     },
-                    model: wall.unwrap_or(default),
+                    model: self.wall_of(j).unwrap_or(default),
                     velocity: v3(m.velocity),
                     duration_s: m.duration_s,
                 }),
                 _ => None,
             })
             .collect()
+    }
+
+    /// The wall model solid `j` states (`None`: unstated, or no entry for it).
+    fn wall_of(&self, j: usize) -> Option<WallModel> {
+        self.walls.solids.get(j).copied().flatten()
     }
 
     /// The solver parameters the scene asks for, in precision `R`, checked (the settings as

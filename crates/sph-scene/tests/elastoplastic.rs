@@ -224,6 +224,15 @@ fn a_moving_box_becomes_a_moving_wall() {
     assert_eq!(w.model, WallModel::FreeSlip);
     assert_eq!((w.velocity.y, w.duration_s), (-0.05, 2.0));
     assert_eq!(parse(BASE).unwrap().motion_end_s(), 0.0);
+    // Edited in code: a scene whose solids are cleared (as the experiments do) is still a
+    // scene, unless a motion is left without its solid.
+    let mut cleared = parse(BASE).unwrap();
+    cleared.solids.clear();
+    cleared.check().unwrap();
+    let mut orphan = s.clone();
+    orphan.solids.clear();
+    let e = orphan.check().unwrap_err().to_string();
+    assert!(e.contains("solid[0].motion"), "{e}");
 }
 
 /// A motion is refused, at its key, on a solid that is not a box, without walls of
