@@ -9,7 +9,8 @@
 //!
 //! Keys (defaults): `s` spacing (0.02 m), `E` (5.84e5 Pa), `alpha` (α_Π, 0.1), `phi`
 //! (30°), `C` (0.2), `cap` (6 s), `L` period (1.2 m), `H` bed height (0.2 m), `w` slot
-//! width (0.24 m), `sump` (0.6 m), `geo` (1: geostatic start; 0: unstressed), `u` the
+//! width (0.24 m), `sump` (0.6 m), `geo` (1: geostatic start; 0: unstressed), `k0` the
+//! geostatic start's ratio of horizontal to vertical stress (default `ν/(1 − ν)`), `u` the
 //! viscosity's fixed velocity scale (m/s; 0, the default: the speed of sound), `psi` the
 //! dilatancy angle (0°), `door` a trapdoor's speed (m/s; 0, the default: an open slot over
 //! the sump; `DrainedSetup::trapdoor_speed_m_s`), `match` the cone's match (`psa` plane strain associated, the
@@ -74,7 +75,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     let youngs = params.youngs_modulus;
     let alpha_phi = cone_match.alpha(phi);
+    let k0 = num("k0", -1.0)?;
     let (mut solver, mut state) = drained_bed(params, setup)?;
+    if k0 >= 0.0 {
+        // The geostatic start with the horizontal stresses K0 times the vertical one.
+        let geo = elastoplastic_granular::initial::geostatic(solver.params(), &state.positions)?;
+        let set: Vec<_> = geo
+            .iter()
+            .map(|m| {
+                let v = m[(1, 1)];
+                nalgebra::Matrix3::from_diagonal(&nalgebra::Vector3::new(k0 * v, v, k0 * v))
+            })
+            .collect();
+        solver.scheme_mut().set_stress(&set)?;
+        println!("initial stress: K0 = {k0}");
+    }
     let (steps, dt) = solver.params().explicit_steps();
     let predicted = cone_match.predicted_repose_angle_deg(phi);
     println!(
