@@ -367,7 +367,11 @@ fn announce<R: Real>(sim: &SceneSim<R>, scene: &Scene, plan: &RunPlan, run: &Run
         scene.name,
         sim.state.len(),
         sim.solver().name(),
-        sim.solver().boundary().name(),
+        match scene.boundary.model {
+            // The solver's boundary is then the collision net under the particles' walls.
+            sph_scene::BoundaryModel::Particles => "particles",
+            _ => sim.solver().boundary().name(),
+        },
         plan.first_frame,
         plan.last_frame,
         scene.frame_dt_s,
