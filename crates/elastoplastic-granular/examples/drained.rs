@@ -10,7 +10,8 @@
 //! Keys (defaults): `s` spacing (0.02 m), `E` (5.84e5 Pa), `alpha` (α_Π, 0.1), `phi`
 //! (30°), `C` (0.2), `cap` (6 s), `L` period (1.2 m), `H` bed height (0.2 m), `w` slot
 //! width (0.24 m), `sump` (0.6 m), `geo` (1: geostatic start; 0: unstressed), `k0` the
-//! geostatic start's ratio of horizontal to vertical stress (default `ν/(1 − ν)`), `u` the
+//! geostatic start's ratio of horizontal to vertical stress (default `ν/(1 − ν)`), `layers`
+//! (1: every 0.1 s, the flanks' layers' stress in slope axes, `layer_state`), `u` the
 //! viscosity's fixed velocity scale (m/s; 0, the default: the speed of sound), `psi` the
 //! dilatancy angle (0°), `door` a trapdoor's speed (m/s; 0, the default: an open slot over
 //! the sump; `DrainedSetup::trapdoor_speed_m_s`), `match` the cone's match (`psa` plane strain associated, the
@@ -76,6 +77,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let youngs = params.youngs_modulus;
     let alpha_phi = cone_match.alpha(phi);
     let k0 = num("k0", -1.0)?;
+    let layers = num("layers", 0.0)? != 0.0;
     let (mut solver, mut state) = drained_bed(params, setup)?;
     if k0 >= 0.0 {
         // The geostatic start with the horizontal stresses K0 times the vertical one.
@@ -151,6 +153,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         samples.push(now);
         // Not at rest while the trapdoor still moves.
         let rest = at_rest(&samples, s)? && setup.trapdoor_travel_s().is_none_or(|d| t > d);
+        if layers && frame % 6 == 0 && !rest {
+            if let Some(m) = &measured {
+                layer_state(&solver, &state, &setup, s, m.angle_deg, alpha_phi, t);
+            }
+        }
         if frame % 6 == 0 || rest {
             let flanks = measured.as_ref().map_or(String::new(), |m| {
                 m.flanks
@@ -296,4 +303,80 @@ fn flank_stress(
             rows.len(), med(0), beta.tan(), med(1), 3.0 * alpha_phi, med(2), med(3), med(4), med(5)
         );
     }
+}
+
+/// The flanks' surface layer (0–1 spacing below the top grain of each column) and the layer
+/// 2–5 spacings deep, between 20 % and 80 % of the bed's height, at time `t`: the medians
+/// of the normal-stress difference along the slope `dN = (σ_ss − σ_nn)/(2 p_in)` (`s`
+/// down the slope at `beta_deg`, `n` its outward normal, `p_in = −(σ_ss + σ_nn)/2`;
+/// positive: the slope-parallel stress less compressive, an extending layer), `τ/σ_n` on
+/// the slope-parallel plane, the yield ratio `√J2/(3 α_φ p)`, the downslope speed (m/s) and
+/// the pressure `p` (Pa).
+fn layer_state(
+    solver: &elastoplastic_granular::Elastoplastic<f64>,
+    state: &elastoplastic_granular::ParticleSet<f64>,
+    setup: &DrainedSetup,
+    s: f64,
+    beta_deg: f64,
+    alpha_phi: f64,
+    t: f64,
+) {
+    let stress = solver.scheme().stress();
+    let bins = (setup.period_x_m / s).ceil() as usize + 1;
+    let mut top = vec![f64::NEG_INFINITY; bins];
+    for p in &state.positions {
+        if setup.on_floor(p) {
+            let b = ((p.x / s) as usize).min(bins - 1);
+            top[b] = top[b].max(p.y);
+        }
+    }
+    let h = setup.bed_height_m;
+    let beta = beta_deg.to_radians();
+    let mut out = format!("  layers t {t:.2} beta {beta_deg:.2}:");
+    for (lo, hi) in [(-0.1, 1.1), (1.9, 5.1)] {
+        let mut rows: Vec<[f64; 5]> = Vec::new();
+        for ((p, sg), v) in state.positions.iter().zip(stress).zip(&state.velocities) {
+            if !setup.on_floor(p) {
+                continue;
+            }
+            let left = p.x < 0.5 * setup.period_x_m;
+            let b = ((p.x / s) as usize).min(bins - 1);
+            let depth = top[b] - p.y;
+            if !(depth >= lo * s && depth <= hi * s && p.y > 0.2 * h && p.y < 0.8 * h) {
+                continue;
+            }
+            // n the outward normal, d down the slope (towards the slot).
+            let (sign, (sb, cb)) = (if left { -1.0 } else { 1.0 }, beta.sin_cos());
+            let n = nalgebra::Vector3::new(sign * sb, cb, 0.0);
+            let d = nalgebra::Vector3::new(sign * cb, -sb, 0.0);
+            let snn = n.dot(&(sg * n));
+            let sss = d.dot(&(sg * d));
+            let tau = d.dot(&(sg * n)).abs();
+            let p3 = -sg.trace() / 3.0;
+            let dev = sg - nalgebra::Matrix3::identity() * (-p3);
+            let j2 = 0.5 * (dev * dev).trace();
+            let p_in = -(snn + sss) / 2.0;
+            rows.push([
+                (sss - snn) / (2.0 * p_in),
+                tau / -snn,
+                j2.sqrt() / (3.0 * alpha_phi * p3),
+                v.dot(&d),
+                p3,
+            ]);
+        }
+        let med = |k: usize| {
+            let mut v: Vec<f64> = rows
+                .iter()
+                .map(|r| r[k])
+                .filter(|x| x.is_finite())
+                .collect();
+            v.sort_by(f64::total_cmp);
+            v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+        };
+        out += &format!(
+            "  [{lo:.0}-{hi:.0}s: n {} dN {:+.3} tau/sn {:.3} yield {:.3} v_down {:.4} p {:.0}]",
+            rows.len(), med(0), med(1), med(2), med(3), med(4)
+        );
+    }
+    println!("{out}");
 }
