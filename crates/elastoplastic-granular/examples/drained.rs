@@ -233,14 +233,7 @@ fn flank_stress(
     alpha_phi: f64,
 ) {
     let stress = solver.scheme().stress();
-    let bins = (setup.period_x_m / s).ceil() as usize + 1;
-    let mut top = vec![f64::NEG_INFINITY; bins];
-    for p in &state.positions {
-        if setup.on_floor(p) {
-            let b = ((p.x / s) as usize).min(bins - 1);
-            top[b] = top[b].max(p.y);
-        }
-    }
+    let depth_of = floor_depths(state, setup, s);
     let h = setup.bed_height_m;
     let beta = beta_deg.to_radians();
     for (name, left) in [("left", true), ("right", false)] {
@@ -249,8 +242,7 @@ fn flank_stress(
             if !setup.on_floor(p) || (p.x < 0.5 * setup.period_x_m) != left {
                 continue;
             }
-            let b = ((p.x / s) as usize).min(bins - 1);
-            let depth = top[b] - p.y;
+            let depth = depth_of(p);
             if !(depth >= 1.9 * s && depth <= 5.1 * s && p.y > 0.2 * h && p.y < 0.8 * h) {
                 continue;
             }
@@ -289,15 +281,7 @@ fn flank_stress(
                 p3,
             ]);
         }
-        let med = |k: usize| {
-            let mut v: Vec<f64> = rows
-                .iter()
-                .map(|r| r[k])
-                .filter(|x| x.is_finite())
-                .collect();
-            v.sort_by(f64::total_cmp);
-            v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
-        };
+        let med = |k: usize| median(rows.iter().map(|r| r[k]));
         println!(
             "{name} flank ({} grains, 2-5 spacings deep): tau/sigma_n {:.3} (tan beta {:.3}), R/p_in {:.3} (3 alpha {:.3}), yield ratio {:.3}, s_zz/p {:.3}, major principal stress at {:.1} deg from the horizontal (toward the crest), p {:.0} Pa",
             rows.len(), med(0), beta.tan(), med(1), 3.0 * alpha_phi, med(2), med(3), med(4), med(5)
@@ -322,14 +306,7 @@ fn layer_state(
     t: f64,
 ) {
     let stress = solver.scheme().stress();
-    let bins = (setup.period_x_m / s).ceil() as usize + 1;
-    let mut top = vec![f64::NEG_INFINITY; bins];
-    for p in &state.positions {
-        if setup.on_floor(p) {
-            let b = ((p.x / s) as usize).min(bins - 1);
-            top[b] = top[b].max(p.y);
-        }
-    }
+    let depth_of = floor_depths(state, setup, s);
     let h = setup.bed_height_m;
     let beta = beta_deg.to_radians();
     let mut out = format!("  layers t {t:.2} beta {beta_deg:.2}:");
@@ -340,8 +317,7 @@ fn layer_state(
                 continue;
             }
             let left = p.x < 0.5 * setup.period_x_m;
-            let b = ((p.x / s) as usize).min(bins - 1);
-            let depth = top[b] - p.y;
+            let depth = depth_of(p);
             if !(depth >= lo * s && depth <= hi * s && p.y > 0.2 * h && p.y < 0.8 * h) {
                 continue;
             }
@@ -364,19 +340,37 @@ fn layer_state(
                 p3,
             ]);
         }
-        let med = |k: usize| {
-            let mut v: Vec<f64> = rows
-                .iter()
-                .map(|r| r[k])
-                .filter(|x| x.is_finite())
-                .collect();
-            v.sort_by(f64::total_cmp);
-            v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
-        };
-        out += &format!(
+        let med = |k: usize| median(rows.iter().map(|r| r[k]));
+        out +=
+            &format!(
             "  [{lo:.0}-{hi:.0}s: n {} dN {:+.3} tau/sn {:.3} yield {:.3} v_down {:.4} p {:.0}]",
             rows.len(), med(0), med(1), med(2), med(3), med(4)
         );
     }
     println!("{out}");
+}
+
+/// The depth (m) of a grain below the top grain on the floor of its column (columns one
+/// spacing `s` wide along `x`), from the grains of `state` on the floor.
+fn floor_depths(
+    state: &elastoplastic_granular::ParticleSet<f64>,
+    setup: &DrainedSetup,
+    s: f64,
+) -> impl Fn(&elastoplastic_granular::Vec3<f64>) -> f64 {
+    let bins = (setup.period_x_m / s).ceil() as usize + 1;
+    let mut top = vec![f64::NEG_INFINITY; bins];
+    for p in &state.positions {
+        if setup.on_floor(p) {
+            let b = ((p.x / s) as usize).min(bins - 1);
+            top[b] = top[b].max(p.y);
+        }
+    }
+    move |p| top[((p.x / s) as usize).min(bins - 1)] - p.y
+}
+
+/// The median of the finite values (`NaN` when there is none).
+fn median(values: impl Iterator<Item = f64>) -> f64 {
+    let mut v: Vec<f64> = values.filter(|x| x.is_finite()).collect();
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
 }

@@ -247,7 +247,9 @@ fn a_moving_wall_of_the_parameters_stops_after_its_duration() {
     let (mut solver, mut state) = slab_on_scheduled_floor(0.2);
     let start = solver.scheme().boundary_particles().to_vec();
     assert_eq!(start.len(), 8 * 3 * 4, "three rows across the periods");
-    assert!(start.iter().all(|b| b.velocity == Vec3::new(0.0, -0.05, 0.0)));
+    assert!(start
+        .iter()
+        .all(|b| b.velocity == Vec3::new(0.0, -0.05, 0.0)));
     let y0 = state.positions.iter().map(|x| x.y).sum::<f64>() / state.len() as f64;
     for _ in 0..20 {
         solver.step(&mut state).unwrap();
@@ -255,7 +257,10 @@ fn a_moving_wall_of_the_parameters_stops_after_its_duration() {
     let (_, dt) = slab_params().0.explicit_steps();
     for (b, a) in solver.scheme().boundary_particles().iter().zip(&start) {
         let moved = b.position.y - a.position.y;
-        assert!((moved + 0.01).abs() <= 0.5 * 0.05 * dt + 1e-12, "moved {moved}");
+        assert!(
+            (moved + 0.01).abs() <= 0.5 * 0.05 * dt + 1e-12,
+            "moved {moved}"
+        );
         assert_eq!(b.velocity, Vec3::zeros());
     }
     let y1 = state.positions.iter().map(|x| x.y).sum::<f64>() / state.len() as f64;
@@ -283,15 +288,21 @@ fn a_moving_wall_across_the_seam_wraps() {
     let (mut p, _, hi) = slab_params();
     p.boundary_particle_region = Some(Aabb::new(Vec3::zeros(), hi).unwrap());
     let wall = MovingWall {
-        region: Aabb::new(Vec3::new(-2.0 * S, -3.0 * S, -1.0), Vec3::new(2.0 * S, 0.0, 1.0))
-            .unwrap(),
+        region: Aabb::new(
+            Vec3::new(-2.0 * S, -3.0 * S, -1.0),
+            Vec3::new(2.0 * S, 0.0, 1.0),
+        )
+        .unwrap(),
         model: WallModel::NoSlip,
         velocity: Vec3::zeros(),
         duration_s: 1.0,
     };
     let b = sample_moving_wall(&wall, &p, 10_000).unwrap();
     assert_eq!(b.len(), 4 * 3 * 4);
-    let mut columns: Vec<i64> = b.iter().map(|b| (b.position.x / S * 2.0).round() as i64).collect();
+    let mut columns: Vec<i64> = b
+        .iter()
+        .map(|b| (b.position.x / S * 2.0).round() as i64)
+        .collect();
     columns.sort_unstable();
     columns.dedup();
     assert_eq!(columns, vec![1, 3, 13, 15], "x in half spacings");

@@ -140,7 +140,10 @@ impl Scene {
             if m.duration_s > MAX_WALL_MOTION_S {
                 return Err(ctx.invalid(
                     format!("{field}.duration"),
-                    format!("at most MAX_WALL_MOTION_S = {MAX_WALL_MOTION_S} s, got {}", m.duration_s),
+                    format!(
+                        "at most MAX_WALL_MOTION_S = {MAX_WALL_MOTION_S} s, got {}",
+                        m.duration_s
+                    ),
                 ));
             }
         }

@@ -44,7 +44,10 @@ impl Scene {
                 .tank
                 .iter()
                 .map(|_| self.walls.tank.unwrap_or(default))
-                .chain(self.standing_solids().map(|j| self.wall_of(j).unwrap_or(default)))
+                .chain(
+                    self.standing_solids()
+                        .map(|j| self.wall_of(j).unwrap_or(default)),
+                )
                 .collect();
             e.moving_walls = self.moving_walls(default);
             e.boundary_particle_region = self.tank.or_else(|| {

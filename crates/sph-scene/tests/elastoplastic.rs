@@ -213,11 +213,18 @@ fn a_moving_box_becomes_a_moving_wall() {
     let s = parse(&moving).unwrap();
     assert_eq!(s.motion_end_s(), 2.0);
     assert_eq!(s.standing_solids().collect::<Vec<_>>(), vec![1]);
-    assert_eq!(s.build_solids::<f64>().unwrap().len(), 2, "the tank and the sphere");
+    assert_eq!(
+        s.build_solids::<f64>().unwrap().len(),
+        2,
+        "the tank and the sphere"
+    );
     let SolverParams::Elastoplastic(p) = s.solver_params::<f64>().unwrap() else {
         panic!("not elastoplastic")
     };
-    assert_eq!(p.wall_models, vec![WallModel::Coulomb(0.4), WallModel::NoSlip]);
+    assert_eq!(
+        p.wall_models,
+        vec![WallModel::Coulomb(0.4), WallModel::NoSlip]
+    );
     assert_eq!(p.moving_walls.len(), 1);
     let w = &p.moving_walls[0];
     assert_eq!((w.region.min.x, w.region.max.y), (0.2, 0.1));
@@ -244,7 +251,13 @@ fn bad_motions_name_their_key() {
     let sphere = BASE.replacen("radius = 0.03", &format!("radius = 0.03\n{motion}"), 1);
     let e = parse(&sphere).unwrap_err();
     assert!(e.contains("solid[1].motion") && e.contains("box"), "{e}");
-    let on_box = |m: &str| BASE.replacen("wall = \"free-slip\"", &format!("wall = \"free-slip\"\n{m}"), 1);
+    let on_box = |m: &str| {
+        BASE.replacen(
+            "wall = \"free-slip\"",
+            &format!("wall = \"free-slip\"\n{m}"),
+            1,
+        )
+    };
     for (m, key) in [
         (
             "motion = { velocity = [0.0, nan, 0.0], duration = 2.0 }",

@@ -300,35 +300,63 @@ fn granular_repose_scenes_are_drained_beds() {
 fn granular_repose_trapdoor_scenes_lower_a_door_under_the_slot() {
     for theta in [20, 30, 40] {
         let open = Scene::load(&scene_path(&format!("granular_repose_{theta}.toml"))).unwrap();
-        let s = Scene::load(&scene_path(&format!("granular_repose_trapdoor_{theta}.toml")))
-            .unwrap();
+        let s = Scene::load(&scene_path(&format!(
+            "granular_repose_trapdoor_{theta}.toml"
+        )))
+        .unwrap();
         assert_eq!(s.solver.periodic_axes(), open.solver.periodic_axes());
         assert_eq!(counts(&s), counts(&open), "θ = {theta}: the same bed");
         use sph_scene::SolidSpec::Box;
         use sph_scene::WallModel::{FreeSlip, NoSlip};
-        let (Some(Box { min, max }), Some(Box { min: plate, max: plate_top })) =
-            (s.solids.first(), open.solids.first())
+        let (
+            Some(Box { min, max }),
+            Some(Box {
+                min: plate,
+                max: plate_top,
+            }),
+        ) = (s.solids.first(), open.solids.first())
         else {
             panic!("the plates are boxes")
         };
         assert_eq!((min, max), (plate, plate_top), "the open scene's plate");
-        assert_eq!(s.walls.solids, vec![Some(NoSlip), Some(FreeSlip), Some(NoSlip)]);
+        assert_eq!(
+            s.walls.solids,
+            vec![Some(NoSlip), Some(FreeSlip), Some(NoSlip)]
+        );
         let tank = s.tank.unwrap();
-        let Some(Box { min: wmin, max: wmax }) = s.solids.get(1) else {
+        let Some(Box {
+            min: wmin,
+            max: wmax,
+        }) = s.solids.get(1)
+        else {
             panic!("the channel's walls are a box")
         };
         assert_eq!((wmin[0], wmax[0], wmax[1]), (min[0], max[0], 0.0));
         assert_eq!(wmin[1], tank.min.y, "the walls reach the channel's floor");
-        assert!((max[1] - 0.6 - tank.min.y - 0.1).abs() < 1e-12, "0.6 m under the plate");
-        let Some(Box { min: door, max: top }) = s.solids.get(2) else {
+        assert!(
+            (max[1] - 0.6 - tank.min.y - 0.1).abs() < 1e-12,
+            "0.6 m under the plate"
+        );
+        let Some(Box {
+            min: door,
+            max: top,
+        }) = s.solids.get(2)
+        else {
             panic!("the trapdoor is a box")
         };
-        assert_eq!((door[0], top[0], top[1]), (-0.12, 0.12, 0.0), "fills the slot");
+        assert_eq!(
+            (door[0], top[0], top[1]),
+            (-0.12, 0.12, 0.0),
+            "fills the slot"
+        );
         assert_eq!(s.motions[..2], [None, None]);
         let m = s.motions[2].expect("the trapdoor moves");
         assert_eq!(m.velocity, [0.0, -0.05, 0.0]);
         let travel = 0.05 * m.duration_s;
         assert!((travel - 0.6).abs() < 1e-12 && door[1] - travel > tank.min.y);
-        assert!(s.quick().duration_s > m.duration_s, "the cap after the door stops");
+        assert!(
+            s.quick().duration_s > m.duration_s,
+            "the cap after the door stops"
+        );
     }
 }

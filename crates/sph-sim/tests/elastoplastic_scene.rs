@@ -205,9 +205,8 @@ fn a_trapdoor_in_a_scene_lowers_the_grains_over_it() {
         }
         by_id
     };
-    let mean_drop = |set: &[usize]| {
-        set.iter().map(|&i| start[i].y - now[i].y).sum::<f64>() / set.len() as f64
-    };
+    let mean_drop =
+        |set: &[usize]| set.iter().map(|&i| start[i].y - now[i].y).sum::<f64>() / set.len() as f64;
     let (door, plate) = (mean_drop(&over_door), mean_drop(&middle));
     eprintln!("over the door {door:.5} m, over the plate {plate:.5} m");
     assert!(door > 0.005 && door < 0.015, "over the door: {door} m");
