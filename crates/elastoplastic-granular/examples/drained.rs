@@ -32,6 +32,7 @@ use elastoplastic_granular::{ConeMatch, ElastoplasticParams};
 use granular_measure::{angle_of_repose, ReposeOptions, RestSample};
 
 mod pieces;
+use pieces::slope::{floor_depths, layer_state, median, Flanks};
 use pieces::{at_rest, elapsed_over_budget, resume, sample, save_run};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -155,7 +156,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let rest = at_rest(&samples, s)? && setup.trapdoor_travel_s().is_none_or(|d| t > d);
         if layers && frame % 6 == 0 && !rest {
             if let Some(m) = &measured {
-                layer_state(&solver, &state, &setup, s, m.angle_deg, alpha_phi, t);
+                let line = layer_state(
+                    &solver,
+                    &state,
+                    &flanks(&setup),
+                    s,
+                    m.angle_deg,
+                    alpha_phi,
+                    t,
+                );
+                println!("{line}");
             }
         }
         if frame % 6 == 0 || rest {
@@ -233,7 +243,7 @@ fn flank_stress(
     alpha_phi: f64,
 ) {
     let stress = solver.scheme().stress();
-    let depth_of = floor_depths(state, setup, s);
+    let depth_of = floor_depths(state, &flanks(setup), s);
     let h = setup.bed_height_m;
     let beta = beta_deg.to_radians();
     for (name, left) in [("left", true), ("right", false)] {
@@ -289,88 +299,13 @@ fn flank_stress(
     }
 }
 
-/// The flanks' surface layer (0–1 spacing below the top grain of each column) and the layer
-/// 2–5 spacings deep, between 20 % and 80 % of the bed's height, at time `t`: the medians
-/// of the normal-stress difference along the slope `dN = (σ_ss − σ_nn)/(2 p_in)` (`s`
-/// down the slope at `beta_deg`, `n` its outward normal, `p_in = −(σ_ss + σ_nn)/2`;
-/// positive: the slope-parallel stress less compressive, an extending layer), `τ/σ_n` on
-/// the slope-parallel plane, the yield ratio `√J2/(3 α_φ p)`, the downslope speed (m/s) and
-/// the pressure `p` (Pa).
-fn layer_state(
-    solver: &elastoplastic_granular::Elastoplastic<f64>,
-    state: &elastoplastic_granular::ParticleSet<f64>,
-    setup: &DrainedSetup,
-    s: f64,
-    beta_deg: f64,
-    alpha_phi: f64,
-    t: f64,
-) {
-    let stress = solver.scheme().stress();
-    let depth_of = floor_depths(state, setup, s);
-    let h = setup.bed_height_m;
-    let beta = beta_deg.to_radians();
-    let mut out = format!("  layers t {t:.2} beta {beta_deg:.2}:");
-    for (lo, hi) in [(-0.1, 1.1), (1.9, 5.1)] {
-        let mut rows: Vec<[f64; 5]> = Vec::new();
-        for ((p, sg), v) in state.positions.iter().zip(stress).zip(&state.velocities) {
-            if !setup.on_floor(p) {
-                continue;
-            }
-            let left = p.x < 0.5 * setup.period_x_m;
-            let depth = depth_of(p);
-            if !(depth >= lo * s && depth <= hi * s && p.y > 0.2 * h && p.y < 0.8 * h) {
-                continue;
-            }
-            // n the outward normal, d down the slope (towards the slot).
-            let (sign, (sb, cb)) = (if left { -1.0 } else { 1.0 }, beta.sin_cos());
-            let n = nalgebra::Vector3::new(sign * sb, cb, 0.0);
-            let d = nalgebra::Vector3::new(sign * cb, -sb, 0.0);
-            let snn = n.dot(&(sg * n));
-            let sss = d.dot(&(sg * d));
-            let tau = d.dot(&(sg * n)).abs();
-            let p3 = -sg.trace() / 3.0;
-            let dev = sg - nalgebra::Matrix3::identity() * (-p3);
-            let j2 = 0.5 * (dev * dev).trace();
-            let p_in = -(snn + sss) / 2.0;
-            rows.push([
-                (sss - snn) / (2.0 * p_in),
-                tau / -snn,
-                j2.sqrt() / (3.0 * alpha_phi * p3),
-                v.dot(&d),
-                p3,
-            ]);
-        }
-        let med = |k: usize| median(rows.iter().map(|r| r[k]));
-        out +=
-            &format!(
-            "  [{lo:.0}-{hi:.0}s: n {} dN {:+.3} tau/sn {:.3} yield {:.3} v_down {:.4} p {:.0}]",
-            rows.len(), med(0), med(1), med(2), med(3), med(4)
-        );
+/// The drained bed's two slopes: the grains on the plate, the left one left of the period's
+/// middle.
+fn flanks(setup: &DrainedSetup) -> Flanks<'_> {
+    Flanks {
+        on_heap: Box::new(|p| setup.on_floor(p)),
+        left: Box::new(|p| p.x < 0.5 * setup.period_x_m),
+        period_x_m: setup.period_x_m,
+        height_m: setup.bed_height_m,
     }
-    println!("{out}");
-}
-
-/// The depth (m) of a grain below the top grain on the floor of its column (columns one
-/// spacing `s` wide along `x`), from the grains of `state` on the floor.
-fn floor_depths(
-    state: &elastoplastic_granular::ParticleSet<f64>,
-    setup: &DrainedSetup,
-    s: f64,
-) -> impl Fn(&elastoplastic_granular::Vec3<f64>) -> f64 {
-    let bins = (setup.period_x_m / s).ceil() as usize + 1;
-    let mut top = vec![f64::NEG_INFINITY; bins];
-    for p in &state.positions {
-        if setup.on_floor(p) {
-            let b = ((p.x / s) as usize).min(bins - 1);
-            top[b] = top[b].max(p.y);
-        }
-    }
-    move |p| top[((p.x / s) as usize).min(bins - 1)] - p.y
-}
-
-/// The median of the finite values (`NaN` when there is none).
-fn median(values: impl Iterator<Item = f64>) -> f64 {
-    let mut v: Vec<f64> = values.filter(|x| x.is_finite()).collect();
-    v.sort_by(f64::total_cmp);
-    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
 }

@@ -16,6 +16,7 @@ use sph_solver::{Solids, SolverError};
 use crate::boundary_particles::boundary_block;
 use crate::params::{ElastoplasticParams, InitialStress, MovingWall, WallModel};
 use crate::periodic::PeriodicAxis;
+use crate::pour::Pour;
 use crate::solver::{Elastoplastic, ElastoplasticScheme};
 use crate::walls::volume_map_walls;
 
@@ -423,5 +424,87 @@ pub fn cut_slope<R: Real>(
     let rows = aabb([0.0, -BOUNDARY_ROWS * s.as_f64(), 0.0], [l, 0.0, d])?;
     let floor = boundary_block(&rows, s, v(0.0, 1.0, 0.0), WallModel::NoSlip, 1 << 22)?;
     solver.scheme_mut().set_boundary_particles(floor)?;
+    Ok((solver, state))
+}
+
+/// A heap poured onto a floor (the funnel method; [`crate::Pour`]): a no-slip floor of
+/// boundary particles (three rows under `y = 0`, the floor plane only keeping grains out)
+/// across a period `period_x_m` along `x` and `slab_depth_m` along `z` (plane strain
+/// without walls), no grains at the start, and a funnel `funnel_width_m` wide across the
+/// slab at the period's middle that pours `volume_m3` at `rate_m3_s`, its top
+/// `funnel_top_m` above the floor.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PouredSetup {
+    /// The period along `x` (m; a multiple of the spacing).
+    pub period_x_m: f64,
+    /// The slab's depth along `z` (m; a multiple of the spacing).
+    pub slab_depth_m: f64,
+    /// The funnel's width along `x` (m; at least a spacing).
+    pub funnel_width_m: f64,
+    /// The funnel's top above the floor (m): the heap must stay below it.
+    pub funnel_top_m: f64,
+    /// The bulk volume poured (m³).
+    pub volume_m3: f64,
+    /// The rate (m³/s).
+    pub rate_m3_s: f64,
+}
+
+impl PouredSetup {
+    /// The heap of run 40 of `docs/elastoplastic-granular.md` at spacing `s` (m): period
+    /// 1.6 m, slab three spacings deep, a funnel 0.1 m wide (a stream five grains wide at
+    /// 20 mm: a stream one grain wide builds a loose heap), 0.16 m² of cross-section poured
+    /// at 0.012 m² a second (30 grains a second at 20 mm).
+    pub fn for_spacing(s: f64) -> Self {
+        let slab = 3.0 * s;
+        Self {
+            period_x_m: 1.6,
+            slab_depth_m: slab,
+            funnel_width_m: 0.1,
+            funnel_top_m: 1.0,
+            volume_m3: 0.16 * slab,
+            rate_m3_s: 0.012 * slab,
+        }
+    }
+}
+
+/// The solver and its (empty) particle set at `t = 0` for `params` (its spacing sets the
+/// lattice; its `periodic`, `wall_models`, `pour` and `initial_stress` are replaced), set
+/// up as `setup` says ([`PouredSetup`]).
+pub fn poured_heap<R: Real>(
+    mut params: ElastoplasticParams<R>,
+    setup: PouredSetup,
+) -> Result<(Elastoplastic<R>, ParticleSet<R>), SolverError> {
+    let s = params.common.particle_spacing;
+    let (l, d) = (setup.period_x_m, setup.slab_depth_m);
+    params.periodic = [(0, l), (2, d)]
+        .into_iter()
+        .map(|(axis, hi)| PeriodicAxis {
+            axis,
+            lo: R::zero(),
+            hi: R::of_f64(hi),
+        })
+        .collect();
+    params.wall_models = vec![WallModel::ContactOnly];
+    params.initial_stress = InitialStress::None;
+    let half = 0.5 * setup.funnel_width_m;
+    params.pour = Some(Pour {
+        region: aabb(
+            [0.5 * l - half, 0.0, 0.0],
+            [0.5 * l + half, setup.funnel_top_m, d],
+        )?,
+        volume_m3: R::of_f64(setup.volume_m3),
+        rate_m3_s: R::of_f64(setup.rate_m3_s),
+    });
+    let solids: Solids<R> = vec![Box::new(Plane::new(v(0.0, 0.0, 0.0), v(0.0, 1.0, 0.0))?)];
+    let domain = aabb(
+        [-0.05, -0.05, -0.05],
+        [l + 0.05, setup.funnel_top_m + 0.1, d + 0.05],
+    )?;
+    let walls = volume_map_walls(solids, &params, domain)?;
+    let mut solver = ElastoplasticScheme::solver(params, walls)?;
+    let rows = aabb([0.0, -BOUNDARY_ROWS * s.as_f64(), 0.0], [l, 0.0, d])?;
+    let floor = boundary_block(&rows, s, v(0.0, 1.0, 0.0), WallModel::NoSlip, 1 << 22)?;
+    solver.scheme_mut().set_boundary_particles(floor)?;
+    let state = ParticleSet::from_positions(Vec::new(), R::zero(), R::zero());
     Ok((solver, state))
 }

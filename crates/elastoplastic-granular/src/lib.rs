@@ -97,6 +97,7 @@ mod kernels;
 mod params;
 mod passes;
 pub mod periodic;
+pub mod pour;
 mod scratch;
 mod settings;
 mod solver;
@@ -119,6 +120,7 @@ pub use params::{
     MAX_YOUNGS_MODULUS_PA,
 };
 pub use periodic::PeriodicAxis;
+pub use pour::{Pour, MAX_POURED_GRAINS};
 pub use settings::{Axis, ElastoplasticSettings, PeriodicSetting, WITH_COMMON_FRICTION_ANGLE_DEG};
 pub use solver::{
     Elastoplastic, ElastoplasticScheme, ELASTOPLASTIC_PHASES, ELASTOPLASTIC_STATE_ARRAYS,

@@ -4,6 +4,7 @@ use sph_core::{Aabb, Real, Vec3};
 use sph_solver::{CommonParams, SolverError};
 
 use crate::periodic::PeriodicAxis;
+use crate::pour::Pour;
 use crate::stress::{ConeMatch, DruckerPrager};
 
 /// Largest Young's modulus accepted (Pa): 1 TPa, above any granular material's, so that the
@@ -130,6 +131,7 @@ pub enum InitialStress {
 /// | `periodic` | none | |
 /// | `boundary_particle_region` | none (walls from the boundary) | |
 /// | `moving_walls` | none | |
+/// | `pour` | none | |
 /// | `initial_stress` | none | |
 #[derive(Debug, Clone, PartialEq)]
 pub struct ElastoplasticParams<R: Real> {
@@ -185,6 +187,9 @@ pub struct ElastoplasticParams<R: Real> {
     /// lowered under a bed, a gate lifted), sampled on the same lattice as the solids'
     /// walls (they need `boundary_particle_region`); see [`MovingWall`].
     pub moving_walls: Vec<MovingWall<R>>,
+    /// Grains poured during the run, a layer at a time where the heap grows (the funnel
+    /// method of forming a heap; see [`Pour`]).
+    pub pour: Option<Pour<R>>,
     /// The stress the particles start from.
     pub initial_stress: InitialStress,
 }
@@ -265,6 +270,7 @@ impl<R: Real> ElastoplasticParams<R> {
             periodic: Vec::new(),
             boundary_particle_region: None,
             moving_walls: Vec::new(),
+            pour: None,
             initial_stress: InitialStress::None,
         }
     }
@@ -428,6 +434,9 @@ impl<R: Real> ElastoplasticParams<R> {
             }
         }
         self.validate_moving_walls()?;
+        if let Some(p) = &self.pour {
+            p.validate(f(self.common.particle_spacing), self.common.gravity)?;
+        }
         let reach = f(self.common.support_radius + self.skin);
         for (k, a) in self.periodic.iter().enumerate() {
             if a.axis > 2 || self.periodic[..k].iter().any(|b| b.axis == a.axis) {

@@ -15,6 +15,7 @@ use sph_solver::{
 use crate::kernels::ELASTOPLASTIC_KERNEL;
 use crate::params::{ElastoplasticParams, InitialStress, MovingWall};
 use crate::periodic::PeriodicAxis;
+use crate::pour::Pour;
 use crate::solver::{Elastoplastic, NAME};
 use crate::stress::ConeMatch;
 
@@ -283,6 +284,20 @@ impl<R: Real> ElastoplasticParams<R> {
                     })
                 })
                 .collect::<Result<_, SolverError>>()?,
+            pour: self
+                .pour
+                .map(|p| {
+                    let v3 = |v| sph_solver::settings::convert3(NAME, "pour", v);
+                    Ok::<_, SolverError>(Pour {
+                        region: Aabb {
+                            min: v3(&p.region.min)?,
+                            max: v3(&p.region.max)?,
+                        },
+                        volume_m3: c("pour", p.volume_m3)?,
+                        rate_m3_s: c("pour", p.rate_m3_s)?,
+                    })
+                })
+                .transpose()?,
             initial_stress: self.initial_stress,
         })
     }

@@ -22,6 +22,7 @@ use crate::params::{ElastoplasticParams, InitialStress, WallModel};
 use crate::passes::{
     boundary_pair_terms, max_displacement, momentum_pass, stress_pass, StepInputs,
 };
+use crate::pour::Pouring;
 use crate::scratch::Scratch;
 use crate::walls::{SharedWalls, WallSampler};
 
@@ -47,8 +48,10 @@ const REORDER: usize = 5;
 /// (`6 n` values per particle in the order xx, yy, zz, xy, yz, zx) and the equivalent
 /// plastic shear strain (`n` values). The density is the particles' own. Once a wall of
 /// boundary particles has moved, also `boundary_motion`: each boundary particle's position
-/// and wall velocity (6 values per boundary particle, m and m/s).
-pub const ELASTOPLASTIC_STATE_ARRAYS: &[&str] = &["stress", "plastic_strain", "boundary_motion"];
+/// and wall velocity (6 values per boundary particle, m and m/s). With a pour
+/// ([`crate::Pour`]), `pour`: the layers placed so far (one value).
+pub const ELASTOPLASTIC_STATE_ARRAYS: &[&str] =
+    &["stress", "plastic_strain", "boundary_motion", "pour"];
 
 /// The elastic–plastic granular solver of Bui et al. (2008); see the crate documentation.
 pub type Elastoplastic<R> = FrameSolver<R, ElastoplasticScheme<R>>;
@@ -79,6 +82,8 @@ pub struct ElastoplasticScheme<R: Real> {
     searches: u64,
     /// The initial stress is still to be applied (at the first frame's start).
     initial_stress_pending: bool,
+    /// The parameters' pour, under way.
+    pouring: Option<Pouring>,
 }
 
 /// A moving wall ([`crate::MovingWall`]) to stop: its boundary particles and the time (s
@@ -177,7 +182,17 @@ impl<R: Real> ElastoplasticScheme<R> {
                 stop_s: wall.duration_s.as_f64(),
             });
         }
+        let g = params.common.gravity.norm().as_f64();
+        let pouring = params.pour.as_ref().map(|p| {
+            Pouring::new(
+                p,
+                params.common.particle_spacing.as_f64(),
+                g,
+                &params.periodic,
+            )
+        });
         let mut scheme = Self {
+            pouring,
             c: Consts::new(&params)?,
             initial_stress_pending: params.initial_stress == InitialStress::Geostatic,
             params,
@@ -419,6 +434,33 @@ impl<R: Real> ElastoplasticScheme<R> {
         );
     }
 
+    /// The layers of the parameters' pour due by the start of frame `at.step` that have
+    /// room ([`crate::Pour`]): the new grains at rest and unstressed, after the others.
+    fn pour(&mut self, state: &mut ParticleSet<R>, at: StepAt) -> Result<(), SolverError> {
+        let Some(pouring) = &mut self.pouring else {
+            return Ok(());
+        };
+        let time_s = at.step as f64 * self.params.common.dt.as_f64();
+        let (mass, rho0) = (
+            self.params.common.particle_mass(),
+            self.params.common.rest_density,
+        );
+        let old = state.len();
+        if pouring.pour(time_s, state, mass, rho0)? > 0 {
+            let n = state.len();
+            self.resize(n);
+            self.scratch.stress[old..n].fill(Matrix3::zeros());
+            self.scratch.plastic_strain[old..n].fill(R::zero());
+            self.lists_valid = false;
+        }
+        Ok(())
+    }
+
+    /// The parameters' pour: layers placed so far and in all (`None` without a pour).
+    pub fn poured_layers(&self) -> Option<(usize, usize)> {
+        self.pouring.as_ref().map(|p| (p.poured, p.layers()))
+    }
+
     /// Explicit steps taken so far, and neighbour searches made for them.
     pub fn counts(&self) -> (u64, u64) {
         (self.explicit_steps, self.searches)
@@ -620,6 +662,9 @@ impl<R: Real> SubstepScheme<R> for ElastoplasticScheme<R> {
         _last: bool,
         stats: &mut StepStats,
     ) -> Result<(), SolverError> {
+        if at.substep == 0 {
+            self.pour(state, at)?;
+        }
         self.time_step(state, at, stats)
     }
     /// The stress (Pa, `xx, yy, zz, xy, yz, zx`) and the equivalent plastic shear strain:
@@ -640,6 +685,9 @@ impl<R: Real> SubstepScheme<R> for ElastoplasticScheme<R> {
                     })
                     .collect(),
             ));
+        }
+        if let Some(p) = &self.pouring {
+            arrays.push(("pour".into(), vec![R::of_f64(p.poured as f64)]));
         }
     }
     fn restore_arrays(
@@ -664,8 +712,34 @@ impl<R: Real> SubstepScheme<R> for ElastoplasticScheme<R> {
                     name: "boundary_motion",
                     len: 6 * self.boundary_particles.len(),
                 },
+                ArraySpec {
+                    name: "pour",
+                    len: 1,
+                },
             ],
         )?;
+        if let Some(p) = &mut self.pouring {
+            let poured = found[3].map_or(0.0, |v| v[0].as_f64());
+            let layers = p.layers();
+            if !(poured >= 0.0 && poured <= layers as f64 && poured.fract() == 0.0)
+                || poured as usize * p.grains_per_layer() > n
+            {
+                return Err(SolverError::InvalidSolverState {
+                    solver: NAME.to_owned(),
+                    reason: format!(
+                        "the pour's layers placed ({poured}) must be a whole number in [0, {layers}] whose grains the {n} particles hold"
+                    ),
+                });
+            }
+            p.poured = poured as usize;
+        } else if found[3].is_some() {
+            return Err(SolverError::InvalidSolverState {
+                solver: NAME.to_owned(),
+                reason:
+                    "the state carries a pour's progress (`pour`) but the parameters have no pour"
+                        .into(),
+            });
+        }
         if let Some(v) = found[2] {
             if v.iter().any(|x| !x.is_finite()) {
                 return Err(SolverError::InvalidSolverState {

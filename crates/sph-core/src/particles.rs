@@ -76,6 +76,18 @@ impl<R: Real> ParticleSet<R> {
         self.densities.push(density);
     }
 
+    /// Reserves room for `additional` more particles in every array, failing (rather than
+    /// aborting) when the memory cannot be had: for sizes a user's input sets.
+    pub fn try_reserve(
+        &mut self,
+        additional: usize,
+    ) -> Result<(), std::collections::TryReserveError> {
+        self.positions.try_reserve(additional)?;
+        self.velocities.try_reserve(additional)?;
+        self.masses.try_reserve(additional)?;
+        self.densities.try_reserve(additional)
+    }
+
     /// Number of particles.
     pub fn len(&self) -> usize {
         self.positions.len()

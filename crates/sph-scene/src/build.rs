@@ -233,6 +233,22 @@ impl Scene {
             .fold(0.0, f64::max)
     }
 
+    /// The grains the scene's pour adds during the run, at its spacing (0 without a pour;
+    /// [`elastoplastic_granular::Pour::grains`]).
+    pub fn poured_grains(&self) -> usize {
+        self.pour.map_or(0, |p| {
+            let pour = elastoplastic_granular::Pour {
+                region: sph_core::Aabb {
+                    min: crate::geom::v3(p.min),
+                    max: crate::geom::v3(p.max),
+                },
+                volume_m3: p.volume_m3,
+                rate_m3_s: p.rate_m3_s,
+            };
+            pour.grains(self.particle_spacing)
+        })
+    }
+
     /// Particle-level checks: count limit, non-empty fluids, inside the tank, outside solids.
     pub(crate) fn validate_particles(&self, ctx: &Ctx) -> Result<(), SceneError> {
         let mut total = 0.0;
@@ -243,6 +259,19 @@ impl Scene {
                     format!("fluid[{i}]"),
                     format!(
                         "the fluids up to this one need about {total:.3e} particles at particle_spacing {} m, more than the maximum of {MAX_PARTICLES}",
+                        self.particle_spacing
+                    ),
+                ));
+            }
+        }
+        if let Some(p) = &self.pour {
+            // Checked before the run adds them: the pour's volume over spacing³.
+            total += (p.volume_m3 / self.particle_spacing.powi(3)).max(0.0);
+            if !(total <= MAX_PARTICLES as f64) {
+                return Err(ctx.invalid(
+                    "pour.volume",
+                    format!(
+                        "the fluids and the pour need about {total:.3e} particles at particle_spacing {} m, more than the maximum of {MAX_PARTICLES}",
                         self.particle_spacing
                     ),
                 ));

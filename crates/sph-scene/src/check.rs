@@ -147,6 +147,33 @@ impl Scene {
                 ));
             }
         }
+        if let Some(p) = &self.pour {
+            if !elastoplastic {
+                return Err(ctx.invalid(
+                    "pour",
+                    format!(
+                        "a pour adds grains during the run: only solver kind = \"elastoplastic\" takes them, not \"{}\"",
+                        self.solver.kind_name()
+                    ),
+                ));
+            }
+            ctx.check_box("pour", &p.min, &p.max)?;
+            if let Some(t) = &self.tank {
+                let (lo, hi) = (t.min, t.max);
+                if (0..3).any(|a| p.min[a] < lo[a] || p.max[a] > hi[a]) {
+                    return Err(ctx.invalid(
+                        "pour",
+                        format!(
+                            "the pour's box {} – {} must lie inside the tank {} – {}",
+                            fmt3(&v3(p.min)),
+                            fmt3(&v3(p.max)),
+                            fmt3(&lo),
+                            fmt3(&hi)
+                        ),
+                    ));
+                }
+            }
+        }
         if self.walls.tank.is_some() && self.tank.is_none() {
             return Err(ctx.invalid("tank.wall", "a wall model without a tank"));
         }

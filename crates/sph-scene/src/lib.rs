@@ -250,6 +250,17 @@
 //! # kind = "mesh":  path, scale/translate or fit (as for fluids), sdf_cell (m, grid spacing of
 //! #                 the signed distance field, default particle_spacing / 2)
 //!
+//! # [pour]                         # optional, solver kind = "elastoplastic" only: grains
+//! #                                # poured during the run, a layer at a time, onto the
+//! #                                # heap under a funnel that follows its top (PourSpec,
+//! #                                # elastoplastic_granular::Pour; gravity along −y)
+//! # min = [0.79, 0.0, 0.0]         # m: the funnel's box, inside the tank; each layer is a
+//! # max = [0.81, 1.0, 0.06]        # grain per lattice node over its x–z face, at rest, one
+//! #                                # spacing above the highest landed grain under it; the
+//! #                                # heap must stay below max[1]
+//! # volume = 0.0096                # m³ of bulk volume (grains × spacing³), > 0
+//! # rate = 0.0007                  # m³/s, > 0; a run is at rest only after the last layer
+//!
 //! [output]                         # optional
 //! every_frames = 1                 # write a VTK frame every N frames (>= 1, default 1)
 //! vtk = true                       # default true
@@ -371,6 +382,6 @@ pub use pbf::PbfSettings;
 pub use pcisph::PcisphSettings;
 pub use spec::{
     BoundaryModel, BoundarySpec, FluidSpec, InitialMasses, MeshPlacement, MeshSpec, OutputSpec,
-    Precision, QuickSpec, Scene, SceneWalls, SolidMotion, SolidSpec, WallModel,
+    PourSpec, Precision, QuickSpec, Scene, SceneWalls, SolidMotion, SolidSpec, WallModel,
 };
 pub use sph_solver::CommonSettings;

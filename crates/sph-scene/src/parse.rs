@@ -148,6 +148,7 @@ fn from_raw(
         solids,
         walls,
         motions,
+        pour: raw.pour,
         solver,
         boundary: raw.boundary,
         output: output(raw.output.as_ref()),

@@ -4,7 +4,7 @@ use serde::Deserialize;
 
 use ssfr_render::RenderConfig;
 
-use crate::{BoundarySpec, Precision, SolidMotion, SolverKind, WallModel};
+use crate::{BoundarySpec, PourSpec, Precision, SolidMotion, SolverKind, WallModel};
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -20,6 +20,7 @@ pub(crate) struct RawScene {
     pub fluid: Vec<RawFluid>,
     #[serde(default)]
     pub solid: Vec<RawSolid>,
+    pub pour: Option<PourSpec>,
     pub output: Option<RawOutput>,
     pub quick: Option<RawQuick>,
     /// The renderer's settings (`ssfr-render`), checked against the scene by `Scene::check`.

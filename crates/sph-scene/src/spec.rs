@@ -245,6 +245,25 @@ pub struct SolidMotion {
     pub duration_s: f64,
 }
 
+/// A pour (`[pour]`): grains added during the run a layer at a time, where the heap under
+/// the box grows (the funnel method of forming a heap; the elastoplastic solver's
+/// [`elastoplastic_granular::Pour`], which says where each layer goes and when). The
+/// volume is bulk volume (grains × spacing³), so a pour is the same at every spacing.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PourSpec {
+    /// The funnel's box (m): its lower corner.
+    pub min: [f64; 3],
+    /// Its upper corner (m): the heap must stay below its top.
+    pub max: [f64; 3],
+    /// The bulk volume poured (m³).
+    #[serde(rename = "volume")]
+    pub volume_m3: f64,
+    /// The rate (m³ of bulk volume per second).
+    #[serde(rename = "rate")]
+    pub rate_m3_s: f64,
+}
+
 /// The wall model of the tank and of each solid as written (`wall = "free-slip"`,
 /// `"no-slip"` or `{ coulomb = μ_w }`; absent = [`SceneWalls::DEFAULT`]). Only walls of
 /// boundary particles (`[boundary] model = "particles"`) have models.
@@ -312,6 +331,8 @@ pub struct Scene {
     pub walls: SceneWalls,
     /// Each solid's motion (`[[solid]] motion`), in file order; `None`: it stands still.
     pub motions: Vec<Option<SolidMotion>>,
+    /// Grains poured during the run (`[pour]`), if any.
+    pub pour: Option<PourSpec>,
     /// Solver settings.
     pub solver: SolverSpec,
     /// Boundary settings.

@@ -282,3 +282,77 @@ fn bad_motions_name_their_key() {
     let e = parse(&collision).unwrap_err();
     assert!(e.contains("boundary.model") || e.contains("motion"), "{e}");
 }
+
+/// The `[pour]` table of `BASE`'s tank: a funnel two spacings wide, ten layers of six grains.
+const POUR: &str =
+    "[pour]\nmin = [0.28, 0.0, 0.0]\nmax = [0.32, 0.35, 0.06]\nvolume = 0.00048\nrate = 0.00144\n";
+
+/// A pour reaches the solver's parameters as its `Pour`, and the scene counts its grains.
+#[test]
+fn a_pour_becomes_the_solvers_pour() {
+    let s = parse(&format!("{BASE}{POUR}")).unwrap();
+    assert_eq!(s.poured_grains(), 60);
+    assert_eq!(parse(BASE).unwrap().poured_grains(), 0);
+    let SolverParams::Elastoplastic(p) = s.solver_params::<f64>().unwrap() else {
+        panic!("not elastoplastic")
+    };
+    let pour = p.pour.expect("a pour");
+    assert_eq!((pour.region.min.x, pour.region.max.y), (0.28, 0.35));
+    assert_eq!((pour.volume_m3, pour.rate_m3_s), (0.00048, 0.00144));
+    assert_eq!(pour.layers(0.02), 10);
+    // The quick spacing halves the grains per layer's edge: the same volume, more grains.
+    let fine = parse(&format!("{BASE}{POUR}").replacen(
+        "particle_spacing = 0.02",
+        "particle_spacing = 0.01",
+        1,
+    ))
+    .unwrap();
+    assert_eq!(fine.poured_grains(), 480);
+}
+
+/// A pour is refused, at its key: outside the tank, an empty box, a volume or a rate that
+/// is not positive, an unknown field, gravity across `y`, and with a solver other than the
+/// elastoplastic one (edited in code).
+#[test]
+fn bad_pours_name_their_key() {
+    let with = |from: &str, to: &str| format!("{BASE}{}", POUR.replacen(from, to, 1));
+    for (from, to, key, reason) in [
+        (
+            "max = [0.32, 0.35",
+            "max = [0.32, 0.45",
+            "pour",
+            "inside the tank",
+        ),
+        (
+            "min = [0.28",
+            "min = [0.32",
+            "pour.min",
+            "min must be < max",
+        ),
+        ("volume = 0.00048", "volume = 0.0", "pour", "volume"),
+        ("rate = 0.00144", "rate = -1.0", "pour", "rate"),
+        (
+            "rate = 0.00144",
+            "rate = 0.00144\nspeed = 1.0",
+            "speed",
+            "unknown field",
+        ),
+        ("min = [0.28, 0.0", "min = [0.31, 0.0", "pour", "spacing"),
+    ] {
+        let e = parse(&with(from, to)).unwrap_err();
+        assert!(e.contains(key) && e.contains(reason), "{to}: {e}");
+    }
+    let sideways = format!("{BASE}{POUR}").replacen(
+        "frame_dt = 0.016",
+        "frame_dt = 0.016\ngravity = [-9.81, 0.0, 0.0]",
+        1,
+    );
+    let e = parse(&sideways).unwrap_err();
+    assert!(e.contains("pour") && e.contains("gravity along −y"), "{e}");
+    let mut other = parse(&format!("{BASE}{POUR}")).unwrap();
+    other.solver = other.solver.with_kind(sph_scene::SolverKind::Pbf);
+    other.boundary.model = BoundaryModel::Collision;
+    other.walls = Default::default();
+    let e = other.check().unwrap_err().to_string();
+    assert!(e.contains("pour") && e.contains("elastoplastic"), "{e}");
+}

@@ -357,9 +357,14 @@ impl<R: Real> SceneSim<R> {
                 self.scene.source.display()
             ));
         }
-        let n = self.state.len();
-        if c.ids.len() != n {
-            return Err(format!("{} particles; the scene has {n}", c.ids.len()));
+        let (first, poured) = (self.initial_particles(), self.scene.poured_grains());
+        let n = c.ids.len();
+        if n < first || n > first + poured {
+            return Err(if poured == 0 {
+                format!("{n} particles; the scene has {first}")
+            } else {
+                format!("{n} particles; the scene has {first} and pours {poured} more")
+            });
         }
         let mut seen = vec![false; n];
         for &i in &c.ids {

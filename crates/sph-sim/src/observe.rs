@@ -158,6 +158,8 @@ impl RestCriterion {
 /// [`judge_rest`] after each frame, on one sample per frame and one of the run's first
 /// state) and the scene's moving solids have stopped ([`Scene::motion_end_s`]: a heap
 /// is not at rest on a trapdoor still being lowered); the scene's duration is then a cap.
+/// With a pour, only the frames after its last layer are sampled
+/// ([`SceneSim::pour_finished`]).
 ///
 /// [`Scene::motion_end_s`]: sph_scene::Scene::motion_end_s
 #[derive(Debug, Clone)]
@@ -232,6 +234,13 @@ impl RestObserver {
     }
 
     fn take<R: Real>(&mut self, sim: &SceneSim<R>) -> Result<(), SimError> {
+        if !sim.pour_finished() {
+            // Grains are still being poured: the heap is judged on the frames after the
+            // last layer only.
+            self.samples.clear();
+            self.verdict = None;
+            return Ok(());
+        }
         if self.samples.last().is_some_and(|s| s.time_s >= sim.time_s) {
             return Ok(()); // the carried samples end at this state
         }

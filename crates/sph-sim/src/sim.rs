@@ -20,7 +20,8 @@ pub struct SceneSim<R: Real> {
     pub scene: Scene,
     /// The particles (reordered by cell by the solver from time to time).
     pub state: ParticleSet<R>,
-    /// For each particle of `state`, its index in the scene's initial order.
+    /// For each particle of `state`, its index in the scene's initial order (the grains a
+    /// pour adds take the next indices, in the order they are poured).
     pub ids: Vec<u32>,
     /// Frames done.
     pub frame: usize,
@@ -34,6 +35,8 @@ pub struct SceneSim<R: Real> {
     pub volume_maps: Vec<CacheUse>,
     solver: Box<dyn FluidSolver<R>>,
     id_scratch: Vec<u32>,
+    /// The particles the scene starts with.
+    initial_particles: usize,
 }
 
 impl<R: Real> std::fmt::Debug for SceneSim<R> {
@@ -100,7 +103,18 @@ impl<R: Real> SceneSim<R> {
             volume_maps,
             solver,
             id_scratch: Vec::new(),
+            initial_particles: n as usize,
         })
+    }
+
+    /// The particles the scene starts with (a pour adds [`Scene::poured_grains`] more).
+    pub fn initial_particles(&self) -> usize {
+        self.initial_particles
+    }
+
+    /// Whether the scene's pour (if any) has added all its grains.
+    pub fn pour_finished(&self) -> bool {
+        self.state.len() >= self.initial_particles + self.scene.poured_grains()
     }
 
     /// The solver.
@@ -128,6 +142,9 @@ impl<R: Real> SceneSim<R> {
         if let Some(perm) = self.solver.last_permutation() {
             apply_permutation(&mut self.ids, perm, &mut self.id_scratch);
         }
+        // Grains a pour added during the frame, after the others.
+        let n = self.state.len() as u32;
+        self.ids.extend(self.ids.len() as u32..n);
         self.frame += 1;
         self.time_s = self.frame as f64 * self.scene.frame_dt_s;
         Ok(stats)

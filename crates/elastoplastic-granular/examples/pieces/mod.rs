@@ -3,6 +3,10 @@
 //! `HEAP_RESUME=FILE` (continue a saved run; the same arguments must be given). Shared by
 //! the `heap_30` and `drained` examples.
 
+#![allow(dead_code)] // each example uses some of the pieces
+
+pub mod slope;
+
 use granular_measure::{judge_rest, rest_sample, PileShape, RestSample, RestSettings, Vec3};
 
 /// Standard gravity (m/s²) of the examples' set-ups.
