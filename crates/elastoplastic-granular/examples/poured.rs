@@ -12,7 +12,8 @@
 //! `psa` plane strain associated: `ConeMatch`), `cap` (30 s), `L` period (1.6 m), `w` the
 //! funnel's width (0.1 m), `area` the cross-section poured (0.16 m²; the volume is it times
 //! the slab's depth, three spacings), `q` the rate in m² of cross-section a second (0.012),
-//! `layers` (1: every 0.1 s, the flanks' layers' stress in slope axes).
+//! `layers` (1: every 0.1 s, the flanks' layers' stress in slope axes), `u` the viscosity's
+//! fixed velocity scale (m/s; 0, the default: the speed of sound).
 //!
 //! Prints every 0.1 s: time, grains, 99th-percentile speed and fastest grain two spacings
 //! deep, the angle (mean of the flanks) and each flank's, the heap's height, wall time; at
@@ -46,6 +47,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut params = ElastoplasticParams::<f64>::for_spacing(s, phi);
     params.youngs_modulus = num("E", 5.84e5)?;
     params.viscosity_alpha = num("alpha", params.viscosity_alpha)?;
+    let u = num("u", 0.0)?;
+    params.viscosity_speed_m_s = (u > 0.0).then_some(u);
     params.cone_match = match args.iter().find_map(|a| a.strip_prefix("match=")) {
         None | Some("ss") => ConeMatch::SimpleShear,
         Some("ps") => ConeMatch::PlaneStrain,

@@ -1,5 +1,5 @@
-//! The fixed-base heap of the shipped scene `granular_repose_thesis_30` built in Rust, and a
-//! drained bed ([`drained_bed`]). Whether a heap is at rest is judged by
+//! The fixed-base heap of the shipped scene `granular_repose_thesis_30` built in Rust, a
+//! drained bed ([`drained_bed`]) and a poured heap ([`poured_heap`]). Whether a heap is at rest is judged by
 //! `granular_measure::rest` (the examples `heap_30` and `drained` do).
 //!
 //! Geometry (m): a tank `[0, 2.4] × [0, 0.8] × [0, 0.03]`, a base `[0.8, 1.6] × [0, 0.25]`
