@@ -28,48 +28,28 @@
 use std::time::Instant;
 
 use elastoplastic_granular::heap::{drained_bed, DrainedSetup};
-use elastoplastic_granular::{ConeMatch, ElastoplasticParams};
+use elastoplastic_granular::ConeMatch;
 use granular_measure::{angle_of_repose, ReposeOptions, RestSample};
 
 mod pieces;
+use pieces::args::Args;
 use pieces::slope::{floor_depths, layer_state, median, Flanks};
 use pieces::{at_rest, elapsed_over_budget, resume, sample, save_run};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let num = |key: &str, d: f64| -> Result<f64, Box<dyn std::error::Error>> {
-        match args
-            .iter()
-            .find_map(|a| a.strip_prefix(key).and_then(|r| r.strip_prefix('=')))
-        {
-            Some(a) => Ok(a.parse()?),
-            None => Ok(d),
-        }
-    };
-    let s = num("s", 0.02)?;
-    let phi = num("phi", 30.0)?;
-    let mut params = ElastoplasticParams::<f64>::for_spacing(s, phi);
-    params.youngs_modulus = num("E", 5.84e5)?;
-    params.viscosity_alpha = num("alpha", params.viscosity_alpha)?;
-    params.cfl_number = num("C", params.cfl_number)?;
-    params.dilatancy_angle_deg = num("psi", 0.0)?;
-    params.cone_match = match args.iter().find_map(|a| a.strip_prefix("match=")) {
-        None | Some("psa") => ConeMatch::PlaneStrainAssociated,
-        Some("ps") => ConeMatch::PlaneStrain,
-        Some("ss") => ConeMatch::SimpleShear,
-        Some(other) => return Err(format!("match={other}: expected psa, ps or ss").into()),
-    };
+    let args = Args::from_env();
+    let (mut params, s, phi) = args.material(ConeMatch::PlaneStrainAssociated)?;
+    params.cfl_number = args.num("C", params.cfl_number)?;
+    params.dilatancy_angle_deg = args.num("psi", 0.0)?;
     let cone_match = params.cone_match;
-    let u = num("u", 0.0)?;
-    params.viscosity_speed_m_s = (u > 0.0).then_some(u);
-    let cap_s = num("cap", 6.0)?;
+    let cap_s = args.num("cap", 6.0)?;
     let mut setup = DrainedSetup::for_spacing(s);
-    setup.period_x_m = num("L", setup.period_x_m)?;
-    setup.bed_height_m = num("H", setup.bed_height_m)?;
-    setup.slot_width_m = num("w", setup.slot_width_m)?;
-    setup.sump_depth_m = num("sump", setup.sump_depth_m)?;
-    setup.geostatic = num("geo", 1.0)? != 0.0;
-    let door = num("door", 0.0)?;
+    setup.period_x_m = args.num("L", setup.period_x_m)?;
+    setup.bed_height_m = args.num("H", setup.bed_height_m)?;
+    setup.slot_width_m = args.num("w", setup.slot_width_m)?;
+    setup.sump_depth_m = args.num("sump", setup.sump_depth_m)?;
+    setup.geostatic = args.num("geo", 1.0)? != 0.0;
+    let door = args.num("door", 0.0)?;
     setup.trapdoor_speed_m_s = (door > 0.0).then_some(door);
     println!(
         "{setup:?}, alpha_Pi {}, viscosity speed {:?}, psi {} deg",
@@ -77,8 +57,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     let youngs = params.youngs_modulus;
     let alpha_phi = cone_match.alpha(phi);
-    let k0 = num("k0", -1.0)?;
-    let layers = num("layers", 0.0)? != 0.0;
+    let k0 = args.num("k0", -1.0)?;
+    let layers = args.num("layers", 0.0)? != 0.0;
     let (mut solver, mut state) = drained_bed(params, setup)?;
     if k0 >= 0.0 {
         // The geostatic start with the horizontal stresses K0 times the vertical one.

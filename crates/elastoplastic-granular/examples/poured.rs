@@ -24,46 +24,26 @@
 use std::time::Instant;
 
 use elastoplastic_granular::heap::{poured_heap, PouredSetup};
-use elastoplastic_granular::{ConeMatch, ElastoplasticParams, ParticleSet, Vec3};
+use elastoplastic_granular::{ConeMatch, ParticleSet, Vec3};
 use granular_measure::{angle_of_repose, ReposeOptions, RestSample};
 
 mod pieces;
+use pieces::args::Args;
 use pieces::slope::{layer_state, Flanks};
 use pieces::{at_rest, sample};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let num = |key: &str, d: f64| -> Result<f64, Box<dyn std::error::Error>> {
-        match args
-            .iter()
-            .find_map(|a| a.strip_prefix(key).and_then(|r| r.strip_prefix('=')))
-        {
-            Some(a) => Ok(a.parse()?),
-            None => Ok(d),
-        }
-    };
-    let s = num("s", 0.02)?;
-    let phi = num("phi", 30.0)?;
-    let mut params = ElastoplasticParams::<f64>::for_spacing(s, phi);
-    params.youngs_modulus = num("E", 5.84e5)?;
-    params.viscosity_alpha = num("alpha", params.viscosity_alpha)?;
-    let u = num("u", 0.0)?;
-    params.viscosity_speed_m_s = (u > 0.0).then_some(u);
-    params.cone_match = match args.iter().find_map(|a| a.strip_prefix("match=")) {
-        None | Some("ss") => ConeMatch::SimpleShear,
-        Some("ps") => ConeMatch::PlaneStrain,
-        Some("psa") => ConeMatch::PlaneStrainAssociated,
-        Some(other) => return Err(format!("match={other}: expected ss, ps or psa").into()),
-    };
+    let args = Args::from_env();
+    let (params, s, phi) = args.material(ConeMatch::SimpleShear)?;
     let cone_match = params.cone_match;
     let alpha_phi = cone_match.alpha(phi);
-    let cap_s = num("cap", 30.0)?;
-    let layers = num("layers", 0.0)? != 0.0;
+    let cap_s = args.num("cap", 30.0)?;
+    let layers = args.num("layers", 0.0)? != 0.0;
     let mut setup = PouredSetup::for_spacing(s);
-    setup.period_x_m = num("L", setup.period_x_m)?;
-    setup.funnel_width_m = num("w", setup.funnel_width_m)?;
-    setup.volume_m3 = num("area", 0.16)? * setup.slab_depth_m;
-    setup.rate_m3_s = num("q", 0.012)? * setup.slab_depth_m;
+    setup.period_x_m = args.num("L", setup.period_x_m)?;
+    setup.funnel_width_m = args.num("w", setup.funnel_width_m)?;
+    setup.volume_m3 = args.num("area", 0.16)? * setup.slab_depth_m;
+    setup.rate_m3_s = args.num("q", 0.012)? * setup.slab_depth_m;
     let youngs = params.youngs_modulus;
     let (mut solver, mut state) = poured_heap(params, setup)?;
     let predicted = cone_match.predicted_repose_angle_deg(phi);

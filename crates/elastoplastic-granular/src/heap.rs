@@ -396,6 +396,30 @@ pub fn cut_slope<R: Real>(
             reason: "a slope's angle must lie in (0, 90) degrees",
         });
     }
+    params.initial_stress = InitialStress::Geostatic;
+    let region = aabb([0.0, 0.0, 0.0], [l, setup.height_m, d])?;
+    let mut positions = cubic_lattice(&region, s, 1 << 22)?;
+    positions.retain(|p| p.y.as_f64() <= setup.surface_m(p.x.as_f64()));
+    let state = ParticleSet::from_positions(
+        positions,
+        params.common.particle_mass(),
+        params.common.rest_density,
+    );
+    let solver = floored_slab(params, l, d, setup.height_m)?;
+    Ok((solver, state))
+}
+
+/// The solver of a slab periodic along `x` (period `l`, m) and `z` (depth `d`, m) over a
+/// floor at `y = 0`: the floor's plane only keeps grains out, [`BOUNDARY_ROWS`] rows of
+/// no-slip boundary particles under it carry its stress; the walls' domain reaches `top_m`
+/// above the floor. Replaces `params`' `periodic` and `wall_models`.
+fn floored_slab<R: Real>(
+    mut params: ElastoplasticParams<R>,
+    l: f64,
+    d: f64,
+    top_m: f64,
+) -> Result<Elastoplastic<R>, SolverError> {
+    let s = params.common.particle_spacing;
     params.periodic = [(0, l), (2, d)]
         .into_iter()
         .map(|(axis, hi)| PeriodicAxis {
@@ -405,26 +429,14 @@ pub fn cut_slope<R: Real>(
         })
         .collect();
     params.wall_models = vec![WallModel::ContactOnly];
-    params.initial_stress = InitialStress::Geostatic;
     let solids: Solids<R> = vec![Box::new(Plane::new(v(0.0, 0.0, 0.0), v(0.0, 1.0, 0.0))?)];
-    let domain = aabb(
-        [-0.05, -0.05, -0.05],
-        [l + 0.05, setup.height_m + 0.1, d + 0.05],
-    )?;
+    let domain = aabb([-0.05, -0.05, -0.05], [l + 0.05, top_m + 0.1, d + 0.05])?;
     let walls = volume_map_walls(solids, &params, domain)?;
-    let region = aabb([0.0, 0.0, 0.0], [l, setup.height_m, d])?;
-    let mut positions = cubic_lattice(&region, s, 1 << 22)?;
-    positions.retain(|p| p.y.as_f64() <= setup.surface_m(p.x.as_f64()));
-    let state = ParticleSet::from_positions(
-        positions,
-        params.common.particle_mass(),
-        params.common.rest_density,
-    );
     let mut solver = ElastoplasticScheme::solver(params, walls)?;
     let rows = aabb([0.0, -BOUNDARY_ROWS * s.as_f64(), 0.0], [l, 0.0, d])?;
     let floor = boundary_block(&rows, s, v(0.0, 1.0, 0.0), WallModel::NoSlip, 1 << 22)?;
     solver.scheme_mut().set_boundary_particles(floor)?;
-    Ok((solver, state))
+    Ok(solver)
 }
 
 /// A heap poured onto a floor (the funnel method; [`crate::Pour`]): a no-slip floor of
@@ -474,17 +486,7 @@ pub fn poured_heap<R: Real>(
     mut params: ElastoplasticParams<R>,
     setup: PouredSetup,
 ) -> Result<(Elastoplastic<R>, ParticleSet<R>), SolverError> {
-    let s = params.common.particle_spacing;
     let (l, d) = (setup.period_x_m, setup.slab_depth_m);
-    params.periodic = [(0, l), (2, d)]
-        .into_iter()
-        .map(|(axis, hi)| PeriodicAxis {
-            axis,
-            lo: R::zero(),
-            hi: R::of_f64(hi),
-        })
-        .collect();
-    params.wall_models = vec![WallModel::ContactOnly];
     params.initial_stress = InitialStress::None;
     let half = 0.5 * setup.funnel_width_m;
     params.pour = Some(Pour {
@@ -495,16 +497,7 @@ pub fn poured_heap<R: Real>(
         volume_m3: R::of_f64(setup.volume_m3),
         rate_m3_s: R::of_f64(setup.rate_m3_s),
     });
-    let solids: Solids<R> = vec![Box::new(Plane::new(v(0.0, 0.0, 0.0), v(0.0, 1.0, 0.0))?)];
-    let domain = aabb(
-        [-0.05, -0.05, -0.05],
-        [l + 0.05, setup.funnel_top_m + 0.1, d + 0.05],
-    )?;
-    let walls = volume_map_walls(solids, &params, domain)?;
-    let mut solver = ElastoplasticScheme::solver(params, walls)?;
-    let rows = aabb([0.0, -BOUNDARY_ROWS * s.as_f64(), 0.0], [l, 0.0, d])?;
-    let floor = boundary_block(&rows, s, v(0.0, 1.0, 0.0), WallModel::NoSlip, 1 << 22)?;
-    solver.scheme_mut().set_boundary_particles(floor)?;
+    let solver = floored_slab(params, l, d, setup.funnel_top_m)?;
     let state = ParticleSet::from_positions(Vec::new(), R::zero(), R::zero());
     Ok((solver, state))
 }

@@ -236,17 +236,8 @@ impl Scene {
     /// The grains the scene's pour adds during the run, at its spacing (0 without a pour;
     /// [`elastoplastic_granular::Pour::grains`]).
     pub fn poured_grains(&self) -> usize {
-        self.pour.map_or(0, |p| {
-            let pour = elastoplastic_granular::Pour {
-                region: sph_core::Aabb {
-                    min: crate::geom::v3(p.min),
-                    max: crate::geom::v3(p.max),
-                },
-                volume_m3: p.volume_m3,
-                rate_m3_s: p.rate_m3_s,
-            };
-            pour.grains(self.particle_spacing)
-        })
+        self.pour
+            .map_or(0, |p| p.to_pour().grains(self.particle_spacing))
     }
 
     /// Particle-level checks: count limit, non-empty fluids, inside the tank, outside solids.

@@ -14,7 +14,7 @@ use sph_core::{Aabb, Real};
 use sph_solver::{CommonSettings, SceneValues, SolverError};
 
 use crate::error::Ctx;
-use elastoplastic_granular::{MovingWall, Pour};
+use elastoplastic_granular::MovingWall;
 
 use crate::geom::v3;
 use crate::{Precision, Scene, SceneError, SceneWalls, SolidSpec, SolverParams, WallModel};
@@ -50,14 +50,7 @@ impl Scene {
                 )
                 .collect();
             e.moving_walls = self.moving_walls(default);
-            e.pour = self.pour.map(|p| Pour {
-                region: Aabb {
-                    min: v3(p.min),
-                    max: v3(p.max),
-                },
-                volume_m3: p.volume_m3,
-                rate_m3_s: p.rate_m3_s,
-            });
+            e.pour = self.pour.as_ref().map(crate::PourSpec::to_pour);
             e.boundary_particle_region = self.tank.or_else(|| {
                 self.fluids.iter().map(|f| f.bounds()).reduce(|a, b| Aabb {
                     min: a.min.inf(&b.min),

@@ -264,6 +264,20 @@ pub struct PourSpec {
     pub rate_m3_s: f64,
 }
 
+impl PourSpec {
+    /// The solver's pour ([`elastoplastic_granular::Pour`]) this table describes.
+    pub fn to_pour(&self) -> elastoplastic_granular::Pour<f64> {
+        elastoplastic_granular::Pour {
+            region: Aabb {
+                min: crate::geom::v3(self.min),
+                max: crate::geom::v3(self.max),
+            },
+            volume_m3: self.volume_m3,
+            rate_m3_s: self.rate_m3_s,
+        }
+    }
+}
+
 /// The wall model of the tank and of each solid as written (`wall = "free-slip"`,
 /// `"no-slip"` or `{ coulomb = μ_w }`; absent = [`SceneWalls::DEFAULT`]). Only walls of
 /// boundary particles (`[boundary] model = "particles"`) have models.

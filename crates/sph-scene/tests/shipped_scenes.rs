@@ -361,21 +361,37 @@ fn granular_repose_trapdoor_scenes_lower_a_door_under_the_slot() {
     }
 }
 
-/// `granular_heap_poured.toml` (run 40 of `docs/elastoplastic-granular.md`, the Rust set-up
-/// `heap::PouredSetup::for_spacing`): no grains at the start, a funnel one spacing wide (at
-/// the quick spacing) at the period's middle pouring 0.16 m² of cross-section over the
-/// slab's 0.06 m at 30 spacings² a second.
+/// `granular_repose_poured_{20,30,40}.toml` (run 40 of `docs/elastoplastic-granular.md`, the
+/// Rust set-up `heap::PouredSetup::for_spacing`): no grains at the start, a funnel 0.1 m wide
+/// at the period's middle pouring 0.16 m² of cross-section over the slab's 0.06 m at
+/// 0.012 m² a second; the period holds the heap the cone predicts with room beyond its toes.
 #[test]
-fn granular_heap_poured_pours_the_examples_heap() {
-    let full = Scene::load(&scene_path("granular_heap_poured.toml")).unwrap();
-    let quick = full.quick();
-    assert_eq!(counts(&quick).0, 0);
-    assert_eq!((quick.poured_grains(), full.poured_grains()), (1200, 9600));
+fn granular_repose_poured_pours_the_examples_heap() {
     let setup = elastoplastic_granular::heap::PouredSetup::for_spacing(0.02);
-    let pour = quick.pour.unwrap();
-    assert!((pour.volume_m3 - setup.volume_m3).abs() < 1e-12);
-    assert!((pour.rate_m3_s - setup.rate_m3_s).abs() < 1e-12);
-    assert!((pour.max[0] - pour.min[0] - setup.funnel_width_m).abs() < 1e-12);
-    assert_eq!(0.5 * (pour.min[0] + pour.max[0]), 0.5 * setup.period_x_m);
-    assert_eq!(quick.solver.periodic_axes()[0], (0, 0.0, setup.period_x_m));
+    for theta in [20.0_f64, 30.0, 40.0] {
+        let full =
+            Scene::load(&scene_path(&format!("granular_repose_poured_{theta}.toml"))).unwrap();
+        let quick = full.quick();
+        assert_eq!(counts(&quick).0, 0);
+        assert_eq!((quick.poured_grains(), full.poured_grains()), (1200, 9600));
+        let pour = quick.pour.unwrap();
+        assert!((pour.volume_m3 - setup.volume_m3).abs() < 1e-12);
+        assert!((pour.rate_m3_s - setup.rate_m3_s).abs() < 1e-12);
+        assert!((pour.max[0] - pour.min[0] - setup.funnel_width_m).abs() < 1e-12);
+        let (axis, lo, period) = quick.solver.periodic_axes()[0];
+        assert_eq!((axis, lo), (0, 0.0));
+        assert!((0.5 * (pour.min[0] + pour.max[0]) - 0.5 * period).abs() < 1e-12);
+        let SolverSpec::Elastoplastic(e) = &quick.solver else {
+            panic!("theta {theta}: not elastoplastic")
+        };
+        assert_eq!(e.friction_angle_deg, theta);
+        // The triangle of the poured cross-section at the predicted slope θ, with a fifth of
+        // the period to spare beyond its toes: base = 2 sqrt(area / tan θ).
+        let area = pour.volume_m3 / 0.06;
+        let base = 2.0 * (area / theta.to_radians().tan()).sqrt();
+        assert!(
+            base < 0.8 * period,
+            "theta {theta}: base {base} m, period {period} m"
+        );
+    }
 }

@@ -5,6 +5,7 @@
 
 #![allow(dead_code)] // each example uses some of the pieces
 
+pub mod args;
 pub mod slope;
 
 use granular_measure::{judge_rest, rest_sample, PileShape, RestSample, RestSettings, Vec3};

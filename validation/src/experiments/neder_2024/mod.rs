@@ -47,6 +47,8 @@ pub struct SceneRun {
     /// With a [`RestCriterion`]: the time (s) from which the heap was at rest by it (the run
     /// stopped once it was); `None` if that did not happen before the scene's duration.
     pub rest_from_s: Option<f64>,
+    /// Whether the scene's pour (if any) placed all its grains.
+    pub pour_finished: bool,
 }
 
 fn run_in<R: Real>(
@@ -76,6 +78,7 @@ fn run_in<R: Real>(
         initial_potential_energy_j,
         blow_up: outcome.divergence().map(|d| d.to_string()),
         rest_from_s: rest.and_then(|r| r.rest_from_s),
+        pour_finished: sim.pour_finished(),
     })
 }
 
