@@ -134,8 +134,9 @@ fn column_scene(base: &Scene, a: f64, laws: &[Regime; 2]) -> Result<Scene> {
 }
 
 /// `column` with the elastic–plastic solver (see the module docs): the template's friction
-/// angle, the thesis's cone, boundary particles with Coulomb walls, periodic across `z`.
-fn elastoplastic_column(column: &Scene) -> Result<Scene> {
+/// angle, the thesis's cone, walls of no-slip boundary particles, a geostatic start, and
+/// periodic across the tank along each of `periodic_axes` (`[Axis::Z]`: plane strain).
+pub(super) fn elastoplastic_column(column: &Scene, periodic_axes: &[Axis]) -> Result<Scene> {
     let SolverSpec::Granular(granular) = &column.solver else {
         bail!("{TEMPLATE}: the template must be a granular scene");
     };
@@ -151,11 +152,21 @@ fn elastoplastic_column(column: &Scene) -> Result<Scene> {
     settings.cone_match = Some(ConeMatch::PlaneStrain);
     settings.youngs_modulus = Some(ELASTOPLASTIC_YOUNGS_MODULUS_PA);
     settings.initial_stress = Some(InitialStress::Geostatic);
-    settings.periodic = Some(vec![PeriodicSetting {
-        axis: Axis::Z,
-        lo: tank.min.z,
-        hi: tank.max.z,
-    }]);
+    if !periodic_axes.is_empty() {
+        settings.periodic = Some(
+            periodic_axes
+                .iter()
+                .map(|&axis| {
+                    let k = axis.index();
+                    PeriodicSetting {
+                        axis,
+                        lo: tank.min[k],
+                        hi: tank.max[k],
+                    }
+                })
+                .collect(),
+        );
+    }
     let mut scene = column.clone();
     scene.solver = SolverSpec::Elastoplastic(settings);
     scene.boundary.model = BoundaryModel::Particles;
@@ -215,7 +226,13 @@ impl Experiment for GranularColumnCollapse {
         let elastoplastic: Vec<(Model, f64, Scene)> = scenes
             .iter()
             .filter(|(_, a, _)| ctx.mode == Mode::Full || ELASTOPLASTIC_QUICK.contains(a))
-            .map(|(_, a, s)| Ok((Model::Elastoplastic, *a, elastoplastic_column(s)?)))
+            .map(|(_, a, s)| {
+                Ok((
+                    Model::Elastoplastic,
+                    *a,
+                    elastoplastic_column(s, &[Axis::Z])?,
+                ))
+            })
             .collect::<Result<_>>()?;
         scenes.extend(elastoplastic);
         ctx.progress
@@ -340,7 +357,7 @@ impl Experiment for GranularColumnCollapse {
 
 /// Which model ran a column.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Model {
+pub(super) enum Model {
     /// The thesis's IISPH granular solver (the shipped template).
     Thesis,
     /// The elastic–plastic solver ([`elastoplastic_column`]).
@@ -348,14 +365,14 @@ enum Model {
 }
 
 impl Model {
-    fn name(self) -> &'static str {
+    pub(super) fn name(self) -> &'static str {
         match self {
             Model::Thesis => "iisph-granular",
             Model::Elastoplastic => "elastoplastic",
         }
     }
     /// The prefix of its metrics (none for the thesis's, as before).
-    fn prefix(self) -> &'static str {
+    pub(super) fn prefix(self) -> &'static str {
         match self {
             Model::Thesis => "",
             Model::Elastoplastic => "elastoplastic/",

@@ -34,6 +34,16 @@
 //! add a dependence on `R0/d` that a continuum model does not have. The slope angles are
 //! reported (metrics, `deposits.csv`, `angles.png` against the friction angle and the
 //! static slope of the yield cone), not checked: the paper gives no law for them here.
+//!
+//! **The elastic–plastic model** (crate `elastoplastic-granular`, Bui et al. 2008) runs the
+//! same columns (`elastoplastic/…` metrics, the same checks and band) as the planar
+//! experiment builds them ([`super::granular_column_collapse::elastoplastic_column`]: the
+//! template's friction angle with the thesis's cone, `E` = 0.584 MPa, a geostatic start,
+//! walls of no-slip boundary particles; nothing periodic). Quick mode runs the `a` = 1
+//! column ([`ELASTOPLASTIC_QUICK`]: 1,600 grains at 10 mm; the `a` = 0.5 column is four
+//! times as many, its radius twice the template's), full mode all four. Its deposits' slopes
+//! are metrics (`elastoplastic/a=…/deposit_slope_deg`), not in the plots, which are the
+//! thesis model's.
 
 use anyhow::{bail, Result};
 use granular_measure::{
@@ -43,11 +53,13 @@ use granular_measure::{
 use sph_core::Vec3;
 use sph_scene::{FluidSpec, Scene, SolverSpec};
 
-use super::granular_column_collapse::{band, load_laws, plot_runout, Regime, RunoutPlot, BAND};
+use super::granular_column_collapse::{
+    band, elastoplastic_column, load_laws, plot_runout, Model, Regime, RunoutPlot, BAND,
+};
 use super::scene_edit::shipped;
 use super::{run_scene, solver_error_check};
 use crate::helpers::{plot_xy, write_csv_rows, Legend, Marker, PlotSpec, Series, SeriesStyle};
-use crate::{Check, Context, Experiment, Outcome};
+use crate::{Check, Context, Experiment, Mode, Outcome};
 
 /// The experiment.
 pub struct GranularColumnCollapseAxisymmetric;
@@ -56,12 +68,15 @@ pub struct GranularColumnCollapseAxisymmetric;
 const ASPECT_RATIOS: [f64; 4] = [0.5, 1.0, 2.0, 4.0];
 /// The shipped template scene.
 const TEMPLATE: &str = "granular_column_collapse_axisymmetric";
+/// The aspect ratios the elastic–plastic model runs in quick mode (full mode: all).
+const ELASTOPLASTIC_QUICK: [f64; 1] = [1.0];
 /// The reference law.
 const LAW_FILE: &str =
     "granular-column-collapse-axisymmetric/lube_2004_axisymmetric_runout_law.csv";
 
-/// One column: its geometry and its scene.
+/// One column: its model, its geometry and its scene.
 struct Column {
+    model: Model,
     a: f64,
     r0: f64,
     h0: f64,
@@ -122,6 +137,7 @@ fn column(base: &Scene, a: f64, laws: &[Regime; 2]) -> Result<Column> {
     scene.name = format!("{TEMPLATE}_a{a}");
     scene.check()?;
     Ok(Column {
+        model: Model::Thesis,
         a,
         r0,
         h0,
@@ -167,8 +183,22 @@ fn measure(col: &Column, last: &[Vec3<f64>], late: Option<&[Vec3<f64>]>) -> Resu
     })
 }
 
+/// `col` with the elastic–plastic solver.
+fn elastoplastic(col: &Column) -> Result<Column> {
+    Ok(Column {
+        model: Model::Elastoplastic,
+        scene: elastoplastic_column(&col.scene, &[])?,
+        ..*col
+    })
+}
+
+/// The metrics' prefix of a column: `a=…`, `elastoplastic/a=…`.
+fn tag(col: &Column) -> String {
+    format!("{}a={}", col.model.prefix(), col.a)
+}
+
 fn checks(out: &mut Outcome, col: &Column, res: &ColumnResult, laws: &[Regime; 2]) {
-    let tag = format!("a={}", col.a);
+    let tag = tag(col);
     let s = col.scene.particle_spacing;
     let (lo, hi, regime) = band(laws, col.a);
     out.metric(format!("{tag}/normalised_runout"), res.normalised);
@@ -202,6 +232,7 @@ fn csv_row(col: &Column, res: &ColumnResult, laws: &[Regime; 2], particles: usiz
     let (lo, hi, regime) = band(laws, col.a);
     let slope = res.slope_deg.map_or("nan".into(), |d| format!("{d:.2}"));
     vec![
+        col.model.name().to_string(),
         format!("{}", col.a),
         format!("{:.4}", col.r0),
         format!("{:.4}", col.h0),
@@ -237,7 +268,11 @@ impl Experiment for GranularColumnCollapseAxisymmetric {
         "granular-column-collapse-axisymmetric"
     }
     fn crates(&self) -> &'static [&'static str] {
-        &["iisph-granular", "granular-measure"]
+        &[
+            "iisph-granular",
+            "elastoplastic-granular",
+            "granular-measure",
+        ]
     }
     fn scenes(&self) -> &'static [&'static str] {
         &["granular_column_collapse_axisymmetric"]
@@ -250,16 +285,23 @@ impl Experiment for GranularColumnCollapseAxisymmetric {
     fn run(&self, ctx: &mut Context) -> Result<Outcome> {
         let laws = load_laws(ctx, LAW_FILE)?;
         let base = shipped(TEMPLATE, ctx.mode)?;
-        let columns: Vec<Column> = ASPECT_RATIOS
+        let mut columns: Vec<Column> = ASPECT_RATIOS
             .iter()
             .map(|&a| column(&base, a, &laws))
             .collect::<Result<_>>()?;
+        let elastoplastic_columns: Vec<Column> = columns
+            .iter()
+            .filter(|c| ctx.mode == Mode::Full || ELASTOPLASTIC_QUICK.contains(&c.a))
+            .map(elastoplastic)
+            .collect::<Result<_>>()?;
+        columns.extend(elastoplastic_columns);
         ctx.progress
             .set_length(columns.iter().map(|c| c.scene.frame_count() as u64).sum());
         let mut out = Outcome::new();
-        let (mut rows, mut simulated, mut deposits) = (Vec::new(), Vec::new(), Vec::new());
+        let (mut rows, mut deposits) = (Vec::new(), Vec::new());
+        let (mut simulated, mut simulated_elastoplastic) = (Vec::new(), Vec::new());
         for col in &columns {
-            let tag = format!("a={}", col.a);
+            let tag = tag(col);
             let late = (col.scene.frame_count() as f64 * 0.9).round() as usize;
             let run = run_scene(ctx, &col.scene, &[late])?;
             out.metric(format!("{tag}/particles"), run.particles as f64);
@@ -271,14 +313,22 @@ impl Experiment for GranularColumnCollapseAxisymmetric {
             let res = measure(col, &run.final_positions, late_positions)?;
             checks(&mut out, col, &res, &laws);
             rows.push(csv_row(col, &res, &laws, run.particles));
-            simulated.push((col.a, res.normalised));
-            deposits.push((col.a, col.r0, res));
+            match col.model {
+                Model::Thesis => {
+                    simulated.push((col.a, res.normalised));
+                    deposits.push((col.a, col.r0, res));
+                }
+                Model::Elastoplastic => simulated_elastoplastic.push((col.a, res.normalised)),
+            }
         }
         write_outputs(ctx, &rows, &deposits)?;
         plot_runout(
             ctx,
             &laws,
-            &[("IISPH granular (θ = 30°)", &simulated)],
+            &[
+                ("IISPH granular (θ = 30°)", &simulated),
+                ("elastic–plastic (θ = 30°)", &simulated_elastoplastic),
+            ],
             &RunoutPlot {
                 title: "Axisymmetric granular column collapse: runout",
                 x_label: "aspect ratio a = H0/R0",
@@ -287,7 +337,7 @@ impl Experiment for GranularColumnCollapseAxisymmetric {
                     "Lube et al. 2004: 1.24 a (a < 1.7)",
                     "Lube et al. 2004: 1.6 a^(1/2) (a > 1.7)",
                 ],
-                caption: "normalised runout against aspect ratio, IISPH against both regimes of Lube et al. (2004)",
+                caption: "normalised runout against aspect ratio, IISPH and the elastic–plastic model against both regimes of Lube et al. (2004)",
             },
         )?;
         let (theta, static_slope) = friction_and_static_slope(&base);
@@ -310,6 +360,7 @@ fn write_outputs(
     write_csv_rows(
         &ctx.path("runout.csv"),
         &[
+            "model",
             "a",
             "R0_m",
             "H0_m",
