@@ -37,10 +37,10 @@
 //!
 //! **The elastic–plastic model** (crate `elastoplastic-granular`, Bui et al. 2008) runs the
 //! same columns (`elastoplastic/…` metrics, the same checks and band) as the planar
-//! experiment builds them ([`super::granular_column_collapse::elastoplastic_column`]: the
+//! experiment builds them (`granular_column_collapse::elastoplastic_column`: the
 //! template's friction angle with the thesis's cone, `E` = 0.584 MPa, a geostatic start,
 //! walls of no-slip boundary particles; nothing periodic). Quick mode runs the `a` = 1
-//! column ([`ELASTOPLASTIC_QUICK`]: 1,600 grains at 10 mm; the `a` = 0.5 column is four
+//! column (`ELASTOPLASTIC_QUICK`: 1,600 grains at 10 mm; the `a` = 0.5 column is four
 //! times as many, its radius twice the template's), full mode all four. Its deposits' slopes
 //! are metrics (`elastoplastic/a=…/deposit_slope_deg`), not in the plots, which are the
 //! thesis model's.
