@@ -196,6 +196,14 @@ fn plan(mode: Mode) -> Vec<Plan> {
         p.extend(THETAS.map(|t| sweep(cone, t)));
     }
     p.push(case("theta=0".into(), 0.0, SIMPLE_SHEAR, Variant::Plain));
+    p.push(case(
+        "stiff/simple-shear/theta=30".into(),
+        30.0,
+        SIMPLE_SHEAR,
+        Variant::Coarse {
+            modulus_factor: STIFF_FACTOR,
+        },
+    ));
     if mode == Mode::Full {
         // Quick mode's own 30° heap is the coarse heap (the viscosity's velocity scale
         // defaults to the sound speed of `E`).
@@ -207,16 +215,6 @@ fn plan(mode: Mode) -> Vec<Plan> {
                 modulus_factor: 1.0,
             },
         ));
-    }
-    p.push(case(
-        "stiff/simple-shear/theta=30".into(),
-        30.0,
-        SIMPLE_SHEAR,
-        Variant::Coarse {
-            modulus_factor: STIFF_FACTOR,
-        },
-    ));
-    if mode == Mode::Full {
         for cone in THESIS_MATCHES {
             for theta in THETAS {
                 p.push(case(
