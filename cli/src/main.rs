@@ -2,8 +2,10 @@
 //! it).
 //!
 //! - `particles run SCENE [--quick] [--frames N] [--out DIR] [--render]
-//!   [--checkpoint-every N] [--resume]`: runs a scene file: VTK frames, `stats.csv`, rendered
-//!   frames, checkpoints ([`sph_sim::run_scene`]);
+//!   [--checkpoint-every N] [--resume] [--set KEY=VALUE]... [--until-rest [planar|conical]]`:
+//!   runs a scene file, its keys overridden, to its end or until the material is at rest:
+//!   VTK frames, `stats.csv`, rendered frames, checkpoints, the rest verdict
+//!   ([`sph_sim::run_scene`]);
 //! - `particles render DIR [--scene SCENE] [--quick] [--out DIR]`: renders an earlier run's
 //!   VTK frames to PNG;
 //! - `particles comets POPULATION.toml [--out DIR]`: a population study of test particles

@@ -6,7 +6,7 @@ use anyhow::{Context as _, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use sph_scene::Scene;
 use sph_sim::render::render_params;
-use sph_sim::RunDir;
+use sph_sim::{RunDir, RunSource};
 use ssfr_render::Renderer;
 
 /// Arguments of `particles render`.
@@ -26,14 +26,17 @@ pub struct RenderArgs {
 }
 
 /// The scene of a run directory: `scene` if given (with `quick`), else the one the run
-/// recorded.
+/// recorded (with its overrides).
 pub fn scene_of_run(run: &RunDir, scene: Option<&Path>, quick: bool) -> Result<Scene> {
-    let (path, quick) = match scene {
-        Some(p) => (p.to_path_buf(), quick),
+    let source = match scene {
+        Some(p) => RunSource {
+            scene: p.to_path_buf(),
+            quick,
+            overrides: Vec::new(),
+        },
         None => run.read_source()?,
     };
-    let s = Scene::load(&path)?;
-    Ok(if quick { s.quick() } else { s })
+    Ok(source.load()?)
 }
 
 /// Runs `particles render`.

@@ -22,6 +22,16 @@ pub enum Shape {
     Conical,
 }
 
+impl Shape {
+    /// The pile shape of `granular-measure` (a conical pile around the particles' centroid).
+    pub fn pile(self) -> PileShape {
+        match self {
+            Shape::Planar => PileShape::Planar,
+            Shape::Conical => PileShape::Conical { axis_xz: None },
+        }
+    }
+}
+
 /// Arguments of `particles repose`.
 #[derive(Debug, clap::Args)]
 pub struct ReposeArgs {
@@ -58,10 +68,7 @@ pub fn run(a: &ReposeArgs) -> Result<()> {
     let positions = sph_sim::vtk::read_positions(&file)?;
     let s = scene.particle_spacing;
     let floor = scene.tank.map_or(0.0, |t| t.min.y);
-    let shape = match a.shape {
-        Shape::Planar => PileShape::Planar,
-        Shape::Conical => PileShape::Conical { axis_xz: None },
-    };
+    let shape = a.shape.pile();
     let opts = match a.shape {
         Shape::Planar => ReposeOptions::planar(floor, s),
         Shape::Conical => ReposeOptions::conical(floor, s),

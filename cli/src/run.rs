@@ -5,7 +5,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 use anyhow::{Context, Result};
+use sph_sim::observe::RestCriterion;
 use sph_sim::{run_scene, SceneRunOptions};
+use sph_scene::Override;
 
 /// Arguments of `particles run`.
 #[derive(Debug, clap::Args)]
@@ -36,9 +38,25 @@ pub struct RunArgs {
     #[arg(long, conflicts_with = "cache")]
     no_cache: bool,
     /// Continue from OUT's checkpoint: the frames and statistics come out bit-identical to
-    /// an uninterrupted run's (but for the wall-clock columns).
+    /// an uninterrupted run's (but for the wall-clock columns). The overrides recorded in
+    /// OUT apply (a --set given must repeat them).
     #[arg(long)]
     resume: bool,
+    /// Override a key of the scene file by its dotted path, e.g. `--set
+    /// solver.friction_angle_deg=40 --set fluid[0].max=[0.5,0.3,0.1]` (VALUE is TOML; a bare
+    /// word is a string); checked as the file is, and recorded in OUT so that `render`,
+    /// `repose` and `--resume` see the same scene. Repeatable; applied in order, before
+    /// `--quick`'s overrides.
+    #[arg(long = "set", value_name = "KEY=VALUE", value_parser = Override::parse)]
+    set: Vec<Override>,
+    /// Stop once the material is at rest (crate granular-measure's criterion: the
+    /// 99th-percentile speed and the fastest particle two spacings below the surface under
+    /// 0.05 sqrt(g s) for 0.5 s, the heap's angle moving less than 0.3° over 1 s), the
+    /// scene's duration then a cap. The heap's angle is taken as a planar heap (profile
+    /// along x) or, with `--until-rest conical`, a pile around its centroid. The samples go
+    /// to OUT/rest_samples.csv and the verdict to OUT/rest.json.
+    #[arg(long, value_name = "SHAPE", value_enum, num_args = 0..=1, default_missing_value = "planar")]
+    until_rest: Option<crate::repose::Shape>,
 }
 
 /// `--frames N`: a whole number >= 1.
@@ -82,6 +100,11 @@ pub fn run(a: &RunArgs) -> Result<()> {
             a.cache
                 .clone()
                 .unwrap_or_else(|| PathBuf::from("target").join("cache").join("volume-maps"))
+        }),
+        overrides: a.set.clone(),
+        until_rest: a.until_rest.map(|shape| RestCriterion {
+            shape: shape.pile(),
+            ..RestCriterion::default()
         }),
         cancel: Some(cancel.clone()),
     };

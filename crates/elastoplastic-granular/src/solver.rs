@@ -397,6 +397,18 @@ impl<R: Real> ElastoplasticScheme<R> {
         self.boundary_moved = true;
     }
 
+    /// The parameters' initial stress of the particles at `positions` (sized for them), if
+    /// it is still to be applied. The geostatic stress is a function of each particle's
+    /// position, so applying it before or after a reordering gives each particle the same.
+    fn apply_initial_stress(&mut self, positions: &[Vec3<R>]) -> Result<(), SolverError> {
+        if self.initial_stress_pending {
+            let stress = crate::initial::geostatic(&self.params, positions)?;
+            self.scratch.stress[..positions.len()].copy_from_slice(&stress);
+            self.initial_stress_pending = false;
+        }
+        Ok(())
+    }
+
     /// The per-particle arrays: stress (`xx, yy, zz, xy, yz, zx`) and plastic strain.
     fn particle_arrays(&self, arrays: &mut Vec<(String, Vec<R>)>) {
         let s = &self.scratch;
@@ -645,15 +657,15 @@ impl<R: Real> SubstepScheme<R> for ElastoplasticScheme<R> {
             apply_permutation(&mut s.plastic_strain, p, &mut s.permute_r);
             self.resize(n);
         }
-        if self.initial_stress_pending {
-            let stress = crate::initial::geostatic(&self.params, &state.positions)?;
-            self.scratch.stress[..n].copy_from_slice(&stress);
-            self.initial_stress_pending = false;
-        }
+        self.apply_initial_stress(&state.positions)?;
         // Every frame starts from fresh lists, so that a run resumed from a checkpoint
         // repeats the uninterrupted one bit for bit.
         self.lists_valid = false;
         Ok(())
+    }
+    fn prepare(&mut self, state: &ParticleSet<R>) -> Result<(), SolverError> {
+        self.resize(state.len());
+        self.apply_initial_stress(&state.positions)
     }
     fn substep(
         &mut self,

@@ -45,6 +45,7 @@ pub mod frame_loop;
 pub mod observe;
 mod record;
 pub mod render;
+pub mod rest_log;
 pub mod run;
 pub mod run_dir;
 pub mod saved;
@@ -57,7 +58,7 @@ pub use factory::{build_boundary, build_solver, density_kernel, VOLUME_MAP_CONTA
 pub use frame_loop::{run_frames, Divergence, Ending, Flow, FrameObserver, RunOutcome, RunPlan};
 pub use record::{FrameRecord, STATS_COLUMNS, STATS_EXTRA_COLUMNS};
 pub use run::{run_scene, SceneRunOptions};
-pub use run_dir::RunDir;
+pub use run_dir::{RunDir, RunSource};
 pub use saved::SceneSource;
 pub use setup::SceneSetup;
 pub use sim::SceneSim;

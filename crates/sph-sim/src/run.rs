@@ -12,14 +12,16 @@ use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use sph_core::Real;
-use sph_scene::Scene;
+use sph_scene::{Override, Scene};
 
 use crate::checkpoint::CheckpointObserver;
 use crate::error::SimError;
 use crate::frame_loop::{run_frames, Flow, FrameObserver, RunOutcome, RunPlan};
 use crate::record::FrameRecord;
+use crate::observe::RestCriterion;
 use crate::render::RenderObserver;
-use crate::run_dir::RunDir;
+use crate::rest_log::RestLog;
+use crate::run_dir::{RunDir, RunSource};
 use crate::sim::SceneSim;
 use crate::with_precision;
 
@@ -247,6 +249,14 @@ pub struct SceneRunOptions {
     pub render: bool,
     /// A directory of volume maps to load from and add to (`None`: build them, keep none).
     pub volume_map_cache: Option<PathBuf>,
+    /// Overrides of the scene file's keys (`particles run --set KEY=VALUE`), applied as the
+    /// file is read and checked with it; recorded in the run directory (a resumed run with
+    /// none takes the recorded ones).
+    pub overrides: Vec<Override>,
+    /// Stop once the material is at rest by this criterion (`particles run --until-rest`;
+    /// the scene's duration is then a cap): its samples and verdict are written to the run
+    /// directory ([`crate::rest_log`]).
+    pub until_rest: Option<RestCriterion>,
     /// A cancellation flag (set by a Ctrl-C handler): checked per row of nodes while the
     /// volume maps are built (the run then fails with
     /// [`sph_solver::SolverError::Cancelled`]) and after each frame (the run ends
@@ -265,29 +275,62 @@ pub fn last_frame(scene: &Scene, max_frames: Option<usize>) -> Result<usize, Sim
     }
 }
 
-/// Loads the scene at `path` and runs it into `opts.out_dir` ([`crate::run_dir`]): a
-/// progress bar, VTK frames, `stats.csv`, checkpoints, and with `opts.render` the frames
-/// rendered in process ([`crate::render::RenderObserver`]). A fresh run first removes what
-/// an earlier run left in the directory; `opts.resume` continues from its checkpoint
-/// (refused by name if it is another scene's, another version's, or damaged). Returns how
-/// the run ended: a blow-up is [`crate::frame_loop::Ending::Diverged`], naming the frame,
-/// step and particle (the files up to it are kept).
+/// Loads the scene at `path` (with `opts.overrides`) and runs it into `opts.out_dir`
+/// ([`crate::run_dir`]): a progress bar, VTK frames, `stats.csv`, checkpoints, with
+/// `opts.render` the frames rendered in process ([`crate::render::RenderObserver`]) and with
+/// `opts.until_rest` a stop at rest ([`crate::rest_log`]). A fresh run first removes what an
+/// earlier run left in the directory; `opts.resume` continues from its checkpoint (refused
+/// by name if it is another scene's, another version's, or damaged) with the overrides the
+/// directory records. Returns how the run ended: a blow-up is
+/// [`crate::frame_loop::Ending::Diverged`], naming the frame, step and particle (the files up
+/// to it are kept).
 pub fn run_scene(path: &Path, opts: &SceneRunOptions) -> Result<RunOutcome, SimError> {
-    let scene = Scene::load(path)?;
-    let scene = if opts.quick { scene.quick() } else { scene };
-    let last = last_frame(&scene, opts.max_frames)?;
     let run = RunDir::new(&opts.out_dir);
     run.create()?;
+    let source = run_source(path, opts, &run)?;
+    let scene = source.load()?;
+    let last = last_frame(&scene, opts.max_frames)?;
     // Checked before any work, so that a bad [render] table costs nothing.
     let render = match opts.render {
         true => Some(RenderObserver::new(&scene, &run)?),
         false => None,
     };
-    with_precision!(scene.precision, R => run_scene_in::<R>(path, &scene, &run, last, opts, render))
+    with_precision!(scene.precision, R => run_scene_in::<R>(&source, &scene, &run, last, opts, render))
+}
+
+/// The scene a run reads: the one asked for, and on `--resume` the overrides recorded in
+/// the directory (those asked for, if any, must be the same).
+fn run_source(path: &Path, opts: &SceneRunOptions, run: &RunDir) -> Result<RunSource, SimError> {
+    let asked = RunSource {
+        scene: path.to_path_buf(),
+        quick: opts.quick,
+        overrides: opts.overrides.clone(),
+    };
+    let recorded = run.path().join(crate::run_dir::RUN_SOURCE_FILE);
+    if !opts.resume || !recorded.is_file() {
+        return Ok(asked);
+    }
+    let recorded = run.read_source()?;
+    let args = |o: &[Override]| match o {
+        [] => "none".to_string(),
+        o => o.iter().map(|o| format!("--set {}", o.to_arg())).collect::<Vec<_>>().join(" "),
+    };
+    if !asked.overrides.is_empty() && asked.overrides != recorded.overrides {
+        return Err(SimError::Invalid(format!(
+            "--resume: the run in {} was made with overrides {}, not {}: give the same --set or none",
+            run.path().display(),
+            args(&recorded.overrides),
+            args(&asked.overrides)
+        )));
+    }
+    Ok(RunSource {
+        overrides: recorded.overrides,
+        ..asked
+    })
 }
 
 fn run_scene_in<R: Real>(
-    path: &Path,
+    source: &RunSource,
     scene: &Scene,
     run: &RunDir,
     last: usize,
@@ -312,7 +355,7 @@ fn run_scene_in<R: Real>(
         run.remove_outputs(Some(sim.frame))?;
     } else {
         run.remove_outputs(None)?;
-        run.write_source(path, opts.quick)?;
+        run.write_source(source)?;
     }
     let plan = RunPlan {
         first_frame: sim.frame,
@@ -332,8 +375,15 @@ fn run_scene_in<R: Real>(
             Flow::Continue
         }
     });
+    let mut rest = match opts.until_rest {
+        Some(c) => Some(RestLog::new(c, run, resumed.then_some(sim.time_s))?),
+        None => None,
+    };
     let mut observers: Vec<&mut dyn FrameObserver<R>> = vec![&mut stats, &mut vtk];
     if let Some(r) = render.as_mut() {
+        observers.push(r);
+    }
+    if let Some(r) = rest.as_mut() {
         observers.push(r);
     }
     observers.push(&mut ctrl_c);
@@ -356,6 +406,13 @@ fn run_scene_in<R: Real>(
         )),
         run.stats_csv().display()
     );
+    if let Some(r) = &rest {
+        eprintln!(
+            "rest: {}; verdict in {}",
+            r.summary(),
+            run.path().join(crate::rest_log::REST_VERDICT_FILE).display()
+        );
+    }
     result
 }
 

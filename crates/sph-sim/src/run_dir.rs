@@ -1,12 +1,15 @@
 //! The output directory of a scene run: what it holds and under which names.
 //!
 //! ```text
-//! OUT/scene_source.txt     the scene file (absolute path) and the mode, `quick` or `full`
+//! OUT/scene_source.txt     the scene file (absolute path), the mode (`quick` or `full`)
+//!                          and a line `set KEY=VALUE` per override (`run --set`)
 //! OUT/stats.csv            one row per frame (written and flushed as each frame ends)
 //! OUT/frame_NNNNN.vtk      particle frames (legacy VTK), every `output.every_frames`
 //! OUT/passive_NNNNN.vtk    passive points of the same frames (granular upscaling)
 //! OUT/checkpoint.sphck     the last checkpoint (`run --checkpoint-every N`, `--resume`)
 //! OUT/render/frame_NNNNN.png  rendered frames (`run --render`, `render OUT`)
+//! OUT/rest_samples.csv     the rest criterion's samples (`run --until-rest`)
+//! OUT/rest.json            its verdict at the run's end
 //! ```
 //!
 //! A fresh run removes what an earlier run left under these names (and nothing else), so
@@ -14,10 +17,14 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::error::SimError;
+use sph_scene::{Override, Scene};
 
-/// The file naming the scene and mode of a run, so that `render OUT` and `repose OUT` find
-/// the scene: two lines, the absolute scene path and `quick` or `full`.
+use crate::error::SimError;
+use crate::saved::SceneSource;
+
+/// The file naming the scene, mode and overrides of a run, so that `render OUT`,
+/// `repose OUT` and `run --resume` find the scene: the absolute scene path, `quick` or
+/// `full`, then a line `set KEY=VALUE` per override.
 pub const RUN_SOURCE_FILE: &str = "scene_source.txt";
 /// The per-frame statistics.
 pub const STATS_FILE: &str = "stats.csv";
@@ -115,7 +122,12 @@ impl RunDir {
         }
         if after.is_none() {
             stale.extend(
-                [self.stats_csv(), self.checkpoint()]
+                [
+                    self.stats_csv(),
+                    self.checkpoint(),
+                    self.path.join(crate::rest_log::REST_SAMPLES_FILE),
+                    self.path.join(crate::rest_log::REST_VERDICT_FILE),
+                ]
                     .into_iter()
                     .filter(|p| p.is_file()),
             );
@@ -126,19 +138,22 @@ impl RunDir {
         Ok(stale.len())
     }
 
-    /// Records the scene and mode of the run ([`RUN_SOURCE_FILE`]).
-    pub fn write_source(&self, scene: &Path, quick: bool) -> Result<(), SimError> {
-        let abs = std::path::absolute(scene).unwrap_or_else(|_| scene.to_path_buf());
+    /// Records the scene, the mode and the overrides of the run ([`RUN_SOURCE_FILE`]).
+    pub fn write_source(&self, source: &RunSource) -> Result<(), SimError> {
+        let abs = std::path::absolute(&source.scene).unwrap_or_else(|_| source.scene.clone());
         let path = self.path.join(RUN_SOURCE_FILE);
-        let mode = if quick { "quick" } else { "full" };
-        std::fs::write(&path, format!("{}\n{mode}\n", abs.display()))
-            .map_err(|e| SimError::output(&path, e))
+        let mode = if source.quick { "quick" } else { "full" };
+        let mut text = format!("{}\n{mode}\n", abs.display());
+        for o in &source.overrides {
+            text.push_str(&format!("set {}\n", o.to_arg()));
+        }
+        std::fs::write(&path, text).map_err(|e| SimError::output(&path, e))
     }
 
-    /// The scene file and mode recorded by [`RunDir::write_source`].
-    pub fn read_source(&self) -> Result<(PathBuf, bool), SimError> {
+    /// The scene file, mode and overrides recorded by [`RunDir::write_source`].
+    pub fn read_source(&self) -> Result<RunSource, SimError> {
         let path = self.path.join(RUN_SOURCE_FILE);
-        let text = sph_core::input::read_text_limited(&path, 64 * 1024, "run source file")
+        let text = sph_core::input::read_text_limited(&path, 1 << 20, "run source file")
             .map_err(|e| {
                 SimError::Invalid(format!(
                     "{e} (no scene recorded for this run directory: give --scene SCENE)"
@@ -156,7 +171,41 @@ impl RunDir {
                 ))
             }
         };
-        Ok((scene, quick))
+        let mut overrides = Vec::new();
+        for (k, line) in lines.enumerate() {
+            let arg = line.strip_prefix("set ").ok_or_else(|| {
+                SimError::input(&path, format!("line {} is not `set KEY=VALUE`", k + 3))
+            })?;
+            let o = Override::parse(arg)
+                .map_err(|e| SimError::input(&path, format!("line {}: {e}", k + 3)))?;
+            overrides.push(o);
+        }
+        Ok(RunSource {
+            scene,
+            quick,
+            overrides,
+        })
+    }
+}
+
+/// What a run directory records of its scene ([`RUN_SOURCE_FILE`]): the scene file, whether
+/// its `[quick]` overrides apply, and the overrides of its keys (`particles run --set`), so
+/// that `render`, `repose` and `--resume` see the scene the run ran.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunSource {
+    /// The scene file.
+    pub scene: PathBuf,
+    /// Whether the scene's `[quick]` overrides apply.
+    pub quick: bool,
+    /// The overrides of the file's keys, in order.
+    pub overrides: Vec<Override>,
+}
+
+impl RunSource {
+    /// The checked scene: the file read with the overrides applied, then quick mode
+    /// ([`SceneSource::load`]).
+    pub fn load(&self) -> Result<Scene, SimError> {
+        SceneSource::load(&self.scene, self.overrides.clone(), self.quick).map(|(_, s)| s)
     }
 }
 

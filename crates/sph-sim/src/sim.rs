@@ -12,7 +12,7 @@ use sph_solver::{FluidSolver, StepStats};
 use crate::error::SimError;
 use crate::factory::build_solver;
 use crate::setup::SceneSetup;
-use crate::vtk::{write_particle_frame, write_point_frame, ParticleFrame};
+use crate::vtk::{values_per_particle, write_particle_frame, write_point_frame, ParticleFrame};
 
 /// A scene being simulated in precision `R`.
 pub struct SceneSim<R: Real> {
@@ -88,10 +88,13 @@ impl<R: Real> SceneSim<R> {
             calibration,
             volume_maps,
         } = setup;
-        let solver = build_solver(params, boundary).map_err(|source| SimError::Setup {
+        let setup_error = |source| SimError::Setup {
             file: scene.source.display().to_string(),
             source,
-        })?;
+        };
+        let mut solver = build_solver(params, boundary).map_err(setup_error)?;
+        // Frame 0 is written with the solver's fields (an initial stress) before any step.
+        solver.prepare(&state).map_err(setup_error)?;
         let n = state.len() as u32;
         Ok(Self {
             scene,
@@ -172,19 +175,16 @@ impl<R: Real> SceneSim<R> {
     /// The solver's per-particle fields (`FluidSolver::particle_fields`, e.g. the
     /// elastic–plastic stress and plastic strain) in the scene's original particle order:
     /// `(name, k, values)` with `k` values per particle, particle `i`'s at `k i .. k (i + 1)`.
-    /// A field whose length is not a multiple of the particle count is an error.
+    /// A field whose length is not a multiple of the particle count is an error; with no
+    /// particles yet (a pour before its first layer) the fields are left out.
     pub fn particle_fields(&self) -> Result<Vec<(String, usize, Vec<R>)>, SimError> {
         let n = self.ids.len();
         let mut out = Vec::new();
         for (name, values) in self.solver.particle_fields() {
-            let k = match values.len().checked_div(n) {
-                Some(k) if k > 0 && k * n == values.len() => k,
-                _ => {
-                    return Err(SimError::Invalid(format!(
-                        "solver field {name:?} has {} values, not a positive multiple of the {n} particles",
-                        values.len()
-                    )))
-                }
+            let Some(k) =
+                values_per_particle(&name, values.len(), n).map_err(SimError::Invalid)?
+            else {
+                continue; // no particles yet (a pour before its first layer)
             };
             let mut ordered = values.clone();
             for (&id, chunk) in self.ids.iter().zip(values.chunks_exact(k)) {

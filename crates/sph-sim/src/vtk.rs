@@ -89,6 +89,19 @@ pub fn write_particle_frame<R: Real>(
     )
 }
 
+/// How many values per particle a solver field of `len` values holds for `n` particles: a
+/// positive whole number, or `None` for an empty field of no particles (a pour before its
+/// first layer); anything else is an error naming the field.
+pub(crate) fn values_per_particle(name: &str, len: usize, n: usize) -> Result<Option<usize>, String> {
+    match len.checked_div(n) {
+        Some(k) if k * n == len && k > 0 => Ok(Some(k)),
+        _ if len == 0 && n == 0 => Ok(None),
+        _ => Err(format!(
+            "solver field {name:?} has {len} values, not a positive multiple of the {n} particles"
+        )),
+    }
+}
+
 /// The point attributes of the solver's fields (see [`write_particle_frame`]).
 fn field_attributes<R: Real>(
     path: &Path,
@@ -98,18 +111,10 @@ fn field_attributes<R: Real>(
     let mut out = Vec::new();
     let mut other = Vec::new();
     for (name, values) in fields {
-        let k = match values.len().checked_div(n) {
-            Some(k) if k * n == values.len() && k > 0 => k,
-            _ if values.is_empty() && n == 0 => continue,
-            _ => {
-                return Err(SimError::output(
-                    path,
-                    format!(
-                        "solver field {name:?} has {} values, not a positive multiple of the {n} particles",
-                        values.len()
-                    ),
-                ))
-            }
+        let Some(k) = values_per_particle(name, values.len(), n)
+            .map_err(|reason| SimError::output(path, reason))?
+        else {
+            continue;
         };
         let data: Vec<f32> = values.iter().map(|v| v.as_f64() as f32).collect();
         match k {

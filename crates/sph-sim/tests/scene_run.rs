@@ -61,6 +61,8 @@ fn runs_a_scene_and_writes_frames_and_statistics() {
                 resume: false,
                 render: false,
                 volume_map_cache: None,
+                overrides: Vec::new(),
+                until_rest: None,
                 cancel: None,
             },
         )
@@ -127,6 +129,8 @@ fn runs_iisph_and_granular_scenes_with_passive_points() {
                 resume: false,
                 render: false,
                 volume_map_cache: None,
+                overrides: Vec::new(),
+                until_rest: None,
                 cancel: None,
             },
         )
@@ -177,6 +181,8 @@ fn malformed_scene_names_file_and_field() {
             resume: false,
             render: false,
             volume_map_cache: None,
+            overrides: Vec::new(),
+            until_rest: None,
             cancel: None,
         },
     )
@@ -201,6 +207,8 @@ fn zero_frames_and_a_file_as_output_are_refused() {
         resume: false,
         render: false,
         volume_map_cache: None,
+        overrides: Vec::new(),
+        until_rest: None,
         cancel: None,
     };
     let err = run_scene(&scene, &opts(dir.join("out"), Some(0))).unwrap_err();

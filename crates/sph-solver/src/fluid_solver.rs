@@ -42,6 +42,14 @@ pub trait FluidSolver<R: Real>: Send {
     fn passive_points(&self) -> Option<&[Vec3<R>]> {
         None
     }
+    /// Readies the solver's per-particle state for `state` before its first
+    /// [`FluidSolver::step`] (e.g. the elastic–plastic solver's initial stress), so that
+    /// [`FluidSolver::particle_fields`] describes frame 0; a solver that is not prepared
+    /// does the same at its first step, with the same result. Nothing by default.
+    fn prepare(&mut self, state: &ParticleSet<R>) -> Result<(), SolverError> {
+        let _ = state;
+        Ok(())
+    }
     /// Per-particle fields the solver carries beside the [`ParticleSet`], for output frames:
     /// `(name, values)` in the particles' current order, `values.len()` a multiple `k` of the
     /// particle count (`k` values per particle: 1 a scalar, 3 a vector, 6 a symmetric tensor

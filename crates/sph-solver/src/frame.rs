@@ -102,6 +102,13 @@ pub trait SubstepScheme<R: Real>: Send + Sized {
         permutation: Option<&[u32]>,
         stats: &mut StepStats,
     ) -> Result<(), SolverError>;
+    /// Readies what the scheme carries per particle for `state` before its first frame
+    /// ([`FluidSolver::prepare`]): e.g. an initial stress, so that the state at frame 0 can
+    /// be written out with its [`SubstepScheme::particle_fields`]. Nothing by default.
+    fn prepare(&mut self, state: &ParticleSet<R>) -> Result<(), SolverError> {
+        let _ = state;
+        Ok(())
+    }
     /// One time step of `common.substeps` (`at`; `last` for the frame's last one): advances
     /// `state` by `Δt = dt / substeps` and writes positions, velocities and densities, after
     /// checking for divergence ([`SolverError::BlowUp`], `state` unchanged).
@@ -370,6 +377,9 @@ impl<R: Real, S: SubstepScheme<R>> FluidSolver<R> for FrameSolver<R, S> {
     }
     fn passive_points(&self) -> Option<&[Vec3<R>]> {
         self.scheme.passive_points()
+    }
+    fn prepare(&mut self, state: &ParticleSet<R>) -> Result<(), SolverError> {
+        self.scheme.prepare(state)
     }
     fn particle_fields(&self) -> Vec<(String, Vec<R>)> {
         let mut fields = Vec::new();
