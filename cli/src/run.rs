@@ -5,9 +5,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 use anyhow::{Context, Result};
+use sph_scene::Override;
 use sph_sim::observe::RestCriterion;
 use sph_sim::{run_scene, SceneRunOptions};
-use sph_scene::Override;
 
 /// Arguments of `particles run`.
 #[derive(Debug, clap::Args)]

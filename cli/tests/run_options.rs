@@ -51,19 +51,37 @@ fn ok(o: &Output) -> String {
 fn an_override_is_checked_recorded_and_taken_by_resume() {
     let out = temp_dir("set");
     // Checked as the file is: an unknown key is refused with its path.
-    let o = run(&out, &["--frames", "1", "--set", "solver.friction_angle_degs=25"]);
+    let o = run(
+        &out,
+        &["--frames", "1", "--set", "solver.friction_angle_degs=25"],
+    );
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success());
     assert!(err.contains("friction_angle_degs"), "{err}");
     // Taken: the solver's friction angle moves the run.
     let set = ["--set", "solver.friction_angle_deg=25"];
-    ok(&run(&out, &["--frames", "2", "--checkpoint-every", "1", set[0], set[1]]));
+    ok(&run(
+        &out,
+        &["--frames", "2", "--checkpoint-every", "1", set[0], set[1]],
+    ));
     let source = std::fs::read_to_string(out.join("scene_source.txt")).unwrap();
-    assert!(source.ends_with("quick\nset solver.friction_angle_deg=25\n"), "{source}");
+    assert!(
+        source.ends_with("quick\nset solver.friction_angle_deg=25\n"),
+        "{source}"
+    );
     let whole = std::fs::read(out.join("frame_00000.vtk")).unwrap();
     let stats = std::fs::read_to_string(out.join("stats.csv")).unwrap();
     // Another override on --resume is refused by name.
-    let o = run(&out, &["--frames", "3", "--resume", "--set", "solver.friction_angle_deg=30"]);
+    let o = run(
+        &out,
+        &[
+            "--frames",
+            "3",
+            "--resume",
+            "--set",
+            "solver.friction_angle_deg=30",
+        ],
+    );
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success());
     assert!(err.contains("--set solver.friction_angle_deg=25"), "{err}");
@@ -75,7 +93,15 @@ fn an_override_is_checked_recorded_and_taken_by_resume() {
     // And the override changed the run: the default angle gives other frames.
     let plain = temp_dir("set-plain");
     ok(&run(&plain, &["--frames", "2", "--checkpoint-every", "0"]));
-    let first_row = |s: &str| s.lines().nth(1).unwrap().split(',').take(4).collect::<Vec<_>>().join(",");
+    let first_row = |s: &str| {
+        s.lines()
+            .nth(1)
+            .unwrap()
+            .split(',')
+            .take(4)
+            .collect::<Vec<_>>()
+            .join(",")
+    };
     let plain_stats = std::fs::read_to_string(plain.join("stats.csv")).unwrap();
     assert_ne!(first_row(&plain_stats), first_row(&stats));
     std::fs::remove_dir_all(&out).ok();
@@ -85,7 +111,10 @@ fn an_override_is_checked_recorded_and_taken_by_resume() {
 #[test]
 fn until_rest_writes_its_samples_and_verdict_and_resumes_bit_for_bit() {
     let whole = temp_dir("rest-whole");
-    let err = ok(&run(&whole, &["--frames", "3", "--checkpoint-every", "0", "--until-rest"]));
+    let err = ok(&run(
+        &whole,
+        &["--frames", "3", "--checkpoint-every", "0", "--until-rest"],
+    ));
     assert!(err.contains("rest: not at rest"), "{err}");
     let samples = std::fs::read_to_string(whole.join("rest_samples.csv")).unwrap();
     // The first state and one sample per frame.
@@ -95,7 +124,10 @@ fn until_rest_writes_its_samples_and_verdict_and_resumes_bit_for_bit() {
     assert!(verdict.contains("\"speed_scale\": 0.05"), "{verdict}");
     // Stopped after frame 1 (its checkpoint), then resumed to frame 3.
     let split = temp_dir("rest-split");
-    ok(&run(&split, &["--frames", "1", "--checkpoint-every", "1", "--until-rest"]));
+    ok(&run(
+        &split,
+        &["--frames", "1", "--checkpoint-every", "1", "--until-rest"],
+    ));
     ok(&run(&split, &["--frames", "3", "--resume", "--until-rest"]));
     let resumed = std::fs::read_to_string(split.join("rest_samples.csv")).unwrap();
     assert_eq!(resumed, samples);

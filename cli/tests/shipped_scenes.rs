@@ -73,7 +73,9 @@ fn run_scene(scene: &Path, root: &Path, cache: &Path) -> Result<String, String> 
     }
     let source = std::fs::read_to_string(out.join("scene_source.txt")).unwrap_or_default();
     if !source.ends_with("quick\nset output.every_frames=1\n") {
-        return Err(format!("{stem}: the run did not record its override:\n{source}"));
+        return Err(format!(
+            "{stem}: the run did not record its override:\n{source}"
+        ));
     }
     let mut hash = Sha256::new();
     let mut last = (0, 0);
@@ -118,7 +120,8 @@ fn read_back(stem: &str, out: &Path) -> Result<(), String> {
     let dir = out.to_string_lossy();
     if stem.starts_with("granular") {
         let o = particles(&["repose", &dir]);
-        let measured = o.status.success() && String::from_utf8_lossy(&o.stdout).contains("angle of repose");
+        let measured =
+            o.status.success() && String::from_utf8_lossy(&o.stdout).contains("angle of repose");
         if !measured && !String::from_utf8_lossy(&o.stderr).contains("degenerate pile") {
             return Err(format!("{stem}: particles repose failed\n{}", text(&o)));
         }

@@ -288,14 +288,25 @@ fn a_prepared_solver_shows_the_initial_stress_at_frame_0_and_steps_as_an_unprepa
     FluidSolver::prepare(&mut prepared, &prepared_state).unwrap();
     let fields = FluidSolver::particle_fields(&prepared);
     let (name, stress) = &fields[0];
-    assert_eq!((name.as_str(), stress.len()), ("stress", 6 * prepared_state.len()));
+    assert_eq!(
+        (name.as_str(), stress.len()),
+        ("stress", 6 * prepared_state.len())
+    );
     // The top of the layer is lighter than its bottom: the initial stress is there.
     let syy = |i: usize| stress[6 * i + 1];
     let (top, bottom) = (0..prepared_state.len()).fold((0, 0), |(t, b), i| {
         let y = |k: usize| prepared_state.positions[k].y;
-        (if y(i) > y(t) { i } else { t }, if y(i) < y(b) { i } else { b })
+        (
+            if y(i) > y(t) { i } else { t },
+            if y(i) < y(b) { i } else { b },
+        )
     });
-    assert!(syy(bottom) < syy(top) && syy(top) < 0.0, "{} {}", syy(bottom), syy(top));
+    assert!(
+        syy(bottom) < syy(top) && syy(top) < 0.0,
+        "{} {}",
+        syy(bottom),
+        syy(top)
+    );
     for _ in 0..2 {
         plain.step(&mut plain_state).unwrap();
         prepared.step(&mut prepared_state).unwrap();

@@ -221,7 +221,10 @@ mod tests {
         let back = read_samples(&path, 0.2).unwrap();
         assert_eq!(back.len(), 2);
         assert_eq!(back[1], samples[1]);
-        assert_eq!(back[0].percentile_speed_m_s.to_bits(), (1.0f64 / 3.0).to_bits());
+        assert_eq!(
+            back[0].percentile_speed_m_s.to_bits(),
+            (1.0f64 / 3.0).to_bits()
+        );
         assert!(back[0].deep_max_speed_m_s.is_nan());
         assert_eq!(read_samples(&path, 0.15).unwrap().len(), 1);
         std::fs::remove_dir_all(&dir).ok();

@@ -17,8 +17,8 @@ use sph_scene::{Override, Scene};
 use crate::checkpoint::CheckpointObserver;
 use crate::error::SimError;
 use crate::frame_loop::{run_frames, Flow, FrameObserver, RunOutcome, RunPlan};
-use crate::record::FrameRecord;
 use crate::observe::RestCriterion;
+use crate::record::FrameRecord;
 use crate::render::RenderObserver;
 use crate::rest_log::RestLog;
 use crate::run_dir::{RunDir, RunSource};
@@ -313,7 +313,11 @@ fn run_source(path: &Path, opts: &SceneRunOptions, run: &RunDir) -> Result<RunSo
     let recorded = run.read_source()?;
     let args = |o: &[Override]| match o {
         [] => "none".to_string(),
-        o => o.iter().map(|o| format!("--set {}", o.to_arg())).collect::<Vec<_>>().join(" "),
+        o => o
+            .iter()
+            .map(|o| format!("--set {}", o.to_arg()))
+            .collect::<Vec<_>>()
+            .join(" "),
     };
     if !asked.overrides.is_empty() && asked.overrides != recorded.overrides {
         return Err(SimError::Invalid(format!(
@@ -410,7 +414,9 @@ fn run_scene_in<R: Real>(
         eprintln!(
             "rest: {}; verdict in {}",
             r.summary(),
-            run.path().join(crate::rest_log::REST_VERDICT_FILE).display()
+            run.path()
+                .join(crate::rest_log::REST_VERDICT_FILE)
+                .display()
         );
     }
     result

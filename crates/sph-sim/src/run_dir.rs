@@ -128,8 +128,8 @@ impl RunDir {
                     self.path.join(crate::rest_log::REST_SAMPLES_FILE),
                     self.path.join(crate::rest_log::REST_VERDICT_FILE),
                 ]
-                    .into_iter()
-                    .filter(|p| p.is_file()),
+                .into_iter()
+                .filter(|p| p.is_file()),
             );
         }
         for p in &stale {
@@ -153,8 +153,8 @@ impl RunDir {
     /// The scene file, mode and overrides recorded by [`RunDir::write_source`].
     pub fn read_source(&self) -> Result<RunSource, SimError> {
         let path = self.path.join(RUN_SOURCE_FILE);
-        let text = sph_core::input::read_text_limited(&path, 1 << 20, "run source file")
-            .map_err(|e| {
+        let text =
+            sph_core::input::read_text_limited(&path, 1 << 20, "run source file").map_err(|e| {
                 SimError::Invalid(format!(
                     "{e} (no scene recorded for this run directory: give --scene SCENE)"
                 ))

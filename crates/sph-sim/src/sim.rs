@@ -181,8 +181,7 @@ impl<R: Real> SceneSim<R> {
         let n = self.ids.len();
         let mut out = Vec::new();
         for (name, values) in self.solver.particle_fields() {
-            let Some(k) =
-                values_per_particle(&name, values.len(), n).map_err(SimError::Invalid)?
+            let Some(k) = values_per_particle(&name, values.len(), n).map_err(SimError::Invalid)?
             else {
                 continue; // no particles yet (a pour before its first layer)
             };

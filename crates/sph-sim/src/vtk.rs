@@ -92,7 +92,11 @@ pub fn write_particle_frame<R: Real>(
 /// How many values per particle a solver field of `len` values holds for `n` particles: a
 /// positive whole number, or `None` for an empty field of no particles (a pour before its
 /// first layer); anything else is an error naming the field.
-pub(crate) fn values_per_particle(name: &str, len: usize, n: usize) -> Result<Option<usize>, String> {
+pub(crate) fn values_per_particle(
+    name: &str,
+    len: usize,
+    n: usize,
+) -> Result<Option<usize>, String> {
     match len.checked_div(n) {
         Some(k) if k * n == len && k > 0 => Ok(Some(k)),
         _ if len == 0 && n == 0 => Ok(None),
