@@ -7,8 +7,12 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use granular_measure::{angle_of_repose, PileShape, ReposeOptions};
+use granular_measure::{
+    angle_of_repose, flank_layer_stress, FlankLayers, PileShape, ReposeMeasurement, ReposeOptions,
+};
+use sph_core::Vec3;
 use sph_sim::observe::RestCriterion;
+use sph_sim::vtk::FrameRead;
 use sph_sim::{RunDir, Scene};
 
 use crate::render::scene_of_run;
@@ -49,6 +53,14 @@ pub struct ReposeArgs {
     /// With --scene: apply its `[quick]` overrides.
     #[arg(long)]
     quick: bool,
+    /// Also print the stress of the flanks' layers in the slope's axes (a planar heap of a
+    /// solver that writes a `stress` field, e.g. the elastic–plastic one): for the surface
+    /// layer and the layer 2–5 spacings deep, between 20 % and 80 % of the heap's height,
+    /// the medians of the normal-stress difference along the slope, the mobilised friction
+    /// on the slope-parallel plane, √J2/p, the speed down the slope and the pressure
+    /// (`granular_measure::flank`).
+    #[arg(long)]
+    layers: bool,
 }
 
 /// Measures the frame and prints the angle, the flanks and the resolution, then the rest
@@ -65,7 +77,8 @@ pub fn run(a: &ReposeArgs) -> Result<()> {
             .map(|(_, p)| p.clone())
             .with_context(|| format!("{}: no frame_*.vtk to measure", a.dir.display()))?,
     };
-    let positions = sph_sim::vtk::read_positions(&file)?;
+    let frame = sph_sim::vtk::read_particle_frame(&file)?;
+    let positions = &frame.positions;
     let s = scene.particle_spacing;
     let floor = scene.tank.map_or(0.0, |t| t.min.y);
     let shape = a.shape.pile();
@@ -74,7 +87,7 @@ pub fn run(a: &ReposeArgs) -> Result<()> {
         Shape::Conical => ReposeOptions::conical(floor, s),
     }
     .with_spacing(s);
-    let m = angle_of_repose(&positions, &opts)
+    let m = angle_of_repose(positions, &opts)
         .with_context(|| format!("measuring {}", file.display()))?;
     println!(
         "{}: angle of repose {:.2}° (resolution ±{:.2}°), pile height {:.4} m, {} particles",
@@ -94,15 +107,77 @@ pub fn run(a: &ReposeArgs) -> Result<()> {
             f.rms_residual_m
         );
     }
+    if a.layers {
+        anyhow::ensure!(
+            a.shape == Shape::Planar,
+            "--layers measures a planar heap's flanks (give --shape planar)"
+        );
+        print_layers(&frame, &file, s, floor, &m)?;
+    }
     // The frames of DIR up to the measured one.
     let upto = frames.iter().position(|(_, p)| same_file(p, &file));
     match upto {
-        Some(i) => print_rest(&scene, shape, &frames[..=i])?,
+        Some(i) => {
+            print_rest(&scene, shape, &frames[..=i])?;
+            let verdict = a.dir.join(sph_sim::rest_log::REST_VERDICT_FILE);
+            if i + 1 == frames.len() && verdict.is_file() {
+                let text = std::fs::read_to_string(&verdict)
+                    .with_context(|| format!("reading {}", verdict.display()))?;
+                let summary = text
+                    .lines()
+                    .find_map(|l| l.trim().strip_prefix("\"summary\": "))
+                    .map(|l| l.trim_end_matches(',').trim_matches('"').to_string())
+                    .unwrap_or_else(|| "unreadable".into());
+                println!(
+                    "the run's own verdict (run --until-rest, judged every frame, {}): {summary}",
+                    verdict.display()
+                );
+            }
+        }
         None => println!(
             "rest: not judged ({} is not one of {}'s frames)",
             file.display(),
             a.dir.display()
         ),
+    }
+    Ok(())
+}
+
+/// Prints the flanks' layers' stress ([`flank_layer_stress`]) at the measured slope.
+fn print_layers(
+    frame: &FrameRead,
+    file: &Path,
+    spacing_m: f64,
+    floor_y: f64,
+    m: &ReposeMeasurement,
+) -> Result<()> {
+    let stress = frame.stress.as_ref().with_context(|| {
+        format!(
+            "{}: the frame has no stress field (--layers needs a solver that carries one, kind = \"elastoplastic\")",
+            file.display()
+        )
+    })?;
+    let velocities = frame
+        .velocities
+        .as_ref()
+        .with_context(|| format!("{}: the frame has no velocities", file.display()))?;
+    let f64s = |v: &[Vec3<f32>]| -> Vec<Vec3<f64>> { v.iter().map(|p| p.cast()).collect() };
+    let stress: Vec<[f64; 6]> = stress.iter().map(|t| t.map(f64::from)).collect();
+    let mut opts = FlankLayers::new(spacing_m, m.angle_deg, floor_y);
+    opts.apex_x_m = Some(m.apex_d_m);
+    let layers = flank_layer_stress(&f64s(&frame.positions), &f64s(velocities), &stress, &opts)?;
+    for l in layers {
+        println!(
+            "  layer {:.0}-{:.0} spacings deep: {} grains, dN {:+.3}, tau/sigma_n {:.3}, sqrt(J2)/p {:.3}, v_down {:.4} m/s, p {:.0} Pa",
+            l.depth_spacings.0.max(0.0),
+            l.depth_spacings.1.floor(),
+            l.grains,
+            l.normal_stress_difference,
+            l.shear_over_normal,
+            l.sqrt_j2_over_pressure,
+            l.downslope_speed_m_s,
+            l.pressure_pa
+        );
     }
     Ok(())
 }

@@ -91,7 +91,6 @@
 //!   speed of sound is `√(E/ρ0)` as in Bui (SPHinXsys uses `√(K/ρ0)`).
 
 pub mod boundary_particles;
-pub mod heap;
 pub mod initial;
 mod kernels;
 mod params;

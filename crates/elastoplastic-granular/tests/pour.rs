@@ -2,7 +2,8 @@
 //! grains start unstressed, a run resumes bit for bit in the middle of a pour, a buried
 //! funnel and bad pours are refused with their reason.
 
-use elastoplastic_granular::heap::{poured_heap, PouredSetup};
+mod common;
+use common::heap::{poured_heap, PouredSetup};
 use elastoplastic_granular::{
     boundary_block, cubic_lattice, Aabb, Elastoplastic, ElastoplasticParams, InitialStress,
     ParticleSet, PeriodicAxis, Pour, SolverError, Vec3, WallModel,

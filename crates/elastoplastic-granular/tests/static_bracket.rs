@@ -32,7 +32,8 @@
 //! spacing error of the flanks measured at this spacing (2.14° at 20 mm, run 16 of the
 //! docs).
 
-use elastoplastic_granular::heap::{cut_slope, SlopeSetup};
+mod common;
+use common::heap::{cut_slope, SlopeSetup};
 use elastoplastic_granular::{ConeMatch, ElastoplasticParams};
 
 const S: f64 = 0.02;

@@ -6,8 +6,10 @@
 //! positions (a VTK frame read back, a simulation state, an experiment's run): the **angle of
 //! repose** of a settled pile ([`repose`]) and the **runout** of a collapsed column, planar
 //! ([`runout()`]) or axisymmetric ([`radial_runout`]) ([`mod@runout`]), and whether a heap is
-//! **at rest** ([`rest`]: robust speeds and the angle's drift over time, with the margins). They depend on the
-//! particle positions (and, for rest, velocities) only, not on the solver that made them.
+//! **at rest** ([`rest`]: robust speeds and the angle's drift over time, with the margins),
+//! and the **stress of a heap's flanks** in the slope's axes ([`flank`], from a solver that
+//! carries a stress per particle). They depend on the particle positions (velocities, stress)
+//! only, not on the solver that made them.
 //!
 //! Conventions: SI units (m, degrees for angles); gravity along −y, so "up" is +y and the
 //! floor is the plane `y = floor_y`. Heights and distances are those of particle **centres**
@@ -24,11 +26,13 @@
 //! doi:10.1103/PhysRevE.72.041301.
 
 mod error;
+pub mod flank;
 pub mod repose;
 pub mod rest;
 pub mod runout;
 
 pub use error::MeasureError;
+pub use flank::{flank_layer_stress, FlankLayers, LayerStress};
 pub use repose::{
     angle_of_repose, surface_profile, FlankFit, PileShape, ReposeMeasurement, ReposeOptions,
     SurfacePoint,

@@ -361,13 +361,13 @@ fn granular_repose_trapdoor_scenes_lower_a_door_under_the_slot() {
     }
 }
 
-/// `granular_repose_poured_{20,30,40}.toml` (run 40 of `docs/elastoplastic-granular.md`, the
-/// Rust set-up `heap::PouredSetup::for_spacing`): no grains at the start, a funnel 0.1 m wide
+/// `granular_repose_poured_{20,30,40}.toml`: no grains at the start, a funnel 0.1 m wide
 /// at the period's middle pouring 0.16 m² of cross-section over the slab's 0.06 m at
-/// 0.012 m² a second; the period holds the heap the cone predicts with room beyond its toes.
+/// 0.012 m² a second (30 grains a second at 20 mm); the period holds the heap the cone
+/// predicts with room beyond its toes.
 #[test]
-fn granular_repose_poured_pours_the_examples_heap() {
-    let setup = elastoplastic_granular::heap::PouredSetup::for_spacing(0.02);
+fn granular_repose_poured_pours_a_heap_the_period_holds() {
+    let slab = 0.06;
     for theta in [20.0_f64, 30.0, 40.0] {
         let full =
             Scene::load(&scene_path(&format!("granular_repose_poured_{theta}.toml"))).unwrap();
@@ -375,9 +375,10 @@ fn granular_repose_poured_pours_the_examples_heap() {
         assert_eq!(counts(&quick).0, 0);
         assert_eq!((quick.poured_grains(), full.poured_grains()), (1200, 9600));
         let pour = quick.pour.unwrap();
-        assert!((pour.volume_m3 - setup.volume_m3).abs() < 1e-12);
-        assert!((pour.rate_m3_s - setup.rate_m3_s).abs() < 1e-12);
-        assert!((pour.max[0] - pour.min[0] - setup.funnel_width_m).abs() < 1e-12);
+        assert!((pour.volume_m3 - 0.16 * slab).abs() < 1e-12);
+        assert!((pour.rate_m3_s - 0.012 * slab).abs() < 1e-12);
+        assert!((pour.max[0] - pour.min[0] - 0.1).abs() < 1e-12);
+        assert!((pour.max[2] - pour.min[2] - slab).abs() < 1e-12);
         let (axis, lo, period) = quick.solver.periodic_axes()[0];
         assert_eq!((axis, lo), (0, 0.0));
         assert!((0.5 * (pour.min[0] + pour.max[0]) - 0.5 * period).abs() < 1e-12);

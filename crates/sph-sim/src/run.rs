@@ -16,7 +16,7 @@ use sph_scene::{Override, Scene};
 
 use crate::checkpoint::CheckpointObserver;
 use crate::error::SimError;
-use crate::frame_loop::{run_frames, Flow, FrameObserver, RunOutcome, RunPlan};
+use crate::frame_loop::{run_frames, Ending, Flow, FrameObserver, RunOutcome, RunPlan};
 use crate::observe::RestCriterion;
 use crate::record::FrameRecord;
 use crate::render::RenderObserver;
@@ -26,7 +26,8 @@ use crate::sim::SceneSim;
 use crate::with_precision;
 
 /// Writes `frame_NNNNN.vtk` (and `passive_NNNNN.vtk` when the solver advects passive
-/// points) every `output.every_frames` frames, frame 0 included.
+/// points) every `output.every_frames` frames, frame 0 included, and the last frame of a run
+/// that completed or stopped.
 #[derive(Debug)]
 pub struct VtkObserver {
     run: RunDir,
@@ -89,6 +90,17 @@ impl<R: Real> FrameObserver<R> for VtkObserver {
     fn start(&mut self, sim: &SceneSim<R>, plan: &RunPlan) -> Result<(), SimError> {
         if !plan.resumed {
             self.write(sim)?;
+        } else if !plan.first_frame.is_multiple_of(self.every) {
+            // The last frame of the run resumed from, off the cadence: an uninterrupted run
+            // has no such file.
+            for p in [
+                self.run.frame_vtk(sim.frame),
+                self.run.passive_vtk(sim.frame),
+            ] {
+                if p.is_file() {
+                    std::fs::remove_file(&p).map_err(|e| SimError::output(&p, e))?;
+                }
+            }
         }
         self.check_output_volume(plan)
     }
@@ -97,6 +109,16 @@ impl<R: Real> FrameObserver<R> for VtkObserver {
             self.write(sim)?;
         }
         Ok(Flow::Continue)
+    }
+    /// A run that completed or was stopped (at rest) between two frames of the cadence ends
+    /// with its last frame written, so that `repose` and `render` see the state it ended in.
+    fn finish(&mut self, sim: &SceneSim<R>, outcome: Option<&RunOutcome>) -> Result<(), SimError> {
+        let ended =
+            outcome.is_some_and(|o| matches!(o.ending, Ending::Completed | Ending::Stopped { .. }));
+        if ended && !sim.frame.is_multiple_of(self.every) {
+            self.write(sim)?;
+        }
+        Ok(())
     }
 }
 
@@ -286,10 +308,10 @@ pub fn last_frame(scene: &Scene, max_frames: Option<usize>) -> Result<usize, Sim
 /// to it are kept).
 pub fn run_scene(path: &Path, opts: &SceneRunOptions) -> Result<RunOutcome, SimError> {
     let run = RunDir::new(&opts.out_dir);
-    run.create()?;
     let source = run_source(path, opts, &run)?;
     let scene = source.load()?;
     let last = last_frame(&scene, opts.max_frames)?;
+    run.create()?;
     // Checked before any work, so that a bad [render] table costs nothing.
     let render = match opts.render {
         true => Some(RenderObserver::new(&scene, &run)?),

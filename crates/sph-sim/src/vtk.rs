@@ -214,6 +214,9 @@ pub struct FrameRead {
     /// Velocities (m/s): the `velocity` point data, `None` if the frame has none (passive
     /// points).
     pub velocities: Option<Vec<Vec3<f32>>>,
+    /// The solver's `stress` field (Pa, tension positive; `xx, yy, zz, xy, yz, zx` of the
+    /// symmetric tensor written as its full 3×3), `None` if the frame has none.
+    pub stress: Option<Vec<[f32; 6]>>,
 }
 
 /// Reads the particle positions (m) of one frame written by [`write_particle_frame`] or
@@ -252,6 +255,7 @@ pub fn read_particle_frame(path: &Path) -> Result<FrameRead, SimError> {
     };
     let mut out = Vec::new();
     let mut vel: Option<Vec<Vec3<f32>>> = Some(Vec::new());
+    let mut stress: Option<Vec<[f32; 6]>> = Some(Vec::new());
     for piece in pieces {
         let vtkio::model::Piece::Inline(p) = piece else {
             return Err(corrupt("a piece is not inline".into()));
@@ -288,6 +292,26 @@ pub fn read_particle_frame(path: &Path) -> Result<FrameRead, SimError> {
             }
             _ => vel = None,
         }
+        let sg = p.data.point.iter().find_map(|a| match a {
+            Attribute::DataArray(d) if d.name == "stress" => Some(d.data.clone()),
+            _ => None,
+        });
+        match (sg, stress.as_mut()) {
+            (Some(data), Some(acc)) => {
+                let t: Vec<f32> = data
+                    .cast_into()
+                    .ok_or_else(|| corrupt("the stresses are not numbers".into()))?;
+                if t.len() != 3 * pts.len() {
+                    return Err(corrupt(format!(
+                        "{} stress components for {} particles (9 each)",
+                        t.len(),
+                        pts.len() / 3
+                    )));
+                }
+                acc.extend(t.chunks(9).map(|c| [c[0], c[4], c[8], c[1], c[5], c[2]]));
+            }
+            _ => stress = None,
+        }
     }
     for (what, arr) in [
         ("particle", Some(&out)),
@@ -308,6 +332,7 @@ pub fn read_particle_frame(path: &Path) -> Result<FrameRead, SimError> {
         time_s,
         positions: out,
         velocities: vel,
+        stress,
     })
 }
 
@@ -440,8 +465,12 @@ mod tests {
         });
         let pair = pair.unwrap();
         assert_eq!((pair.name.as_str(), pair.elem), ("pair", 2));
-        // the reader of the frame still reads it
-        assert_eq!(read_particle_frame(&path).unwrap().positions.len(), 2);
+        // the reader of the frame still reads it, with the stress in the solver's order
+        let read = read_particle_frame(&path).unwrap();
+        assert_eq!(read.positions.len(), 2);
+        let stress = read.stress.unwrap();
+        assert_eq!(stress[0], [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+        assert_eq!(stress[1], [-1.0, -2.0, -3.0, -4.0, -5.0, -6.0]);
         let bad = vec![("short".to_string(), vec![1.0f64, 2.0, 3.0])];
         let err = frame(&bad, &dir.join("g.vtk")).unwrap_err().to_string();
         assert!(err.contains("\"short\" has 3 values"), "{err}");

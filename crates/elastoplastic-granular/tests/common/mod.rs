@@ -1,0 +1,3 @@
+//! Set-ups shared by the crate's tests.
+
+pub mod heap;
