@@ -1,64 +1,14 @@
 //! The messages of `particles run` for arguments a user can get wrong (what `cargo xtask
 //! run` passes on), as reviewed snapshots (`tests/snapshots/cli_errors__<case>.snap`).
-//! Each case runs the binary in a fresh directory holding a valid scene (`good.toml` with
-//! `cube.obj`), a malformed one (`bad.toml`) and a plain file (`notes.txt`); every case must
-//! fail before simulating anything, with exit code 1 or 2 and the message on stderr (the
-//! directory reads `<dir>`). Review new snapshots as described in
+//! Each case runs the binary in a fresh directory holding a valid scene (`good.toml`), a
+//! malformed one (`bad.toml`) and a plain file (`notes.txt`); every case must fail before
+//! simulating anything, with exit code 1 or 2 and the message on stderr (the directory
+//! reads `<dir>`); the harness is `cli/tests/common/mod.rs`. Review new snapshots as described in
 //! `crates/sph-scene/tests/error_snapshots.rs`.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
 
-const GOOD: &str = r#"
-name = "good"
-[simulation]
-particle_spacing = 0.05
-duration = 0.1
-frame_dt = 0.02
-[solver]
-kind = "pbf"
-substeps = 2
-iterations = 2
-[tank]
-min = [0.0, 0.0, 0.0]
-max = [1.0, 1.0, 1.0]
-[[fluid]]
-kind = "block"
-min = [0.0, 0.0, 0.0]
-max = [0.2, 0.2, 0.2]
-[output]
-vtk = false
-"#;
-
-/// A fresh directory with the files the cases use.
-fn case_dir(case: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("particles-cli-{}-{case}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(dir.join("good.toml"), GOOD).unwrap();
-    std::fs::write(
-        dir.join("bad.toml"),
-        GOOD.replace("frame_dt = 0.02", "frame_dt = 1e30"),
-    )
-    .unwrap();
-    std::fs::write(dir.join("notes.txt"), "not a directory\n").unwrap();
-    dir
-}
-
-/// Runs `particles ARGS` in `dir`; returns (exit code, stderr with `dir` as `<dir>`).
-fn run(dir: &Path, args: &[&str]) -> (i32, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_particles"))
-        .args(args)
-        .current_dir(dir)
-        .env("NO_COLOR", "1")
-        .env_remove("CLICOLOR_FORCE")
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr)
-        .replace(&dir.display().to_string(), "<dir>")
-        .trim_end()
-        .to_string();
-    (out.status.code().unwrap_or(-1), stderr)
-}
+use common::{check_error_cases, error_case_dir, particles_bin, run_in, GOOD_SCENE};
 
 #[test]
 fn command_line_error_messages() {
@@ -83,17 +33,9 @@ fn command_line_error_messages() {
         ("scene_not_toml", &["run", "notes.txt"]),
         ("unknown_command", &["rnu"]),
     ];
-    for (name, args) in cases {
-        let dir = case_dir(name);
-        let (code, stderr) = run(&dir, args);
-        assert!(
-            code == 1 || code == 2,
-            "{name}: exit code {code}, stderr:\n{stderr}"
-        );
-        insta::assert_snapshot!(*name, stderr);
-        // Nothing was simulated: no output directory appeared.
-        assert!(!dir.join("target").exists(), "{name}: wrote output");
-    }
+    check_error_cases(particles_bin(), "particles-cli", cases, |name, stderr| {
+        insta::assert_snapshot!(name, stderr);
+    });
 }
 
 /// A run whose frame files cannot fit on the disk is refused after its first frame file,
@@ -101,14 +43,14 @@ fn command_line_error_messages() {
 /// frame) over the 10⁷ frames the scene format allows is 27.5 TB.
 #[test]
 fn frame_files_that_cannot_fit_on_the_disk_are_refused() {
-    let dir = case_dir("output_volume");
-    let scene = GOOD
+    let dir = error_case_dir("particles-cli", "output_volume");
+    let scene = GOOD_SCENE
         .replace("particle_spacing = 0.05", "particle_spacing = 0.02")
         .replace("duration = 0.1", "duration = 2e5")
         .replace("max = [0.2, 0.2, 0.2]", "max = [1.0, 0.5, 1.0]")
         .replace("vtk = false", "vtk = true");
     std::fs::write(dir.join("big.toml"), scene).unwrap();
-    let (code, stderr) = run(&dir, &["run", "big.toml", "--out", "out"]);
+    let (code, stderr) = run_in(particles_bin(), &dir, &["run", "big.toml", "--out", "out"]);
     assert_eq!(code, 1, "{stderr}");
     let error = stderr
         .lines()

@@ -2,10 +2,11 @@
 //! rerun into the same directory leaves no stale frames and keeps the statistics of every
 //! finished frame.
 
-use std::path::PathBuf;
-use std::process::Command;
+mod common;
 
-const BIN: &str = env!("CARGO_BIN_EXE_particles");
+use std::path::Path;
+
+use common::{error_lines, particles_ok, run_particles, temp_dir};
 
 const SCENE: &str = r#"name = "errors"
 [simulation]
@@ -31,34 +32,16 @@ every_frames = 1
 vtk = true
 "#;
 
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("particles-errors-{name}-{}", std::process::id()));
-    std::fs::remove_dir_all(&d).ok();
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// The `error:` lines of a failing command, with the temporary directory as `TMP`.
-fn error_of(args: &[&str], tmp: &std::path::Path) -> String {
-    let o = Command::new(BIN).args(args).output().unwrap();
+/// The `error:` lines of a failing command (run in `tmp`), with `tmp` written `TMP`.
+fn error_of(args: &[&str], tmp: &Path) -> String {
+    let o = run_particles(args, tmp, &[]);
     assert!(!o.status.success(), "{args:?} should fail");
-    let stderr = String::from_utf8_lossy(&o.stderr);
-    let lines: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error:")).collect();
-    lines.join("\n").replace(tmp.to_str().unwrap(), "TMP")
-}
-
-fn run_ok(args: &[&str]) {
-    let o = Command::new(BIN).args(args).output().unwrap();
-    assert!(
-        o.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    error_lines(&o, tmp, "TMP")
 }
 
 #[test]
 fn unwritable_output_and_corrupt_frames_are_named() {
-    let dir = temp_dir("named");
+    let dir = temp_dir("particles-errors", "named");
     let scene = dir.join("s.toml");
     std::fs::write(&scene, SCENE).unwrap();
     let s = scene.to_str().unwrap();
@@ -71,7 +54,7 @@ fn unwritable_output_and_corrupt_frames_are_named() {
     );
     let out = dir.join("out");
     let out_s = out.to_str().unwrap();
-    run_ok(&["run", s, "--frames", "2", "--out", out_s]);
+    particles_ok(["run", s, "--frames", "2", "--out", out_s], &dir);
     let frame = out.join("frame_00001.vtk");
     let bytes = std::fs::read(&frame).unwrap();
     std::fs::write(&frame, &bytes[..bytes.len() / 2]).unwrap();
@@ -87,13 +70,13 @@ fn unwritable_output_and_corrupt_frames_are_named() {
 
 #[test]
 fn a_shorter_rerun_leaves_no_stale_frames() {
-    let dir = temp_dir("rerun");
+    let dir = temp_dir("particles-errors", "rerun");
     let scene = dir.join("s.toml");
     std::fs::write(&scene, SCENE).unwrap();
     let (s, out) = (scene.to_str().unwrap(), dir.join("out"));
     let out_s = out.to_str().unwrap();
-    run_ok(&["run", s, "--frames", "6", "--out", out_s]);
-    run_ok(&["run", s, "--frames", "3", "--out", out_s]);
+    particles_ok(["run", s, "--frames", "6", "--out", out_s], &dir);
+    particles_ok(["run", s, "--frames", "3", "--out", out_s], &dir);
     let mut frames: Vec<String> = std::fs::read_dir(&out)
         .unwrap()
         .filter_map(|e| e.ok())

@@ -2,13 +2,13 @@
 //! creep: the angle, then the rest verdict judged over the run's last second of frames with
 //! each quantity's bound and by how much it misses.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
 
+use std::path::{Path, PathBuf};
+
+use common::{particles_ok, stdout_of, temp_dir};
 use sph_core::Vec3;
 use sph_sim::vtk::{write_particle_frame, ParticleFrame};
-
-const BIN: &str = env!("CARGO_BIN_EXE_particles");
 
 /// A scene of spacing 10 mm and frames of 0.05 s, gravity −9.81 m/s² (the default): the
 /// speed bound is 0.05 √(9.81 · 0.01) = 0.01566 m/s.
@@ -30,13 +30,6 @@ kind = "block"
 min = [0.0, 0.0, 0.0]
 max = [0.1, 0.1, 0.03]
 "#;
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("particles-repose-{name}-{}", std::process::id()));
-    std::fs::remove_dir_all(&d).ok();
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 /// A planar heap with 30° flanks on a 0.6 m base, three particles across the slab, on a
 /// 10 mm lattice; with a flag per particle: at least two spacings below its column's top.
@@ -85,22 +78,18 @@ fn write_run(dir: &Path, deep_speed: impl Fn(f64) -> f32) -> PathBuf {
 }
 
 fn repose(dir: &Path, scene: &Path) -> String {
-    let o = Command::new(BIN)
-        .args([
-            "repose",
-            dir.to_str().unwrap(),
-            "--scene",
-            scene.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    String::from_utf8_lossy(&o.stdout).into_owned()
+    let args = [
+        "repose",
+        dir.to_str().unwrap(),
+        "--scene",
+        scene.to_str().unwrap(),
+    ];
+    stdout_of(&particles_ok(args, dir))
 }
 
 #[test]
 fn a_still_heap_is_at_rest_from_its_first_frame() {
-    let dir = temp_dir("still");
+    let dir = temp_dir("particles-repose", "still");
     let scene = write_run(&dir, |_| 0.0);
     let out = repose(&dir, &scene);
     assert!(
@@ -122,7 +111,7 @@ fn a_still_heap_is_at_rest_from_its_first_frame() {
 fn a_creeping_slab_under_a_still_surface_misses_by_its_speed() {
     // Deep particles at 5 cm/s from t = 0.9 s (the surface still): the deep speed misses
     // by 5 − 1.566 cm/s, and the speeds have not held at all at the last frame.
-    let dir = temp_dir("creep");
+    let dir = temp_dir("particles-repose", "creep");
     let scene = write_run(&dir, |t| if t >= 0.9 { 0.05 } else { 0.0 });
     let out = repose(&dir, &scene);
     assert!(out.contains("rest: not at rest at t = 1.200 s"), "{out}");

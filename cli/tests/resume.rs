@@ -3,11 +3,12 @@
 //! statistics (but for the wall-clock columns) as an uninterrupted run; checkpoints of
 //! another scene or damaged ones are refused by name.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+mod common;
 
-const BIN: &str = env!("CARGO_BIN_EXE_particles");
+use std::path::Path;
+use std::process::Stdio;
+
+use common::{error_lines, particles_ok, temp_dir, wait_until};
 
 /// Small scenes of every solver kind with carried state: PBF (frame counter, reordering),
 /// IISPH water (warm-started pressures), granular with upscaling (stresses, passive points).
@@ -52,30 +53,14 @@ vtk = true
     )
 }
 
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("particles-resume-{name}-{}", std::process::id()));
-    std::fs::remove_dir_all(&d).ok();
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn particles(args: &[&str]) -> Command {
-    let mut c = Command::new(BIN);
-    // The default volume-map cache (`target/cache/volume-maps` here) stays out of the tree.
-    c.args(args)
-        .current_dir(std::env::temp_dir())
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped());
-    c
+/// Where the commands run: the default volume-map cache (`target/cache/volume-maps` there)
+/// stays out of the tree.
+fn cwd() -> std::path::PathBuf {
+    std::env::temp_dir()
 }
 
 fn run_ok(args: &[&str]) {
-    let out = particles(args).output().unwrap();
-    assert!(
-        out.status.success(),
-        "particles {args:?} failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    particles_ok(args, &cwd());
 }
 
 /// The statistics without the wall-clock columns (those named `*_s` but `time_s` and
@@ -112,26 +97,29 @@ fn outputs(dir: &Path) -> Vec<(String, Vec<u8>)> {
     v
 }
 
+/// The number of rows of the statistics file `stats` (0 before it exists).
+fn rows(stats: &Path) -> usize {
+    std::fs::read_to_string(stats)
+        .map(|t| t.lines().count().saturating_sub(1))
+        .unwrap_or(0)
+}
+
 /// Kills `particles run` with SIGKILL once its statistics hold `frames` rows; panics if the
 /// run ended before (the scene is then too fast for the test to mean anything).
 fn run_and_kill_after(args: &[&str], stats: &Path, frames: usize) -> usize {
-    let mut child = particles(args).stderr(Stdio::null()).spawn().unwrap();
-    let t0 = Instant::now();
-    loop {
-        let rows = std::fs::read_to_string(stats)
-            .map(|t| t.lines().count().saturating_sub(1))
-            .unwrap_or(0);
-        if rows >= frames || t0.elapsed() > Duration::from_secs(300) {
-            child.kill().unwrap(); // SIGKILL on Unix
-            child.wait().unwrap();
-            return rows;
-        }
-        assert!(
-            child.try_wait().unwrap().is_none(),
-            "the run ended before it could be killed at frame {frames}"
-        );
-        std::thread::sleep(Duration::from_millis(1));
-    }
+    let mut child = common::particles(args, &cwd(), &[])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    wait_until(
+        &mut child,
+        &format!("the run reaching frame {frames} to be killed there"),
+        || rows(stats) >= frames,
+    );
+    child.kill().unwrap(); // SIGKILL on Unix
+    child.wait().unwrap();
+    rows(stats)
 }
 
 /// Asserts that the run in `b` wrote what the run in `a` wrote.
@@ -152,7 +140,7 @@ fn assert_same_outputs(name: &str, a: &Path, b: &Path) {
 #[test]
 fn a_run_stopped_part_way_resumes_bit_for_bit() {
     for (name, solver) in SCENES {
-        let dir = temp_dir(name);
+        let dir = temp_dir("particles-resume", name);
         let scene = dir.join("scene.toml");
         std::fs::write(&scene, scene_text(solver)).unwrap();
         let cache = dir.join("cache");
@@ -177,7 +165,7 @@ fn a_run_stopped_part_way_resumes_bit_for_bit() {
 fn a_killed_run_resumes_bit_for_bit() {
     // The richest carried state: granular stresses, warm-started pressures, passive points.
     let (name, solver) = SCENES[2];
-    let dir = temp_dir("killed");
+    let dir = temp_dir("particles-resume", "killed");
     let scene = dir.join("scene.toml");
     std::fs::write(&scene, scene_text_at(solver, 0.01)).unwrap();
     let cache = dir.join("cache");
@@ -215,21 +203,16 @@ fn a_killed_run_resumes_bit_for_bit() {
 
 #[test]
 fn foreign_damaged_and_missing_checkpoints_are_refused_by_name() {
-    let dir = temp_dir("refused");
+    let dir = temp_dir("particles-resume", "refused");
     let (a, b) = (dir.join("a.toml"), dir.join("b.toml"));
     std::fs::write(&a, scene_text(SCENES[0].1)).unwrap();
     std::fs::write(&b, scene_text(SCENES[1].1)).unwrap();
     let out = dir.join("out");
     let out_s = out.to_str().unwrap();
     let err = |args: &[&str]| {
-        let o = particles(args).output().unwrap();
+        let o = common::run_particles(args, &cwd(), &[]);
         assert!(!o.status.success(), "{args:?} should fail");
-        String::from_utf8_lossy(&o.stderr)
-            .lines()
-            .filter(|l| l.starts_with("error:"))
-            .collect::<Vec<_>>()
-            .join("\n")
-            .replace(dir.to_str().unwrap(), "TMP")
+        error_lines(&o, &dir, "TMP")
     };
     let a_s = a.to_str().unwrap();
     insta::assert_snapshot!(

@@ -368,8 +368,13 @@ fn fifo(path: &Path) -> Option<()> {
 
 #[test]
 fn devices_pipes_and_huge_files_are_refused_before_they_are_read() {
-    use symplectic::io::PopulationSpec;
-    let t = std::time::Instant::now();
+    // Nothing is read: each refusal is the one that comes from the metadata, before the
+    // file is opened (`guard::regular_file_size`). That is checked by the messages, not by
+    // a time bound (speed is measured in benchmarks, never asserted in a test): a reader that
+    // read first would block on the FIFO, or read /dev/zero up to its limit and fail with
+    // another message, and would call the big file one that "grew past" its limit "while
+    // read" instead of naming its size from its metadata.
+    use symplectic::io::{PopulationSpec, MAX_SPEC_FILE_BYTES};
     // The specification: /dev/zero never ends (8 GB read before), a FIFO blocks in open().
     let e = PopulationSpec::from_file(Path::new("/dev/zero"))
         .unwrap_err()
@@ -389,9 +394,13 @@ fn devices_pipes_and_huge_files_are_refused_before_they_are_read() {
     // A specification larger than MAX_SPEC_FILE_BYTES, refused from its metadata.
     let big = dir.join("big.toml");
     let f = std::fs::File::create(&big).unwrap();
-    f.set_len(symplectic::io::MAX_SPEC_FILE_BYTES + 1).unwrap();
+    f.set_len(MAX_SPEC_FILE_BYTES + 1).unwrap();
     let e = PopulationSpec::from_file(&big).unwrap_err().to_string();
-    assert!(e.contains("MAX_SPEC_FILE_BYTES"), "{e}");
+    let from_metadata = format!(
+        "{} bytes, more than the {MAX_SPEC_FILE_BYTES} bytes allowed (MAX_SPEC_FILE_BYTES)",
+        MAX_SPEC_FILE_BYTES + 1
+    );
+    assert!(e.contains(&from_metadata), "{e}");
     // The particle file and a saved population.
     let e = read_particle_rows(Path::new("/dev/zero"), ParticleKind::BarycentricElements)
         .unwrap_err()
@@ -401,8 +410,6 @@ fn devices_pipes_and_huge_files_are_refused_before_they_are_read() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("is a device, not a regular file"), "{e}");
-    // None of them read anything: far below the seconds that reading gigabytes takes.
-    assert!(t.elapsed().as_secs() < 5, "{:?}", t.elapsed());
 }
 
 mod elements_of_states {
