@@ -314,6 +314,9 @@ pub fn write_repose_csv(ctx: &mut Context, rows: Vec<Vec<String>>) -> Result<()>
     Ok(())
 }
 
+/// A match's predicted angle of repose for `repose.png`: its legend and `β(θ)` (degrees).
+pub type Prediction<'a> = (&'a str, fn(f64) -> f64);
+
 /// The measured angles of one model under one match, for `repose.png`.
 pub struct AngleSeries {
     /// The legend: model and match.
@@ -329,7 +332,7 @@ pub struct AngleSeries {
 pub fn plot_angles(
     ctx: &mut Context,
     title: &str,
-    predictions: [(&str, fn(f64) -> f64); 2],
+    predictions: [Prediction<'_>; 2],
     measured: Vec<AngleSeries>,
 ) -> Result<()> {
     let mut series: Vec<Series> = predictions

@@ -58,7 +58,7 @@
 //! at 20 mm (a face steeper than the flank at the slot's edge), the 20° one and θ = 0 blow up
 //! while draining into the sump (`docs/elastoplastic-granular.md`).
 
-mod checks;
+pub mod checks;
 pub mod plan;
 
 use anyhow::Result;

@@ -10,9 +10,9 @@ use crate::scene_runs::shipped_scene;
 use crate::Mode;
 
 /// The shipped scene θ = 0 runs in (a period of 1.6 m: the poured layer 0.1 m deep).
-const LIQUID_SCENE_THETA: f64 = 40.0;
+pub const LIQUID_SCENE_THETA: f64 = 40.0;
 /// The factor on Young's modulus of the modulus check.
-const STIFF_FACTOR: f64 = 10.0;
+pub const STIFF_FACTOR: f64 = 10.0;
 /// Full mode's 30° simple-shear heap at the quick spacing (the spacing and modulus checks'
 /// coarse heap).
 pub const COARSE_TAG: &str = "coarse/simple-shear/theta=30";

@@ -30,7 +30,7 @@
 //! the repeat's and the deeper slab's differences. The heaps creep and do not reach rest:
 //! documented deviations (`reference-data/deviations.toml`).
 
-mod checks;
+pub mod checks;
 pub mod plan;
 
 use anyhow::Result;

@@ -10,9 +10,9 @@ use crate::scene_runs::shipped_scene;
 use crate::Mode;
 
 /// The 30° simple-shear heap also runs in a slab this many times deeper.
-const WIDE_SLAB_FACTOR: f64 = 2.0;
+pub const WIDE_SLAB_FACTOR: f64 = 2.0;
 /// The shipped scene θ = 0 runs in.
-const LIQUID_SCENE_THETA: f64 = 20.0;
+pub const LIQUID_SCENE_THETA: f64 = 20.0;
 /// The sweep's 30° simple-shear heap.
 pub const PLAIN_30_TAG: &str = "thesis/simple-shear/theta=30";
 /// The repeat of [`PLAIN_30_TAG`] with the block shifted by half a spacing.
