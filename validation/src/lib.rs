@@ -27,7 +27,8 @@ pub mod helpers;
 pub mod papers;
 pub mod report;
 pub mod runner;
-pub mod sim;
+pub mod scene_runs;
+pub mod verdict;
 
 pub use experiments::registry;
 

@@ -8,7 +8,7 @@ use anyhow::{Context as _, Result};
 use serde::Serialize;
 
 use crate::deviations::CheckVerdict;
-use crate::runner::{CheckRecord, Status, Verdict};
+use crate::verdict::{CheckRecord, Status, Verdict};
 use crate::{fmt_num, Mode};
 
 #[derive(Serialize)]

@@ -1,5 +1,5 @@
-//! Runs the selected experiments and records their verdicts; [`crate::report`] writes them
-//! out (`verdict.json`, `summary.json`, `report.md`, the terminal table).
+//! Runs the selected experiments and records their verdicts ([`crate::verdict`]);
+//! [`crate::report`] writes them out (`verdict.json`, `summary.json`, `report.md`, the terminal table).
 //!
 //! Output layout (`<out>` defaults to `target/validation` under the workspace root):
 //!
@@ -9,7 +9,6 @@
 //!   "metrics", "checks": [{"name", "value", "bound", "pass", "origin"}], ...}]}`;
 //! - `<out>/report.md` — every check in one table, then each experiment's notes and plots.
 
-use std::collections::BTreeMap;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
@@ -17,11 +16,11 @@ use std::time::Instant;
 
 use anyhow::{bail, Context as _, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use serde::Serialize;
 
 use crate::deviations::{CheckVerdict, Deviations};
 use crate::report;
-use crate::{reference_data_dir, Artifact, Check, Context, Experiment, Mode, Outcome};
+use crate::verdict::{judge, status_of, Verdict};
+use crate::{reference_data_dir, Context, Experiment, Mode, Outcome};
 
 /// What to run and where to write.
 #[derive(Debug, Clone)]
@@ -32,141 +31,6 @@ pub struct RunOptions {
     pub only: Vec<String>,
     /// Output directory.
     pub out: PathBuf,
-}
-
-/// Final state of an experiment.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Status {
-    /// Ran, every check passed.
-    Pass,
-    /// Ran, every miss is a documented deviation (see [`crate::deviations`]).
-    Deviation,
-    /// Ran, and some check failed undocumented, or a documented deviation passed or was not
-    /// produced (the deviations list is out of date).
-    Fail,
-    /// Returned an error or panicked.
-    Error,
-}
-
-impl Status {
-    /// `"pass"`, `"deviation"`, `"fail"` or `"error"`.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Status::Pass => "pass",
-            Status::Deviation => "deviation",
-            Status::Fail => "fail",
-            Status::Error => "error",
-        }
-    }
-
-    /// Console label (misses in capitals).
-    pub fn label(self) -> &'static str {
-        match self {
-            Status::Pass => "pass",
-            Status::Deviation => "deviation",
-            Status::Fail => "FAIL",
-            Status::Error => "ERROR",
-        }
-    }
-
-    /// Whether this status fails the run (exit code 1).
-    pub fn fails_run(self) -> bool {
-        matches!(self, Status::Fail | Status::Error)
-    }
-}
-
-/// A check with its verdict against the deviations list.
-#[derive(Debug, Clone, Serialize)]
-pub struct CheckRecord {
-    /// The check as the experiment reported it.
-    #[serde(flatten)]
-    pub check: Check,
-    /// pass / deviation / fail / unexpected-pass / stale-entry.
-    pub verdict: CheckVerdict,
-    /// The documented deviation's one-line summary, when listed.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub deviation: Option<String>,
-}
-
-/// The checks of one run against the deviations documented for `id` in `mode`, with a
-/// stale-entry record for each documented check that was not produced (only when the
-/// experiment ran to the end: an error says nothing about its checks).
-pub fn judge(
-    id: &str,
-    mode: Mode,
-    checks: Vec<Check>,
-    deviations: &Deviations,
-    ran: bool,
-) -> Vec<CheckRecord> {
-    let mut records: Vec<CheckRecord> = checks
-        .into_iter()
-        .map(|check| {
-            let dev = deviations.find(id, &check.name, mode);
-            CheckRecord {
-                verdict: CheckVerdict::of(&check, dev.is_some()),
-                deviation: dev.map(|d| d.summary().to_string()),
-                check,
-            }
-        })
-        .collect();
-    if ran {
-        for d in deviations.for_experiment(id, mode) {
-            if !records.iter().any(|r| r.check.name == d.check) {
-                records.push(CheckRecord {
-                    check: Check {
-                        name: d.check.clone(),
-                        value: f64::NAN,
-                        bound: "(not produced)".into(),
-                        pass: false,
-                        origin: format!("{} lists it", crate::deviations::DEVIATIONS_FILE),
-                    },
-                    verdict: CheckVerdict::StaleEntry,
-                    deviation: Some(d.summary().to_string()),
-                });
-            }
-        }
-    }
-    records
-}
-
-/// The status of an experiment from its error and its judged checks.
-pub fn status_of(error: bool, checks: &[CheckRecord]) -> Status {
-    if error {
-        Status::Error
-    } else if checks.iter().any(|c| c.verdict.fails_run()) {
-        Status::Fail
-    } else if checks.iter().any(|c| c.verdict == CheckVerdict::Deviation) {
-        Status::Deviation
-    } else {
-        Status::Pass
-    }
-}
-
-/// Everything recorded about one experiment run (the content of `verdict.json`).
-#[derive(Debug, Clone, Serialize)]
-pub struct Verdict {
-    /// Experiment id.
-    pub id: String,
-    /// What it reproduces.
-    pub source: String,
-    /// pass / deviation / fail / error.
-    pub status: Status,
-    /// Wall-clock time of `run`, seconds.
-    pub wall_s: f64,
-    /// Metrics.
-    pub metrics: BTreeMap<String, f64>,
-    /// Checks, with their verdicts.
-    pub checks: Vec<CheckRecord>,
-    /// Notes.
-    pub notes: Vec<String>,
-    /// Error or panic message when `status` is error.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub error: Option<String>,
-    /// Plots (relative to the experiment's directory).
-    pub plots: Vec<Artifact>,
-    /// Data files (relative to the experiment's directory).
-    pub files: Vec<Artifact>,
 }
 
 /// Selects experiments by id, in registry order; unknown ids are an error naming the
@@ -355,6 +219,8 @@ pub fn succeeded(verdicts: &[Verdict]) -> bool {
 mod tests {
     use super::*;
     use crate::report::terminal_table;
+    use crate::verdict::Status;
+    use crate::Check;
 
     struct Fails;
     impl Experiment for Fails {
@@ -485,40 +351,6 @@ evidence = "test"
             .to_string();
         assert!(err.contains("known: fails, panics, errs"), "{err}");
         std::fs::remove_dir_all(&out).ok();
-    }
-
-    #[test]
-    fn strict_deviations() {
-        // A documented deviation that passes, and one that is not produced, fail the run.
-        let stale = format!(
-            "{DEVIATIONS}\n[[deviation]]\nexperiment = \"documented\"\ncheck = \"gone\"\n\
-             modes = [\"quick\"]\nexplanation = \"x\"\nevidence = \"y\"\n\
-             [[deviation]]\nexperiment = \"documented\"\ncheck = \"passes\"\n\
-             modes = [\"quick\"]\nexplanation = \"x\"\nevidence = \"y\"\n"
-        );
-        let deviations = Deviations::parse(&stale, "test").unwrap();
-        let checks = vec![
-            Check::less_than("misses", 2.0, 1.0, "test"),
-            Check::less_than("passes", 0.0, 1.0, "test"),
-        ];
-        let judged = judge("documented", Mode::Quick, checks.clone(), &deviations, true);
-        let verdicts: Vec<CheckVerdict> = judged.iter().map(|c| c.verdict).collect();
-        assert_eq!(
-            verdicts,
-            [
-                CheckVerdict::Deviation,
-                CheckVerdict::UnexpectedPass,
-                CheckVerdict::StaleEntry
-            ]
-        );
-        assert_eq!(status_of(false, &judged), Status::Fail);
-        // Full mode lists nothing: the miss is an undocumented failure there.
-        let full = judge("documented", Mode::Full, checks.clone(), &deviations, true);
-        assert_eq!(full[0].verdict, CheckVerdict::Fail);
-        // An experiment that errored is not judged stale.
-        let errored = judge("documented", Mode::Quick, vec![], &deviations, false);
-        assert!(errored.is_empty());
-        assert_eq!(status_of(true, &errored), Status::Error);
     }
 
     #[test]

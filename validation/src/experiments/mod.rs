@@ -1,5 +1,6 @@
 //! The experiments, one module each (file name = experiment id), in one folder per paper of
-//! `docs/papers.md`: the paper whose crates each experiment validates.
+//! `docs/papers.md`: the paper whose crates each experiment validates. No paper folder imports
+//! another: what several share lives outside them ([`crate::scene_runs`], [`crate::helpers`]).
 
 use crate::Experiment;
 
@@ -26,7 +27,8 @@ pub fn registry() -> Vec<Box<dyn Experiment>> {
         Box::new(macklin_muller_2013::pbf_vorticity::PbfVorticity),
         Box::new(macklin_muller_2013::dam_break_front::DamBreakFront),
         Box::new(macklin_muller_2013::pbf_performance::PbfPerformance),
-        Box::new(neder_2024::granular_repose::GranularRepose),
+        Box::new(bui_2008::granular_repose::GranularRepose),
+        Box::new(neder_2024::granular_repose_thesis::GranularReposeThesis),
         Box::new(neder_2024::granular_column_collapse::GranularColumnCollapse),
         Box::new(
             neder_2024::granular_column_collapse_axisymmetric::GranularColumnCollapseAxisymmetric,

@@ -1,8 +1,10 @@
 //! Shared helpers of the experiments: CSV output, reference-data loading, plotting,
-//! summary statistics and (re-exported from `sph-core`) the seeded generator.
+//! summary statistics, (re-exported from `sph-core`) the seeded generator, and the angle-of-repose
+//! experiments' shared runs, measures and outputs ([`repose`]).
 
 mod data;
 mod plot;
+pub mod repose;
 pub mod solar_system;
 pub mod stats;
 

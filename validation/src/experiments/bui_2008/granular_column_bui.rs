@@ -51,12 +51,11 @@ use granular_measure::{angle_of_repose, normalised_runout, runout, ReposeOptions
 use sph_core::Vec3;
 use sph_scene::{FluidSpec, Scene, SolverSpec};
 
-use crate::experiments::neder_2024::scene_edit::shipped;
-use crate::experiments::neder_2024::{
-    run_scene_until_rest, solver_error_check, RestCriterion, SceneRun,
-};
 use crate::helpers::{
     load_reference_csv, plot_xy, write_csv_rows, Legend, Marker, PlotSpec, Series, SeriesStyle,
+};
+use crate::scene_runs::{
+    run_scene_until_rest, shipped_scene, solver_error_check, RestCriterion, SceneRun,
 };
 use crate::{Check, Context, Experiment, Outcome};
 
@@ -99,7 +98,7 @@ struct Column {
 /// The shipped scene in `ctx`'s mode with the slab [`SLAB_SPACINGS`] deep, its column and
 /// its friction angle and cone match.
 fn column_scene(ctx: &Context) -> Result<(Scene, Column, f64, ConeMatch)> {
-    let mut scene = shipped(SCENE, ctx.mode)?;
+    let mut scene = shipped_scene(SCENE, ctx.mode)?;
     let depth = SLAB_SPACINGS * scene.particle_spacing;
     let Some(tank) = scene.tank.as_mut() else {
         bail!("{SCENE}: the scene needs a tank (its floor and back wall)");

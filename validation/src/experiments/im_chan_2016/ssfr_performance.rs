@@ -13,7 +13,7 @@ use ssfr_render::{FrameStats, ParticleView, Renderer};
 
 use crate::helpers::stats::{median, spread};
 use crate::helpers::write_csv_rows;
-use crate::sim::shipped_scene;
+use crate::scene_runs::shipped_scene;
 use crate::{Check, Context, Experiment, Outcome};
 use sph_sim::render::render_params;
 

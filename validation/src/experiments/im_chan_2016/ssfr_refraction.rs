@@ -27,7 +27,7 @@ use ssfr_render::{
 
 use super::shapes::Shape;
 use crate::helpers::{plot_xy, write_csv_rows, Legend, PlotSpec, Series};
-use crate::sim::{advance_frames, scene_sim, shipped_scene, SceneSim};
+use crate::scene_runs::{advance_frames, scene_sim, shipped_scene, SceneSim};
 use crate::{Check, Context, Experiment, Outcome};
 use sph_sim::observe::OnFrame;
 use sph_sim::render::render_params;

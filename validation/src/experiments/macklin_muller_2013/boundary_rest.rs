@@ -15,7 +15,7 @@ use sph_sim::observe::OnFrame;
 use sph_sim::{Flow, FrameRecord};
 
 use crate::helpers::{plot_xy, write_csv_rows, Legend, PlotSpec, Series, SeriesStyle};
-use crate::sim::{run_frames, scene_sim, shipped_scene, SceneSim};
+use crate::scene_runs::{run_frames, scene_sim, shipped_scene, SceneSim};
 use crate::{Check, Context, Experiment, Outcome};
 
 /// The experiment.

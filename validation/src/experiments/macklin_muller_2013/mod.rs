@@ -6,7 +6,6 @@
 
 pub mod boundary_rest;
 pub mod dam_break_front;
-pub mod fluid_runs;
 pub mod kernels;
 pub mod pbf_bunny_density;
 pub mod pbf_convergence;

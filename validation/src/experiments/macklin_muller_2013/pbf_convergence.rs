@@ -27,7 +27,7 @@ use sph_core::Real;
 use sph_scene::{Scene, SolverParams};
 
 use crate::helpers::{plot_xy, write_csv_rows, Legend, PlotSpec, Series, SeriesStyle};
-use crate::sim::{advance_frames, scene_sim, shipped_scene};
+use crate::scene_runs::{advance_frames, scene_sim, shipped_scene};
 use crate::{Check, Context, Experiment, Outcome};
 
 /// The experiment.

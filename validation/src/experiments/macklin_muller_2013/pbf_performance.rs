@@ -27,7 +27,7 @@ use sph_sim::observe::Recorder;
 
 use crate::helpers::stats::median;
 use crate::helpers::{load_reference_csv, write_csv_rows, ReferenceTable};
-use crate::sim::{advance_frames, scene_sim, shipped_scene};
+use crate::scene_runs::{advance_frames, scene_sim, shipped_scene};
 use crate::{fmt_num, Check, Context, Experiment, Outcome};
 
 /// The experiment.

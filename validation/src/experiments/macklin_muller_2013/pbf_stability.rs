@@ -15,9 +15,9 @@
 use anyhow::Result;
 use sph_scene::SolverKind;
 
-use super::fluid_runs::{run_fluid, FluidRun};
 use crate::helpers::{plot_xy, write_csv_rows, Legend, PlotSpec, Series, SeriesStyle};
-use crate::sim::shipped_scene;
+use crate::scene_runs::shipped_scene;
+use crate::scene_runs::{run_fluid, FluidRun};
 use crate::{fmt_num, Check, Context, Experiment, Outcome};
 
 /// The experiment.

@@ -26,7 +26,7 @@ use sph_sim::{Flow, FrameRecord};
 use crate::helpers::{
     plot_xy, side_view_png, write_csv_rows, Legend, PlotSpec, Series, SeriesStyle,
 };
-use crate::sim::{advance_frames, scene_sim, shipped_scene, SceneSim};
+use crate::scene_runs::{advance_frames, scene_sim, shipped_scene, SceneSim};
 use crate::{Check, Context, Experiment, Outcome};
 
 /// The experiment.

@@ -43,11 +43,10 @@ use elastoplastic_granular::{
 use granular_measure::{normalised_runout, runout, RunoutOptions};
 use sph_scene::{BoundaryModel, FluidSpec, InitialMasses, Scene, SolverSpec, WallModel};
 
-use super::scene_edit::{set_block_and_tank, shipped};
-use super::{run_scene, solver_error_check};
 use crate::helpers::{
     load_reference_csv, plot_xy, write_csv_rows, Legend, Marker, PlotSpec, Series, SeriesStyle,
 };
+use crate::scene_runs::{run_scene, set_block_and_tank, shipped_scene, solver_error_check};
 use crate::{Check, Context, Experiment, Mode, Outcome};
 
 /// The experiment.
@@ -218,7 +217,7 @@ impl Experiment for GranularColumnCollapse {
 
     fn run(&self, ctx: &mut Context) -> Result<Outcome> {
         let laws = load_laws(ctx, "granular-column-collapse/lube_2005_runout_law.csv")?;
-        let base = shipped(TEMPLATE, ctx.mode)?;
+        let base = shipped_scene(TEMPLATE, ctx.mode)?;
         let mut scenes: Vec<(Model, f64, Scene)> = ASPECT_RATIOS
             .iter()
             .map(|&a| Ok((Model::Thesis, a, column_scene(&base, a, &laws)?)))

@@ -56,9 +56,8 @@ use sph_scene::{FluidSpec, Scene, SolverSpec};
 use super::granular_column_collapse::{
     band, elastoplastic_column, load_laws, plot_runout, Model, Regime, RunoutPlot, BAND,
 };
-use super::scene_edit::shipped;
-use super::{run_scene, solver_error_check};
 use crate::helpers::{plot_xy, write_csv_rows, Legend, Marker, PlotSpec, Series, SeriesStyle};
+use crate::scene_runs::{run_scene, shipped_scene, solver_error_check};
 use crate::{Check, Context, Experiment, Mode, Outcome};
 
 /// The experiment.
@@ -284,7 +283,7 @@ impl Experiment for GranularColumnCollapseAxisymmetric {
 
     fn run(&self, ctx: &mut Context) -> Result<Outcome> {
         let laws = load_laws(ctx, LAW_FILE)?;
-        let base = shipped(TEMPLATE, ctx.mode)?;
+        let base = shipped_scene(TEMPLATE, ctx.mode)?;
         let mut columns: Vec<Column> = ASPECT_RATIOS
             .iter()
             .map(|&a| column(&base, a, &laws))

@@ -23,10 +23,9 @@ use sph_core::Real;
 use sph_scene::{Scene, SolverKind};
 use sph_sim::observe::{FrameTimer, Recorder};
 
-use super::scene_edit::{set_block_and_tank, shipped};
-use super::solver_error_check;
 use crate::helpers::write_csv_rows;
-use crate::sim::{advance_frames, scene_sim};
+use crate::scene_runs::{advance_frames, scene_sim};
+use crate::scene_runs::{set_block_and_tank, shipped_scene, solver_error_check};
 use crate::{Check, Context, Experiment, Mode, Outcome};
 
 /// The experiment.
@@ -38,7 +37,7 @@ pub const WARM_UP_STEPS: usize = 3;
 const PARTICLES: usize = 100_000;
 
 fn pile_scene(mode: Mode, measured_steps: usize) -> Result<Scene> {
-    let mut scene = shipped("granular_repose_thesis_30", mode)?;
+    let mut scene = shipped_scene("granular_repose_thesis_30", mode)?;
     scene.particle_spacing = 0.005;
     scene.frame_dt_s = 0.001;
     scene.duration_s = 0.001 * (WARM_UP_STEPS + measured_steps) as f64;

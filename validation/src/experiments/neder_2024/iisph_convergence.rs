@@ -33,9 +33,9 @@ use sph_scene::{BoundaryModel, IisphSettings, Scene};
 use sph_sim::observe::{OnFrame, Recorder};
 use sph_sim::{Flow, FrameRecord, RunPlan};
 
-use super::scene_edit::{iisph_solver, shipped};
 use crate::helpers::{plot_xy, write_csv_rows, Legend, PlotSpec, Series, SeriesStyle};
-use crate::sim::{advance_frames, scene_sim, SceneSim};
+use crate::scene_runs::{advance_frames, scene_sim, SceneSim};
+use crate::scene_runs::{iisph_solver, shipped_scene};
 use crate::{Check, Context, Experiment, Mode, Outcome};
 
 /// The experiment.
@@ -60,7 +60,7 @@ const ETA: f64 = 1e-3;
 
 /// The dam break with IISPH at step `dt_s`, one step per frame, `extra` solver settings.
 fn iisph_scene(mode: Mode, dt_s: f64, duration_s: f64, iisph: IisphSettings) -> Result<Scene> {
-    let mut scene = shipped("dam_break", mode)?;
+    let mut scene = shipped_scene("dam_break", mode)?;
     if mode == Mode::Quick {
         scene.particle_spacing = QUICK_SPACING_M;
     }
@@ -206,7 +206,7 @@ impl Experiment for IisphConvergence {
     }
 
     fn run(&self, ctx: &mut Context) -> Result<Outcome> {
-        let precision = shipped("dam_break", ctx.mode)?.precision;
+        let precision = shipped_scene("dam_break", ctx.mode)?.precision;
         let r = sph_sim::with_precision!(precision, R => run_in::<R>(ctx)?);
         let mut out = Outcome::new();
         out.metric("particles", r.particles as f64);

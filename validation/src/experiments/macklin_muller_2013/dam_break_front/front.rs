@@ -8,7 +8,7 @@ use sph_scene::Scene;
 use sph_sim::observe::OnFrame;
 use sph_sim::{Flow, FrameRecord, SceneSim};
 
-use crate::sim::{advance_frames, scene_sim};
+use crate::scene_runs::{advance_frames, scene_sim};
 use crate::Context;
 
 /// Column width `a` of the scene (m).

@@ -16,7 +16,7 @@ use anyhow::Result;
 use sph_scene::{BoundaryModel, IisphSettings, InitialMasses, Scene};
 
 use super::front::{interpolate, simulate, FrontRun};
-use crate::experiments::neder_2024::scene_edit::{iisph_solver, shipped};
+use crate::scene_runs::{iisph_solver, shipped_scene};
 use crate::{Context, Mode};
 
 /// Spacing of the IISPH curve in quick mode (m): `a/16`, 16 × 32 × 8 = 4,096 particles (the
@@ -38,7 +38,7 @@ pub struct IisphFront {
 
 /// The Martin & Moyce scene with IISPH (see the module documentation).
 pub fn iisph_scene(ctx: &Context) -> Result<Scene> {
-    let mut scene = shipped("martin_moyce", ctx.mode)?;
+    let mut scene = shipped_scene("martin_moyce", ctx.mode)?;
     let mut substeps = scene.solver.substeps() as f64;
     if ctx.mode == Mode::Quick {
         // same CFL number as the scene's steps at the coarser spacing

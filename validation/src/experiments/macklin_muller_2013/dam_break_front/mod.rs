@@ -34,7 +34,7 @@ use crate::helpers::{
 };
 use sph_scene::Scene;
 
-use crate::sim::shipped_scene;
+use crate::scene_runs::shipped_scene;
 use crate::{Check, Context, Experiment, Outcome};
 use front::{fitted_slope, interpolate, simulate, COLUMN_WIDTH_M, FRONT_QUANTILE};
 use iisph_front::IisphFront;

@@ -1,5 +1,6 @@
-//! The shipped scenes in the validation's modes; scene running itself is the `sph-sim`
-//! crate.
+//! The simulation of a scene and its frame loop as the experiments use them: volume maps
+//! from the experiments' cache, the progress bar ticked once a frame; scene running itself is
+//! the `sph-sim` crate.
 
 use anyhow::Result;
 use sph_scene::Scene;
@@ -8,13 +9,7 @@ use sph_sim::observe::OnFrame;
 pub use sph_sim::SceneSim;
 use sph_sim::{Flow, FrameObserver, FrameRecord, RunOutcome, RunPlan};
 
-use crate::{workspace_root, Mode};
-
-/// The shipped scene `scenes/<name>.toml`, with its `[quick]` overrides in quick mode.
-pub fn shipped_scene(name: &str, mode: Mode) -> Result<Scene> {
-    let scene = Scene::load(&workspace_root().join("scenes").join(format!("{name}.toml")))?;
-    Ok(mode.pick(scene.quick(), scene))
-}
+use crate::{workspace_root, Context};
 
 /// The volume-map cache of the experiments, `target/cache/volume-maps` under the workspace
 /// root (shared with `particles run`'s default when run from the root): a map built by one
@@ -38,7 +33,7 @@ pub fn scene_sim<R: sph_core::Real>(scene: &Scene) -> Result<SceneSim<R>> {
 /// frame (and the frames left when the run ended early); returns how the run ended (a
 /// blow-up is [`sph_sim::Ending::Diverged`], kept as a result).
 pub fn run_frames<R: sph_core::Real>(
-    ctx: &crate::Context,
+    ctx: &Context,
     sim: &mut SceneSim<R>,
     frames: usize,
     observers: &mut [&mut dyn FrameObserver<R>],
@@ -63,7 +58,7 @@ pub fn run_frames<R: sph_core::Real>(
 /// `observers`), a divergence being an error (the solver's, naming the frame, step and
 /// particle): for experiments whose scenes must not blow up.
 pub fn advance_frames<R: sph_core::Real>(
-    ctx: &crate::Context,
+    ctx: &Context,
     sim: &mut SceneSim<R>,
     frames: usize,
     observers: &mut [&mut dyn FrameObserver<R>],

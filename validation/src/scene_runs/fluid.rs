@@ -1,5 +1,5 @@
-//! Shared by the PBF/PCISPH experiments: a scene run through the frame loop recording every
-//! frame, which keeps a blow-up as a result instead of an error.
+//! A fluid scene run through the frame loop recording every frame (the PBF/PCISPH
+//! experiments), which keeps a blow-up as a result instead of an error.
 //!
 //! A run also stops as diverged when a frame ends with `max ρ/ρ0 >` [`DIVERGED_DENSITY_RATIO`]:
 //! the solver reports no error then (its state is finite and inside the tank), but a liquid
@@ -12,7 +12,7 @@ use sph_scene::{Scene, SolverKind};
 use sph_sim::observe::{DensityLimit, Recorder};
 use sph_sim::FrameRecord;
 
-use crate::sim::{run_frames, scene_sim, SceneSim};
+use super::{potential_energy_j, run_frames, scene_sim};
 use crate::Context;
 
 /// `max ρ/ρ0` above which a run counts as diverged (twice the rest density: 100 %
@@ -67,28 +67,6 @@ impl FluidRun {
             .map(|s| s.max_density_ratio)
             .fold(f64::NAN, f64::max)
     }
-}
-
-/// Potential energy `Σ m_i |g| (y_i − y_floor)` (J) of the particles of `sim` above the
-/// scene's tank floor (the lowest particle without a tank).
-pub fn potential_energy_j<R: Real>(sim: &SceneSim<R>) -> f64 {
-    let g = sim.scene.gravity.iter().map(|x| x * x).sum::<f64>().sqrt();
-    let floor = sim.scene.tank.map_or_else(
-        || {
-            sim.state
-                .positions
-                .iter()
-                .map(|p| p.y.as_f64())
-                .fold(f64::INFINITY, f64::min)
-        },
-        |t| t.min.y,
-    );
-    sim.state
-        .positions
-        .iter()
-        .zip(&sim.state.masses)
-        .map(|(p, m)| m.as_f64() * g * (p.y.as_f64() - floor))
-        .sum()
 }
 
 fn run_in<R: Real>(ctx: &Context, scene: &Scene, label: String) -> Result<FluidRun> {

@@ -1,0 +1,164 @@
+//! The runs of `granular-repose` and their scenes: the shipped poured scenes with the friction
+//! angle and the cone's match set, and the coarse (spacing and modulus) variants.
+
+use anyhow::Result;
+use elastoplastic_granular::ConeMatch;
+use sph_scene::{Scene, SolverParams, SolverSpec};
+
+use crate::helpers::repose::THETAS;
+use crate::scene_runs::shipped_scene;
+use crate::Mode;
+
+/// The shipped scene θ = 0 runs in (a period of 1.6 m: the poured layer 0.1 m deep).
+pub const LIQUID_SCENE_THETA: f64 = 40.0;
+/// The factor on Young's modulus of the modulus check.
+pub const STIFF_FACTOR: f64 = 10.0;
+/// Full mode's 30° simple-shear heap at the quick spacing (the spacing and modulus checks'
+/// coarse heap).
+pub const COARSE_TAG: &str = "coarse/simple-shear/theta=30";
+/// The modulus check's stiff heap.
+pub const STIFF_TAG: &str = "stiff/simple-shear/theta=30";
+/// The sweep's 30° simple-shear heap (quick mode's coarse heap).
+pub const PLAIN_30_TAG: &str = "simple-shear/theta=30";
+/// The matches of the sweeps, in run order.
+pub const MATCHES: [ConeMatch; 2] = [ConeMatch::SimpleShear, ConeMatch::PlaneStrain];
+
+/// How a case departs from its shipped scene.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Variant {
+    /// The scene as shipped for the mode.
+    Plain,
+    /// At the quick spacing, with `viscosity_speed_m_s` the speed of sound of the scene's
+    /// modulus and the modulus times `factor` (1: the spacing check's coarse heap).
+    Coarse {
+        /// The factor on Young's modulus.
+        modulus_factor: f64,
+    },
+}
+
+/// One planned run.
+#[derive(Debug, Clone)]
+pub struct Plan {
+    /// The case's tag.
+    pub tag: String,
+    /// The friction angle (degrees).
+    pub theta_deg: f64,
+    /// The cone's match.
+    pub cone: ConeMatch,
+    /// How it departs from the shipped scene.
+    pub variant: Variant,
+}
+
+/// The runs of `mode`: the sweep under both matches, θ = 0 and the stiff heap (both modes);
+/// full mode adds the coarse heap of the spacing check.
+pub fn plan(mode: Mode) -> Vec<Plan> {
+    let case = |tag: String, theta_deg: f64, cone: ConeMatch, variant: Variant| Plan {
+        tag,
+        theta_deg,
+        cone,
+        variant,
+    };
+    let mut p = Vec::new();
+    for cone in MATCHES {
+        p.extend(THETAS.map(|t| {
+            case(
+                format!("{}/theta={t:.0}", cone.name()),
+                t,
+                cone,
+                Variant::Plain,
+            )
+        }));
+    }
+    let ss = ConeMatch::SimpleShear;
+    p.push(case("theta=0".into(), 0.0, ss, Variant::Plain));
+    let stiff = Variant::Coarse {
+        modulus_factor: STIFF_FACTOR,
+    };
+    p.push(case(STIFF_TAG.into(), 30.0, ss, stiff));
+    if mode == Mode::Full {
+        // Quick mode's own 30° heap is the coarse heap (the viscosity's velocity scale
+        // defaults to the sound speed of `E`).
+        let coarse = Variant::Coarse {
+            modulus_factor: 1.0,
+        };
+        p.push(case(COARSE_TAG.into(), 30.0, ss, coarse));
+    }
+    p
+}
+
+/// The scene of a planned case: the shipped poured scene of its θ (θ = 0: of
+/// [`LIQUID_SCENE_THETA`]; a coarse variant at the quick spacing) with the friction angle and
+/// the match set, and its variant applied.
+pub fn scene_for(p: &Plan, mode: Mode) -> Result<Scene> {
+    let scene_theta = if p.theta_deg > 0.0 {
+        p.theta_deg
+    } else {
+        LIQUID_SCENE_THETA
+    };
+    let mode = match p.variant {
+        Variant::Coarse { .. } => Mode::Quick,
+        Variant::Plain => mode,
+    };
+    let mut scene = shipped_scene(&format!("granular_repose_poured_{scene_theta:.0}"), mode)?;
+    let kind = scene.solver.kind_name();
+    let SolverSpec::Elastoplastic(e) = &mut scene.solver else {
+        anyhow::bail!(
+            "{}: solver kind = \"{kind}\" is not the model of case {}",
+            scene.source.display(),
+            p.tag
+        );
+    };
+    e.friction_angle_deg = p.theta_deg;
+    e.cone_match = Some(p.cone);
+    if let Variant::Coarse { modulus_factor } = p.variant {
+        let SolverParams::Elastoplastic(params) = scene.solver_params::<f64>()? else {
+            anyhow::bail!("{}: not elastoplastic", scene.source.display());
+        };
+        let sound_speed = params.sound_speed();
+        let modulus = params.youngs_modulus;
+        if let SolverSpec::Elastoplastic(e) = &mut scene.solver {
+            e.viscosity_speed_m_s = Some(sound_speed);
+            e.youngs_modulus = Some(modulus_factor * modulus);
+        }
+    }
+    scene.check()?;
+    Ok(scene)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Quick mode runs the two sweeps, θ = 0 and the stiff heap (CI's budget); full mode adds
+    /// the coarse heap.
+    #[test]
+    fn the_plans_of_both_modes() {
+        let tags = |m| plan(m).into_iter().map(|p| p.tag).collect::<Vec<_>>();
+        let quick = [
+            "simple-shear/theta=20",
+            "simple-shear/theta=30",
+            "simple-shear/theta=40",
+            "plane-strain/theta=20",
+            "plane-strain/theta=30",
+            "plane-strain/theta=40",
+            "theta=0",
+            STIFF_TAG,
+        ];
+        assert_eq!(tags(Mode::Quick), quick);
+        let mut full = quick.to_vec();
+        full.push(COARSE_TAG);
+        assert_eq!(tags(Mode::Full), full);
+    }
+
+    #[test]
+    fn scenes_carry_the_model_and_the_variant() {
+        for p in plan(Mode::Quick) {
+            let scene = scene_for(&p, Mode::Quick).unwrap();
+            let SolverSpec::Elastoplastic(e) = &scene.solver else {
+                panic!("{}: not elastoplastic", p.tag);
+            };
+            assert_eq!(e.friction_angle_deg, p.theta_deg);
+            assert_eq!(e.cone_match, Some(p.cone));
+        }
+    }
+}
