@@ -5,9 +5,10 @@
 //! as one whole run.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
-const BIN: &str = env!("CARGO_BIN_EXE_particles");
+mod common;
+use common::{run_particles, stderr_of};
 
 fn scene() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -18,11 +19,12 @@ fn scene() -> PathBuf {
 }
 
 fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("particles-options-{name}-{}", std::process::id()));
-    std::fs::remove_dir_all(&d).ok();
+    let d = common::temp_dir("particles-options", name);
+    std::fs::remove_dir_all(&d).ok(); // the runs create it: a fresh run starts without one
     d
 }
 
+/// `particles run` of the quick Bui column into `out` with `extra` arguments, one thread.
 fn run(out: &Path, extra: &[&str]) -> Output {
     let scene = scene();
     let mut args = vec![
@@ -34,15 +36,11 @@ fn run(out: &Path, extra: &[&str]) -> Output {
         "--no-cache".into(),
     ];
     args.extend(extra.iter().map(|s| s.to_string()));
-    Command::new(BIN)
-        .args(&args)
-        .env("RAYON_NUM_THREADS", "1")
-        .output()
-        .unwrap()
+    run_particles(&args, &std::env::temp_dir(), &[("RAYON_NUM_THREADS", "1")])
 }
 
 fn ok(o: &Output) -> String {
-    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    let err = stderr_of(o);
     assert!(o.status.success(), "{err}");
     err
 }
@@ -55,7 +53,7 @@ fn an_override_is_checked_recorded_and_taken_by_resume() {
         &out,
         &["--frames", "1", "--set", "solver.friction_angle_degs=25"],
     );
-    let err = String::from_utf8_lossy(&o.stderr);
+    let err = stderr_of(&o);
     assert!(!o.status.success());
     assert!(err.contains("friction_angle_degs"), "{err}");
     // Taken: the solver's friction angle moves the run.
@@ -82,7 +80,7 @@ fn an_override_is_checked_recorded_and_taken_by_resume() {
             "solver.friction_angle_deg=30",
         ],
     );
-    let err = String::from_utf8_lossy(&o.stderr);
+    let err = stderr_of(&o);
     assert!(!o.status.success());
     assert!(err.contains("--set solver.friction_angle_deg=25"), "{err}");
     // None given: the recorded one is taken.

@@ -8,11 +8,12 @@
 //! checks that an override reaches the run and is recorded for `render` and `repose`.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use sha2::{Digest, Sha256};
 
-const BIN: &str = env!("CARGO_BIN_EXE_particles");
+mod common;
+use common::{run_particles, stderr_of, stdout_of};
 
 fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -21,20 +22,17 @@ fn workspace() -> PathBuf {
         .to_path_buf()
 }
 
+/// `particles ARGS` on one thread (so that the frames are bit-reproducible).
 fn particles(args: &[&str]) -> Output {
-    Command::new(BIN)
-        .args(args)
-        .env("RAYON_NUM_THREADS", "1")
-        .output()
-        .expect("the particles binary runs")
+    run_particles(args, &workspace(), &[("RAYON_NUM_THREADS", "1")])
 }
 
 fn text(o: &Output) -> String {
     format!(
         "status {:?}\nstdout:\n{}\nstderr:\n{}",
         o.status.code(),
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
+        stdout_of(o),
+        stderr_of(o)
     )
 }
 
@@ -120,9 +118,8 @@ fn read_back(stem: &str, out: &Path) -> Result<(), String> {
     let dir = out.to_string_lossy();
     if stem.starts_with("granular") {
         let o = particles(&["repose", &dir]);
-        let measured =
-            o.status.success() && String::from_utf8_lossy(&o.stdout).contains("angle of repose");
-        if !measured && !String::from_utf8_lossy(&o.stderr).contains("degenerate pile") {
+        let measured = o.status.success() && stdout_of(&o).contains("angle of repose");
+        if !measured && !stderr_of(&o).contains("degenerate pile") {
             return Err(format!("{stem}: particles repose failed\n{}", text(&o)));
         }
     } else {
@@ -137,8 +134,7 @@ fn read_back(stem: &str, out: &Path) -> Result<(), String> {
 
 #[test]
 fn every_shipped_scene_runs_from_the_command_line() {
-    let root = std::env::temp_dir().join(format!("particles-shipped-{}", std::process::id()));
-    std::fs::remove_dir_all(&root).ok();
+    let root = common::temp_dir("particles-shipped", "scenes");
     let cache = root.join("volume-maps");
     let mut scenes: Vec<PathBuf> = std::fs::read_dir(workspace().join("scenes"))
         .unwrap()
