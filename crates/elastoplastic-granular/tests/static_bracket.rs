@@ -29,8 +29,8 @@
 //! (in-plane, from its start) half a spacing — none has left its lattice site — and fails
 //! when one has moved more than two spacings — a slip beyond where elastic settlement
 //! and the staircase surface's corner grains reach. The margin of ±4° is twice the
-//! spacing error of the flanks measured at this spacing (2.14° at 20 mm, run 16 of the
-//! docs).
+//! spacing error of the flanks measured at this spacing (2.14° at 20 mm for the drained
+//! heaps: `docs/elastoplastic-granular.md`).
 
 mod common;
 use common::heap::{cut_slope, SlopeSetup};

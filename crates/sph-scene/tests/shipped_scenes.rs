@@ -251,7 +251,7 @@ fn granular_heap_elastoplastic_is_a_periodic_slab_with_particle_walls() {
     assert_eq!(p.viscosity_alpha, 0.5);
 }
 
-/// The drained heaps of `granular-repose` (run 16 of `docs/elastoplastic-granular.md`): a
+/// The drained heaps (`scenes/granular_repose_{20,30,40}.toml`): a
 /// bed 0.2 m high, periodic along `x` (the period per θ) and `z` (0.06 m), on a no-slip plate
 /// with a slot 0.24 m wide centred on the seam, the sump's floor 0.6 m below the plate; the
 /// particle counts their comments state.
@@ -291,8 +291,8 @@ fn granular_repose_scenes_are_drained_beds() {
     }
 }
 
-/// The trapdoor variants of the drained heaps (runs 33, 36 and 37 of
-/// `docs/elastoplastic-granular.md`): the open-slot scene's bed, period and plate, with a
+/// The trapdoor variants of the drained heaps (`scenes/granular_repose_trapdoor_*.toml`):
+/// the open-slot scene's bed, period and plate, with a
 /// channel 0.6 m deep under the slot (free-slip walls down to the tank's floor) closed by a
 /// no-slip trapdoor filling the slot that is lowered at 5 cm/s for 12 s (0.6 m: it stops
 /// above the channel's floor), the cap after it stops.

@@ -230,7 +230,7 @@ pub fn check_pairs(out: &mut Outcome, by_tag: &[(String, Measured)], mode: Mode)
             "simple-shear/theta=30/modulus: |angle at 10 E - angle at E| (deg), viscosity speed held",
             (stiff.angle_deg - coarse.angle_deg).abs(),
             SPACING_MODULUS_DEG,
-            "criterion of docs/elastoplastic-granular.md (runs 17-18): a heap of a rigid-enough material does not depend on its stiffness (1°); the viscosity's velocity scale held at the sound speed of E",
+            "criterion of docs/elastoplastic-granular.md: a heap of a rigid-enough material does not depend on its stiffness (1°); the viscosity's velocity scale held at the sound speed of E",
         ));
     }
     let flanks = by_tag
