@@ -143,7 +143,8 @@ pub struct PouredSetup {
 }
 
 impl PouredSetup {
-    /// The poured heap of the shipped scenes (its Rust set-up) at spacing `s` (m): period
+    /// The poured heap (the shipped scenes' at 20 mm, where their slab is three spacings
+    /// deep) at spacing `s` (m): period
     /// 1.6 m, slab three spacings deep, a funnel 0.1 m wide (a stream five grains wide at
     /// 20 mm: a stream one grain wide builds a loose heap), 0.16 m² of cross-section poured
     /// at 0.012 m² a second (30 grains a second at 20 mm).
