@@ -51,6 +51,7 @@ pub mod run_dir;
 pub mod saved;
 mod setup;
 mod sim;
+mod source;
 pub mod vtk;
 
 pub use error::SimError;
@@ -59,9 +60,9 @@ pub use frame_loop::{run_frames, Divergence, Ending, Flow, FrameObserver, RunOut
 pub use record::{FrameRecord, STATS_COLUMNS, STATS_EXTRA_COLUMNS};
 pub use run::{run_scene, SceneRunOptions};
 pub use run_dir::{RunDir, RunSource};
-pub use saved::SceneSource;
 pub use setup::SceneSetup;
 pub use sim::SceneSim;
+pub use source::SceneSource;
 pub use sph_scene::{Precision, Scene};
 
 /// Runs `$body` with the type `$R` bound to the real type of precision `$p` (an

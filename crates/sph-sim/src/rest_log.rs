@@ -22,10 +22,7 @@ use crate::record::FrameRecord;
 use crate::run_dir::RunDir;
 use crate::sim::SceneSim;
 
-/// The samples' file of a run directory.
-pub const REST_SAMPLES_FILE: &str = "rest_samples.csv";
-/// The verdict's file of a run directory.
-pub const REST_VERDICT_FILE: &str = "rest.json";
+pub use crate::run_dir::{REST_SAMPLES_FILE, REST_VERDICT_FILE};
 const HEADER: &str = "time_s,percentile_speed_m_s,deep_max_speed_m_s,deep_particles,angle_deg";
 
 /// A [`RestObserver`] whose samples go to `OUT/rest_samples.csv` as they are taken and

@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 use sph_scene::{Override, Scene};
 
 use crate::error::SimError;
-use crate::saved::SceneSource;
+use crate::source::SceneSource;
 
 /// The file naming the scene, mode and overrides of a run, so that `render OUT`,
 /// `repose OUT` and `run --resume` find the scene: the absolute scene path, `quick` or
@@ -30,6 +30,10 @@ pub const RUN_SOURCE_FILE: &str = "scene_source.txt";
 pub const STATS_FILE: &str = "stats.csv";
 /// The checkpoint of a run.
 pub const CHECKPOINT_FILE: &str = "checkpoint.sphck";
+/// The rest criterion's samples (`run --until-rest`, [`crate::rest_log`]).
+pub const REST_SAMPLES_FILE: &str = "rest_samples.csv";
+/// The rest criterion's verdict at the run's end.
+pub const REST_VERDICT_FILE: &str = "rest.json";
 /// The rendered frames' subdirectory.
 pub const RENDER_DIR: &str = "render";
 
@@ -125,8 +129,8 @@ impl RunDir {
                 [
                     self.stats_csv(),
                     self.checkpoint(),
-                    self.path.join(crate::rest_log::REST_SAMPLES_FILE),
-                    self.path.join(crate::rest_log::REST_VERDICT_FILE),
+                    self.path.join(REST_SAMPLES_FILE),
+                    self.path.join(REST_VERDICT_FILE),
                 ]
                 .into_iter()
                 .filter(|p| p.is_file()),

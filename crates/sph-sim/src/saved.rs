@@ -23,56 +23,17 @@ use std::path::{Path, PathBuf};
 
 use sha2::{Digest, Sha256};
 use sph_core::Real;
-use sph_scene::{Override, Scene};
+use sph_scene::Override;
 
 use crate::checkpoint::{encode, write_atomically, MAX_CHECKPOINT_BYTES};
 use crate::error::SimError;
 use crate::sim::SceneSim;
+pub use crate::source::SceneSource;
 
 /// The magic bytes opening a saved simulation.
 pub const SAVED_MAGIC: &[u8; 8] = b"SPHSIMSV";
 /// The saved-simulation format this build writes and reads.
 pub const SAVED_FORMAT_VERSION: u32 = 1;
-
-/// Where a simulation's scene comes from: the scene file's path and text, and what was
-/// applied to it (overrides, quick mode).
-#[derive(Debug, Clone, PartialEq)]
-pub struct SceneSource {
-    /// The scene file (messages name it; mesh paths are relative to its directory).
-    pub path: PathBuf,
-    /// The scene file's text as read.
-    pub text: String,
-    /// The overrides applied to the file's keys, in order ([`Override`]).
-    pub overrides: Vec<Override>,
-    /// Whether the scene's `[quick]` overrides apply ([`Scene::quick`]).
-    pub quick: bool,
-}
-
-impl SceneSource {
-    /// Reads the scene file at `path` ([`Scene::read_text`]) and returns its source with the
-    /// checked scene ([`SceneSource::scene`]).
-    pub fn load(
-        path: &Path,
-        overrides: Vec<Override>,
-        quick: bool,
-    ) -> Result<(Self, Scene), SimError> {
-        let source = Self {
-            path: path.to_path_buf(),
-            text: Scene::read_text(path)?,
-            overrides,
-            quick,
-        };
-        let scene = source.scene()?;
-        Ok((source, scene))
-    }
-
-    /// The checked scene: the text with the overrides applied ([`Scene::parse_str_with`]),
-    /// then the `[quick]` overrides if asked.
-    pub fn scene(&self) -> Result<Scene, SimError> {
-        let scene = Scene::parse_str_with(&self.text, &self.path, &self.overrides)?;
-        Ok(if self.quick { scene.quick() } else { scene })
-    }
-}
 
 /// The bytes of a saved simulation: `source` and the checkpoint of `sim`.
 pub fn encode_saved<R: Real>(source: &SceneSource, sim: &SceneSim<R>) -> Vec<u8> {
