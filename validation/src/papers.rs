@@ -1,6 +1,5 @@
-//! The four papers the workspace implements, as `docs/papers.md` rows them, and Bui et al.
-//! (2008), whose model the crate `elastoplastic-granular` implements (listed among the other
-//! works there); and the paper → crates → experiments → scenes → reference-data table
+//! The five papers the workspace implements, as `docs/papers.md` rows them (Bui et al. 2008's
+//! model is the crate `elastoplastic-granular`); and the paper → crates → experiments → scenes → reference-data table
 //! generated from the registry.
 //!
 //! Each experiment lives in the folder of the paper whose crates it validates
@@ -30,7 +29,7 @@ pub enum Paper {
 }
 
 impl Paper {
-    /// The papers, in `docs/papers.md`'s order (the four, then Bui et al. 2008).
+    /// The papers, in `docs/papers.md`'s order.
     pub const ALL: [Paper; 5] = [
         Paper::MacklinMuller2013,
         Paper::Neder2024,
