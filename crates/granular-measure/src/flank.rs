@@ -78,7 +78,11 @@ impl FlankLayers {
         if !(0.0 <= lo && lo < hi && hi <= 1.0) {
             return bad("height_band", lo, "0 <= from < to <= 1");
         }
-        if let Some((a, _)) = self.layers_spacings.iter().find(|(a, b)| !(a < b)) {
+        if let Some((a, _)) = self
+            .layers_spacings
+            .iter()
+            .find(|(a, b)| a.partial_cmp(b) != Some(std::cmp::Ordering::Less))
+        {
             return bad("layers_spacings", *a, "each layer's from < to");
         }
         Ok(())
