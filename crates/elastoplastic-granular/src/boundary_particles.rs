@@ -96,7 +96,7 @@ pub fn boundary_block<R: Real>(
     let len = normal.norm();
     if !(len.is_finite() && len > R::zero()) {
         return Err(SolverError::InvalidParameter {
-            solver: crate::solver::NAME,
+            solver: crate::name::NAME,
             name: "normal",
             value: len.as_f64(),
             reason: "a boundary block's normal must be finite and non-zero (value: its length)",
@@ -309,7 +309,7 @@ pub const MAX_BOUNDARY_LATTICE_NODES: f64 = (1u64 << 28) as f64;
 
 fn sampling_error(name: &'static str, value: f64, reason: &'static str) -> SolverError {
     SolverError::InvalidParameter {
-        solver: crate::solver::NAME,
+        solver: crate::name::NAME,
         name,
         value,
         reason,

@@ -15,7 +15,7 @@ use crate::params::ElastoplasticParams;
 
 fn alloc_error(value: usize) -> SolverError {
     SolverError::InvalidParameter {
-        solver: crate::solver::NAME,
+        solver: crate::name::NAME,
         name: "initial_stress",
         value: value as f64,
         reason: "could not allocate the initial stress (value: the particle count)",

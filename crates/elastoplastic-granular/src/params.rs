@@ -1,11 +1,13 @@
 //! The parameters of [`Elastoplastic`](crate::Elastoplastic), their defaults and bounds.
 
 use sph_core::{Aabb, Real, Vec3};
-use sph_solver::{CommonParams, SolverError};
+use sph_solver::scene_boundary::{PeriodicAxis, Pour};
+use sph_solver::{CommonParams, SolverError, SolverParameters};
 
-use crate::periodic::PeriodicAxis;
-use crate::pour::Pour;
+use crate::name::NAME;
 use crate::stress::{ConeMatch, DruckerPrager};
+
+pub use sph_solver::scene_boundary::{MovingWall, WallModel, MAX_WALL_FRICTION, MAX_WALL_MOTION_S};
 
 /// Largest Young's modulus accepted (Pa): 1 TPa, above any granular material's, so that the
 /// explicit step count stays finite.
@@ -29,11 +31,6 @@ pub const MAX_EXPLICIT_STEPS_PER_SUBSTEP: usize = 100_000;
 pub const MAX_WALL_MODELS: usize = 64;
 /// Most moving walls ([`ElastoplasticParams::moving_walls`]).
 pub const MAX_MOVING_WALLS: usize = 64;
-/// Longest motion of a moving wall accepted (s): a year, past any run.
-pub const MAX_WALL_MOTION_S: f64 = 3.2e7;
-/// Largest wall friction coefficient `μ_w` of [`WallModel::Coulomb`] accepted: 10, a wall
-/// friction angle of 84°, past any measured wall–grain pair (a rough wall is `NoSlip`).
-pub const MAX_WALL_FRICTION: f64 = 10.0;
 /// Rows of boundary particles standing for a wall
 /// ([`ElastoplasticParams::boundary_particle_region`]): three, so that a particle at the
 /// wall sees a full support (2.4 spacings) of boundary particles behind it.
@@ -60,38 +57,10 @@ pub const DEFAULT_ARTIFICIAL_STRESS_EXPONENT: f64 = 2.55;
 pub const DEFAULT_CFL_NUMBER: f64 = 0.2;
 /// Neighbour-list skin of the defaults, as a fraction of the particle spacing.
 pub const DEFAULT_SKIN_OVER_SPACING: f64 = 0.3;
-/// Support radius of the defaults over the particle spacing: Bui et al. (2008)'s cubic
-/// B-spline with smoothing length `1.2 s` has support `2.4 s`.
-pub const DEFAULT_SUPPORT_OVER_SPACING: f64 = 2.4;
-
-/// How a solid acts on the particles next to it.
-///
-/// With volume-map walls ([`crate::walls`]) the wall's share of each SPH sum is its
-/// volume-map gradient `∇Ψ`, its stress mirrors the particle's and it is at rest; with
-/// boundary particles ([`crate::boundary_particles`]) each particle carries its solid's
-/// model and the stress and velocity extrapolated from the grains are mirrored, kept, or
-/// (Coulomb) mirrored in part. In scene files: `wall = "free-slip"`, `"no-slip"` or
-/// `{ coulomb = 0.4 }`.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
-#[serde(rename_all = "kebab-case", deny_unknown_fields)]
-#[non_exhaustive]
-pub enum WallModel {
-    /// Only the normal part of the wall traction and of the velocity difference: grains
-    /// slide along the wall without resistance (plane-strain slab walls).
-    FreeSlip,
-    /// The whole traction; the wall's velocity (zero) enters the velocity gradient.
-    NoSlip,
-    /// Coulomb friction with coefficient `μ_w` (the value, `0 ≤ μ_w ≤`
-    /// [`MAX_WALL_FRICTION`]): the tangential traction the wall takes is at most `μ_w`
-    /// times the compressive normal one (boundary particles only; see
-    /// [`crate::boundary_particles`] for the terms).
-    Coulomb(f64),
-    /// The solid only keeps the particles out (projection to the contact distance); its
-    /// share of the sums comes from boundary particles
-    /// ([`ElastoplasticScheme::set_boundary_particles`](crate::ElastoplasticScheme::set_boundary_particles)).
-    #[serde(skip)]
-    ContactOnly,
-}
+/// Support radius of the defaults over the particle spacing, Bui et al. (2008)'s: their
+/// cubic B-spline with smoothing length `1.2 s` has support `2.4 s` (the other solvers'
+/// default is [`sph_solver::DEFAULT_SUPPORT_OVER_SPACING`], 2).
+pub const BUI_SUPPORT_OVER_SPACING: f64 = 2.4;
 
 /// The stress the particles start from (in scene files `initial_stress = "geostatic"` or
 /// `"none"`).
@@ -114,7 +83,7 @@ pub enum InitialStress {
 /// | field | default | source |
 /// |---|---|---|
 /// | `common.rest_density` | 2040 kg/m³ | [`DEFAULT_REST_DENSITY`] |
-/// | `common.support_radius` | `2.4 s` | [`DEFAULT_SUPPORT_OVER_SPACING`] |
+/// | `common.support_radius` | `2.4 s` | [`BUI_SUPPORT_OVER_SPACING`] |
 /// | `common.substeps` | 1 (the explicit steps are sub-cycled inside it) | |
 /// | `youngs_modulus` | 5.84 MPa | [`DEFAULT_YOUNGS_MODULUS_PA`] |
 /// | `poisson_ratio` | 0.3 | [`DEFAULT_POISSON_RATIO`] |
@@ -194,35 +163,9 @@ pub struct ElastoplasticParams<R: Real> {
     pub initial_stress: InitialStress,
 }
 
-/// A wall of boundary particles that moves at a constant velocity from the start of the run
-/// for `duration_s` and then stands still: the nodes of the particle lattice (that of
-/// [`ElastoplasticParams::boundary_particle_region`]) inside the box `region` and within
-/// [`BOUNDARY_PARTICLE_ROWS`] spacings of its faces, a box across a periodic axis's ends
-/// wrapped into the period. Each particle takes the model `model`, the outward normal of
-/// the box's nearest face, and the wall velocity `velocity` while the wall moves (the wall
-/// models act on the grains' velocity relative to it: module
-/// [`crate::boundary_particles`]). The solver stops the wall at the explicit step nearest
-/// `duration_s` from the run's start (its clock is the frame count, which checkpoints
-/// carry, so a resumed run stops it at the same step).
-///
-/// A moving wall is not a solid of the solver's boundary: nothing but its particles'
-/// stress keeps grains out of it (the collision boundary's contact projection is for
-/// solids that stand still), as for Bui et al. (2008)'s rows of boundary particles.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct MovingWall<R: Real> {
-    /// The box the wall's particles fill at the start (m).
-    pub region: Aabb<R>,
-    /// Its wall model (not [`WallModel::ContactOnly`]).
-    pub model: WallModel,
-    /// Its velocity while it moves (m/s).
-    pub velocity: Vec3<R>,
-    /// How long it moves from the run's start (s, ≥ 0).
-    pub duration_s: R,
-}
-
 fn invalid(name: &'static str, value: f64, reason: &'static str) -> SolverError {
     SolverError::InvalidParameter {
-        solver: crate::solver::NAME,
+        solver: NAME,
         name,
         value,
         reason,
@@ -249,7 +192,7 @@ impl<R: Real> ElastoplasticParams<R> {
     pub fn for_spacing(s: R, friction_angle_deg: R) -> Self {
         let mut common = CommonParams::for_spacing(s);
         common.rest_density = R::of_f64(DEFAULT_REST_DENSITY);
-        common.support_radius = s * R::of_f64(DEFAULT_SUPPORT_OVER_SPACING);
+        common.support_radius = s * R::of_f64(BUI_SUPPORT_OVER_SPACING);
         Self {
             common,
             youngs_modulus: R::of_f64(DEFAULT_YOUNGS_MODULUS_PA),
@@ -329,7 +272,7 @@ impl<R: Real> ElastoplasticParams<R> {
     /// Checks every field; the error ([`SolverError::InvalidParameter`]) names the first
     /// invalid one.
     pub fn validate(&self) -> Result<(), SolverError> {
-        self.common.validate(crate::solver::NAME)?;
+        self.common.validate(NAME)?;
         let f = |v: R| v.as_f64();
         check_range(
             "youngs_modulus",
@@ -435,7 +378,7 @@ impl<R: Real> ElastoplasticParams<R> {
         }
         self.validate_moving_walls()?;
         if let Some(p) = &self.pour {
-            p.validate(f(self.common.particle_spacing), self.common.gravity)?;
+            p.validate(NAME, f(self.common.particle_spacing), self.common.gravity)?;
         }
         let reach = f(self.common.support_radius + self.skin);
         for (k, a) in self.periodic.iter().enumerate() {
@@ -537,5 +480,22 @@ impl<R: Real> ElastoplasticParams<R> {
             }
         }
         Ok(())
+    }
+}
+
+impl<R: Real> SolverParameters<R> for ElastoplasticParams<R> {
+    type In<S: Real> = ElastoplasticParams<S>;
+    const NAME: &'static str = NAME;
+
+    fn common(&self) -> &CommonParams<R> {
+        &self.common
+    }
+
+    fn validate(&self) -> Result<(), SolverError> {
+        ElastoplasticParams::validate(self)
+    }
+
+    fn convert<S: Real>(&self) -> Result<ElastoplasticParams<S>, SolverError> {
+        self.try_convert()
     }
 }

@@ -11,24 +11,7 @@
 
 use sph_core::{Real, Vec3};
 
-/// One periodic axis: the particles' coordinate `axis` (0 = x, 1 = y, 2 = z) lives in
-/// `[lo, hi)` (m) and the medium repeats with period `hi − lo`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PeriodicAxis<R: Real> {
-    /// The axis (0 = x, 1 = y, 2 = z).
-    pub axis: usize,
-    /// Lower end of the period (m).
-    pub lo: R,
-    /// Upper end of the period (m).
-    pub hi: R,
-}
-
-impl<R: Real> PeriodicAxis<R> {
-    /// The period `hi − lo` (m).
-    pub fn period(&self) -> R {
-        self.hi - self.lo
-    }
-}
+pub use sph_solver::scene_boundary::PeriodicAxis;
 
 /// The images of the particles near the periodic ends.
 #[derive(Debug, Clone, Default)]

@@ -6,59 +6,24 @@
 
 use serde::Deserialize;
 use sph_core::{Aabb, Real};
+use sph_solver::scene_boundary::{
+    BoundaryFeatures, MovingWall, PeriodicAxis, PeriodicSetting, Pour, SceneBoundary,
+};
 use sph_solver::settings::convert;
 use sph_solver::{
-    Boundary, CommonParams, CommonSettings, FluidSolver, KernelKind, SceneValues, SolverError,
-    SolverSettings,
+    Boundary, CommonSettings, FluidSolver, KernelKind, SceneValues, SolverError, SolverSettings,
 };
 
 use crate::kernels::ELASTOPLASTIC_KERNEL;
-use crate::params::{ElastoplasticParams, InitialStress, MovingWall};
-use crate::periodic::PeriodicAxis;
-use crate::pour::Pour;
-use crate::solver::{Elastoplastic, NAME};
+use crate::name::NAME;
+use crate::params::{ElastoplasticParams, InitialStress};
+use crate::solver::Elastoplastic;
 use crate::stress::ConeMatch;
 
 /// The friction angle (degrees) of settings made for this kind from another solver's
 /// ([`SolverSettings::with_common`]): 30°, the shipped heaps' (a cohesionless material
 /// needs one; the other solvers have none).
 pub const WITH_COMMON_FRICTION_ANGLE_DEG: f64 = 30.0;
-
-/// An axis in scene files: `"x"`, `"y"` or `"z"`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Axis {
-    /// `x` (0).
-    X,
-    /// `y` (1).
-    Y,
-    /// `z` (2).
-    Z,
-}
-
-impl Axis {
-    /// The coordinate index (0, 1, 2).
-    pub fn index(self) -> usize {
-        match self {
-            Axis::X => 0,
-            Axis::Y => 1,
-            Axis::Z => 2,
-        }
-    }
-}
-
-/// One periodic axis as a scene writes it: `{ axis = "z", lo = 0.0, hi = 0.03 }` (m),
-/// [`PeriodicAxis`].
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PeriodicSetting {
-    /// The axis.
-    pub axis: Axis,
-    /// Lower end of the period (m).
-    pub lo: f64,
-    /// Upper end of the period (m).
-    pub hi: f64,
-}
 
 /// The `[solver]` settings of `kind = "elastoplastic"`; `None` = the default of
 /// [`ElastoplasticParams::for_spacing`]. Units and ranges as in [`ElastoplasticParams`].
@@ -116,6 +81,18 @@ impl SolverSettings for ElastoplasticSettings {
     type Params<R: Real> = ElastoplasticParams<R>;
 
     const DENSITY_KERNEL: KernelKind = ELASTOPLASTIC_KERNEL;
+
+    /// Walls of boundary particles (the solver's only walls in scene files), a model per
+    /// wall, moving walls, periodic axes and a pour.
+    const BOUNDARY_FEATURES: BoundaryFeatures = BoundaryFeatures {
+        collision: false,
+        volume_map: false,
+        particles: true,
+        wall_models: true,
+        moving_walls: true,
+        periodic: true,
+        pour: true,
+    };
 
     /// Friction angle [`WITH_COMMON_FRICTION_ANGLE_DEG`], every other setting the default.
     fn with_common(common: CommonSettings, _iterations: usize) -> Self {
@@ -185,29 +162,40 @@ impl SolverSettings for ElastoplasticSettings {
         );
         set(&mut p.cfl_number, self.cfl_number);
         set(&mut p.skin, self.skin);
-        p.periodic = self
-            .periodic_axes()
-            .into_iter()
-            .map(|(axis, lo, hi)| PeriodicAxis { axis, lo, hi })
-            .collect();
+        p.periodic = self.periodic();
         if let Some(s) = self.initial_stress {
             p.initial_stress = s;
         }
         p
     }
 
-    fn common_params<R: Real>(params: &ElastoplasticParams<R>) -> &CommonParams<R> {
-        &params.common
+    fn periodic(&self) -> Vec<PeriodicAxis<f64>> {
+        self.periodic
+            .iter()
+            .flatten()
+            .map(PeriodicSetting::to_axis)
+            .collect()
     }
 
-    fn convert<S: Real>(
-        params: &ElastoplasticParams<f64>,
-    ) -> Result<ElastoplasticParams<S>, SolverError> {
-        params.try_convert()
-    }
-
-    fn validate<R: Real>(params: &ElastoplasticParams<R>) -> Result<(), SolverError> {
-        params.validate()
+    /// Each solid's wall model (unstated: `default_wall`), the moving walls, the region of
+    /// the boundary particles, the periodic axes and the pour.
+    fn take_scene_boundary(
+        params: &mut ElastoplasticParams<f64>,
+        boundary: SceneBoundary<f64>,
+    ) -> Result<(), SolverError> {
+        boundary.check_supported(NAME, &Self::BOUNDARY_FEATURES)?;
+        let default = boundary.default_wall;
+        params.default_wall = default;
+        params.wall_models = boundary
+            .wall_models
+            .iter()
+            .map(|w| w.unwrap_or(default))
+            .collect();
+        params.moving_walls = boundary.moving_walls;
+        params.pour = boundary.pour;
+        params.boundary_particle_region = boundary.boundary_particle_region;
+        params.periodic = boundary.periodic;
+        Ok(())
     }
 
     fn build<R: Real>(

@@ -11,7 +11,7 @@ use sph_kernels::KernelKind;
 use sph_solver::boundary::{check_volume_kernel, VolumeMapBoundary};
 use sph_solver::state::{match_arrays, ArraySpec};
 use sph_solver::step::{blow_up, check_divergence, FramePhases, StepAt};
-use sph_solver::{CommonParams, FrameSolver, SchemeParts, SolverError, StepStats, SubstepScheme};
+use sph_solver::{FrameSolver, SchemeParts, SolverError, StepStats, SubstepScheme};
 
 use crate::boundary_particles::{
     extrapolate, sample_moving_wall, sample_solids, BoundaryParticle, Extrapolation,
@@ -26,7 +26,7 @@ use crate::pour::Pouring;
 use crate::scratch::Scratch;
 use crate::walls::{SharedWalls, WallSampler};
 
-pub(crate) const NAME: &str = "elastoplastic";
+pub(crate) use crate::name::NAME;
 
 /// The phases [`Elastoplastic::step`](FrameSolver::step) times.
 pub const ELASTOPLASTIC_PHASES: &[&str] = &[
@@ -617,7 +617,6 @@ impl<R: Real> ElastoplasticScheme<R> {
 
 impl<R: Real> SubstepScheme<R> for ElastoplasticScheme<R> {
     type Params = ElastoplasticParams<R>;
-    const NAME: &'static str = NAME;
     const PHASES: &'static [&'static str] = ELASTOPLASTIC_PHASES;
     const FRAME_PHASES: FramePhases = FramePhases {
         checks: BEGIN,
@@ -626,12 +625,6 @@ impl<R: Real> SubstepScheme<R> for ElastoplasticScheme<R> {
     };
     const DENSITY_KERNEL: KernelKind = ELASTOPLASTIC_KERNEL;
 
-    fn validate(params: &ElastoplasticParams<R>) -> Result<(), SolverError> {
-        params.validate()
-    }
-    fn common_of(params: &ElastoplasticParams<R>) -> &CommonParams<R> {
-        &params.common
-    }
     /// Any boundary: its summed `∇Ψ` (if it has volume) takes `default_wall`; per-solid
     /// models need [`ElastoplasticScheme::solver`].
     fn new(params: ElastoplasticParams<R>, parts: SchemeParts<R>) -> Result<Self, SolverError> {

@@ -1,7 +1,7 @@
 //! Parameters of the IISPH solver (water) and of its granular extension.
 
 use sph_core::{Real, Vec3};
-use sph_solver::{CommonParams, SolverError};
+use sph_solver::{CommonParams, SolverError, SolverParameters};
 
 /// Name of the solver in errors and reports.
 pub(crate) const NAME: &str = "IISPH";
@@ -448,5 +448,22 @@ mod tests {
         let g = g.with_cone_match(ConeMatch::SimpleShear);
         assert!((g.alpha() - ConeMatch::SimpleShear.alpha(30.0)).abs() < 1e-12);
         assert!((g.predicted_repose_angle_deg() - 30.0).abs() < 1e-9);
+    }
+}
+
+impl<R: Real> SolverParameters<R> for IisphParams<R> {
+    type In<S: Real> = IisphParams<S>;
+    const NAME: &'static str = NAME;
+
+    fn common(&self) -> &CommonParams<R> {
+        &self.common
+    }
+
+    fn validate(&self) -> Result<(), SolverError> {
+        IisphParams::validate(self)
+    }
+
+    fn convert<S: Real>(&self) -> Result<IisphParams<S>, SolverError> {
+        self.try_convert()
     }
 }

@@ -8,8 +8,7 @@ use serde::Deserialize;
 use sph_core::Real;
 use sph_solver::settings::{convert, convert3};
 use sph_solver::{
-    Boundary, CommonParams, CommonSettings, FluidSolver, KernelKind, SceneValues, SolverError,
-    SolverSettings,
+    Boundary, CommonSettings, FluidSolver, KernelKind, SceneValues, SolverError, SolverSettings,
 };
 
 use crate::params::NAME;
@@ -158,18 +157,6 @@ macro_rules! iisph_kind {
             key: &dyn Fn(&'static str) -> String,
         ) -> Result<(), (&'static str, String)> {
             self.iisph.check_written(key)
-        }
-
-        fn common_params<R: Real>(params: &IisphParams<R>) -> &CommonParams<R> {
-            &params.common
-        }
-
-        fn convert<S: Real>(params: &IisphParams<f64>) -> Result<IisphParams<S>, SolverError> {
-            params.try_convert()
-        }
-
-        fn validate<R: Real>(params: &IisphParams<R>) -> Result<(), SolverError> {
-            params.validate()
         }
 
         fn build<R: Real>(

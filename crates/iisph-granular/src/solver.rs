@@ -10,9 +10,7 @@ use sph_core::{apply_permutation, ParticleSet, Real, Vec3};
 use sph_kernels::KernelKind;
 use sph_solver::state::match_arrays;
 use sph_solver::step::{check_divergence, density_at, FramePhases, StepAt, MIN_LEN};
-use sph_solver::{
-    ArraySpec, CommonParams, FrameSolver, SchemeParts, SolverError, StepStats, SubstepScheme,
-};
+use sph_solver::{ArraySpec, FrameSolver, SchemeParts, SolverError, StepStats, SubstepScheme};
 
 use crate::friction;
 use crate::granular::Sym3;
@@ -77,7 +75,6 @@ pub struct IisphScheme<R: Real> {
 
 impl<R: Real> SubstepScheme<R> for IisphScheme<R> {
     type Params = IisphParams<R>;
-    const NAME: &'static str = NAME;
     const PHASES: &'static [&'static str] = IISPH_PHASES;
     const FRAME_PHASES: FramePhases = FramePhases {
         checks: INTEGRATE,
@@ -86,12 +83,6 @@ impl<R: Real> SubstepScheme<R> for IisphScheme<R> {
     };
     const DENSITY_KERNEL: KernelKind = IISPH_KERNEL;
 
-    fn validate(params: &IisphParams<R>) -> Result<(), SolverError> {
-        params.validate()
-    }
-    fn common_of(params: &IisphParams<R>) -> &CommonParams<R> {
-        &params.common
-    }
     fn new(params: IisphParams<R>, parts: SchemeParts<R>) -> Result<Self, SolverError> {
         Ok(Self {
             c: Consts::new(&params)?,

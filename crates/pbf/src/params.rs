@@ -1,7 +1,10 @@
 //! Solver parameters, with the paper's values where it gives them.
 
 use sph_core::Real;
-use sph_solver::{CommonParams, SolverError};
+use sph_solver::{CommonParams, SolverError, SolverParameters};
+
+/// Name of the solver in errors and reports.
+pub(crate) const NAME: &str = "PBF";
 
 pub use sph_solver::DEFAULT_SUPPORT_OVER_SPACING;
 
@@ -107,7 +110,7 @@ impl<R: Real> Default for PbfParams<R> {
 
 fn invalid(name: &'static str, value: f64, reason: &'static str) -> SolverError {
     SolverError::InvalidParameter {
-        solver: "PBF",
+        solver: NAME,
         name,
         value,
         reason,
@@ -192,9 +195,9 @@ impl<R: Real> PbfParams<R> {
 
     /// Checks every field; the error names the first invalid one.
     pub fn validate(&self) -> Result<(), SolverError> {
-        self.common.validate("PBF")?;
+        self.common.validate(NAME)?;
         self.common.check_iteration_count(
-            "PBF",
+            NAME,
             "solver_iterations",
             self.solver_iterations,
             MAX_SOLVER_ITERATIONS,
@@ -251,5 +254,22 @@ impl<R: Real> PbfParams<R> {
         }
         self.scorr_unit()?;
         Ok(())
+    }
+}
+
+impl<R: Real> SolverParameters<R> for PbfParams<R> {
+    type In<S: Real> = PbfParams<S>;
+    const NAME: &'static str = NAME;
+
+    fn common(&self) -> &CommonParams<R> {
+        &self.common
+    }
+
+    fn validate(&self) -> Result<(), SolverError> {
+        PbfParams::validate(self)
+    }
+
+    fn convert<S: Real>(&self) -> Result<PbfParams<S>, SolverError> {
+        self.try_convert()
     }
 }

@@ -6,8 +6,7 @@ use serde::Deserialize;
 use sph_core::Real;
 use sph_solver::settings::convert;
 use sph_solver::{
-    Boundary, CommonParams, CommonSettings, FluidSolver, KernelKind, SceneValues, SolverError,
-    SolverSettings,
+    Boundary, CommonSettings, FluidSolver, KernelKind, SceneValues, SolverError, SolverSettings,
 };
 
 use crate::{Pbf, PbfParams, DEFAULT_RELATIVE_CFM, PBF_KERNEL};
@@ -51,7 +50,7 @@ pub struct PbfSettings {
 }
 
 /// The solver's name in errors.
-const NAME: &str = "PBF";
+use crate::params::NAME;
 
 impl SolverSettings for PbfSettings {
     type Params<R: Real> = PbfParams<R>;
@@ -167,18 +166,6 @@ impl SolverSettings for PbfSettings {
     fn key_of(params: &PbfParams<f64>, name: &str, value: f64) -> Option<(&'static str, f64)> {
         let d_ref = params.reference_denominator()?;
         (name == "cfm_epsilon").then(|| ("relative_cfm", value / d_ref))
-    }
-
-    fn common_params<R: Real>(params: &PbfParams<R>) -> &CommonParams<R> {
-        &params.common
-    }
-
-    fn convert<S: Real>(params: &PbfParams<f64>) -> Result<PbfParams<S>, SolverError> {
-        params.try_convert()
-    }
-
-    fn validate<R: Real>(params: &PbfParams<R>) -> Result<(), SolverError> {
-        params.validate()
     }
 
     fn build<R: Real>(

@@ -11,9 +11,7 @@ use sph_solver::boundary::check_volume_kernel;
 use sph_solver::step::{
     check_divergence, check_masses, check_predicted, FramePhases, StepAt, MIN_LEN,
 };
-use sph_solver::{
-    Boundary, CommonParams, FrameSolver, SchemeParts, SolverError, StepStats, SubstepScheme,
-};
+use sph_solver::{Boundary, FrameSolver, SchemeParts, SolverError, StepStats, SubstepScheme};
 
 use crate::kernels::{Consts, PBF_KERNEL};
 use crate::params::PbfParams;
@@ -77,7 +75,7 @@ const CONSTRAINT_SOLVE: usize = 3;
 const VELOCITY_UPDATE: usize = 4;
 const REORDER: usize = 5;
 
-const NAME: &str = "PBF";
+use crate::params::NAME;
 
 /// What [`PbfScheme::evaluate_constraints`] computed, borrowed from the solver.
 #[derive(Debug, Clone, Copy)]
@@ -94,7 +92,6 @@ pub struct ConstraintEval<'a, R: Real> {
 
 impl<R: Real> SubstepScheme<R> for PbfScheme<R> {
     type Params = PbfParams<R>;
-    const NAME: &'static str = NAME;
     const PHASES: &'static [&'static str] = PBF_PHASES;
     const FRAME_PHASES: FramePhases = FramePhases {
         checks: INTEGRATE,
@@ -103,12 +100,6 @@ impl<R: Real> SubstepScheme<R> for PbfScheme<R> {
     };
     const DENSITY_KERNEL: KernelKind = PBF_KERNEL;
 
-    fn validate(params: &PbfParams<R>) -> Result<(), SolverError> {
-        params.validate()
-    }
-    fn common_of(params: &PbfParams<R>) -> &CommonParams<R> {
-        &params.common
-    }
     fn new(params: PbfParams<R>, parts: SchemeParts<R>) -> Result<Self, SolverError> {
         Ok(Self {
             c: Consts::new(&params)?,

@@ -1,7 +1,10 @@
 //! Parameters of the PCISPH solver.
 
 use sph_core::Real;
-use sph_solver::{CommonParams, SolverError};
+use sph_solver::{CommonParams, SolverError, SolverParameters};
+
+/// Name of the solver in errors and reports.
+pub(crate) const NAME: &str = "PCISPH";
 
 /// Most prediction-correction iterations per time step ([`PcisphParams::pressure_iterations`])
 /// accepted, bounded by what can finish: Macklin & Müller (2013, §8) run 4, SPlisHSPlasH
@@ -64,7 +67,7 @@ impl<R: Real> Default for PcisphParams<R> {
 
 fn invalid(name: &'static str, value: f64, reason: &'static str) -> SolverError {
     SolverError::InvalidParameter {
-        solver: "PCISPH",
+        solver: NAME,
         name,
         value,
         reason,
@@ -140,9 +143,9 @@ impl<R: Real> PcisphParams<R> {
     /// Checks every field; the error ([`SolverError::InvalidParameter`]) names the first
     /// invalid one.
     pub fn validate(&self) -> Result<(), SolverError> {
-        self.common.validate("PCISPH")?;
+        self.common.validate(NAME)?;
         self.common.check_iteration_count(
-            "PCISPH",
+            NAME,
             "pressure_iterations",
             self.pressure_iterations,
             MAX_PRESSURE_ITERATIONS,
@@ -162,5 +165,22 @@ impl<R: Real> PcisphParams<R> {
         }
         self.scaling_factor()?;
         Ok(())
+    }
+}
+
+impl<R: Real> SolverParameters<R> for PcisphParams<R> {
+    type In<S: Real> = PcisphParams<S>;
+    const NAME: &'static str = NAME;
+
+    fn common(&self) -> &CommonParams<R> {
+        &self.common
+    }
+
+    fn validate(&self) -> Result<(), SolverError> {
+        PcisphParams::validate(self)
+    }
+
+    fn convert<S: Real>(&self) -> Result<PcisphParams<S>, SolverError> {
+        self.try_convert()
     }
 }

@@ -6,8 +6,7 @@ use serde::Deserialize;
 use sph_core::Real;
 use sph_solver::settings::convert;
 use sph_solver::{
-    Boundary, CommonParams, CommonSettings, FluidSolver, KernelKind, SceneValues, SolverError,
-    SolverSettings,
+    Boundary, CommonSettings, FluidSolver, KernelKind, SceneValues, SolverError, SolverSettings,
 };
 
 use crate::{Pcisph, PcisphParams, PCISPH_KERNEL};
@@ -32,7 +31,7 @@ pub struct PcisphSettings {
 }
 
 /// The solver's name in errors.
-const NAME: &str = "PCISPH";
+use crate::params::NAME;
 
 impl SolverSettings for PcisphSettings {
     type Params<R: Real> = PcisphParams<R>;
@@ -82,18 +81,6 @@ impl SolverSettings for PcisphSettings {
             p.density_error_tolerance = Some(t);
         }
         p
-    }
-
-    fn common_params<R: Real>(params: &PcisphParams<R>) -> &CommonParams<R> {
-        &params.common
-    }
-
-    fn convert<S: Real>(params: &PcisphParams<f64>) -> Result<PcisphParams<S>, SolverError> {
-        params.try_convert()
-    }
-
-    fn validate<R: Real>(params: &PcisphParams<R>) -> Result<(), SolverError> {
-        params.validate()
     }
 
     fn build<R: Real>(

@@ -9,7 +9,7 @@ use sph_kernels::{Kernel, KernelKind};
 use sph_solver::step::{
     check_divergence, check_predicted, density_at, FramePhases, StepAt, MIN_LEN,
 };
-use sph_solver::{CommonParams, FrameSolver, SchemeParts, SolverError, StepStats, SubstepScheme};
+use sph_solver::{FrameSolver, SchemeParts, SolverError, StepStats, SubstepScheme};
 
 use crate::kernels::{Consts, PCISPH_KERNEL};
 use crate::params::PcisphParams;
@@ -30,7 +30,6 @@ const DETECT_NEIGHBOURS: usize = 2;
 const PRESSURE_SOLVE: usize = 3;
 const VELOCITY_UPDATE: usize = 4;
 const REORDER: usize = 5;
-const NAME: &str = "PCISPH";
 
 /// The PCISPH solver of Solenthaler & Pajarola (2009); see the crate documentation.
 pub type Pcisph<R> = FrameSolver<R, PcisphScheme<R>>;
@@ -56,7 +55,6 @@ fn advance<R: Real>(x: Vec3<R>, v: Vec3<R>, a: Vec3<R>, dt: R) -> (Vec3<R>, Vec3
 
 impl<R: Real> SubstepScheme<R> for PcisphScheme<R> {
     type Params = PcisphParams<R>;
-    const NAME: &'static str = NAME;
     const PHASES: &'static [&'static str] = PCISPH_PHASES;
     const FRAME_PHASES: FramePhases = FramePhases {
         checks: INTEGRATE,
@@ -65,12 +63,6 @@ impl<R: Real> SubstepScheme<R> for PcisphScheme<R> {
     };
     const DENSITY_KERNEL: KernelKind = PCISPH_KERNEL;
 
-    fn validate(params: &PcisphParams<R>) -> Result<(), SolverError> {
-        params.validate()
-    }
-    fn common_of(params: &PcisphParams<R>) -> &CommonParams<R> {
-        &params.common
-    }
     fn new(params: PcisphParams<R>, parts: SchemeParts<R>) -> Result<Self, SolverError> {
         Ok(Self {
             c: Consts::new(&params)?,

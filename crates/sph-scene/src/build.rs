@@ -234,7 +234,7 @@ impl Scene {
     }
 
     /// The grains the scene's pour adds during the run, at its spacing (0 without a pour;
-    /// [`elastoplastic_granular::Pour::grains`]).
+    /// [`sph_solver::Pour::grains`]).
     pub fn poured_grains(&self) -> usize {
         self.pour
             .map_or(0, |p| p.to_pour().grains(self.particle_spacing))

@@ -19,7 +19,7 @@ use crate::mesh_io::placement_field;
 use crate::{
     BoundaryModel, FluidSpec, QuickSpec, Scene, SceneError, SolidSpec, SolverKind, WallModel,
 };
-use elastoplastic_granular::{MAX_WALL_FRICTION, MAX_WALL_MOTION_S};
+use sph_solver::scene_boundary::{BoundaryFeature, MAX_WALL_FRICTION, MAX_WALL_MOTION_S};
 
 impl Scene {
     /// Checks every value of the scene, as [`Scene::load`] does: after editing a loaded
@@ -77,26 +77,38 @@ impl Scene {
         Ok(())
     }
 
-    /// The boundary model against the solver, the walls' models, and the periodic axes
-    /// against the tank.
+    /// The boundary model against the solver (its declared
+    /// [`BoundaryFeatures`](sph_solver::BoundaryFeatures)), the walls' models, moving solids,
+    /// the pour and the periodic axes against the solver and the tank.
     fn check_walls(&self, ctx: &Ctx) -> Result<(), SceneError> {
-        let particles = self.boundary.model == BoundaryModel::Particles;
-        let elastoplastic = self.solver.kind() == SolverKind::Elastoplastic;
-        if elastoplastic && !particles {
-            return Err(ctx.invalid(
-                "boundary.model",
-                "solver kind = \"elastoplastic\" needs model = \"particles\" (walls of boundary particles): with volume maps or collisions alone a granular layer does not come to rest on its walls (docs/elastoplastic-granular.md)",
-            ));
-        }
-        if particles && !elastoplastic {
+        let takes = self.solver.kind().boundary_features();
+        let model = match self.boundary.model {
+            BoundaryModel::VolumeMap => BoundaryFeature::VolumeMap,
+            BoundaryModel::Collision => BoundaryFeature::Collision,
+            BoundaryModel::Particles => BoundaryFeature::Particles,
+        };
+        if !takes.supports(model) {
+            let models: Vec<String> = [
+                BoundaryFeature::VolumeMap,
+                BoundaryFeature::Collision,
+                BoundaryFeature::Particles,
+            ]
+            .into_iter()
+            .filter(|f| takes.supports(*f))
+            .map(|f| f.scene_key().to_string())
+            .collect();
             return Err(ctx.invalid(
                 "boundary.model",
                 format!(
-                    "model = \"particles\" is the elastoplastic solver's; solver kind = \"{}\" takes \"volume-map\" or \"collision\"",
-                    self.solver.kind_name()
+                    "solver kind = \"{}\" does not take {} (it takes {}){}",
+                    self.solver.kind_name(),
+                    model.scene_key(),
+                    models.join(" or "),
+                    takers(model)
                 ),
             ));
         }
+        let particles = self.boundary.model == BoundaryModel::Particles;
         let walls = std::iter::once(("tank.wall".to_string(), self.walls.tank)).chain(
             self.walls
                 .solids
@@ -112,6 +124,7 @@ impl Scene {
                     "a wall model applies to walls of boundary particles: set [boundary] model = \"particles\"",
                 ));
             }
+            self.refuse_untaken(ctx, &field, BoundaryFeature::WallModels)?;
             if let WallModel::Coulomb(mu) = wall {
                 if !(0.0..=MAX_WALL_FRICTION).contains(&mu) {
                     return Err(ctx.invalid(
@@ -127,9 +140,13 @@ impl Scene {
             if !particles {
                 return Err(ctx.invalid(
                     field,
-                    "a moving solid is a wall of boundary particles: set [boundary] model = \"particles\" (the elastoplastic solver)",
+                    format!(
+                        "a moving solid is a wall of boundary particles: set [boundary] model = \"particles\"{}",
+                        takers(BoundaryFeature::MovingWalls)
+                    ),
                 ));
             }
+            self.refuse_untaken(ctx, &field, BoundaryFeature::MovingWalls)?;
             match self.solids.get(j) {
                 Some(SolidSpec::Box { .. }) => {}
                 Some(_) => return Err(ctx.invalid(field, "only a solid of kind = \"box\" moves")),
@@ -148,15 +165,7 @@ impl Scene {
             }
         }
         if let Some(p) = &self.pour {
-            if !elastoplastic {
-                return Err(ctx.invalid(
-                    "pour",
-                    format!(
-                        "a pour adds grains during the run: only solver kind = \"elastoplastic\" takes them, not \"{}\"",
-                        self.solver.kind_name()
-                    ),
-                ));
-            }
+            self.refuse_untaken(ctx, "pour", BoundaryFeature::Pour)?;
             ctx.check_box("pour", &p.min, &p.max)?;
             if let Some(t) = &self.tank {
                 let (lo, hi) = (t.min, t.max);
@@ -177,6 +186,9 @@ impl Scene {
         if self.walls.tank.is_some() && self.tank.is_none() {
             return Err(ctx.invalid("tank.wall", "a wall model without a tank"));
         }
+        if !self.solver.periodic_axes().is_empty() {
+            self.refuse_untaken(ctx, "solver.periodic", BoundaryFeature::Periodic)?;
+        }
         if let Some(t) = &self.tank {
             for (axis, lo, hi) in self.solver.periodic_axes() {
                 if axis < 3 && (lo != t.min[axis] || hi != t.max[axis]) {
@@ -191,6 +203,27 @@ impl Scene {
             }
         }
         Ok(())
+    }
+
+    /// An error at `field` when the scene's solver does not take `feature`.
+    fn refuse_untaken(
+        &self,
+        ctx: &Ctx,
+        field: &str,
+        feature: BoundaryFeature,
+    ) -> Result<(), SceneError> {
+        if self.solver.kind().boundary_features().supports(feature) {
+            return Ok(());
+        }
+        Err(ctx.invalid(
+            field,
+            format!(
+                "solver kind = \"{}\" does not take {}{}",
+                self.solver.kind_name(),
+                feature.scene_key(),
+                takers(feature)
+            ),
+        ))
     }
 
     /// `[quick]`: each override in range and consistent with the solver.
@@ -222,6 +255,21 @@ impl Scene {
             }
         }
         Ok(())
+    }
+}
+
+/// The solvers that take `feature`, for a message: `; solver kind = "…" takes it` (empty
+/// when none does).
+pub(crate) fn takers(feature: BoundaryFeature) -> String {
+    let kinds: Vec<String> = SolverKind::ALL
+        .iter()
+        .filter(|k| k.boundary_features().supports(feature))
+        .map(|k| format!("\"{}\"", k.name()))
+        .collect();
+    if kinds.is_empty() {
+        String::new()
+    } else {
+        format!("; solver kind = {} takes it", kinds.join(" or "))
     }
 }
 

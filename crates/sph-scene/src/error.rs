@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use sph_core::Aabb;
 
 use crate::geom::{v3, AXES};
-use crate::overrides::is_override_span;
+use crate::override_span::is_override_span;
 
 /// Errors of scene loading and building. Every variant names the scene file, the field path
 /// and the reason.

@@ -159,8 +159,8 @@
 //! The elastic–plastic granular solver (crate `elastoplastic-granular`, Bui, Fukagawa, Sako
 //! & Ohno 2008: a per-particle stress, elastic and capped by the Drucker–Prager cone matched
 //! to Mohr–Coulomb; explicit steps sub-cycled inside each frame) requires
-//! `[boundary] model = "particles"`; each key is an `ElastoplasticParams` field, defaults
-//! its `for_spacing`'s:
+//! `[boundary] model = "particles"`; each key is a field of that crate's parameters,
+//! defaults their `for_spacing`'s:
 //!
 //! ```toml
 //! [solver]
@@ -357,6 +357,7 @@ mod geom;
 mod limits;
 mod mesh_io;
 mod obj;
+mod override_span;
 mod overrides;
 mod params;
 mod parse;
@@ -374,12 +375,10 @@ pub use limits::{
     MAX_SDF_NODES,
 };
 pub use overrides::Override;
-pub use solver_spec::{SolverKind, SolverParams, SolverSpec};
 // The settings of each solver, owned by its crate (the variants of `SolverSpec`).
-pub use elastoplastic_granular::ElastoplasticSettings;
-pub use iisph_granular::{GranularSettings, IisphSettings, WaterSettings};
-pub use pbf::PbfSettings;
-pub use pcisph::PcisphSettings;
+pub use iisph_granular::IisphSettings;
+pub use solver_spec::settings::*;
+pub use solver_spec::{SolverKind, SolverParams, SolverSpec};
 pub use spec::{
     BoundaryModel, BoundarySpec, FluidSpec, InitialMasses, MeshPlacement, MeshSpec, OutputSpec,
     PourSpec, Precision, QuickSpec, Scene, SceneWalls, SolidMotion, SolidSpec, WallModel,

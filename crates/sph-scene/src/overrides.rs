@@ -16,21 +16,8 @@ use toml::de::{DeTable, DeValue};
 use toml::Spanned;
 
 use crate::error::Ctx;
+use crate::override_span::override_span;
 use crate::SceneError;
-
-/// The span given to the keys and values an override puts into the document: past the end
-/// of any scene text ([`crate::MAX_SCENE_FILE_BYTES`]), so that messages can tell them from
-/// the file's own ([`is_override_span`]).
-const OVERRIDE_OFFSET: usize = usize::MAX / 2;
-
-/// Whether a span of the document belongs to a value set by an override (not in the file).
-pub(crate) fn is_override_span(start: usize) -> bool {
-    start >= OVERRIDE_OFFSET
-}
-
-fn override_span() -> std::ops::Range<usize> {
-    OVERRIDE_OFFSET..OVERRIDE_OFFSET
-}
 
 /// One override: a key of the scene file, by its dotted path, and the value it takes.
 #[derive(Debug, Clone, PartialEq)]

@@ -11,17 +11,16 @@
 //! and `particle_spacing` in `[simulation]`).
 
 use sph_core::{Aabb, Real};
+use sph_solver::scene_boundary::{BoundaryFeature, MovingWall, PeriodicAxis, SceneBoundary};
 use sph_solver::{CommonSettings, SceneValues, SolverError};
 
 use crate::error::Ctx;
-use elastoplastic_granular::MovingWall;
-
 use crate::geom::v3;
 use crate::{Precision, Scene, SceneError, SceneWalls, SolidSpec, SolverParams, WallModel};
 
 impl Scene {
     /// The scene's values every solver's parameters take: spacing, frame length, gravity.
-    fn scene_values(&self) -> SceneValues {
+    pub(crate) fn scene_values(&self) -> SceneValues {
         SceneValues {
             particle_spacing: self.particle_spacing,
             frame_dt: self.frame_dt_s,
@@ -29,40 +28,55 @@ impl Scene {
         }
     }
 
-    /// The solver's parameters in `f64` from the `[solver]` settings and the scene's values,
-    /// with the walls of a solver that takes them from the scene: for `elastoplastic`, each
-    /// solid's wall model (the tank first, as in [`Scene::build_solids`]; unstated walls
-    /// [`SceneWalls::DEFAULT`](crate::SceneWalls::DEFAULT)), the region whose walls
-    /// become boundary particles (the tank, or else the box of the fluids) and the moving
-    /// solids as moving walls ([`crate::SolidMotion`]).
-    fn solver_params_f64(&self) -> SolverParams<f64> {
-        let mut p = self.solver.params(&self.scene_values());
-        if let SolverParams::Elastoplastic(e) = &mut p {
-            let default = SceneWalls::DEFAULT;
-            e.default_wall = default;
-            e.wall_models = self
+    /// The scene's boundary besides the solids' shapes, solver-neutral: each wall's stated
+    /// model (the tank first, then the solids that stand still, as in
+    /// [`Scene::build_solids`]; unstated walls [`SceneWalls::DEFAULT`]), the moving solids
+    /// as moving walls ([`crate::SolidMotion`]), the region whose walls become boundary
+    /// particles in a solver that makes them (the tank, or else the box of the fluids), the
+    /// solver's periodic axes and the pour.
+    pub fn scene_boundary(&self) -> SceneBoundary<f64> {
+        let default = SceneWalls::DEFAULT;
+        SceneBoundary {
+            default_wall: default,
+            wall_models: self
                 .tank
                 .iter()
-                .map(|_| self.walls.tank.unwrap_or(default))
-                .chain(
-                    self.standing_solids()
-                        .map(|j| self.wall_of(j).unwrap_or(default)),
-                )
-                .collect();
-            e.moving_walls = self.moving_walls(default);
-            e.pour = self.pour.as_ref().map(crate::PourSpec::to_pour);
-            e.boundary_particle_region = self.tank.or_else(|| {
+                .map(|_| self.walls.tank)
+                .chain(self.standing_solids().map(|j| self.wall_of(j)))
+                .collect(),
+            moving_walls: self.moving_walls(default),
+            boundary_particle_region: self.tank.or_else(|| {
                 self.fluids.iter().map(|f| f.bounds()).reduce(|a, b| Aabb {
                     min: a.min.inf(&b.min),
                     max: a.max.sup(&b.max),
                 })
-            });
+            }),
+            periodic: self
+                .solver
+                .periodic_axes()
+                .into_iter()
+                .map(|(axis, lo, hi)| PeriodicAxis { axis, lo, hi })
+                .collect(),
+            pour: self.pour.as_ref().map(crate::PourSpec::to_pour),
         }
-        p
     }
 
-    /// The moving solids as the elastoplastic solver's moving walls: each a box (the parser
-    /// refuses a motion on another kind) with its wall model.
+    /// The solver's parameters in `f64` from the `[solver]` settings and the scene's values,
+    /// with the parts of the scene's boundary ([`Scene::scene_boundary`]) the solver takes
+    /// ([`sph_solver::SolverSettings::BOUNDARY_FEATURES`],
+    /// [`sph_solver::SolverSettings::take_scene_boundary`]). A part the solver does not take
+    /// is left out here and refused by [`Scene::check`] at its key (`check.rs`), so that
+    /// the parameters of a scene's solver changed in code
+    /// ([`SolverSpec::with_kind`](crate::SolverSpec::with_kind)) can still be built.
+    fn solver_params_f64(&self) -> Result<SolverParams<f64>, SolverError> {
+        let mut p = self.solver.params(&self.scene_values());
+        let takes = self.solver.kind().boundary_features();
+        p.take_scene_boundary(self.scene_boundary().only(&takes))?;
+        Ok(p)
+    }
+
+    /// The moving solids as moving walls: each a box (the parser refuses a motion on another
+    /// kind) with its wall model.
     fn moving_walls(&self, default: WallModel) -> Vec<MovingWall<f64>> {
         self.solids
             .iter()
@@ -107,7 +121,9 @@ impl Scene {
             lines: Some(&self.lines),
             ..Ctx::new(&self.source)
         };
-        let p = self.solver_params_f64();
+        let p = self
+            .solver_params_f64()
+            .map_err(|e| self.boundary_error(&ctx, e))?;
         p.try_convert::<R>()
             .map_err(|e| self.param_error(&ctx, &p, Some(R::NAME), e))
     }
@@ -127,7 +143,9 @@ impl Scene {
         self.solver
             .check_written(&key)
             .map_err(|(name, reason)| ctx.invalid(self.key(name), reason))?;
-        let p = self.solver_params_f64();
+        let p = self
+            .solver_params_f64()
+            .map_err(|e| self.boundary_error(ctx, e))?;
         p.validate()
             .map_err(|e| self.param_error(ctx, &p, None, e))?;
         let converted = p
@@ -139,6 +157,23 @@ impl Scene {
                 .map_err(|e| self.param_error(ctx, &p, Some(R::NAME), e))?;
         }
         Ok(converted)
+    }
+
+    /// A solver's refusal `e` of the scene's boundary, at the key of the feature it does not
+    /// take.
+    fn boundary_error(&self, ctx: &Ctx, e: SolverError) -> SceneError {
+        match e {
+            SolverError::UnsupportedFeature { feature, .. } => ctx.invalid(
+                feature_field(feature),
+                format!(
+                    "solver kind = \"{}\" does not take {}{}",
+                    self.solver.kind_name(),
+                    feature.scene_key(),
+                    crate::check::takers(feature)
+                ),
+            ),
+            e => ctx.invalid("solver", e.to_string()),
+        }
     }
 
     /// A solver's refusal `e` of a parameter of `p`, at the scene key it comes from: the
@@ -198,6 +233,15 @@ impl Scene {
             .map(|(old, _)| *old)
             .find(|old| written.contains(old));
         format!("solver.{}", old.unwrap_or(name))
+    }
+}
+
+/// The scene field of a boundary feature, for the line of an error about it.
+pub(crate) fn feature_field(feature: BoundaryFeature) -> &'static str {
+    match feature {
+        BoundaryFeature::Periodic => "solver.periodic",
+        BoundaryFeature::Pour => "pour",
+        _ => "boundary.model",
     }
 }
 

@@ -7,9 +7,10 @@
 
 use serde::Deserialize;
 use sph_core::Real;
+use sph_solver::scene_boundary::{BoundaryFeatures, SceneBoundary};
 use sph_solver::{
     Boundary, CommonParams, CommonSettings, FluidSolver, KernelKind, SceneValues, SolverError,
-    SolverSettings,
+    SolverParameters, SolverSettings,
 };
 
 /// Defines the solver enums from one line per solver:
@@ -17,8 +18,14 @@ use sph_solver::{
 macro_rules! solvers {
     ($(
         $(#[$doc:meta])*
-        $Kind:ident = $name:literal, $Settings:ty [$($Part:ty),*];
+        $Kind:ident = $name:literal, $Settings:path [$($Part:ty),*];
     )+) => {
+        /// The settings struct of each solver (the variants of [`SolverSpec`]), owned by its
+        /// crate and re-exported here.
+        pub mod settings {
+            $( pub use $Settings; )+
+        }
+
         /// Which solver a scene is meant for: the tag (`kind`) of the `[solver]` table, and
         /// [`SolverSpec::kind`]. Code can name a solver without its settings with it (e.g.
         /// to run one scene with two solvers, [`SolverSpec::with_kind`]).
@@ -42,6 +49,22 @@ macro_rules! solvers {
             pub fn density_kernel(self) -> KernelKind {
                 match self {
                     $( SolverKind::$Kind => <$Settings as SolverSettings>::DENSITY_KERNEL, )+
+                }
+            }
+
+            /// The solver's name in errors and reports (its parameters'
+            /// [`SolverParameters::NAME`], e.g. `"PBF"`).
+            pub fn label(self) -> &'static str {
+                match self {
+                    $( SolverKind::$Kind => <<$Settings as SolverSettings>::Params<f64> as SolverParameters<f64>>::NAME, )+
+                }
+            }
+
+            /// The scene boundary features the solver takes
+            /// ([`SolverSettings::BOUNDARY_FEATURES`]).
+            pub fn boundary_features(self) -> BoundaryFeatures {
+                match self {
+                    $( SolverKind::$Kind => <$Settings as SolverSettings>::BOUNDARY_FEATURES, )+
                 }
             }
 
@@ -132,6 +155,16 @@ macro_rules! solvers {
                 }
             }
 
+            /// The periodic axes the settings state ([`SolverSettings::periodic`]) as
+            /// `(axis, lo, hi)` (0 = x, 1 = y, 2 = z; m), empty for a solver without them:
+            /// the tank is open along them.
+            pub fn periodic_axes(&self) -> Vec<(usize, f64, f64)> {
+                let axes = match self {
+                    $( SolverSpec::$Kind(s) => s.periodic(), )+
+                };
+                axes.into_iter().map(|a| (a.axis, a.lo, a.hi)).collect()
+            }
+
             /// The checks of the settings as written ([`SolverSettings::check_written`]).
             pub(crate) fn check_written(
                 &self,
@@ -176,14 +209,14 @@ macro_rules! solvers {
             /// The parameters every solver has.
             pub fn common(&self) -> &CommonParams<R> {
                 match self {
-                    $( SolverParams::$Kind(p) => <$Settings as SolverSettings>::common_params(p), )+
+                    $( SolverParams::$Kind(p) => p.common(), )+
                 }
             }
 
             /// The solver's own range checks (its parameters' `validate`).
             pub fn validate(&self) -> Result<(), SolverError> {
                 match self {
-                    $( SolverParams::$Kind(p) => <$Settings as SolverSettings>::validate(p), )+
+                    $( SolverParams::$Kind(p) => SolverParameters::validate(p), )+
                 }
             }
 
@@ -204,8 +237,20 @@ macro_rules! solvers {
             /// value that does not fit).
             pub fn try_convert<S: Real>(&self) -> Result<SolverParams<S>, SolverError> {
                 Ok(match self {
-                    $( SolverParams::$Kind(p) => SolverParams::$Kind(<$Settings as SolverSettings>::convert(p)?), )+
+                    $( SolverParams::$Kind(p) => SolverParams::$Kind(SolverParameters::convert::<S>(p)?), )+
                 })
+            }
+
+            /// Takes the scene's boundary into the parameters
+            /// ([`SolverSettings::take_scene_boundary`]: an error when the solver does not
+            /// take a feature the boundary uses).
+            pub(crate) fn take_scene_boundary(
+                &mut self,
+                boundary: SceneBoundary<f64>,
+            ) -> Result<(), SolverError> {
+                match self {
+                    $( SolverParams::$Kind(p) => <$Settings as SolverSettings>::take_scene_boundary(p, boundary), )+
+                }
             }
 
             /// The key of a refused parameter `name` (value `value`) that is not itself a key,
@@ -266,15 +311,6 @@ impl SolverSpec {
     /// The density kernel of the solver.
     pub fn density_kernel(&self) -> KernelKind {
         self.kind().density_kernel()
-    }
-
-    /// The periodic axes `(axis, lo, hi)` (0 = x, 1 = y, 2 = z; m) of a solver that has
-    /// them (`elastoplastic`'s `periodic`), empty otherwise: the tank is open along them.
-    pub fn periodic_axes(&self) -> Vec<(usize, f64, f64)> {
-        match self {
-            SolverSpec::Elastoplastic(e) => e.periodic_axes(),
-            _ => Vec::new(),
-        }
     }
 
     /// These settings for solver `kind`: a copy when `kind` is this solver's; otherwise the

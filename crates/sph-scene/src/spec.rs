@@ -9,7 +9,7 @@ use serde::Deserialize;
 use sph_core::{Aabb, TriangleMesh};
 use ssfr_render::RenderConfig;
 
-pub use elastoplastic_granular::WallModel;
+pub use sph_solver::WallModel;
 
 use crate::error::FieldLines;
 use crate::sample_cache::FluidSampleCache;
@@ -232,7 +232,7 @@ pub enum SolidSpec {
 /// A solid's motion (`[[solid]] motion = { velocity = [0.0, -0.05, 0.0], duration = 12.0 }`):
 /// it moves at `velocity` from the run's start for `duration` seconds, then stands still.
 /// Only a box moves, and only as a wall of boundary particles (`[boundary] model =
-/// "particles"`, the elastoplastic solver's: a [`elastoplastic_granular::MovingWall`]); a
+/// "particles"`, the elastoplastic solver's: a [`sph_solver::MovingWall`]); a
 /// moving solid is not one of the boundary's solids ([`Scene::build_solids`]), so nothing
 /// but its particles keeps the grains out of it.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
@@ -247,7 +247,7 @@ pub struct SolidMotion {
 
 /// A pour (`[pour]`): grains added during the run a layer at a time, where the heap under
 /// the box grows (the funnel method of forming a heap; the elastoplastic solver's
-/// [`elastoplastic_granular::Pour`], which says where each layer goes and when). The
+/// [`sph_solver::Pour`]; the solver says where each layer goes and when). The
 /// volume is bulk volume (grains × spacing³), so a pour is the same at every spacing.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -265,9 +265,9 @@ pub struct PourSpec {
 }
 
 impl PourSpec {
-    /// The solver's pour ([`elastoplastic_granular::Pour`]) this table describes.
-    pub fn to_pour(&self) -> elastoplastic_granular::Pour<f64> {
-        elastoplastic_granular::Pour {
+    /// The solver's pour ([`sph_solver::Pour`]) this table describes.
+    pub fn to_pour(&self) -> sph_solver::Pour<f64> {
+        sph_solver::Pour {
             region: Aabb {
                 min: crate::geom::v3(self.min),
                 max: crate::geom::v3(self.max),

@@ -2,6 +2,8 @@ use neighbour_search::SearchError;
 use sph_core::CoreError;
 use sph_kernels::KernelError;
 
+use crate::scene_boundary::BoundaryFeature;
+
 /// Why a volume-map file was refused (in [`SolverError::MapFile`]).
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[non_exhaustive]
@@ -70,6 +72,15 @@ pub enum SolverError {
         value: f64,
         /// Why it is rejected.
         reason: &'static str,
+    },
+    /// The scene asks for a boundary feature the solver does not take
+    /// ([`SolverSettings::take_scene_boundary`](crate::SolverSettings::take_scene_boundary)).
+    #[error("solver {solver} does not take {}", feature.scene_key())]
+    UnsupportedFeature {
+        /// Which solver.
+        solver: &'static str,
+        /// The feature, with its scene key ([`BoundaryFeature::scene_key`]).
+        feature: BoundaryFeature,
     },
     /// The particle state given to the solver is invalid (array lengths, non-finite position
     /// or velocity); the inner error names the particle and axis.

@@ -26,6 +26,7 @@ use crate::boundary::check_volume_kernel;
 use crate::boundary::{Boundary, CollisionBoundary};
 use crate::error::SolverError;
 use crate::fluid_solver::{FluidSolver, Solids};
+use crate::parameters::SolverParameters;
 use crate::params::CommonParams;
 use crate::state::SolverState;
 use crate::stats::StepStats;
@@ -65,10 +66,12 @@ impl<R: Real> fmt::Debug for SchemeParts<R> {
 ///
 /// Adding a solver means implementing this trait (see the crate docs, "Adding a solver").
 pub trait SubstepScheme<R: Real>: Send + Sized {
-    /// The solver's parameters (embedding [`CommonParams`] as `common`).
-    type Params: Clone + fmt::Debug + Send;
-    /// The name in errors ([`SolverError::InvalidParameter`], [`SolverError::BlowUp`]).
-    const NAME: &'static str;
+    /// The solver's parameters (embedding [`CommonParams`] as `common`; their name, range
+    /// check and common part are their [`SolverParameters`]').
+    type Params: SolverParameters<R>;
+    /// The name in errors ([`SolverError::InvalidParameter`], [`SolverError::BlowUp`]): the
+    /// parameters' [`SolverParameters::NAME`].
+    const NAME: &'static str = <Self::Params as SolverParameters<R>>::NAME;
     /// The phases its [`StepStats::phases`] report, in order.
     const PHASES: &'static [&'static str];
     /// Which of [`SubstepScheme::PHASES`] take the frame shell's checks, reordering and
@@ -77,10 +80,6 @@ pub trait SubstepScheme<R: Real>: Send + Sized {
     /// The kernel of its density sum (a volume boundary must have been integrated with it).
     const DENSITY_KERNEL: KernelKind;
 
-    /// Checks every parameter; the error names the first invalid one.
-    fn validate(params: &Self::Params) -> Result<(), SolverError>;
-    /// The parameters every solver has.
-    fn common_of(params: &Self::Params) -> &CommonParams<R>;
     /// The scheme for `params` (validated by the caller) with `parts`.
     fn new(params: Self::Params, parts: SchemeParts<R>) -> Result<Self, SolverError>;
     /// The parameters.
@@ -169,7 +168,7 @@ impl<R: Real, S: SubstepScheme<R>> FrameSolver<R, S> {
     /// A solver with validated `params` and the given solids as a [`CollisionBoundary`]
     /// with the particle radius `s / 2` as contact distance.
     pub fn new(params: S::Params, solids: Solids<R>) -> Result<Self, SolverError> {
-        let radius = S::common_of(&params).particle_radius();
+        let radius = params.common().particle_radius();
         let boundary = CollisionBoundary::new(solids, radius)?;
         Self::with_boundary(params, Box::new(boundary))
     }
@@ -182,8 +181,8 @@ impl<R: Real, S: SubstepScheme<R>> FrameSolver<R, S> {
         params: S::Params,
         boundary: Box<dyn Boundary<R>>,
     ) -> Result<Self, SolverError> {
-        S::validate(&params)?;
-        let common = S::common_of(&params);
+        params.validate()?;
+        let common = params.common();
         check_volume_kernel(
             &*boundary,
             S::NAME,
@@ -281,7 +280,7 @@ impl<R: Real, S: SubstepScheme<R>> FrameSolver<R, S> {
         let frame = self.frames;
         self.frames += 1;
         let mut stats = StepStats::new(S::PHASES);
-        let common = S::common_of(self.scheme.params());
+        let common = self.scheme.params().common();
         let substeps = common.substeps;
         let rest_density = common.rest_density;
         begin_frame(
@@ -358,7 +357,7 @@ impl<R: Real, S: SubstepScheme<R>> FluidSolver<R> for FrameSolver<R, S> {
         FrameSolver::step(self, state)
     }
     fn common(&self) -> &CommonParams<R> {
-        S::common_of(self.scheme.params())
+        self.scheme.params().common()
     }
     fn boundary(&self) -> &dyn Boundary<R> {
         FrameSolver::boundary(self)

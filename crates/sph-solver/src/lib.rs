@@ -39,14 +39,18 @@
 //! - `scratch.rs`: its per-particle buffers (structure of arrays), resized once per frame;
 //! - `passes.rs`: the per-particle loops (each writes one particle's values, so results do
 //!   not depend on the thread count);
-//! - `solver.rs`: `pub struct DfsphScheme<R>` implementing [`SubstepScheme`] (name,
-//!   `PHASES`, `FRAME_PHASES`, `DENSITY_KERNEL`, `validate`, `new`, `begin_frame`,
+//! - `params.rs` also implements [`SolverParameters`] for the parameters (the solver's
+//!   name, `common`, `validate`, `convert` between precisions), once for the frame shell
+//!   and the settings;
+//! - `solver.rs`: `pub struct DfsphScheme<R>` implementing [`SubstepScheme`] (
+//!   `PHASES`, `FRAME_PHASES`, `DENSITY_KERNEL`, `new`, `begin_frame`,
 //!   `substep`, and `save_arrays`/`restore_arrays` when it carries anything between frames,
 //!   e.g. warm-started pressures) and `pub type Dfsph<R> = FrameSolver<R, DfsphScheme<R>>`.
 //!
 //! - `settings.rs`: `DfsphSettings`, its scene-facing `[solver]` table (serde,
 //!   `deny_unknown_fields`, [`CommonSettings`] flattened, each key the name of the
-//!   parameter it sets), implementing [`SolverSettings`] (see [`settings`]).
+//!   parameter it sets), implementing [`SolverSettings`] (see [`settings`]), which also
+//!   declares the scene boundary features it takes ([`scene_boundary`]).
 //!
 //! `Dfsph::new(params, solids)` and `Dfsph::with_boundary(params, boundary)` then exist, and
 //! `Dfsph<R>` is a [`FluidSolver`]. Scene files reach it through one registration line in
@@ -59,7 +63,9 @@ mod error;
 mod fluid_solver;
 pub mod frame;
 pub mod initial;
+mod parameters;
 mod params;
+pub mod scene_boundary;
 pub mod settings;
 pub mod state;
 mod stats;
@@ -75,9 +81,13 @@ pub use boundary::{
 pub use error::{MapFileProblem, SolverError};
 pub use fluid_solver::{FluidSolver, Solids};
 pub use frame::{FrameSolver, SchemeParts, SubstepScheme};
+pub use parameters::SolverParameters;
 pub use params::{
     CommonParams, DEFAULT_SUPPORT_OVER_SPACING, MAX_ITERATIONS_PER_FRAME, MAX_SUBSTEPS,
     VOLUME_MAP_CONTACT_FRACTION,
+};
+pub use scene_boundary::{
+    BoundaryFeature, BoundaryFeatures, MovingWall, PeriodicAxis, Pour, SceneBoundary, WallModel,
 };
 pub use settings::{CommonSettings, SceneValues, SolverSettings};
 pub use state::{ArraySpec, SolverState};

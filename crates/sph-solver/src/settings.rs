@@ -16,7 +16,8 @@ use serde::Deserialize;
 use sph_core::{Real, Vec3};
 use sph_kernels::KernelKind;
 
-use crate::{Boundary, CommonParams, FluidSolver, SolverError};
+use crate::scene_boundary::{BoundaryFeatures, PeriodicAxis, SceneBoundary};
+use crate::{Boundary, CommonParams, FluidSolver, SolverError, SolverParameters};
 
 /// The settings every solver has, flattened into each solver's settings (`[solver]` keys
 /// `substeps`, `rest_density`, `support_over_spacing`, `reorder_every`). `None` = the
@@ -88,8 +89,13 @@ pub struct SceneValues {
 /// solver crate for its settings struct: everything a scene reader needs to make and run
 /// the solver (see the module documentation).
 pub trait SolverSettings: Sized + Clone + std::fmt::Debug + PartialEq {
-    /// The solver's parameters in precision `R`.
-    type Params<R: Real>: Clone + std::fmt::Debug + PartialEq;
+    /// The solver's parameters in precision `R` (their name, common part, range check and
+    /// conversion: [`SolverParameters`]).
+    type Params<R: Real>: SolverParameters<R>;
+
+    /// The scene boundary features the solver takes ([`crate::scene_boundary`]): by
+    /// default solids as collision boundaries or volume maps only.
+    const BOUNDARY_FEATURES: BoundaryFeatures = BoundaryFeatures::SOLIDS_ONLY;
 
     /// The density kernel of the solver (the kernel its volume maps are integrated with and
     /// its masses calibrated with).
@@ -146,14 +152,27 @@ pub trait SolverSettings: Sized + Clone + std::fmt::Debug + PartialEq {
         None
     }
 
-    /// The parameters every solver has.
-    fn common_params<R: Real>(params: &Self::Params<R>) -> &CommonParams<R>;
+    /// The periodic axes the settings state (`periodic` of a solver whose `[solver]` table
+    /// has that key); none by default.
+    fn periodic(&self) -> Vec<PeriodicAxis<f64>> {
+        Vec::new()
+    }
 
-    /// The parameters in precision `S` (an error names a value that does not fit).
-    fn convert<S: Real>(params: &Self::Params<f64>) -> Result<Self::Params<S>, SolverError>;
-
-    /// The parameters' own range checks (`validate`).
-    fn validate<R: Real>(params: &Self::Params<R>) -> Result<(), SolverError>;
+    /// Takes the scene's boundary (walls, moving walls, boundary particles, periodic axes,
+    /// pour) into `params`. By default takes nothing and refuses a boundary that uses a
+    /// feature beyond [`BoundaryFeatures::SOLIDS_ONLY`]'s
+    /// ([`SolverError::UnsupportedFeature`]); a solver that declares more
+    /// [`SolverSettings::BOUNDARY_FEATURES`] takes them here.
+    fn take_scene_boundary(
+        params: &mut Self::Params<f64>,
+        boundary: SceneBoundary<f64>,
+    ) -> Result<(), SolverError> {
+        let _ = params;
+        boundary.check_supported(
+            <Self::Params<f64> as SolverParameters<f64>>::NAME,
+            &BoundaryFeatures::SOLIDS_ONLY,
+        )
+    }
 
     /// The solver with these parameters and `boundary` (its constructor validates them).
     fn build<R: Real>(

@@ -7,7 +7,8 @@
 //! * **Travel per step.** A solver step of `Δt = frame_dt / substeps` moves a particle that
 //!   starts at the fluid's largest initial speed `|v0|` and falls freely by
 //!   `d = (|v0| + |g| Δt) Δt` (semi-implicit Euler, the integrator of every solver here).
-//!   The scene is refused when `d` exceeds the support radius `h`: such a particle leaves
+//!   The scene is refused when `d` exceeds the support radius `h` (the solver's own: its
+//!   `support_over_spacing`, or its default, times the spacing): such a particle leaves
 //!   its whole kernel neighbourhood within one step, so the neighbours found once per step
 //!   cannot see what it hits, and the density or pressure solve cannot act on it. This is
 //!   the Courant–Friedrichs–Lewy condition `v Δt ≤ λ h` (Courant, Friedrichs & Lewy 1928,
@@ -21,7 +22,7 @@
 //!   doi:10.2312/egst.20141034), and speeds grow after the first step. The message says
 //!   how many substeps would pass.
 
-use sph_solver::{DEFAULT_SUPPORT_OVER_SPACING, MAX_SUBSTEPS};
+use sph_solver::MAX_SUBSTEPS;
 
 use crate::error::Ctx;
 use crate::geom::v3;
@@ -80,17 +81,18 @@ pub(super) fn check(ctx: &Ctx, scene: &Scene, quick: Option<&QuickSpec>) -> Resu
     }
 
     let dt = scene.frame_dt_s / substeps as f64;
-    let ratio = scene
+    // The solver's own support radius: `support_over_spacing` if set, else its default.
+    let h = scene
         .solver
+        .params(&scene.scene_values())
         .common()
-        .support_over_spacing
-        .unwrap_or(DEFAULT_SUPPORT_OVER_SPACING);
+        .support_radius;
+    let ratio = h / scene.particle_spacing;
     // No substeps, or no neighbourhood: refused by the solver's own checks, which follow
     // (`params.rs`), at their fields.
     if substeps == 0 || !(ratio.is_finite() && ratio > 1.0) {
         return Ok(());
     }
-    let h = ratio * scene.particle_spacing;
     let g = v3(scene.gravity).norm();
     let v0 = scene
         .fluids

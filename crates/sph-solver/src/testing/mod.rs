@@ -174,7 +174,7 @@ where
 {
     const BLOCK: [usize; 3] = [6, 6, 4];
     const TANK: [f64; 3] = [12.0, 10.0, 4.0];
-    let common = S::common_of(params);
+    let common = crate::SolverParameters::common(params);
     let (state, _, _) = block_in_tank(common, BLOCK, TANK);
     let make = || -> Box<dyn FluidSolver<R>> {
         let (_, solids, tank) = block_in_tank(common, BLOCK, TANK);
