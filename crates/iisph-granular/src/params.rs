@@ -57,6 +57,10 @@ pub const MAX_PRESSURE_ITERATIONS: usize = 100_000;
 /// of repose no longer changes beyond 50); an iteration is two neighbour passes.
 pub const MAX_FRICTION_ITERATIONS: usize = 1000;
 
+/// The cone's match of [`GranularParams::with_friction_angle`]: plane strain, the thesis's
+/// eq. 14 ([`ConeMatch::default`]).
+pub const DEFAULT_CONE_MATCH: ConeMatch = ConeMatch::PlaneStrain;
+
 /// How the Drucker–Prager cone `‖s‖_F ≤ α p` is matched to the friction angle `θ`: which
 /// state of stress the cone is made to agree with Mohr–Coulomb's `|τ| ≤ tan θ · σ_n` in
 /// ([`GranularParams::cone_match`]).
@@ -195,7 +199,7 @@ impl<R: Real> GranularParams<R> {
     pub fn with_friction_angle(friction_angle_deg: R) -> Self {
         Self {
             friction_angle_deg,
-            cone_match: ConeMatch::default(),
+            cone_match: DEFAULT_CONE_MATCH,
             drag_coefficient: R::zero(),
             air_velocity: Vec3::zeros(),
             air_density: R::of_f64(AIR_DENSITY),
