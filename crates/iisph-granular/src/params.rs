@@ -397,6 +397,23 @@ impl<R: Real> IisphParams<R> {
     }
 }
 
+impl<R: Real> SolverParameters<R> for IisphParams<R> {
+    type In<S: Real> = IisphParams<S>;
+    const NAME: &'static str = NAME;
+
+    fn common(&self) -> &CommonParams<R> {
+        &self.common
+    }
+
+    fn validate(&self) -> Result<(), SolverError> {
+        IisphParams::validate(self)
+    }
+
+    fn convert<S: Real>(&self) -> Result<IisphParams<S>, SolverError> {
+        self.try_convert()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::{ConeMatch, GranularParams};
@@ -452,22 +469,5 @@ mod tests {
         let g = g.with_cone_match(ConeMatch::SimpleShear);
         assert!((g.alpha() - ConeMatch::SimpleShear.alpha(30.0)).abs() < 1e-12);
         assert!((g.predicted_repose_angle_deg() - 30.0).abs() < 1e-9);
-    }
-}
-
-impl<R: Real> SolverParameters<R> for IisphParams<R> {
-    type In<S: Real> = IisphParams<S>;
-    const NAME: &'static str = NAME;
-
-    fn common(&self) -> &CommonParams<R> {
-        &self.common
-    }
-
-    fn validate(&self) -> Result<(), SolverError> {
-        IisphParams::validate(self)
-    }
-
-    fn convert<S: Real>(&self) -> Result<IisphParams<S>, SolverError> {
-        self.try_convert()
     }
 }
