@@ -2,7 +2,7 @@
 
 use sph_core::{Aabb, Real, Vec3};
 use sph_solver::scene_boundary::{PeriodicAxis, Pour};
-use sph_solver::{CommonParams, SolverError, SolverParameters};
+use sph_solver::{CommonParams, SolverError};
 
 use crate::name::NAME;
 use crate::stress::{ConeMatch, DruckerPrager};
@@ -486,19 +486,4 @@ impl<R: Real> ElastoplasticParams<R> {
     }
 }
 
-impl<R: Real> SolverParameters<R> for ElastoplasticParams<R> {
-    type In<S: Real> = ElastoplasticParams<S>;
-    const NAME: &'static str = NAME;
-
-    fn common(&self) -> &CommonParams<R> {
-        &self.common
-    }
-
-    fn validate(&self) -> Result<(), SolverError> {
-        ElastoplasticParams::validate(self)
-    }
-
-    fn convert<S: Real>(&self) -> Result<ElastoplasticParams<S>, SolverError> {
-        self.try_convert()
-    }
-}
+sph_solver::solver_parameters!(ElastoplasticParams, NAME);

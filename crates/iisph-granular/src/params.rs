@@ -1,7 +1,7 @@
 //! Parameters of the IISPH solver (water) and of its granular extension.
 
 use sph_core::{Real, Vec3};
-use sph_solver::{CommonParams, SolverError, SolverParameters};
+use sph_solver::{CommonParams, SolverError};
 
 /// Name of the solver in errors and reports.
 pub(crate) const NAME: &str = "IISPH";
@@ -397,22 +397,7 @@ impl<R: Real> IisphParams<R> {
     }
 }
 
-impl<R: Real> SolverParameters<R> for IisphParams<R> {
-    type In<S: Real> = IisphParams<S>;
-    const NAME: &'static str = NAME;
-
-    fn common(&self) -> &CommonParams<R> {
-        &self.common
-    }
-
-    fn validate(&self) -> Result<(), SolverError> {
-        IisphParams::validate(self)
-    }
-
-    fn convert<S: Real>(&self) -> Result<IisphParams<S>, SolverError> {
-        self.try_convert()
-    }
-}
+sph_solver::solver_parameters!(IisphParams, NAME);
 
 #[cfg(test)]
 mod tests {
