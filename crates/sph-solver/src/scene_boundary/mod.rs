@@ -158,3 +158,60 @@ impl<R: Real> SceneBoundary<R> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pour() -> Pour<f64> {
+        Pour {
+            region: Aabb {
+                min: [0.0, 0.0, 0.0].into(),
+                max: [0.1, 0.1, 0.1].into(),
+            },
+            volume_m3: 1e-3,
+            rate_m3_s: 1e-3,
+        }
+    }
+
+    /// A solver of solids only refuses a pour by its scene key, takes a boundary without
+    /// one, and takes what [`SceneBoundary::only`] leaves of any boundary.
+    #[test]
+    fn solids_only_refuses_what_it_does_not_take() {
+        let solids = BoundaryFeatures::SOLIDS_ONLY;
+        let plain = SceneBoundary::<f64>::solids_only();
+        assert!(plain.features().is_empty());
+        assert!(plain.check_supported("t", &solids).is_ok());
+        let poured = SceneBoundary {
+            pour: Some(pour()),
+            wall_models: vec![None, Some(WallModel::FreeSlip)],
+            ..SceneBoundary::solids_only()
+        };
+        assert_eq!(
+            poured.features(),
+            vec![BoundaryFeature::WallModels, BoundaryFeature::Pour]
+        );
+        let e = poured.check_supported("t", &solids).unwrap_err();
+        assert_eq!(
+            e,
+            SolverError::UnsupportedFeature {
+                solver: "t",
+                feature: BoundaryFeature::WallModels
+            }
+        );
+        assert!(e.to_string().contains("wall"), "{e}");
+        let kept = poured.clone().only(&solids);
+        assert!(kept.features().is_empty());
+        assert!(kept.check_supported("t", &solids).is_ok());
+        let all = BoundaryFeatures {
+            particles: true,
+            wall_models: true,
+            moving_walls: true,
+            periodic: true,
+            pour: true,
+            ..solids
+        };
+        assert_eq!(poured.clone().only(&all), poured);
+        assert_eq!(BoundaryFeature::Pour.scene_key(), "[pour]");
+    }
+}
