@@ -2,7 +2,7 @@
 
 use sph_core::{Aabb, Real, Vec3};
 use sph_solver::scene_boundary::{PeriodicAxis, Pour};
-use sph_solver::{CommonParams, SolverError, SolverParameters};
+use sph_solver::{CommonParams, SolverError};
 
 use crate::name::NAME;
 use crate::stress::{ConeMatch, DruckerPrager};
@@ -55,6 +55,9 @@ pub const DEFAULT_ARTIFICIAL_STRESS_EXPONENT: f64 = 2.55;
 /// CFL number `C` of `Δt = C h / c` of the defaults (Bui et al. 2008 take 0.1–0.2; the upper
 /// end).
 pub const DEFAULT_CFL_NUMBER: f64 = 0.2;
+/// The cone's match of the defaults: Bui et al. (2008)'s plane strain of an associated
+/// material ([`ConeMatch::default`]).
+pub const DEFAULT_CONE_MATCH: ConeMatch = ConeMatch::PlaneStrainAssociated;
 /// Neighbour-list skin of the defaults, as a fraction of the particle spacing.
 pub const DEFAULT_SKIN_OVER_SPACING: f64 = 0.3;
 /// Support radius of the defaults over the particle spacing, Bui et al. (2008)'s: their
@@ -198,7 +201,7 @@ impl<R: Real> ElastoplasticParams<R> {
             youngs_modulus: R::of_f64(DEFAULT_YOUNGS_MODULUS_PA),
             poisson_ratio: R::of_f64(DEFAULT_POISSON_RATIO),
             friction_angle_deg,
-            cone_match: ConeMatch::default(),
+            cone_match: DEFAULT_CONE_MATCH,
             dilatancy_angle_deg: R::zero(),
             cohesion: R::zero(),
             viscosity_alpha: R::of_f64(DEFAULT_VISCOSITY_ALPHA),
@@ -483,19 +486,4 @@ impl<R: Real> ElastoplasticParams<R> {
     }
 }
 
-impl<R: Real> SolverParameters<R> for ElastoplasticParams<R> {
-    type In<S: Real> = ElastoplasticParams<S>;
-    const NAME: &'static str = NAME;
-
-    fn common(&self) -> &CommonParams<R> {
-        &self.common
-    }
-
-    fn validate(&self) -> Result<(), SolverError> {
-        ElastoplasticParams::validate(self)
-    }
-
-    fn convert<S: Real>(&self) -> Result<ElastoplasticParams<S>, SolverError> {
-        self.try_convert()
-    }
-}
+sph_solver::solver_parameters!(ElastoplasticParams, NAME);

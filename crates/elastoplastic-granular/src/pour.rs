@@ -212,8 +212,8 @@ impl Pouring {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use sph_core::Aabb;
     use proptest::prelude::*;
+    use sph_core::Aabb;
 
     fn pouring(periodic_z: bool) -> Pouring {
         let pour = Pour {

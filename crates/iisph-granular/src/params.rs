@@ -1,7 +1,7 @@
 //! Parameters of the IISPH solver (water) and of its granular extension.
 
 use sph_core::{Real, Vec3};
-use sph_solver::{CommonParams, SolverError, SolverParameters};
+use sph_solver::{CommonParams, SolverError};
 
 /// Name of the solver in errors and reports.
 pub(crate) const NAME: &str = "IISPH";
@@ -56,6 +56,10 @@ pub const MAX_PRESSURE_ITERATIONS: usize = 100_000;
 /// accepted, bounded by what can finish: the crate's study of the cap went to 400 (the angle
 /// of repose no longer changes beyond 50); an iteration is two neighbour passes.
 pub const MAX_FRICTION_ITERATIONS: usize = 1000;
+
+/// The cone's match of [`GranularParams::with_friction_angle`]: plane strain, the thesis's
+/// eq. 14 ([`ConeMatch::default`]).
+pub const DEFAULT_CONE_MATCH: ConeMatch = ConeMatch::PlaneStrain;
 
 /// How the Drucker–Prager cone `‖s‖_F ≤ α p` is matched to the friction angle `θ`: which
 /// state of stress the cone is made to agree with Mohr–Coulomb's `|τ| ≤ tan θ · σ_n` in
@@ -195,7 +199,7 @@ impl<R: Real> GranularParams<R> {
     pub fn with_friction_angle(friction_angle_deg: R) -> Self {
         Self {
             friction_angle_deg,
-            cone_match: ConeMatch::default(),
+            cone_match: DEFAULT_CONE_MATCH,
             drag_coefficient: R::zero(),
             air_velocity: Vec3::zeros(),
             air_density: R::of_f64(AIR_DENSITY),
@@ -393,6 +397,8 @@ impl<R: Real> IisphParams<R> {
     }
 }
 
+sph_solver::solver_parameters!(IisphParams, NAME);
+
 #[cfg(test)]
 mod tests {
     use super::{ConeMatch, GranularParams};
@@ -448,22 +454,5 @@ mod tests {
         let g = g.with_cone_match(ConeMatch::SimpleShear);
         assert!((g.alpha() - ConeMatch::SimpleShear.alpha(30.0)).abs() < 1e-12);
         assert!((g.predicted_repose_angle_deg() - 30.0).abs() < 1e-9);
-    }
-}
-
-impl<R: Real> SolverParameters<R> for IisphParams<R> {
-    type In<S: Real> = IisphParams<S>;
-    const NAME: &'static str = NAME;
-
-    fn common(&self) -> &CommonParams<R> {
-        &self.common
-    }
-
-    fn validate(&self) -> Result<(), SolverError> {
-        IisphParams::validate(self)
-    }
-
-    fn convert<S: Real>(&self) -> Result<IisphParams<S>, SolverError> {
-        self.try_convert()
     }
 }

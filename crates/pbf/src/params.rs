@@ -1,7 +1,7 @@
 //! Solver parameters, with the paper's values where it gives them.
 
 use sph_core::Real;
-use sph_solver::{CommonParams, SolverError, SolverParameters};
+use sph_solver::{CommonParams, SolverError};
 
 /// Name of the solver in errors and reports.
 pub(crate) const NAME: &str = "PBF";
@@ -257,19 +257,4 @@ impl<R: Real> PbfParams<R> {
     }
 }
 
-impl<R: Real> SolverParameters<R> for PbfParams<R> {
-    type In<S: Real> = PbfParams<S>;
-    const NAME: &'static str = NAME;
-
-    fn common(&self) -> &CommonParams<R> {
-        &self.common
-    }
-
-    fn validate(&self) -> Result<(), SolverError> {
-        PbfParams::validate(self)
-    }
-
-    fn convert<S: Real>(&self) -> Result<PbfParams<S>, SolverError> {
-        self.try_convert()
-    }
-}
+sph_solver::solver_parameters!(PbfParams, NAME);

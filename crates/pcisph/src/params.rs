@@ -1,7 +1,7 @@
 //! Parameters of the PCISPH solver.
 
 use sph_core::Real;
-use sph_solver::{CommonParams, SolverError, SolverParameters};
+use sph_solver::{CommonParams, SolverError};
 
 /// Name of the solver in errors and reports.
 pub(crate) const NAME: &str = "PCISPH";
@@ -168,19 +168,4 @@ impl<R: Real> PcisphParams<R> {
     }
 }
 
-impl<R: Real> SolverParameters<R> for PcisphParams<R> {
-    type In<S: Real> = PcisphParams<S>;
-    const NAME: &'static str = NAME;
-
-    fn common(&self) -> &CommonParams<R> {
-        &self.common
-    }
-
-    fn validate(&self) -> Result<(), SolverError> {
-        PcisphParams::validate(self)
-    }
-
-    fn convert<S: Real>(&self) -> Result<PcisphParams<S>, SolverError> {
-        self.try_convert()
-    }
-}
+sph_solver::solver_parameters!(PcisphParams, NAME);

@@ -2,7 +2,7 @@ use neighbour_search::SearchError;
 use sph_core::CoreError;
 use sph_kernels::KernelError;
 
-use crate::scene_boundary::BoundaryFeature;
+use crate::scene_boundary::feature::BoundaryFeature;
 
 /// Why a volume-map file was refused (in [`SolverError::MapFile`]).
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]

@@ -30,3 +30,28 @@ pub trait SolverParameters<R: Real>: Clone + fmt::Debug + PartialEq + Send {
     /// first finite value that does not fit, [`crate::settings::convert`]).
     fn convert<S: Real>(&self) -> Result<Self::In<S>, SolverError>;
 }
+
+/// Implements [`SolverParameters`] for a solver's parameters type `$Params<R>` named
+/// `$name`: `common` is its field `common`, `validate` and `convert` are its inherent
+/// `validate` and `try_convert` (e.g. `sph_solver::solver_parameters!(PbfParams, NAME);`).
+#[macro_export]
+macro_rules! solver_parameters {
+    ($Params:ident, $name:expr) => {
+        impl<R: $crate::Real> $crate::SolverParameters<R> for $Params<R> {
+            type In<S: $crate::Real> = $Params<S>;
+            const NAME: &'static str = $name;
+
+            fn common(&self) -> &$crate::CommonParams<R> {
+                &self.common
+            }
+
+            fn validate(&self) -> Result<(), $crate::SolverError> {
+                $Params::validate(self)
+            }
+
+            fn convert<S: $crate::Real>(&self) -> Result<$Params<S>, $crate::SolverError> {
+                self.try_convert()
+            }
+        }
+    };
+}

@@ -7,10 +7,13 @@
 //! flattened into it, and implements [`SolverSettings`] for it: the defaults stay those of
 //! the parameters' own constructor (`for_spacing`), the one range check is the parameters'
 //! own `validate`, and the parameters are built once, in `f64`, then converted to the
-//! precision the solver runs in ([`SolverSettings::convert`], failing on a value that does
-//! not fit, [`convert`]). A scene reader (`sph-scene`) registers each settings struct with
-//! one line; the solver kinds, the scene's solver enum, the factory and the density kernel
-//! follow from this trait.
+//! precision the solver runs in ([`SolverParameters::convert`], failing on a value that
+//! does not fit, [`convert`]). The settings also declare the scene boundary features the
+//! solver takes ([`SolverSettings::BOUNDARY_FEATURES`], [`crate::scene_boundary`]) and take
+//! the scene's boundary into the parameters ([`SolverSettings::take_scene_boundary`]). A
+//! scene reader (`sph-scene`) registers each settings struct with one line; the solver
+//! kinds, the scene's solver enum, the factory and the density kernel follow from this
+//! trait.
 
 use serde::Deserialize;
 use sph_core::{Real, Vec3};

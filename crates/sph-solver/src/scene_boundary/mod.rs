@@ -10,66 +10,19 @@
 //! a solver that does not take a feature the scene uses refuses it
 //! ([`SolverError::UnsupportedFeature`], naming the scene key).
 
+pub(crate) mod feature;
 mod periodic;
 mod pour;
 mod walls;
 
 use sph_core::{Aabb, Real};
 
+pub use feature::BoundaryFeature;
 pub use periodic::{Axis, PeriodicAxis, PeriodicSetting};
 pub use pour::{Pour, MAX_POURED_GRAINS};
 pub use walls::{MovingWall, WallModel, MAX_WALL_FRICTION, MAX_WALL_MOTION_S};
 
 use crate::SolverError;
-
-/// One feature of a scene's boundary that a solver may or may not take.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[non_exhaustive]
-pub enum BoundaryFeature {
-    /// Solids as collision boundaries (`[boundary] model = "collision"`).
-    Collision,
-    /// Solids as volume maps (`[boundary] model = "volume-map"`).
-    VolumeMap,
-    /// Walls of boundary particles (`[boundary] model = "particles"`,
-    /// [`SceneBoundary::boundary_particle_region`]).
-    Particles,
-    /// A wall model per solid (`wall` of `[tank]` and `[[solid]]`,
-    /// [`SceneBoundary::wall_models`]).
-    WallModels,
-    /// Moving walls (`motion` of a `[[solid]]`, [`SceneBoundary::moving_walls`]).
-    MovingWalls,
-    /// Periodic axes (`[solver] periodic`, [`SceneBoundary::periodic`]).
-    Periodic,
-    /// A pour (`[pour]`, [`SceneBoundary::pour`]).
-    Pour,
-}
-
-impl BoundaryFeature {
-    /// Every feature.
-    pub const ALL: [BoundaryFeature; 7] = [
-        BoundaryFeature::Collision,
-        BoundaryFeature::VolumeMap,
-        BoundaryFeature::Particles,
-        BoundaryFeature::WallModels,
-        BoundaryFeature::MovingWalls,
-        BoundaryFeature::Periodic,
-        BoundaryFeature::Pour,
-    ];
-
-    /// The scene key that asks for it, as the file writes it (`[pour]`, `solver.periodic`,
-    /// `[boundary] model = "particles"`, …).
-    pub fn scene_key(self) -> &'static str {
-        match self {
-            BoundaryFeature::Collision => "[boundary] model = \"collision\"",
-            BoundaryFeature::VolumeMap => "[boundary] model = \"volume-map\"",
-            BoundaryFeature::Particles => "[boundary] model = \"particles\"",
-            BoundaryFeature::WallModels => "wall (of [tank] or a [[solid]])",
-            BoundaryFeature::MovingWalls => "motion (of a [[solid]])",
-            BoundaryFeature::Periodic => "solver.periodic",
-            BoundaryFeature::Pour => "[pour]",
-        }
-    }
-}
 
 /// Which [`BoundaryFeature`]s a solver takes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -203,5 +156,62 @@ impl<R: Real> SceneBoundary<R> {
             Some(feature) => Err(SolverError::UnsupportedFeature { solver, feature }),
             None => Ok(()),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pour() -> Pour<f64> {
+        Pour {
+            region: Aabb {
+                min: [0.0, 0.0, 0.0].into(),
+                max: [0.1, 0.1, 0.1].into(),
+            },
+            volume_m3: 1e-3,
+            rate_m3_s: 1e-3,
+        }
+    }
+
+    /// A solver of solids only refuses a pour by its scene key, takes a boundary without
+    /// one, and takes what [`SceneBoundary::only`] leaves of any boundary.
+    #[test]
+    fn solids_only_refuses_what_it_does_not_take() {
+        let solids = BoundaryFeatures::SOLIDS_ONLY;
+        let plain = SceneBoundary::<f64>::solids_only();
+        assert!(plain.features().is_empty());
+        assert!(plain.check_supported("t", &solids).is_ok());
+        let poured = SceneBoundary {
+            pour: Some(pour()),
+            wall_models: vec![None, Some(WallModel::FreeSlip)],
+            ..SceneBoundary::solids_only()
+        };
+        assert_eq!(
+            poured.features(),
+            vec![BoundaryFeature::WallModels, BoundaryFeature::Pour]
+        );
+        let e = poured.check_supported("t", &solids).unwrap_err();
+        assert_eq!(
+            e,
+            SolverError::UnsupportedFeature {
+                solver: "t",
+                feature: BoundaryFeature::WallModels
+            }
+        );
+        assert!(e.to_string().contains("wall"), "{e}");
+        let kept = poured.clone().only(&solids);
+        assert!(kept.features().is_empty());
+        assert!(kept.check_supported("t", &solids).is_ok());
+        let all = BoundaryFeatures {
+            particles: true,
+            wall_models: true,
+            moving_walls: true,
+            periodic: true,
+            pour: true,
+            ..solids
+        };
+        assert_eq!(poured.clone().only(&all), poured);
+        assert_eq!(BoundaryFeature::Pour.scene_key(), "[pour]");
     }
 }
