@@ -167,12 +167,7 @@ pub struct ElastoplasticParams<R: Real> {
 }
 
 fn invalid(name: &'static str, value: f64, reason: &'static str) -> SolverError {
-    SolverError::InvalidParameter {
-        solver: NAME,
-        name,
-        value,
-        reason,
-    }
+    SolverError::invalid(NAME, name, value, reason)
 }
 
 fn check_range(

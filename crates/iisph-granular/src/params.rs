@@ -282,20 +282,11 @@ impl<R: Real> GranularParams<R> {
 }
 
 fn invalid(name: &'static str, value: f64, reason: &'static str) -> SolverError {
-    SolverError::InvalidParameter {
-        solver: NAME,
-        name,
-        value,
-        reason,
-    }
+    SolverError::invalid(NAME, name, value, reason)
 }
 
 fn non_negative<R: Real>(name: &'static str, v: R) -> Result<(), SolverError> {
-    if v.is_finite_value() && v >= R::zero() {
-        Ok(())
-    } else {
-        Err(invalid(name, v.as_f64(), "must be finite and >= 0"))
-    }
+    SolverError::non_negative(NAME, name, v)
 }
 
 impl<R: Real> Default for IisphParams<R> {

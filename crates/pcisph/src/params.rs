@@ -66,12 +66,7 @@ impl<R: Real> Default for PcisphParams<R> {
 }
 
 fn invalid(name: &'static str, value: f64, reason: &'static str) -> SolverError {
-    SolverError::InvalidParameter {
-        solver: NAME,
-        name,
-        value,
-        reason,
-    }
+    SolverError::invalid(NAME, name, value, reason)
 }
 
 impl<R: Real> PcisphParams<R> {

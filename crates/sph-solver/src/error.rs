@@ -2,6 +2,8 @@ use neighbour_search::SearchError;
 use sph_core::CoreError;
 use sph_kernels::KernelError;
 
+use sph_core::Real;
+
 use crate::scene_boundary::feature::BoundaryFeature;
 
 /// Why a volume-map file was refused (in [`SolverError::MapFile`]).
@@ -145,4 +147,41 @@ pub enum SolverError {
         /// What does not fit.
         reason: String,
     },
+}
+
+impl SolverError {
+    /// [`SolverError::InvalidParameter`]: `solver`'s parameter `name` = `value`, refused for
+    /// `reason`.
+    pub fn invalid(
+        solver: &'static str,
+        name: &'static str,
+        value: f64,
+        reason: &'static str,
+    ) -> Self {
+        SolverError::InvalidParameter {
+            solver,
+            name,
+            value,
+            reason,
+        }
+    }
+
+    /// `Ok` when `v` (parameter `name` of `solver`) is finite and `>= 0`, else
+    /// [`SolverError::InvalidParameter`] ("must be finite and >= 0").
+    pub fn non_negative<R: Real>(
+        solver: &'static str,
+        name: &'static str,
+        v: R,
+    ) -> Result<(), SolverError> {
+        if v.is_finite_value() && v >= R::zero() {
+            Ok(())
+        } else {
+            Err(Self::invalid(
+                solver,
+                name,
+                v.as_f64(),
+                "must be finite and >= 0",
+            ))
+        }
+    }
 }
