@@ -16,7 +16,7 @@
 //! Why a pour: a heap formed by pouring grows by surface avalanches that stop at its toe
 //! (in compression), where a drained heap's flanks form while they flow out (in extension);
 //! with a Drucker–Prager cone the two stand at different angles
-//! (`docs/elastoplastic-granular.md`, run 40).
+//! (`docs/elastoplastic-granular.md`, "Walls, moving walls, periodic axes and the pour").
 
 use sph_core::{ParticleSet, Real, Vec3};
 use sph_solver::SolverError;

@@ -110,7 +110,7 @@ pub(crate) fn build_boundary_reporting<R: Real>(
         // under the wall the boundary particles carry. At the particle radius (the
         // `collision` model's) it would hold the first layer, which rests half a spacing
         // above the wall, rigidly in place of the boundary particles' stress and round the
-        // solids' edges by half a spacing (docs/elastoplastic-granular.md, run 31).
+        // solids' edges by half a spacing (docs/elastoplastic-granular.md, "Walls, moving walls, periodic axes and the pour").
         BoundaryModel::Collision | BoundaryModel::Particles => {
             let contact = if scene.boundary.model == BoundaryModel::Particles {
                 c.volume_map_contact_distance()
