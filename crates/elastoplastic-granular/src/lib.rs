@@ -77,7 +77,8 @@
 //!   mirrors the particle's and its velocity is zero (free-slip: normal components only).
 //!   Particles are also projected out of the solids to the contact distance, as in the
 //!   workspace's other solvers.
-//! - Periodic axes ([`periodic`]) by images of the particles near the ends.
+//! - Periodic axes by images of the particles near the ends
+//!   (`sph_solver::scene_boundary::PeriodicImages`).
 //! - Time integration: symplectic Euler instead of Bui's leap-frog.
 //! - A particle without any granular neighbour inside the kernel support (a grain out of
 //!   contact) carries no stress; otherwise its zero velocity gradient would keep the last
@@ -96,7 +97,6 @@ mod kernels;
 mod name;
 mod params;
 mod passes;
-pub mod periodic;
 pub mod pour;
 mod scratch;
 mod settings;
@@ -119,12 +119,12 @@ pub use params::{
     MAX_FRICTION_ANGLE_DEG, MAX_MOVING_WALLS, MAX_POISSON_RATIO, MAX_VISCOSITY_COEFFICIENT,
     MAX_WALL_FRICTION, MAX_WALL_MODELS, MAX_WALL_MOTION_S, MAX_YOUNGS_MODULUS_PA,
 };
-pub use periodic::PeriodicAxis;
 pub use pour::{Pour, MAX_POURED_GRAINS};
 pub use settings::{ElastoplasticSettings, WITH_COMMON_FRICTION_ANGLE_DEG};
 pub use solver::{
     Elastoplastic, ElastoplasticScheme, ELASTOPLASTIC_PHASES, ELASTOPLASTIC_STATE_ARRAYS,
 };
+pub use sph_solver::scene_boundary::PeriodicAxis;
 pub use sph_solver::scene_boundary::{Axis, PeriodicSetting, SceneBoundary};
 pub use stress::{ConeMatch, DruckerPrager, StressUpdate};
 pub use walls::volume_map_walls;

@@ -56,7 +56,7 @@ pub const DEFAULT_ARTIFICIAL_STRESS_EXPONENT: f64 = 2.55;
 /// end).
 pub const DEFAULT_CFL_NUMBER: f64 = 0.2;
 /// The cone's match of the defaults: Bui et al. (2008)'s plane strain of an associated
-/// material ([`ConeMatch::default`]).
+/// material.
 pub const DEFAULT_CONE_MATCH: ConeMatch = ConeMatch::PlaneStrainAssociated;
 /// Neighbour-list skin of the defaults, as a fraction of the particle spacing.
 pub const DEFAULT_SKIN_OVER_SPACING: f64 = 0.3;

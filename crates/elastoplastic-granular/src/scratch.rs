@@ -4,8 +4,9 @@
 use nalgebra::Matrix3;
 use sph_core::{Real, Vec3};
 
-use crate::boundary_particles::{BoundaryLists, BoundaryParticle};
-use crate::periodic::Images;
+use sph_solver::boundary::wall_extrapolation::BoundaryLists;
+use sph_solver::boundary::BoundaryParticle;
+use sph_solver::scene_boundary::PeriodicImages;
 
 /// Per-particle arrays (structure of arrays).
 #[derive(Debug, Clone, Default)]
@@ -40,7 +41,7 @@ pub(crate) struct Scratch<R: Real> {
     pub wall_grad: Vec<Vec3<R>>,
     /// Images of the particles near periodic ends, and the particles followed by them (the
     /// array the neighbour lists index).
-    pub images: Images<R>,
+    pub images: PeriodicImages<R>,
     pub x_ext: Vec<Vec3<R>>,
     /// Permutation scratch.
     pub permute_m: Vec<Matrix3<R>>,

@@ -9,21 +9,22 @@ use nalgebra::Matrix3;
 use sph_core::{apply_permutation, ParticleSet, Real, Vec3};
 use sph_kernels::KernelKind;
 use sph_solver::boundary::{check_volume_kernel, VolumeMapBoundary};
+use sph_solver::scene_boundary::{PeriodicAxis, Pour};
 use sph_solver::state::{match_arrays, ArraySpec};
 use sph_solver::step::{blow_up, check_divergence, FramePhases, StepAt};
 use sph_solver::{FrameSolver, SchemeParts, SolverError, StepStats, SubstepScheme};
 
-use crate::boundary_particles::{
-    extrapolate, sample_moving_wall, sample_solids, BoundaryParticle, Extrapolation,
-    MAX_BOUNDARY_PARTICLES,
-};
+use sph_solver::boundary::wall_extrapolation::{extrapolate, Extrapolation};
+use sph_solver::boundary::{BoundaryParticle, MAX_BOUNDARY_PARTICLES};
+
+use crate::boundary_particles::{sample_moving_wall, sample_solids};
 use crate::kernels::{Consts, ELASTOPLASTIC_KERNEL};
 use crate::params::{ElastoplasticParams, InitialStress, WallModel};
 use crate::passes::{
     boundary_pair_terms, max_displacement, momentum_pass, stress_pass, StepInputs,
 };
-use crate::pour::Pouring;
 use crate::scratch::Scratch;
+use crate::stress::artificial_stress;
 use crate::walls::{SharedWalls, WallSampler};
 
 pub(crate) use crate::name::NAME;
@@ -49,7 +50,8 @@ const REORDER: usize = 5;
 /// plastic shear strain (`n` values). The density is the particles' own. Once a wall of
 /// boundary particles has moved, also `boundary_motion`: each boundary particle's position
 /// and wall velocity (6 values per boundary particle, m and m/s). With a pour
-/// ([`crate::Pour`]), `pour`: the layers placed so far (one value).
+/// ([`crate::Pour`]), the frame shell adds `pour`
+/// ([`sph_solver::frame::POUR_STATE_ARRAY`]): the layers placed so far (one value).
 pub const ELASTOPLASTIC_STATE_ARRAYS: &[&str] =
     &["stress", "plastic_strain", "boundary_motion", "pour"];
 
@@ -82,8 +84,6 @@ pub struct ElastoplasticScheme<R: Real> {
     searches: u64,
     /// The initial stress is still to be applied (at the first frame's start).
     initial_stress_pending: bool,
-    /// The parameters' pour, under way.
-    pouring: Option<Pouring>,
 }
 
 /// A moving wall ([`crate::MovingWall`]) to stop: its boundary particles and the time (s
@@ -182,17 +182,7 @@ impl<R: Real> ElastoplasticScheme<R> {
                 stop_s: wall.duration_s.as_f64(),
             });
         }
-        let g = params.common.gravity.norm().as_f64();
-        let pouring = params.pour.as_ref().map(|p| {
-            Pouring::new(
-                p,
-                params.common.particle_spacing.as_f64(),
-                g,
-                &params.periodic,
-            )
-        });
         let mut scheme = Self {
-            pouring,
             c: Consts::new(&params)?,
             initial_stress_pending: params.initial_stress == InitialStress::Geostatic,
             params,
@@ -446,33 +436,6 @@ impl<R: Real> ElastoplasticScheme<R> {
         );
     }
 
-    /// The layers of the parameters' pour due by the start of frame `at.step` that have
-    /// room ([`crate::Pour`]): the new grains at rest and unstressed, after the others.
-    fn pour(&mut self, state: &mut ParticleSet<R>, at: StepAt) -> Result<(), SolverError> {
-        let Some(pouring) = &mut self.pouring else {
-            return Ok(());
-        };
-        let time_s = at.step as f64 * self.params.common.dt.as_f64();
-        let (mass, rho0) = (
-            self.params.common.particle_mass(),
-            self.params.common.rest_density,
-        );
-        let old = state.len();
-        if pouring.pour(time_s, state, mass, rho0)? > 0 {
-            let n = state.len();
-            self.resize(n);
-            self.scratch.stress[old..n].fill(Matrix3::zeros());
-            self.scratch.plastic_strain[old..n].fill(R::zero());
-            self.lists_valid = false;
-        }
-        Ok(())
-    }
-
-    /// The parameters' pour: layers placed so far and in all (`None` without a pour).
-    pub fn poured_layers(&self) -> Option<(usize, usize)> {
-        self.pouring.as_ref().map(|p| (p.poured, p.layers()))
-    }
-
     /// Explicit steps taken so far, and neighbour searches made for them.
     pub fn counts(&self) -> (u64, u64) {
         (self.explicit_steps, self.searches)
@@ -562,7 +525,7 @@ impl<R: Real> ElastoplasticScheme<R> {
             let bp = &self.boundary_particles;
             if !bp.is_empty() {
                 let e = Extrapolation {
-                    c: self.c,
+                    kernel: self.c.kernel,
                     images: &s.images,
                     x: &s.x,
                     rho: &s.rho,
@@ -575,19 +538,21 @@ impl<R: Real> ElastoplasticScheme<R> {
             stress_pass(s, &inputs);
             if !bp.is_empty() {
                 let e = Extrapolation {
-                    c: self.c,
+                    kernel: self.c.kernel,
                     images: &s.images,
                     x: &s.x,
                     rho: &s.rho,
                     particles: bp,
                     gravity: self.params.common.gravity,
                 };
+                let (rho0, eps) = (self.c.rho0, self.c.eps_stress);
+                let art = |s_b: &Matrix3<R>| artificial_stress(s_b, rho0, eps);
                 extrapolate(
                     &e,
                     &s.boundary_lists,
                     &mut s.stress_new,
                     None,
-                    Some(&mut s.art),
+                    Some((&mut s.art, &art)),
                 );
                 boundary_pair_terms(s, n);
             }
@@ -660,6 +625,22 @@ impl<R: Real> SubstepScheme<R> for ElastoplasticScheme<R> {
         self.resize(state.len());
         self.apply_initial_stress(&state.positions)
     }
+    fn pour(&self) -> Option<&Pour<R>> {
+        self.params.pour.as_ref()
+    }
+    fn periodic_axes(&self) -> &[PeriodicAxis<R>] {
+        &self.params.periodic
+    }
+    /// Poured grains start unstressed, with no plastic strain, and the neighbour lists are
+    /// rebuilt.
+    fn init_emitted(&mut self, state: &ParticleSet<R>, first: usize) -> Result<(), SolverError> {
+        let n = state.len();
+        self.resize(n);
+        self.scratch.stress[first..n].fill(Matrix3::zeros());
+        self.scratch.plastic_strain[first..n].fill(R::zero());
+        self.lists_valid = false;
+        Ok(())
+    }
     fn substep(
         &mut self,
         state: &mut ParticleSet<R>,
@@ -667,9 +648,6 @@ impl<R: Real> SubstepScheme<R> for ElastoplasticScheme<R> {
         _last: bool,
         stats: &mut StepStats,
     ) -> Result<(), SolverError> {
-        if at.substep == 0 {
-            self.pour(state, at)?;
-        }
         self.time_step(state, at, stats)
     }
     /// The stress (Pa, `xx, yy, zz, xy, yz, zx`) and the equivalent plastic shear strain:
@@ -690,9 +668,6 @@ impl<R: Real> SubstepScheme<R> for ElastoplasticScheme<R> {
                     })
                     .collect(),
             ));
-        }
-        if let Some(p) = &self.pouring {
-            arrays.push(("pour".into(), vec![R::of_f64(p.poured as f64)]));
         }
     }
     fn restore_arrays(
@@ -717,34 +692,8 @@ impl<R: Real> SubstepScheme<R> for ElastoplasticScheme<R> {
                     name: "boundary_motion",
                     len: 6 * self.boundary_particles.len(),
                 },
-                ArraySpec {
-                    name: "pour",
-                    len: 1,
-                },
             ],
         )?;
-        if let Some(p) = &mut self.pouring {
-            let poured = found[3].map_or(0.0, |v| v[0].as_f64());
-            let layers = p.layers();
-            if !(poured >= 0.0 && poured <= layers as f64 && poured.fract() == 0.0)
-                || poured as usize * p.grains_per_layer() > n
-            {
-                return Err(SolverError::InvalidSolverState {
-                    solver: NAME.to_owned(),
-                    reason: format!(
-                        "the pour's layers placed ({poured}) must be a whole number in [0, {layers}] whose grains the {n} particles hold"
-                    ),
-                });
-            }
-            p.poured = poured as usize;
-        } else if found[3].is_some() {
-            return Err(SolverError::InvalidSolverState {
-                solver: NAME.to_owned(),
-                reason:
-                    "the state carries a pour's progress (`pour`) but the parameters have no pour"
-                        .into(),
-            });
-        }
         if let Some(v) = found[2] {
             if v.iter().any(|x| !x.is_finite()) {
                 return Err(SolverError::InvalidSolverState {

@@ -46,96 +46,18 @@ pub struct DruckerPrager<R: Real> {
     pub shear_modulus: R,
     /// Bulk modulus `K = E/(3(1 − 2ν))` (Pa).
     pub bulk_modulus: R,
-    /// `α_φ` of the friction angle ([`ConeMatch::alpha`], dimensionless).
+    /// `α_φ` of the friction angle ([`ConeMatch::alpha_phi`], dimensionless).
     pub alpha_phi: R,
-    /// `α_ψ` of the dilatancy angle ([`ConeMatch::alpha`], dimensionless).
+    /// `α_ψ` of the dilatancy angle ([`ConeMatch::alpha_phi`], dimensionless).
     pub alpha_psi: R,
     /// `k_c` of the cohesion ([`ConeMatch::k_c`], Pa).
     pub k_c: R,
 }
 
-/// `tan a/√(9 + 12 tan² a)` for an angle `a` in degrees: the plane-strain Drucker–Prager
-/// coefficient of Bui et al. (2008) ([`ConeMatch::PlaneStrainAssociated`]).
-pub fn plane_strain_alpha(angle_deg: f64) -> f64 {
-    let t = angle_deg.to_radians().tan();
-    t / (9.0 + 12.0 * t * t).sqrt()
-}
-
-/// Where the Drucker–Prager cone `√J2 + α_φ I1 ≤ k_c` meets Mohr–Coulomb's
-/// `|τ| ≤ c + σ_n tan φ`: the state of stress in which a friction angle `φ` and a cohesion
-/// `c` fix `α_φ` and `k_c` (and the dilatancy angle `ψ` fixes `α_ψ` the same way). In scene
-/// files `cone_match = "plane-strain-associated"` (the default), `"plane-strain"` or
-/// `"simple-shear"`. In the thesis's notation of crate `iisph-granular` (`‖s‖_F ≤ α p`),
-/// `α = 3√2 α_φ`, and the two crates' `plane-strain` and `simple-shear` are the same cones.
-///
-/// | match | `α_φ` | `k_c` | repose `β` at φ = 20°, 30°, 40° |
-/// |---|---|---|---|
-/// | `PlaneStrainAssociated` | `tan φ/√(9 + 12 tan² φ)` | `3c/√(9 + 12 tan² φ)` | 18.5°, 25.7°, 31.1° |
-/// | `PlaneStrain` | `sin φ / 3` | `c cos φ` | 18.9°, 26.6°, 32.7° |
-/// | `SimpleShear` | `tan φ / 3` | `c` | 20°, 30°, 40° |
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-#[non_exhaustive]
-pub enum ConeMatch {
-    /// Bui et al. (2008)'s match: the cone through Mohr–Coulomb in plane strain for an
-    /// associated material (`ψ = φ`), the match of their column collapse.
-    #[default]
-    PlaneStrainAssociated,
-    /// Plane strain at zero dilatancy: the plastic strain rate has no out-of-plane part, so
-    /// `s_zz = 0`, `√J2` is the Mohr circle's radius and `−I1/3` its centre, and
-    /// Mohr–Coulomb is `√J2 ≤ −(I1/3) sin φ + c cos φ` exactly (the thesis's eq. 14 match).
-    PlaneStrain,
-    /// Simple shear on the planes of slip (the stress of a flank that flowed and stopped,
-    /// see the module docs): `√J2 = |τ|`, `−I1/3 = σ_n`, so Coulomb's law on the slip planes
-    /// is `√J2 ≤ −(I1/3) tan φ + c`. Under it the friction angle is the angle of repose.
-    SimpleShear,
-}
-
-impl ConeMatch {
-    /// `α` for an angle `a` (degrees): `α_φ` of a friction angle, `α_ψ` of a dilatancy angle.
-    pub fn alpha(self, angle_deg: f64) -> f64 {
-        let a = angle_deg.to_radians();
-        match self {
-            ConeMatch::PlaneStrainAssociated => plane_strain_alpha(angle_deg),
-            ConeMatch::PlaneStrain => a.sin() / 3.0,
-            ConeMatch::SimpleShear => a.tan() / 3.0,
-        }
-    }
-
-    /// The name in scene files.
-    pub fn name(self) -> &'static str {
-        match self {
-            ConeMatch::PlaneStrainAssociated => "plane-strain-associated",
-            ConeMatch::PlaneStrain => "plane-strain",
-            ConeMatch::SimpleShear => "simple-shear",
-        }
-    }
-
-    /// `k_c` (Pa) of cohesion `c` (Pa) at friction angle `φ` (degrees).
-    pub fn k_c(self, cohesion: f64, friction_angle_deg: f64) -> f64 {
-        let t = friction_angle_deg.to_radians().tan();
-        match self {
-            ConeMatch::PlaneStrainAssociated => 3.0 * cohesion / (9.0 + 12.0 * t * t).sqrt(),
-            ConeMatch::PlaneStrain => cohesion * friction_angle_deg.to_radians().cos(),
-            ConeMatch::SimpleShear => cohesion,
-        }
-    }
-
-    /// The slope (degrees) a cohesionless heap of zero dilatancy that formed by flowing
-    /// comes to rest at: `atan(3 α_φ)` (module docs).
-    pub fn predicted_repose_angle_deg(self, friction_angle_deg: f64) -> f64 {
-        (3.0 * self.alpha(friction_angle_deg)).atan().to_degrees()
-    }
-
-    /// The steepest slope (degrees) a settled cohesionless wedge holds: the cone's
-    /// Mohr–Coulomb angle in plane strain, `asin(3 α_φ)` (90° when `3 α_φ ≥ 1`; module docs).
-    pub fn max_stable_slope_deg(self, friction_angle_deg: f64) -> f64 {
-        (3.0 * self.alpha(friction_angle_deg))
-            .min(1.0)
-            .asin()
-            .to_degrees()
-    }
-}
+/// How the cone is matched to Mohr–Coulomb: the vocabulary the granular solvers share
+/// (`sph_solver::cone_match`, with the table of `α_φ`, `k_c` and the slope at rest of each
+/// match); this solver uses `α_φ` and `k_c` as they are.
+pub use sph_solver::cone_match::{plane_strain_alpha, ConeMatch};
 
 /// The stress increment of one explicit step and what it did plastically.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -190,8 +112,8 @@ impl<R: Real> DruckerPrager<R> {
         Self {
             shear_modulus: R::of_f64(youngs_modulus / (2.0 * (1.0 + poisson_ratio))),
             bulk_modulus: R::of_f64(youngs_modulus / (3.0 * (1.0 - 2.0 * poisson_ratio))),
-            alpha_phi: R::of_f64(cone_match.alpha(friction_angle_deg)),
-            alpha_psi: R::of_f64(cone_match.alpha(dilatancy_angle_deg)),
+            alpha_phi: R::of_f64(cone_match.alpha_phi(friction_angle_deg)),
+            alpha_psi: R::of_f64(cone_match.alpha_phi(dilatancy_angle_deg)),
             k_c: R::of_f64(cone_match.k_c(cohesion, friction_angle_deg)),
         }
     }

@@ -37,19 +37,19 @@ fn small_pour(layers: f64, funnel_top_m: f64) -> (Elastoplastic<f64>, ParticleSe
 #[test]
 fn a_pour_adds_its_layers_on_schedule() {
     let (mut solver, mut state) = small_pour(12.0, 1.0);
-    assert_eq!(solver.scheme().poured_layers(), Some((0, 12)));
+    assert_eq!(solver.poured_layers(), Some((0, 12)));
     assert_eq!(state.len(), 0);
     let mut frame_start_s = 0.0f64;
     for _ in 0..32 {
         solver.step(&mut state).unwrap();
-        let (done, _) = solver.scheme().poured_layers().unwrap();
+        let (done, _) = solver.poured_layers().unwrap();
         // Due at the frame's start: floor(30 t).
         let due = (30.0 * frame_start_s + 1e-9).floor() as usize;
         assert!(done <= due.min(12), "{done} layers by {frame_start_s} s");
         assert_eq!(state.len(), 6 * done);
         frame_start_s += 0.016;
     }
-    assert_eq!(solver.scheme().poured_layers(), Some((12, 12)));
+    assert_eq!(solver.poured_layers(), Some((12, 12)));
     assert_eq!(state.len(), 72);
     assert!(state.positions.iter().all(|p| p.y > 0.0 && p.y < 0.3));
 }
@@ -89,7 +89,7 @@ fn poured_grains_start_unstressed() {
     rows.extend(floor(0.3, l));
     solver.scheme_mut().set_boundary_particles(rows).unwrap();
     let before = state.len();
-    while solver.scheme().poured_layers() == Some((0, 10)) {
+    while solver.poured_layers() == Some((0, 10)) {
         solver.step(&mut state).unwrap();
     }
     assert_eq!(state.len(), before + 6);
@@ -129,10 +129,7 @@ fn a_pour_resumes_bit_for_bit() {
     for _ in 0..25 {
         second.step(&mut resumed_state).unwrap();
     }
-    assert_eq!(
-        first.scheme().poured_layers(),
-        second.scheme().poured_layers()
-    );
+    assert_eq!(first.poured_layers(), second.poured_layers());
     assert_eq!(state.positions, resumed_state.positions);
     assert_eq!(state.velocities, resumed_state.velocities);
     assert_eq!(first.scheme().stress(), second.scheme().stress());

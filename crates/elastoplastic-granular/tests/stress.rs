@@ -239,7 +239,7 @@ mod cone_match {
             }
         }
         assert_eq!(
-            ConeMatch::PlaneStrainAssociated.alpha(30.0),
+            ConeMatch::PlaneStrainAssociated.alpha_phi(30.0),
             plane_strain_alpha(30.0)
         );
         // a settled wedge of the default match holds to asin(3 α_φ) = 28.71° at φ = 30°

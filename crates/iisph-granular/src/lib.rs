@@ -153,7 +153,7 @@
 //!   imposes;
 //! - simple shear: `tan β = tan θ`, **β = θ**: the friction angle is the angle of repose.
 //!
-//! [`ConeMatch::predicted_repose_angle_deg`] returns `atan(α/√2)`. The Coulomb friction at
+//! [`ConeMatch::predicted_repose_angle_deg`] returns `atan(α/√2)` (`= atan(3 α_φ)`, [`cone_alpha`]). The Coulomb friction at
 //! walls (see the deviations) uses `μ = tan θ` under either match. The thesis's match is the
 //! default so that its experiments run as printed; the workspace's repose scenes
 //! (`scenes/granular_repose_thesis_*.toml`) choose `cone_match = "simple-shear"`, so that
@@ -322,7 +322,7 @@ mod walls;
 
 pub use kernels::IISPH_KERNEL;
 pub use params::{
-    ConeMatch, GranularParams, IisphParams, AIR_DENSITY, DEFAULT_CONE_MATCH,
+    cone_alpha, ConeMatch, GranularParams, IisphParams, AIR_DENSITY, DEFAULT_CONE_MATCH,
     DEFAULT_DRAG_CONE_HALF_ANGLE_DEG, DEFAULT_FRICTION_MAX_ITERATIONS, DEFAULT_FRICTION_RELAXATION,
     DEFAULT_FRICTION_TOLERANCE, DEFAULT_MAX_ITERATIONS, DEFAULT_MIN_ITERATIONS,
     MAX_FRICTION_ITERATIONS, MAX_PRESSURE_ITERATIONS,

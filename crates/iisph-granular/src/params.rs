@@ -57,67 +57,35 @@ pub const MAX_PRESSURE_ITERATIONS: usize = 100_000;
 /// of repose no longer changes beyond 50); an iteration is two neighbour passes.
 pub const MAX_FRICTION_ITERATIONS: usize = 1000;
 
-/// The cone's match of [`GranularParams::with_friction_angle`]: plane strain, the thesis's
-/// eq. 14 ([`ConeMatch::default`]).
+/// The cone's match of [`GranularParams::with_friction_angle`] and of scenes that name none:
+/// plane strain, the thesis's eq. 14, so that its experiments run as printed.
 pub const DEFAULT_CONE_MATCH: ConeMatch = ConeMatch::PlaneStrain;
 
-/// How the Drucker–Prager cone `‖s‖_F ≤ α p` is matched to the friction angle `θ`: which
-/// state of stress the cone is made to agree with Mohr–Coulomb's `|τ| ≤ tan θ · σ_n` in
-/// ([`GranularParams::cone_match`]).
+/// How the Drucker–Prager cone is matched to Mohr–Coulomb (`sph_solver::cone_match`, the
+/// vocabulary the granular solvers share; [`GranularParams::cone_match`]).
+pub use sph_solver::ConeMatch;
+
+/// The Drucker–Prager coefficient `α` of this solver's cone `‖s‖_F ≤ α p` for friction
+/// angle `θ` (degrees) under the match `cone`: what a match means here.
 ///
-/// The two matches predict different angles for a slope at rest (derivation in the crate
-/// docs, "The yield cone's matching and the angle of repose"): in a surface layer that has
-/// flowed and stopped the stress is close to simple shear with `p ≈ σ_n`, so the slope
-/// angle `β` at rest obeys `tan β = α / √2`, i.e.
+/// The cone `√J2 + α_φ I1 ≤ k_c` of the shared vocabulary is, with `p = −I1/3` and
+/// `‖s‖_F = √(2 J2)`, the cone `‖s‖_F ≤ 3√2 α_φ p`: `α = 3√2 α_φ`. The two matches of the
+/// thesis's experiments are written in closed form (derivation in the crate docs, "The
+/// yield cone's matching and the angle of repose"; a slope that flowed and stopped rests
+/// at `tan β = α / √2`):
 ///
 /// | match | `α` | slope at rest `β` | θ = 20°, 30°, 40° |
 /// | --- | --- | --- | --- |
 /// | [`ConeMatch::PlaneStrain`] (the thesis's eq. 14) | `√2 sin θ` | `atan(sin θ)` | 18.9°, 26.6°, 32.7° |
 /// | [`ConeMatch::SimpleShear`] | `√2 tan θ` | `θ` | 20°, 30°, 40° |
-///
-/// In scene files: `cone_match = "plane-strain"` or `"simple-shear"` (`[solver]`, kind
-/// `"granular"`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-#[non_exhaustive]
-pub enum ConeMatch {
-    /// `α = √2 sin θ` (Neder 2024 eq. 14, after Alduán & Otaduy 2011): the cone agrees with
-    /// Mohr–Coulomb in plane strain with zero dilatancy. A slope rests at `atan(sin θ)`,
-    /// below `θ`. The default, so that the thesis's experiments run as printed.
-    #[default]
-    PlaneStrain,
-    /// `α = √2 tan θ`: the cone agrees with Mohr–Coulomb in simple shear (`|τ| ≤ tan θ · p`,
-    /// the `μ_s = tan θ` of μ(I)-type continuum codes). A slope rests at `θ`: the friction
-    /// angle *is* the angle of repose.
-    SimpleShear,
-}
-
-impl ConeMatch {
-    /// The Drucker–Prager coefficient `α` of the cone `‖s‖_F ≤ α p` for friction angle `θ`
-    /// (degrees).
-    pub fn alpha(self, friction_angle_deg: f64) -> f64 {
-        let t = friction_angle_deg.to_radians();
-        std::f64::consts::SQRT_2
-            * match self {
-                ConeMatch::PlaneStrain => t.sin(),
-                ConeMatch::SimpleShear => t.tan(),
-            }
-    }
-
-    /// The angle (degrees) at which a cohesionless slope comes to rest under this match,
-    /// `atan(α / √2)`: `atan(sin θ)` (plane strain) or `θ` (simple shear).
-    pub fn predicted_repose_angle_deg(self, friction_angle_deg: f64) -> f64 {
-        (self.alpha(friction_angle_deg) / std::f64::consts::SQRT_2)
-            .atan()
-            .to_degrees()
-    }
-
-    /// The name used in scene files: `"plane-strain"` or `"simple-shear"`.
-    pub fn name(self) -> &'static str {
-        match self {
-            ConeMatch::PlaneStrain => "plane-strain",
-            ConeMatch::SimpleShear => "simple-shear",
-        }
+/// | [`ConeMatch::PlaneStrainAssociated`] (Bui et al. 2008) | `3√2 tan θ/√(9 + 12 tan² θ)` | `atan(3 tan θ/√(9 + 12 tan² θ))` | 18.5°, 25.7°, 31.1° |
+pub fn cone_alpha(cone: ConeMatch, friction_angle_deg: f64) -> f64 {
+    let t = friction_angle_deg.to_radians();
+    let r2 = std::f64::consts::SQRT_2;
+    match cone {
+        ConeMatch::PlaneStrain => r2 * t.sin(),
+        ConeMatch::SimpleShear => r2 * t.tan(),
+        other => 3.0 * r2 * other.alpha_phi(friction_angle_deg),
     }
 }
 
@@ -215,10 +183,13 @@ impl<R: Real> GranularParams<R> {
         Self { cone_match, ..self }
     }
 
-    /// The Drucker–Prager friction coefficient `α` ([`ConeMatch::alpha`]): `√2 sin θ`
+    /// The Drucker–Prager friction coefficient `α` ([`cone_alpha`]): `√2 sin θ`
     /// (Neder 2024 eq. 14) or `√2 tan θ`.
     pub fn alpha(&self) -> R {
-        R::of_f64(self.cone_match.alpha(self.friction_angle_deg.as_f64()))
+        R::of_f64(cone_alpha(
+            self.cone_match,
+            self.friction_angle_deg.as_f64(),
+        ))
     }
 
     /// The angle (degrees) at which a slope of this material comes to rest
@@ -392,7 +363,7 @@ sph_solver::solver_parameters!(IisphParams, NAME);
 
 #[cfg(test)]
 mod tests {
-    use super::{ConeMatch, GranularParams};
+    use super::{cone_alpha, ConeMatch, GranularParams};
 
     /// `α` of both matches against values computed by hand (sin 30° = 1/2, tan 45° = 1,
     /// tan 30° = 1/√3) and against the closed forms at 20° and 40°.
@@ -400,22 +371,29 @@ mod tests {
     fn cone_alpha_values() {
         let r2 = std::f64::consts::SQRT_2;
         let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
-        assert!(close(ConeMatch::PlaneStrain.alpha(30.0), r2 / 2.0));
-        assert!(close(ConeMatch::SimpleShear.alpha(30.0), r2 / 3f64.sqrt()));
-        assert!(close(ConeMatch::SimpleShear.alpha(45.0), r2));
-        assert!(close(ConeMatch::PlaneStrain.alpha(0.0), 0.0));
-        assert!(close(ConeMatch::SimpleShear.alpha(0.0), 0.0));
+        assert!(close(cone_alpha(ConeMatch::PlaneStrain, 30.0), r2 / 2.0));
+        assert!(close(
+            cone_alpha(ConeMatch::SimpleShear, 30.0),
+            r2 / 3f64.sqrt()
+        ));
+        assert!(close(cone_alpha(ConeMatch::SimpleShear, 45.0), r2));
+        assert!(close(cone_alpha(ConeMatch::PlaneStrain, 0.0), 0.0));
+        assert!(close(cone_alpha(ConeMatch::SimpleShear, 0.0), 0.0));
         for t in [20.0f64, 40.0] {
             assert!(close(
-                ConeMatch::PlaneStrain.alpha(t),
+                cone_alpha(ConeMatch::PlaneStrain, t),
                 r2 * t.to_radians().sin()
             ));
             assert!(close(
-                ConeMatch::SimpleShear.alpha(t),
+                cone_alpha(ConeMatch::SimpleShear, t),
                 r2 * t.to_radians().tan()
             ));
             // The simple-shear cone is the wider one for every θ in (0, 90).
-            assert!(ConeMatch::SimpleShear.alpha(t) > ConeMatch::PlaneStrain.alpha(t));
+            assert!(cone_alpha(ConeMatch::SimpleShear, t) > cone_alpha(ConeMatch::PlaneStrain, t));
+            // Every match is the shared vocabulary's cone: `α = 3√2 α_φ`.
+            for m in ConeMatch::ALL {
+                assert!(close(cone_alpha(m, t), 3.0 * r2 * m.alpha_phi(t)), "{m:?}");
+            }
         }
     }
 
@@ -443,7 +421,7 @@ mod tests {
         assert_eq!(g.cone_match, ConeMatch::PlaneStrain);
         assert!((g.alpha() - std::f64::consts::SQRT_2 * 0.5).abs() < 1e-12);
         let g = g.with_cone_match(ConeMatch::SimpleShear);
-        assert!((g.alpha() - ConeMatch::SimpleShear.alpha(30.0)).abs() < 1e-12);
+        assert!((g.alpha() - cone_alpha(ConeMatch::SimpleShear, 30.0)).abs() < 1e-12);
         assert!((g.predicted_repose_angle_deg() - 30.0).abs() < 1e-9);
     }
 }

@@ -108,7 +108,8 @@ pub struct GranularSettings {
     pub iisph: IisphSettings,
     /// [`GranularParams::friction_angle_deg`] (degrees, required).
     pub friction_angle_deg: f64,
-    /// [`GranularParams::cone_match`]: `"plane-strain"` (the default) or `"simple-shear"`.
+    /// [`GranularParams::cone_match`]: `"plane-strain"` (the default), `"simple-shear"` or
+    /// `"plane-strain-associated"` ([`crate::cone_alpha`]).
     pub cone_match: Option<ConeMatch>,
     /// [`GranularParams::drag_coefficient`].
     pub drag_coefficient: Option<f64>,

@@ -209,13 +209,13 @@ fn granular_cone_match() {
         panic!("{:?}", s.solver)
     };
     assert_eq!(p.cone_match, None);
-    assert!((alpha(&s) - ConeMatch::PlaneStrain.alpha(30.0)).abs() < 1e-12);
+    assert!((alpha(&s) - iisph_granular::cone_alpha(ConeMatch::PlaneStrain, 30.0)).abs() < 1e-12);
     let s = granular("\ncone_match = \"simple-shear\"").unwrap();
     let SolverSpec::Granular(p) = &s.solver else {
         panic!("{:?}", s.solver)
     };
     assert_eq!(p.cone_match, Some(ConeMatch::SimpleShear));
-    assert!((alpha(&s) - ConeMatch::SimpleShear.alpha(30.0)).abs() < 1e-12);
+    assert!((alpha(&s) - iisph_granular::cone_alpha(ConeMatch::SimpleShear, 30.0)).abs() < 1e-12);
     let e = granular("\ncone_match = \"simple_shear\"")
         .unwrap_err()
         .to_string();

@@ -9,8 +9,11 @@
 //!    ([`crate::step::begin_frame`]);
 //! 3. [`SubstepScheme::begin_frame`]: the scheme resizes its buffers and permutes what it
 //!    carries per particle;
-//! 4. `common.substeps` calls of [`SubstepScheme::substep`];
-//! 5. the density and energy statistics ([`crate::step::end_frame`]).
+//! 4. the scheme's pour ([`SubstepScheme::pour`]), if it has one: the layers due by the
+//!    frame's start time are appended to the state ([`PourEmitter`]) and handed to the
+//!    scheme ([`SubstepScheme::init_emitted`]);
+//! 5. `common.substeps` calls of [`SubstepScheme::substep`];
+//! 6. the density and energy statistics ([`crate::step::end_frame`]).
 //!
 //! [`FrameSolver`] dereferences to its scheme, so a scheme's own accessors (e.g. IISPH's
 //! pressures) are methods of the solver.
@@ -28,7 +31,8 @@ use crate::error::SolverError;
 use crate::fluid_solver::{FluidSolver, Solids};
 use crate::parameters::SolverParameters;
 use crate::params::CommonParams;
-use crate::state::SolverState;
+use crate::scene_boundary::{PeriodicAxis, Pour, PourEmitter};
+use crate::state::{match_arrays, ArraySpec, SolverState};
 use crate::stats::StepStats;
 use crate::step::{begin_frame, end_frame, CellReorder, FramePhases, StepAt, StepNeighbours};
 
@@ -137,6 +141,27 @@ pub trait SubstepScheme<R: Real>: Send + Sized {
     fn passive_points(&self) -> Option<&[Vec3<R>]> {
         None
     }
+    /// The pour the frame shell steps for this scheme ([`PourEmitter`]), if its parameters
+    /// have one (a scheme that declares
+    /// [`BoundaryFeatures::pour`](crate::scene_boundary::BoundaryFeatures)); `None` by
+    /// default.
+    fn pour(&self) -> Option<&Pour<R>> {
+        None
+    }
+    /// The periodic axes the scheme's particles live on (the pour wraps its room test
+    /// across them); none by default.
+    fn periodic_axes(&self) -> &[PeriodicAxis<R>] {
+        &[]
+    }
+    /// The hook of the pour: the particles `first..state.len()` were just appended by the
+    /// frame shell's [`PourEmitter`] (at rest, with the particle mass and the rest density)
+    /// after [`SubstepScheme::begin_frame`] and before the frame's first substep. The
+    /// scheme readies what it carries per particle for them (e.g. a zero stress) and drops
+    /// anything sized to the old count (neighbour lists). Nothing by default.
+    fn init_emitted(&mut self, state: &ParticleSet<R>, first: usize) -> Result<(), SolverError> {
+        let _ = (state, first);
+        Ok(())
+    }
     /// Appends the per-particle fields written with each output frame
     /// ([`FluidSolver::particle_fields`]); nothing by default.
     fn particle_fields(&self, fields: &mut Vec<(String, Vec<R>)>) {
@@ -151,7 +176,12 @@ pub struct FrameSolver<R: Real, S: SubstepScheme<R>> {
     reorder: CellReorder<R>,
     frames: u64,
     partials: Vec<[f64; 3]>,
+    emitter: Option<PourEmitter>,
 }
+
+/// The name of the array that carries a pour's progress in a [`SolverState`] (the layers
+/// placed so far, one value).
+pub const POUR_STATE_ARRAY: &str = "pour";
 
 impl<R: Real, S: SubstepScheme<R>> fmt::Debug for FrameSolver<R, S> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -193,14 +223,30 @@ impl<R: Real, S: SubstepScheme<R>> FrameSolver<R, S> {
         Ok(Self::from_scheme(S::new(params, parts)?))
     }
 
-    /// A solver running `scheme` from frame 0.
+    /// A solver running `scheme` from frame 0 (with an emitter for the scheme's pour, if it
+    /// has one).
     pub fn from_scheme(scheme: S) -> Self {
+        let common = scheme.params().common();
+        let emitter = scheme.pour().map(|p| {
+            PourEmitter::new(
+                p,
+                common.particle_spacing.as_f64(),
+                common.gravity.norm().as_f64(),
+                scheme.periodic_axes(),
+            )
+        });
         Self {
             scheme,
             reorder: CellReorder::default(),
             frames: 0,
             partials: Vec::new(),
+            emitter,
         }
+    }
+
+    /// The pour under way: layers placed so far and in all (`None` without a pour).
+    pub fn poured_layers(&self) -> Option<(usize, usize)> {
+        self.emitter.as_ref().map(|p| (p.poured(), p.layers()))
     }
 
     /// The scheme.
@@ -293,6 +339,15 @@ impl<R: Real, S: SubstepScheme<R>> FrameSolver<R, S> {
         )?;
         self.scheme
             .begin_frame(state, self.reorder.last_permutation(), &mut stats)?;
+        if let Some(emitter) = &mut self.emitter {
+            let common = self.scheme.params().common();
+            let time_s = frame as f64 * common.dt.as_f64();
+            let first = state.len();
+            let (mass, density) = (common.particle_mass(), common.rest_density);
+            if emitter.emit(S::NAME, time_s, state, mass, density)? > 0 {
+                self.scheme.init_emitted(state, first)?;
+            }
+        }
         for sub in 0..substeps {
             let at = StepAt {
                 solver: S::NAME,
@@ -317,6 +372,9 @@ impl<R: Real, S: SubstepScheme<R>> FrameSolver<R, S> {
     pub fn save_state(&self) -> SolverState<R> {
         let mut arrays = Vec::new();
         self.scheme.save_arrays(&mut arrays);
+        if let Some(p) = &self.emitter {
+            arrays.push((POUR_STATE_ARRAY.into(), vec![R::of_f64(p.poured() as f64)]));
+        }
         SolverState::new(self.scheme.name(), self.frames, arrays)
     }
 
@@ -333,7 +391,36 @@ impl<R: Real, S: SubstepScheme<R>> FrameSolver<R, S> {
                 reason: format!("the state was written by solver `{}`", state.solver),
             });
         }
-        self.scheme.restore_arrays(&state.arrays, particles)?;
+        let (pour, arrays): (Vec<_>, Vec<_>) = state
+            .arrays
+            .iter()
+            .cloned()
+            .partition(|(n, _)| self.emitter.is_some() && n == POUR_STATE_ARRAY);
+        let poured = match &self.emitter {
+            Some(p) => {
+                let spec = [ArraySpec {
+                    name: POUR_STATE_ARRAY,
+                    len: 1,
+                }];
+                Some(match match_arrays(name, &pour, &spec)?[0] {
+                    Some(v) => p.check_poured(name, v[0].as_f64(), particles)?,
+                    None => 0,
+                })
+            }
+            None if arrays.iter().any(|(n, _)| n == POUR_STATE_ARRAY) => {
+                return Err(SolverError::InvalidSolverState {
+                    solver: name.to_owned(),
+                    reason: format!(
+                        "the state carries a pour's progress (`{POUR_STATE_ARRAY}`) but the parameters have no pour"
+                    ),
+                })
+            }
+            None => None,
+        };
+        self.scheme.restore_arrays(&arrays, particles)?;
+        if let (Some(p), Some(k)) = (&mut self.emitter, poured) {
+            p.set_poured(k);
+        }
         self.frames = state.frames;
         Ok(())
     }

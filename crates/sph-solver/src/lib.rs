@@ -58,6 +58,7 @@
 //! enums, the factory and the density kernel follow.
 
 pub mod boundary;
+pub mod cone_match;
 pub mod csr;
 mod error;
 mod fluid_solver;
@@ -78,6 +79,7 @@ pub use boundary::{
     CollisionBoundary, Interpolation, VolumeMap, VolumeMapBoundary, VolumeMapBuild,
     VolumeMapOptions, VolumeMapStats,
 };
+pub use cone_match::ConeMatch;
 pub use error::{MapFileProblem, SolverError};
 pub use fluid_solver::{FluidSolver, Solids};
 pub use frame::{FrameSolver, SchemeParts, SubstepScheme};

@@ -7,11 +7,22 @@
 //!   Implicit Boundary Representation for SPH" (MIG '19). Each solid contributes its share
 //!   of every particle's density, `ρ_B = ρ0 Ψ(x)` with `Ψ(x) = ∫_solid W(x − y) dy`, and its
 //!   gradient `∇Ψ` to the pressure forces; see the module `volume_map` for the equations.
+//!
+//! Walls of boundary particles (Adami, Hu & Adams 2012), for a solver that declares them
+//! ([`crate::scene_boundary::BoundaryFeatures::particles`]): their layout on the particle
+//! lattice ([`particles`]: solids' walls, moving walls, blocks) and the extrapolation of
+//! their stress and velocity with a wall model per particle ([`wall_extrapolation`]).
 
 mod collision;
+pub mod particles;
 pub mod volume_map;
+pub mod wall_extrapolation;
 
 pub use collision::CollisionBoundary;
+pub use particles::{
+    boundary_block, BoundaryParticle, WallLattice, MAX_BOUNDARY_LATTICE_NODES,
+    MAX_BOUNDARY_PARTICLES,
+};
 pub use volume_map::{
     half_space_volume, half_space_volume_derivative, CacheUse, Interpolation, VolumeMap,
     VolumeMapBoundary, VolumeMapBuild, VolumeMapCache, VolumeMapKey, VolumeMapOptions,

@@ -10,6 +10,7 @@
 //! a solver that does not take a feature the scene uses refuses it
 //! ([`SolverError::UnsupportedFeature`], naming the scene key).
 
+mod emitter;
 pub(crate) mod feature;
 mod periodic;
 mod pour;
@@ -17,8 +18,9 @@ mod walls;
 
 use sph_core::{Aabb, Real};
 
+pub use emitter::{PourEmitter, ROOM_OVER_SPACING};
 pub use feature::BoundaryFeature;
-pub use periodic::{Axis, PeriodicAxis, PeriodicSetting};
+pub use periodic::{image_offsets, Axis, PeriodicAxis, PeriodicImages, PeriodicSetting};
 pub use pour::{Pour, MAX_POURED_GRAINS};
 pub use walls::{MovingWall, WallModel, MAX_WALL_FRICTION, MAX_WALL_MOTION_S};
 

@@ -1,6 +1,7 @@
 //! A pour as a scene states it (`[pour]`): grains added during the run, a layer at a time,
 //! from a funnel's box. A solver that takes pours ([`BoundaryFeatures::pour`](super::BoundaryFeatures))
-//! places the layers (crate `elastoplastic-granular`, module `pour`).
+//! returns it from [`SubstepScheme::pour`](crate::SubstepScheme::pour), and the frame shell
+//! places the layers ([`PourEmitter`](super::PourEmitter)).
 
 use sph_core::{Aabb, Real, Vec3};
 

@@ -128,7 +128,11 @@ fn column_scene(ctx: &Context) -> Result<(Scene, Column, f64, ConeMatch)> {
             p.hi = z_hi;
         }
     }
-    let (phi, cone) = (e.friction_angle_deg, e.cone_match.unwrap_or_default());
+    let (phi, cone) = (
+        e.friction_angle_deg,
+        e.cone_match
+            .unwrap_or(elastoplastic_granular::DEFAULT_CONE_MATCH),
+    );
     scene.check()?;
     Ok((scene, column, phi, cone))
 }

@@ -255,7 +255,7 @@ fn friction_and_static_slope(base: &Scene) -> (f64, f64) {
     match &base.solver {
         SolverSpec::Granular(g) => {
             let theta = g.friction_angle_deg;
-            let cone = g.cone_match.unwrap_or_default();
+            let cone = g.cone_match.unwrap_or(iisph_granular::DEFAULT_CONE_MATCH);
             (theta, cone.predicted_repose_angle_deg(theta))
         }
         _ => (f64::NAN, f64::NAN),

@@ -1,0 +1,262 @@
+//! The values of boundary (dummy) particles, extrapolated from the particles around them:
+//! Adami, Hu & Adams (2012), "A generalized wall boundary condition for smoothed particle hydrodynamics", *J. Comput. Phys.*
+//! 231:7057–7075, with the pressure generalised to the stress tensor as in Bui et al.
+//! (2008, rows of fixed boundary particles) and Project Chrono's CRM (Hu, Rakhsha, Yang,
+//! Negrut et al. 2021, *CMAME* 385:114022, boundary condition enforcing markers).
+//!
+//! For a boundary particle `b` with unit normal `n_b` (pointing into the particles' side),
+//! over the particle neighbours `f` (Shepard weights `W_bf`, `r_bf = x_b − x_f`):
+//!
+//! ```text
+//! σ̄_b = (Σ_f σ_f W_bf − I Σ_f ρ_f (g·r_bf) W_bf) / Σ_f W_bf     (Adami eq. 27, stress)
+//! ṽ_b = Σ_f v_f W_bf / Σ_f W_bf
+//! free-slip:  σ_b = P σ̄_b P,  v_b = P ṽ_b,   P = I − 2 n_b n_bᵀ (the mirror image)
+//! no-slip:    σ_b = σ̄_b,      v_b = −ṽ_b                       (wall at rest)
+//! Coulomb:    σ_b = σ̄_b − 2(1 − χ)(n t_tᵀ + t_t nᵀ),  v_b = −(ṽ·n) n + (1 − 2χ) ṽ_t
+//! ```
+//!
+//! **Coulomb walls** (wall friction coefficient `μ_w`). Write the extrapolated traction on
+//! the wall's plane as `σ̄ n = t_n n + t_t` (`t_n = nᵀσ̄n`, compressive when negative;
+//! `t_t = (I − nnᵀ) σ̄ n` its tangential part) and the velocity as `ṽ = (ṽ·n) n + ṽ_t`. The
+//! mirror is `P σ̄ P = σ̄ − 2(n t_tᵀ + t_t nᵀ)`: it keeps `t_n` and the in-plane block and
+//! reverses `t_t`. A particle next to the wall and its boundary neighbours enter the
+//! momentum sum through `σ_i/ρ_i² + σ_b/ρ_b²`, so the traction the wall carries is that of
+//! the mean `(σ̄ + σ_b)/2`: its normal part is `t_n` for every model, its tangential part
+//! `0` for free-slip (the mirror), `t_t` for no-slip, and `χ t_t` for
+//! `σ_b = σ̄ − 2(1 − χ)(n t_tᵀ + t_t nᵀ)`. Coulomb's law, a tangential traction at most
+//! `μ_w` times the compressive normal one, gives
+//!
+//! ```text
+//! χ = min(1, μ_w max(−t_n, 0) / |t_t|)    (χ = 1 when t_t = 0; 0 ≤ χ ≤ 1)
+//! ```
+//!
+//! so a wall below the limit acts as no-slip (`χ = 1`), a sliding one passes exactly
+//! `μ_w |t_n|` in the direction of `t_t`, and a wall in tension (`t_n ≥ 0`, no contact)
+//! is free-slip (`χ = 0`). The velocity follows the same blend between the mirror of the
+//! tangential velocity (no-slip, `−ṽ_t`) and its copy (free-slip, `+ṽ_t`), so that the
+//! velocity gradient at a wall that slides does not keep loading the shear the limit
+//! removes. `μ_w = 0` is free-slip; a large `μ_w` is no-slip.
+//!
+//! **Moving walls.** A boundary particle with a wall velocity `v_w` moves with it (`x_b +=
+//! v_w Δt` each explicit step) and its model acts on the relative velocity: `v_b = v_w +
+//! f(ṽ − v_w)` with `f` the fixed wall's rule above (`−u`, the mirror `P u`, or Coulomb's
+//! blend). The wall's acceleration is taken as zero (Adami et al. 2012, eq. 27, has
+//! `g − a_w`): a wall moves at constant velocity between the changes its owner makes.
+//!
+//! A solver gives them a density and a mass (the elastic–plastic solver: `ρ0` and a
+//! particle's) and lets them enter its sums as neighbours. A fluid's pressure is the
+//! isotropic case `σ = −p I`, for which the rule is Adami et al.'s own. The
+//! isotropic gravity term carries the hydrostatic gradient of the normal stress across the
+//! wall (the part the wall must supply for a resting layer to carry its weight). A boundary
+//! particle without particle neighbours carries no stress and no velocity.
+
+use nalgebra::Matrix3;
+use rayon::prelude::*;
+use sph_core::{Real, Vec3};
+use sph_kernels::Kernel;
+
+use super::particles::BoundaryParticle;
+use crate::scene_boundary::{PeriodicImages, WallModel};
+use crate::step::MIN_LEN;
+use crate::NeighbourLists;
+
+/// The stress and velocity of a Coulomb boundary particle with unit normal `n` and wall
+/// friction coefficient `mu` from the extrapolated `s_bar`, `v_bar` (module docs).
+pub fn coulomb<R: Real>(
+    s_bar: &Matrix3<R>,
+    v_bar: &Vec3<R>,
+    n: &Vec3<R>,
+    mu: R,
+) -> (Matrix3<R>, Vec3<R>) {
+    let t = s_bar * n;
+    let t_n = n.dot(&t);
+    let t_t = t - n * t_n;
+    let tau = t_t.norm();
+    let limit = mu * (-t_n).max(R::zero());
+    let chi = if tau > limit { limit / tau } else { R::one() };
+    let two = R::of_f64(2.0);
+    let s_b = s_bar - (n * t_t.transpose() + t_t * n.transpose()) * (two * (R::one() - chi));
+    let v_n = n.dot(v_bar);
+    let v_t = v_bar - n * v_n;
+    (s_b, v_t * (R::one() - two * chi) - n * v_n)
+}
+
+/// What [`extrapolate`] reads.
+#[derive(Debug, Clone, Copy)]
+pub struct Extrapolation<'a, R: Real, K: Kernel<R>> {
+    /// The kernel of the Shepard weights.
+    pub kernel: K,
+    /// The images of the particles near periodic ends (empty without periodic axes).
+    pub images: &'a PeriodicImages<R>,
+    /// Positions of the particles then the boundary particles.
+    pub x: &'a [Vec3<R>],
+    /// Densities of the particles (those of the boundary particles are not read).
+    pub rho: &'a [R],
+    /// The boundary particles.
+    pub particles: &'a [BoundaryParticle<R>],
+    /// Gravity (m/s²).
+    pub gravity: Vec3<R>,
+}
+
+/// The particle neighbours of each boundary particle (from the neighbour lists, in their
+/// order: the extrapolation's sums add in the same order as over the whole lists, whose
+/// other entries are boundary particles), rebuilt at each neighbour search, and their
+/// Shepard weights `W_bf` and gravity terms `ρ_f (g·r_bf) W_bf`, computed once per step for
+/// both extrapolations of the step.
+#[derive(Debug, Clone, Default)]
+pub struct BoundaryLists<R: Real> {
+    /// CSR offsets: boundary particle `k`'s entries are `start[k]..start[k + 1]`.
+    start: Vec<usize>,
+    /// The lists' entry (a particle or an image of one).
+    entry: Vec<u32>,
+    /// The particle it resolves to.
+    grain: Vec<u32>,
+    /// The boundary particle (`0..`) whose entry it is.
+    owner: Vec<u32>,
+    weight: Vec<R>,
+    weighted_gravity: Vec<R>,
+}
+
+impl<R: Real> BoundaryLists<R> {
+    /// Keeps, for each of the `count` boundary particles `n..n + count` of `nb`, the entries
+    /// that resolve to a particle (`< n`). Grows its arrays to the pair count (reusing them).
+    pub fn rebuild(
+        &mut self,
+        nb: &NeighbourLists,
+        images: &PeriodicImages<R>,
+        x: &[Vec3<R>],
+        n: usize,
+        count: usize,
+    ) {
+        self.start.clear();
+        self.entry.clear();
+        self.grain.clear();
+        self.owner.clear();
+        self.start.push(0);
+        for k in 0..count {
+            for &j in nb.neighbours(n + k) {
+                let (f, _) = images.resolve(j as usize, x);
+                if f < n {
+                    self.entry.push(j);
+                    self.grain.push(f as u32);
+                    self.owner.push(k as u32);
+                }
+            }
+            self.start.push(self.entry.len());
+        }
+        let len = self.entry.len();
+        self.weight.resize(len, R::zero());
+        self.weighted_gravity.resize(len, R::zero());
+    }
+
+    /// The weights and gravity terms at the positions `e.x` (boundary particles from `n =
+    /// e.x.len() − e.particles.len()` on).
+    pub fn weigh<K: Kernel<R>>(&mut self, e: &Extrapolation<'_, R, K>) {
+        let n = e.x.len() - e.particles.len();
+        let (entry, owner) = (&self.entry, &self.owner);
+        self.weight
+            .par_iter_mut()
+            .zip(self.weighted_gravity.par_iter_mut())
+            .enumerate()
+            .with_min_len(MIN_LEN)
+            .for_each(|(m, (w, wg))| {
+                let (j, xj) = e.images.resolve(entry[m] as usize, e.x);
+                let r = e.x[n + owner[m] as usize] - xj;
+                *w = e.kernel.value(r.norm());
+                *wg = e.rho[j] * e.gravity.dot(&r) * *w;
+            });
+    }
+}
+
+/// A tensor a solver derives from each boundary particle's stress (e.g. the elastic–plastic
+/// solver's artificial stress), written by [`extrapolate`] beside it.
+pub type Derived<'a, R> = (
+    &'a mut [Matrix3<R>],
+    &'a (dyn Fn(&Matrix3<R>) -> Matrix3<R> + Sync),
+);
+
+/// Writes the boundary particles' stress into `stress[n..]` from the particles' `stress[..n]`
+/// (module docs), a tensor derived from it into `derived.0[n..]` if given (`derived.1` of
+/// the stress), and their velocity into `v[n..]` if given (from `v[..n]`), with the weights
+/// of the last [`BoundaryLists::weigh`].
+pub fn extrapolate<R: Real, K: Kernel<R>>(
+    e: &Extrapolation<'_, R, K>,
+    lists: &BoundaryLists<R>,
+    stress: &mut [Matrix3<R>],
+    v: Option<&mut [Vec3<R>]>,
+    derived: Option<Derived<'_, R>>,
+) {
+    let n = e.x.len() - e.particles.len();
+    let (s_head, s_tail) = stress.split_at_mut(n);
+    let (v_head, v_tail) = match v {
+        Some(v) => {
+            let (h, t) = v.split_at_mut(n);
+            (Some(&*h), Some(t))
+        }
+        None => (None, None),
+    };
+    let (art_tail, derive) = match derived {
+        Some((a, f)) => (Some(&mut a[n..]), Some(f)),
+        None => (None, None),
+    };
+    let two = R::of_f64(2.0);
+    let work =
+        |k: usize, sig: &mut Matrix3<R>, vel: Option<&mut Vec3<R>>, a: Option<&mut Matrix3<R>>| {
+            let mut sum_s = Matrix3::zeros();
+            let mut sum_g = R::zero();
+            let mut sum_v = Vec3::zeros();
+            let mut sum_w = R::zero();
+            for m in lists.start[k]..lists.start[k + 1] {
+                let j = lists.grain[m] as usize;
+                let w = lists.weight[m];
+                sum_s += s_head[j] * w;
+                sum_g += lists.weighted_gravity[m];
+                if let Some(vh) = v_head {
+                    sum_v += vh[j] * w;
+                }
+                sum_w += w;
+            }
+            let p = &e.particles[k];
+            let mirror = Matrix3::identity() - p.normal * p.normal.transpose() * two;
+            let (s_bar, v_bar) = if sum_w > R::zero() {
+                ((sum_s - Matrix3::identity() * sum_g) / sum_w, sum_v / sum_w)
+            } else {
+                (Matrix3::zeros(), Vec3::zeros())
+            };
+            // A moving wall: its models act on the velocity relative to it.
+            let moving = p.velocity != Vec3::zeros();
+            let v_rel = if moving { v_bar - p.velocity } else { v_bar };
+            let (s_b, v_b) = match p.model {
+                WallModel::NoSlip => (s_bar, -v_rel),
+                WallModel::Coulomb(mu) => coulomb(&s_bar, &v_rel, &p.normal, R::of_f64(mu)),
+                _ => (mirror * s_bar * mirror, mirror * v_rel),
+            };
+            let v_b = if moving { v_b + p.velocity } else { v_b };
+            *sig = s_b;
+            if let Some(vel) = vel {
+                *vel = v_b;
+            }
+            if let (Some(a), Some(f)) = (a, derive) {
+                *a = f(&s_b);
+            }
+        };
+    match (v_tail, art_tail) {
+        (Some(vt), None) => s_tail
+            .par_iter_mut()
+            .zip(vt.par_iter_mut())
+            .enumerate()
+            .with_min_len(MIN_LEN)
+            .for_each(|(k, (sig, vel))| work(k, sig, Some(vel), None)),
+        (None, Some(at)) => s_tail
+            .par_iter_mut()
+            .zip(at.par_iter_mut())
+            .enumerate()
+            .with_min_len(MIN_LEN)
+            .for_each(|(k, (sig, a))| work(k, sig, None, Some(a))),
+        _ => s_tail
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(MIN_LEN)
+            .for_each(|(k, sig)| work(k, sig, None, None)),
+    }
+}
