@@ -127,7 +127,6 @@ pub use solver::{
 pub use sph_solver::scene_boundary::PeriodicAxis;
 pub use sph_solver::scene_boundary::{Axis, PeriodicSetting, SceneBoundary};
 pub use stress::{ConeMatch, DruckerPrager, StressUpdate};
-pub use walls::volume_map_walls;
 
 pub use sph_core::sampling::cubic_lattice;
 pub use sph_core::{Aabb, BoxSdf, Inverted, ParticleSet, Plane, Vec3};

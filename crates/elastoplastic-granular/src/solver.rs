@@ -156,7 +156,7 @@ impl<R: Real> ElastoplasticScheme<R> {
                         solver: NAME,
                         name: "wall_models",
                         value: params.wall_models.len() as f64,
-                        reason: "a wall model per solid needs the walls of `volume_map_walls` given to `ElastoplasticScheme::solver`, or boundary particles",
+                        reason: "a wall model per solid needs the walls of `Elastoplastic::volume_map_walls` given to `ElastoplasticScheme::solver`, or boundary particles",
                     });
                 }
                 if parts.boundary.has_volume() {
@@ -207,7 +207,7 @@ impl<R: Real> ElastoplasticScheme<R> {
     }
 
     /// The solver with `params` and volume-map `walls` (from
-    /// [`volume_map_walls`](crate::volume_map_walls)), each solid taking its wall model
+    /// [`FrameSolver::volume_map_walls`]), each solid taking its wall model
     /// ([`ElastoplasticParams::wall_model`]). Errors: invalid parameters, or walls
     /// integrated with another kernel or support radius.
     pub fn solver(

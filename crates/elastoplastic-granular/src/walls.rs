@@ -14,33 +14,11 @@
 
 use std::sync::Arc;
 
-use sph_core::{Aabb, Real, Sdf, Vec3};
+use sph_core::{Real, Sdf, Vec3};
 use sph_kernels::KernelKind;
-use sph_solver::boundary::{Boundary, ClosestPoint, VolumeMapBoundary, VolumeMapOptions};
-use sph_solver::{Solids, SolverError};
+use sph_solver::boundary::{Boundary, ClosestPoint, VolumeMapBoundary};
 
-use crate::kernels::ELASTOPLASTIC_KERNEL;
-use crate::params::{ElastoplasticParams, WallModel};
-
-/// Volume-map walls of `solids` for a solver with `params`, over `domain` (the region the
-/// particles can reach), with the recommended contact distance
-/// ([`CommonParams::volume_map_contact_distance`](sph_solver::CommonParams::volume_map_contact_distance)).
-///
-/// Errors: those of [`VolumeMapBoundary::new`].
-pub fn volume_map_walls<R: Real>(
-    solids: Solids<R>,
-    params: &ElastoplasticParams<R>,
-    domain: Aabb<R>,
-) -> Result<VolumeMapBoundary<R>, SolverError> {
-    VolumeMapBoundary::new(
-        solids,
-        ELASTOPLASTIC_KERNEL,
-        params.common.support_radius,
-        domain,
-        params.common.volume_map_contact_distance(),
-        VolumeMapOptions::default(),
-    )
-}
+use crate::params::WallModel;
 
 /// A [`VolumeMapBoundary`] shared between the frame shell (as its [`Boundary`]) and the
 /// scheme (which samples it solid by solid).

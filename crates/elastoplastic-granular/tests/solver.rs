@@ -2,9 +2,9 @@
 //! thread counts, resuming from a checkpoint, parameter checks.
 
 use elastoplastic_granular::{
-    boundary_block, volume_map_walls, Aabb, BoxSdf, Elastoplastic, ElastoplasticParams,
-    ElastoplasticScheme, InitialStress, Inverted, ParticleSet, PeriodicAxis, Plane, Solids,
-    SolverError, Vec3, WallModel,
+    boundary_block, Aabb, BoxSdf, Elastoplastic, ElastoplasticParams, ElastoplasticScheme,
+    InitialStress, Inverted, ParticleSet, PeriodicAxis, Plane, Solids, SolverError, Vec3,
+    WallModel,
 };
 use nalgebra::Matrix3;
 use sph_core::sampling::cubic_lattice;
@@ -19,7 +19,7 @@ fn block(w: f64, d: f64, box_w: f64) -> (Elastoplastic<f64>, ParticleSet<f64>) {
     p.wall_models = vec![WallModel::FreeSlip];
     let tank = Aabb::new(Vec3::zeros(), Vec3::new(box_w, 0.5, 0.03)).unwrap();
     let solids: Solids<f64> = vec![Box::new(Inverted(BoxSdf::new(tank).unwrap()))];
-    let walls = volume_map_walls(solids, &p, tank).unwrap();
+    let walls = Elastoplastic::volume_map_walls(solids, &p, tank, None).unwrap();
     let region = Aabb::new(Vec3::zeros(), Vec3::new(w, d, 0.03)).unwrap();
     let x = cubic_lattice(&region, S, 100_000).unwrap();
     let state = ParticleSet::from_positions(x, p.common.particle_mass(), p.common.rest_density);
@@ -49,7 +49,7 @@ fn periodic_layer(d: f64, geostatic: bool) -> (Elastoplastic<f64>, ParticleSet<f
         hi + Vec3::new(0.05, 0.3, 0.05),
     )
     .unwrap();
-    let walls = volume_map_walls(solids, &p, domain).unwrap();
+    let walls = Elastoplastic::volume_map_walls(solids, &p, domain, None).unwrap();
     let x = cubic_lattice(&Aabb::new(Vec3::zeros(), hi).unwrap(), S, 100_000).unwrap();
     let state = ParticleSet::from_positions(x, p.common.particle_mass(), p.common.rest_density);
     if geostatic {

@@ -3,8 +3,8 @@
 //! the motion, and invalid values are named.
 
 use elastoplastic_granular::{
-    volume_map_walls, Aabb, BoxSdf, ElastoplasticParams, ElastoplasticScheme, Inverted,
-    ParticleSet, Solids, Vec3, WallModel,
+    Aabb, BoxSdf, Elastoplastic, ElastoplasticParams, ElastoplasticScheme, Inverted, ParticleSet,
+    Solids, Vec3, WallModel,
 };
 use sph_core::sampling::cubic_lattice;
 
@@ -20,7 +20,7 @@ fn velocities(speed: Option<f64>) -> Vec<Vec3<f64>> {
     p.wall_models = vec![WallModel::FreeSlip];
     let tank = Aabb::new(Vec3::zeros(), Vec3::new(0.2, 0.3, 0.03)).unwrap();
     let solids: Solids<f64> = vec![Box::new(Inverted(BoxSdf::new(tank).unwrap()))];
-    let walls = volume_map_walls(solids, &p, tank).unwrap();
+    let walls = Elastoplastic::volume_map_walls(solids, &p, tank, None).unwrap();
     let region = Aabb::new(Vec3::zeros(), Vec3::new(0.08, 0.1, 0.03)).unwrap();
     let x = cubic_lattice(&region, S, 100_000).unwrap();
     let mut state = ParticleSet::from_positions(x, p.common.particle_mass(), p.common.rest_density);

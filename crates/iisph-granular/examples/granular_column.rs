@@ -13,8 +13,8 @@
 
 use granular_measure as measure;
 use iisph_granular::{
-    calibrate_masses, cubic_lattice, volume_map_walls, Aabb, BoxSdf, Iisph, IisphParams, Inverted,
-    ParticleSet, Solids, Vec3, IISPH_KERNEL,
+    calibrate_masses, cubic_lattice, Aabb, BoxSdf, Iisph, IisphParams, Inverted, ParticleSet,
+    Solids, Vec3, IISPH_KERNEL,
 };
 
 /// Particle spacing (m), as the scene's `[quick]` table.
@@ -31,7 +31,7 @@ pub fn build() -> Result<(Iisph<f32>, ParticleSet<f32>), Box<dyn std::error::Err
     let tank = Aabb::new(Vec3::zeros(), Vec3::new(0.8, 0.25, 0.04))?;
     let column = Aabb::new(Vec3::zeros(), Vec3::new(COLUMN_LENGTH, 0.2, 0.04))?;
     let solids: Solids<f32> = vec![Box::new(Inverted(BoxSdf::new(tank)?))];
-    let walls = volume_map_walls(solids, &params, tank, None)?;
+    let walls = Iisph::volume_map_walls(solids, &params, tank, None)?;
 
     // Particles on a lattice half a spacing from the walls, masses ρ0 s³, then lowered
     // where the lattice plus the walls' share would start above ρ0.

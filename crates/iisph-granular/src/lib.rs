@@ -318,7 +318,6 @@ mod scratch;
 mod settings;
 mod solver;
 pub mod upscale;
-mod walls;
 
 pub use kernels::IISPH_KERNEL;
 pub use params::{
@@ -329,7 +328,6 @@ pub use params::{
 };
 pub use settings::{GranularSettings, IisphSettings, WaterSettings};
 pub use solver::{Iisph, IisphScheme, IISPH_PHASES, IISPH_STATE_ARRAYS};
-pub use walls::volume_map_walls;
 
 pub use sph_core::{
     sampling::cubic_lattice, Aabb, BoxSdf, Inverted, ParticleSet, Plane, Real, Sdf, Sphere, Vec3,

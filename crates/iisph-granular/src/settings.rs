@@ -186,6 +186,8 @@ impl SolverSettings for WaterSettings {
 
 impl SolverSettings for GranularSettings {
     iisph_kind!();
+    /// The name the IISPH scheme gives itself with friction ([`crate::IisphScheme`]).
+    const LABEL: &'static str = "IISPH-granular";
 
     /// No friction (`friction_angle_deg = 0`), every other setting the default.
     fn with_common(common: CommonSettings, _iterations: usize) -> Self {

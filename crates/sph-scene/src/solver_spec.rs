@@ -52,11 +52,11 @@ macro_rules! solvers {
                 }
             }
 
-            /// The solver's name in errors and reports (its parameters'
-            /// [`SolverParameters::NAME`], e.g. `"PBF"`).
+            /// The solver's name in reports (its settings' [`SolverSettings::LABEL`],
+            /// the name the solver gives itself, e.g. `"PBF"`, `"IISPH-granular"`).
             pub fn label(self) -> &'static str {
                 match self {
-                    $( SolverKind::$Kind => <<$Settings as SolverSettings>::Params<f64> as SolverParameters<f64>>::NAME, )+
+                    $( SolverKind::$Kind => <$Settings as SolverSettings>::LABEL, )+
                 }
             }
 

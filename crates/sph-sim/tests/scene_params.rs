@@ -83,8 +83,8 @@ fn edited(scene: &Scene) -> Vec<(String, Scene)> {
     out
 }
 
-#[test]
-fn shipped_scenes_build_the_same_parameters() {
+/// The shipped scene files, sorted.
+fn shipped_scenes() -> Vec<PathBuf> {
     let mut paths: Vec<PathBuf> = std::fs::read_dir(scenes_dir())
         .unwrap()
         .map(|e| e.unwrap().path())
@@ -92,7 +92,12 @@ fn shipped_scenes_build_the_same_parameters() {
         .collect();
     paths.sort();
     assert!(paths.len() >= 11, "{paths:?}");
-    for path in paths {
+    paths
+}
+
+#[test]
+fn shipped_scenes_build_the_same_parameters() {
+    for path in shipped_scenes() {
         let scene = Scene::load(&path).unwrap();
         let name = path.file_stem().unwrap().to_string_lossy().into_owned();
         let mut out = String::new();
@@ -102,5 +107,30 @@ fn shipped_scenes_build_the_same_parameters() {
             describe(&mut out, &label, &s);
         }
         insta::assert_snapshot!(name, out);
+    }
+}
+
+/// The label the registration gives each solver kind (`SolverKind::label`, from the
+/// settings' `SolverSettings::LABEL`) is the name the built solver gives itself
+/// (`FluidSolver::name`): for the first shipped scene of every kind, or the dam break
+/// carried over to a kind no scene ships (`SolverSpec::with_kind`).
+#[test]
+fn each_kind_is_labelled_as_its_solver_names_itself() {
+    let scenes: Vec<Scene> = shipped_scenes()
+        .iter()
+        .map(|p| Scene::load(p).unwrap().quick())
+        .collect();
+    let dam_break = scenes.iter().find(|s| s.name == "dam_break").unwrap();
+    for &kind in SolverKind::ALL {
+        let scene = match scenes.iter().find(|s| s.solver.kind() == kind) {
+            Some(s) => s.clone(),
+            None => {
+                let mut s = dam_break.clone();
+                s.solver = s.solver.with_kind(kind);
+                s
+            }
+        };
+        let sim = sph_sim::SceneSim::<f32>::new(&scene).unwrap();
+        assert_eq!(kind.label(), sim.solver().name(), "{}", scene.name);
     }
 }

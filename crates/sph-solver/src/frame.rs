@@ -22,11 +22,13 @@ use std::fmt;
 use std::ops::{Deref, DerefMut};
 
 use neighbour_search::{Method, NeighbourLists};
-use sph_core::{ParticleSet, Real, Sdf, Vec3};
+use sph_core::{Aabb, ParticleSet, Real, Sdf, Vec3};
 use sph_kernels::KernelKind;
 
 use crate::boundary::check_volume_kernel;
-use crate::boundary::{Boundary, CollisionBoundary};
+use crate::boundary::{
+    Boundary, CollisionBoundary, VolumeMapBoundary, VolumeMapCache, VolumeMapOptions,
+};
 use crate::error::SolverError;
 use crate::fluid_solver::{FluidSolver, Solids};
 use crate::parameters::SolverParameters;
@@ -221,6 +223,35 @@ impl<R: Real, S: SubstepScheme<R>> FrameSolver<R, S> {
         )?;
         let parts = SchemeParts::new(boundary, common.neighbour_method);
         Ok(Self::from_scheme(S::new(params, parts)?))
+    }
+
+    /// Volume-map walls of `solids` (Bender, Kugelstadt, Weiler & Koschier 2019) for this
+    /// solver with `params`: integrated with its density kernel
+    /// ([`SubstepScheme::DENSITY_KERNEL`]) at its support radius over `domain` (the region
+    /// the particles can reach, e.g. the tank's box), with the recommended contact distance
+    /// ([`CommonParams::volume_map_contact_distance`]), default [`VolumeMapOptions`] and
+    /// optionally a [`VolumeMapCache`] directory (maps are then loaded from or written to
+    /// it); what scene files get with `[boundary] model = "volume-map"`. Give them to
+    /// [`FrameSolver::with_boundary`].
+    ///
+    /// Errors: those of [`VolumeMapBoundary::with_cache`] (bad domain, unusable support
+    /// radius, a solid whose grid would be too large).
+    pub fn volume_map_walls(
+        solids: Solids<R>,
+        params: &S::Params,
+        domain: Aabb<R>,
+        cache: Option<&VolumeMapCache>,
+    ) -> Result<VolumeMapBoundary<R>, SolverError> {
+        let common = params.common();
+        VolumeMapBoundary::with_cache(
+            solids,
+            S::DENSITY_KERNEL,
+            common.support_radius,
+            domain,
+            common.volume_map_contact_distance(),
+            VolumeMapOptions::default(),
+            cache,
+        )
     }
 
     /// A solver running `scheme` from frame 0 (with an emitter for the scheme's pour, if it

@@ -96,6 +96,11 @@ pub trait SolverSettings: Sized + Clone + std::fmt::Debug + PartialEq {
     /// conversion: [`SolverParameters`]).
     type Params<R: Real>: SolverParameters<R>;
 
+    /// The solver's name in reports: the name its solver gives itself for these settings
+    /// ([`FluidSolver::name`](crate::FluidSolver::name)); by default its parameters'
+    /// [`SolverParameters::NAME`].
+    const LABEL: &'static str = <Self::Params<f64> as SolverParameters<f64>>::NAME;
+
     /// The scene boundary features the solver takes ([`crate::scene_boundary`]): by
     /// default solids as collision boundaries or volume maps only.
     const BOUNDARY_FEATURES: BoundaryFeatures = BoundaryFeatures::SOLIDS_ONLY;

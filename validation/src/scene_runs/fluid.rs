@@ -100,13 +100,7 @@ pub fn run_fluid(
     scene.solver = scene.solver.with_kind(kind);
     scene.solver.common_mut().substeps = substeps;
     scene.solver.set_iterations(iterations);
-    let name = match kind {
-        SolverKind::Pbf => "PBF",
-        SolverKind::Pcisph => "PCISPH",
-        SolverKind::Iisph => "IISPH",
-        SolverKind::Granular => "IISPH-granular",
-        SolverKind::Elastoplastic => "elastoplastic",
-    };
+    let name = kind.label();
     let walls = match scene.boundary.model {
         sph_scene::BoundaryModel::VolumeMap => "volume maps",
         sph_scene::BoundaryModel::Collision => "collision walls",

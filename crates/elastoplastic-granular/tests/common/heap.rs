@@ -7,9 +7,8 @@
 #![allow(dead_code)] // each test file uses a part
 
 use elastoplastic_granular::{
-    boundary_block, cubic_lattice, volume_map_walls, Aabb, Elastoplastic, ElastoplasticParams,
-    ElastoplasticScheme, InitialStress, ParticleSet, PeriodicAxis, Plane, Pour, Solids,
-    SolverError, Vec3, WallModel,
+    boundary_block, cubic_lattice, Aabb, Elastoplastic, ElastoplasticParams, ElastoplasticScheme,
+    InitialStress, ParticleSet, PeriodicAxis, Plane, Pour, Solids, SolverError, Vec3, WallModel,
 };
 use sph_core::Real;
 
@@ -112,7 +111,7 @@ fn floored_slab<R: Real>(
     params.wall_models = vec![WallModel::ContactOnly];
     let solids: Solids<R> = vec![Box::new(Plane::new(v(0.0, 0.0, 0.0), v(0.0, 1.0, 0.0))?)];
     let domain = aabb([-0.05, -0.05, -0.05], [l + 0.05, top_m + 0.1, d + 0.05])?;
-    let walls = volume_map_walls(solids, &params, domain)?;
+    let walls = Elastoplastic::volume_map_walls(solids, &params, domain, None)?;
     let mut solver = ElastoplasticScheme::solver(params, walls)?;
     let rows = aabb([0.0, -BOUNDARY_ROWS * s.as_f64(), 0.0], [l, 0.0, d])?;
     let floor = boundary_block(&rows, s, v(0.0, 1.0, 0.0), WallModel::NoSlip, 1 << 22)?;
