@@ -222,10 +222,11 @@ mod tests {
     use crate::verdict::Status;
     use crate::Check;
 
-    struct Fails;
-    impl Experiment for Fails {
+    /// An experiment of the tests: its id and what its run does.
+    struct Stub(&'static str, fn() -> Result<Outcome>);
+    impl Experiment for Stub {
         fn id(&self) -> &'static str {
-            "fails"
+            self.0
         }
         fn source(&self) -> &'static str {
             "test"
@@ -234,60 +235,22 @@ mod tests {
             &[]
         }
         fn run(&self, _ctx: &mut Context) -> Result<Outcome> {
-            let mut o = Outcome::new();
-            o.metric("m", 1.0);
-            o.check(Check::less_than("c", 2.0, 1.0, "test"));
-            Ok(o)
-        }
-    }
-    struct Panics;
-    impl Experiment for Panics {
-        fn id(&self) -> &'static str {
-            "panics"
-        }
-        fn source(&self) -> &'static str {
-            "test"
-        }
-        fn crates(&self) -> &'static [&'static str] {
-            &[]
-        }
-        fn run(&self, _ctx: &mut Context) -> Result<Outcome> {
-            panic!("boom")
-        }
-    }
-    struct Errs;
-    impl Experiment for Errs {
-        fn id(&self) -> &'static str {
-            "errs"
-        }
-        fn source(&self) -> &'static str {
-            "test"
-        }
-        fn crates(&self) -> &'static [&'static str] {
-            &[]
-        }
-        fn run(&self, _ctx: &mut Context) -> Result<Outcome> {
-            bail!("no data")
+            (self.1)()
         }
     }
 
-    struct Documented;
-    impl Experiment for Documented {
-        fn id(&self) -> &'static str {
-            "documented"
-        }
-        fn source(&self) -> &'static str {
-            "test"
-        }
-        fn crates(&self) -> &'static [&'static str] {
-            &[]
-        }
-        fn run(&self, _ctx: &mut Context) -> Result<Outcome> {
-            let mut o = Outcome::new();
-            o.check(Check::less_than("misses", 2.0, 1.0, "test"));
-            o.check(Check::less_than("passes", 0.0, 1.0, "test"));
-            Ok(o)
-        }
+    fn fails() -> Result<Outcome> {
+        let mut o = Outcome::new();
+        o.metric("m", 1.0);
+        o.check(Check::less_than("c", 2.0, 1.0, "test"));
+        Ok(o)
+    }
+
+    fn documented() -> Result<Outcome> {
+        let mut o = Outcome::new();
+        o.check(Check::less_than("misses", 2.0, 1.0, "test"));
+        o.check(Check::less_than("passes", 0.0, 1.0, "test"));
+        Ok(o)
     }
 
     const DEVIATIONS: &str = r#"
@@ -302,10 +265,10 @@ evidence = "test"
     #[test]
     fn statuses_and_files() {
         let all: Vec<Box<dyn Experiment>> = vec![
-            Box::new(Fails),
-            Box::new(Panics),
-            Box::new(Errs),
-            Box::new(Documented),
+            Box::new(Stub("fails", fails)),
+            Box::new(Stub("panics", || panic!("boom"))),
+            Box::new(Stub("errs", || bail!("no data"))),
+            Box::new(Stub("documented", documented)),
         ];
         let out = std::env::temp_dir().join(format!("validation-runner-{}", std::process::id()));
         let opts = RunOptions {

@@ -12,6 +12,7 @@ use granular_measure::{
 };
 use sph_core::Vec3;
 use sph_scene::Scene;
+use sph_solver::ConeMatch;
 
 use super::{plot_xy, write_csv_rows, Legend, Marker, PlotSpec, Series, SeriesStyle};
 use crate::scene_runs::{
@@ -21,6 +22,8 @@ use crate::{Check, Context, Outcome};
 
 /// The friction angles (degrees) of the sweeps, each with its shipped scenes.
 pub const THETAS: [f64; 3] = [20.0, 30.0, 40.0];
+/// The matches of the sweeps, in run order.
+pub const MATCHES: [ConeMatch; 2] = [ConeMatch::SimpleShear, ConeMatch::PlaneStrain];
 /// Horizontal run of the steepest-slope measure (m).
 pub const STEEPEST_RUN_M: f64 = 0.2;
 /// Band of the comparison with the prediction in quick mode (degrees): the measure's
@@ -33,6 +36,19 @@ pub const TOLERANCE_QUICK_DEG: f64 = 2.0;
 /// layer's thickness (a-priori bound of this project: a liquid at rest is flat; half the
 /// layer allows a particle's roughness on a layer of about ten particles).
 pub const FLAT_RELIEF_FRACTION: f64 = 0.5;
+
+/// One planned run of a repose case; `V` says how it departs from its shipped scene.
+#[derive(Debug, Clone)]
+pub struct Plan<V> {
+    /// The case's tag.
+    pub tag: String,
+    /// The friction angle (degrees).
+    pub theta_deg: f64,
+    /// The cone's match.
+    pub cone: ConeMatch,
+    /// How it departs from the shipped scene.
+    pub variant: V,
+}
 
 /// One run of a repose case: its tag, friction angle, scene and what it gave.
 pub struct HeapRun {
@@ -248,7 +264,7 @@ pub fn check_flatness(out: &mut Outcome, tag: &str, worst: f64, place: &str) {
 
 /// The angle increases with θ under one match (`name`, e.g. `"simple-shear"` or
 /// `"thesis/plane-strain"`), when it ran at all three angles (`angles` in θ's order).
-pub fn check_increasing(out: &mut Outcome, name: &str, angles: &[f64]) {
+fn check_increasing(out: &mut Outcome, name: &str, angles: &[f64]) {
     if angles.len() == THETAS.len() {
         let increasing = angles.windows(2).all(|w| w[1] > w[0]);
         out.check(Check::equals(
@@ -314,59 +330,88 @@ pub fn write_repose_csv(ctx: &mut Context, rows: Vec<Vec<String>>) -> Result<()>
     Ok(())
 }
 
-/// A match's predicted angle of repose for `repose.png`: its legend and `β(θ)` (degrees).
-pub type Prediction<'a> = (&'a str, fn(f64) -> f64);
-
-/// The measured angles of one model under one match, for `repose.png`.
-pub struct AngleSeries {
-    /// The legend: model and match.
-    pub label: String,
-    /// `(θ, measured angle)` (degrees).
-    pub points: Vec<(f64, f64)>,
+/// How one model's heaps are drawn in `repose.png` and `profiles.png`.
+pub struct ReposeFigures<'a> {
+    /// The model in the legend, e.g. `"elastic-plastic"`.
+    pub model: &'a str,
     /// The model's marker.
     pub marker: Marker,
+    /// The heaps in the title of `repose.png`, e.g. `"poured heaps"`.
+    pub heaps: &'a str,
+    /// The title of `profiles.png`.
+    pub profiles_title: &'a str,
 }
 
-/// `repose.png`: each match's prediction `predictions` (label, `β(θ)`) dashed, and the
-/// measured angles `measured` (the i-th of each in the i-th colour).
-pub fn plot_angles(
+/// `repose.png` (each match's prediction dashed, and the measured angles `measured` of the
+/// sweeps, the i-th match in the i-th colour) and `profiles.png` (the final profiles).
+pub fn plot_repose(
     ctx: &mut Context,
-    title: &str,
-    predictions: [Prediction<'_>; 2],
-    measured: Vec<AngleSeries>,
+    figures: &ReposeFigures<'_>,
+    measured: &[(ConeMatch, f64, Measured)],
+    profiles: &[(String, Vec<(f64, f64)>)],
 ) -> Result<()> {
+    let predictions: [(&str, ConeMatch); 2] = [
+        ("simple-shear match: β = θ", ConeMatch::SimpleShear),
+        (
+            "plane-strain match: β = atan(sin θ)",
+            ConeMatch::PlaneStrain,
+        ),
+    ];
     let mut series: Vec<Series> = predictions
         .iter()
         .enumerate()
-        .map(|(i, (label, predicted))| {
+        .map(|(i, (label, cone))| {
             let curve = (0..=50)
-                .map(|t| (f64::from(t), predicted(f64::from(t))))
+                .map(|t| (f64::from(t), cone.predicted_repose_angle_deg(f64::from(t))))
                 .collect();
             Series::styled(*label, curve, SeriesStyle::Dashed, i)
         })
         .collect();
-    for (i, m) in measured.into_iter().enumerate() {
-        if !m.points.is_empty() {
-            series.push(Series::markers(m.label, m.points, m.marker, i % 2));
+    for (i, cone) in MATCHES.iter().enumerate() {
+        let points: Vec<(f64, f64)> = measured
+            .iter()
+            .filter(|(c, _, _)| c == cone)
+            .map(|(_, t, m)| (*t, m.angle_deg))
+            .collect();
+        if !points.is_empty() {
+            let label = format!("{}, {}: band fit 20–80 %", figures.model, cone.name());
+            series.push(Series::markers(label, points, figures.marker, i % 2));
         }
     }
+    let title = format!(
+        "Angle of repose of {} against the yield cone's prediction",
+        figures.heaps
+    );
     let spec = PlotSpec {
         legend: Legend::UpperLeft,
         series,
         x_range: Some((0.0, 50.0)),
         y_range: Some((0.0, 50.0)),
-        ..PlotSpec::new(title, "friction angle θ (deg)", "angle of repose β (deg)")
+        ..PlotSpec::new(&title, "friction angle θ (deg)", "angle of repose β (deg)")
     };
     plot_xy(&ctx.path("repose.png"), &spec)?;
     ctx.add_plot(
         "repose.png",
         "measured angle of repose per model and match against the friction angle, with each match's prediction",
     );
-    Ok(())
+    plot_profiles(ctx, figures.profiles_title, profiles)
+}
+
+/// The angle increases with θ under each match run at all three angles (`measured`: the
+/// sweeps' heaps, in θ's order); each check named `{prefix}{match}`.
+pub fn check_order(out: &mut Outcome, prefix: &str, measured: &[(ConeMatch, f64, Measured)]) {
+    for cone in MATCHES {
+        let angles: Vec<f64> = measured
+            .iter()
+            .filter(|(c, _, _)| *c == cone)
+            .map(|(_, _, m)| m.angle_deg)
+            .collect();
+        check_increasing(out, &format!("{prefix}{}", cone.name()), &angles);
+    }
 }
 
 /// `profiles.png`: the final surface profile of each sweep run.
-pub fn plot_profiles(
+fn plot_profiles(
     ctx: &mut Context,
     title: &str,
     profiles: &[(String, Vec<(f64, f64)>)],

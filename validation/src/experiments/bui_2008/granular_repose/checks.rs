@@ -8,10 +8,10 @@ use granular_measure::SurfacePoint;
 use sph_core::Vec3;
 use sph_scene::Scene;
 
-use super::plan::{COARSE_TAG, MATCHES, PLAIN_30_TAG, STIFF_TAG};
+use super::plan::{COARSE_TAG, PLAIN_30_TAG, STIFF_TAG};
 use crate::helpers::repose::{
-    check_completed, check_flatness, check_increasing, check_rest, heap_metrics, measure_heap,
-    pool_relief, rest_settings, HeapRun, Measured,
+    check_completed, check_flatness, check_rest, heap_metrics, measure_heap, pool_relief,
+    rest_settings, HeapRun, Measured,
 };
 use crate::scene_runs::RestCriterion;
 use crate::{Check, Mode, Outcome};
@@ -192,19 +192,6 @@ fn check_spread(
         3.0 * s,
         "physics: without friction there is no yield stress, the poured material spreads over the whole floor like a liquid; on a covered floor the highest grains of neighbouring bins (one spacing wide) are less than two spacings apart, three allows one bin the profile drops as a pit",
     ));
-}
-
-/// The angle increases with θ under each match run at all three angles (`measured`: the
-/// sweeps' heaps, in θ's order).
-pub fn check_order(out: &mut Outcome, measured: &[(ConeMatch, f64, Measured)]) {
-    for cone in MATCHES {
-        let angles: Vec<f64> = measured
-            .iter()
-            .filter(|(c, _, _)| *c == cone)
-            .map(|(_, _, m)| m.angle_deg)
-            .collect();
-        check_increasing(out, cone.name(), &angles);
-    }
 }
 
 /// The pairs: the modulus check (both modes: the stiff heap against the coarse one, quick

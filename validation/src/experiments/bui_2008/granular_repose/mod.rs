@@ -64,14 +64,12 @@ pub mod plan;
 use anyhow::Result;
 use elastoplastic_granular::ConeMatch;
 
-use self::checks::{
-    check_flat, check_heap, check_order, check_pairs, check_run, rest_criterion, Floor,
-};
+use self::checks::{check_flat, check_heap, check_pairs, check_run, rest_criterion, Floor};
 pub use self::checks::{SPACING_MODULUS_DEG, TOLERANCE_FULL_DEG};
-use self::plan::{plan, scene_for, Plan, MATCHES};
+use self::plan::{plan, scene_for, Plan};
 use crate::helpers::repose::{
-    csv_row, final_profile, is_sweep, plot_angles, plot_profiles, run_heap, write_repose_csv,
-    AngleSeries, HeapRun, Measured,
+    check_order, csv_row, final_profile, is_sweep, plot_repose, run_heap, write_repose_csv,
+    HeapRun, Measured, ReposeFigures,
 };
 pub use crate::helpers::repose::{STEEPEST_RUN_M, TOLERANCE_QUICK_DEG};
 use crate::helpers::Marker;
@@ -163,47 +161,15 @@ fn judge(ctx: &mut Context, runs: &[(Plan, HeapRun)]) -> Result<Outcome> {
             }
         }
     }
-    check_order(&mut out, &measured);
+    check_order(&mut out, "", &measured);
     check_pairs(&mut out, &by_tag, ctx.mode);
     write_repose_csv(ctx, rows)?;
-    plot(ctx, &measured, &profiles)?;
+    let figures = ReposeFigures {
+        model: "elastic-plastic",
+        marker: Marker::Circle,
+        heaps: "poured heaps",
+        profiles_title: "Surface profiles at the end of each run (poured heaps: the floor at y = 0, the funnel at the period's middle)",
+    };
+    plot_repose(ctx, &figures, &measured, &profiles)?;
     Ok(out)
-}
-
-/// `repose.png` (both matches' predictions and measured angles) and `profiles.png`.
-fn plot(
-    ctx: &mut Context,
-    measured: &[(ConeMatch, f64, Measured)],
-    profiles: &[(String, Vec<(f64, f64)>)],
-) -> Result<()> {
-    let series = MATCHES
-        .iter()
-        .map(|cone| AngleSeries {
-            label: format!("elastic-plastic, {}: band fit 20–80 %", cone.name()),
-            points: measured
-                .iter()
-                .filter(|(c, _, _)| c == cone)
-                .map(|(_, t, m)| (*t, m.angle_deg))
-                .collect(),
-            marker: Marker::Circle,
-        })
-        .collect();
-    plot_angles(
-        ctx,
-        "Angle of repose of poured heaps against the yield cone's prediction",
-        [
-            ("simple-shear match: β = θ", |t| {
-                ConeMatch::SimpleShear.predicted_repose_angle_deg(t)
-            }),
-            ("plane-strain match: β = atan(sin θ)", |t| {
-                ConeMatch::PlaneStrain.predicted_repose_angle_deg(t)
-            }),
-        ],
-        series,
-    )?;
-    plot_profiles(
-        ctx,
-        "Surface profiles at the end of each run (poured heaps: the floor at y = 0, the funnel at the period's middle)",
-        profiles,
-    )
 }

@@ -5,7 +5,7 @@ use anyhow::Result;
 use elastoplastic_granular::ConeMatch;
 use sph_scene::{Scene, SolverParams, SolverSpec};
 
-use crate::helpers::repose::THETAS;
+use crate::helpers::repose::{self, MATCHES, THETAS};
 use crate::scene_runs::shipped_scene;
 use crate::Mode;
 
@@ -20,8 +20,6 @@ pub const COARSE_TAG: &str = "coarse/simple-shear/theta=30";
 pub const STIFF_TAG: &str = "stiff/simple-shear/theta=30";
 /// The sweep's 30° simple-shear heap (quick mode's coarse heap).
 pub const PLAIN_30_TAG: &str = "simple-shear/theta=30";
-/// The matches of the sweeps, in run order.
-pub const MATCHES: [ConeMatch; 2] = [ConeMatch::SimpleShear, ConeMatch::PlaneStrain];
 
 /// How a case departs from its shipped scene.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -37,17 +35,7 @@ pub enum Variant {
 }
 
 /// One planned run.
-#[derive(Debug, Clone)]
-pub struct Plan {
-    /// The case's tag.
-    pub tag: String,
-    /// The friction angle (degrees).
-    pub theta_deg: f64,
-    /// The cone's match.
-    pub cone: ConeMatch,
-    /// How it departs from the shipped scene.
-    pub variant: Variant,
-}
+pub type Plan = repose::Plan<Variant>;
 
 /// The runs of `mode`: the sweep under both matches, θ = 0 and the stiff heap (both modes);
 /// full mode adds the coarse heap of the spacing check.

@@ -8,10 +8,10 @@ use iisph_granular::ConeMatch;
 use sph_core::Vec3;
 use sph_scene::{FluidSpec, Scene, SolidSpec};
 
-use super::plan::{MATCHES, PLAIN_30_TAG, REPEAT_TAG, WIDE_TAG};
+use super::plan::{PLAIN_30_TAG, REPEAT_TAG, WIDE_TAG};
 use crate::helpers::repose::{
-    check_completed, check_flatness, check_increasing, check_rest, heap_metrics, measure_heap,
-    pool_relief, rest_settings, HeapRun, Measured, TOLERANCE_QUICK_DEG,
+    check_completed, check_flatness, check_rest, heap_metrics, measure_heap, pool_relief,
+    rest_settings, HeapRun, Measured, TOLERANCE_QUICK_DEG,
 };
 use crate::scene_runs::RestCriterion;
 use crate::{Check, Outcome};
@@ -213,19 +213,6 @@ pub fn check_flat(out: &mut Outcome, case: &HeapRun, base: Base) -> Result<()> {
     }
     check_flatness(out, tag, worst, "in the troughs");
     Ok(())
-}
-
-/// The angle increases with θ under each match run at all three angles (`measured`: the
-/// sweeps' heaps, in θ's order).
-pub fn check_order(out: &mut Outcome, measured: &[(ConeMatch, f64, Measured)]) {
-    for cone in MATCHES {
-        let angles: Vec<f64> = measured
-            .iter()
-            .filter(|(c, _, _)| *c == cone)
-            .map(|(_, _, m)| m.angle_deg)
-            .collect();
-        check_increasing(out, &format!("thesis/{}", cone.name()), &angles);
-    }
 }
 
 /// The repeat's and the deeper slab's differences from the 30° simple-shear heap (metrics).

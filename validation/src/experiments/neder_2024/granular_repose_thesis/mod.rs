@@ -36,13 +36,11 @@ pub mod plan;
 use anyhow::Result;
 use iisph_granular::ConeMatch;
 
-use self::checks::{
-    check_flat, check_heap, check_order, check_run, pair_metrics, rest_criterion, Base,
-};
-use self::plan::{plan, scene_for, Plan, MATCHES};
+use self::checks::{check_flat, check_heap, check_run, pair_metrics, rest_criterion, Base};
+use self::plan::{plan, scene_for, Plan};
 use crate::helpers::repose::{
-    csv_row, final_profile, is_sweep, plot_angles, plot_profiles, run_heap, write_repose_csv,
-    AngleSeries, HeapRun, Measured, STEEPEST_RUN_M,
+    check_order, csv_row, final_profile, is_sweep, plot_repose, run_heap, write_repose_csv,
+    HeapRun, Measured, ReposeFigures, STEEPEST_RUN_M,
 };
 use crate::helpers::Marker;
 use crate::{Context, Experiment, Mode, Outcome};
@@ -133,47 +131,15 @@ fn judge(ctx: &mut Context, runs: &[(Plan, HeapRun)]) -> Result<Outcome> {
             }
         }
     }
-    check_order(&mut out, &measured);
+    check_order(&mut out, "thesis/", &measured);
     pair_metrics(&mut out, &by_tag);
     write_repose_csv(ctx, rows)?;
-    plot(ctx, &measured, &profiles)?;
+    let figures = ReposeFigures {
+        model: "thesis IISPH",
+        marker: Marker::Ring,
+        heaps: "fixed-base heaps",
+        profiles_title: "Surface profiles at the end of each run (fixed-base heaps: the base between its edges, the troughs beside it)",
+    };
+    plot_repose(ctx, &figures, &measured, &profiles)?;
     Ok(out)
-}
-
-/// `repose.png` (both matches' predictions and measured angles) and `profiles.png`.
-fn plot(
-    ctx: &mut Context,
-    measured: &[(ConeMatch, f64, Measured)],
-    profiles: &[(String, Vec<(f64, f64)>)],
-) -> Result<()> {
-    let series = MATCHES
-        .iter()
-        .map(|cone| AngleSeries {
-            label: format!("thesis IISPH, {}: band fit 20–80 %", cone.name()),
-            points: measured
-                .iter()
-                .filter(|(c, _, _)| c == cone)
-                .map(|(_, t, m)| (*t, m.angle_deg))
-                .collect(),
-            marker: Marker::Ring,
-        })
-        .collect();
-    plot_angles(
-        ctx,
-        "Angle of repose of fixed-base heaps against the yield cone's prediction",
-        [
-            ("simple-shear match: β = θ", |t| {
-                ConeMatch::SimpleShear.predicted_repose_angle_deg(t)
-            }),
-            ("plane-strain match: β = atan(sin θ)", |t| {
-                ConeMatch::PlaneStrain.predicted_repose_angle_deg(t)
-            }),
-        ],
-        series,
-    )?;
-    plot_profiles(
-        ctx,
-        "Surface profiles at the end of each run (fixed-base heaps: the base between its edges, the troughs beside it)",
-        profiles,
-    )
 }

@@ -5,7 +5,7 @@ use anyhow::Result;
 use iisph_granular::ConeMatch;
 use sph_scene::{FluidSpec, Scene, SolidSpec, SolverSpec};
 
-use crate::helpers::repose::THETAS;
+use crate::helpers::repose::{self, MATCHES, THETAS};
 use crate::scene_runs::shipped_scene;
 use crate::Mode;
 
@@ -19,8 +19,6 @@ pub const PLAIN_30_TAG: &str = "thesis/simple-shear/theta=30";
 pub const REPEAT_TAG: &str = "thesis/repeat/simple-shear/theta=30";
 /// [`PLAIN_30_TAG`] in the slab [`WIDE_SLAB_FACTOR`] times deeper.
 pub const WIDE_TAG: &str = "thesis/wide/simple-shear/theta=30";
-/// The matches of the sweeps, in run order.
-pub const MATCHES: [ConeMatch; 2] = [ConeMatch::SimpleShear, ConeMatch::PlaneStrain];
 
 /// How a case departs from its shipped scene.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -34,17 +32,7 @@ pub enum Variant {
 }
 
 /// One planned run.
-#[derive(Debug, Clone)]
-pub struct Plan {
-    /// The case's tag.
-    pub tag: String,
-    /// The friction angle (degrees).
-    pub theta_deg: f64,
-    /// The cone's match.
-    pub cone: ConeMatch,
-    /// How it departs from the shipped scene.
-    pub variant: Variant,
-}
+pub type Plan = repose::Plan<Variant>;
 
 /// The runs of `mode`: none in quick mode (the replay costs more than CI's quick budget);
 /// in full mode the sweep under both matches, θ = 0, the repeat and the deeper slab.
