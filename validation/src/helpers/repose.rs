@@ -18,7 +18,7 @@ use super::{plot_xy, write_csv_rows, Legend, Marker, PlotSpec, Series, SeriesSty
 use crate::scene_runs::{
     run_scene_until_rest, solver_error_check, RestCriterion, RestSettings, SceneRun,
 };
-use crate::{Check, Context, Outcome};
+use crate::{Check, Context, Mode, Outcome};
 
 /// The friction angles (degrees) of the sweeps, each with its shipped scenes.
 pub const THETAS: [f64; 3] = [20.0, 30.0, 40.0];
@@ -86,6 +86,51 @@ pub fn rest_settings(theta_deg: f64) -> RestSettings {
             .filter(|_| theta_deg > 0.0),
         ..RestSettings::default()
     }
+}
+
+/// What the heaps of one experiment stand on, read from its scenes.
+pub trait Ground: Copy {
+    /// The ground of `scene`.
+    fn of(scene: &Scene) -> Result<Self>;
+    /// The heap's grains among `positions`.
+    fn heap(self, positions: &[Vec3<f64>]) -> Vec<Vec3<f64>>;
+    /// The height the heap stands on (m): the floor of its planar measure.
+    fn level_y(self) -> f64;
+}
+
+/// Builds every planned case's scene with `scene_for` (refusing a bad one before any run),
+/// then runs each until at rest by `rest` (or to its cap), its diagnostic line measured on
+/// the ground `G` of its scene.
+pub fn run_plans<V, G: Ground>(
+    ctx: &mut Context,
+    plans: Vec<Plan<V>>,
+    scene_for: impl Fn(&Plan<V>, Mode) -> Result<Scene>,
+    rest: impl Fn(&Scene, f64) -> RestCriterion,
+) -> Result<Vec<(Plan<V>, HeapRun)>> {
+    let scenes = plans
+        .iter()
+        .map(|p| scene_for(p, ctx.mode))
+        .collect::<Result<Vec<_>>>()?;
+    ctx.progress
+        .set_length(scenes.iter().map(|s| s.frame_count() as u64).sum());
+    let mut runs = Vec::new();
+    for (p, scene) in plans.into_iter().zip(scenes) {
+        let criterion = rest(&scene, p.theta_deg);
+        let ground = G::of(&scene).ok();
+        let heap = |pos: &[_]| ground.map_or_else(Vec::new, |g| g.heap(pos));
+        let level_y = ground.map(G::level_y);
+        let run = run_heap(
+            ctx,
+            p.tag.clone(),
+            p.theta_deg,
+            scene,
+            criterion,
+            level_y,
+            heap,
+        )?;
+        runs.push((p, run));
+    }
+    Ok(runs)
 }
 
 /// Runs `scene` until at rest by `rest` (or to its cap) and prints the run's diagnostic line

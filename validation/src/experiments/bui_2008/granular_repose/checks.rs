@@ -11,7 +11,7 @@ use sph_scene::Scene;
 use super::plan::{COARSE_TAG, PLAIN_30_TAG, STIFF_TAG};
 use crate::helpers::repose::{
     check_completed, check_flatness, check_rest, heap_metrics, measure_heap, pool_relief,
-    rest_settings, HeapRun, Measured,
+    rest_settings, Ground, HeapRun, Measured,
 };
 use crate::scene_runs::RestCriterion;
 use crate::{Check, Mode, Outcome};
@@ -40,9 +40,9 @@ pub struct Floor {
     pub x1: f64,
 }
 
-impl Floor {
+impl Ground for Floor {
     /// The floor of a poured scene: its tank's.
-    pub fn of(scene: &Scene) -> Result<Floor> {
+    fn of(scene: &Scene) -> Result<Floor> {
         let Some(tank) = scene.tank else {
             anyhow::bail!(
                 "{}: a poured heap needs a tank (its floor)",
@@ -57,8 +57,12 @@ impl Floor {
     }
 
     /// The heap's grains: those above the floor.
-    pub fn heap(self, positions: &[Vec3<f64>]) -> Vec<Vec3<f64>> {
+    fn heap(self, positions: &[Vec3<f64>]) -> Vec<Vec3<f64>> {
         positions.iter().copied().filter(|p| p.y > self.y).collect()
+    }
+
+    fn level_y(self) -> f64 {
+        self.y
     }
 }
 

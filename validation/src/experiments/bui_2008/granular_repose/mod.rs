@@ -68,7 +68,7 @@ use self::checks::{check_flat, check_heap, check_pairs, check_run, rest_criterio
 pub use self::checks::{SPACING_MODULUS_DEG, TOLERANCE_FULL_DEG};
 use self::plan::{plan, scene_for, Plan};
 use crate::helpers::repose::{
-    check_order, csv_row, final_profile, is_sweep, plot_repose, run_heap, write_repose_csv,
+    check_order, csv_row, final_profile, is_sweep, plot_repose, run_plans, write_repose_csv,
     HeapRun, Measured, ReposeFigures,
 };
 pub use crate::helpers::repose::{STEEPEST_RUN_M, TOLERANCE_QUICK_DEG};
@@ -111,26 +111,9 @@ impl Experiment for GranularRepose {
     }
 }
 
-/// Builds every planned case's scene (refusing a bad one before any run), then runs each
-/// until at rest or to its cap.
+/// Every planned case run until at rest or to its cap.
 fn run_all(ctx: &mut Context) -> Result<Vec<(Plan, HeapRun)>> {
-    let plan = plan(ctx.mode);
-    let scenes = plan
-        .iter()
-        .map(|p| scene_for(p, ctx.mode))
-        .collect::<Result<Vec<_>>>()?;
-    ctx.progress
-        .set_length(scenes.iter().map(|s| s.frame_count() as u64).sum());
-    let mut runs = Vec::new();
-    for (p, scene) in plan.into_iter().zip(scenes) {
-        let rest = rest_criterion(&scene, p.theta_deg);
-        let floor = Floor::of(&scene).ok();
-        let heap = |pos: &[_]| floor.map_or_else(Vec::new, |f| f.heap(pos));
-        let floor_y = floor.map(|f| f.y);
-        let run = run_heap(ctx, p.tag.clone(), p.theta_deg, scene, rest, floor_y, heap)?;
-        runs.push((p, run));
-    }
-    Ok(runs)
+    run_plans::<_, Floor>(ctx, plan(ctx.mode), scene_for, rest_criterion)
 }
 
 /// The checks of every run, the order, the pairs, and the outputs.

@@ -11,7 +11,7 @@ use sph_scene::{FluidSpec, Scene, SolidSpec};
 use super::plan::{PLAIN_30_TAG, REPEAT_TAG, WIDE_TAG};
 use crate::helpers::repose::{
     check_completed, check_flatness, check_rest, heap_metrics, measure_heap, pool_relief,
-    rest_settings, HeapRun, Measured, TOLERANCE_QUICK_DEG,
+    rest_settings, Ground, HeapRun, Measured, TOLERANCE_QUICK_DEG,
 };
 use crate::scene_runs::RestCriterion;
 use crate::{Check, Outcome};
@@ -33,9 +33,9 @@ pub struct Base {
     pub block_top_y: f64,
 }
 
-impl Base {
+impl Ground for Base {
     /// The base and block of `scene`.
-    pub fn of(scene: &Scene) -> Result<Base> {
+    fn of(scene: &Scene) -> Result<Base> {
         let (Some(SolidSpec::Box { min, max }), Some(FluidSpec::Block { max: bmax, .. })) =
             (scene.solids.first(), scene.fluids.first())
         else {
@@ -53,12 +53,16 @@ impl Base {
     }
 
     /// The heap's grains: those above the base, between its edges.
-    pub fn heap(self, positions: &[Vec3<f64>]) -> Vec<Vec3<f64>> {
+    fn heap(self, positions: &[Vec3<f64>]) -> Vec<Vec3<f64>> {
         positions
             .iter()
             .copied()
             .filter(|p| p.y > self.top_y && p.x > self.x0 && p.x < self.x1)
             .collect()
+    }
+
+    fn level_y(self) -> f64 {
+        self.top_y
     }
 }
 

@@ -39,7 +39,7 @@ use iisph_granular::ConeMatch;
 use self::checks::{check_flat, check_heap, check_run, pair_metrics, rest_criterion, Base};
 use self::plan::{plan, scene_for, Plan};
 use crate::helpers::repose::{
-    check_order, csv_row, final_profile, is_sweep, plot_repose, run_heap, write_repose_csv,
+    check_order, csv_row, final_profile, is_sweep, plot_repose, run_plans, write_repose_csv,
     HeapRun, Measured, ReposeFigures, STEEPEST_RUN_M,
 };
 use crate::helpers::Marker;
@@ -82,26 +82,9 @@ impl Experiment for GranularReposeThesis {
     }
 }
 
-/// Builds every planned case's scene (refusing a bad one before any run), then runs each
-/// until at rest or to its cap.
+/// Every planned case run until at rest or to its cap.
 fn run_all(ctx: &mut Context) -> Result<Vec<(Plan, HeapRun)>> {
-    let plan = plan(ctx.mode);
-    let scenes = plan
-        .iter()
-        .map(|p| scene_for(p, ctx.mode))
-        .collect::<Result<Vec<_>>>()?;
-    ctx.progress
-        .set_length(scenes.iter().map(|s| s.frame_count() as u64).sum());
-    let mut runs = Vec::new();
-    for (p, scene) in plan.into_iter().zip(scenes) {
-        let rest = rest_criterion(&scene, p.theta_deg);
-        let base = Base::of(&scene).ok();
-        let heap = |pos: &[_]| base.map_or_else(Vec::new, |b| b.heap(pos));
-        let floor_y = base.map(|b| b.top_y);
-        let run = run_heap(ctx, p.tag.clone(), p.theta_deg, scene, rest, floor_y, heap)?;
-        runs.push((p, run));
-    }
-    Ok(runs)
+    run_plans::<_, Base>(ctx, plan(ctx.mode), scene_for, rest_criterion)
 }
 
 /// The checks of every run, the order, the pairs' metrics, and the outputs.
