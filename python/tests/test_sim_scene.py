@@ -354,9 +354,9 @@ friction_angle_deg = 30.0
 cone_match = "simple-shear"
 youngs_modulus = 5.84e5
 initial_stress = "geostatic"
-periodic = [{ axis = "z", lo = 0.0, hi = 0.06 }]
 [boundary]
 model = "particles"
+periodic = [{ axis = "z", lo = 0.0, hi = 0.06 }]
 [tank]
 min = [0.0, 0.0, 0.0]
 max = [0.3, 0.3, 0.06]

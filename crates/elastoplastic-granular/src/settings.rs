@@ -6,9 +6,7 @@
 
 use serde::Deserialize;
 use sph_core::{Aabb, Real};
-use sph_solver::scene_boundary::{
-    BoundaryFeatures, MovingWall, PeriodicAxis, PeriodicSetting, Pour, SceneBoundary,
-};
+use sph_solver::scene_boundary::{BoundaryFeatures, MovingWall, PeriodicAxis, Pour, SceneBoundary};
 use sph_solver::settings::convert;
 use sph_solver::{
     Boundary, CommonSettings, FluidSolver, KernelKind, SceneValues, SolverError, SolverSettings,
@@ -60,21 +58,8 @@ pub struct ElastoplasticSettings {
     pub cfl_number: Option<f64>,
     /// [`ElastoplasticParams::skin`] (m).
     pub skin: Option<f64>,
-    /// [`ElastoplasticParams::periodic`] (absent = none).
-    pub periodic: Option<Vec<PeriodicSetting>>,
     /// [`ElastoplasticParams::initial_stress`]: `"none"` (the default) or `"geostatic"`.
     pub initial_stress: Option<InitialStress>,
-}
-
-impl ElastoplasticSettings {
-    /// The periodic axes as `(axis index, lo, hi)` (m).
-    pub fn periodic_axes(&self) -> Vec<(usize, f64, f64)> {
-        self.periodic
-            .iter()
-            .flatten()
-            .map(|p| (p.axis.index(), p.lo, p.hi))
-            .collect()
-    }
 }
 
 impl SolverSettings for ElastoplasticSettings {
@@ -111,7 +96,6 @@ impl SolverSettings for ElastoplasticSettings {
             artificial_stress_exponent: None,
             cfl_number: None,
             skin: None,
-            periodic: None,
             initial_stress: None,
         }
     }
@@ -162,19 +146,10 @@ impl SolverSettings for ElastoplasticSettings {
         );
         set(&mut p.cfl_number, self.cfl_number);
         set(&mut p.skin, self.skin);
-        p.periodic = self.periodic();
         if let Some(s) = self.initial_stress {
             p.initial_stress = s;
         }
         p
-    }
-
-    fn periodic(&self) -> Vec<PeriodicAxis<f64>> {
-        self.periodic
-            .iter()
-            .flatten()
-            .map(PeriodicSetting::to_axis)
-            .collect()
     }
 
     /// Each solid's wall model (unstated: `default_wall`), the moving walls, the region of

@@ -186,8 +186,8 @@ impl Scene {
     }
 
     /// The boundary signed distance fields in precision `R`: the tank first (as
-    /// `Inverted<BoxSdf>`, when there is one; open along the solver's periodic axes,
-    /// [`SolverSpec::periodic_axes`](crate::SolverSpec::periodic_axes): its box reaches
+    /// `Inverted<BoxSdf>`, when there is one; open along the periodic axes
+    /// ([`Scene::periodic_axes`]): its box reaches
     /// [`OPEN_TANK_REACH`] times its extent (at least 1 m) past each end there, so that
     /// particles crossing a periodic end, which the solver wraps, meet no wall), then the
     /// solids that stand still in file order ([`Scene::standing_solids`]; meshes as
@@ -200,7 +200,7 @@ impl Scene {
         let mut out: Vec<Box<dyn Sdf<R>>> = Vec::with_capacity(self.solids.len() + 1);
         if let Some(t) = &self.tank {
             let (mut lo, mut hi) = (t.min, t.max);
-            for (axis, _, _) in self.solver.periodic_axes() {
+            for (axis, _, _) in self.periodic_axes() {
                 if axis < 3 {
                     let reach = OPEN_TANK_REACH * (hi[axis] - lo[axis]).max(1.0);
                     lo[axis] -= reach;

@@ -186,14 +186,14 @@ impl Scene {
         if self.walls.tank.is_some() && self.tank.is_none() {
             return Err(ctx.invalid("tank.wall", "a wall model without a tank"));
         }
-        if !self.solver.periodic_axes().is_empty() {
-            self.refuse_untaken(ctx, "solver.periodic", BoundaryFeature::Periodic)?;
+        if !self.boundary.periodic.is_empty() {
+            self.refuse_untaken(ctx, "boundary.periodic", BoundaryFeature::Periodic)?;
         }
         if let Some(t) = &self.tank {
-            for (axis, lo, hi) in self.solver.periodic_axes() {
+            for (axis, lo, hi) in self.periodic_axes() {
                 if axis < 3 && (lo != t.min[axis] || hi != t.max[axis]) {
                     return Err(ctx.invalid(
-                        "solver.periodic",
+                        "boundary.periodic",
                         format!(
                             "the period along {} must be the tank's extent [{}, {}] (the tank is open along a periodic axis), got [{lo}, {hi}]",
                             AXES[axis], t.min[axis], t.max[axis]

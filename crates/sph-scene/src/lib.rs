@@ -188,9 +188,6 @@
 //! #                                # (default 0.3 particle_spacing)
 //! # initial_stress = "none"        # "none" | "geostatic" (σ_v = −ρ0 g depth along gravity,
 //! #                                # K0 σ_v across it, K0 = ν/(1 − ν), per column)
-//! # periodic = [{ axis = "z", lo = 0.0, hi = 0.03 }] # m: periodic axes; with a tank, the
-//! #                                # period is its extent along the axis and the tank is
-//! #                                # open there
 //! # rest_density, support_over_spacing (default 2.4), reorder_every as above
 //! ```
 //!
@@ -207,6 +204,10 @@
 //!                                  # "calibrated": those masses lowered where the lattice
 //!                                  # plus the walls' share ρ0 Ψ would start above ρ0 (see
 //!                                  # InitialMasses; positions are not moved)
+//! # periodic = [{ axis = "z", lo = 0.0, hi = 0.03 }] # m: periodic axes, for a solver that
+//! #                                # takes them (the elastoplastic one); with a tank, the
+//! #                                # period is its extent along the axis and the tank is
+//! #                                # open there
 //!
 //! [tank]                           # optional: the container, a closed box (particles inside)
 //! min = [0.0, 0.0, 0.0]            # m

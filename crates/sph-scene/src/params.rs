@@ -11,7 +11,7 @@
 //! and `particle_spacing` in `[simulation]`).
 
 use sph_core::{Aabb, Real};
-use sph_solver::scene_boundary::{BoundaryFeature, MovingWall, PeriodicAxis, SceneBoundary};
+use sph_solver::scene_boundary::{BoundaryFeature, MovingWall, SceneBoundary};
 use sph_solver::{CommonSettings, SceneValues, SolverError};
 
 use crate::error::Ctx;
@@ -51,12 +51,7 @@ impl Scene {
                     max: a.max.sup(&b.max),
                 })
             }),
-            periodic: self
-                .solver
-                .periodic_axes()
-                .into_iter()
-                .map(|(axis, lo, hi)| PeriodicAxis { axis, lo, hi })
-                .collect(),
+            periodic: self.boundary.periodic.iter().map(|p| p.to_axis()).collect(),
             pour: self.pour.as_ref().map(crate::PourSpec::to_pour),
         }
     }
@@ -209,11 +204,15 @@ impl Scene {
     }
 
     /// The scene key of the parameter (or setting) `name`: `dt`, `gravity` and
-    /// `particle_spacing` in `[simulation]`, any other in `[solver]` under its name or the
+    /// `particle_spacing` in `[simulation]`, `pour` and `periodic` (`[boundary]`) where the
+    /// scene states them, any other in `[solver]` under its name or the
     /// old name the file writes for it (the solver's `RENAMED`).
     pub(crate) fn key(&self, name: &str) -> String {
         if name == "pour" {
             return name.to_owned();
+        }
+        if name == "periodic" {
+            return "boundary.periodic".to_owned();
         }
         let simulation = match name {
             "dt" => Some("frame_dt"),
@@ -239,7 +238,7 @@ impl Scene {
 /// The scene field of a boundary feature, for the line of an error about it.
 pub(crate) fn feature_field(feature: BoundaryFeature) -> &'static str {
     match feature {
-        BoundaryFeature::Periodic => "solver.periodic",
+        BoundaryFeature::Periodic => "boundary.periodic",
         BoundaryFeature::Pour => "pour",
         _ => "boundary.model",
     }

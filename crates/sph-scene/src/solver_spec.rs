@@ -155,16 +155,6 @@ macro_rules! solvers {
                 }
             }
 
-            /// The periodic axes the settings state ([`SolverSettings::periodic`]) as
-            /// `(axis, lo, hi)` (0 = x, 1 = y, 2 = z; m), empty for a solver without them:
-            /// the tank is open along them.
-            pub fn periodic_axes(&self) -> Vec<(usize, f64, f64)> {
-                let axes = match self {
-                    $( SolverSpec::$Kind(s) => s.periodic(), )+
-                };
-                axes.into_iter().map(|a| (a.axis, a.lo, a.hi)).collect()
-            }
-
             /// The checks of the settings as written ([`SolverSettings::check_written`]).
             pub(crate) fn check_written(
                 &self,

@@ -7,6 +7,7 @@ use std::sync::Arc;
 
 use serde::Deserialize;
 use sph_core::{Aabb, TriangleMesh};
+use sph_solver::scene_boundary::PeriodicSetting;
 use ssfr_render::RenderConfig;
 
 pub use sph_solver::WallModel;
@@ -50,12 +51,18 @@ pub enum BoundaryModel {
 
 /// Boundary settings: the `[boundary]` table (optional; [`BoundarySpec::default`] when
 /// absent).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BoundarySpec {
     /// The boundary model (default [`BoundaryModel::default`]).
     #[serde(default)]
     pub model: BoundaryModel,
+    /// The periodic axes (`periodic = [{ axis = "z", lo = 0.0, hi = 0.03 }]`, m; default
+    /// none): the medium repeats along each with period `hi − lo`, for a solver that takes
+    /// them (`sph_solver::scene_boundary::BoundaryFeatures::periodic`). With a tank the
+    /// period is the tank's extent along the axis, and the tank is open along it.
+    #[serde(default)]
+    pub periodic: Vec<PeriodicSetting>,
     /// The fluid's initial masses with respect to the density the solver sees at the start,
     /// the lattice's plus the boundary's (`initial_masses`; default
     /// [`InitialMasses::Lattice`]).
@@ -367,6 +374,16 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// The periodic axes (`[boundary] periodic`) as `(axis, lo, hi)` (0 = x, 1 = y, 2 = z;
+    /// m): the tank is open along them.
+    pub fn periodic_axes(&self) -> Vec<(usize, f64, f64)> {
+        self.boundary
+            .periodic
+            .iter()
+            .map(|p| (p.axis.index(), p.lo, p.hi))
+            .collect()
+    }
+
     /// The scene with the `[quick]` overrides applied (and `quick_overrides` cleared); a
     /// copy of `self` when there are none. Meshes are shared, not reloaded.
     pub fn quick(&self) -> Scene {

@@ -28,9 +28,9 @@ artificial_stress_exponent = 3.0
 cfl_number = 0.15
 skin = 0.004
 initial_stress = "geostatic"
-periodic = [{ axis = "z", lo = 0.0, hi = 0.06 }]
 [boundary]
 model = "particles"
+periodic = [{ axis = "z", lo = 0.0, hi = 0.06 }]
 [tank]
 min = [0.0, 0.0, 0.0]
 max = [0.6, 0.4, 0.06]
@@ -146,7 +146,7 @@ fn refusals_name_their_key() {
             "solid[0].wall",
         ),
         ("wall = \"free-slip\"", "wall = \"sticky\"", "wall"),
-        ("hi = 0.06 }", "hi = 0.05 }", "solver.periodic"),
+        ("hi = 0.06 }", "hi = 0.05 }", "boundary.periodic"),
         (
             "youngs_modulus = 1e6",
             "youngs_modulus = -1.0",
@@ -156,6 +156,12 @@ fn refusals_name_their_key() {
             "skin = 0.004",
             "skin = 0.004\nrestitution = 0.5",
             "restitution",
+        ),
+        // The periodic axes are the scene's: in `[solver]` they are refused with where they go.
+        (
+            "skin = 0.004",
+            "skin = 0.004\nperiodic = []",
+            "solver.periodic: the periodic axes are the scene's, not the solver's: write them under [boundary]",
         ),
     ];
     for (from, to, key) in cases {

@@ -232,7 +232,7 @@ fn granular_heap_elastoplastic_is_a_periodic_slab_with_particle_walls() {
     let s = Scene::load(&scene_path("granular_heap_elastoplastic.toml")).unwrap();
     assert_eq!(s.solver.kind(), sph_scene::SolverKind::Elastoplastic);
     assert_eq!(s.boundary.model, BoundaryModel::Particles);
-    assert_eq!(s.solver.periodic_axes(), vec![(2, 0.0, 0.06)]);
+    assert_eq!(s.periodic_axes(), vec![(2, 0.0, 0.06)]);
     assert_eq!(s.walls.tank, Some(sph_scene::WallModel::FreeSlip));
     assert_eq!(s.walls.solids, vec![Some(sph_scene::WallModel::NoSlip)]);
     assert_eq!(counts(&s), (80 * 30 * 6, 40 * 15 * 3));
@@ -261,10 +261,7 @@ fn granular_repose_scenes_are_drained_beds() {
         let s = Scene::load(&scene_path(&format!("granular_repose_{theta:.0}.toml"))).unwrap();
         assert_eq!(s.solver.kind(), sph_scene::SolverKind::Elastoplastic);
         assert_eq!(s.boundary.model, BoundaryModel::Particles);
-        assert_eq!(
-            s.solver.periodic_axes(),
-            vec![(0, 0.0, period), (2, 0.0, 0.06)]
-        );
+        assert_eq!(s.periodic_axes(), vec![(0, 0.0, period), (2, 0.0, 0.06)]);
         let SolverSpec::Elastoplastic(e) = &s.solver else {
             panic!("not elastoplastic")
         };
@@ -304,7 +301,7 @@ fn granular_repose_trapdoor_scenes_lower_a_door_under_the_slot() {
             "granular_repose_trapdoor_{theta}.toml"
         )))
         .unwrap();
-        assert_eq!(s.solver.periodic_axes(), open.solver.periodic_axes());
+        assert_eq!(s.periodic_axes(), open.periodic_axes());
         assert_eq!(counts(&s), counts(&open), "θ = {theta}: the same bed");
         use sph_scene::SolidSpec::Box;
         use sph_scene::WallModel::{FreeSlip, NoSlip};
@@ -379,7 +376,7 @@ fn granular_repose_poured_pours_a_heap_the_period_holds() {
         assert!((pour.rate_m3_s - 0.012 * slab).abs() < 1e-12);
         assert!((pour.max[0] - pour.min[0] - 0.1).abs() < 1e-12);
         assert!((pour.max[2] - pour.min[2] - slab).abs() < 1e-12);
-        let (axis, lo, period) = quick.solver.periodic_axes()[0];
+        let (axis, lo, period) = quick.periodic_axes()[0];
         assert_eq!((axis, lo), (0, 0.0));
         assert!((0.5 * (pour.min[0] + pour.max[0]) - 0.5 * period).abs() < 1e-12);
         let SolverSpec::Elastoplastic(e) = &quick.solver else {

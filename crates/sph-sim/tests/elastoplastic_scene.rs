@@ -24,9 +24,9 @@ substeps = 1
 friction_angle_deg = 30.0
 youngs_modulus = 5.84e5
 initial_stress = "geostatic"
-periodic = [{ axis = "z", lo = 0.0, hi = 0.06 }]
 [boundary]
 model = "particles"
+periodic = [{ axis = "z", lo = 0.0, hi = 0.06 }]
 [tank]
 min = [0.0, 0.0, 0.0]
 max = [0.6, 0.4, 0.06]
@@ -148,9 +148,9 @@ friction_angle_deg = 30.0
 cone_match = "simple-shear"
 youngs_modulus = 5.84e5
 initial_stress = "geostatic"
-periodic = [{ axis = "x", lo = 0.0, hi = 0.4 }, { axis = "z", lo = 0.0, hi = 0.06 }]
 [boundary]
 model = "particles"
+periodic = [{ axis = "x", lo = 0.0, hi = 0.4 }, { axis = "z", lo = 0.0, hi = 0.06 }]
 [tank]
 min = [0.0, -0.3, 0.0]
 max = [0.4, 0.3, 0.06]
@@ -230,9 +230,9 @@ substeps = 1
 friction_angle_deg = 30.0
 cone_match = "simple-shear"
 youngs_modulus = 5.84e5
-periodic = [{ axis = "x", lo = 0.0, hi = 0.4 }, { axis = "z", lo = 0.0, hi = 0.06 }]
 [boundary]
 model = "particles"
+periodic = [{ axis = "x", lo = 0.0, hi = 0.4 }, { axis = "z", lo = 0.0, hi = 0.06 }]
 [tank]
 min = [0.0, 0.0, 0.0]
 max = [0.4, 0.5, 0.06]

@@ -19,7 +19,7 @@ use serde::Deserialize;
 use sph_core::{Real, Vec3};
 use sph_kernels::KernelKind;
 
-use crate::scene_boundary::{BoundaryFeatures, PeriodicAxis, SceneBoundary};
+use crate::scene_boundary::{BoundaryFeatures, SceneBoundary};
 use crate::{Boundary, CommonParams, FluidSolver, SolverError, SolverParameters};
 
 /// The settings every solver has, flattened into each solver's settings (`[solver]` keys
@@ -158,12 +158,6 @@ pub trait SolverSettings: Sized + Clone + std::fmt::Debug + PartialEq {
     fn key_of(params: &Self::Params<f64>, name: &str, value: f64) -> Option<(&'static str, f64)> {
         let _ = (params, name, value);
         None
-    }
-
-    /// The periodic axes the settings state (`periodic` of a solver whose `[solver]` table
-    /// has that key); none by default.
-    fn periodic(&self) -> Vec<PeriodicAxis<f64>> {
-        Vec::new()
     }
 
     /// Takes the scene's boundary (walls, moving walls, boundary particles, periodic axes,

@@ -37,6 +37,12 @@ pub(super) fn parse(
         return Err(ctx.invalid("solver", format!("must be a table, not {found}")));
     };
     t.remove("kind");
+    if t.contains_key("periodic") {
+        return Err(ctx.invalid(
+            "solver.periodic",
+            "the periodic axes are the scene's, not the solver's: write them under [boundary] (`[boundary] periodic = [...]`)",
+        ));
+    }
     // The flattened parts first, for their errors' paths and lines (see `SolverSpec::read`).
     SolverSpec::read(
         kind,

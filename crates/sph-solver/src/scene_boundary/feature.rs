@@ -17,7 +17,7 @@ pub enum BoundaryFeature {
     WallModels,
     /// Moving walls (`motion` of a `[[solid]]`, [`SceneBoundary::moving_walls`](super::SceneBoundary::moving_walls)).
     MovingWalls,
-    /// Periodic axes (`[solver] periodic`, [`SceneBoundary::periodic`](super::SceneBoundary::periodic)).
+    /// Periodic axes (`[boundary] periodic`, [`SceneBoundary::periodic`](super::SceneBoundary::periodic)).
     Periodic,
     /// A pour (`[pour]`, [`SceneBoundary::pour`](super::SceneBoundary::pour)).
     Pour,
@@ -35,7 +35,7 @@ impl BoundaryFeature {
         BoundaryFeature::Pour,
     ];
 
-    /// The scene key that asks for it, as the file writes it (`[pour]`, `solver.periodic`,
+    /// The scene key that asks for it, as the file writes it (`[pour]`, `boundary.periodic`,
     /// `[boundary] model = "particles"`, …).
     pub fn scene_key(self) -> &'static str {
         match self {
@@ -44,7 +44,7 @@ impl BoundaryFeature {
             BoundaryFeature::Particles => "[boundary] model = \"particles\"",
             BoundaryFeature::WallModels => "wall (of [tank] or a [[solid]])",
             BoundaryFeature::MovingWalls => "motion (of a [[solid]])",
-            BoundaryFeature::Periodic => "solver.periodic",
+            BoundaryFeature::Periodic => "boundary.periodic",
             BoundaryFeature::Pour => "[pour]",
         }
     }

@@ -122,17 +122,17 @@ fn column_scene(ctx: &Context) -> Result<(Scene, Column, f64, ConeMatch)> {
             scene.solver.kind_name()
         );
     };
-    for p in e.periodic.iter_mut().flatten() {
-        if p.axis == Axis::Z {
-            p.lo = z_lo;
-            p.hi = z_hi;
-        }
-    }
     let (phi, cone) = (
         e.friction_angle_deg,
         e.cone_match
             .unwrap_or(elastoplastic_granular::DEFAULT_CONE_MATCH),
     );
+    for p in scene.boundary.periodic.iter_mut() {
+        if p.axis == Axis::Z {
+            p.lo = z_lo;
+            p.hi = z_hi;
+        }
+    }
     scene.check()?;
     Ok((scene, column, phi, cone))
 }

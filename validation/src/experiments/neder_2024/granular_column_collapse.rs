@@ -151,23 +151,19 @@ pub(super) fn elastoplastic_column(column: &Scene, periodic_axes: &[Axis]) -> Re
     settings.cone_match = Some(ConeMatch::PlaneStrain);
     settings.youngs_modulus = Some(ELASTOPLASTIC_YOUNGS_MODULUS_PA);
     settings.initial_stress = Some(InitialStress::Geostatic);
-    if !periodic_axes.is_empty() {
-        settings.periodic = Some(
-            periodic_axes
-                .iter()
-                .map(|&axis| {
-                    let k = axis.index();
-                    PeriodicSetting {
-                        axis,
-                        lo: tank.min[k],
-                        hi: tank.max[k],
-                    }
-                })
-                .collect(),
-        );
-    }
     let mut scene = column.clone();
     scene.solver = SolverSpec::Elastoplastic(settings);
+    scene.boundary.periodic = periodic_axes
+        .iter()
+        .map(|&axis| {
+            let k = axis.index();
+            PeriodicSetting {
+                axis,
+                lo: tank.min[k],
+                hi: tank.max[k],
+            }
+        })
+        .collect();
     scene.boundary.model = BoundaryModel::Particles;
     scene.boundary.initial_masses = InitialMasses::Lattice;
     scene.walls.tank = Some(WallModel::NoSlip);
