@@ -97,7 +97,7 @@ pub trait SolverSettings: Sized + Clone + std::fmt::Debug + PartialEq {
     type Params<R: Real>: SolverParameters<R>;
 
     /// The solver's name in reports: the name its solver gives itself for these settings
-    /// ([`FluidSolver::name`](crate::FluidSolver::name)); by default its parameters'
+    /// ([`FluidSolver::name`]); by default its parameters'
     /// [`SolverParameters::NAME`].
     const LABEL: &'static str = <Self::Params<f64> as SolverParameters<f64>>::NAME;
 
