@@ -120,6 +120,7 @@ fn a_pour_resumes_bit_for_bit() {
     }
     let saved = first.save_state();
     assert!(saved.arrays.iter().any(|(name, _)| name == "pour"));
+    let n_saved = state.len();
     let mut resumed_state = state.clone();
     for _ in 0..25 {
         first.step(&mut state).unwrap();
@@ -133,6 +134,16 @@ fn a_pour_resumes_bit_for_bit() {
     assert_eq!(state.positions, resumed_state.positions);
     assert_eq!(state.velocities, resumed_state.velocities);
     assert_eq!(first.scheme().stress(), second.scheme().stress());
+    // The pour's progress is found wherever the state lists it, not only last.
+    let mut reordered = saved.clone();
+    reordered.arrays.rotate_right(1);
+    assert_eq!(reordered.arrays[0].0, "pour");
+    let (mut third, _) = small_pour(30.0, 1.0);
+    let (mut fourth, _) = small_pour(30.0, 1.0);
+    third.restore_state(&saved, n_saved).unwrap();
+    fourth.restore_state(&reordered, n_saved).unwrap();
+    assert_eq!(third.poured_layers(), fourth.poured_layers());
+    assert_eq!(third.save_state(), fourth.save_state());
 }
 
 /// A saved pour's progress that does not fit is refused: more layers than the pour has, or

@@ -18,6 +18,7 @@
 //! [`FrameSolver`] dereferences to its scheme, so a scheme's own accessors (e.g. IISPH's
 //! pressures) are methods of the solver.
 
+use std::borrow::Cow;
 use std::fmt;
 use std::ops::{Deref, DerefMut};
 
@@ -422,11 +423,32 @@ impl<R: Real, S: SubstepScheme<R>> FrameSolver<R, S> {
                 reason: format!("the state was written by solver `{}`", state.solver),
             });
         }
-        let (pour, arrays): (Vec<_>, Vec<_>) = state
-            .arrays
-            .iter()
-            .cloned()
-            .partition(|(n, _)| self.emitter.is_some() && n == POUR_STATE_ARRAY);
+        // The pour's progress is the frame shell's; `save_state` writes it last, so the
+        // scheme's arrays are the slice before it (copied apart only for a state that has it
+        // elsewhere).
+        let is_pour = |a: &(String, Vec<R>)| a.0 == POUR_STATE_ARRAY;
+        let pour_at = state.arrays.iter().position(is_pour);
+        if self.emitter.is_none() && pour_at.is_some() {
+            return Err(SolverError::InvalidSolverState {
+                solver: name.to_owned(),
+                reason: format!(
+                    "the state carries a pour's progress (`{POUR_STATE_ARRAY}`) but the parameters have no pour"
+                ),
+            });
+        }
+        type Arrays<'a, R> = Cow<'a, [(String, Vec<R>)]>;
+        let (arrays, pour): (Arrays<'_, R>, Arrays<'_, R>) = match pour_at {
+            None => (Cow::Borrowed(&state.arrays[..]), Cow::Borrowed(&[])),
+            Some(k) if k + 1 == state.arrays.len() => {
+                let (rest, pour) = state.arrays.split_at(k);
+                (Cow::Borrowed(rest), Cow::Borrowed(pour))
+            }
+            Some(_) => {
+                let (pour, rest): (Vec<_>, Vec<_>) =
+                    state.arrays.iter().cloned().partition(|a| is_pour(a));
+                (Cow::Owned(rest), Cow::Owned(pour))
+            }
+        };
         let poured = match &self.emitter {
             Some(p) => {
                 let spec = [ArraySpec {
@@ -436,14 +458,6 @@ impl<R: Real, S: SubstepScheme<R>> FrameSolver<R, S> {
                 Some(match match_arrays(name, &pour, &spec)?[0] {
                     Some(v) => p.check_poured(name, v[0].as_f64(), particles)?,
                     None => 0,
-                })
-            }
-            None if arrays.iter().any(|(n, _)| n == POUR_STATE_ARRAY) => {
-                return Err(SolverError::InvalidSolverState {
-                    solver: name.to_owned(),
-                    reason: format!(
-                        "the state carries a pour's progress (`{POUR_STATE_ARRAY}`) but the parameters have no pour"
-                    ),
                 })
             }
             None => None,
