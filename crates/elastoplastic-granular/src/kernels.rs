@@ -34,12 +34,35 @@ pub(crate) struct Consts<R: Real> {
     /// apart has a zero kernel and gradient (the relative margin `1e-4` covers the
     /// rounding of the squares, so that the exact test stays the kernel's own).
     pub support2_above: R,
+    /// `ρ0 / (m0 σ0)` of the density summation: `σ0 = Σ_k W(|k| s)` the number density
+    /// (1/m³) of the full cubic lattice of spacing `s`, `m0 = ρ0 s³` ([`lattice_number_density`]),
+    /// so that a grain inside a full lattice of grains of mass `m0` sums to `ρ0`.
+    pub summation_scale: R,
+}
+
+/// The number density `σ0 = Σ_k W(|k| s)` (1/m³) of the simple cubic lattice of spacing `s`
+/// (the particle at the origin included) under `kernel`: what a particle inside a full
+/// lattice sums.
+pub(crate) fn lattice_number_density<R: Real>(kernel: &CubicSpline<R>, s: R) -> R {
+    let reach = (kernel.support_radius() / s).as_f64().ceil() as i64;
+    let mut sum = R::zero();
+    for i in -reach..=reach {
+        for j in -reach..=reach {
+            for k in -reach..=reach {
+                let r2 = (i * i + j * j + k * k) as f64;
+                sum += kernel.value(s * R::of_f64(r2.sqrt()));
+            }
+        }
+    }
+    sum
 }
 
 impl<R: Real> Consts<R> {
     pub(crate) fn new(p: &ElastoplasticParams<R>) -> Result<Self, SolverError> {
         let kernel = CubicSpline::new(p.common.support_radius)?;
         let h = p.smoothing_length();
+        let s = p.common.particle_spacing;
+        let sigma0 = lattice_number_density(&kernel, s);
         Ok(Self {
             kernel,
             material: p.material(),
@@ -55,6 +78,7 @@ impl<R: Real> Consts<R> {
             support2_above: p.common.support_radius
                 * p.common.support_radius
                 * R::of_f64(1.0 + 1e-4),
+            summation_scale: R::one() / (s * s * s * sigma0),
         })
     }
 }

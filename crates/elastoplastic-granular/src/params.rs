@@ -27,6 +27,8 @@ pub const MAX_ARTIFICIAL_STRESS_EXPONENT: f64 = 10.0;
 /// Most explicit steps in one [`SubstepScheme::substep`](sph_solver::SubstepScheme) (one
 /// `dt / substeps`): a run must be able to finish; raise `common.substeps` instead.
 pub const MAX_EXPLICIT_STEPS_PER_SUBSTEP: usize = 100_000;
+/// Longest density re-initialisation interval accepted (s).
+pub const MAX_DENSITY_REINIT_INTERVAL_S: f64 = 1e6;
 /// Most solids with their own wall model.
 pub const MAX_WALL_MODELS: usize = 64;
 /// Most moving walls ([`ElastoplasticParams::moving_walls`]).
@@ -58,6 +60,12 @@ pub const DEFAULT_CFL_NUMBER: f64 = 0.2;
 /// The cone's match of the defaults: Bui et al. (2008)'s plane strain of an associated
 /// material.
 pub const DEFAULT_CONE_MATCH: ConeMatch = ConeMatch::PlaneStrainAssociated;
+/// How often the density is re-initialised by kernel summation by default (s): every
+/// 2 ms, the interval at which SPHinXsys's granular examples (Zhang, Zhang & Hu's
+/// `test_2d_column_collapse`, its `DensitySummationComplexFreeSurface` once per advection
+/// step of `Dt = 0.002 s`) re-initialise theirs; see
+/// [`ElastoplasticParams::density_reinit_interval_s`].
+pub const DEFAULT_DENSITY_REINIT_INTERVAL_S: f64 = 0.002;
 /// Neighbour-list skin of the defaults, as a fraction of the particle spacing.
 pub const DEFAULT_SKIN_OVER_SPACING: f64 = 0.3;
 /// Support radius of the defaults over the particle spacing, Bui et al. (2008)'s: their
@@ -99,6 +107,7 @@ pub enum InitialStress {
 /// | `artificial_stress_epsilon`, `_exponent` | 0.5, 2.55 | Gray et al. 2001 |
 /// | `cfl_number` | 0.2 | [`DEFAULT_CFL_NUMBER`] |
 /// | `skin` | `0.3 s` | [`DEFAULT_SKIN_OVER_SPACING`] |
+/// | `density_reinit_interval_s` | 0.002 s | [`DEFAULT_DENSITY_REINIT_INTERVAL_S`] |
 /// | `default_wall`, `wall_models` | no-slip, none | |
 /// | `periodic` | none | |
 /// | `boundary_particle_region` | none (walls from the boundary) | |
@@ -141,6 +150,18 @@ pub struct ElastoplasticParams<R: Real> {
     /// Neighbour-list skin (m): lists are built with radius `support + skin` and kept while
     /// no particle has moved more than `skin / 2` since.
     pub skin: R,
+    /// How often the density is re-initialised (s; 0: never, the continuity equation alone
+    /// as Bui et al. 2008 publish it). Between re-initialisations the density follows the
+    /// continuity equation; at each, every grain takes the kernel summation's density with
+    /// the free-surface floor, `ρ_i = max(ρ0 Σ_j m_j W_ij / (m0 σ0), ρ0)` (`σ0 = Σ_k W(|k| s)`
+    /// the number density of the full cubic lattice of spacing `s`, `m0 = ρ0 s³`; grains
+    /// and boundary particles summed), as SPHinXsys's free-surface density summation does:
+    /// a grain that separates from the bulk, or lies at its surface, keeps `ρ0` instead of
+    /// the continuity equation's ever lower density, whose `m/ρ` and `σ/ρ²` otherwise grow
+    /// without bound and feed energy into the grain's next contact. The re-initialisation
+    /// falls on the first of every `max(1, round(interval/Δt))` explicit steps of a substep,
+    /// so a run resumed from a checkpoint repeats the uninterrupted one.
+    pub density_reinit_interval_s: R,
     /// The wall model of solids past the end of `wall_models`.
     pub default_wall: WallModel,
     /// The wall model of each solid, by index in the boundary's solids.
@@ -206,6 +227,7 @@ impl<R: Real> ElastoplasticParams<R> {
             artificial_stress_exponent: R::of_f64(DEFAULT_ARTIFICIAL_STRESS_EXPONENT),
             cfl_number: R::of_f64(DEFAULT_CFL_NUMBER),
             skin: s * R::of_f64(DEFAULT_SKIN_OVER_SPACING),
+            density_reinit_interval_s: R::of_f64(DEFAULT_DENSITY_REINIT_INTERVAL_S),
             default_wall: WallModel::NoSlip,
             wall_models: Vec::new(),
             periodic: Vec::new(),
@@ -265,6 +287,17 @@ impl<R: Real> ElastoplasticParams<R> {
             usize::MAX
         };
         (n, sub / R::of_f64(n as f64))
+    }
+
+    /// The explicit steps between two density re-initialisations (`None`: never): the
+    /// interval over the explicit step, rounded, at least one.
+    pub fn density_reinit_steps(&self) -> Option<usize> {
+        if self.density_reinit_interval_s <= R::zero() {
+            return None;
+        }
+        let (_, dt) = self.explicit_steps();
+        let k = (self.density_reinit_interval_s / dt).as_f64().round();
+        Some(if k >= 1.0 && k < usize::MAX as f64 { k as usize } else { 1 })
     }
 
     /// Checks every field; the error ([`SolverError::InvalidParameter`]) names the first
@@ -355,6 +388,13 @@ impl<R: Real> ElastoplasticParams<R> {
             0.0,
             f(self.common.support_radius),
             "must be in [0, support_radius] m",
+        )?;
+        check_range(
+            "density_reinit_interval_s",
+            f(self.density_reinit_interval_s),
+            0.0,
+            MAX_DENSITY_REINIT_INTERVAL_S,
+            "must be in [0, 1e6] s (0: never)",
         )?;
         if self.wall_models.len() > MAX_WALL_MODELS {
             return Err(invalid(

@@ -38,6 +38,36 @@ impl<R: Real> StepInputs<'_, R> {
     }
 }
 
+/// The density re-initialisation
+/// ([`ElastoplasticParams::density_reinit_interval_s`](crate::ElastoplasticParams)): each
+/// grain's density becomes the kernel sum over itself, its grain neighbours and the boundary
+/// particles, normalised by the full lattice's, floored at `ρ0` (free surface, separated
+/// grains).
+pub(crate) fn reinitialise_density<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>) {
+    let c = inp.c;
+    let n = inp.masses.len();
+    let h2 = c.support2_above;
+    let w0 = c.kernel.value(R::zero());
+    let (x, images) = (&s.x[..], &s.images);
+    s.rho[..n]
+        .par_iter_mut()
+        .enumerate()
+        .with_min_len(MIN_LEN)
+        .for_each(|(i, rho)| {
+            let xi = x[i];
+            let mut sum = inp.masses[i] * w0;
+            for &j in inp.nb.neighbours(i) {
+                let (j, xj) = images.resolve(j as usize, x);
+                let r2 = (xi - xj).norm_squared();
+                if r2 <= h2 {
+                    sum += inp.mass(j) * c.kernel.value(r2.sqrt());
+                }
+            }
+            let summed = sum * c.summation_scale;
+            *rho = if summed > c.rho0 { summed } else { c.rho0 };
+        });
+}
+
 /// Pass 1: the wall gradients at `x`, the velocity gradient `L_i` and the continuity rate
 /// from `x`, `v`, `ρ`; the stress update (rate and return, [`crate::DruckerPrager::update`];
 /// zero for a particle without granular neighbours inside the support), the density and

@@ -58,6 +58,8 @@ pub struct ElastoplasticSettings {
     pub cfl_number: Option<f64>,
     /// [`ElastoplasticParams::skin`] (m).
     pub skin: Option<f64>,
+    /// [`ElastoplasticParams::density_reinit_interval_s`] (s; 0: never).
+    pub density_reinit_interval_s: Option<f64>,
     /// [`ElastoplasticParams::initial_stress`]: `"none"` (the default) or `"geostatic"`.
     pub initial_stress: Option<InitialStress>,
 }
@@ -96,6 +98,7 @@ impl SolverSettings for ElastoplasticSettings {
             artificial_stress_exponent: None,
             cfl_number: None,
             skin: None,
+            density_reinit_interval_s: None,
             initial_stress: None,
         }
     }
@@ -146,6 +149,10 @@ impl SolverSettings for ElastoplasticSettings {
         );
         set(&mut p.cfl_number, self.cfl_number);
         set(&mut p.skin, self.skin);
+        set(
+            &mut p.density_reinit_interval_s,
+            self.density_reinit_interval_s,
+        );
         if let Some(s) = self.initial_stress {
             p.initial_stress = s;
         }
@@ -217,6 +224,10 @@ impl<R: Real> ElastoplasticParams<R> {
             )?,
             cfl_number: c("cfl_number", self.cfl_number)?,
             skin: c("skin", self.skin)?,
+            density_reinit_interval_s: c(
+                "density_reinit_interval_s",
+                self.density_reinit_interval_s,
+            )?,
             default_wall: self.default_wall,
             wall_models: self.wall_models.clone(),
             periodic: self

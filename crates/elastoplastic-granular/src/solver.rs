@@ -21,7 +21,8 @@ use crate::boundary_particles::{sample_moving_wall, sample_solids};
 use crate::kernels::{Consts, ELASTOPLASTIC_KERNEL};
 use crate::params::{ElastoplasticParams, InitialStress, WallModel};
 use crate::passes::{
-    boundary_pair_terms, max_displacement, momentum_pass, stress_pass, StepInputs,
+    boundary_pair_terms, max_displacement, momentum_pass, reinitialise_density, stress_pass,
+    StepInputs,
 };
 use crate::scratch::Scratch;
 use crate::stress::artificial_stress;
@@ -454,6 +455,7 @@ impl<R: Real> ElastoplasticScheme<R> {
         stats: &mut StepStats,
     ) -> Result<(), SolverError> {
         let (steps, dt) = self.params.explicit_steps();
+        let reinit = self.params.density_reinit_steps();
         let h = self.params.common.support_radius;
         let skin = self.params.skin;
         let half = R::of_f64(0.5);
@@ -522,6 +524,9 @@ impl<R: Real> ElastoplasticScheme<R> {
                 boundary_mass,
             };
             let t = Instant::now();
+            if reinit.is_some_and(|every| k % every == 0) {
+                reinitialise_density(s, &inputs);
+            }
             let bp = &self.boundary_particles;
             if !bp.is_empty() {
                 let e = Extrapolation {
