@@ -1,9 +1,19 @@
 //! The initial stress of [`InitialStress::Geostatic`](crate::InitialStress::Geostatic): a
-//! column of grains at rest under gravity in an elastic oedometer (no lateral strain) has
-//! the vertical stress of its weight, `σ_v = −ρ0 |g| d` at depth `d`, and the horizontal
-//! stress `K0 σ_v`, `K0 = ν/(1 − ν)` (the elastic earth pressure at rest, e.g. Craig's
-//! *Soil Mechanics*, §10.2). Bui et al. (2008) start their column collapse from the same
-//! stress.
+//! column of grains at rest under gravity has the vertical stress of its weight,
+//! `σ_v = −ρ0 |g| d` at depth `d`, and the horizontal stress `K0 σ_v` with Jaky's coefficient
+//! of earth pressure at rest of a normally consolidated granular soil, `K0 = 1 − sin φ`
+//! (J. Jaky, "The coefficient of earth pressure at rest", *Journal of the Society of
+//! Hungarian Architects and Engineers* 78(22), 355–358, 1944; e.g. Craig's *Soil
+//! Mechanics*, §10.2), the choice of SPHinXsys's granular column collapse.
+//!
+//! Why not the elastic oedometer's `ν/(1 − ν)`: at ν = 0.3 it is 0.43, below Rankine's
+//! active coefficient `(1 − sin φ)/(1 + sin φ)` for φ ≳ 23° and, for the cones the solver
+//! matches, outside the cone already at smaller angles (Bui's plane-strain match at
+//! φ = 19.8°: `√J2 + α_φ I1 = +0.10 |σ_v|`), so the first step's return would leave the whole
+//! column plastic before it has moved. Jaky's `K0` lies between the active and the passive
+//! coefficients for every φ (`1 − sin φ ≥ (1 − sin φ)/(1 + sin φ)`), and inside the cone
+//! for the matches and angles the solver's scenes use ([`tests`]). A friction angle of zero
+//! (a granular liquid) gives `K0 = 1`: the hydrostatic stress.
 
 use std::collections::HashMap;
 
@@ -68,8 +78,7 @@ pub fn geostatic<R: Real>(
             })
             .or_insert(h);
     }
-    let nu = params.poisson_ratio;
-    let k0 = nu / (R::one() - nu);
+    let k0 = jaky_k0(params.friction_angle_deg);
     let shape = Matrix3::identity() * k0 + down * down.transpose() * (R::one() - k0);
     let rho_g = params.common.rest_density * g_norm;
     let half = R::of_f64(0.5);
@@ -81,12 +90,46 @@ pub fn geostatic<R: Real>(
     Ok(out)
 }
 
+/// Jaky's coefficient of earth pressure at rest, `K0 = 1 − sin φ` (φ in degrees).
+pub fn jaky_k0<R: Real>(friction_angle_deg: R) -> R {
+    R::one() - R::of_f64(friction_angle_deg.as_f64().to_radians().sin())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::ConeMatch;
+    use crate::DruckerPrager;
 
-    /// A column of four particles under `g = −9.81 ŷ`: `σ_yy = −ρ0 g d` at depths
-    /// `s/2, 3s/2, …`, `σ_xx = σ_zz = K0 σ_yy`, no shear (the formula above, by hand).
+    /// Jaky's `K0` lies inside every match's cone for φ from 15° to 45° (a column at rest
+    /// starts elastic), between Rankine's active and passive coefficients; the elastic
+    /// oedometer's `ν/(1 − ν)` at ν = 0.3 does not (outside Bui's plane-strain cone at the
+    /// bars' 19.8°, the reason for the change: see the module docs).
+    #[test]
+    fn jaky_k0_starts_inside_the_cone() {
+        let f = |k0: f64, phi: f64, cone: ConeMatch| {
+            let m = DruckerPrager::<f64>::matched(5.84e6, 0.3, phi, 0.0, 0.0, cone);
+            m.yield_function(&Matrix3::from_diagonal(&Vec3::new(-k0, -1.0, -k0)))
+        };
+        for phi in [15.0, 19.8, 21.9, 25.0, 30.0, 35.0, 40.0, 45.0] {
+            let k0 = jaky_k0(phi);
+            let s = f64::sin(phi.to_radians());
+            assert!(k0 >= (1.0 - s) / (1.0 + s) && k0 <= (1.0 + s) / (1.0 - s));
+            for cone in [
+                ConeMatch::PlaneStrainAssociated,
+                ConeMatch::PlaneStrain,
+                ConeMatch::SimpleShear,
+            ] {
+                assert!(f(k0, phi, cone) < 0.0, "phi = {phi}, {cone:?}");
+            }
+        }
+        let elastic = 0.3 / 0.7;
+        assert!(f(elastic, 19.8, ConeMatch::PlaneStrainAssociated) > 0.05);
+    }
+
+    /// A column of four particles under `g = −9.81 ŷ` at φ = 30°: `σ_yy = −ρ0 g d` at depths
+    /// `s/2, 3s/2, …`, `σ_xx = σ_zz = K0 σ_yy` with `K0 = 1 − sin 30° = 0.5`, no shear (the
+    /// formula above, by hand).
     #[test]
     fn a_column_carries_its_weight() {
         let s = 0.1;
@@ -95,7 +138,7 @@ mod tests {
             .map(|k| Vec3::new(0.05, 0.05 + s * k as f64, 0.05))
             .collect();
         let st = geostatic(&p, &x).unwrap();
-        let k0 = 0.3 / 0.7;
+        let k0 = 1.0 - 30f64.to_radians().sin();
         for (k, m) in st.iter().enumerate() {
             let d = (3 - k) as f64 * s + 0.5 * s;
             let sv = -2040.0 * 9.81 * d;

@@ -82,10 +82,11 @@ pub enum InitialStress {
     /// Unstressed: the grains settle under gravity from zero stress (the default).
     #[default]
     None,
-    /// At rest under gravity in each column (Jaky's `K0 = ν/(1 − ν)` of the elastic
-    /// oedometer): `σ_v = −ρ0 |g| d` along gravity, `K0 σ_v` across it, `d` the depth below
-    /// the column's top particle plus half a spacing (columns one spacing wide across
-    /// gravity), applied to the state the first frame starts from.
+    /// At rest under gravity in each column (Jaky's `K0 = 1 − sin φ`, the earth pressure at
+    /// rest of a normally consolidated granular soil: [`crate::initial`]): `σ_v = −ρ0 |g| d`
+    /// along gravity, `K0 σ_v` across it, `d` the depth below the column's top particle plus
+    /// half a spacing (columns one spacing wide across gravity), applied to the state the
+    /// first frame starts from.
     Geostatic,
 }
 

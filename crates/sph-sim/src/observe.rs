@@ -281,14 +281,21 @@ impl<R: Real> FrameObserver<R> for RestObserver {
     }
 }
 
-/// Keeps the positions (in the solver's current order, as `f64`) at the chosen frames,
-/// the run's first frame included if chosen.
+/// Keeps the positions (as `f64`, in the order the scene created the particles: element `k`
+/// is the particle with id `k`, [`SceneSim::to_original_order`]) at the chosen frames, the
+/// run's first frame included if chosen, and the solver's per-particle fields
+/// ([`SceneSim::particle_fields`], e.g. the elastic–plastic solver's `plastic_strain`) named
+/// in [`Snapshots::fields`], in the same order.
 #[derive(Debug, Clone, Default)]
 pub struct Snapshots {
     /// The frames to keep.
     pub frames: Vec<usize>,
     /// `(frame, positions)` of the kept frames, in order.
     pub taken: Vec<(usize, Vec<Vec3<f64>>)>,
+    /// The names of the solver's fields to keep with the positions.
+    pub fields: Vec<String>,
+    /// `(frame, name, values per particle, values)` of the kept fields, in order.
+    pub taken_fields: Vec<(usize, String, usize, Vec<f64>)>,
 }
 
 impl Snapshots {
@@ -296,15 +303,32 @@ impl Snapshots {
     pub fn at(frames: &[usize]) -> Self {
         Self {
             frames: frames.to_vec(),
-            taken: Vec::new(),
+            ..Self::default()
         }
     }
 
-    fn take<R: Real>(&mut self, sim: &SceneSim<R>) {
+    /// Also keeps the solver's fields `names` at the same frames.
+    pub fn with_fields(mut self, names: &[&str]) -> Self {
+        self.fields = names.iter().map(|s| s.to_string()).collect();
+        self
+    }
+
+    fn take<R: Real>(&mut self, sim: &SceneSim<R>) -> Result<(), SimError> {
         if self.frames.contains(&sim.frame) {
-            self.taken
-                .push((sim.frame, positions_f64(&sim.state.positions)));
+            let positions = positions_f64(&sim.state.positions);
+            // One id per particle by construction; the solver's order if that ever failed.
+            let ordered = sim.to_original_order(&positions).unwrap_or(positions);
+            self.taken.push((sim.frame, ordered));
+            if !self.fields.is_empty() {
+                for (name, k, values) in sim.particle_fields()? {
+                    if self.fields.contains(&name) {
+                        let values = values.iter().map(|v| v.as_f64()).collect();
+                        self.taken_fields.push((sim.frame, name, k, values));
+                    }
+                }
+            }
         }
+        Ok(())
     }
 }
 
@@ -317,11 +341,10 @@ pub fn positions_f64<R: Real>(p: &[Vec3<R>]) -> Vec<Vec3<f64>> {
 
 impl<R: Real> FrameObserver<R> for Snapshots {
     fn start(&mut self, sim: &SceneSim<R>, _: &RunPlan) -> Result<(), SimError> {
-        self.take(sim);
-        Ok(())
+        self.take(sim)
     }
     fn frame(&mut self, sim: &SceneSim<R>, _: &FrameRecord) -> Result<Flow, SimError> {
-        self.take(sim);
+        self.take(sim)?;
         Ok(Flow::Continue)
     }
 }

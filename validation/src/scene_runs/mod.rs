@@ -33,8 +33,12 @@ pub struct SceneRun {
     /// With a [`RestCriterion`]: its verdict at the end of the run (every quantity judged
     /// with its bound and by how much it misses).
     pub rest_verdict: Option<RestVerdict>,
-    /// Positions (m) at the requested frames, `(frame, positions)`; frame 0 = initial.
+    /// Positions (m) at the requested frames, `(frame, positions)`, in the scene's initial
+    /// order (element `k` is the particle with id `k`); frame 0 = initial.
     pub snapshots: Vec<(usize, Vec<Vec3<f64>>)>,
+    /// The solver's fields kept at the requested frames ([`run_scene_until_rest_keeping`]):
+    /// `(frame, name, values per particle, values)`, in the scene's initial order.
+    pub snapshot_fields: Vec<(usize, String, usize, Vec<f64>)>,
     /// Positions at the end of the run.
     pub final_positions: Vec<Vec3<f64>>,
     /// For each of [`SceneRun::final_positions`], the particle's index in the scene's
@@ -55,12 +59,13 @@ fn run_in<R: Real>(
     ctx: &Context,
     scene: &Scene,
     snapshot_frames: &[usize],
+    fields: &[&str],
     rest: Option<RestCriterion>,
 ) -> Result<SceneRun> {
     let mut sim = scene_sim::<R>(scene)?;
     let initial_potential_energy_j = potential_energy_j(&sim);
     let mut recorder = Recorder::default();
-    let mut snapshots = Snapshots::at(snapshot_frames);
+    let mut snapshots = Snapshots::at(snapshot_frames).with_fields(fields);
     let mut rest = rest.map(RestObserver::new);
     let mut observers: Vec<&mut dyn FrameObserver<R>> = vec![&mut recorder, &mut snapshots];
     if let Some(r) = rest.as_mut() {
@@ -72,6 +77,7 @@ fn run_in<R: Real>(
         frames: recorder.records,
         rest_verdict: rest.as_ref().and_then(|r| r.verdict),
         snapshots: snapshots.taken,
+        snapshot_fields: snapshots.taken_fields,
         final_positions: positions_f64(&sim.state.positions),
         final_ids: sim.ids.clone(),
         initial_potential_energy_j,
@@ -85,13 +91,25 @@ fn run_in<R: Real>(
 /// solver error during a frame ends the run and is kept in [`SceneRun::blow_up`]; set-up
 /// errors (the scene, the solver factory) are returned.
 pub fn run_scene(ctx: &Context, scene: &Scene, snapshot_frames: &[usize]) -> Result<SceneRun> {
-    sph_sim::with_precision!(scene.precision, R => run_in::<R>(ctx, scene, snapshot_frames, None))
+    sph_sim::with_precision!(scene.precision, R => run_in::<R>(ctx, scene, snapshot_frames, &[], None))
 }
 
 /// Runs `scene` until it is at rest by `rest` ([`SceneRun::rest_from_s`]) or to its end (its
 /// duration is the cap), as [`run_scene`] otherwise.
 pub fn run_scene_until_rest(ctx: &Context, scene: &Scene, rest: RestCriterion) -> Result<SceneRun> {
-    sph_sim::with_precision!(scene.precision, R => run_in::<R>(ctx, scene, &[], Some(rest)))
+    run_scene_until_rest_keeping(ctx, scene, &[], &[], rest)
+}
+
+/// [`run_scene_until_rest`], keeping the positions at `snapshot_frames` as [`run_scene`]
+/// does, and the solver's fields named in `fields` ([`SceneRun::snapshot_fields`]).
+pub fn run_scene_until_rest_keeping(
+    ctx: &Context,
+    scene: &Scene,
+    snapshot_frames: &[usize],
+    fields: &[&str],
+    rest: RestCriterion,
+) -> Result<SceneRun> {
+    sph_sim::with_precision!(scene.precision, R => run_in::<R>(ctx, scene, snapshot_frames, fields, Some(rest)))
 }
 
 /// The failing check of a run that a solver error (a blow-up) ended early: a blow-up is an

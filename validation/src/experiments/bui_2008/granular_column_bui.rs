@@ -8,11 +8,12 @@
 //! floor of a tank 0.8 m long, a fixed wall behind it (`x = 0`), released at `t = 0` (the
 //! plate in front removed) from its geostatic stress; plane strain as a slab three spacings
 //! deep, periodic across `z` (the experiment sets the tank's depth, the block's and the
-//! period to `3 s` in either mode); `E` = 5.84 MPa, `ν` = 0.3, `ρ0` = 2040 kg/m³, `c` = 0,
-//! `ψ` = 0 (as SPHinXsys's `test_2d_column_collapse` transcribes Bui's material), φ = 19.8°
-//! (the value quoted for the bars; SPHinXsys runs 21.9°, `reference-data/granular-column-bui/
-//! SOURCE.md`), the cone matched as Bui matched it (`ConeMatch::PlaneStrainAssociated`).
-//! Walls of no-slip boundary particles.
+//! period to `3 s` in either mode); the material whole from one transcription, SPHinXsys's
+//! `test_2d_column_collapse`: `E` = 5.84 MPa, `ν` = 0.3, `ρ0` = 2040 kg/m³, `c` = 0, `ψ` = 0,
+//! φ = 21.9° (other sources quote 19.8° for the bars, `reference-data/granular-column-bui/
+//! SOURCE.md`), the cone matched as Bui matched it (`ConeMatch::PlaneStrainAssociated`); the
+//! geostatic start with Jaky's `K0 = 1 − sin φ` (inside the cone: the column starts
+//! elastic). Walls of no-slip boundary particles.
 //!
 //! **Rest** ([`granular_measure::rest`], default figures, all grains): the run stops once the
 //! 99th-percentile speed and the fastest grain two spacings deep have stayed below
@@ -22,12 +23,20 @@
 //! **Measures**, on the grains followed from their initial lattice position (`x0, y0`) to
 //! the deposit:
 //!
-//! - *Failure line*: a grain moved when it travelled more than one spacing in the `(x, y)`
-//!   plane. In each initial row (height `y` of one spacing), the boundary between the grains
-//!   left in place (behind) and those that moved (in front) lies at
+//! - *First slip surface* (the failure line Rankine's theory describes): at
+//!   [`SLIP_TIMES_S`] after the release, a grain has failed when its equivalent plastic shear
+//!   strain exceeds [`SLIP_PLASTIC_STRAIN`] (Rankine's active wedge is plastic throughout,
+//!   the ground behind it elastic: the plastic zone's edge is the slip line); the same with
+//!   "has moved more than [`SLIP_THRESHOLD_SPACINGS`] of a spacing" is reported beside it. In
+//!   each initial row (height `y` of one spacing), the boundary between the grains left in
+//!   place (behind) and those that failed (in front) lies at
 //!   `x_b = L0 · (grains of the row that did not move) / (grains of the row)`. The line through
 //!   the column's toe `(L0, 0)` is fitted to the rows, `L0 − x_b = y cot β` by least squares
-//!   (`cot β = Σ y (L0 − x_b) / Σ y²`); `β` is its angle from the horizontal.
+//!   (`cot β = Σ y (L0 − x_b) / Σ y²`); `β` is its angle from the horizontal. The line at
+//!   [`SLIP_CHECK_S`] is checked; the others are reported.
+//! - *Final moved zone*: the same fit on the deposit, a grain moved when it travelled more
+//!   than one spacing by the end: the edge of everything that moved, which on a spreading
+//!   deposit follows the final surface rather than the first slip surface; reported.
 //! - *Back of the column*: the highest grain among those that started within
 //!   [`BACK_SPACINGS`] spacings of the back wall, before and after.
 //! - *Deposit slope*: [`granular_measure::angle_of_repose`] on the deposit (planar, floor
@@ -40,10 +49,12 @@
 //! - *Potential energy kept*: `Σ y_final / Σ y_initial` over the grains (equal masses).
 //!
 //! **Checks**: the deposit's front clear of the far wall (validity); at rest by [`REST_BY_S`]; the back keeps its height within one spacing (the
-//! wall holds the material behind the failure line, which does not move); the failure line
-//! at Rankine's `45° + φ/2` within `1.5 sin²β s/H0` rad (see [`failure_line_tolerance_deg`]);
-//! the energy kept against SPHinXsys's 0.690 within [`ENERGY_BAND`]. The deposit slope and
-//! the runout are reported, not judged: the paper's own figures are not in our library.
+//! wall holds the material behind the failure line, which does not move); the first slip
+//! surface at Rankine's `45° + φ/2` within `1.5 sin²β s/H0` rad (see
+//! [`failure_line_tolerance_deg`]); the energy kept against SPHinXsys's 0.690 (the same
+//! material, φ = 21.9°) within [`ENERGY_BAND`]. The deposit's slope, its profile and the
+//! runout are reported, **not checked**: Bui et al.'s measured figures are not in our
+//! library (`reference-data/granular-column-bui/SOURCE.md`).
 
 use anyhow::{bail, Result};
 use elastoplastic_granular::{Axis, ConeMatch};
@@ -55,7 +66,7 @@ use crate::helpers::{
     load_reference_csv, plot_xy, write_csv_rows, Legend, Marker, PlotSpec, Series, SeriesStyle,
 };
 use crate::scene_runs::{
-    run_scene_until_rest, shipped_scene, solver_error_check, RestCriterion, SceneRun,
+    run_scene_until_rest_keeping, shipped_scene, solver_error_check, RestCriterion, SceneRun,
 };
 use crate::{Check, Context, Experiment, Outcome};
 
@@ -74,10 +85,25 @@ const SLAB_SPACINGS: f64 = 3.0;
 pub const REST_BY_S: f64 = 1.0;
 /// The grains within this many spacings of the back wall are the back of the column.
 pub const BACK_SPACINGS: f64 = 3.0;
+/// The times (s after the release) of the first slip surface's measurements: the wedge in
+/// front of Rankine's line starts to slide at once and has slid centimetres by 0.1 s
+/// (`½ g (sin β − cos β tan φ) t²` = 3 cm on β = 56°, φ = 21.9°), long before the deposit
+/// spreads.
+pub const SLIP_TIMES_S: [f64; 3] = [0.05, 0.10, 0.15];
+/// A grain has failed when its equivalent plastic shear strain exceeds this: about thirty times the
+/// column's largest elastic strain (`ρ0 g H0/E` = 3.4·10⁻⁴), far below the strain of a slip
+/// band that has slid centimetres by [`SLIP_CHECK_S`].
+pub const SLIP_PLASTIC_STRAIN: f64 = 0.01;
+/// The measurement of [`SLIP_TIMES_S`] that is checked.
+pub const SLIP_CHECK_S: f64 = 0.10;
+/// A grain has started to slip when it has moved this fraction of a spacing: far above the
+/// elastic settlement of the column under its own weight (`ρ0 g H0²/(2E)` = 0.02 mm) and far
+/// below the wedge's slide by [`SLIP_CHECK_S`].
+pub const SLIP_THRESHOLD_SPACINGS: f64 = 0.25;
 /// Band around SPHinXsys's fraction of the initial potential energy kept at rest: this
-/// project's, set before the run (SPHinXsys is a peer code, not an experiment: φ = 21.9°
-/// against 19.8°, another wall condition and viscosity; the Rankine wedges of the two angles
-/// differ by 4 % of their volume, about 0.01 in the fraction).
+/// project's, set before the run (SPHinXsys is a peer code, not an experiment: the same
+/// material and friction angle, but another wall condition, viscosity and stress
+/// diffusion).
 pub const ENERGY_BAND: f64 = 0.05;
 /// SPHinXsys's regression figure (file in `reference-data/granular-column-bui/`).
 const SPHINXSYS_FILE: &str = "granular-column-bui/sphinxsys_column_collapse_energy.csv";
@@ -199,7 +225,17 @@ impl Experiment for GranularColumnBui {
         let s = scene.particle_spacing;
         ctx.progress.set_length(scene.frame_count() as u64);
         let t0 = std::time::Instant::now();
-        let run = run_scene_until_rest(ctx, &scene, RestCriterion::default())?;
+        let slip_frames: Vec<usize> = SLIP_TIMES_S
+            .iter()
+            .map(|t| (t / scene.frame_dt_s).round() as usize)
+            .collect();
+        let run = run_scene_until_rest_keeping(
+            ctx,
+            &scene,
+            &slip_frames,
+            &["plastic_strain"],
+            RestCriterion::default(),
+        )?;
         let wall_s = t0.elapsed().as_secs_f64();
 
         let mut out = Outcome::new();
@@ -241,19 +277,47 @@ impl Experiment for GranularColumnBui {
             "physics: Rankine's active wedge fails in front of the line through the toe; the material behind it, held by the wall, does not move (one spacing: the grain size)",
         ));
 
-        // the failure line against Rankine's
-        let (rows, beta) = failure_line(&initial, &moved, column, s);
+        // the first slip surface against Rankine's line; the final moved zone beside it
         let rankine = 45.0 + 0.5 * phi;
         let tol = failure_line_tolerance_deg(rankine, s, column.height);
-        out.metric("failure_line_deg", beta);
         out.metric("rankine_deg", rankine);
         out.metric("failure_line_tolerance_deg", tol);
+        let (_, final_zone) = failure_line(&initial, &moved, column, s);
+        out.metric("final_moved_zone_deg", final_zone);
         out.metric(
             "moved_fraction",
             moved.iter().filter(|&&m| m).count() as f64 / moved.len() as f64,
         );
+        let mut slip = None;
+        for (&t, &frame) in SLIP_TIMES_S.iter().zip(&slip_frames) {
+            let at = run.snapshots.iter().find(|(f, _)| *f == frame);
+            let strain = run
+                .snapshot_fields
+                .iter()
+                .find(|(f, name, k, _)| *f == frame && name == "plastic_strain" && *k == 1);
+            let (Some((_, at)), Some((_, _, _, strain))) = (at, strain) else {
+                out.note(format!("no snapshot at t = {t} s (the run ended before)"));
+                continue;
+            };
+            let moved_early: Vec<bool> = initial
+                .iter()
+                .zip(at)
+                .map(|(a, b)| (b.x - a.x).hypot(b.y - a.y) > SLIP_THRESHOLD_SPACINGS * s)
+                .collect();
+            let (_, beta_moved) = failure_line(&initial, &moved_early, column, s);
+            out.metric(&format!("moved_zone_{:.0}ms_deg", 1e3 * t), beta_moved);
+            let failed: Vec<bool> = strain.iter().map(|&e| e > SLIP_PLASTIC_STRAIN).collect();
+            let (rows, beta) = failure_line(&initial, &failed, column, s);
+            out.metric(&format!("slip_surface_{:.0}ms_deg", 1e3 * t), beta);
+            if t == SLIP_CHECK_S {
+                slip = Some((rows, beta));
+            }
+        }
+        let Some((rows, beta)) = slip else {
+            bail!("no snapshot at the slip surface's time {SLIP_CHECK_S} s");
+        };
         out.check(Check::within(
-            format!("failure line through the toe (deg) against Rankine's 45 + phi/2 = {rankine:.2}"),
+            format!("first slip surface at {SLIP_CHECK_S} s through the toe (deg) against Rankine's 45 + phi/2 = {rankine:.2}"),
             beta,
             rankine - tol,
             rankine + tol,
@@ -312,11 +376,11 @@ impl Experiment for GranularColumnBui {
         )?;
         ctx.add_file(
             "failure_line.csv",
-            "per initial row: the boundary between the grains that stayed (behind) and those that moved more than one spacing",
+            "per initial row: the boundary between the grains that stayed (behind) and those whose plastic strain exceeded 0.01 at 0.1 s (the first slip surface)",
         );
         plot_deposit(ctx, &run, column, &rows, beta, rankine)?;
         out.note(format!(
-            "phi = {phi} deg, cone {}, spacing {s} m, slab {SLAB_SPACINGS} spacings periodic in z; a grain moved if it travelled more than one spacing in (x, y); rest by granular_measure::rest (default figures, all grains)",
+            "phi = {phi} deg, cone {}, spacing {s} m, slab {SLAB_SPACINGS} spacings periodic in z; first slip surface: the edge of the grains whose plastic strain exceeds {SLIP_PLASTIC_STRAIN} at {SLIP_CHECK_S} s; final moved zone: by more than one spacing at rest; the deposit's slope, profile and runout are not checked (Bui et al.'s measured figures are not in our library); rest by granular_measure::rest (default figures, all grains)",
             cone.name()
         ));
         Ok(out)
@@ -382,7 +446,7 @@ fn plot_deposit(
             3,
         ),
         Series::line(
-            format!("fitted failure line: {beta_deg:.1}°"),
+            format!("first slip surface (0.1 s): {beta_deg:.1}°"),
             line(beta_deg),
             3,
         ),
@@ -412,7 +476,7 @@ fn plot_deposit(
     plot_xy(&ctx.path("deposit.png"), &spec)?;
     ctx.add_plot(
         "deposit.png",
-        "the deposit at rest, the initial column, the failure line fitted through the toe and Rankine's",
+        "the deposit at rest, the initial column, each row's boundary at 0.1 s and the first slip surface fitted through the toe, and Rankine's line",
     );
     Ok(())
 }
