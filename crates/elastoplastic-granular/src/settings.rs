@@ -269,6 +269,7 @@ impl<R: Real> ElastoplasticParams<R> {
                         },
                         volume_m3: c("pour", p.volume_m3)?,
                         rate_m3_s: c("pour", p.rate_m3_s)?,
+                        seed: p.seed,
                     })
                 })
                 .transpose()?,

@@ -261,6 +261,9 @@
 //! #                                # heap must stay below max[1]
 //! # volume = 0.0096                # m³ of bulk volume (grains × spacing³), > 0
 //! # rate = 0.0007                  # m³/s, > 0; a run is at rest only after the last layer
+//! # seed = 1                       # optional: each layer shifted by a seeded random
+//! #                                # fraction of a spacing along x and z (an ensemble of
+//! #                                # pours: seeds varied); absent: alternate layers ±s/4 in x
 //!
 //! [output]                         # optional
 //! every_frames = 1                 # write a VTK frame every N frames (>= 1, default 1)

@@ -269,6 +269,11 @@ pub struct PourSpec {
     /// The rate (m³ of bulk volume per second).
     #[serde(rename = "rate")]
     pub rate_m3_s: f64,
+    /// The seed of the layers' random shifts ([`sph_solver::Pour::seed`]; absent: alternate
+    /// layers shifted a quarter spacing either way): pours of different seeds are an
+    /// ensemble.
+    #[serde(default)]
+    pub seed: Option<u64>,
 }
 
 impl PourSpec {
@@ -281,6 +286,7 @@ impl PourSpec {
             },
             volume_m3: self.volume_m3,
             rate_m3_s: self.rate_m3_s,
+            seed: self.seed,
         }
     }
 }

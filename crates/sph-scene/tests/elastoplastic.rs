@@ -306,6 +306,14 @@ fn a_pour_becomes_the_solvers_pour() {
     assert_eq!((pour.region.min.x, pour.region.max.y), (0.28, 0.35));
     assert_eq!((pour.volume_m3, pour.rate_m3_s), (0.00048, 0.00144));
     assert_eq!(pour.layers(0.02), 10);
+    assert_eq!(pour.seed, None);
+    // A seed is the pour's (an ensemble of pours: one scene, seeds varied).
+    let seeded = parse(&format!("{BASE}{POUR}seed = 7\n")).unwrap();
+    let SolverParams::Elastoplastic(q) = seeded.solver_params::<f64>().unwrap() else {
+        panic!("not elastoplastic")
+    };
+    assert_eq!(q.pour.expect("a pour").seed, Some(7));
+    assert!(parse(&format!("{BASE}{POUR}seed = -1\n")).is_err());
     // The quick spacing halves the grains per layer's edge: the same volume, more grains.
     let fine = parse(&format!("{BASE}{POUR}").replacen(
         "particle_spacing = 0.02",

@@ -139,6 +139,8 @@ pub struct PouredSetup {
     pub volume_m3: f64,
     /// The rate (m³/s).
     pub rate_m3_s: f64,
+    /// The pour's seed ([`Pour::seed`]).
+    pub seed: Option<u64>,
 }
 
 impl PouredSetup {
@@ -156,6 +158,7 @@ impl PouredSetup {
             funnel_top_m: 1.0,
             volume_m3: 0.16 * slab,
             rate_m3_s: 0.012 * slab,
+            seed: None,
         }
     }
 }
@@ -177,6 +180,7 @@ pub fn poured_heap<R: Real>(
         )?,
         volume_m3: R::of_f64(setup.volume_m3),
         rate_m3_s: R::of_f64(setup.rate_m3_s),
+        seed: setup.seed,
     });
     let solver = floored_slab(params, l, d, setup.funnel_top_m)?;
     let state = ParticleSet::from_positions(Vec::new(), R::zero(), R::zero());

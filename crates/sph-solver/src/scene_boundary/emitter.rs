@@ -12,9 +12,10 @@
 //! spacing), and at least half a spacing above the box's floor. Layers fall due at the
 //! pour's rate (bulk volume: grains × spacing³); one is placed at the start of a frame when
 //! no grain is nearer than [`ROOM_OVER_SPACING`] spacings to any of its grains, otherwise
-//! it waits for the next frame (the pour then runs late). Alternate layers are shifted a
-//! quarter spacing either way along `x`, so that a narrow pour does not stack its grains in
-//! columns. Gravity must point along `−y` ([`Pour::validate`]).
+//! it waits for the next frame (the pour then runs late). Each layer is shifted across
+//! gravity by [`Pour::layer_shift`] (alternate layers a quarter spacing either way along `x`,
+//! or a seeded random shift of up to half a spacing along `x` and `z`), so that a narrow pour
+//! does not stack its grains in columns. Gravity must point along `−y` ([`Pour::validate`]).
 
 use sph_core::{ParticleSet, Real, Vec3};
 
@@ -43,6 +44,8 @@ pub struct PourEmitter {
     periodic: Vec<(usize, f64)>,
     /// Layers placed so far.
     poured: usize,
+    /// The pour (its layers' shifts).
+    pour: Pour<f64>,
 }
 
 impl PourEmitter {
@@ -74,6 +77,15 @@ impl PourEmitter {
                 .map(|a| (a.axis, a.period().as_f64()))
                 .collect(),
             poured: 0,
+            pour: Pour {
+                region: sph_core::Aabb {
+                    min: lo,
+                    max: hi,
+                },
+                volume_m3: p.volume_m3.as_f64(),
+                rate_m3_s: p.rate_m3_s.as_f64(),
+                seed: p.seed,
+            },
         }
     }
 
@@ -168,15 +180,11 @@ impl PourEmitter {
                 ),
             });
         }
-        let shift = if self.poured.is_multiple_of(2) {
-            -0.25
-        } else {
-            0.25
-        } * s;
+        let [dx, dz] = self.pour.layer_shift(self.poured, s);
         let layer: Vec<[f64; 3]> = self
             .nodes
             .iter()
-            .map(|[nx, nz]| [nx + shift, y, *nz])
+            .map(|[nx, nz]| [nx + dx, y, nz + dz])
             .collect();
         Ok(self.has_room(&layer, x).then_some(layer))
     }
@@ -256,6 +264,7 @@ mod tests {
             },
             volume_m3: 0.001,
             rate_m3_s: 0.0001,
+            seed: None,
         };
         let axes = [PeriodicAxis {
             axis: 2,

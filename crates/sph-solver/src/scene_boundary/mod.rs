@@ -173,6 +173,7 @@ mod tests {
             },
             volume_m3: 1e-3,
             rate_m3_s: 1e-3,
+            seed: None,
         }
     }
 

@@ -25,9 +25,44 @@ pub struct Pour<R: Real> {
     pub volume_m3: R,
     /// The pour's rate (m³ of bulk volume per second).
     pub rate_m3_s: R,
+    /// `Some(seed)`: each layer is shifted across gravity (along `x` and `z`) by a uniform
+    /// random fraction of a spacing in `[−s/2, s/2)`, drawn from the seed and the layer's
+    /// number (SplitMix64, no state: a resumed run repeats its layers), so that pours of
+    /// different seeds form different heaps of the same material (an ensemble of pours, as
+    /// an experimenter repeats one); `None`: alternate layers shifted a quarter spacing
+    /// either way along `x`.
+    pub seed: Option<u64>,
+}
+
+/// SplitMix64's output for `state` (Steele, Lea & Flood, "Fast splittable pseudorandom
+/// number generators", OOPSLA 2014): a well-mixed 64-bit value of a counter.
+fn splitmix64(state: u64) -> u64 {
+    let mut z = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+/// A uniform value in `[0, 1)` from the 53 high bits of `bits`.
+fn unit(bits: u64) -> f64 {
+    (bits >> 11) as f64 / (1u64 << 53) as f64
 }
 
 impl<R: Real> Pour<R> {
+    /// The shift (m) of layer `k` (from 0) along `x` and `z` at spacing `s`: the seeded
+    /// draw of [`Pour::seed`], or `∓s/4` along `x` for alternate layers without a seed.
+    pub fn layer_shift(&self, k: usize, s: f64) -> [f64; 2] {
+        match self.seed {
+            None => [if k.is_multiple_of(2) { -0.25 } else { 0.25 } * s, 0.0],
+            Some(seed) => {
+                let base = splitmix64(seed ^ (k as u64).wrapping_mul(0xd1b5_4a32_d192_ed03));
+                let x = unit(splitmix64(base));
+                let z = unit(splitmix64(base ^ 0x2545_f491_4f6c_dd1d));
+                [(x - 0.5) * s, (z - 0.5) * s]
+            }
+        }
+    }
+
     /// The lattice nodes of a layer along `x` and `z` at spacing `s` (m): `⌊extent/s⌋` each,
     /// at least one when the extent is a spacing or more.
     pub fn layer_nodes(&self, s: f64) -> [usize; 2] {
