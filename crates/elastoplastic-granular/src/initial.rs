@@ -11,9 +11,14 @@
 //! matches, outside the cone already at smaller angles (Bui's plane-strain match at
 //! φ = 19.8°: `√J2 + α_φ I1 = +0.10 |σ_v|`), so the first step's return would leave the whole
 //! column plastic before it has moved. Jaky's `K0` lies between the active and the passive
-//! coefficients for every φ (`1 − sin φ ≥ (1 − sin φ)/(1 + sin φ)`), and inside the cone
-//! for the matches and angles the solver's scenes use ([`tests`]). A friction angle of zero
-//! (a granular liquid) gives `K0 = 1`: the hydrostatic stress.
+//! coefficients for every φ (`1 − sin φ ≥ (1 − sin φ)/(1 + sin φ)`), but the matched cone
+//! is not Mohr–Coulomb: for the plane-strain matches at large angles (40° and above) Jaky's
+//! state lies just outside it. The start then takes the cone's own active coefficient, the
+//! least `K` whose state `(−K, −1, −K) σ_v` is inside the cone (cohesion ignored: it only
+//! widens the cone), `K_a = (1 − √3 α_φ)/(1 + 2√3 α_φ)` from `√J2 = (1 − K)|σ_v|/√3`,
+//! `I1 = (1 + 2K) σ_v`: `K0 = max(1 − sin φ, K_a)`, on the cone in that case
+//! ([`tests`]). A friction angle of zero (a granular liquid) gives `K0 = 1`: the hydrostatic
+//! stress.
 
 use std::collections::HashMap;
 
@@ -78,7 +83,7 @@ pub fn geostatic<R: Real>(
             })
             .or_insert(h);
     }
-    let k0 = jaky_k0(params.friction_angle_deg);
+    let k0 = geostatic_k0(params);
     let shape = Matrix3::identity() * k0 + down * down.transpose() * (R::one() - k0);
     let rho_g = params.common.rest_density * g_norm;
     let half = R::of_f64(0.5);
@@ -88,6 +93,19 @@ pub fn geostatic<R: Real>(
         out.push(shape * (-rho_g * depth));
     }
     Ok(out)
+}
+
+/// The coefficient of the geostatic start: Jaky's `1 − sin φ`, or the matched cone's active
+/// coefficient where that is larger (module docs).
+pub fn geostatic_k0<R: Real>(params: &ElastoplasticParams<R>) -> R {
+    let jaky = jaky_k0(params.friction_angle_deg);
+    let a = 3f64.sqrt() * params.cone_match.alpha_phi(params.friction_angle_deg.as_f64());
+    let active = R::of_f64((1.0 - a) / (1.0 + 2.0 * a));
+    if active > jaky {
+        active
+    } else {
+        jaky
+    }
 }
 
 /// Jaky's coefficient of earth pressure at rest, `K0 = 1 − sin φ` (φ in degrees).
@@ -101,26 +119,34 @@ mod tests {
     use crate::ConeMatch;
     use crate::DruckerPrager;
 
-    /// Jaky's `K0` lies inside every match's cone for φ from 15° to 45° (a column at rest
-    /// starts elastic), between Rankine's active and passive coefficients; the elastic
-    /// oedometer's `ν/(1 − ν)` at ν = 0.3 does not (outside Bui's plane-strain cone at the
-    /// bars' 19.8°, the reason for the change: see the module docs).
+    /// The geostatic start is admissible for every match and φ from 15° to 45° (inside the
+    /// cone, or on it where Jaky's state is not: `f` at rounding level), between Rankine's
+    /// active and passive coefficients; Jaky's `K0` itself is strictly inside every match's
+    /// cone up to 35° and the simple-shear cone up to 45° (a column at rest starts elastic);
+    /// the elastic oedometer's `ν/(1 − ν)` at ν = 0.3 is not (outside Bui's plane-strain cone
+    /// at the bars' 19.8°, the reason for the change: see the module docs).
     #[test]
-    fn jaky_k0_starts_inside_the_cone() {
+    fn the_geostatic_start_is_admissible() {
         let f = |k0: f64, phi: f64, cone: ConeMatch| {
             let m = DruckerPrager::<f64>::matched(5.84e6, 0.3, phi, 0.0, 0.0, cone);
             m.yield_function(&Matrix3::from_diagonal(&Vec3::new(-k0, -1.0, -k0)))
         };
-        for phi in [15.0, 19.8, 21.9, 25.0, 30.0, 35.0, 40.0, 45.0] {
-            let k0 = jaky_k0(phi);
+        for phi in [15.0f64, 19.8, 21.9, 25.0, 30.0, 35.0, 40.0, 45.0] {
             let s = f64::sin(phi.to_radians());
-            assert!(k0 >= (1.0 - s) / (1.0 + s) && k0 <= (1.0 + s) / (1.0 - s));
             for cone in [
                 ConeMatch::PlaneStrainAssociated,
                 ConeMatch::PlaneStrain,
                 ConeMatch::SimpleShear,
             ] {
-                assert!(f(k0, phi, cone) < 0.0, "phi = {phi}, {cone:?}");
+                let mut p = ElastoplasticParams::<f64>::for_spacing(0.01, phi);
+                p.cone_match = cone;
+                let k0 = geostatic_k0(&p);
+                assert!(k0 >= (1.0 - s) / (1.0 + s) && k0 <= (1.0 + s) / (1.0 - s));
+                assert!(f(k0, phi, cone) <= 1e-12, "phi = {phi}, {cone:?}: K0 = {k0}");
+                if phi <= 35.0 || cone == ConeMatch::SimpleShear {
+                    assert_eq!(k0, jaky_k0(phi), "phi = {phi}, {cone:?}");
+                    assert!(f(k0, phi, cone) < 0.0, "phi = {phi}, {cone:?}");
+                }
             }
         }
         let elastic = 0.3 / 0.7;

@@ -23,6 +23,7 @@
 //!
 //! ```text
 //! ρ̇_i  = Σ_j m_j (v_i − v_j)·∇_i W_ij                                   (continuity)
+//! ρ_i  ← max(ρ0 Σ_j m_j W_ij / (m0 σ0), ρ0)   every 2 ms, if set        (re-initialisation)
 //! L_i  = Σ_j (m_j/ρ_j) (v_j − v_i) ⊗ ∇_i W_ij                            (velocity gradient)
 //! σ̇    = σ ωᵀ + ω σ + 2G ė + K tr(ε̇) I − λ̇ [3 α_ψ K I + (G/√J2) s]      (Jaumann rate)
 //! λ̇    = (3 α_φ K tr ε̇ + (G/√J2) s:ε̇) / (9 α_φ α_ψ K + G)   on the cone, if > 0
@@ -80,6 +81,13 @@
 //! - Periodic axes by images of the particles near the ends
 //!   (`sph_solver::scene_boundary::PeriodicImages`).
 //! - Time integration: symplectic Euler instead of Bui's leap-frog.
+//! - Optionally ([`ElastoplasticParams::density_reinit_interval_s`], off by default as in
+//!   Bui et al.), the density is re-initialised every 2 ms ([`DENSITY_REINIT_INTERVAL_S`])
+//!   by the kernel sum with the free-surface floor `ρ0`, as SPHinXsys's granular examples
+//!   re-initialise theirs: a grain that separates keeps `ρ0` instead of a continuity density
+//!   falling without bound (the frictionless pour's blow-up).
+//! - The geostatic start ([`InitialStress::Geostatic`]) takes Jaky's `K0 = 1 − sin φ`
+//!   ([`initial`]): the elastic `ν/(1 − ν)` lies outside the matched cones.
 //! - A particle without any granular neighbour inside the kernel support (a grain out of
 //!   contact) carries no stress; otherwise its zero velocity gradient would keep the last
 //!   stress, which acts as a spring against walls.
@@ -113,7 +121,7 @@ pub use params::{
     ElastoplasticParams, InitialStress, MovingWall, WallModel, BOUNDARY_PARTICLE_ROWS,
     BUI_SUPPORT_OVER_SPACING, DEFAULT_ARTIFICIAL_STRESS_EPSILON,
     DEFAULT_ARTIFICIAL_STRESS_EXPONENT, DEFAULT_CFL_NUMBER, DEFAULT_CONE_MATCH,
-    DEFAULT_DENSITY_REINIT_INTERVAL_S,
+    DENSITY_REINIT_INTERVAL_S,
     DEFAULT_POISSON_RATIO, DEFAULT_REST_DENSITY, DEFAULT_SKIN_OVER_SPACING,
     DEFAULT_VISCOSITY_ALPHA, DEFAULT_VISCOSITY_BETA, DEFAULT_YOUNGS_MODULUS_PA,
     MAX_ARTIFICIAL_STRESS_EXPONENT, MAX_COHESION_PA, MAX_DENSITY_REINIT_INTERVAL_S,

@@ -60,12 +60,14 @@ pub const DEFAULT_CFL_NUMBER: f64 = 0.2;
 /// The cone's match of the defaults: Bui et al. (2008)'s plane strain of an associated
 /// material.
 pub const DEFAULT_CONE_MATCH: ConeMatch = ConeMatch::PlaneStrainAssociated;
-/// How often the density is re-initialised by kernel summation by default (s): every
-/// 2 ms, the interval at which SPHinXsys's granular examples (Zhang, Zhang & Hu's
-/// `test_2d_column_collapse`, its `DensitySummationComplexFreeSurface` once per advection
-/// step of `Dt = 0.002 s`) re-initialise theirs; see
-/// [`ElastoplasticParams::density_reinit_interval_s`].
-pub const DEFAULT_DENSITY_REINIT_INTERVAL_S: f64 = 0.002;
+/// The density re-initialisation's interval a scene sets to turn it on (s): 2 ms, the
+/// interval at which SPHinXsys's granular examples (its `test_2d_column_collapse`, a
+/// `DensitySummationComplexFreeSurface` once per advection step of `Dt = 0.002 s`)
+/// re-initialise theirs; see [`ElastoplasticParams::density_reinit_interval_s`]. The default
+/// is off (0, Bui et al.'s continuity equation alone): on, the poured heaps of the shipped
+/// scenes stand at other angles (one pour each at 20 mm: 45.5° instead of 38.6° at 40°,
+/// simple-shear match), which only ensembles of pours can judge.
+pub const DENSITY_REINIT_INTERVAL_S: f64 = 0.002;
 /// Neighbour-list skin of the defaults, as a fraction of the particle spacing.
 pub const DEFAULT_SKIN_OVER_SPACING: f64 = 0.3;
 /// Support radius of the defaults over the particle spacing, Bui et al. (2008)'s: their
@@ -108,7 +110,7 @@ pub enum InitialStress {
 /// | `artificial_stress_epsilon`, `_exponent` | 0.5, 2.55 | Gray et al. 2001 |
 /// | `cfl_number` | 0.2 | [`DEFAULT_CFL_NUMBER`] |
 /// | `skin` | `0.3 s` | [`DEFAULT_SKIN_OVER_SPACING`] |
-/// | `density_reinit_interval_s` | 0.002 s | [`DEFAULT_DENSITY_REINIT_INTERVAL_S`] |
+/// | `density_reinit_interval_s` | 0 (off; [`DENSITY_REINIT_INTERVAL_S`] to turn it on) | Bui et al. 2008 |
 /// | `default_wall`, `wall_models` | no-slip, none | |
 /// | `periodic` | none | |
 /// | `boundary_particle_region` | none (walls from the boundary) | |
@@ -228,7 +230,7 @@ impl<R: Real> ElastoplasticParams<R> {
             artificial_stress_exponent: R::of_f64(DEFAULT_ARTIFICIAL_STRESS_EXPONENT),
             cfl_number: R::of_f64(DEFAULT_CFL_NUMBER),
             skin: s * R::of_f64(DEFAULT_SKIN_OVER_SPACING),
-            density_reinit_interval_s: R::of_f64(DEFAULT_DENSITY_REINIT_INTERVAL_S),
+            density_reinit_interval_s: R::zero(),
             default_wall: WallModel::NoSlip,
             wall_models: Vec::new(),
             periodic: Vec::new(),

@@ -1,7 +1,7 @@
 //! Robust at every friction angle: a column of grains released on a floor of boundary
 //! particles collapses without a blow-up for every friction angle from 0° to 50° in 5°
 //! steps, at the quick spacing of the shipped scenes (20 mm) and their modulus, with the
-//! solver's default density re-initialisation; the grains stay finite, above the floor, at
+//! density re-initialisation on (`DENSITY_REINIT_INTERVAL_S`); the grains stay finite, above the floor, at
 //! densities near `ρ0`, the frictionless material flowing out and the deposits standing
 //! taller the higher the friction.
 
@@ -75,7 +75,7 @@ fn a_collapse_survives_every_friction_angle() {
     let mut heights = Vec::new();
     for k in 0..=10 {
         let theta = 5.0 * k as f64;
-        let state = collapse(theta, elastoplastic_granular::DEFAULT_DENSITY_REINIT_INTERVAL_S)
+        let state = collapse(theta, elastoplastic_granular::DENSITY_REINIT_INTERVAL_S)
             .unwrap_or_else(|e| panic!("theta = {theta}°: {e}"));
         for (i, (x, rho)) in state.positions.iter().zip(&state.densities).enumerate() {
             assert!(

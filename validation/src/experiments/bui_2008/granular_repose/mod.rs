@@ -20,7 +20,10 @@
 //! its flanks, which stop at its toes: each flank is a flank formed by flowing, the case of
 //! the prediction. The period (2.4 m at 20°, 1.6 m at 30° and 40°) keeps the toes clear of
 //! the period's ends. Each scene runs with the match set by the experiment; θ = 0 (friction 0,
-//! cohesion 0: a granular liquid) runs in the 40° scene and spreads over its floor.
+//! cohesion 0: a granular liquid) runs in the 40° scene and spreads over its floor, with the
+//! density re-initialisation on (`ElastoplasticParams::density_reinit_interval_s` at
+//! SPHinXsys's 2 ms: with the continuity equation alone it blew up at 26.1 s, a separated
+//! grain's density collapsing; the heaps run the model's default, continuity alone).
 //!
 //! **Rest** ([`granular_measure::rest`] with [`RestSettings::default`](crate::scene_runs::RestSettings::default), judged on the frames
 //! after the last layer): a run stops once the 99th-percentile speed of the grains and the

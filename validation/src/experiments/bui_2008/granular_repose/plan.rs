@@ -75,8 +75,8 @@ pub fn plan(mode: Mode) -> Vec<Plan> {
 }
 
 /// The scene of a planned case: the shipped poured scene of its θ (θ = 0: of
-/// [`LIQUID_SCENE_THETA`]; a coarse variant at the quick spacing) with the friction angle and
-/// the match set, and its variant applied.
+/// [`LIQUID_SCENE_THETA`], with the density re-initialisation on; a coarse variant at the
+/// quick spacing) with the friction angle and the match set, and its variant applied.
 pub fn scene_for(p: &Plan, mode: Mode) -> Result<Scene> {
     let scene_theta = if p.theta_deg > 0.0 {
         p.theta_deg
@@ -98,6 +98,12 @@ pub fn scene_for(p: &Plan, mode: Mode) -> Result<Scene> {
     };
     e.friction_angle_deg = p.theta_deg;
     e.cone_match = Some(p.cone);
+    if p.theta_deg == 0.0 {
+        // The granular liquid separates from its sloshing surface: with the continuity
+        // equation alone a separated grain's density collapses and its next contact blows
+        // the run up (the crate's `angle_sweep` test holds the control).
+        e.density_reinit_interval_s = Some(elastoplastic_granular::DENSITY_REINIT_INTERVAL_S);
+    }
     if let Variant::Coarse { modulus_factor } = p.variant {
         let SolverParams::Elastoplastic(params) = scene.solver_params::<f64>()? else {
             anyhow::bail!("{}: not elastoplastic", scene.source.display());
