@@ -767,7 +767,8 @@ pub use crate::guard::available_memory;
 /// `i_deg`, `q_au`, the barycentric state `x_au … vz_au_per_day`, the Tisserand parameter
 /// with respect to Jupiter `tisserand_jupiter` and the dynamical class `class`
 /// ([`classify`](crate::classify): `trans_neptunian`, `centaur`, `jupiter_family`, `other`),
-/// and `in_encounter` (whether the particle is being integrated through an encounter).
+/// and `in_encounter` (whether the particle, active, is being integrated through an
+/// encounter; `false` for every removed particle).
 pub fn population_table(population: &Population) -> Result<RecordBatch, SymplecticError> {
     let members = population.members();
     let n = members.len();
@@ -831,7 +832,11 @@ pub fn population_table(population: &Population) -> Result<RecordBatch, Symplect
     arrays.push(Arc::new(StringArray::from(class)));
     fields.push(Field::new("in_encounter", DataType::Boolean, false));
     arrays.push(Arc::new(BooleanArray::from_iter(
-        members.iter().map(|m| Some(m.encounter.is_some())),
+        // Active members only: a removed member is in no encounter (a checkpoint of an
+        // earlier version may still hold the encounter state it was removed in).
+        members
+            .iter()
+            .map(|m| Some(m.status == ParticleStatus::Active && m.encounter.is_some())),
     )));
     RecordBatch::try_new(Arc::new(Schema::new(fields)), arrays).map_err(|e| {
         SymplecticError::Output {

@@ -67,7 +67,8 @@ pub struct PopulationMember {
     pub sun_position: Vec3,
     /// The encounter mode's state while the particle is in it
     /// ([`Encounters`](crate::Encounters)); `particle`
-    /// then holds its position, velocity and time, not `p₄`.
+    /// then holds its position, velocity and time, not `p₄`. `None` once the particle is
+    /// removed, in the encounter mode or not.
     #[serde(default)]
     pub encounter: Option<Box<Encounter>>,
 }

@@ -747,6 +747,11 @@ impl WindowContext<'_> {
                 }
             }
         }
+        // A member removed in the encounter mode (collision, perihelion, ejection, a failed
+        // step) is no longer in it: its state at removal is in `particle`.
+        if m.status != ParticleStatus::Active {
+            m.encounter = None;
+        }
         (steps, f64::NEG_INFINITY)
     }
 
