@@ -176,7 +176,9 @@ pub struct SpanSpec {
     pub years: f64,
     /// Snapshot cadence (years).
     pub snapshot_every_years: f64,
-    /// Checkpoint cadence (years; default: at every snapshot).
+    /// Checkpoint cadence (years, from the epoch; default: at every snapshot). A study also
+    /// writes its checkpoint at the end and when stopped by Ctrl-C, never at the snapshots
+    /// between two checkpoint times.
     pub checkpoint_every_years: Option<f64>,
 }
 

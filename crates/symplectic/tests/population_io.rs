@@ -197,14 +197,61 @@ fn a_resumed_study_writes_identical_files() {
             })
         }));
         assert!(interrupted.is_err(), "k = {k}: not interrupted");
+        // Resumed if killed after the first checkpoint (20 years), started afresh before.
+        let checkpointed = out2.join("checkpoint.json").exists();
         let resumed = run_study(&spec2, &out2, |_| {}).unwrap();
-        assert_eq!(resumed.resumed, out2.join("checkpoint.json").exists());
+        assert_eq!(resumed.resumed, checkpointed, "k = {k}");
         assert_eq!(files(&out2), straight, "k = {k}: resumed files differ");
     }
     // Rerun over a finished directory: resumes, rewrites the same files.
     let again = run_study(&spec, &out, |_| {}).unwrap();
     assert!(again.resumed);
     assert_eq!(files(&out), straight);
+}
+
+/// Checkpoints at their own cadence, not at every snapshot: snapshots every 10 years and
+/// checkpoints every 30 over 120 years write 13 snapshots and 4 checkpoints (30, 60, 90 and
+/// 120 years, the last also the end). A run killed at 45 years (after the snapshot at 40,
+/// before the checkpoint at 60) left the checkpoint of 30 years, older than the last
+/// snapshot; resumed from it, it rewrites the snapshots from 40 years on and ends with the
+/// files of the uninterrupted run, byte for byte.
+#[test]
+fn checkpoints_follow_their_own_cadence_and_resume_across_snapshots() {
+    let spec = with(SPEC, "snapshot_every_years = 50.0", "snapshot_every_years = 10.0");
+    let spec = with(&spec, "checkpoint_every_years = 20.0", "checkpoint_every_years = 30.0");
+    let (spec_path, out) = study("cadence", &spec, GOOD_ROWS);
+    let straight = run_study(&spec_path, &out, |_| {}).unwrap();
+    assert_eq!(
+        (straight.snapshots_written, straight.checkpoints_written),
+        (13, 4)
+    );
+    let straight_files = files(&out);
+
+    let (spec2, out2) = study("cadence-killed", &spec, GOOD_ROWS);
+    let killed_at = 45.0 * 365.25;
+    // A panic in the callback stands for kill -9: the files are those written so far.
+    let killed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        run_study(&spec2, &out2, |p| {
+            assert!(p.time < killed_at, "killed");
+        })
+    }));
+    assert!(killed.is_err(), "not killed");
+    // The checkpoint on disk is the one of 30 years: not rewritten at the snapshots of 40
+    // years (written, below) or at any snapshot before.
+    let checkpoint: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out2.join("checkpoint.json")).unwrap()).unwrap();
+    assert_eq!(checkpoint["population"]["time"], 30.0 * 365.25);
+    assert_eq!(checkpoint["next_snapshot"], 4, "snapshots 0–30 years before it");
+    assert_eq!(checkpoint["next_checkpoint"], 2);
+    assert!(out2.join("snapshots/snapshot_000004.parquet").exists(), "40 years");
+    let resumed = run_study(&spec2, &out2, |_| {}).unwrap();
+    assert!(resumed.resumed);
+    // Snapshots 40–120 years (9) again; checkpoints at 60, 90 and 120 years.
+    assert_eq!(
+        (resumed.snapshots_written, resumed.checkpoints_written),
+        (9, 3)
+    );
+    assert_eq!(files(&out2), straight_files, "resumed files differ");
 }
 
 /// Rows given directly build the same population as the particle file they came from, and
