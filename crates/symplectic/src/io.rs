@@ -61,8 +61,8 @@ pub struct PopulationSpec {
     #[serde(default)]
     pub removal: RemovalRules,
     /// Integration through close encounters ([`Encounters`](crate::Encounters); off if the
-    /// table is absent; `[encounters]` with no field takes the defaults: 3 Hill radii,
-    /// tolerance 10⁻¹²).
+    /// table is absent; `[encounters]` with no field takes the defaults: switch at 3 Hill
+    /// radii, hand back beyond 3.5, tolerance 10⁻¹²).
     #[serde(default)]
     pub encounters: Option<crate::Encounters>,
 }
@@ -770,7 +770,8 @@ pub use crate::guard::available_memory;
 /// with respect to Jupiter `tisserand_jupiter` and the dynamical class `class`
 /// ([`classify`](crate::classify): `trans_neptunian`, `centaur`, `jupiter_family`, `other`),
 /// and `in_encounter` (whether the particle, active, is being integrated through an
-/// encounter; `false` for every removed particle).
+/// encounter; `false` for every removed particle) and `encounters_begun` (its switches to
+/// the encounter mode so far, [`PopulationMember::encounters_begun`](crate::PopulationMember)).
 pub fn population_table(population: &Population) -> Result<RecordBatch, SymplecticError> {
     let members = population.members();
     let n = members.len();
@@ -839,6 +840,10 @@ pub fn population_table(population: &Population) -> Result<RecordBatch, Symplect
         members
             .iter()
             .map(|m| Some(m.status == ParticleStatus::Active && m.encounter.is_some())),
+    )));
+    fields.push(Field::new("encounters_begun", DataType::UInt64, false));
+    arrays.push(Arc::new(UInt64Array::from_iter_values(
+        members.iter().map(|m| u64::from(m.encounters_begun)),
     )));
     RecordBatch::try_new(Arc::new(Schema::new(fields)), arrays).map_err(|e| {
         SymplecticError::Output {

@@ -70,7 +70,9 @@
 //!   or where `B₀, B₁` no longer dominate (the paper's condition 35, read as a factor 2), a
 //!   particle is integrated by Bulirsch–Stoer together with the Sun and the planets, which
 //!   are advanced from the last grid state rather than interpolated, and handed back to the
-//!   map afterwards; ends by collision with a planet's radius
+//!   map outside 3.5 Hill radii (a hysteresis band: a comet skimming 3 Hill radii switches
+//!   once, not at every dip; [`PopulationMember::encounters_begun`] counts the switches);
+//!   ends by collision with a planet's radius
 //!   ([`ParticleStatus::Collision`]), and never for lost regularisation. Checked against
 //!   REBOUND's IAS15 on single encounters with Jupiter and Neptune down to 0.02 Hill radii
 //!   (within 5·10⁻¹² AU) and against a fine fixed-step RK4 (property test); as a population,
@@ -153,8 +155,8 @@
 //! ejection from energy and angular momentum: ≈ 40 flops, 1 square root): about 1000 flops
 //! and 30 square roots or divisions, all on data in L1. S6 has 3 drifts, 4 kicks and 3
 //! interpolations. Each particle is one [`PopulationMember`] of
-//! [`Population::bytes_per_particle`] bytes (192 on x86-64; 184 before the encounter state), stepped many times per window
-//! while it sits in L1, so memory traffic is 2 × 192 bytes per particle per window, not per
+//! [`Population::bytes_per_particle`] bytes (200 on x86-64; 192 before the count of encounters begun, 184 before the encounter state), stepped many times per window
+//! while it sits in L1, so memory traffic is 2 × 200 bytes per particle per window, not per
 //! step. The ephemeris window (360 bytes per planet step for five bodies, ≈ 2 ×
 //! [`DEFAULT_WINDOW_STEPS`] steps, ≈ 180 KB) is shared read-only by all threads and stays in
 //! L2; extending it costs one planet step per grid point, once for the whole population
@@ -184,7 +186,8 @@ mod work;
 
 pub use classes::{classify, tisserand_jupiter, DynamicalClass};
 pub use encounter::{
-    integrate_through, Encounter, EncounterOutcome, Encounters, DEFAULT_ENCOUNTER_HILL_FACTOR,
+    integrate_through, Encounter, EncounterOutcome, Encounters,
+    DEFAULT_ENCOUNTER_HAND_BACK_HILL_FACTOR, DEFAULT_ENCOUNTER_HILL_FACTOR,
     DEFAULT_ENCOUNTER_TOLERANCE,
 };
 pub use ephemeris::{BodyStates, Ephemeris};

@@ -1,6 +1,7 @@
 //! The encounter state of population members ([`Encounters`]): cleared when a member is
-//! removed inside an encounter, and written to the population table (`in_encounter`) for
-//! active members only.
+//! removed inside an encounter, written to the population table (`in_encounter`) for active
+//! members only, and the switches counted (`encounters_begun`) with and without the
+//! hand-back radius's hysteresis.
 
 use symplectic::{
     outer_solar_system, BodyStates, Encounters, Ephemeris, Frame, Integrator, ParticleIntegrator,
@@ -98,4 +99,134 @@ fn a_comet_removed_in_an_encounter_is_no_longer_in_it() {
             .unwrap();
         assert_eq!((flag.value(0), flag.value(1)), (false, true));
     }
+}
+
+/// A comet circling Jupiter at `radius_hill` Hill radii, retrograde, in Hill's approximation
+/// (a quasi-satellite: Jupiter's semi-major axis, in its own orbit's frame `r̂` radial, `t̂`
+/// along the orbit, `ĥ` normal): the epicycle `x = −A cos nt`, `y = 2A sin nt` of the linear
+/// Hill equations with a vertical oscillation `z = √3 A cos nt`, whose distance
+/// `√(x² + y² + z²) = 2A` is constant; `v = V_J + A n t̂` at `t = 0`, then scaled to
+/// Jupiter's two-body energy (no drift along the orbit).
+fn quasi_satellite(radius_hill: f64) -> (Vec3, Vec3) {
+    let b = bodies_at_epoch();
+    let (q_j, v_j) = (
+        b.positions[1] - b.positions[0],
+        b.velocities[1] - b.velocities[0],
+    );
+    let hill = q_j.norm() * (b.gm[1] / (3.0 * b.gm[0])).cbrt();
+    let h = q_j.cross(&v_j);
+    let n = h.norm() / q_j.norm_squared();
+    let (r_hat, h_hat) = (q_j.normalize(), h.normalize());
+    let t_hat = h_hat.cross(&r_hat);
+    let a = 0.5 * radius_hill * hill;
+    let q = q_j - a * r_hat + 3f64.sqrt() * a * h_hat;
+    let v = v_j + a * n * t_hat;
+    let mu = b.gm[0] + b.gm[1];
+    let speed2 = v_j.norm_squared() + 2.0 * mu * (1.0 / q.norm() - 1.0 / q_j.norm());
+    let v = v * (speed2.sqrt() / v.norm());
+    (q + b.positions[0], v + b.velocities[0])
+}
+
+/// Advances `pop` (one member) to `years` in quarter years; returns the member's distance to
+/// Jupiter in Hill radii at each of those synchronisations (from the ephemeris at the
+/// member's own time).
+fn hill_ratios(pop: &mut Population, years: f64) -> Vec<f64> {
+    let mut bodies = BodyStates::default();
+    let mut ratios = Vec::new();
+    let mut t = 0.0;
+    while t < years * DAYS_PER_YEAR {
+        t += 0.25 * DAYS_PER_YEAR;
+        pop.advance_to(t, |_| {}).unwrap();
+        let m = &pop.members()[0];
+        pop.ephemeris()
+            .interpolate(m.particle.time, &mut bodies, false)
+            .unwrap();
+        let sun_jupiter = bodies.positions[1] - bodies.positions[0];
+        let hill = sun_jupiter.norm() * (bodies.gm[1] / (3.0 * bodies.gm[0])).cbrt();
+        ratios.push((m.particle.position - bodies.positions[1]).norm() / hill);
+    }
+    ratios
+}
+
+/// A quasi-satellite of Jupiter started at 3.2 Hill radii skims the switch radius: over
+/// its first 7 years it dips below 3 R_H, rises above it (to about 3.2) and dips again,
+/// not reaching 3.5 in between, then leaves. With the default hand-back radius (3.5 R_H) it switches
+/// to the encounter mode once and stays in it through the skim; with the hand-back at the
+/// switch radius (no hysteresis) it switches at each dip. The counts are read from the
+/// member, the table's `encounters_begun` and the population's progress.
+#[test]
+fn a_comet_skimming_the_switch_radius_switches_once_with_hysteresis() {
+    let years = 10.0;
+    let comet = quasi_satellite(3.2);
+    let mut with = population(&[comet], Encounters::default());
+    assert_eq!(with.encounters().unwrap().hand_back_hill_factor, 3.5);
+    let ratios = hill_ratios(&mut with, years);
+    // The skim, from the trajectory: dips below 3 R_H that start from above it, and the
+    // highest point between the first two (it rises above 3 R_H, not to 3.5).
+    let dips: Vec<usize> = (1..ratios.len())
+        .filter(|&k| ratios[k - 1] >= 3.0 && ratios[k] < 3.0)
+        .collect();
+    assert!(dips.len() >= 2, "{} dips below 3 R_H: {ratios:.2?}", dips.len());
+    let skim_high = ratios[dips[0]..dips[1]]
+        .iter()
+        .fold(0.0f64, |a, &b| a.max(b));
+    assert!(
+        (3.0..3.5).contains(&skim_high),
+        "up to {skim_high} R_H between the dips: {ratios:.2?}"
+    );
+    let begun = |p: &Population| p.members()[0].encounters_begun;
+    assert_eq!(begun(&with), 1, "with hysteresis");
+    assert_eq!(with.progress().encounters_begun, 1);
+
+    let sharp = Encounters {
+        hand_back_hill_factor: Encounters::default().hill_factor,
+        ..Encounters::default()
+    };
+    let mut without = population(&[comet], sharp);
+    hill_ratios(&mut without, years);
+    assert!(begun(&without) > 1, "{} switches without hysteresis", begun(&without));
+    #[cfg(feature = "io")]
+    {
+        let table = symplectic::io::population_table(&without).unwrap();
+        let column = table
+            .column_by_name("encounters_begun")
+            .unwrap()
+            .as_any()
+            .downcast_ref::<arrow_array::UInt64Array>()
+            .unwrap();
+        assert_eq!(column.value(0), u64::from(begun(&without)));
+    }
+}
+
+/// The hand-back radius is checked: finite, positive, not inside the switch radius; the
+/// error names the setting.
+#[test]
+fn a_hand_back_radius_inside_the_switch_radius_is_refused() {
+    let comet = quasi_satellite(3.2);
+    let mut pop = population(&[comet], Encounters::default());
+    for bad in [2.9, 0.0, -1.0, f64::NAN, f64::INFINITY] {
+        let e = pop
+            .set_encounters(Some(Encounters {
+                hand_back_hill_factor: bad,
+                ..Encounters::default()
+            }))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("encounters.hand_back_hill_factor"), "{bad}: {e}");
+    }
+    let e = pop
+        .set_encounters(Some(Encounters {
+            hill_factor: 4.0,
+            ..Encounters::default()
+        }))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains(">= encounters.hill_factor"), "{e}");
+    // Equal radii: a sharp switch, allowed.
+    pop.set_encounters(Some(Encounters {
+        hill_factor: 4.0,
+        hand_back_hill_factor: 4.0,
+        ..Encounters::default()
+    }))
+    .unwrap();
 }

@@ -77,7 +77,7 @@ pub const DEFAULT_WINDOW_STEPS: u32 = 256;
 /// counted with callgrind, 10² comets, 2026-11-25): at about 0.175 µs (≈ 610 cycles) per
 /// step the processor retired nearly four instructions per cycle, so one particle at a time
 /// is bound by the number of instructions, not by the latency of its chains (stepping whole
-/// particles in turn, round-robin, gained nothing). A particle's 192 bytes stay in registers
+/// particles in turn, round-robin, gained nothing). A particle's 200 bytes stay in registers
 /// and L1 through the window; the step is not bandwidth-bound.
 ///
 /// **Lanes.** In the barycentric variant (either scheme) a window therefore steps its
@@ -233,6 +233,7 @@ impl Population {
                     status: ParticleStatus::Active,
                     sun_position: bodies.positions[0],
                     encounter: None,
+                    encounters_begun: 0,
                 })
             })
             .collect::<Result<Vec<_>, SymplecticError>>()?;
@@ -350,17 +351,23 @@ impl Population {
 
     /// Where the population stands.
     pub fn progress(&self) -> PopulationProgress {
-        let active = self
+        let (active, encounters_begun) = self
             .members
             .par_iter()
             .with_min_len(4096)
-            .filter(|m| m.status == ParticleStatus::Active)
-            .count();
+            .map(|m| {
+                (
+                    usize::from(m.status == ParticleStatus::Active),
+                    u64::from(m.encounters_begun),
+                )
+            })
+            .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
         PopulationProgress {
             time: self.time,
             particle_steps: self.particle_steps,
             active,
             removed: self.members.len() - active,
+            encounters_begun,
         }
     }
 
