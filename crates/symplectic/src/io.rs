@@ -11,6 +11,9 @@ use arrow_array::{ArrayRef, BooleanArray, Float64Array, RecordBatch, StringArray
 use arrow_schema::{DataType, Field, Schema};
 use serde::Deserialize;
 
+use crate::classes::{
+    inclination_to_plane, jupiter_orbit_normal, levison_class, orbital_region, tisserand_jupiter,
+};
 use crate::kepler::{state_from_elements, ConicElements};
 use crate::{
     outer_solar_system, Ephemeris, Frame, Integrator, ParticleIntegrator, ParticleStatus, Planets,
@@ -766,9 +769,15 @@ pub use crate::guard::available_memory;
 /// The table of every particle now: `id`, `status`, `time_days` (the particle's own time:
 /// the steps are variable, so each particle is at the first step end at or after the
 /// snapshot time), `removal_time_days` (NaN if active), barycentric osculating `a_au`, `e`,
-/// `i_deg`, `q_au`, the barycentric state `x_au … vz_au_per_day`, the Tisserand parameter
-/// with respect to Jupiter `tisserand_jupiter` and the dynamical class `class`
-/// ([`classify`](crate::classify): `trans_neptunian`, `centaur`, `jupiter_family`, `other`),
+/// `i_deg` (to the frame's reference plane), `q_au`, the barycentric state
+/// `x_au … vz_au_per_day`, the Tisserand parameter with respect to Jupiter
+/// `tisserand_jupiter` (with the inclination to Jupiter's orbital plane,
+/// [`tisserand_jupiter`](crate::classes::tisserand_jupiter); NaN if unbound), the region by
+/// perihelion and semi-major axis `region` ([`orbital_region`](crate::classes::orbital_region):
+/// `trans_neptunian`, `centaur`, `perihelion_inside_jupiter`, `unbound`), Levison's (1996)
+/// class `levison_class` ([`levison_class`](crate::classes::levison_class):
+/// `jupiter_family`, `encke_type`, `chiron_type`, `halley_type`, `long_period`,
+/// `unclassified`),
 /// and `in_encounter` (whether the particle, active, is being integrated through an
 /// encounter; `false` for every removed particle) and `encounters_begun` (its switches to
 /// the encounter mode so far, [`PopulationMember::encounters_begun`](crate::PopulationMember)).
@@ -777,14 +786,18 @@ pub fn population_table(population: &Population) -> Result<RecordBatch, Symplect
     let n = members.len();
     let mut cols: Vec<Vec<f64>> = (0..13).map(|_| Vec::with_capacity(n)).collect();
     let mut status = Vec::with_capacity(n);
-    let mut class = Vec::with_capacity(n);
+    let (mut region, mut levison) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    let jupiter_normal = jupiter_orbit_normal(population.ephemeris());
     for (i, m) in members.iter().enumerate() {
         let el = population.elements(i)?;
         let q = population.barycentric_position(i);
         let v = m.particle.velocity;
         let (label, removal_time) = status_label(&m.status, population.ephemeris().planets());
         status.push(label);
-        class.push(crate::classify(&el).label());
+        let i_jupiter = jupiter_normal.map_or(f64::NAN, |n| inclination_to_plane(&q, &v, &n));
+        let t_j = tisserand_jupiter(el.semi_major_axis, el.eccentricity, i_jupiter);
+        region.push(orbital_region(&el).label());
+        levison.push(levison_class(el.semi_major_axis, el.eccentricity, t_j).label());
         let row = [
             m.particle.time,
             removal_time,
@@ -798,7 +811,7 @@ pub fn population_table(population: &Population) -> Result<RecordBatch, Symplect
             v.x,
             v.y,
             v.z,
-            crate::tisserand_jupiter(&el),
+            t_j,
         ];
         for (c, x) in cols.iter_mut().zip(row) {
             c.push(x);
@@ -831,8 +844,10 @@ pub fn population_table(population: &Population) -> Result<RecordBatch, Symplect
         fields.push(Field::new(*name, DataType::Float64, false));
         arrays.push(Arc::new(Float64Array::from(c)));
     }
-    fields.push(Field::new("class", DataType::Utf8, false));
-    arrays.push(Arc::new(StringArray::from(class)));
+    fields.push(Field::new("region", DataType::Utf8, false));
+    arrays.push(Arc::new(StringArray::from(region)));
+    fields.push(Field::new("levison_class", DataType::Utf8, false));
+    arrays.push(Arc::new(StringArray::from(levison)));
     fields.push(Field::new("in_encounter", DataType::Boolean, false));
     arrays.push(Arc::new(BooleanArray::from_iter(
         // Active members only: a removed member is in no encounter (a checkpoint of an

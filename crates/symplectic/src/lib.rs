@@ -79,8 +79,10 @@
 //!   300 Centaurs over 1 Myr against REBOUND's MERCURIUS with the same initial conditions and
 //!   end rules (survival, lifetimes, fractions ejected, collided and reaching q < 2.5 AU;
 //!   the validation experiment `centaur-population`);
-//! - [`classes`]: the dynamical class (trans-Neptunian, Centaur, Jupiter-family) by
-//!   Tisserand parameter and perihelion after Levison (1996), in the population tables;
+//! - [`classes`]: Levison's (1996) comet classes by the Tisserand parameter with respect to
+//!   Jupiter (Jupiter-family, Encke-type, Chiron-type, Halley-type, long-period) and, apart,
+//!   the region of an orbit by perihelion and semi-major axis (trans-Neptunian, Centaur,
+//!   perihelion inside Jupiter's orbit), both in the population tables;
 //! - [`samples`]: seeded sample populations (SplitMix64) shared with the peer scripts;
 //! - with the feature `io`: `io` (the population TOML, the particle CSV with line/column
 //!   errors, Parquet tables readable by pandas and polars) and `study` (a whole study with
@@ -184,7 +186,7 @@ pub mod solar_system;
 pub mod study;
 mod work;
 
-pub use classes::{classify, tisserand_jupiter, DynamicalClass};
+pub use classes::{levison_class, orbital_region, tisserand_jupiter, LevisonClass, OrbitalRegion};
 pub use encounter::{
     integrate_through, Encounter, EncounterOutcome, Encounters,
     DEFAULT_ENCOUNTER_HAND_BACK_HILL_FACTOR, DEFAULT_ENCOUNTER_HILL_FACTOR,

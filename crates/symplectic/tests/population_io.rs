@@ -287,7 +287,8 @@ fn rows_given_directly_build_the_files_population() {
 }
 
 /// A study with an `[encounters]` table builds a population integrated through encounters,
-/// and its table carries the classes, the Tisserand parameter and the encounter flag; an
+/// and its table carries the region, Levison's class, the Tisserand parameter, the encounter
+/// flag and the count of encounters begun; an
 /// `[encounters]` table together with the Hill-sphere removal rule is refused by name.
 #[test]
 fn a_study_with_encounters_integrates_through_them() {
@@ -307,17 +308,38 @@ fn a_study_with_encounters_integrates_through_them() {
     pop.advance_to(5.0 * 365.25, |_| {}).unwrap();
     let table = population_table(&pop).unwrap();
     let schema = table.schema();
-    for column in ["tisserand_jupiter", "class", "in_encounter"] {
+    for column in [
+        "tisserand_jupiter",
+        "region",
+        "levison_class",
+        "in_encounter",
+        "encounters_begun",
+    ] {
         assert!(schema.field_with_name(column).is_ok(), "{column}");
     }
-    let classes = table
-        .column_by_name("class")
+    let labels = |column: &str| {
+        table
+            .column_by_name(column)
+            .unwrap()
+            .as_any()
+            .downcast_ref::<arrow_array::StringArray>()
+            .unwrap()
+            .clone()
+    };
+    // a = 14 AU, q = 11.6 AU: between the giants. T_J = 5.203/14 + 2 cos 2.2° √((14/5.203)
+    // (1 − 0.17²)) = 3.60 from the initial elements (five years on, within a few 0.01: the
+    // comet meets no planet closer than Saturn's Hill sphere): T_J > 3 and a > a_J,
+    // Chiron-type.
+    assert_eq!(labels("region").value(0), "centaur");
+    assert_eq!(labels("levison_class").value(0), "chiron_type");
+    let t_j = table
+        .column_by_name("tisserand_jupiter")
         .unwrap()
         .as_any()
-        .downcast_ref::<arrow_array::StringArray>()
-        .unwrap();
-    // a = 14 AU, q = 11.6 AU: a Centaur.
-    assert_eq!(classes.value(0), "centaur");
+        .downcast_ref::<arrow_array::Float64Array>()
+        .unwrap()
+        .value(0);
+    assert!((t_j - 3.60).abs() < 0.1, "T_J = {t_j}");
     let both = spec_text.replace("[removal]\n", "[removal]\nhill_factor = 1.0\n");
     let (bad, _) = study("encounters-bad", &both, rows);
     let err = PopulationSpec::from_file(&bad)
