@@ -31,9 +31,18 @@ pub const MAX_SPEC_FILE_BYTES: u64 = 1 << 20;
 /// the rows are counted and checked against the memory available before any is kept.
 pub const MAX_PARTICLE_FILE_BYTES: u64 = 1 << 36;
 
-/// Most snapshot tables one study writes (`span.years / span.snapshot_every_years + 1`): a
-/// cadence far below the span writes files faster than anyone reads them.
+/// Most snapshot tables one study writes: `⌈span.years / span.snapshot_every_years⌉ + 1`
+/// (the first at the epoch, the last at the end; [`snapshot_count`]). A cadence far below
+/// the span writes files faster than anyone reads them.
 pub const MAX_SNAPSHOTS: f64 = 10_000.0;
+
+/// The number of snapshot tables a study of `span_years` with one every `every_years`
+/// writes: at the epoch, every `every_years` after it, and at the end,
+/// `⌈span/every⌉ + 1` (as a float: a cadence far below the span asks for more than any
+/// integer type holds).
+pub fn snapshot_count(span_years: f64, every_years: f64) -> f64 {
+    (span_years / every_years).ceil() + 1.0
+}
 
 /// Most checkpoints one study writes (`span.years / span.checkpoint_every_years`): each
 /// rewrites the whole population.
@@ -266,15 +275,22 @@ impl PopulationSpec {
     /// grid one particle step needs, a first step that moves the particles' clocks.
     fn check_limits(&self, path: &Path) -> Result<(), SymplecticError> {
         let span = &self.span;
-        let snapshots = span.years / span.snapshot_every_years + 1.0;
+        let snapshots = snapshot_count(span.years, span.snapshot_every_years);
         if snapshots > MAX_SNAPSHOTS {
+            // The count exactly while f64 holds it as an integer (2⁵³), in e-notation beyond.
+            let requested = if snapshots < 2f64.powi(53) {
+                format!("{snapshots:.0}")
+            } else {
+                format!("{snapshots:.3e}")
+            };
             return Err(spec_error(
                 path,
                 "span.snapshot_every_years",
                 format!(
-                    "{} years over a span of {} years writes {snapshots:.3e} snapshot files, more than MAX_SNAPSHOTS = {MAX_SNAPSHOTS}: take at least {:.6e} years",
+                    "one snapshot every {} years over a span of {} years is {requested} snapshot files (at the epoch, every {} years, at the end), more than the cap of {MAX_SNAPSHOTS} per study (MAX_SNAPSHOTS): take at least {:.6e} years",
                     span.snapshot_every_years,
                     span.years,
+                    span.snapshot_every_years,
                     span.years / (MAX_SNAPSHOTS - 1.0)
                 ),
             ));

@@ -395,8 +395,27 @@ fn specification_limits_name_the_key_and_the_bound() {
         ),
         GOOD_ROWS,
     );
+    // The requested count, ⌈120/10⁻⁶⌉ + 1 = 120000001 (120/1e-6 rounds to 1.2·10⁸ exactly
+    // in IEEE double, as Python's float division gives), and the cap.
     assert!(
-        e.contains("`span.snapshot_every_years`") && e.contains("MAX_SNAPSHOTS"),
+        e.contains("`span.snapshot_every_years`")
+            && e.contains(" 120000001 snapshot files")
+            && e.contains("the cap of 10000 per study (MAX_SNAPSHOTS)"),
+        "{e}"
+    );
+    // Just over the cap: 120 years every 0.012 is ⌈10000⌉ + 1 = 10001 files (120/0.012
+    // rounds to 10000 exactly in IEEE double, as Python's float division gives).
+    let e = bad_study(
+        "snapshot_cap",
+        &with(
+            SPEC,
+            "snapshot_every_years = 50.0",
+            "snapshot_every_years = 0.012",
+        ),
+        GOOD_ROWS,
+    );
+    assert!(
+        e.contains(" 10001 snapshot files") && e.contains("cap of 10000"),
         "{e}"
     );
     let e = bad_study(
