@@ -83,7 +83,10 @@ impl LevisonClass {
 
     /// Whether Levison calls the class ecliptic (`T_J > 2`).
     pub fn is_ecliptic(self) -> bool {
-        matches!(self, Self::JupiterFamily | Self::EnckeType | Self::ChironType)
+        matches!(
+            self,
+            Self::JupiterFamily | Self::EnckeType | Self::ChironType
+        )
     }
 }
 
@@ -245,12 +248,29 @@ mod tests {
     #[test]
     fn known_comets_have_their_published_tisserand_and_class() {
         let published = [
-            ("1P/Halley", 17.834, 0.96714, 162.26, -0.605, LevisonClass::HalleyType),
-            ("2P/Encke", 2.2151, 0.8483, 11.78, 3.025, LevisonClass::EnckeType),
+            (
+                "1P/Halley",
+                17.834,
+                0.96714,
+                162.26,
+                -0.605,
+                LevisonClass::HalleyType,
+            ),
+            (
+                "2P/Encke",
+                2.2151,
+                0.8483,
+                11.78,
+                3.025,
+                LevisonClass::EnckeType,
+            ),
         ];
         for (name, a, e, i, listed, class) in published {
             let t = tisserand_jupiter(a, e, f64::to_radians(i));
-            assert!((t - listed).abs() < 0.01, "{name}: T_J {t}, listed {listed}");
+            assert!(
+                (t - listed).abs() < 0.01,
+                "{name}: T_J {t}, listed {listed}"
+            );
             assert_eq!(levison_class(a, e, t), class, "{name}");
         }
         let classes = [
@@ -265,7 +285,10 @@ mod tests {
         assert!(!LevisonClass::LongPeriod.is_ecliptic() && LevisonClass::EnckeType.is_ecliptic());
         // Unbound: no T_J, no class.
         assert!(tisserand_jupiter(-5.0, 1.5, 0.1).is_nan());
-        assert_eq!(levison_class(-5.0, 1.5, f64::NAN), LevisonClass::Unclassified);
+        assert_eq!(
+            levison_class(-5.0, 1.5, f64::NAN),
+            LevisonClass::Unclassified
+        );
     }
 
     /// The q-and-a regions of known objects (JPL Small-Body Database elements, rounded):
@@ -275,8 +298,14 @@ mod tests {
     fn known_objects_fall_in_their_regions() {
         use OrbitalRegion::*;
         assert_eq!(orbital_region(&el(13.7, 0.38, 6.9)), Centaur);
-        assert_eq!(orbital_region(&el(2.2151, 0.8483, 11.78)), PerihelionInsideJupiter);
-        assert_eq!(orbital_region(&el(17.834, 0.96714, 162.26)), PerihelionInsideJupiter);
+        assert_eq!(
+            orbital_region(&el(2.2151, 0.8483, 11.78)),
+            PerihelionInsideJupiter
+        );
+        assert_eq!(
+            orbital_region(&el(17.834, 0.96714, 162.26)),
+            PerihelionInsideJupiter
+        );
         assert_eq!(orbital_region(&el(67.9, 0.44, 44.0)), TransNeptunian);
         assert_eq!(orbital_region(&el(39.5, 0.25, 17.1)), TransNeptunian);
         assert_eq!(orbital_region(&el(-5.0, 1.5, 10.0)), Unbound);

@@ -788,10 +788,10 @@ pub use crate::guard::available_memory;
 /// `i_deg` (to the frame's reference plane), `q_au`, the barycentric state
 /// `x_au … vz_au_per_day`, the Tisserand parameter with respect to Jupiter
 /// `tisserand_jupiter` (with the inclination to Jupiter's orbital plane,
-/// [`tisserand_jupiter`](crate::classes::tisserand_jupiter); NaN if unbound), the region by
-/// perihelion and semi-major axis `region` ([`orbital_region`](crate::classes::orbital_region):
+/// [`tisserand_jupiter`]; NaN if unbound), the region by
+/// perihelion and semi-major axis `region` ([`orbital_region`]:
 /// `trans_neptunian`, `centaur`, `perihelion_inside_jupiter`, `unbound`), Levison's (1996)
-/// class `levison_class` ([`levison_class`](crate::classes::levison_class):
+/// class `levison_class` ([`levison_class`]:
 /// `jupiter_family`, `encke_type`, `chiron_type`, `halley_type`, `long_period`,
 /// `unclassified`),
 /// and `in_encounter` (whether the particle, active, is being integrated through an

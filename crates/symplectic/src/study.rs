@@ -108,10 +108,7 @@ pub fn run_study(
     let end = epoch + spec.span.years * DAYS_PER_YEAR;
     let snap_every = spec.span.snapshot_every_years * DAYS_PER_YEAR;
     // Without a cadence of their own, checkpoints go with the snapshots.
-    let ck_every = spec
-        .span
-        .checkpoint_every_years
-        .map(|y| y * DAYS_PER_YEAR);
+    let ck_every = spec.span.checkpoint_every_years.map(|y| y * DAYS_PER_YEAR);
     let snap_time = |k: u64| (epoch + k as f64 * snap_every).min(end);
     let ck_time = |k: u64| ck_every.map_or(f64::INFINITY, |every| epoch + k as f64 * every);
     let (mut written, mut checkpoints) = (0, 0);

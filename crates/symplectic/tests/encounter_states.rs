@@ -70,7 +70,10 @@ fn a_comet_removed_in_an_encounter_is_no_longer_in_it() {
     // 2 Hill radii along the orbit at Jupiter's ≈ 0.0075 AU/day (checked below).
     let trailing = co_orbital(2.0 * hill / 0.0075);
     let start_ratio = (trailing.0 - q_j).norm() / hill;
-    assert!((1.5..2.5).contains(&start_ratio), "{start_ratio} Hill radii");
+    assert!(
+        (1.5..2.5).contains(&start_ratio),
+        "{start_ratio} Hill radii"
+    );
     let mut pop = population(&[falling, trailing], Encounters::default());
     pop.advance_to(DAYS_PER_YEAR, |_| {}).unwrap();
     let [fell, trails] = pop.members() else {
@@ -85,9 +88,15 @@ fn a_comet_removed_in_an_encounter_is_no_longer_in_it() {
         }
         ref s => panic!("expected a collision with Jupiter, got {s:?}"),
     }
-    assert!(fell.encounter.is_none(), "removed, still in the encounter mode");
+    assert!(
+        fell.encounter.is_none(),
+        "removed, still in the encounter mode"
+    );
     assert_eq!(trails.status, ParticleStatus::Active);
-    assert!(trails.encounter.is_some(), "trailing Jupiter, not in an encounter");
+    assert!(
+        trails.encounter.is_some(),
+        "trailing Jupiter, not in an encounter"
+    );
     #[cfg(feature = "io")]
     {
         let table = symplectic::io::population_table(&pop).unwrap();
@@ -166,7 +175,11 @@ fn a_comet_skimming_the_switch_radius_switches_once_with_hysteresis() {
     let dips: Vec<usize> = (1..ratios.len())
         .filter(|&k| ratios[k - 1] >= 3.0 && ratios[k] < 3.0)
         .collect();
-    assert!(dips.len() >= 2, "{} dips below 3 R_H: {ratios:.2?}", dips.len());
+    assert!(
+        dips.len() >= 2,
+        "{} dips below 3 R_H: {ratios:.2?}",
+        dips.len()
+    );
     let skim_high = ratios[dips[0]..dips[1]]
         .iter()
         .fold(0.0f64, |a, &b| a.max(b));
@@ -184,7 +197,11 @@ fn a_comet_skimming_the_switch_radius_switches_once_with_hysteresis() {
     };
     let mut without = population(&[comet], sharp);
     hill_ratios(&mut without, years);
-    assert!(begun(&without) > 1, "{} switches without hysteresis", begun(&without));
+    assert!(
+        begun(&without) > 1,
+        "{} switches without hysteresis",
+        begun(&without)
+    );
     #[cfg(feature = "io")]
     {
         let table = symplectic::io::population_table(&without).unwrap();

@@ -217,8 +217,16 @@ fn a_resumed_study_writes_identical_files() {
 /// files of the uninterrupted run, byte for byte.
 #[test]
 fn checkpoints_follow_their_own_cadence_and_resume_across_snapshots() {
-    let spec = with(SPEC, "snapshot_every_years = 50.0", "snapshot_every_years = 10.0");
-    let spec = with(&spec, "checkpoint_every_years = 20.0", "checkpoint_every_years = 30.0");
+    let spec = with(
+        SPEC,
+        "snapshot_every_years = 50.0",
+        "snapshot_every_years = 10.0",
+    );
+    let spec = with(
+        &spec,
+        "checkpoint_every_years = 20.0",
+        "checkpoint_every_years = 30.0",
+    );
     let (spec_path, out) = study("cadence", &spec, GOOD_ROWS);
     let straight = run_study(&spec_path, &out, |_| {}).unwrap();
     assert_eq!(
@@ -241,9 +249,15 @@ fn checkpoints_follow_their_own_cadence_and_resume_across_snapshots() {
     let checkpoint: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out2.join("checkpoint.json")).unwrap()).unwrap();
     assert_eq!(checkpoint["population"]["time"], 30.0 * 365.25);
-    assert_eq!(checkpoint["next_snapshot"], 4, "snapshots 0–30 years before it");
+    assert_eq!(
+        checkpoint["next_snapshot"], 4,
+        "snapshots 0–30 years before it"
+    );
     assert_eq!(checkpoint["next_checkpoint"], 2);
-    assert!(out2.join("snapshots/snapshot_000004.parquet").exists(), "40 years");
+    assert!(
+        out2.join("snapshots/snapshot_000004.parquet").exists(),
+        "40 years"
+    );
     let resumed = run_study(&spec2, &out2, |_| {}).unwrap();
     assert!(resumed.resumed);
     // Snapshots 40–120 years (9) again; checkpoints at 60, 90 and 120 years.
