@@ -16,7 +16,9 @@ pub const FINAL_TABLE: &str = "final.parquet";
 pub const SNAPSHOT_DIR: &str = "snapshots";
 
 const STUDY_FORMAT: &str = "symplectic-population-study";
-const STUDY_VERSION: u32 = 1;
+/// 2: the population's encounter settings have a hand-back radius (a version 1 checkpoint
+/// goes on handed back at its switch radius, as it was integrated).
+const STUDY_VERSION: u32 = 2;
 
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -67,15 +69,19 @@ pub fn run_study(
     let spec = PopulationSpec::parse(&spec_text, spec_path)?;
     let checkpoint_path = out_dir.join(CHECKPOINT_FILE);
     let (mut state, resumed) = if checkpoint_path.exists() {
-        let c: StudyCheckpoint = crate::load_checkpoint(&checkpoint_path)?;
-        if c.format != STUDY_FORMAT || c.version != STUDY_VERSION {
+        let mut c: StudyCheckpoint = crate::load_checkpoint(&checkpoint_path)?;
+        if c.format != STUDY_FORMAT || !(1..=STUDY_VERSION).contains(&c.version) {
             return Err(SymplecticError::Checkpoint {
                 path: checkpoint_path.display().to_string(),
                 reason: format!(
-                    "format {:?} version {}, expected {STUDY_FORMAT:?} version {STUDY_VERSION}",
+                    "format {:?} version {}, expected {STUDY_FORMAT:?} version 1 to {STUDY_VERSION}",
                     c.format, c.version
                 ),
             });
+        }
+        if c.version == 1 {
+            c.population.keep_version_1_hand_back();
+            c.version = STUDY_VERSION;
         }
         if c.spec != spec_text {
             return Err(SymplecticError::Checkpoint {

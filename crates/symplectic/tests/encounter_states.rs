@@ -247,3 +247,67 @@ fn a_hand_back_radius_inside_the_switch_radius_is_refused() {
     }))
     .unwrap();
 }
+
+/// A population saved before the hand-back radius existed (checkpoint version 1: no
+/// `hand_back_hill_factor`, no `encounters_begun`) goes on as it was integrated, handed
+/// back at its switch radius, and continues bit for bit as a population built that way;
+/// a later version is refused by name.
+#[test]
+fn a_version_1_checkpoint_goes_on_without_hysteresis() {
+    let dir = std::env::temp_dir().join(format!("encounter-states-v1-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("population.json");
+    let comet = quasi_satellite(3.2);
+    let sharp = Encounters {
+        hand_back_hill_factor: Encounters::default().hill_factor,
+        ..Encounters::default()
+    };
+    let mut straight = population(&[comet], sharp);
+    straight.advance_to(10.0 * DAYS_PER_YEAR, |_| {}).unwrap();
+    let mut first = population(&[comet], sharp);
+    first.advance_to(2.0 * DAYS_PER_YEAR, |_| {}).unwrap();
+    first.save(&path).unwrap();
+    // The file as version 1 wrote it: the new fields taken out.
+    let mut json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    assert_eq!(json["version"], 2);
+    json["version"] = 1.into();
+    let population_json = json["population"].as_object_mut().unwrap();
+    population_json["encounters"]
+        .as_object_mut()
+        .unwrap()
+        .remove("hand_back_hill_factor")
+        .unwrap();
+    for m in population_json["members"].as_array_mut().unwrap() {
+        m.as_object_mut()
+            .unwrap()
+            .remove("encounters_begun")
+            .unwrap();
+    }
+    std::fs::write(&path, serde_json::to_vec(&json).unwrap()).unwrap();
+    let mut resumed = Population::load(&path).unwrap();
+    assert_eq!(
+        resumed.encounters(),
+        Some(sharp),
+        "handed back at the switch radius"
+    );
+    resumed.advance_to(10.0 * DAYS_PER_YEAR, |_| {}).unwrap();
+    // The trajectory bit for bit (the count of switches starts at 0 in a version 1 file).
+    let m = (&resumed.members()[0], &straight.members()[0]);
+    assert_eq!(
+        (&m.0.particle, &m.0.status, &m.0.encounter),
+        (&m.1.particle, &m.1.status, &m.1.encounter)
+    );
+    assert_eq!(
+        m.0.encounters_begun + first.members()[0].encounters_begun,
+        m.1.encounters_begun
+    );
+    json["version"] = 3.into();
+    std::fs::write(&path, serde_json::to_vec(&json).unwrap()).unwrap();
+    let e = Population::load(&path).unwrap_err().to_string();
+    assert!(
+        e.contains("version 3, expected") && e.contains("version 1 to 2"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
