@@ -13,7 +13,7 @@
 //!
 //! `particles=N particle_years_per_s=X particle_steps_per_s=Y threads=T seconds=S active=A ...`
 //!
-//! with the counts of each end (labels as in the Parquet tables) and of each dynamical class
+//! with the counts of each end and of each orbital region (labels as in the Parquet tables)
 //! of the active comets. The particle-years count each comet until its end. The clock covers
 //! `advance_to` only. `CENTAUR_THROUGHPUT_INITIAL=FILE` writes the initial barycentric states
 //! (as `comet_throughput` does) and `CENTAUR_THROUGHPUT_FINAL=FILE` each comet's status
@@ -23,7 +23,7 @@ use std::collections::BTreeMap;
 use std::time::Instant;
 
 use symplectic::io::status_label;
-use symplectic::{classify, ParticleStatus};
+use symplectic::{orbital_region, ParticleStatus};
 
 const DAYS_PER_YEAR: f64 = 365.25;
 
@@ -76,7 +76,7 @@ fn run() -> Result<(), String> {
         ));
         if m.status == ParticleStatus::Active {
             let el = population.elements(i).map_err(|e| e.to_string())?;
-            *classes.entry(classify(&el).label()).or_default() += 1;
+            *classes.entry(orbital_region(&el).label()).or_default() += 1;
         }
     }
     if let Ok(path) = std::env::var("CENTAUR_THROUGHPUT_FINAL") {

@@ -81,11 +81,12 @@ pub fn run(args: &CometsArgs) -> Result<()> {
     bar.finish();
     let p = summary.progress;
     println!(
-        "{}: {} particles active, {} removed; {} particle steps; {}{} snapshots written to {}, final table {}",
+        "{}: {} particles active, {} removed; {} particle steps; {} switches to the encounter integrator; {}{} snapshots written to {}, final table {}",
         args.population.display(),
         p.active,
         p.removed,
         p.particle_steps,
+        p.encounters_begun,
         if summary.resumed { "resumed; " } else { "" },
         summary.snapshots_written,
         out.join(SNAPSHOT_DIR).display(),

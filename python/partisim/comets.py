@@ -104,8 +104,10 @@ class PopulationSpec:
     encounters : dict or None
         Integrate the particles through close encounters instead of removing them (the
         ``[encounters]`` table of a population file): ``{}`` takes the defaults, or give
-        ``hill_factor`` (Hill radii where the encounter integrator takes over, default 3)
-        and ``tolerance`` (its relative error per step, default 1e-12). Barycentric variant
+        ``hill_factor`` (Hill radii where the encounter integrator takes over, default 3),
+        ``hand_back_hill_factor`` (Hill radii beyond which it hands the particle back to the
+        map, at least ``hill_factor``, default 3.5) and ``tolerance`` (its relative error per
+        step, default 1e-12). Barycentric variant
         only, and not with the removal rule ``hill_factor``. A particle that hits a planet
         stops with the status ``collision_<planet>``. ``None`` (default): off.
 

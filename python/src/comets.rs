@@ -281,7 +281,8 @@ impl Population {
     }
 
     /// The snapshot table (the columns of `cargo xtask comets`' Parquet snapshots) as a
-    /// dict of numpy arrays (`status` and `class` lists of str, `in_encounter` booleans).
+    /// dict of numpy arrays (`status`, `region` and `levison_class` lists of str,
+    /// `in_encounter` booleans, `encounters_begun` integers).
     fn table<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let batch = population_table(&self.inner).map_err(rust_err)?;
         let d = PyDict::new(py);

@@ -11,6 +11,9 @@ use arrow_array::{ArrayRef, BooleanArray, Float64Array, RecordBatch, StringArray
 use arrow_schema::{DataType, Field, Schema};
 use serde::Deserialize;
 
+use crate::classes::{
+    inclination_to_plane, jupiter_orbit_normal, levison_class, orbital_region, tisserand_jupiter,
+};
 use crate::kepler::{state_from_elements, ConicElements};
 use crate::{
     outer_solar_system, Ephemeris, Frame, Integrator, ParticleIntegrator, ParticleStatus, Planets,
@@ -28,9 +31,18 @@ pub const MAX_SPEC_FILE_BYTES: u64 = 1 << 20;
 /// the rows are counted and checked against the memory available before any is kept.
 pub const MAX_PARTICLE_FILE_BYTES: u64 = 1 << 36;
 
-/// Most snapshot tables one study writes (`span.years / span.snapshot_every_years + 1`): a
-/// cadence far below the span writes files faster than anyone reads them.
+/// Most snapshot tables one study writes: `⌈span.years / span.snapshot_every_years⌉ + 1`
+/// (the first at the epoch, the last at the end; [`snapshot_count`]). A cadence far below
+/// the span writes files faster than anyone reads them.
 pub const MAX_SNAPSHOTS: f64 = 10_000.0;
+
+/// The number of snapshot tables a study of `span_years` with one every `every_years`
+/// writes: at the epoch, every `every_years` after it, and at the end,
+/// `⌈span/every⌉ + 1` (as a float: a cadence far below the span asks for more than any
+/// integer type holds).
+pub fn snapshot_count(span_years: f64, every_years: f64) -> f64 {
+    (span_years / every_years).ceil() + 1.0
+}
 
 /// Most checkpoints one study writes (`span.years / span.checkpoint_every_years`): each
 /// rewrites the whole population.
@@ -61,8 +73,8 @@ pub struct PopulationSpec {
     #[serde(default)]
     pub removal: RemovalRules,
     /// Integration through close encounters ([`Encounters`](crate::Encounters); off if the
-    /// table is absent; `[encounters]` with no field takes the defaults: 3 Hill radii,
-    /// tolerance 10⁻¹²).
+    /// table is absent; `[encounters]` with no field takes the defaults: switch at 3 Hill
+    /// radii, hand back beyond 3.5, tolerance 10⁻¹²).
     #[serde(default)]
     pub encounters: Option<crate::Encounters>,
 }
@@ -176,7 +188,9 @@ pub struct SpanSpec {
     pub years: f64,
     /// Snapshot cadence (years).
     pub snapshot_every_years: f64,
-    /// Checkpoint cadence (years; default: at every snapshot).
+    /// Checkpoint cadence (years, from the epoch; default: at every snapshot). A study also
+    /// writes its checkpoint at the end and when stopped by Ctrl-C, never at the snapshots
+    /// between two checkpoint times.
     pub checkpoint_every_years: Option<f64>,
 }
 
@@ -261,15 +275,22 @@ impl PopulationSpec {
     /// grid one particle step needs, a first step that moves the particles' clocks.
     fn check_limits(&self, path: &Path) -> Result<(), SymplecticError> {
         let span = &self.span;
-        let snapshots = span.years / span.snapshot_every_years + 1.0;
+        let snapshots = snapshot_count(span.years, span.snapshot_every_years);
         if snapshots > MAX_SNAPSHOTS {
+            // The count exactly while f64 holds it as an integer (2⁵³), in e-notation beyond.
+            let requested = if snapshots < 2f64.powi(53) {
+                format!("{snapshots:.0}")
+            } else {
+                format!("{snapshots:.3e}")
+            };
             return Err(spec_error(
                 path,
                 "span.snapshot_every_years",
                 format!(
-                    "{} years over a span of {} years writes {snapshots:.3e} snapshot files, more than MAX_SNAPSHOTS = {MAX_SNAPSHOTS}: take at least {:.6e} years",
+                    "one snapshot every {} years over a span of {} years is {requested} snapshot files (at the epoch, every {} years, at the end), more than the cap of {MAX_SNAPSHOTS} per study (MAX_SNAPSHOTS): take at least {:.6e} years",
                     span.snapshot_every_years,
                     span.years,
+                    span.snapshot_every_years,
                     span.years / (MAX_SNAPSHOTS - 1.0)
                 ),
             ));
@@ -764,23 +785,35 @@ pub use crate::guard::available_memory;
 /// The table of every particle now: `id`, `status`, `time_days` (the particle's own time:
 /// the steps are variable, so each particle is at the first step end at or after the
 /// snapshot time), `removal_time_days` (NaN if active), barycentric osculating `a_au`, `e`,
-/// `i_deg`, `q_au`, the barycentric state `x_au … vz_au_per_day`, the Tisserand parameter
-/// with respect to Jupiter `tisserand_jupiter` and the dynamical class `class`
-/// ([`classify`](crate::classify): `trans_neptunian`, `centaur`, `jupiter_family`, `other`),
-/// and `in_encounter` (whether the particle is being integrated through an encounter).
+/// `i_deg` (to the frame's reference plane), `q_au`, the barycentric state
+/// `x_au … vz_au_per_day`, the Tisserand parameter with respect to Jupiter
+/// `tisserand_jupiter` (with the inclination to Jupiter's orbital plane,
+/// [`tisserand_jupiter`]; NaN if unbound), the region by
+/// perihelion and semi-major axis `region` ([`orbital_region`]:
+/// `trans_neptunian`, `centaur`, `perihelion_inside_jupiter`, `unbound`), Levison's (1996)
+/// class `levison_class` ([`levison_class`]:
+/// `jupiter_family`, `encke_type`, `chiron_type`, `halley_type`, `long_period`,
+/// `unclassified`),
+/// and `in_encounter` (whether the particle, active, is being integrated through an
+/// encounter; `false` for every removed particle) and `encounters_begun` (its switches to
+/// the encounter mode so far, [`PopulationMember::encounters_begun`](crate::PopulationMember)).
 pub fn population_table(population: &Population) -> Result<RecordBatch, SymplecticError> {
     let members = population.members();
     let n = members.len();
     let mut cols: Vec<Vec<f64>> = (0..13).map(|_| Vec::with_capacity(n)).collect();
     let mut status = Vec::with_capacity(n);
-    let mut class = Vec::with_capacity(n);
+    let (mut region, mut levison) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    let jupiter_normal = jupiter_orbit_normal(population.ephemeris());
     for (i, m) in members.iter().enumerate() {
         let el = population.elements(i)?;
         let q = population.barycentric_position(i);
         let v = m.particle.velocity;
         let (label, removal_time) = status_label(&m.status, population.ephemeris().planets());
         status.push(label);
-        class.push(crate::classify(&el).label());
+        let i_jupiter = jupiter_normal.map_or(f64::NAN, |n| inclination_to_plane(&q, &v, &n));
+        let t_j = tisserand_jupiter(el.semi_major_axis, el.eccentricity, i_jupiter);
+        region.push(orbital_region(&el).label());
+        levison.push(levison_class(el.semi_major_axis, el.eccentricity, t_j).label());
         let row = [
             m.particle.time,
             removal_time,
@@ -794,7 +827,7 @@ pub fn population_table(population: &Population) -> Result<RecordBatch, Symplect
             v.x,
             v.y,
             v.z,
-            crate::tisserand_jupiter(&el),
+            t_j,
         ];
         for (c, x) in cols.iter_mut().zip(row) {
             c.push(x);
@@ -827,11 +860,21 @@ pub fn population_table(population: &Population) -> Result<RecordBatch, Symplect
         fields.push(Field::new(*name, DataType::Float64, false));
         arrays.push(Arc::new(Float64Array::from(c)));
     }
-    fields.push(Field::new("class", DataType::Utf8, false));
-    arrays.push(Arc::new(StringArray::from(class)));
+    fields.push(Field::new("region", DataType::Utf8, false));
+    arrays.push(Arc::new(StringArray::from(region)));
+    fields.push(Field::new("levison_class", DataType::Utf8, false));
+    arrays.push(Arc::new(StringArray::from(levison)));
     fields.push(Field::new("in_encounter", DataType::Boolean, false));
     arrays.push(Arc::new(BooleanArray::from_iter(
-        members.iter().map(|m| Some(m.encounter.is_some())),
+        // Active members only: a removed member is in no encounter (a checkpoint of an
+        // earlier version may still hold the encounter state it was removed in).
+        members
+            .iter()
+            .map(|m| Some(m.status == ParticleStatus::Active && m.encounter.is_some())),
+    )));
+    fields.push(Field::new("encounters_begun", DataType::UInt64, false));
+    arrays.push(Arc::new(UInt64Array::from_iter_values(
+        members.iter().map(|m| u64::from(m.encounters_begun)),
     )));
     RecordBatch::try_new(Arc::new(Schema::new(fields)), arrays).map_err(|e| {
         SymplecticError::Output {

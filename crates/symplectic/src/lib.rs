@@ -70,15 +70,19 @@
 //!   or where `B₀, B₁` no longer dominate (the paper's condition 35, read as a factor 2), a
 //!   particle is integrated by Bulirsch–Stoer together with the Sun and the planets, which
 //!   are advanced from the last grid state rather than interpolated, and handed back to the
-//!   map afterwards; ends by collision with a planet's radius
+//!   map outside 3.5 Hill radii (a hysteresis band: a comet skimming 3 Hill radii switches
+//!   once, not at every dip; [`PopulationMember::encounters_begun`] counts the switches);
+//!   ends by collision with a planet's radius
 //!   ([`ParticleStatus::Collision`]), and never for lost regularisation. Checked against
 //!   REBOUND's IAS15 on single encounters with Jupiter and Neptune down to 0.02 Hill radii
 //!   (within 5·10⁻¹² AU) and against a fine fixed-step RK4 (property test); as a population,
 //!   300 Centaurs over 1 Myr against REBOUND's MERCURIUS with the same initial conditions and
 //!   end rules (survival, lifetimes, fractions ejected, collided and reaching q < 2.5 AU;
 //!   the validation experiment `centaur-population`);
-//! - [`classes`]: the dynamical class (trans-Neptunian, Centaur, Jupiter-family) by
-//!   Tisserand parameter and perihelion after Levison (1996), in the population tables;
+//! - [`classes`]: Levison's (1996) comet classes by the Tisserand parameter with respect to
+//!   Jupiter (Jupiter-family, Encke-type, Chiron-type, Halley-type, long-period) and, apart,
+//!   the region of an orbit by perihelion and semi-major axis (trans-Neptunian, Centaur,
+//!   perihelion inside Jupiter's orbit), both in the population tables;
 //! - [`samples`]: seeded sample populations (SplitMix64) shared with the peer scripts;
 //! - with the feature `io`: `io` (the population TOML, the particle CSV with line/column
 //!   errors, Parquet tables readable by pandas and polars) and `study` (a whole study with
@@ -153,8 +157,8 @@
 //! ejection from energy and angular momentum: ≈ 40 flops, 1 square root): about 1000 flops
 //! and 30 square roots or divisions, all on data in L1. S6 has 3 drifts, 4 kicks and 3
 //! interpolations. Each particle is one [`PopulationMember`] of
-//! [`Population::bytes_per_particle`] bytes (192 on x86-64; 184 before the encounter state), stepped many times per window
-//! while it sits in L1, so memory traffic is 2 × 192 bytes per particle per window, not per
+//! [`Population::bytes_per_particle`] bytes (200 on x86-64; 192 before the count of encounters begun, 184 before the encounter state), stepped many times per window
+//! while it sits in L1, so memory traffic is 2 × 200 bytes per particle per window, not per
 //! step. The ephemeris window (360 bytes per planet step for five bodies, ≈ 2 ×
 //! [`DEFAULT_WINDOW_STEPS`] steps, ≈ 180 KB) is shared read-only by all threads and stays in
 //! L2; extending it costs one planet step per grid point, once for the whole population
@@ -182,9 +186,10 @@ pub mod solar_system;
 pub mod study;
 mod work;
 
-pub use classes::{classify, tisserand_jupiter, DynamicalClass};
+pub use classes::{levison_class, orbital_region, tisserand_jupiter, LevisonClass, OrbitalRegion};
 pub use encounter::{
-    integrate_through, Encounter, EncounterOutcome, Encounters, DEFAULT_ENCOUNTER_HILL_FACTOR,
+    integrate_through, Encounter, EncounterOutcome, Encounters,
+    DEFAULT_ENCOUNTER_HAND_BACK_HILL_FACTOR, DEFAULT_ENCOUNTER_HILL_FACTOR,
     DEFAULT_ENCOUNTER_TOLERANCE,
 };
 pub use ephemeris::{BodyStates, Ephemeris};

@@ -16,7 +16,9 @@ pub const FINAL_TABLE: &str = "final.parquet";
 pub const SNAPSHOT_DIR: &str = "snapshots";
 
 const STUDY_FORMAT: &str = "symplectic-population-study";
-const STUDY_VERSION: u32 = 1;
+/// 2: the population's encounter settings have a hand-back radius (a version 1 checkpoint
+/// goes on handed back at its switch radius, as it was integrated).
+const STUDY_VERSION: u32 = 2;
 
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -39,17 +41,25 @@ pub struct StudySummary {
     pub progress: PopulationProgress,
     /// Whether it resumed from a checkpoint.
     pub resumed: bool,
-    /// Snapshots written by this call.
+    /// Snapshots written by this call (a run resumed from a checkpoint older than the last
+    /// snapshot rewrites the snapshots after it, identical).
     pub snapshots_written: u64,
+    /// Checkpoints written by this call: at their cadence and at the end (and on Ctrl-C,
+    /// which ends the call with an error instead of a summary).
+    pub checkpoints_written: u64,
 }
 
 /// Runs the study of `spec_path` into `out_dir`: snapshot tables
 /// `snapshots/snapshot_NNNNNN.parquet` at every `span.snapshot_every_years` from the epoch
 /// (the first at the epoch), `final.parquet` at the end, and `checkpoint.json` at every
-/// snapshot and every `span.checkpoint_every_years`. If `out_dir` holds a checkpoint of the
-/// same specification, the study resumes from it; the files it writes are then identical to
-/// those of an uninterrupted run. A bad specification or particle file is refused before
-/// anything is written. `on_sync` sees the progress after every synchronisation window.
+/// `span.checkpoint_every_years` from the epoch (at every snapshot if it is not given), at
+/// the end, and when stopped by Ctrl-C. If `out_dir` holds a checkpoint of the same
+/// specification, the study resumes from it; the files it writes are then identical to
+/// those of an uninterrupted run: a checkpoint older than the last snapshot (a run killed
+/// between checkpoints) holds the index of the first snapshot after it, and the snapshots
+/// from there on are written again, identical (the population is a deterministic function
+/// of its checkpoint). A bad specification or particle file is refused before anything is
+/// written. `on_sync` sees the progress after every synchronisation window.
 pub fn run_study(
     spec_path: &Path,
     out_dir: &Path,
@@ -59,15 +69,19 @@ pub fn run_study(
     let spec = PopulationSpec::parse(&spec_text, spec_path)?;
     let checkpoint_path = out_dir.join(CHECKPOINT_FILE);
     let (mut state, resumed) = if checkpoint_path.exists() {
-        let c: StudyCheckpoint = crate::load_checkpoint(&checkpoint_path)?;
-        if c.format != STUDY_FORMAT || c.version != STUDY_VERSION {
+        let mut c: StudyCheckpoint = crate::load_checkpoint(&checkpoint_path)?;
+        if c.format != STUDY_FORMAT || !(1..=STUDY_VERSION).contains(&c.version) {
             return Err(SymplecticError::Checkpoint {
                 path: checkpoint_path.display().to_string(),
                 reason: format!(
-                    "format {:?} version {}, expected {STUDY_FORMAT:?} version {STUDY_VERSION}",
+                    "format {:?} version {}, expected {STUDY_FORMAT:?} version 1 to {STUDY_VERSION}",
                     c.format, c.version
                 ),
             });
+        }
+        if c.version == 1 {
+            c.population.keep_version_1_hand_back();
+            c.version = STUDY_VERSION;
         }
         if c.spec != spec_text {
             return Err(SymplecticError::Checkpoint {
@@ -99,13 +113,11 @@ pub fn run_study(
     let epoch = spec.particles.epoch_days;
     let end = epoch + spec.span.years * DAYS_PER_YEAR;
     let snap_every = spec.span.snapshot_every_years * DAYS_PER_YEAR;
-    let ck_every = spec
-        .span
-        .checkpoint_every_years
-        .map_or(f64::INFINITY, |y| y * DAYS_PER_YEAR);
+    // Without a cadence of their own, checkpoints go with the snapshots.
+    let ck_every = spec.span.checkpoint_every_years.map(|y| y * DAYS_PER_YEAR);
     let snap_time = |k: u64| (epoch + k as f64 * snap_every).min(end);
-    let ck_time = |k: u64| epoch + k as f64 * ck_every;
-    let mut written = 0;
+    let ck_time = |k: u64| ck_every.map_or(f64::INFINITY, |every| epoch + k as f64 * every);
+    let (mut written, mut checkpoints) = (0, 0);
     loop {
         let next_snap = snap_time(state.next_snapshot);
         let next_ck = ck_time(state.next_checkpoint);
@@ -123,16 +135,23 @@ pub fn run_study(
             }
             return Err(e);
         }
-        if t == next_snap {
+        let snapshot_due = t == next_snap;
+        if snapshot_due {
             let path = snapshot_path(&snap_dir, state.next_snapshot);
             write_parquet(&path, &population_table(&state.population)?)?;
             written += 1;
             state.next_snapshot += 1;
         }
-        if t == next_ck {
+        let checkpoint_due = t == next_ck;
+        if checkpoint_due {
             state.next_checkpoint += 1;
         }
-        crate::save_checkpoint(&checkpoint_path, &state)?;
+        // At its own cadence (with the snapshots if it has none) and at the end: a rerun
+        // over a finished directory then resumes at the end.
+        if checkpoint_due || (ck_every.is_none() && snapshot_due) || t >= end {
+            crate::save_checkpoint(&checkpoint_path, &state)?;
+            checkpoints += 1;
+        }
     }
     state.population.advance_to(end, &mut on_sync)?;
     let final_path = out_dir.join(FINAL_TABLE);
@@ -141,6 +160,7 @@ pub fn run_study(
         progress: state.population.progress(),
         resumed,
         snapshots_written: written,
+        checkpoints_written: checkpoints,
     })
 }
 

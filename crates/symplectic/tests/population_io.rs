@@ -197,14 +197,75 @@ fn a_resumed_study_writes_identical_files() {
             })
         }));
         assert!(interrupted.is_err(), "k = {k}: not interrupted");
+        // Resumed if killed after the first checkpoint (20 years), started afresh before.
+        let checkpointed = out2.join("checkpoint.json").exists();
         let resumed = run_study(&spec2, &out2, |_| {}).unwrap();
-        assert_eq!(resumed.resumed, out2.join("checkpoint.json").exists());
+        assert_eq!(resumed.resumed, checkpointed, "k = {k}");
         assert_eq!(files(&out2), straight, "k = {k}: resumed files differ");
     }
     // Rerun over a finished directory: resumes, rewrites the same files.
     let again = run_study(&spec, &out, |_| {}).unwrap();
     assert!(again.resumed);
     assert_eq!(files(&out), straight);
+}
+
+/// Checkpoints at their own cadence, not at every snapshot: snapshots every 10 years and
+/// checkpoints every 30 over 120 years write 13 snapshots and 4 checkpoints (30, 60, 90 and
+/// 120 years, the last also the end). A run killed at 45 years (after the snapshot at 40,
+/// before the checkpoint at 60) left the checkpoint of 30 years, older than the last
+/// snapshot; resumed from it, it rewrites the snapshots from 40 years on and ends with the
+/// files of the uninterrupted run, byte for byte.
+#[test]
+fn checkpoints_follow_their_own_cadence_and_resume_across_snapshots() {
+    let spec = with(
+        SPEC,
+        "snapshot_every_years = 50.0",
+        "snapshot_every_years = 10.0",
+    );
+    let spec = with(
+        &spec,
+        "checkpoint_every_years = 20.0",
+        "checkpoint_every_years = 30.0",
+    );
+    let (spec_path, out) = study("cadence", &spec, GOOD_ROWS);
+    let straight = run_study(&spec_path, &out, |_| {}).unwrap();
+    assert_eq!(
+        (straight.snapshots_written, straight.checkpoints_written),
+        (13, 4)
+    );
+    let straight_files = files(&out);
+
+    let (spec2, out2) = study("cadence-killed", &spec, GOOD_ROWS);
+    let killed_at = 45.0 * 365.25;
+    // A panic in the callback stands for kill -9: the files are those written so far.
+    let killed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        run_study(&spec2, &out2, |p| {
+            assert!(p.time < killed_at, "killed");
+        })
+    }));
+    assert!(killed.is_err(), "not killed");
+    // The checkpoint on disk is the one of 30 years: not rewritten at the snapshots of 40
+    // years (written, below) or at any snapshot before.
+    let checkpoint: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out2.join("checkpoint.json")).unwrap()).unwrap();
+    assert_eq!(checkpoint["population"]["time"], 30.0 * 365.25);
+    assert_eq!(
+        checkpoint["next_snapshot"], 4,
+        "snapshots 0–30 years before it"
+    );
+    assert_eq!(checkpoint["next_checkpoint"], 2);
+    assert!(
+        out2.join("snapshots/snapshot_000004.parquet").exists(),
+        "40 years"
+    );
+    let resumed = run_study(&spec2, &out2, |_| {}).unwrap();
+    assert!(resumed.resumed);
+    // Snapshots 40–120 years (9) again; checkpoints at 60, 90 and 120 years.
+    assert_eq!(
+        (resumed.snapshots_written, resumed.checkpoints_written),
+        (9, 3)
+    );
+    assert_eq!(files(&out2), straight_files, "resumed files differ");
 }
 
 /// Rows given directly build the same population as the particle file they came from, and
@@ -240,7 +301,8 @@ fn rows_given_directly_build_the_files_population() {
 }
 
 /// A study with an `[encounters]` table builds a population integrated through encounters,
-/// and its table carries the classes, the Tisserand parameter and the encounter flag; an
+/// and its table carries the region, Levison's class, the Tisserand parameter, the encounter
+/// flag and the count of encounters begun; an
 /// `[encounters]` table together with the Hill-sphere removal rule is refused by name.
 #[test]
 fn a_study_with_encounters_integrates_through_them() {
@@ -260,17 +322,38 @@ fn a_study_with_encounters_integrates_through_them() {
     pop.advance_to(5.0 * 365.25, |_| {}).unwrap();
     let table = population_table(&pop).unwrap();
     let schema = table.schema();
-    for column in ["tisserand_jupiter", "class", "in_encounter"] {
+    for column in [
+        "tisserand_jupiter",
+        "region",
+        "levison_class",
+        "in_encounter",
+        "encounters_begun",
+    ] {
         assert!(schema.field_with_name(column).is_ok(), "{column}");
     }
-    let classes = table
-        .column_by_name("class")
+    let labels = |column: &str| {
+        table
+            .column_by_name(column)
+            .unwrap()
+            .as_any()
+            .downcast_ref::<arrow_array::StringArray>()
+            .unwrap()
+            .clone()
+    };
+    // a = 14 AU, q = 11.6 AU: between the giants. T_J = 5.203/14 + 2 cos 2.2° √((14/5.203)
+    // (1 − 0.17²)) = 3.60 from the initial elements (five years on, within a few 0.01: the
+    // comet meets no planet closer than Saturn's Hill sphere): T_J > 3 and a > a_J,
+    // Chiron-type.
+    assert_eq!(labels("region").value(0), "centaur");
+    assert_eq!(labels("levison_class").value(0), "chiron_type");
+    let t_j = table
+        .column_by_name("tisserand_jupiter")
         .unwrap()
         .as_any()
-        .downcast_ref::<arrow_array::StringArray>()
-        .unwrap();
-    // a = 14 AU, q = 11.6 AU: a Centaur.
-    assert_eq!(classes.value(0), "centaur");
+        .downcast_ref::<arrow_array::Float64Array>()
+        .unwrap()
+        .value(0);
+    assert!((t_j - 3.60).abs() < 0.1, "T_J = {t_j}");
     let both = spec_text.replace("[removal]\n", "[removal]\nhill_factor = 1.0\n");
     let (bad, _) = study("encounters-bad", &both, rows);
     let err = PopulationSpec::from_file(&bad)
@@ -326,8 +409,27 @@ fn specification_limits_name_the_key_and_the_bound() {
         ),
         GOOD_ROWS,
     );
+    // The requested count, ⌈120/10⁻⁶⌉ + 1 = 120000001 (120/1e-6 rounds to 1.2·10⁸ exactly
+    // in IEEE double, as Python's float division gives), and the cap.
     assert!(
-        e.contains("`span.snapshot_every_years`") && e.contains("MAX_SNAPSHOTS"),
+        e.contains("`span.snapshot_every_years`")
+            && e.contains(" 120000001 snapshot files")
+            && e.contains("the cap of 10000 per study (MAX_SNAPSHOTS)"),
+        "{e}"
+    );
+    // Just over the cap: 120 years every 0.012 is ⌈10000⌉ + 1 = 10001 files (120/0.012
+    // rounds to 10000 exactly in IEEE double, as Python's float division gives).
+    let e = bad_study(
+        "snapshot_cap",
+        &with(
+            SPEC,
+            "snapshot_every_years = 50.0",
+            "snapshot_every_years = 0.012",
+        ),
+        GOOD_ROWS,
+    );
+    assert!(
+        e.contains(" 10001 snapshot files") && e.contains("cap of 10000"),
         "{e}"
     );
     let e = bad_study(

@@ -39,11 +39,28 @@
 //! lanes.
 //!
 //! **Hand-back.** After a step of the encounter integrator, the particle returns to the map
-//! when it is outside `hill_factor` Hill radii of every planet, `F₁ ≥ ¾ (B₀ + B₁/r)` with
-//! the planets from the ephemeris (a margin above the switch's ½, so that the particle does
-//! not go back and forth), and at least one map step's time (`h/F₁` at the switch) has passed
-//! since the switch. It keeps its step `h` in the new variable `s`; `p₄ = −H` is set anew with
-//! the ephemeris' planets.
+//! when it is outside [`Encounters::hand_back_hill_factor`] Hill radii of every planet (3.5
+//! by default, beyond the switch's 3), `F₁ ≥ ¾ (B₀ + B₁/r)` with the planets from the
+//! ephemeris (a margin above the switch's ½), and at least one map step's time (`h/F₁` at
+//! the switch) has passed since the switch. It keeps its step `h` in the new variable `s`;
+//! `p₄ = −H` is set anew with the ephemeris' planets.
+//!
+//! *Hysteresis.* Both margins keep a particle from going back and forth across one
+//! boundary. A sharp switch in and out at the same radius does: a comet skimming 3 R_H
+//! switches at every dip below it. MERCURY and MERCURIUS have no such boundary: their
+//! changeover function `K(r)` (Chambers 1999, eq. 10: `10y³ − 15y⁴ + 6y⁵` with
+//! `y = (r − 0.1 r_crit)/(0.9 r_crit)`) hands the planet's force over gradually across most of
+//! `r_crit`. Here the switch stays sharp (below) and the hand-back radius is larger instead:
+//! 3.5 R_H, a band of 1/6 of the switch radius. That covers what the distance of a slow
+//! encounter does by itself over an orbit: a comet on Jupiter's orbit a fixed time behind
+//! it is at a distance `∝ 1 + e_J cos ν` (`ν` Jupiter's true anomaly), while
+//! `R_H ∝ |Q_J| ∝ 1/(1 + e_J cos ν)`, so its distance in Hill radii goes as
+//! `(1 + e_J cos ν)²`, ±10 % for Jupiter's `e_J = 0.048`: trailing Jupiter at 3 R_H, it dips
+//! below and rises above 3 R_H once per Jupiter orbit. Jupiter's pull against the Sun's
+//! tidal acceleration `3Ω²r` is `(R_H/r)³`: 3.7 % at 3 R_H, 2.3 % at 3.5 R_H, so the map is
+//! handed no particle it would not have kept. `hand_back_hill_factor = hill_factor` gives
+//! the switch without hysteresis. [`PopulationMember::encounters_begun`](crate::PopulationMember)
+//! counts the switches of each particle.
 //!
 //! **Ends** during an encounter (checked after each step of the encounter integrator): a
 //! collision (closer to a planet's centre than its radius,
@@ -73,6 +90,12 @@ use bulirsch_stoer::{BulirschStoer, Scratch};
 /// Default switch distance, in Hill radii (MERCURY's and MERCURIUS' default).
 pub const DEFAULT_ENCOUNTER_HILL_FACTOR: f64 = 3.0;
 
+/// Default hand-back distance, in Hill radii: beyond the switch's
+/// [`DEFAULT_ENCOUNTER_HILL_FACTOR`] by the ±10 % that Jupiter's eccentricity makes of a
+/// slow encounter's distance in Hill radii over an orbit (module [`encounter`](self),
+/// *Hysteresis*).
+pub const DEFAULT_ENCOUNTER_HAND_BACK_HILL_FACTOR: f64 = 3.5;
+
 /// Default relative tolerance per step of the encounter integrator.
 pub const DEFAULT_ENCOUNTER_TOLERANCE: f64 = 1e-12;
 
@@ -84,6 +107,11 @@ pub struct Encounters {
     /// Switch distance in Hill radii ([`DEFAULT_ENCOUNTER_HILL_FACTOR`]).
     #[serde(default = "default_hill_factor")]
     pub hill_factor: f64,
+    /// Hand-back distance in Hill radii, at least `hill_factor`
+    /// ([`DEFAULT_ENCOUNTER_HAND_BACK_HILL_FACTOR`]): a particle in the encounter mode
+    /// returns to the map only outside it (`hill_factor`: no hysteresis).
+    #[serde(default = "default_hand_back_hill_factor")]
+    pub hand_back_hill_factor: f64,
     /// Relative tolerance per step of the Bulirsch–Stoer integrator
     /// ([`DEFAULT_ENCOUNTER_TOLERANCE`]).
     #[serde(default = "default_tolerance")]
@@ -94,6 +122,10 @@ fn default_hill_factor() -> f64 {
     DEFAULT_ENCOUNTER_HILL_FACTOR
 }
 
+fn default_hand_back_hill_factor() -> f64 {
+    DEFAULT_ENCOUNTER_HAND_BACK_HILL_FACTOR
+}
+
 fn default_tolerance() -> f64 {
     DEFAULT_ENCOUNTER_TOLERANCE
 }
@@ -102,6 +134,7 @@ impl Default for Encounters {
     fn default() -> Self {
         Self {
             hill_factor: DEFAULT_ENCOUNTER_HILL_FACTOR,
+            hand_back_hill_factor: DEFAULT_ENCOUNTER_HAND_BACK_HILL_FACTOR,
             tolerance: DEFAULT_ENCOUNTER_TOLERANCE,
         }
     }
@@ -114,6 +147,23 @@ impl Encounters {
                 name: "encounters.hill_factor",
                 value: self.hill_factor,
                 reason: "must be finite and > 0",
+            });
+        }
+        let hand_back = self.hand_back_hill_factor;
+        if !(hand_back.is_finite() && hand_back > 0.0) {
+            return Err(SymplecticError::InvalidParameter {
+                name: "encounters.hand_back_hill_factor",
+                value: hand_back,
+                reason: "must be finite and > 0",
+            });
+        }
+        if hand_back < self.hill_factor {
+            return Err(SymplecticError::InvalidParameter {
+                name: "encounters.hand_back_hill_factor",
+                value: hand_back,
+                reason: "must be >= encounters.hill_factor, the switch-in distance (the default \
+                         hand-back is 3.5 Hill radii: with hill_factor above it, give \
+                         hand_back_hill_factor too)",
             });
         }
         if !(self.tolerance.is_finite() && self.tolerance > 1e-15 && self.tolerance < 1e-3) {

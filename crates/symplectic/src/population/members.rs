@@ -67,9 +67,17 @@ pub struct PopulationMember {
     pub sun_position: Vec3,
     /// The encounter mode's state while the particle is in it
     /// ([`Encounters`](crate::Encounters)); `particle`
-    /// then holds its position, velocity and time, not `p₄`.
+    /// then holds its position, velocity and time, not `p₄`. `None` once the particle is
+    /// removed, in the encounter mode or not.
     #[serde(default)]
     pub encounter: Option<Box<Encounter>>,
+    /// Switches to the encounter mode so far (encounters begun): one per encounter with
+    /// the hand-back radius beyond the switch's
+    /// ([`Encounters::hand_back_hill_factor`](crate::Encounters::hand_back_hill_factor)),
+    /// more for a particle that goes back and forth. Counted from 0 in a population saved
+    /// before the counter existed.
+    #[serde(default)]
+    pub encounters_begun: u32,
 }
 
 /// Where a [`Population`](crate::Population) stands after a synchronisation.
@@ -83,4 +91,7 @@ pub struct PopulationProgress {
     pub active: usize,
     /// Particles removed.
     pub removed: usize,
+    /// Switches to the encounter mode so far, all particles
+    /// ([`PopulationMember::encounters_begun`]).
+    pub encounters_begun: u64,
 }

@@ -77,7 +77,7 @@ pub const DEFAULT_WINDOW_STEPS: u32 = 256;
 /// counted with callgrind, 10² comets, 2026-11-25): at about 0.175 µs (≈ 610 cycles) per
 /// step the processor retired nearly four instructions per cycle, so one particle at a time
 /// is bound by the number of instructions, not by the latency of its chains (stepping whole
-/// particles in turn, round-robin, gained nothing). A particle's 192 bytes stay in registers
+/// particles in turn, round-robin, gained nothing). A particle's 200 bytes stay in registers
 /// and L1 through the window; the step is not bandwidth-bound.
 ///
 /// **Lanes.** In the barycentric variant (either scheme) a window therefore steps its
@@ -233,6 +233,7 @@ impl Population {
                     status: ParticleStatus::Active,
                     sun_position: bodies.positions[0],
                     encounter: None,
+                    encounters_begun: 0,
                 })
             })
             .collect::<Result<Vec<_>, SymplecticError>>()?;
@@ -350,17 +351,23 @@ impl Population {
 
     /// Where the population stands.
     pub fn progress(&self) -> PopulationProgress {
-        let active = self
+        let (active, encounters_begun) = self
             .members
             .par_iter()
             .with_min_len(4096)
-            .filter(|m| m.status == ParticleStatus::Active)
-            .count();
+            .map(|m| {
+                (
+                    usize::from(m.status == ParticleStatus::Active),
+                    u64::from(m.encounters_begun),
+                )
+            })
+            .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
         PopulationProgress {
             time: self.time,
             particle_steps: self.particle_steps,
             active,
             removed: self.members.len() - active,
+            encounters_begun,
         }
     }
 
@@ -587,24 +594,41 @@ impl Population {
     }
 
     /// Reads a population written by [`Population::save`]; refuses a foreign, truncated or
-    /// other-version file by name. A resumed population continues bit for bit.
+    /// other-version file by name. A resumed population continues bit for bit. A version 1
+    /// file (before the hand-back radius) goes on as it was integrated: its encounter
+    /// settings, which have no [`Encounters::hand_back_hill_factor`], hand back at
+    /// `hill_factor`.
     pub fn load(path: &Path) -> Result<Self, SymplecticError> {
         let e: Envelope = crate::load_checkpoint(path)?;
-        if e.format != POPULATION_FORMAT || e.version != POPULATION_VERSION {
+        if e.format != POPULATION_FORMAT || !(1..=POPULATION_VERSION).contains(&e.version) {
             return Err(SymplecticError::Checkpoint {
                 path: path.display().to_string(),
                 reason: format!(
-                    "format {:?} version {}, expected {POPULATION_FORMAT:?} version {POPULATION_VERSION}",
+                    "format {:?} version {}, expected {POPULATION_FORMAT:?} version 1 to {POPULATION_VERSION}",
                     e.format, e.version
                 ),
             });
         }
-        Ok(e.population)
+        let mut population = e.population;
+        if e.version == 1 {
+            population.keep_version_1_hand_back();
+        }
+        Ok(population)
+    }
+
+    /// A population of a version 1 checkpoint, whose encounter settings had no hand-back
+    /// radius (read as the default, 3.5 Hill radii): handed back at its switch radius, as
+    /// it was integrated up to the checkpoint, so that it goes on the same way.
+    pub(crate) fn keep_version_1_hand_back(&mut self) {
+        if let Some(e) = &mut self.encounters {
+            e.hand_back_hill_factor = e.hill_factor;
+        }
     }
 }
 
 const POPULATION_FORMAT: &str = "symplectic-population";
-const POPULATION_VERSION: u32 = 1;
+/// 2: [`Encounters::hand_back_hill_factor`] and [`PopulationMember::encounters_begun`].
+const POPULATION_VERSION: u32 = 2;
 
 /// [`Envelope`] as written, borrowing the population (no copy of it).
 #[derive(Serialize)]

@@ -669,7 +669,10 @@ impl WindowContext<'_> {
         };
         w.bodies_time = f64::NAN;
         match Encounter::begin(p, &self.grid, settings, map_dt, &mut w.encounter) {
-            Ok(e) => m.encounter = Some(Box::new(e)),
+            Ok(e) => {
+                m.encounter = Some(Box::new(e));
+                m.encounters_begun = m.encounters_begun.saturating_add(1);
+            }
             Err(e) => {
                 m.status = ParticleStatus::IntegrationFailed {
                     time: p.time,
@@ -696,7 +699,7 @@ impl WindowContext<'_> {
             };
             if e.steps > 0 && e.time >= e.earliest_hand_back {
                 let g = e.geometry(&self.hill_coefficients, &self.radii);
-                if g.nearest_ratio >= settings.hill_factor {
+                if g.nearest_ratio >= settings.hand_back_hill_factor {
                     match self.grid.interpolate(e.time, &mut w.bodies, false) {
                         Err(SymplecticError::BeyondEphemeris { time, .. }) => return (steps, time),
                         Err(err) => {
@@ -746,6 +749,11 @@ impl WindowContext<'_> {
                     m.status = status;
                 }
             }
+        }
+        // A member removed in the encounter mode (collision, perihelion, ejection, a failed
+        // step) is no longer in it: its state at removal is in `particle`.
+        if m.status != ParticleStatus::Active {
+            m.encounter = None;
         }
         (steps, f64::NEG_INFINITY)
     }

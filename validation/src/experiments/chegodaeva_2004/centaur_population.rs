@@ -4,8 +4,9 @@
 //!
 //! The population study `populations/centaurs.toml` (300 comets, barycentric `a` 5.5–30 AU,
 //! `e` 0–0.2, `i` 0–10°, random angles; S2 barycentric map with `B₁ = 4·10⁻⁶`, planets S6 at
-//! 730.5 d; encounters inside 3 Hill radii by Bulirsch–Stoer at 10⁻¹²) run through
-//! [`symplectic::io::PopulationSpec`] for 200 kyr (quick) or 1 Myr (`--full`). A comet ends at a
+//! 730.5 d; encounters inside 3 Hill radii by Bulirsch–Stoer at 10⁻¹², handed back to the map
+//! beyond 3.5) run through [`symplectic::io::PopulationSpec`] for 200 kyr (quick) or 1 Myr
+//! (`--full`). A comet ends at a
 //! collision with a planet (its equatorial radius), when its barycentric perihelion falls
 //! below 2.5 AU, or when it is unbound beyond 100 AU.
 //!
@@ -50,23 +51,26 @@ type Ends = Vec<(String, f64)>;
 /// A named end rule: which labels it counts.
 type Rule = (&'static str, fn(&str) -> bool);
 
-fn run_ours(ctx: &Context, span_years: f64) -> Result<Ends> {
+/// Our ends, and the switches to the encounter integrator of all comets
+/// (`PopulationProgress::encounters_begun`).
+fn run_ours(ctx: &Context, span_years: f64) -> Result<(Ends, u64)> {
     let path = workspace_root().join("populations/centaurs.toml");
     let spec = PopulationSpec::from_file(&path)?;
     let mut population = spec.population(&path)?;
     ctx.progress.set_length(span_years as u64);
-    population.advance_to(span_years * DAYS_PER_YEAR, |p| {
+    let progress = population.advance_to(span_years * DAYS_PER_YEAR, |p| {
         ctx.progress.set_position((p.time / DAYS_PER_YEAR) as u64)
     })?;
     let planets = population.ephemeris().planets().clone();
-    Ok(population
+    let ends = population
         .members()
         .iter()
         .map(|m| {
             let (label, t) = status_label(&m.status, &planets);
             censor(label, t / DAYS_PER_YEAR, span_years)
         })
-        .collect())
+        .collect();
+    Ok((ends, progress.encounters_begun))
 }
 
 /// An end after `span` years counts as active (both codes are compared over the same span).
@@ -194,7 +198,7 @@ impl Experiment for CentaurPopulation {
 
     fn run(&self, ctx: &mut Context) -> Result<Outcome> {
         let span = ctx.mode.pick(200_000.0, 1_000_000.0);
-        let ours = run_ours(ctx, span)?;
+        let (ours, encounters_begun) = run_ours(ctx, span)?;
         let reference = reference(ctx, span)?;
         if ours.len() != reference.len() {
             bail!(
@@ -302,6 +306,10 @@ impl Experiment for CentaurPopulation {
             );
         }
         out.metric("comets", ours.len() as f64);
+        out.metric(
+            "ours: switches to the encounter integrator (all comets)",
+            encounters_begun as f64,
+        );
         out.metric("span (years)", span);
         write_csv_rows(
             &ctx.path("ours_ends.csv"),
