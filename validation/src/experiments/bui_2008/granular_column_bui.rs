@@ -305,10 +305,10 @@ impl Experiment for GranularColumnBui {
                 .map(|(a, b)| (b.x - a.x).hypot(b.y - a.y) > SLIP_THRESHOLD_SPACINGS * s)
                 .collect();
             let (_, beta_moved) = failure_line(&initial, &moved_early, column, s);
-            out.metric(&format!("moved_zone_{:.0}ms_deg", 1e3 * t), beta_moved);
+            out.metric(format!("moved_zone_{:.0}ms_deg", 1e3 * t), beta_moved);
             let failed: Vec<bool> = strain.iter().map(|&e| e > SLIP_PLASTIC_STRAIN).collect();
             let (rows, beta) = failure_line(&initial, &failed, column, s);
-            out.metric(&format!("slip_surface_{:.0}ms_deg", 1e3 * t), beta);
+            out.metric(format!("slip_surface_{:.0}ms_deg", 1e3 * t), beta);
             if t == SLIP_CHECK_S {
                 slip = Some((rows, beta));
             }
