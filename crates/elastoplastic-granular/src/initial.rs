@@ -17,7 +17,7 @@
 //! least `K` whose state `(−K, −1, −K) σ_v` is inside the cone (cohesion ignored: it only
 //! widens the cone), `K_a = (1 − √3 α_φ)/(1 + 2√3 α_φ)` from `√J2 = (1 − K)|σ_v|/√3`,
 //! `I1 = (1 + 2K) σ_v`: `K0 = max(1 − sin φ, K_a)`, on the cone in that case
-//! ([`tests`]). A friction angle of zero (a granular liquid) gives `K0 = 1`: the hydrostatic
+//! (the unit test `the_geostatic_start_is_admissible`). A friction angle of zero (a granular liquid) gives `K0 = 1`: the hydrostatic
 //! stress.
 
 use std::collections::HashMap;
