@@ -99,7 +99,10 @@ pub fn geostatic<R: Real>(
 /// coefficient where that is larger (module docs).
 pub fn geostatic_k0<R: Real>(params: &ElastoplasticParams<R>) -> R {
     let jaky = jaky_k0(params.friction_angle_deg);
-    let a = 3f64.sqrt() * params.cone_match.alpha_phi(params.friction_angle_deg.as_f64());
+    let a = 3f64.sqrt()
+        * params
+            .cone_match
+            .alpha_phi(params.friction_angle_deg.as_f64());
     let active = R::of_f64((1.0 - a) / (1.0 + 2.0 * a));
     if active > jaky {
         active
@@ -142,7 +145,10 @@ mod tests {
                 p.cone_match = cone;
                 let k0 = geostatic_k0(&p);
                 assert!(k0 >= (1.0 - s) / (1.0 + s) && k0 <= (1.0 + s) / (1.0 - s));
-                assert!(f(k0, phi, cone) <= 1e-12, "phi = {phi}, {cone:?}: K0 = {k0}");
+                assert!(
+                    f(k0, phi, cone) <= 1e-12,
+                    "phi = {phi}, {cone:?}: K0 = {k0}"
+                );
                 if phi <= 35.0 || cone == ConeMatch::SimpleShear {
                     assert_eq!(k0, jaky_k0(phi), "phi = {phi}, {cone:?}");
                     assert!(f(k0, phi, cone) < 0.0, "phi = {phi}, {cone:?}");

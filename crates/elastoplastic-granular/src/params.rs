@@ -300,7 +300,11 @@ impl<R: Real> ElastoplasticParams<R> {
         }
         let (_, dt) = self.explicit_steps();
         let k = (self.density_reinit_interval_s / dt).as_f64().round();
-        Some(if k >= 1.0 && k < usize::MAX as f64 { k as usize } else { 1 })
+        Some(if k >= 1.0 && k < usize::MAX as f64 {
+            k as usize
+        } else {
+            1
+        })
     }
 
     /// Checks every field; the error ([`SolverError::InvalidParameter`]) names the first

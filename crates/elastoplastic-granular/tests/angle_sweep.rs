@@ -43,7 +43,11 @@ fn collapse(theta_deg: f64, reinit_s: f64) -> Result<ParticleSet<f64>, String> {
     let x = cubic_lattice(&block, S, 10_000).unwrap();
     let mut state = ParticleSet::from_positions(x, p.common.particle_mass(), p.common.rest_density);
     let mut solver = Elastoplastic::new(p, Vec::new()).map_err(|e| e.to_string())?;
-    let rows = Aabb::new(Vec3::new(0.0, -3.0 * S, 0.0), Vec3::new(PERIOD_M, 0.0, slab)).unwrap();
+    let rows = Aabb::new(
+        Vec3::new(0.0, -3.0 * S, 0.0),
+        Vec3::new(PERIOD_M, 0.0, slab),
+    )
+    .unwrap();
     let floor = boundary_block(&rows, S, Vec3::y(), WallModel::NoSlip, 10_000).unwrap();
     solver
         .scheme_mut()
@@ -82,14 +86,24 @@ fn a_collapse_survives_every_friction_angle() {
                 x.iter().all(|c| c.is_finite()) && x.y > 0.0,
                 "theta = {theta}°: grain {i} at {x:?}"
             );
-            assert!(*rho >= 0.9 * 2040.0, "theta = {theta}°: grain {i} at {rho} kg/m³");
+            assert!(
+                *rho >= 0.9 * 2040.0,
+                "theta = {theta}°: grain {i} at {rho} kg/m³"
+            );
         }
         heights.push((theta, centre_height_m(&state)));
     }
     eprintln!("centres of mass (deg, m): {heights:?}");
-    assert!(heights[0].1 < 0.25 * HEIGHT_M, "theta = 0: {:?}", heights[0]);
+    assert!(
+        heights[0].1 < 0.25 * HEIGHT_M,
+        "theta = 0: {:?}",
+        heights[0]
+    );
     for (a, b) in heights[4..].iter().zip(&heights[6..]) {
-        assert!(b.1 > a.1 + 0.25 * S, "{b:?} not above {a:?} by a quarter spacing");
+        assert!(
+            b.1 > a.1 + 0.25 * S,
+            "{b:?} not above {a:?} by a quarter spacing"
+        );
     }
 }
 
@@ -100,7 +114,11 @@ fn without_reinitialisation_the_density_falls() {
     match collapse(0.0, 0.0) {
         Err(e) => eprintln!("continuity alone: {e}"),
         Ok(state) => {
-            let lowest = state.densities.iter().copied().fold(f64::INFINITY, f64::min);
+            let lowest = state
+                .densities
+                .iter()
+                .copied()
+                .fold(f64::INFINITY, f64::min);
             eprintln!("continuity alone: lowest density {lowest} kg/m³");
             assert!(lowest < 0.95 * 2040.0, "lowest density {lowest} kg/m³");
         }

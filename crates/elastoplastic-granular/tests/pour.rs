@@ -74,7 +74,10 @@ fn seeded_pours_are_an_ensemble() {
     let pour = solver.params().pour.unwrap();
     for k in 0..12 {
         let [dx, dz] = pour.layer_shift(k, S);
-        assert!(dx.abs() <= 0.5 * S && dz.abs() <= 0.5 * S, "layer {k}: {dx}, {dz}");
+        assert!(
+            dx.abs() <= 0.5 * S && dz.abs() <= 0.5 * S,
+            "layer {k}: {dx}, {dz}"
+        );
     }
     let distinct: std::collections::BTreeSet<u64> = (0..12)
         .map(|k| pour.layer_shift(k, S)[0].to_bits())

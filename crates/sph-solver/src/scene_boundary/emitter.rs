@@ -78,10 +78,7 @@ impl PourEmitter {
                 .collect(),
             poured: 0,
             pour: Pour {
-                region: sph_core::Aabb {
-                    min: lo,
-                    max: hi,
-                },
+                region: sph_core::Aabb { min: lo, max: hi },
                 volume_m3: p.volume_m3.as_f64(),
                 rate_m3_s: p.rate_m3_s.as_f64(),
                 seed: p.seed,
