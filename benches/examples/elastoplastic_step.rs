@@ -148,7 +148,7 @@ fn run<R: Real>(frames: usize) {
     let w_pps = w_pp / FRAME_S;
     let g_pps = g_pp * g.steps_per_frame / FRAME_S;
     println!(
-        "per particle and simulated second: water {:.3} ms, granular {:.3} ms: granular / water {:.2} (issue's target: at most 3)",
+        "per particle and simulated second: water {:.3} ms, granular {:.3} ms: granular / water {:.2} (target: at most 3)",
         1e-3 * w_pps,
         1e-3 * g_pps,
         g_pps / w_pps

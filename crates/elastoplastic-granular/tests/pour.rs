@@ -15,6 +15,19 @@ const S: f64 = 0.02;
 /// A small poured heap: period 0.4 m, a funnel two spacings wide, `layers` layers of six
 /// grains at 30 layers a second, frames of 16 ms.
 fn small_pour(layers: f64, funnel_top_m: f64) -> (Elastoplastic<f64>, ParticleSet<f64>) {
+    poured(layers, funnel_top_m, None)
+}
+
+/// [`small_pour`] with its funnel's top 1 m up and the pour's seed.
+fn seeded_pour(layers: f64, seed: Option<u64>) -> (Elastoplastic<f64>, ParticleSet<f64>) {
+    poured(layers, 1.0, seed)
+}
+
+fn poured(
+    layers: f64,
+    funnel_top_m: f64,
+    seed: Option<u64>,
+) -> (Elastoplastic<f64>, ParticleSet<f64>) {
     let mut params = ElastoplasticParams::<f64>::for_spacing(S, 30.0);
     params.youngs_modulus = 5.84e5;
     params.common.dt = 0.016;
@@ -25,25 +38,6 @@ fn small_pour(layers: f64, funnel_top_m: f64) -> (Elastoplastic<f64>, ParticleSe
         slab_depth_m: slab,
         funnel_width_m: 2.0 * S,
         funnel_top_m,
-        volume_m3: layers * layer_m3,
-        rate_m3_s: 30.0 * layer_m3,
-        seed: None,
-    };
-    poured_heap(params, setup).unwrap()
-}
-
-/// [`small_pour`] with the pour's seed.
-fn seeded_pour(layers: f64, seed: Option<u64>) -> (Elastoplastic<f64>, ParticleSet<f64>) {
-    let mut params = ElastoplasticParams::<f64>::for_spacing(S, 30.0);
-    params.youngs_modulus = 5.84e5;
-    params.common.dt = 0.016;
-    let slab = 3.0 * S;
-    let layer_m3 = 2.0 * S * S * slab;
-    let setup = PouredSetup {
-        period_x_m: 0.4,
-        slab_depth_m: slab,
-        funnel_width_m: 2.0 * S,
-        funnel_top_m: 1.0,
         volume_m3: layers * layer_m3,
         rate_m3_s: 30.0 * layer_m3,
         seed,
