@@ -73,6 +73,9 @@ pub struct Measured {
     pub steepest_deg: f64,
     /// The difference of the two flanks' angles (degrees).
     pub flank_difference_deg: f64,
+    /// The angle of the flank facing `−x` (the left one) and of the flank facing `+x`
+    /// (degrees; NaN for a flank the measure did not find).
+    pub flank_deg: [f64; 2],
     /// The heap's height (m).
     pub height_m: f64,
 }
@@ -100,37 +103,56 @@ pub trait Ground: Copy {
 
 /// Builds every planned case's scene with `scene_for` (refusing a bad one before any run),
 /// then runs each until at rest by `rest` (or to its cap), its diagnostic line measured on
-/// the ground `G` of its scene.
-pub fn run_plans<V, G: Ground>(
+/// the ground `G` of its scene. The runs go in parallel, one thread each (rayon across
+/// runs, each run in a pool of its own thread): a run's result does not depend on the
+/// thread count (the solvers' determinism tests), and a small heap gains little from a
+/// second thread (1.1× at 700 grains, `docs/performance.md`). Results in plan order.
+pub fn run_plans<V: Send, G: Ground + Send + Sync>(
     ctx: &mut Context,
     plans: Vec<Plan<V>>,
     scene_for: impl Fn(&Plan<V>, Mode) -> Result<Scene>,
-    rest: impl Fn(&Scene, f64) -> RestCriterion,
+    rest: impl Fn(&Scene, f64) -> RestCriterion + Sync,
 ) -> Result<Vec<(Plan<V>, HeapRun)>> {
+    use rayon::prelude::*;
     let scenes = plans
         .iter()
         .map(|p| scene_for(p, ctx.mode))
         .collect::<Result<Vec<_>>>()?;
     ctx.progress
         .set_length(scenes.iter().map(|s| s.frame_count() as u64).sum());
-    let mut runs = Vec::new();
-    for (p, scene) in plans.into_iter().zip(scenes) {
-        let criterion = rest(&scene, p.theta_deg);
-        let ground = G::of(&scene).ok();
-        let heap = |pos: &[_]| ground.map_or_else(Vec::new, |g| g.heap(pos));
-        let level_y = ground.map(G::level_y);
-        let run = run_heap(
-            ctx,
-            p.tag.clone(),
-            p.theta_deg,
-            scene,
-            criterion,
-            level_y,
-            heap,
-        )?;
-        runs.push((p, run));
-    }
-    Ok(runs)
+    let ctx = &*ctx;
+    plans
+        .into_par_iter()
+        .zip(scenes)
+        .with_max_len(1)
+        .map(|(p, scene)| {
+            let one = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
+            one.install(|| run_plan::<V, G>(ctx, p, scene, &rest))
+        })
+        .collect()
+}
+
+/// One run of [`run_plans`].
+fn run_plan<V, G: Ground>(
+    ctx: &Context,
+    p: Plan<V>,
+    scene: Scene,
+    rest: &impl Fn(&Scene, f64) -> RestCriterion,
+) -> Result<(Plan<V>, HeapRun)> {
+    let criterion = rest(&scene, p.theta_deg);
+    let ground = G::of(&scene).ok();
+    let heap = |pos: &[_]| ground.map_or_else(Vec::new, |g| g.heap(pos));
+    let level_y = ground.map(G::level_y);
+    let run = run_heap(
+        ctx,
+        p.tag.clone(),
+        p.theta_deg,
+        scene,
+        criterion,
+        level_y,
+        heap,
+    )?;
+    Ok((p, run))
 }
 
 /// Runs `scene` until at rest by `rest` (or to its cap) and prints the run's diagnostic line
@@ -249,6 +271,7 @@ pub fn measure_heap(
         angle_deg: m.angle_deg,
         steepest_deg: m.steepest_deg.unwrap_or(f64::NAN),
         flank_difference_deg: (flank(-1) - flank(1)).abs(),
+        flank_deg: [flank(-1), flank(1)],
         height_m: m.pile_height_m,
     };
     Some((m, measured))
