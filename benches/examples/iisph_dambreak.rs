@@ -122,6 +122,14 @@ fn run<R: Real>(steps: usize, granular: bool) {
             (h ^ c.as_f64().to_bits()).wrapping_mul(0x0000_0100_0000_01b3)
         });
     println!("end positions checksum: {checksum:016x}");
+    let fnv = |h: u64, c: f64| (h ^ c.to_bits()).wrapping_mul(0x0000_0100_0000_01b3);
+    let rest = state
+        .velocities
+        .iter()
+        .flat_map(|v| [v.x, v.y, v.z])
+        .chain(state.densities.iter().copied())
+        .fold(0xcbf2_9ce4_8422_2325u64, |h, c| fnv(h, c.as_f64()));
+    println!("end velocities and densities checksum: {rest:016x}");
 }
 
 fn main() {
