@@ -161,16 +161,16 @@ trait MulAdd {
     /// `self · a + b`, rounded once.
     fn mul_add_(self, a: Self, b: Self) -> Self;
 }
-impl MulAdd for f32 {
-    fn mul_add_(self, a: f32, b: f32) -> f32 {
-        self.mul_add(a, b)
-    }
+macro_rules! mul_add_impl {
+    ($($t:ty),*) => {$(
+        impl MulAdd for $t {
+            fn mul_add_(self, a: $t, b: $t) -> $t {
+                self.mul_add(a, b)
+            }
+        }
+    )*};
 }
-impl MulAdd for f64 {
-    fn mul_add_(self, a: f64, b: f64) -> f64 {
-        self.mul_add(a, b)
-    }
-}
+mul_add_impl!(f32, f64);
 
 /// The widest FMA loop available at run time for `f32` and `f64`: `(name, lanes of f32,
 /// f32 loop, f64 loop)`.
