@@ -17,8 +17,8 @@ use crate::stress::artificial_stress;
 use crate::walls::{wall_part, WallSampler};
 
 /// What the passes read besides the scratch arrays.
-pub(crate) struct StepInputs<'a, R: Real> {
-    pub c: Consts<R>,
+pub(crate) struct StepInputs<'a, R: Real, K> {
+    pub c: Consts<R, K>,
     pub masses: &'a [R],
     pub nb: &'a NeighbourLists,
     pub boundary: &'a dyn Boundary<R>,
@@ -31,7 +31,7 @@ pub(crate) struct StepInputs<'a, R: Real> {
     pub boundary_mass: R,
 }
 
-impl<R: Real> StepInputs<'_, R> {
+impl<R: Real, K> StepInputs<'_, R, K> {
     #[inline]
     fn mass(&self, j: usize) -> R {
         self.masses.get(j).copied().unwrap_or(self.boundary_mass)
@@ -43,7 +43,10 @@ impl<R: Real> StepInputs<'_, R> {
 /// grain's density becomes the kernel sum over itself, its grain neighbours and the boundary
 /// particles, normalised by the full lattice's, floored at `ρ0` (free surface, separated
 /// grains).
-pub(crate) fn reinitialise_density<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>) {
+pub(crate) fn reinitialise_density<R: Real, K: Kernel<R>>(
+    s: &mut Scratch<R>,
+    inp: &StepInputs<'_, R, K>,
+) {
     let c = inp.c;
     let n = inp.masses.len();
     let h2 = c.support2_above;
@@ -72,7 +75,7 @@ pub(crate) fn reinitialise_density<R: Real>(s: &mut Scratch<R>, inp: &StepInputs
 /// from `x`, `v`, `ρ`; the stress update (rate and return, [`crate::DruckerPrager::update`];
 /// zero for a particle without granular neighbours inside the support), the density and
 /// plastic strain after `Δt`, and the artificial stress of the new stress.
-pub(crate) fn stress_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>) {
+pub(crate) fn stress_pass<R: Real, K: Kernel<R>>(s: &mut Scratch<R>, inp: &StepInputs<'_, R, K>) {
     let c = inp.c;
     let slots = inp.models.len();
     let n = inp.masses.len();
@@ -149,7 +152,7 @@ pub(crate) fn stress_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>) 
 /// Pass 2: the acceleration from the new stresses (with the artificial viscosity and
 /// stress and the walls' share), the velocity and position after `Δt` (symplectic Euler),
 /// the position projected out of the solids and the velocity corrected by that projection.
-pub(crate) fn momentum_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>) {
+pub(crate) fn momentum_pass<R: Real, K: Kernel<R>>(s: &mut Scratch<R>, inp: &StepInputs<'_, R, K>) {
     let c = inp.c;
     let slots = inp.models.len();
     let n = inp.masses.len();
