@@ -60,6 +60,7 @@
 pub mod boundary;
 pub mod cone_match;
 pub mod csr;
+pub mod density_lanes;
 mod dimensions;
 mod error;
 mod fluid_solver;
