@@ -201,7 +201,9 @@ pub use particles::{
 };
 pub use planets::Planets;
 pub use population::{
-    Population, PopulationMember, PopulationProgress, RemovalRules, DEFAULT_WINDOW_STEPS,
+    ApproachRadius, CometEvent, DistanceFrame, DistanceLimit, EventKind, EventLog, EventRules,
+    OpenApproach, Population, PopulationMember, PopulationProgress, RemovalRules,
+    DEFAULT_MAX_EVENTS_PER_PARTICLE, DEFAULT_WINDOW_STEPS, MAX_PERIHELION_THRESHOLDS,
 };
 pub use run::{
     load_checkpoint, save_checkpoint, CometRun, Limits, ParticleStatus, TrackedParticle,
