@@ -51,6 +51,7 @@ fn population(states: &[(Vec3, Vec3)], encounters: Encounters) -> Population {
         hill_factor: None,
         min_perihelion: Some(2.5),
         ejection_distance: Some(100.0),
+        ..RemovalRules::default()
     };
     let ids: Vec<u64> = (0..states.len() as u64).collect();
     let mut pop = Population::new(ephemeris(), integ, rules, 0.0, 1.0, states, &ids).unwrap();

@@ -362,3 +362,50 @@ pub(crate) fn tisserand_at(
     let a_j = JUPITER_SEMI_MAJOR_AXIS_AU;
     Some(a_j * inverse_a + 2.0 * h.dot(&normal) / (normal.norm() * (mu * a_j).sqrt()))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::classes::{inclination_to_plane, tisserand_jupiter};
+
+    /// The element-free `T_J` equals [`tisserand_jupiter`] from the elements, for an orbit
+    /// inclined to a Jupiter whose plane is itself tilted (relative difference 10⁻¹³: a few
+    /// dozen roundings of `O(1)` terms).
+    #[test]
+    fn tisserand_without_elements_equals_the_classes_formula() {
+        let mu = 2.959_122_082_86e-4;
+        let sun = (Vec3::new(0.003, -0.001, 0.0002), Vec3::new(1e-6, 2e-6, -1e-7));
+        let jupiter = (
+            sun.0 + Vec3::new(4.9, 1.2, 0.1),
+            sun.1 + Vec3::new(-0.0018, 0.0072, 0.0002),
+        );
+        let (q, v) = (Vec3::new(3.0, -5.0, 1.0), Vec3::new(0.006, 0.004, -0.001));
+        let h = q.cross(&v);
+        let t_j = tisserand_at(q, v, h, mu, &[sun.0, jupiter.0], &[sun.1, jupiter.1], 1)
+            .expect("a bound orbit");
+        let el = crate::kepler::elements(&q, &v, mu).unwrap();
+        let normal = (jupiter.0 - sun.0).cross(&(jupiter.1 - sun.1)).normalize();
+        let i = inclination_to_plane(&q, &v, &normal);
+        let expected = tisserand_jupiter(el.semi_major_axis, el.eccentricity, i);
+        assert!((t_j / expected - 1.0).abs() < 1e-13, "{t_j} vs {expected}");
+        // Unbound: no T_J.
+        assert!(tisserand_at(q, v * 3.0, h * 3.0, mu, &[sun.0, jupiter.0], &[sun.1, jupiter.1], 1).is_none());
+    }
+
+    /// A full log counts what it does not keep.
+    #[test]
+    fn a_full_log_counts_the_events_it_drops() {
+        let mut log = EventLog::default();
+        let event = CometEvent {
+            time: 1.0,
+            kind: EventKind::TisserandCrossing {
+                before: 3.1,
+                after: 2.9,
+            },
+        };
+        for _ in 0..5 {
+            log.push(event, 3);
+        }
+        assert_eq!((log.events.len(), log.dropped), (3, 2));
+    }
+}
