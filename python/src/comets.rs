@@ -306,7 +306,6 @@ impl Population {
             .map_err(rust_err)
     }
 
-
     /// Writes the snapshot table as Parquet (readable by pandas and polars), atomically.
     fn write_parquet(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         let inner = &self.inner;
@@ -475,9 +474,11 @@ impl Population {
     }
 }
 
-
 /// The columns of `batch` as a dict: numpy arrays of `f64`, `u64` and `bool`, lists of str.
-fn batch_dict<'py>(py: Python<'py>, batch: &arrow_array::RecordBatch) -> PyResult<Bound<'py, PyDict>> {
+fn batch_dict<'py>(
+    py: Python<'py>,
+    batch: &arrow_array::RecordBatch,
+) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     let schema = batch.schema();
     for (field, col) in schema.fields().iter().zip(batch.columns()) {
@@ -495,7 +496,7 @@ fn batch_dict<'py>(py: Python<'py>, batch: &arrow_array::RecordBatch) -> PyResul
         }
     }
     Ok(d)
-    }
+}
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Population>()?;

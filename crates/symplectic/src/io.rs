@@ -17,8 +17,8 @@ use crate::classes::{
 use crate::kepler::{state_from_elements, ConicElements};
 use crate::{
     outer_solar_system, DistanceFrame, Ephemeris, EventRules, Frame, Integrator,
-    ParticleIntegrator, ParticleStatus, Planets, Population, RemovalRules, Scheme,
-    SymplecticError, Variant, Vec3,
+    ParticleIntegrator, ParticleStatus, Planets, Population, RemovalRules, Scheme, SymplecticError,
+    Variant, Vec3,
 };
 
 mod events_table;
@@ -283,7 +283,11 @@ impl PopulationSpec {
                 name,
                 value,
                 reason,
-            } => spec_error(path, &format!("{table}{name}"), format!("{value}: {reason}")),
+            } => spec_error(
+                path,
+                &format!("{table}{name}"),
+                format!("{value}: {reason}"),
+            ),
             other => other,
         };
         self.removal.validate().map_err(|e| named("removal.", e))?;

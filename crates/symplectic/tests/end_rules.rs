@@ -52,7 +52,11 @@ impl Ellipse {
 
     /// Eccentric anomaly of mean anomaly `m` (Newton on `E − e sin E = M`).
     fn eccentric(&self, m: f64) -> f64 {
-        let mut big_e = if self.e > 0.8 { std::f64::consts::PI } else { m };
+        let mut big_e = if self.e > 0.8 {
+            std::f64::consts::PI
+        } else {
+            m
+        };
         for _ in 0..60 {
             big_e -= (big_e - self.e * big_e.sin() - m) / (1.0 - self.e * big_e.cos());
         }
@@ -85,8 +89,7 @@ impl Ellipse {
 fn comet(orbit: Ellipse, m0: f64, rules: RemovalRules, first_step: f64) -> Population {
     let planets = quiet_planets(std::f64::consts::PI);
     let ephemeris = Ephemeris::new(planets, Integrator::S6 { step: 50.0 }).unwrap();
-    let integ =
-        ParticleIntegrator::new(Variant::Barycentric, Scheme::S2, 0.0, PAPER_B1).unwrap();
+    let integ = ParticleIntegrator::new(Variant::Barycentric, Scheme::S2, 0.0, PAPER_B1).unwrap();
     let state = orbit.state(m0);
     Population::new(ephemeris, integ, rules, 0.0, first_step, &[state], &[7]).unwrap()
 }
@@ -129,7 +132,12 @@ fn min_distance_ends_at_the_first_step_after_the_analytic_crossing() {
         }),
         ..RemovalRules::default()
     };
-    let free = comet(orbit, std::f64::consts::PI, RemovalRules::default(), FINE_STEP_DAYS);
+    let free = comet(
+        orbit,
+        std::f64::consts::PI,
+        RemovalRules::default(),
+        FINE_STEP_DAYS,
+    );
     let expected_time = first_step_end_after(free, crossing);
     let mut pop = comet(orbit, std::f64::consts::PI, rules, FINE_STEP_DAYS);
     pop.advance_to(2.0 * crossing, |_| {}).unwrap();
@@ -145,8 +153,14 @@ fn min_distance_ends_at_the_first_step_after_the_analytic_crossing() {
     assert_eq!(frame, DistanceFrame::Heliocentric);
     let m = std::f64::consts::PI + orbit.mean_motion() * time;
     let analytic = orbit.state(m).0.norm();
-    assert!(distance < limit && analytic < limit, "{distance} {analytic}");
-    println!("min_distance: map − closed form {:.2e} AU", distance - analytic);
+    assert!(
+        distance < limit && analytic < limit,
+        "{distance} {analytic}"
+    );
+    println!(
+        "min_distance: map − closed form {:.2e} AU",
+        distance - analytic
+    );
     assert!(
         (distance - analytic).abs() < KEPLER_TOLERANCE_AU,
         "{distance} vs {analytic}"
@@ -174,13 +188,15 @@ fn max_distance_ends_a_bound_orbit_that_ejection_keeps() {
     let expected_time = first_step_end_after(free, crossing);
     let mut pop = comet(orbit, 0.0, rules, FINE_STEP_DAYS);
     pop.advance_to(2.0 * crossing, |_| {}).unwrap();
-    let ParticleStatus::BeyondMaxDistance { time, distance, .. } = pop.members()[0].status
-    else {
+    let ParticleStatus::BeyondMaxDistance { time, distance, .. } = pop.members()[0].status else {
         panic!("{:?}", pop.members()[0].status)
     };
     assert_eq!(time.to_bits(), expected_time.to_bits());
     let analytic = orbit.state(orbit.mean_motion() * time).0.norm();
-    println!("max_distance: map − closed form {:.2e} AU", distance - analytic);
+    println!(
+        "max_distance: map − closed form {:.2e} AU",
+        distance - analytic
+    );
     assert!(distance > limit && (distance - analytic).abs() < KEPLER_TOLERANCE_AU);
     let ejection = RemovalRules {
         ejection_distance: Some(limit),
@@ -227,7 +243,8 @@ fn a_sun_grazer_collides_and_a_near_miss_does_not() {
     );
     let miss = Ellipse { a: 1.0, e: 0.994 };
     let mut kept = comet(miss, pi, rules, 5.0);
-    kept.advance_to(miss.time_at(pi, 2.0 * pi) + 10.0, |_| {}).unwrap();
+    kept.advance_to(miss.time_at(pi, 2.0 * pi) + 10.0, |_| {})
+        .unwrap();
     assert_eq!(kept.members()[0].status, ParticleStatus::Active);
 }
 
@@ -303,7 +320,10 @@ fn a_close_approach_is_recorded_at_its_closed_form_minimum_over_the_step_ends() 
         copy.advance_to(t + 1e-9, |_| {}).unwrap();
     }
     assert!(best.1 < radius, "the orbits pass within {radius} AU");
-    println!("close approach: map − closed form {:.2e} AU", min_distance - best.1);
+    println!(
+        "close approach: map − closed form {:.2e} AU",
+        min_distance - best.1
+    );
     assert_eq!(event.time.to_bits(), best.0.to_bits());
     assert!(
         (min_distance - best.1).abs() < KEPLER_TOLERANCE_AU,

@@ -8,9 +8,9 @@ const DAYS_PER_YEAR: f64 = 365.25;
 use symplectic::kepler::state_from_elements;
 use symplectic::samples::{sample_elements, SampleRanges};
 use symplectic::{
-    outer_solar_system, ApproachRadius, BodyStates, Encounters, Ephemeris, EventKind,
-    EventRules, Frame, Integrator, ParticleIntegrator, ParticleStatus, Population, RemovalRules,
-    Scheme, Variant, Vec3,
+    outer_solar_system, ApproachRadius, BodyStates, Encounters, Ephemeris, EventKind, EventRules,
+    Frame, Integrator, ParticleIntegrator, ParticleStatus, Population, RemovalRules, Scheme,
+    Variant, Vec3,
 };
 
 /// Comets between Jupiter and Saturn (`a` 5.5–9 AU, `e` up to 0.4), which Jupiter scatters
@@ -131,14 +131,20 @@ fn first_perihelion_and_tisserand_events_are_where_a_scan_finds_them() {
             })
             .unwrap_or_default();
         fn sorted(mut v: Vec<(&'static str, f64, f64)>) -> Vec<(&'static str, f64, f64)> {
-            v.sort_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(b.0)).then(b.2.total_cmp(&a.2)));
+            v.sort_by(|a, b| {
+                a.1.total_cmp(&b.1)
+                    .then(a.0.cmp(b.0))
+                    .then(b.2.total_cmp(&a.2))
+            });
             v
         }
         assert_eq!(sorted(recorded.clone()), sorted(expected), "comet {i}");
         perihelion_events += recorded.iter().filter(|e| e.0 == "q").count();
         crossings += recorded.iter().filter(|e| e.0 == "tj").count();
     }
-    println!("{perihelion_events} perihelion events, {crossings} crossings of T_J = 3 in {n} comets");
+    println!(
+        "{perihelion_events} perihelion events, {crossings} crossings of T_J = 3 in {n} comets"
+    );
     assert!(perihelion_events > 0 && crossings > 0);
 }
 
@@ -191,7 +197,10 @@ fn events_survive_checkpoints_shards_and_threads_bit_for_bit() {
         t += DAYS_PER_YEAR;
         first.advance_to(t, |_| {}).unwrap();
     }
-    assert!(open(&first), "a close approach under way at a synchronisation");
+    assert!(
+        open(&first),
+        "a close approach under way at a synchronisation"
+    );
     first.save(&path).unwrap();
     let mut resumed = Population::load(&path).unwrap();
     assert_eq!(resumed, first);
@@ -207,7 +216,10 @@ fn events_survive_checkpoints_shards_and_threads_bit_for_bit() {
             s
         })
         .collect();
-    assert_eq!(Population::merge(shards).unwrap().members(), whole.members());
+    assert_eq!(
+        Population::merge(shards).unwrap().members(),
+        whole.members()
+    );
     // Shards with other event rules are not of one population.
     let mut other = start.shard(0..7).unwrap();
     other.set_events(EventRules::default()).unwrap();

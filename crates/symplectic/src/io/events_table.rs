@@ -34,10 +34,16 @@ pub fn events_table(population: &Population) -> Result<RecordBatch, SymplecticEr
                 EventKind::PerihelionBelow {
                     threshold,
                     perihelion,
-                } => ("perihelion_below", String::new(), [threshold, perihelion, nan, nan, nan, nan]),
-                EventKind::TisserandCrossing { before, after } => {
-                    ("tisserand_crossing", String::new(), [nan, nan, before, after, nan, nan])
-                }
+                } => (
+                    "perihelion_below",
+                    String::new(),
+                    [threshold, perihelion, nan, nan, nan, nan],
+                ),
+                EventKind::TisserandCrossing { before, after } => (
+                    "tisserand_crossing",
+                    String::new(),
+                    [nan, nan, before, after, nan, nan],
+                ),
                 EventKind::CloseApproach {
                     planet,
                     min_distance,

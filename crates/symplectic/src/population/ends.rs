@@ -72,9 +72,15 @@ pub(crate) fn geometric_end(
 /// `radius` and the body passed it within the last `dt` days (outbound, the time since
 /// pericentre from Kepler's equation at most `dt`): Mercury's test for a collision with the
 /// central body between two steps (`mce_cent`, Chambers 1999).
-pub(crate) fn perihelion_passed_within(r: Vec3, v: Vec3, mu: f64, radius: f64, dt: f64) -> Option<f64> {
+pub(crate) fn perihelion_passed_within(
+    r: Vec3,
+    v: Vec3,
+    mu: f64,
+    radius: f64,
+    dt: f64,
+) -> Option<f64> {
     let rv = r.dot(&v);
-    if !(rv > 0.0) {
+    if rv.is_nan() || rv <= 0.0 {
         return None;
     }
     let rn = r.norm();
@@ -83,7 +89,7 @@ pub(crate) fn perihelion_passed_within(r: Vec3, v: Vec3, mu: f64, radius: f64, d
     let alpha = 2.0 / rn - v.norm_squared() / mu;
     let e = (1.0 - h2 * alpha / mu).max(0.0).sqrt();
     let pericentre = h2 / (mu * (1.0 + e));
-    if !(pericentre < radius) {
+    if pericentre.is_nan() || pericentre >= radius {
         return None;
     }
     let since = if alpha > 0.0 {

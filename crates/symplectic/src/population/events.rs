@@ -84,7 +84,9 @@ pub enum ApproachRadius {
 impl EventRules {
     /// Whether any event is recorded.
     pub fn any(&self) -> bool {
-        !self.perihelion_below.is_empty() || self.tisserand_crossing || self.close_approach.is_some()
+        !self.perihelion_below.is_empty()
+            || self.tisserand_crossing
+            || self.close_approach.is_some()
     }
 
     /// Checks the values; errors name the field.
@@ -254,7 +256,12 @@ impl EventLog {
 
     /// Records what `c` shows; `elements_apply`: whether the barycentric elements describe
     /// the orbit (the map, or the encounter mode beyond its switch radius).
-    pub(crate) fn check(&mut self, ctx: &EventContext<'_>, c: &CheckPoint<'_>, elements_apply: bool) {
+    pub(crate) fn check(
+        &mut self,
+        ctx: &EventContext<'_>,
+        c: &CheckPoint<'_>,
+        elements_apply: bool,
+    ) {
         let rules = ctx.rules;
         let cap = rules.max_per_particle;
         if let Some(radius) = rules.close_approach {
@@ -313,7 +320,9 @@ impl EventLog {
         for (j, planet) in c.body_positions.iter().enumerate().skip(1) {
             let limit = match radius {
                 ApproachRadius::Au(r) => r,
-                ApproachRadius::HillRadii(f) => f * (planet - sun).norm() * ctx.hill_coefficients[j - 1],
+                ApproachRadius::HillRadii(f) => {
+                    f * (planet - sun).norm() * ctx.hill_coefficients[j - 1]
+                }
             };
             let distance = (c.position - planet).norm();
             let open = self.open_approaches.iter().position(|o| o.planet == j);
@@ -355,7 +364,7 @@ pub(crate) fn tisserand_at(
     j: usize,
 ) -> Option<f64> {
     let inverse_a = 2.0 / q.norm() - v.norm_squared() / mu;
-    if !(inverse_a > 0.0) {
+    if inverse_a.is_nan() || inverse_a <= 0.0 {
         return None;
     }
     let normal = (positions[j] - positions[0]).cross(&(velocities[j] - velocities[0]));
@@ -374,7 +383,10 @@ mod tests {
     #[test]
     fn tisserand_without_elements_equals_the_classes_formula() {
         let mu = 2.959_122_082_86e-4;
-        let sun = (Vec3::new(0.003, -0.001, 0.0002), Vec3::new(1e-6, 2e-6, -1e-7));
+        let sun = (
+            Vec3::new(0.003, -0.001, 0.0002),
+            Vec3::new(1e-6, 2e-6, -1e-7),
+        );
         let jupiter = (
             sun.0 + Vec3::new(4.9, 1.2, 0.1),
             sun.1 + Vec3::new(-0.0018, 0.0072, 0.0002),
@@ -389,7 +401,16 @@ mod tests {
         let expected = tisserand_jupiter(el.semi_major_axis, el.eccentricity, i);
         assert!((t_j / expected - 1.0).abs() < 1e-13, "{t_j} vs {expected}");
         // Unbound: no T_J.
-        assert!(tisserand_at(q, v * 3.0, h * 3.0, mu, &[sun.0, jupiter.0], &[sun.1, jupiter.1], 1).is_none());
+        assert!(tisserand_at(
+            q,
+            v * 3.0,
+            h * 3.0,
+            mu,
+            &[sun.0, jupiter.0],
+            &[sun.1, jupiter.1],
+            1
+        )
+        .is_none());
     }
 
     /// A full log counts what it does not keep.

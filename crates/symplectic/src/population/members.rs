@@ -3,8 +3,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::encounter::Encounter;
 use super::events::EventLog;
+use crate::encounter::Encounter;
 use crate::particles::TestParticle;
 use crate::run::ParticleStatus;
 use crate::{SymplecticError, Vec3};

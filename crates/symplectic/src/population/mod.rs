@@ -23,7 +23,9 @@ pub use events::{
     ApproachRadius, CometEvent, EventKind, EventLog, EventRules, OpenApproach,
     DEFAULT_MAX_EVENTS_PER_PARTICLE, MAX_PERIHELION_THRESHOLDS,
 };
-pub use members::{DistanceFrame, DistanceLimit, PopulationMember, PopulationProgress, RemovalRules};
+pub use members::{
+    DistanceFrame, DistanceLimit, PopulationMember, PopulationProgress, RemovalRules,
+};
 use window::{run_window, total_gm, StepPath};
 
 /// Default length of a synchronisation window, in planet steps.
