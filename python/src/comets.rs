@@ -72,7 +72,9 @@ fn python_setting(field: &str) -> String {
         ("planets", "scheme") => "planet_scheme".into(),
         ("planets", "frame") => "frame".into(),
         ("removal", k) | ("encounters", k) | ("events", k) if !k.is_empty() => {
-            format!("{table}[{k:?}]")
+            // `removal.min_distance.distance` as `removal["min_distance"]["distance"]`.
+            let keys: String = k.split('.').map(|part| format!("[{part:?}]")).collect();
+            format!("{table}{keys}")
         }
         (_, "") => table.into(),
         (_, k) => k.into(),
