@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use arrow_array::{ArrayRef, BooleanArray, Float64Array, RecordBatch, StringArray, UInt64Array};
-use arrow_schema::{DataType, Field, Schema};
+use arrow_schema::{Field, Schema};
 use serde::Deserialize;
 
 use crate::classes::{
@@ -875,46 +875,73 @@ pub fn population_table(population: &Population) -> Result<RecordBatch, Symplect
         "vz_au_per_day",
         "tisserand_jupiter",
     ];
-    let mut fields = vec![
-        Field::new("id", DataType::UInt64, false),
-        Field::new("status", DataType::Utf8, false),
-    ];
-    let mut arrays: Vec<ArrayRef> = vec![
+    let mut table = Columns::default();
+    table.push(
+        "id",
         Arc::new(UInt64Array::from_iter_values(members.iter().map(|m| m.id))),
-        Arc::new(StringArray::from(status)),
-    ];
-    for (name, c) in names.iter().zip(cols) {
-        fields.push(Field::new(*name, DataType::Float64, false));
-        arrays.push(Arc::new(Float64Array::from(c)));
+    );
+    table.push("status", Arc::new(StringArray::from(status)));
+    table.floats(&names, cols);
+    table.push("region", Arc::new(StringArray::from(region)));
+    table.push("levison_class", Arc::new(StringArray::from(levison)));
+    table.push(
+        "in_encounter",
+        Arc::new(BooleanArray::from_iter(
+            // Active members only: a removed member is in no encounter (a checkpoint of an
+            // earlier version may still hold the encounter state it was removed in).
+            members
+                .iter()
+                .map(|m| Some(m.status == ParticleStatus::Active && m.encounter.is_some())),
+        )),
+    );
+    table.push(
+        "encounters_begun",
+        Arc::new(UInt64Array::from_iter_values(
+            members.iter().map(|m| u64::from(m.encounters_begun)),
+        )),
+    );
+    table.push(
+        "events_dropped",
+        Arc::new(UInt64Array::from_iter_values(
+            members
+                .iter()
+                .map(|m| m.events.as_ref().map_or(0, |log| log.dropped)),
+        )),
+    );
+    table.batch()
+}
+
+/// The columns of a table being built, in order (every column non-nullable).
+#[derive(Default)]
+pub(crate) struct Columns {
+    fields: Vec<Field>,
+    arrays: Vec<ArrayRef>,
+}
+
+impl Columns {
+    /// Appends the column `name`.
+    pub(crate) fn push(&mut self, name: &str, array: ArrayRef) {
+        self.fields
+            .push(Field::new(name, array.data_type().clone(), false));
+        self.arrays.push(array);
     }
-    fields.push(Field::new("region", DataType::Utf8, false));
-    arrays.push(Arc::new(StringArray::from(region)));
-    fields.push(Field::new("levison_class", DataType::Utf8, false));
-    arrays.push(Arc::new(StringArray::from(levison)));
-    fields.push(Field::new("in_encounter", DataType::Boolean, false));
-    arrays.push(Arc::new(BooleanArray::from_iter(
-        // Active members only: a removed member is in no encounter (a checkpoint of an
-        // earlier version may still hold the encounter state it was removed in).
-        members
-            .iter()
-            .map(|m| Some(m.status == ParticleStatus::Active && m.encounter.is_some())),
-    )));
-    fields.push(Field::new("encounters_begun", DataType::UInt64, false));
-    arrays.push(Arc::new(UInt64Array::from_iter_values(
-        members.iter().map(|m| u64::from(m.encounters_begun)),
-    )));
-    fields.push(Field::new("events_dropped", DataType::UInt64, false));
-    arrays.push(Arc::new(UInt64Array::from_iter_values(
-        members
-            .iter()
-            .map(|m| m.events.as_ref().map_or(0, |log| log.dropped)),
-    )));
-    RecordBatch::try_new(Arc::new(Schema::new(fields)), arrays).map_err(|e| {
-        SymplecticError::Output {
-            path: String::new(),
-            reason: e.to_string(),
+
+    /// Appends one `f64` column per name.
+    pub(crate) fn floats(&mut self, names: &[&str], columns: Vec<Vec<f64>>) {
+        for (name, c) in names.iter().zip(columns) {
+            self.push(name, Arc::new(Float64Array::from(c)));
         }
-    })
+    }
+
+    /// The table.
+    pub(crate) fn batch(self) -> Result<RecordBatch, SymplecticError> {
+        RecordBatch::try_new(Arc::new(Schema::new(self.fields)), self.arrays).map_err(|e| {
+            SymplecticError::Output {
+                path: String::new(),
+                reason: e.to_string(),
+            }
+        })
+    }
 }
 
 /// A short label of a status (`active`, `hill_sphere_<planet>`, `collision_<planet>` with the

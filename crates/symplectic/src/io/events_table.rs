@@ -2,9 +2,9 @@
 
 use std::sync::Arc;
 
-use arrow_array::{ArrayRef, BooleanArray, Float64Array, RecordBatch, StringArray, UInt64Array};
-use arrow_schema::{DataType, Field, Schema};
+use arrow_array::{BooleanArray, RecordBatch, StringArray, UInt64Array};
 
+use super::Columns;
 use crate::{EventKind, ParticleStatus, Population, SymplecticError};
 
 /// Name of the events table in a study's output directory.
@@ -73,26 +73,11 @@ pub fn events_table(population: &Population) -> Result<RecordBatch, SymplecticEr
         "min_distance_au",
         "radius_au",
     ];
-    let mut fields = vec![
-        Field::new("id", DataType::UInt64, false),
-        Field::new("event", DataType::Utf8, false),
-    ];
-    let mut arrays: Vec<ArrayRef> = vec![
-        Arc::new(UInt64Array::from(ids)),
-        Arc::new(StringArray::from(kinds)),
-    ];
-    for (name, c) in names.iter().zip(cols) {
-        fields.push(Field::new(*name, DataType::Float64, false));
-        arrays.push(Arc::new(Float64Array::from(c)));
-    }
-    fields.push(Field::new("planet", DataType::Utf8, false));
-    arrays.push(Arc::new(StringArray::from(planet)));
-    fields.push(Field::new("ongoing", DataType::Boolean, false));
-    arrays.push(Arc::new(BooleanArray::from(ongoing)));
-    RecordBatch::try_new(Arc::new(Schema::new(fields)), arrays).map_err(|e| {
-        SymplecticError::Output {
-            path: String::new(),
-            reason: e.to_string(),
-        }
-    })
+    let mut table = Columns::default();
+    table.push("id", Arc::new(UInt64Array::from(ids)));
+    table.push("event", Arc::new(StringArray::from(kinds)));
+    table.floats(&names, cols);
+    table.push("planet", Arc::new(StringArray::from(planet)));
+    table.push("ongoing", Arc::new(BooleanArray::from(ongoing)));
+    table.batch()
 }

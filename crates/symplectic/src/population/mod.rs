@@ -564,7 +564,7 @@ impl Population {
 
     /// Joins shards of one population advanced to the same time ([`Population::shard`]): the
     /// members in identifier order, the ephemeris covering all of them. Errors if the shards
-    /// differ in integrator, rules, planets' step or time, or share an identifier.
+    /// differ in integrator, rules, event rules, planets' step or time, or share an identifier.
     pub fn merge(shards: Vec<Self>) -> Result<Self, SymplecticError> {
         let Some(first) = shards.first() else {
             return Err(SymplecticError::InvalidParameter {
