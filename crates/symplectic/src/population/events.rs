@@ -21,6 +21,17 @@ pub const MAX_PERIHELION_THRESHOLDS: usize = 64;
 /// ([`Encounters`](crate::Encounters)). A particle keeps at most
 /// [`EventRules::max_per_particle`] events; later ones are counted in
 /// [`EventLog::dropped`], never lost silently.
+///
+/// **Cost.** With any event (or any of the rules [`RemovalRules::sun_collision`],
+/// [`RemovalRules::min_distance`], [`RemovalRules::max_distance`]) every step end goes
+/// through the scalar checks instead of only the lanes the vector tests flag: measured
+/// 0.224 µs per particle step against 0.104 µs without (2000 scattered-disk comets over
+/// 5000 years, one thread, S6 planets at 730.5 days, 2026-12-05; the same 7.46·10⁶ steps,
+/// the trajectories are unchanged).
+///
+/// [`RemovalRules::sun_collision`]: crate::RemovalRules::sun_collision
+/// [`RemovalRules::min_distance`]: crate::RemovalRules::min_distance
+/// [`RemovalRules::max_distance`]: crate::RemovalRules::max_distance
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EventRules {
