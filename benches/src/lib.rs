@@ -166,6 +166,7 @@ pub fn scattered_disk_population(
         hill_factor: Some(1.0),
         min_perihelion: Some(26.0),
         ejection_distance: Some(1000.0),
+        ..RemovalRules::default()
     };
     let population = Population::new(
         ephemeris,
@@ -242,6 +243,7 @@ pub fn centaur_population(
         hill_factor: None,
         min_perihelion: Some(2.5),
         ejection_distance: Some(100.0),
+        ..RemovalRules::default()
     };
     let mut population = Population::with_first_steps(
         ephemeris,

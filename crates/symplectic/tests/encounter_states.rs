@@ -51,6 +51,7 @@ fn population(states: &[(Vec3, Vec3)], encounters: Encounters) -> Population {
         hill_factor: None,
         min_perihelion: Some(2.5),
         ejection_distance: Some(100.0),
+        ..RemovalRules::default()
     };
     let ids: Vec<u64> = (0..states.len() as u64).collect();
     let mut pop = Population::new(ephemeris(), integ, rules, 0.0, 1.0, states, &ids).unwrap();
@@ -270,9 +271,14 @@ fn a_version_1_checkpoint_goes_on_without_hysteresis() {
     // The file as version 1 wrote it: the new fields taken out.
     let mut json: serde_json::Value =
         serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
-    assert_eq!(json["version"], 2);
+    assert_eq!(json["version"], 3);
     json["version"] = 1.into();
     let population_json = json["population"].as_object_mut().unwrap();
+    population_json.remove("events").unwrap();
+    let rules = population_json["rules"].as_object_mut().unwrap();
+    for key in ["sun_collision", "min_distance", "max_distance"] {
+        rules.remove(key).unwrap();
+    }
     population_json["encounters"]
         .as_object_mut()
         .unwrap()
@@ -302,11 +308,11 @@ fn a_version_1_checkpoint_goes_on_without_hysteresis() {
         m.0.encounters_begun + first.members()[0].encounters_begun,
         m.1.encounters_begun
     );
-    json["version"] = 3.into();
+    json["version"] = 4.into();
     std::fs::write(&path, serde_json::to_vec(&json).unwrap()).unwrap();
     let e = Population::load(&path).unwrap_err().to_string();
     assert!(
-        e.contains("version 3, expected") && e.contains("version 1 to 2"),
+        e.contains("version 4, expected") && e.contains("version 1 to 3"),
         "{e}"
     );
     std::fs::remove_dir_all(&dir).ok();
