@@ -21,8 +21,8 @@ use crate::boundary_particles::{sample_moving_wall, sample_solids};
 use crate::kernels::{Consts, SpaceConsts, ELASTOPLASTIC_KERNEL};
 use crate::params::{ElastoplasticParams, InitialStress, WallModel};
 use crate::passes::{
-    boundary_pair_terms, max_displacement, momentum_pass, reinitialise_density, stress_pass,
-    StepInputs,
+    boundary_pair_terms, max_displacement, momentum_pass, pair_gradients, reinitialise_density,
+    stress_pass, StepInputs,
 };
 use crate::scratch::Scratch;
 use crate::stress::artificial_stress;
@@ -501,6 +501,7 @@ impl<R: Real> ElastoplasticScheme<R> {
             s.boundary_lists.weigh(&e);
             extrapolate(&e, &s.boundary_lists, &mut s.stress, Some(&mut s.v), None);
         }
+        pair_gradients(s, &inputs);
         stress_pass(s, &inputs);
         if !bp.is_empty() {
             let e = Extrapolation {
