@@ -103,56 +103,37 @@ pub trait Ground: Copy {
 
 /// Builds every planned case's scene with `scene_for` (refusing a bad one before any run),
 /// then runs each until at rest by `rest` (or to its cap), its diagnostic line measured on
-/// the ground `G` of its scene. The runs go in parallel, one thread each (rayon across
-/// runs, each run in a pool of its own thread): a run's result does not depend on the
-/// thread count (the solvers' determinism tests), and a small heap gains little from a
-/// second thread (1.1× at 700 grains, `docs/performance.md`). Results in plan order.
-pub fn run_plans<V: Send, G: Ground + Send + Sync>(
+/// the ground `G` of its scene.
+pub fn run_plans<V, G: Ground>(
     ctx: &mut Context,
     plans: Vec<Plan<V>>,
     scene_for: impl Fn(&Plan<V>, Mode) -> Result<Scene>,
-    rest: impl Fn(&Scene, f64) -> RestCriterion + Sync,
+    rest: impl Fn(&Scene, f64) -> RestCriterion,
 ) -> Result<Vec<(Plan<V>, HeapRun)>> {
-    use rayon::prelude::*;
     let scenes = plans
         .iter()
         .map(|p| scene_for(p, ctx.mode))
         .collect::<Result<Vec<_>>>()?;
     ctx.progress
         .set_length(scenes.iter().map(|s| s.frame_count() as u64).sum());
-    let ctx = &*ctx;
-    plans
-        .into_par_iter()
-        .zip(scenes)
-        .with_max_len(1)
-        .map(|(p, scene)| {
-            let one = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
-            one.install(|| run_plan::<V, G>(ctx, p, scene, &rest))
-        })
-        .collect()
-}
-
-/// One run of [`run_plans`].
-fn run_plan<V, G: Ground>(
-    ctx: &Context,
-    p: Plan<V>,
-    scene: Scene,
-    rest: &impl Fn(&Scene, f64) -> RestCriterion,
-) -> Result<(Plan<V>, HeapRun)> {
-    let criterion = rest(&scene, p.theta_deg);
-    let ground = G::of(&scene).ok();
-    let heap = |pos: &[_]| ground.map_or_else(Vec::new, |g| g.heap(pos));
-    let level_y = ground.map(G::level_y);
-    let run = run_heap(
-        ctx,
-        p.tag.clone(),
-        p.theta_deg,
-        scene,
-        criterion,
-        level_y,
-        heap,
-    )?;
-    Ok((p, run))
+    let mut runs = Vec::new();
+    for (p, scene) in plans.into_iter().zip(scenes) {
+        let criterion = rest(&scene, p.theta_deg);
+        let ground = G::of(&scene).ok();
+        let heap = |pos: &[_]| ground.map_or_else(Vec::new, |g| g.heap(pos));
+        let level_y = ground.map(G::level_y);
+        let run = run_heap(
+            ctx,
+            p.tag.clone(),
+            p.theta_deg,
+            scene,
+            criterion,
+            level_y,
+            heap,
+        )?;
+        runs.push((p, run));
+    }
+    Ok(runs)
 }
 
 /// Runs `scene` until at rest by `rest` (or to its cap) and prints the run's diagnostic line
