@@ -40,8 +40,11 @@ fn dam_break(c: &mut Criterion) {
     group.bench_function("water-step", |b| {
         b.iter(|| water.step(&mut state).expect("step"))
     });
-    let (mut solver, mut grains) =
-        benches::settled_block_elastoplastic::<f32>(0.002).expect("granular scene");
+    let (mut solver, mut grains) = benches::settled_block_elastoplastic::<f32>(
+        0.002,
+        elastoplastic_granular::DEFAULT_YOUNGS_MODULUS_PA,
+    )
+    .expect("granular scene");
     let (steps, _) = solver.params().explicit_steps();
     solver.step(&mut grains).expect("warm-up frame");
     group.throughput(Throughput::Elements((n * steps) as u64));

@@ -1,24 +1,29 @@
 //! The elastic–plastic granular solver's explicit step (Bui et al. 2008,
-//! `elastoplastic-granular`) against the IISPH water step, per particle, on the same 59,319
-//! particles of SPlisHSPlasH's dam break at 25 mm spacing, one after the other in one run:
+//! `elastoplastic-granular`) against the IISPH water step, per particle and per simulated
+//! second, on the same 59,319 particles of SPlisHSPlasH's dam break at 25 mm spacing, one
+//! after the other in one run:
 //!
 //! ```text
-//! RAYON_NUM_THREADS=2 cargo run --release -p benches --example elastoplastic_step -- [FRAMES] [f64]
+//! RAYON_NUM_THREADS=2 cargo run --release -p benches --example elastoplastic_step -- [FRAMES] [f64] [settled] [E=PA]
 //! ```
 //!
 //! Water: our IISPH with volume-map walls, Δt = 2 ms, from rest (as
-//! `examples/iisph_dambreak.rs`), 5 warm-up steps, then `3 FRAMES` timed steps. Granular:
-//! the grains as a block held at rest in a box that fits it, walls of three rows of no-slip
-//! boundary particles, geostatic start (`benches::settled_block_elastoplastic`), frames of
-//! 2 ms (each one substep of `n` explicit steps, `Δt ≤ C h/c`), 1 warm-up frame, then
-//! `FRAMES` timed frames (default 10). A frame starts with a reordering (every tenth) and a
-//! neighbour search; its explicit steps share the lists while no grain moves more than half
-//! the skin. Prints the wall time per explicit step over whole frames (searches included),
-//! the phases per step, per particle (grains; the boundary particles are extra work), the
-//! ratio to the water step per particle, the ratio per particle and **simulated second**
-//! (what users wait for: the water takes one 2 ms step per 2 ms, the grains `n` explicit
-//! steps), and a checksum of the grains' end positions (equal checksums mean bitwise equal
-//! runs).
+//! `examples/iisph_dambreak.rs`), 5 warm-up steps, then `3 FRAMES` timed steps. Granular, by
+//! default the same flowing scene: a granular dam break (`benches::dam_break_elastoplastic`:
+//! the same block released in the same tank, walls of three rows of no-slip boundary
+//! particles, geostatic start) at Young's modulus `E` (default 5.84·10⁵ Pa, the shipped
+//! poured heaps' modulus, at which a metre of grains strains elastically by
+//! ρ0 g H / E ≈ 0.03, far below tan φ = 0.58); with `settled`, the block held at rest in a
+//! box that fits it (`benches::settled_block_elastoplastic`, Bui's 5.84 MPa unless `E=`).
+//! Frames of 2 ms (each one substep of `n` explicit steps, `Δt ≤ C h/c`), 1 warm-up frame,
+//! then `FRAMES` timed frames (default 10). A frame starts with a reordering (every tenth)
+//! and a neighbour search; its explicit steps share the lists while no grain moves more
+//! than half the skin. Prints the wall time per explicit step over whole frames (searches
+//! included), the phases per step, per particle (grains; the boundary particles are extra
+//! work), the ratio to the water step per particle, the ratio per particle and **simulated
+//! second** (what users wait for: the water takes one 2 ms step per 2 ms, the grains `n`
+//! explicit steps), and a checksum of the grains' end positions (equal checksums mean
+//! bitwise equal runs).
 use std::time::Instant;
 
 use iisph_granular::{FluidSolver, Iisph, IisphParams, ParticleSet, Real};
@@ -73,9 +78,28 @@ struct Granular {
 /// The frames of both sides (s): the water's step, the grains' frame.
 const FRAME_S: f64 = 0.002;
 
-fn granular<R: Real>(frames: usize) -> Granular {
-    let (mut solver, mut state) =
-        benches::settled_block_elastoplastic::<R>(FRAME_S).expect("granular scene");
+/// Young's modulus of the shipped poured heaps (Pa), the flowing scene's default.
+const HEAPS_YOUNGS_MODULUS_PA: f64 = 5.84e5;
+
+/// The granular scene: the flowing dam break, or the settled block.
+#[derive(Clone, Copy)]
+enum Scene {
+    DamBreak,
+    Settled,
+}
+
+fn granular<R: Real>(frames: usize, scene: Scene, youngs_modulus_pa: Option<f64>) -> Granular {
+    let (mut solver, mut state) = match scene {
+        Scene::DamBreak => benches::dam_break_elastoplastic::<R>(
+            FRAME_S,
+            youngs_modulus_pa.unwrap_or(HEAPS_YOUNGS_MODULUS_PA),
+        ),
+        Scene::Settled => benches::settled_block_elastoplastic::<R>(
+            FRAME_S,
+            youngs_modulus_pa.unwrap_or(elastoplastic_granular::DEFAULT_YOUNGS_MODULUS_PA),
+        ),
+    }
+    .expect("granular scene");
     solver.step(&mut state).expect("granular warm-up frame");
     let (_, searches0) = solver.counts();
     let mut sum = StepStats::new(elastoplastic_granular::ELASTOPLASTIC_PHASES);
@@ -111,10 +135,10 @@ fn granular<R: Real>(frames: usize) -> Granular {
     }
 }
 
-fn run<R: Real>(frames: usize) {
+fn run<R: Real>(frames: usize, scene: Scene, youngs_modulus_pa: Option<f64>) {
     let threads = rayon::current_num_threads();
     let (w, n) = water::<R>(3 * frames);
-    let g = granular::<R>(frames);
+    let g = granular::<R>(frames, scene, youngs_modulus_pa);
     let w_pp = 1e6 * w / n as f64;
     let g_pp = 1e6 * g.per_step_s / g.grains as f64;
     println!(
@@ -159,9 +183,18 @@ fn run<R: Real>(frames: usize) {
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let frames: usize = args.first().and_then(|s| s.parse().ok()).unwrap_or(10);
-    if args.iter().any(|a| a == "f64") {
-        run::<f64>(frames);
+    let scene = if args.iter().any(|a| a == "settled") {
+        Scene::Settled
     } else {
-        run::<f32>(frames);
+        Scene::DamBreak
+    };
+    let youngs_modulus_pa = args
+        .iter()
+        .find_map(|a| a.strip_prefix("E="))
+        .map(|e| e.parse::<f64>().expect("E=PA: a number of pascals"));
+    if args.iter().any(|a| a == "f64") {
+        run::<f64>(frames, scene, youngs_modulus_pa);
+    } else {
+        run::<f32>(frames, scene, youngs_modulus_pa);
     }
 }

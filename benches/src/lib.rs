@@ -85,10 +85,11 @@ pub fn dam_break_fluid<R: Real>() -> (Vec<Vec3<R>>, Aabb<R>) {
 /// particles) held at rest: the block stands in a box that fits it (an inverted box, open
 /// above it), whose floor and sides are three rows of no-slip boundary particles
 /// (`boundary_particle_region` = the block), from the geostatic stress, frames of `frame_dt`
-/// seconds (one substep; the solver sub-cycles its explicit steps inside). Returns the solver
-/// and the grains.
+/// seconds (one substep; the solver sub-cycles its explicit steps inside), Young's modulus
+/// `youngs_modulus_pa`. Returns the solver and the grains.
 pub fn settled_block_elastoplastic<R: Real>(
     frame_dt: f64,
+    youngs_modulus_pa: f64,
 ) -> Result<
     (
         elastoplastic_granular::Elastoplastic<R>,
@@ -114,11 +115,49 @@ pub fn settled_block_elastoplastic<R: Real>(
     let mut params = ElastoplasticParams::<R>::for_spacing(R::of_f64(s), R::of_f64(30.0));
     params.common.dt = R::of_f64(frame_dt);
     params.common.substeps = 1;
+    params.youngs_modulus = R::of_f64(youngs_modulus_pa);
     params.initial_stress = InitialStress::Geostatic;
     params.boundary_particle_region = Some(block);
     let mass = params.common.particle_mass();
     let rho0 = params.common.rest_density;
     let solids: sph_solver::Solids<R> = vec![Box::new(Inverted(BoxSdf::new(container)?))];
+    let solver = elastoplastic_granular::Elastoplastic::new(params, solids)?;
+    Ok((solver, sph_core::ParticleSet::from_positions(p, mass, rho0)))
+}
+
+/// The elastic–plastic granular solver (Bui et al. 2008, `elastoplastic-granular`, its
+/// defaults for spacing 0.025 m and φ = 30°, Young's modulus `youngs_modulus_pa`) on a
+/// granular dam break: the grains of [`dam_break_fluid`] (59,319 particles, a 0.975 m cube at
+/// the tank's −x end) released in its tank, whose floor and walls are three rows of no-slip
+/// boundary particles up to 1.2 m (`boundary_particle_region`: the tank's width and length,
+/// 1.2 m high: the grains never climb higher), from the geostatic stress, frames of
+/// `frame_dt` seconds (one substep; the solver sub-cycles its explicit steps inside). The
+/// column collapses and spreads along the floor as the water's dam break does, so the
+/// neighbour lists are rebuilt as a flowing scene needs. Returns the solver and the grains.
+pub fn dam_break_elastoplastic<R: Real>(
+    frame_dt: f64,
+    youngs_modulus_pa: f64,
+) -> Result<
+    (
+        elastoplastic_granular::Elastoplastic<R>,
+        sph_core::ParticleSet<R>,
+    ),
+    sph_solver::SolverError,
+> {
+    use elastoplastic_granular::{ElastoplasticParams, InitialStress};
+    use sph_core::{BoxSdf, Inverted};
+    let s = 0.025;
+    let (p, tank) = dam_break_fluid::<R>();
+    let region = Aabb::new(tank.min, Vec3::new(tank.max.x, R::of_f64(1.2), tank.max.z))?;
+    let mut params = ElastoplasticParams::<R>::for_spacing(R::of_f64(s), R::of_f64(30.0));
+    params.common.dt = R::of_f64(frame_dt);
+    params.common.substeps = 1;
+    params.youngs_modulus = R::of_f64(youngs_modulus_pa);
+    params.initial_stress = InitialStress::Geostatic;
+    params.boundary_particle_region = Some(region);
+    let mass = params.common.particle_mass();
+    let rho0 = params.common.rest_density;
+    let solids: sph_solver::Solids<R> = vec![Box::new(Inverted(BoxSdf::new(tank)?))];
     let solver = elastoplastic_granular::Elastoplastic::new(params, solids)?;
     Ok((solver, sph_core::ParticleSet::from_positions(p, mass, rho0)))
 }
