@@ -344,25 +344,6 @@ impl GridView<'_> {
         self.tau
     }
 
-    /// The time of the retained grid state at or before `t` (the state the interpolation at
-    /// `t` starts from); errors as [`GridView::interpolate`] does.
-    pub(crate) fn grid_time_at_or_before(&self, t: f64) -> Result<f64, SymplecticError> {
-        if t > self.newest {
-            return Err(SymplecticError::BeyondEphemeris {
-                time: t,
-                newest: self.newest,
-            });
-        }
-        if !(t.is_finite() && t >= self.oldest) {
-            return Err(SymplecticError::InvalidParameter {
-                name: "ephemeris time",
-                value: t,
-                reason: "not finite, or precedes the retained window of planet states",
-            });
-        }
-        Ok(self.ephemeris.grid_time(self.grid_index(t)))
-    }
-
     /// Index of the grid point at or before `t` (rounding corrected against the grid times).
     #[inline(always)]
     fn grid_index(&self, t: f64) -> u64 {
