@@ -290,6 +290,45 @@ impl Encounter {
         }
     }
 
+    /// Converts the state of a checkpoint written before version 3 (positions of the Sun, the
+    /// planets and the particle, then their velocities) to this version's (the particle and
+    /// its `p₄`): the particle's position and velocity kept, `p₄ = −H` among `bodies` (the
+    /// ephemeris' at the encounter's time), as that version's hand-back set it. A state of
+    /// this version is left alone; one of neither layout is refused by name.
+    pub(crate) fn upgrade(
+        &mut self,
+        integrator: &ParticleIntegrator,
+        previous: &TestParticle,
+        bodies: &BodyStates,
+    ) -> Result<(), SymplecticError> {
+        let len = self.state.len();
+        if len == ENCOUNTER_STATE_LEN {
+            return Ok(());
+        }
+        let objects = len / 6;
+        if len != 6 * objects || objects != bodies.gm.len() + 1 {
+            return Err(SymplecticError::InvalidState {
+                what: "encounter state",
+                reason: format!(
+                    "{len} values: expected {ENCOUNTER_STATE_LEN} (position, velocity, p4), or \
+                     {} as written before checkpoint version 3",
+                    6 * (bodies.gm.len() + 1)
+                ),
+            });
+        }
+        let k = 3 * (objects - 1);
+        let mut p = previous.clone();
+        p.position = Vec3::from_column_slice(&self.state[k..k + 3]);
+        p.velocity = Vec3::from_column_slice(&self.state[3 * objects + k..3 * objects + k + 3]);
+        p.time = self.time;
+        p.p4 = -integrator.hamiltonian(&p, bodies);
+        self.state.clear();
+        self.state
+            .extend(p.position.iter().chain(p.velocity.iter()).copied());
+        self.state.push(p.p4);
+        Ok(())
+    }
+
     /// The particle's barycentric position and velocity.
     pub(crate) fn particle(&self) -> (Vec3, Vec3) {
         (
@@ -400,9 +439,10 @@ pub struct EncounterOutcome {
 
 /// Integrates the Sun and the planets (`bodies`: `G m` and barycentric states at
 /// `bodies.time`) and a massless particle (barycentric `position`, `velocity`) to `t_end`
-/// with the encounter integrator of a [`Population`](crate::Population) (the same steps,
-/// except the last, cut to land on `t_end`): a single encounter, for comparison with other
-/// codes.
+/// with the Bulirsch–Stoer integrator of a [`Population`](crate::Population)'s encounter
+/// mode and its tolerance (the last step cut to land on `t_end`), the bodies integrated along
+/// with the particle from exact states rather than read from an ephemeris: a single
+/// encounter, for comparison with other codes.
 pub fn integrate_through(
     bodies: &BodyStates,
     position: Vec3,

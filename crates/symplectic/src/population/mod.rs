@@ -613,61 +613,7 @@ impl Population {
         if e.version == 1 {
             population.keep_version_1_hand_back();
         }
-        if e.version <= 2 {
-            population.convert_version_2_encounters().map_err(|err| {
-                SymplecticError::Checkpoint {
-                    path: path.display().to_string(),
-                    reason: format!("a version {} encounter state: {err}", e.version),
-                }
-            })?;
-        }
-        let state_len = crate::encounter::ENCOUNTER_STATE_LEN;
-        if let Some(m) = population.members.iter().find(|m| {
-            m.encounter
-                .as_ref()
-                .is_some_and(|e| e.state.len() != state_len)
-        }) {
-            return Err(SymplecticError::Checkpoint {
-                path: path.display().to_string(),
-                reason: format!(
-                    "particle {}: an encounter state of {} values, expected {state_len}",
-                    m.id,
-                    m.encounter.as_ref().map_or(0, |e| e.state.len())
-                ),
-            });
-        }
         Ok(population)
-    }
-
-    /// Members of a version 1 or 2 checkpoint in the encounter mode, whose state held the Sun,
-    /// the planets (integrated from a grid state) and the particle: the particle's position
-    /// and velocity kept, with `p₄ = −H` among the ephemeris' planets at its time (as the old
-    /// hand-back set it), to go on among the ephemeris' planets.
-    fn convert_version_2_encounters(&mut self) -> Result<(), SymplecticError> {
-        let mut bodies = BodyStates::default();
-        for m in &mut self.members {
-            let Some(e) = m.encounter.as_deref_mut() else {
-                continue;
-            };
-            let objects = e.state.len() / 6;
-            if e.state.len() != 6 * objects || objects < 2 {
-                return Err(SymplecticError::InvalidState {
-                    what: "encounter state",
-                    reason: format!("particle {}: {} values", m.id, e.state.len()),
-                });
-            }
-            let k = 3 * (objects - 1);
-            let position = Vec3::from_column_slice(&e.state[k..k + 3]);
-            let velocity = Vec3::from_column_slice(&e.state[3 * objects + k..3 * objects + k + 3]);
-            self.ephemeris.interpolate(e.time, &mut bodies, false)?;
-            let mut p = m.particle.clone();
-            (p.position, p.velocity, p.time) = (position, velocity, e.time);
-            let p4 = -self.integrator.hamiltonian(&p, &bodies);
-            e.state = position.iter().chain(velocity.iter()).copied().collect();
-            e.state.push(p4);
-            m.particle.p4 = p4;
-        }
-        Ok(())
     }
 
     /// A population of a version 1 checkpoint, whose encounter settings had no hand-back
@@ -682,7 +628,9 @@ impl Population {
 
 const POPULATION_FORMAT: &str = "symplectic-population";
 /// 2: [`Encounters::hand_back_hill_factor`] and [`PopulationMember::encounters_begun`];
-/// 3: [`Encounter::state`](crate::Encounter) holds the particle only (and its `p₄`).
+/// 3: [`Encounter::state`](crate::Encounter) holds the particle only (and its `p₄`); an
+/// encounter state of an older file (the Sun, the planets and the particle) is converted
+/// when the member next steps.
 const POPULATION_VERSION: u32 = 3;
 
 /// [`Envelope`] as written, borrowing the population (no copy of it).

@@ -7,7 +7,9 @@ use std::collections::VecDeque;
 use rayon::prelude::*;
 
 use super::members::{PopulationMember, RemovalRules};
-use crate::encounter::{regularisation, Encounter, EncounterScratch, Encounters};
+use crate::encounter::{
+    regularisation, Encounter, EncounterScratch, Encounters, ENCOUNTER_STATE_LEN,
+};
 use crate::ephemeris::{BodyStates, Ephemeris, GridView};
 use crate::lanes::{self, norm, norm_squared, KickLanes, Mask, LANES, V, V3};
 use crate::particles::ParticlePiece;
@@ -688,6 +690,16 @@ impl WindowContext<'_> {
             let Some(e) = m.encounter.as_deref_mut() else {
                 break;
             };
+            if e.state.len() != ENCOUNTER_STATE_LEN {
+                // A state of an older checkpoint.
+                let upgraded = self
+                    .grid
+                    .interpolate(e.time, &mut w.bodies, false)
+                    .and_then(|()| e.upgrade(&self.integrator, &m.particle, &w.bodies));
+                if let Err(err) = upgraded {
+                    return self.encounter_failed(m, err, steps);
+                }
+            }
             if e.steps > 0 && e.time >= e.earliest_hand_back {
                 if w.bodies_time != e.time {
                     if let Err(err) = self.grid.interpolate(e.time, &mut w.bodies, false) {
