@@ -245,12 +245,15 @@ fn midpoint(
 }
 
 /// `max_i |a_i − b_i| / (tol · s_i)` with `s_i` the length of the 3-vector (one object's
-/// position or velocity) that component `i` belongs to, in the layout of [`derivative`]; a
-/// remainder shorter than 3 (the encounter mode's `p₄`) is its own vector.
+/// position or velocity) that component `i` belongs to, in the layout of [`derivative`]. A
+/// remainder shorter than 3 (the encounter mode's `p₄`, a quadrature along the trajectory
+/// the vectors control) is extrapolated with them but not controlled: its own size is no
+/// scale (it passes through zero when a close encounter turns the comet's barycentric
+/// energy round, and a relative test there would stall the step).
 fn scaled_difference(a: &[f64], b: &[f64], tolerance: f64) -> f64 {
     let mut worst = 0.0f64;
-    for (va, vb) in a.chunks(3).zip(b.chunks(3)) {
-        let scale = va.iter().map(|x| x * x).sum::<f64>().sqrt() * tolerance;
+    for (va, vb) in a.chunks_exact(3).zip(b.chunks_exact(3)) {
+        let scale = (va[0] * va[0] + va[1] * va[1] + va[2] * va[2]).sqrt() * tolerance;
         for (x, z) in va.iter().zip(vb) {
             let d = (x - z).abs();
             // An object at rest at the origin (a zero vector) converges when its difference is 0.
