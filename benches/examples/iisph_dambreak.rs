@@ -113,15 +113,10 @@ fn run<R: Real>(steps: usize, granular: bool) {
         last.max_density_ratio, last.mean_density_ratio, last.last_solve_error, last.neighbour_pairs
     );
     println!("max rho/rho0 over all steps {max_ratio:.5}");
-    // FNV-1a of the end positions' bits: equal checksums mean bitwise equal runs.
-    let checksum = state
-        .positions
-        .iter()
-        .flat_map(|x| [x.x, x.y, x.z])
-        .fold(0xcbf2_9ce4_8422_2325u64, |h, c| {
-            (h ^ c.as_f64().to_bits()).wrapping_mul(0x0000_0100_0000_01b3)
-        });
+    // Equal checksums mean bitwise equal runs.
+    let (checksum, rest) = benches::state_checksums(&state);
     println!("end positions checksum: {checksum:016x}");
+    println!("end velocities and densities checksum: {rest:016x}");
 }
 
 fn main() {

@@ -153,4 +153,8 @@ fn main() {
         "end: max rho/rho0 {:.5}, mean rho/rho0 {:.5}, last iteration's mean compression {:.5}, neighbour pairs {}",
         last.max_density_ratio, last.mean_density_ratio, last.last_solve_error, last.neighbour_pairs
     );
+    // Equal checksums mean bitwise equal runs.
+    let (positions, rest) = benches::state_checksums(&state);
+    println!("end positions checksum: {positions:016x}");
+    println!("end velocities and densities checksum: {rest:016x}");
 }

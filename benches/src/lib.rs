@@ -166,6 +166,7 @@ pub fn scattered_disk_population(
         hill_factor: Some(1.0),
         min_perihelion: Some(26.0),
         ejection_distance: Some(1000.0),
+        ..RemovalRules::default()
     };
     let population = Population::new(
         ephemeris,
@@ -242,6 +243,7 @@ pub fn centaur_population(
         hill_factor: None,
         min_perihelion: Some(2.5),
         ejection_distance: Some(100.0),
+        ..RemovalRules::default()
     };
     let mut population = Population::with_first_steps(
         ephemeris,
@@ -296,4 +298,18 @@ pub fn write_comet_states(
         row(&mut out, "particle", i, 0.0, q, v);
     }
     std::fs::write(path, out)
+}
+
+/// FNV-1a checksums of a state's bits: `(positions, velocities and densities)`. Equal
+/// checksums mean bitwise equal runs (the dam-break examples print them).
+pub fn state_checksums<R: Real>(state: &sph_core::ParticleSet<R>) -> (u64, u64) {
+    let fnv = |h: u64, c: R| (h ^ c.as_f64().to_bits()).wrapping_mul(0x0000_0100_0000_01b3);
+    let start = 0xcbf2_9ce4_8422_2325u64;
+    let components = |v: &[Vec3<R>]| v.iter().flat_map(|x| [x.x, x.y, x.z]).collect::<Vec<R>>();
+    let positions = components(&state.positions).into_iter().fold(start, fnv);
+    let rest = components(&state.velocities)
+        .into_iter()
+        .chain(state.densities.iter().copied())
+        .fold(start, fnv);
+    (positions, rest)
 }

@@ -1,5 +1,6 @@
 //! `particles comets POPULATION.toml [--out DIR]`: a population study of test particles among
-//! the planets ([`symplectic::study::run_study`]): snapshots and a final table in Parquet,
+//! the planets ([`symplectic::study::run_study`]): snapshots, a final table and an events
+//! table in Parquet,
 //! checkpoints, resumed bit for bit by running the same command again.
 
 use std::path::PathBuf;
@@ -8,14 +9,14 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use symplectic::io::{PopulationSpec, DAYS_PER_YEAR};
-use symplectic::study::{run_study, FINAL_TABLE, SNAPSHOT_DIR};
+use symplectic::study::{run_study, EVENTS_TABLE, FINAL_TABLE, SNAPSHOT_DIR};
 use symplectic::SymplecticError;
 
 /// Arguments of `particles comets`.
 #[derive(clap::Args)]
 pub struct CometsArgs {
     /// The population specification (TOML: `[planets]`, `[integrator]`, `[particles]`,
-    /// `[span]`, `[removal]`; see `populations/scattered-disk.toml`).
+    /// `[span]`, `[removal]`, `[encounters]`, `[events]`; see `populations/scattered-disk.toml`).
     pub population: PathBuf,
     /// Output directory [default: comets-STEM in the current directory, STEM the TOML file name without .toml]. If
     /// it holds a checkpoint of the same specification, the study resumes from it.
@@ -81,7 +82,7 @@ pub fn run(args: &CometsArgs) -> Result<()> {
     bar.finish();
     let p = summary.progress;
     println!(
-        "{}: {} particles active, {} removed; {} particle steps; {} switches to the encounter integrator; {}{} snapshots written to {}, final table {}",
+        "{}: {} particles active, {} removed; {} particle steps; {} switches to the encounter integrator; {}{} snapshots written to {}, final table {}, {} events to {}{}",
         args.population.display(),
         p.active,
         p.removed,
@@ -91,6 +92,16 @@ pub fn run(args: &CometsArgs) -> Result<()> {
         summary.snapshots_written,
         out.join(SNAPSHOT_DIR).display(),
         out.join(FINAL_TABLE).display(),
+        summary.events,
+        out.join(EVENTS_TABLE).display(),
+        if summary.events_dropped > 0 {
+            format!(
+                " ({} more not kept: logs full, see events.max_per_particle)",
+                summary.events_dropped
+            )
+        } else {
+            String::new()
+        },
     );
     Ok(())
 }

@@ -98,9 +98,22 @@ class PopulationSpec:
     window_steps : int, optional
         Planet steps per synchronisation window (the crate's default if None).
     removal : dict
-        ``hill_factor``, ``min_perihelion`` (AU), ``ejection_distance`` (AU); a rule left out
-        is not applied. A particle that enters ``hill_factor`` Hill radii of a planet stops
-        with the status ``hill_sphere_<planet>`` (``hill_sphere_Jupiter`` ...).
+        ``hill_factor``, ``min_perihelion`` (AU), ``ejection_distance`` (AU, unbound only),
+        ``sun_collision`` (bool: closer than the IAU nominal solar radius, or past a perihelion
+        below it within the last step), ``min_distance`` and ``max_distance`` (dicts
+        ``{"distance": AU, "frame": "heliocentric" or "barycentric"}``; the maximum applies
+        bound or not); a rule left out is not applied. A particle that enters
+        ``hill_factor`` Hill radii of a planet stops with the status ``hill_sphere_<planet>``
+        (``hill_sphere_Jupiter`` ...); the others with ``perihelion``, ``ejected``,
+        ``collision_sun``, ``min_distance_<frame>``, ``max_distance_<frame>``.
+    events : dict
+        What is recorded without removing (the ``[events]`` table of a population file):
+        ``perihelion_below`` (list of AU: the first time the perihelion falls below each),
+        ``tisserand_crossing`` (bool: the first crossing of T_J = 3),
+        ``close_approach`` (``{"hill_radii": f}`` or ``{"au": r}``: each passage inside that
+        radius of a planet, with the smallest distance and its time), ``max_per_particle``
+        (events kept per particle, default 1000; more are counted in the table's
+        ``events_dropped``). Read them with :meth:`Population.events_table`.
     encounters : dict or None
         Integrate the particles through close encounters instead of removing them (the
         ``[encounters]`` table of a population file): ``{}`` takes the defaults, or give
@@ -130,8 +143,9 @@ class PopulationSpec:
     initial_step_days: float = 547.875
     epoch_days: float = 0.0
     window_steps: Optional[int] = None
-    removal: Dict[str, float] = field(default_factory=dict)
+    removal: Dict[str, Any] = field(default_factory=dict)
     encounters: Optional[Dict[str, float]] = None
+    events: Dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         self.particles = _float_rows(self.particles)
@@ -166,7 +180,8 @@ class PopulationSpec:
                 "epoch_days": _number("epoch_days", self.epoch_days),
             },
             "span": {"years": 1.0, "snapshot_every_years": 1.0},
-            "removal": {k: _number(f"removal[{k!r}]", v) for k, v in dict(self.removal).items()},
+            "removal": {k: _setting(f"removal[{k!r}]", v) for k, v in dict(self.removal).items()},
+            "events": {k: _setting(f"events[{k!r}]", v) for k, v in dict(self.events).items()},
         }
         if self.encounters is not None:
             spec["encounters"] = {
@@ -400,6 +415,18 @@ class Population:
         ``polars.read_parquet``)."""
         self._inner.write_parquet(str(path))
 
+    def events_table(self) -> Dict[str, Union[np.ndarray, List[str]]]:
+        """The events so far (the study's ``events.parquet``) as a dict, one row per event:
+        ``id``, ``event`` (``perihelion_below``, ``tisserand_crossing``, ``close_approach``),
+        ``time_days``, ``threshold_au``, ``perihelion_au``, ``tisserand_before``,
+        ``tisserand_after``, ``planet``, ``min_distance_au``, ``radius_au`` (NaN where a
+        column does not apply) and ``ongoing`` (a close approach still under way)."""
+        return self._inner.events_table()
+
+    def write_events_parquet(self, path: str) -> None:
+        """Writes the events table as Parquet."""
+        self._inner.write_events_parquet(str(path))
+
     def shard(self, start: int, stop: int) -> "Population":
         """Members ``start:stop`` as a population of their own."""
         return Population._wrap(self._inner.shard(int(start), int(stop)))
@@ -429,6 +456,23 @@ def _number(name: str, value: Any) -> float:
     if not np.isfinite(x):
         raise _partisim.PartisimError(f"PopulationSpec {name} = {x}: must be a finite number")
     return x
+
+
+def _setting(name: str, value: Any) -> Any:
+    """A rule's value for JSON: a bool kept, a number as :func:`_number`, a dict or a list
+    converted item by item (named ``name[key]``, ``name[index]``)."""
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, str):
+        return value
+    if isinstance(value, (int, np.integer)):
+        # An integer stays one (``max_per_particle``); a float field takes it as well.
+        return int(value)
+    if isinstance(value, dict):
+        return {k: _setting(f"{name}[{k!r}]", v) for k, v in value.items()}
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return [_setting(f"{name}[{i}]", v) for i, v in enumerate(value)]
+    return _number(name, value)
 
 
 def _integer(name: str, value: Any) -> int:

@@ -7,7 +7,9 @@ use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, P
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
-use symplectic::io::{population_table, status_label, write_parquet, ParticleRow, PopulationSpec};
+use symplectic::io::{
+    events_table, population_table, status_label, write_parquet, ParticleRow, PopulationSpec,
+};
 use symplectic::Population as RustPopulation;
 
 use crate::arrays::{check_shape, is_f64, untyped};
@@ -69,7 +71,11 @@ fn python_setting(field: &str) -> String {
         ("planets", "step_days") => "planet_step_days".into(),
         ("planets", "scheme") => "planet_scheme".into(),
         ("planets", "frame") => "frame".into(),
-        ("removal", k) | ("encounters", k) if !k.is_empty() => format!("{table}[{k:?}]"),
+        ("removal", k) | ("encounters", k) | ("events", k) if !k.is_empty() => {
+            // `removal.min_distance.distance` as `removal["min_distance"]["distance"]`.
+            let keys: String = k.split('.').map(|part| format!("[{part:?}]")).collect();
+            format!("{table}{keys}")
+        }
         (_, "") => table.into(),
         (_, k) => k.into(),
     }
@@ -285,23 +291,21 @@ impl Population {
     /// `in_encounter` booleans, `encounters_begun` integers).
     fn table<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let batch = population_table(&self.inner).map_err(rust_err)?;
-        let d = PyDict::new(py);
-        let schema = batch.schema();
-        for (field, col) in schema.fields().iter().zip(batch.columns()) {
-            let any = col.as_any();
-            if let Some(a) = any.downcast_ref::<arrow_array::Float64Array>() {
-                d.set_item(field.name(), a.values().to_vec().into_pyarray(py))?;
-            } else if let Some(a) = any.downcast_ref::<arrow_array::UInt64Array>() {
-                d.set_item(field.name(), a.values().to_vec().into_pyarray(py))?;
-            } else if let Some(a) = any.downcast_ref::<arrow_array::StringArray>() {
-                let v: Vec<&str> = a.iter().map(|s| s.unwrap_or("")).collect();
-                d.set_item(field.name(), v)?;
-            } else if let Some(a) = any.downcast_ref::<arrow_array::BooleanArray>() {
-                let v: Vec<bool> = a.iter().map(|b| b.unwrap_or(false)).collect();
-                d.set_item(field.name(), v.into_pyarray(py))?;
-            }
-        }
-        Ok(d)
+        batch_dict(py, &batch)
+    }
+
+    /// The events table (`symplectic::io::events_table`, the study's `events.parquet`) as a
+    /// dict of numpy arrays (`event` and `planet` lists of str, `ongoing` booleans).
+    fn events_table<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let batch = events_table(&self.inner).map_err(rust_err)?;
+        batch_dict(py, &batch)
+    }
+
+    /// Writes the events table as Parquet, atomically.
+    fn write_events_parquet(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        let inner = &self.inner;
+        py.detach(|| events_table(inner).and_then(|b| write_parquet(&path, &b)))
+            .map_err(rust_err)
     }
 
     /// Writes the snapshot table as Parquet (readable by pandas and polars), atomically.
@@ -470,6 +474,30 @@ impl Population {
         }
         Ok((flat, times))
     }
+}
+
+/// The columns of `batch` as a dict: numpy arrays of `f64`, `u64` and `bool`, lists of str.
+fn batch_dict<'py>(
+    py: Python<'py>,
+    batch: &arrow_array::RecordBatch,
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let schema = batch.schema();
+    for (field, col) in schema.fields().iter().zip(batch.columns()) {
+        let any = col.as_any();
+        if let Some(a) = any.downcast_ref::<arrow_array::Float64Array>() {
+            d.set_item(field.name(), a.values().to_vec().into_pyarray(py))?;
+        } else if let Some(a) = any.downcast_ref::<arrow_array::UInt64Array>() {
+            d.set_item(field.name(), a.values().to_vec().into_pyarray(py))?;
+        } else if let Some(a) = any.downcast_ref::<arrow_array::StringArray>() {
+            let v: Vec<&str> = a.iter().map(|s| s.unwrap_or("")).collect();
+            d.set_item(field.name(), v)?;
+        } else if let Some(a) = any.downcast_ref::<arrow_array::BooleanArray>() {
+            let v: Vec<bool> = a.iter().map(|b| b.unwrap_or(false)).collect();
+            d.set_item(field.name(), v.into_pyarray(py))?;
+        }
+    }
+    Ok(d)
 }
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -16,7 +16,7 @@
 
 use sph_core::{Aabb, Real, Sdf, Vec3};
 use sph_solver::boundary::WallLattice;
-use sph_solver::SolverError;
+use sph_solver::{Dimensions, SolverError};
 
 use crate::name::NAME;
 use crate::params::{ElastoplasticParams, MovingWall, WallModel, BOUNDARY_PARTICLE_ROWS};
@@ -40,7 +40,8 @@ pub fn boundary_block<R: Real>(
 
 /// The wall lattice of `params`: the particle lattice (spacing
 /// `params.common.particle_spacing`) over `params.boundary_particle_region` extended by
-/// [`BOUNDARY_PARTICLE_ROWS`] spacings off the periodic axes; `None` without a region.
+/// [`BOUNDARY_PARTICLE_ROWS`] spacings off the periodic axes, cut to the plane `z = 0` in a
+/// planar run ([`ElastoplasticParams::dimensions`]); `None` without a region.
 pub fn wall_lattice<R: Real>(
     params: &ElastoplasticParams<R>,
 ) -> Result<Option<WallLattice<R>>, SolverError> {
@@ -48,13 +49,18 @@ pub fn wall_lattice<R: Real>(
         .boundary_particle_region
         .as_ref()
         .map(|region| {
-            WallLattice::new(
+            let lattice = WallLattice::new(
                 NAME,
                 region,
                 params.common.particle_spacing,
                 BOUNDARY_PARTICLE_ROWS,
                 &params.periodic,
-            )
+            )?;
+            if params.dimensions == Dimensions::Two {
+                lattice.in_plane(2, R::zero())
+            } else {
+                Ok(lattice)
+            }
         })
         .transpose()
 }

@@ -2,7 +2,7 @@
 
 use sph_core::{Aabb, Real, Vec3};
 use sph_solver::scene_boundary::{PeriodicAxis, Pour};
-use sph_solver::{CommonParams, SolverError};
+use sph_solver::{CommonParams, Dimensions, SolverError};
 
 use crate::name::NAME;
 use crate::stress::{ConeMatch, DruckerPrager};
@@ -117,6 +117,7 @@ pub enum InitialStress {
 /// | `moving_walls` | none | |
 /// | `pour` | none | |
 /// | `initial_stress` | none | |
+/// | `dimensions` | 3 | |
 #[derive(Debug, Clone, PartialEq)]
 pub struct ElastoplasticParams<R: Real> {
     /// The parameters every solver has.
@@ -188,6 +189,14 @@ pub struct ElastoplasticParams<R: Real> {
     pub pour: Option<Pour<R>>,
     /// The stress the particles start from.
     pub initial_stress: InitialStress,
+    /// Three dimensions, or the plane `z = 0` ([`Dimensions::Two`]: a plane-strain run, as
+    /// Bui et al. (2008) compute theirs). In the plane every particle lies at `z = 0`, the
+    /// kernel is the cubic B-spline normalised in 2D over the thickness of one spacing
+    /// (grains keep the mass `ρ0 s³`), walls are boundary particles in the plane (no volume
+    /// maps), gravity lies in the plane and no axis but `x` and `y` is periodic. The velocity
+    /// gradient then has no `z` row or column, so the stress update is the plane-strain one
+    /// (`ε̇_zz = 0`, `σ_zz` from the constitutive law).
+    pub dimensions: Dimensions,
 }
 
 fn invalid(name: &'static str, value: f64, reason: &'static str) -> SolverError {
@@ -238,6 +247,7 @@ impl<R: Real> ElastoplasticParams<R> {
             moving_walls: Vec::new(),
             pour: None,
             initial_stress: InitialStress::None,
+            dimensions: Dimensions::Three,
         }
     }
 
@@ -443,6 +453,22 @@ impl<R: Real> ElastoplasticParams<R> {
             )?;
             if !f(a.lo).is_finite() {
                 return Err(invalid("periodic", f(a.lo), "the lower end must be finite"));
+            }
+        }
+        if self.dimensions == Dimensions::Two {
+            if self.common.gravity.z != R::zero() {
+                return Err(invalid(
+                    "gravity",
+                    f(self.common.gravity.z),
+                    "a planar run (dimensions = 2) needs gravity in the plane z = 0 (value: its z component)",
+                ));
+            }
+            if self.periodic.iter().any(|a| a.axis == 2) {
+                return Err(invalid(
+                    "periodic",
+                    2.0,
+                    "a planar run (dimensions = 2) has no periodic z axis: the plane is its section",
+                ));
             }
         }
         let (n, _) = self.explicit_steps();

@@ -7,6 +7,7 @@ use rayon::prelude::*;
 use sph_core::{Real, Vec3};
 use sph_kernels::Kernel;
 use sph_solver::boundary::Boundary;
+use sph_solver::csr::par_csr_blocks;
 use sph_solver::step::MIN_LEN;
 use sph_solver::NeighbourLists;
 
@@ -17,8 +18,8 @@ use crate::stress::artificial_stress;
 use crate::walls::{wall_part, WallSampler};
 
 /// What the passes read besides the scratch arrays.
-pub(crate) struct StepInputs<'a, R: Real> {
-    pub c: Consts<R>,
+pub(crate) struct StepInputs<'a, R: Real, K> {
+    pub c: Consts<R, K>,
     pub masses: &'a [R],
     pub nb: &'a NeighbourLists,
     pub boundary: &'a dyn Boundary<R>,
@@ -31,7 +32,7 @@ pub(crate) struct StepInputs<'a, R: Real> {
     pub boundary_mass: R,
 }
 
-impl<R: Real> StepInputs<'_, R> {
+impl<R: Real, K> StepInputs<'_, R, K> {
     #[inline]
     fn mass(&self, j: usize) -> R {
         self.masses.get(j).copied().unwrap_or(self.boundary_mass)
@@ -43,7 +44,10 @@ impl<R: Real> StepInputs<'_, R> {
 /// grain's density becomes the kernel sum over itself, its grain neighbours and the boundary
 /// particles, normalised by the full lattice's, floored at `ρ0` (free surface, separated
 /// grains).
-pub(crate) fn reinitialise_density<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>) {
+pub(crate) fn reinitialise_density<R: Real, K: Kernel<R>>(
+    s: &mut Scratch<R>,
+    inp: &StepInputs<'_, R, K>,
+) {
     let c = inp.c;
     let n = inp.masses.len();
     let h2 = c.support2_above;
@@ -68,15 +72,50 @@ pub(crate) fn reinitialise_density<R: Real>(s: &mut Scratch<R>, inp: &StepInputs
         });
 }
 
+/// The kernel gradient `∇_i W_ij` of every grain's listed pair, in the lists' CSR order
+/// (zero beyond the support): computed once per explicit step and read by both passes.
+pub(crate) fn pair_gradients<R: Real, K: Kernel<R>>(
+    s: &mut Scratch<R>,
+    inp: &StepInputs<'_, R, K>,
+) {
+    let n = inp.masses.len();
+    let offsets = &inp.nb.offsets()[..=n];
+    let pairs = offsets[n];
+    s.pair_grad.resize(pairs, Vec3::zeros());
+    let (x, images, h2, kernel) = (&s.x[..], &s.images, inp.c.support2_above, inp.c.kernel);
+    let mut grains = vec![(); n];
+    par_csr_blocks(
+        offsets,
+        &mut grains[..],
+        &mut s.pair_grad[..pairs],
+        &|first, grains: &mut [()], out: &mut [Vec3<R>]| {
+            let base = offsets[first];
+            for i in first..first + grains.len() {
+                let xi = x[i];
+                let at = offsets[i] - base;
+                for (k, &j) in inp.nb.neighbours(i).iter().enumerate() {
+                    let (_, xj) = images.resolve(j as usize, x);
+                    let xij = xi - xj;
+                    out[at + k] = if xij.norm_squared() > h2 {
+                        Vec3::zeros()
+                    } else {
+                        kernel.gradient(&xij)
+                    };
+                }
+            }
+            0.0
+        },
+    );
+}
+
 /// Pass 1: the wall gradients at `x`, the velocity gradient `L_i` and the continuity rate
 /// from `x`, `v`, `ρ`; the stress update (rate and return, [`crate::DruckerPrager::update`];
 /// zero for a particle without granular neighbours inside the support), the density and
 /// plastic strain after `Δt`, and the artificial stress of the new stress.
-pub(crate) fn stress_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>) {
+pub(crate) fn stress_pass<R: Real, K: Kernel<R>>(s: &mut Scratch<R>, inp: &StepInputs<'_, R, K>) {
     let c = inp.c;
     let slots = inp.models.len();
     let n = inp.masses.len();
-    let h2 = c.support2_above;
     // `m_j / ρ_j` of every neighbour, once per particle rather than once per pair (the
     // boundary particles' stays `m_b / ρ0` from `Scratch::resize`).
     s.volume[..n]
@@ -86,6 +125,7 @@ pub(crate) fn stress_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>) 
         .for_each(|(vol, (&m, &r))| *vol = m / r);
     let (x, v, rho, volume) = (&s.x[..], &s.v[..], &s.rho[..], &s.volume[..]);
     let (stress, plastic, images) = (&s.stress[..], &s.plastic_strain[..], &s.images);
+    let (grad, offsets) = (&s.pair_grad[..], inp.nb.offsets());
     s.stress_new[..n]
         .par_iter_mut()
         .zip(s.rho_new[..n].par_iter_mut())
@@ -102,18 +142,14 @@ pub(crate) fn stress_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>) 
                 let mut grad_v = Matrix3::zeros();
                 let mut drho = R::zero();
                 let mut in_contact = false;
-                for &j in inp.nb.neighbours(i) {
-                    let (j, xj) = images.resolve(j as usize, x);
-                    let xij = xi - xj;
-                    // Beyond the support (the lists' skin): a zero gradient, whose terms
+                let grad_i = &grad[offsets[i]..offsets[i + 1]];
+                for (&j, &gw) in inp.nb.neighbours(i).iter().zip(grad_i) {
+                    // Beyond the support (the lists' skin) the gradient is zero, whose terms
                     // would add zeros.
-                    if xij.norm_squared() > h2 {
-                        continue;
-                    }
-                    let gw = c.kernel.gradient(&xij);
                     if gw == Vec3::zeros() {
                         continue;
                     }
+                    let (j, _) = images.resolve(j as usize, x);
                     in_contact |= j < n && j != i;
                     let dv = v[j] - vi;
                     grad_v += dv * gw.transpose() * volume[j];
@@ -149,15 +185,15 @@ pub(crate) fn stress_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>) 
 /// Pass 2: the acceleration from the new stresses (with the artificial viscosity and
 /// stress and the walls' share), the velocity and position after `Δt` (symplectic Euler),
 /// the position projected out of the solids and the velocity corrected by that projection.
-pub(crate) fn momentum_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>) {
+pub(crate) fn momentum_pass<R: Real, K: Kernel<R>>(s: &mut Scratch<R>, inp: &StepInputs<'_, R, K>) {
     let c = inp.c;
     let slots = inp.models.len();
     let n = inp.masses.len();
-    let h2 = c.support2_above;
     let (x, v) = (&s.x[..], &s.v[..]);
     let (sig, rho, art, grads) = (&s.stress_new[..], &s.rho_new[..], &s.art[..], &s.wall_grad);
     let (sig_rho2, art_on) = (&s.stress_over_rho2[..], &s.art_on[..]);
     let images = &s.images;
+    let (grad, offsets) = (&s.pair_grad[..], inp.nb.offsets());
     let two = R::of_f64(2.0);
     let half = R::of_f64(0.5);
     let inv_dt = R::one() / inp.dt;
@@ -172,16 +208,13 @@ pub(crate) fn momentum_pass<R: Real>(s: &mut Scratch<R>, inp: &StepInputs<'_, R>
             let art_i = art[i];
             let art_i_on = art_on[i];
             let mut a = inp.gravity;
-            for &j in inp.nb.neighbours(i) {
-                let (j, xj) = images.resolve(j as usize, x);
-                let xij = xi - xj;
-                if xij.norm_squared() > h2 {
-                    continue;
-                }
-                let gw = c.kernel.gradient(&xij);
+            let grad_i = &grad[offsets[i]..offsets[i + 1]];
+            for (&j, &gw) in inp.nb.neighbours(i).iter().zip(grad_i) {
                 if gw == Vec3::zeros() {
                     continue;
                 }
+                let (j, xj) = images.resolve(j as usize, x);
+                let xij = xi - xj;
                 let rj = rho[j];
                 let mut t = si + sig_rho2[j];
                 // Monaghan's artificial viscosity, for approaching pairs (`Π_ij > 0`: only

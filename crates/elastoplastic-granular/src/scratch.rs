@@ -31,6 +31,9 @@ pub(crate) struct Scratch<R: Real> {
     pub art_on: Vec<bool>,
     /// `m_j/ρ_j` of the step's densities (the velocity gradient's volume).
     pub volume: Vec<R>,
+    /// The kernel gradient of each grain's listed pair (CSR order of the neighbour lists),
+    /// once per explicit step for both passes.
+    pub pair_grad: Vec<Vec3<R>>,
     /// The boundary particles' grain neighbours and Shepard weights.
     pub boundary_lists: BoundaryLists<R>,
     pub x_new: Vec<Vec3<R>>,

@@ -81,6 +81,9 @@ impl SolverSettings for ElastoplasticSettings {
         pour: true,
     };
 
+    /// Plane-strain runs in the plane `z = 0` ([`ElastoplasticParams::dimensions`]).
+    const PLANAR: bool = true;
+
     /// Friction angle [`WITH_COMMON_FRICTION_ANGLE_DEG`], every other setting the default.
     fn with_common(common: CommonSettings, _iterations: usize) -> Self {
         Self {
@@ -156,6 +159,7 @@ impl SolverSettings for ElastoplasticSettings {
         if let Some(s) = self.initial_stress {
             p.initial_stress = s;
         }
+        p.dimensions = scene.dimensions;
         p
     }
 
@@ -274,6 +278,7 @@ impl<R: Real> ElastoplasticParams<R> {
                 })
                 .transpose()?,
             initial_stress: self.initial_stress,
+            dimensions: self.dimensions,
         })
     }
 }

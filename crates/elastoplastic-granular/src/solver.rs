@@ -7,22 +7,22 @@ use std::time::Instant;
 
 use nalgebra::Matrix3;
 use sph_core::{apply_permutation, ParticleSet, Real, Vec3};
-use sph_kernels::KernelKind;
+use sph_kernels::{Kernel, KernelKind};
 use sph_solver::boundary::{check_volume_kernel, VolumeMapBoundary};
 use sph_solver::scene_boundary::{PeriodicAxis, Pour};
 use sph_solver::state::{match_arrays, ArraySpec};
 use sph_solver::step::{blow_up, check_divergence, FramePhases, StepAt};
-use sph_solver::{FrameSolver, SchemeParts, SolverError, StepStats, SubstepScheme};
+use sph_solver::{Dimensions, FrameSolver, SchemeParts, SolverError, StepStats, SubstepScheme};
 
 use sph_solver::boundary::wall_extrapolation::{extrapolate, Extrapolation};
 use sph_solver::boundary::{BoundaryParticle, MAX_BOUNDARY_PARTICLES};
 
 use crate::boundary_particles::{sample_moving_wall, sample_solids};
-use crate::kernels::{Consts, ELASTOPLASTIC_KERNEL};
+use crate::kernels::{Consts, SpaceConsts, ELASTOPLASTIC_KERNEL};
 use crate::params::{ElastoplasticParams, InitialStress, WallModel};
 use crate::passes::{
-    boundary_pair_terms, max_displacement, momentum_pass, reinitialise_density, stress_pass,
-    StepInputs,
+    boundary_pair_terms, max_displacement, momentum_pass, pair_gradients, reinitialise_density,
+    stress_pass, StepInputs,
 };
 use crate::scratch::Scratch;
 use crate::stress::artificial_stress;
@@ -62,7 +62,7 @@ pub type Elastoplastic<R> = FrameSolver<R, ElastoplasticScheme<R>>;
 /// The time step of [`Elastoplastic`] as a [`SubstepScheme`].
 pub struct ElastoplasticScheme<R: Real> {
     params: ElastoplasticParams<R>,
-    c: Consts<R>,
+    c: SpaceConsts<R>,
     parts: SchemeParts<R>,
     walls: WallSampler<R>,
     models: Vec<WallModel>,
@@ -115,6 +115,16 @@ impl<R: Real> ElastoplasticScheme<R> {
             .chain(&params.wall_models)
             .any(|m| matches!(m, WallModel::Coulomb(_)));
         let particle_walls = params.boundary_particle_region.is_some();
+        let planar_volume =
+            matches!(walls, WallSampler::PerSolid(_)) || parts.boundary.has_volume();
+        if params.dimensions == Dimensions::Two && planar_volume {
+            return Err(SolverError::InvalidParameter {
+                solver: NAME,
+                name: "dimensions",
+                value: 2.0,
+                reason: "a planar run takes walls of boundary particles (boundary_particle_region), not volume maps, which are integrated in 3D",
+            });
+        }
         if coulomb && !particle_walls {
             return Err(SolverError::InvalidParameter {
                 solver: NAME,
@@ -184,7 +194,7 @@ impl<R: Real> ElastoplasticScheme<R> {
             });
         }
         let mut scheme = Self {
-            c: Consts::new(&params)?,
+            c: SpaceConsts::new(&params)?,
             initial_stress_pending: params.initial_stress == InitialStress::Geostatic,
             params,
             parts,
@@ -448,6 +458,84 @@ impl<R: Real> ElastoplasticScheme<R> {
         &self.models
     }
 
+    /// One explicit step (number `k` of the substep, `Δt = dt`) of the `n` particles of
+    /// `state` with the kernel and constants `c`: the density re-initialisation when due,
+    /// the boundary particles' extrapolations, the stress and momentum passes, the swap.
+    fn explicit_step<K: Kernel<R>>(
+        &mut self,
+        c: Consts<R, K>,
+        state: &ParticleSet<R>,
+        n: usize,
+        k: usize,
+        dt: R,
+        stats: &mut StepStats,
+    ) {
+        let reinit = self.params.density_reinit_steps();
+        let boundary_mass = self.params.common.particle_mass();
+        let s = &mut self.scratch;
+        let inputs = StepInputs {
+            c,
+            masses: &state.masses,
+            nb: self.parts.neighbours.lists(),
+            boundary: &*self.parts.boundary,
+            walls: &self.walls,
+            models: &self.models,
+            gravity: self.params.common.gravity,
+            dt,
+            boundary_mass,
+        };
+        let t = Instant::now();
+        if reinit.is_some_and(|every| k.is_multiple_of(every)) {
+            reinitialise_density(s, &inputs);
+        }
+        let bp = &self.boundary_particles;
+        if !bp.is_empty() {
+            let e = Extrapolation {
+                kernel: c.kernel,
+                images: &s.images,
+                x: &s.x,
+                rho: &s.rho,
+                particles: bp,
+                gravity: self.params.common.gravity,
+            };
+            s.boundary_lists.weigh(&e);
+            extrapolate(&e, &s.boundary_lists, &mut s.stress, Some(&mut s.v), None);
+        }
+        pair_gradients(s, &inputs);
+        stress_pass(s, &inputs);
+        if !bp.is_empty() {
+            let e = Extrapolation {
+                kernel: c.kernel,
+                images: &s.images,
+                x: &s.x,
+                rho: &s.rho,
+                particles: bp,
+                gravity: self.params.common.gravity,
+            };
+            let (rho0, eps) = (c.rho0, c.eps_stress);
+            let art = |s_b: &Matrix3<R>| artificial_stress(s_b, rho0, eps);
+            extrapolate(
+                &e,
+                &s.boundary_lists,
+                &mut s.stress_new,
+                None,
+                Some((&mut s.art, &art)),
+            );
+            boundary_pair_terms(s, n);
+        }
+        stats.phases.add(STRESS, t.elapsed().as_secs_f64());
+        let t = Instant::now();
+        momentum_pass(s, &inputs);
+        stats.phases.add(MOMENTUM, t.elapsed().as_secs_f64());
+        std::mem::swap(&mut s.x, &mut s.x_new);
+        std::mem::swap(&mut s.v, &mut s.v_new);
+        std::mem::swap(&mut s.rho, &mut s.rho_new);
+        std::mem::swap(&mut s.stress, &mut s.stress_new);
+        std::mem::swap(&mut s.plastic_strain, &mut s.plastic_new);
+        self.explicit_steps += 1;
+        stats.iterations += 1;
+    }
+
     fn time_step(
         &mut self,
         state: &mut ParticleSet<R>,
@@ -455,7 +543,6 @@ impl<R: Real> ElastoplasticScheme<R> {
         stats: &mut StepStats,
     ) -> Result<(), SolverError> {
         let (steps, dt) = self.params.explicit_steps();
-        let reinit = self.params.density_reinit_steps();
         let h = self.params.common.support_radius;
         let skin = self.params.skin;
         let half = R::of_f64(0.5);
@@ -463,7 +550,9 @@ impl<R: Real> ElastoplasticScheme<R> {
         self.scratch.x[..n].copy_from_slice(&state.positions);
         self.scratch.v[..n].copy_from_slice(&state.velocities);
         self.scratch.rho[..n].copy_from_slice(&state.densities);
-        let boundary_mass = self.params.common.particle_mass();
+        if self.params.dimensions == Dimensions::Two {
+            check_in_plane(&state.positions)?;
+        }
         // The clock of the moving walls: the frame count (checkpointed) and the substep.
         let substeps = self.params.common.substeps as f64;
         let substep_start_s = (at.step as f64 * substeps + at.substep as f64)
@@ -512,66 +601,10 @@ impl<R: Real> ElastoplasticScheme<R> {
                 self.boundary_shift = R::zero();
                 self.searches += 1;
             }
-            let inputs = StepInputs {
-                c: self.c,
-                masses: &state.masses,
-                nb: self.parts.neighbours.lists(),
-                boundary: &*self.parts.boundary,
-                walls: &self.walls,
-                models: &self.models,
-                gravity: self.params.common.gravity,
-                dt,
-                boundary_mass,
-            };
-            let t = Instant::now();
-            if reinit.is_some_and(|every| k % every == 0) {
-                reinitialise_density(s, &inputs);
+            match self.c {
+                SpaceConsts::Three(c) => self.explicit_step(c, state, n, k, dt, stats),
+                SpaceConsts::Two(c) => self.explicit_step(c, state, n, k, dt, stats),
             }
-            let bp = &self.boundary_particles;
-            if !bp.is_empty() {
-                let e = Extrapolation {
-                    kernel: self.c.kernel,
-                    images: &s.images,
-                    x: &s.x,
-                    rho: &s.rho,
-                    particles: bp,
-                    gravity: self.params.common.gravity,
-                };
-                s.boundary_lists.weigh(&e);
-                extrapolate(&e, &s.boundary_lists, &mut s.stress, Some(&mut s.v), None);
-            }
-            stress_pass(s, &inputs);
-            if !bp.is_empty() {
-                let e = Extrapolation {
-                    kernel: self.c.kernel,
-                    images: &s.images,
-                    x: &s.x,
-                    rho: &s.rho,
-                    particles: bp,
-                    gravity: self.params.common.gravity,
-                };
-                let (rho0, eps) = (self.c.rho0, self.c.eps_stress);
-                let art = |s_b: &Matrix3<R>| artificial_stress(s_b, rho0, eps);
-                extrapolate(
-                    &e,
-                    &s.boundary_lists,
-                    &mut s.stress_new,
-                    None,
-                    Some((&mut s.art, &art)),
-                );
-                boundary_pair_terms(s, n);
-            }
-            stats.phases.add(STRESS, t.elapsed().as_secs_f64());
-            let t = Instant::now();
-            momentum_pass(s, &inputs);
-            stats.phases.add(MOMENTUM, t.elapsed().as_secs_f64());
-            std::mem::swap(&mut s.x, &mut s.x_new);
-            std::mem::swap(&mut s.v, &mut s.v_new);
-            std::mem::swap(&mut s.rho, &mut s.rho_new);
-            std::mem::swap(&mut s.stress, &mut s.stress_new);
-            std::mem::swap(&mut s.plastic_strain, &mut s.plastic_new);
-            self.explicit_steps += 1;
-            stats.iterations += 1;
         }
         let s = &self.scratch;
         check_divergence(at, &s.x[..n], &s.v[..n], &*self.parts.boundary, h)?;
@@ -582,6 +615,21 @@ impl<R: Real> ElastoplasticScheme<R> {
         stats.substeps += 1;
         stats.neighbour_pairs = self.parts.neighbours.lists().pair_count();
         Ok(())
+    }
+}
+
+/// A planar run's particles all lie in the plane `z = 0`; an error names the first that
+/// does not (its index, and its `z` in the reason).
+fn check_in_plane<R: Real>(positions: &[Vec3<R>]) -> Result<(), SolverError> {
+    match positions.iter().position(|p| p.z != R::zero()) {
+        None => Ok(()),
+        Some(i) => Err(SolverError::InvalidSolverState {
+            solver: NAME.to_owned(),
+            reason: format!(
+                "a planar run (dimensions = 2) keeps every particle in the plane z = 0; particle {i} is at z = {} m",
+                positions[i].z.as_f64()
+            ),
+        }),
     }
 }
 

@@ -5,11 +5,11 @@
 
 use std::time::Instant;
 
-use rayon::prelude::*;
 use sph_core::{apply_permutation, ParticleSet, Real, Vec3};
 use sph_kernels::KernelKind;
+use sph_solver::density_lanes::densities_at;
 use sph_solver::state::match_arrays;
-use sph_solver::step::{check_divergence, density_at, FramePhases, StepAt, MIN_LEN};
+use sph_solver::step::{check_divergence, FramePhases, StepAt};
 use sph_solver::{ArraySpec, FrameSolver, SchemeParts, SolverError, StepStats, SubstepScheme};
 
 use crate::friction;
@@ -466,12 +466,15 @@ impl<R: Real> IisphScheme<R> {
 
         let t = Instant::now();
         if last {
-            let xn = &s.x_new[..];
-            s.density_new
-                .par_iter_mut()
-                .enumerate()
-                .with_min_len(MIN_LEN)
-                .for_each(|(i, rho)| *rho = density_at(&c.kernel, c.rho0, xn, m, nb, volume, i));
+            densities_at(
+                &c.kernel,
+                c.rho0,
+                &s.x_new,
+                m,
+                nb,
+                volume,
+                &mut s.density_new,
+            );
         }
         check_divergence(at, &s.x_new, &s.v_new, &*self.parts.boundary, h)?;
         state.positions.copy_from_slice(&s.x_new);

@@ -66,7 +66,7 @@ impl Scene {
     /// Upper bound of the particle count of fluid `i` (lattice points over its box).
     fn lattice_estimate(&self, i: usize) -> f64 {
         let s = self.particle_spacing;
-        let e = self.fluids[i].bounds().extent();
+        let e = self.block_to_fill(self.fluids[i].bounds()).extent();
         (0..3)
             .map(|a| ((e[a] / s) + 1e-9).floor().max(1.0))
             .product()
@@ -116,10 +116,10 @@ impl Scene {
         };
         match &self.fluids[i] {
             FluidSpec::Block { min, max, .. } => {
-                let b = Aabb {
+                let b = self.block_to_fill(Aabb {
                     min: v3(*min),
                     max: v3(*max),
-                };
+                });
                 cubic_lattice(&b, s, MAX_PARTICLES).map_err(lattice_err)
             }
             FluidSpec::Mesh { mesh, .. } => {
@@ -200,7 +200,9 @@ impl Scene {
         let mut out: Vec<Box<dyn Sdf<R>>> = Vec::with_capacity(self.solids.len() + 1);
         if let Some(t) = &self.tank {
             let (mut lo, mut hi) = (t.min, t.max);
-            for (axis, _, _) in self.periodic_axes() {
+            // In the plane the tank is open along z, as along a periodic axis.
+            let planar_z = self.is_planar().then_some((2, 0.0, 0.0));
+            for (axis, _, _) in self.periodic_axes().into_iter().chain(planar_z) {
                 if axis < 3 {
                     let reach = OPEN_TANK_REACH * (hi[axis] - lo[axis]).max(1.0);
                     lo[axis] -= reach;
@@ -237,7 +239,7 @@ impl Scene {
     /// [`sph_solver::Pour::grains`]).
     pub fn poured_grains(&self) -> usize {
         self.pour
-            .map_or(0, |p| p.to_pour().grains(self.particle_spacing))
+            .map_or(0, |p| self.pour_of(&p).grains(self.particle_spacing))
     }
 
     /// Particle-level checks: count limit, non-empty fluids, inside the tank, outside solids.
@@ -257,7 +259,7 @@ impl Scene {
         }
         if let Some(p) = &self.pour {
             // Checked before the run adds them: the pour's volume over spacing³.
-            total += (p.volume_m3 / self.particle_spacing.powi(3)).max(0.0);
+            total += (self.pour_of(p).volume_m3 / self.particle_spacing.powi(3)).max(0.0);
             if !(total <= MAX_PARTICLES as f64) {
                 return Err(ctx.invalid(
                     "pour.volume",
@@ -289,7 +291,10 @@ impl Scene {
                 // The lattice puts at least one layer per axis, half a spacing inside the
                 // lower corner: in a block thinner than a spacing that layer lies outside it.
                 let s = self.particle_spacing;
-                if let Some(a) = (0..3).find(|&a| max[a] - min[a] < s * (1.0 - 1e-9)) {
+                if let Some(a) = self
+                    .spanned_axes()
+                    .find(|&a| max[a] - min[a] < s * (1.0 - 1e-9))
+                {
                     return Err(ctx.invalid(
                         format!("{field}.max"),
                         format!(
@@ -326,10 +331,11 @@ impl Scene {
                 ));
             }
             if let Some(t) = &self.tank {
-                if let Some(p) = pts
-                    .iter()
-                    .find(|p| !(0..3).all(|a| p[a] > t.min[a] && p[a] < t.max[a]))
-                {
+                if let Some(p) = pts.iter().find(|p| {
+                    !self
+                        .spanned_axes()
+                        .all(|a| p[a] > t.min[a] && p[a] < t.max[a])
+                }) {
                     return Err(ctx.invalid(
                         field,
                         format!("particle at {} is not strictly inside the tank", fmt3(p)),

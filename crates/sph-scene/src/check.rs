@@ -68,6 +68,7 @@ impl Scene {
             check_solid(ctx, &format!("solid[{j}]"), s)?;
         }
         self.check_walls(ctx)?;
+        self.check_planar(ctx)?;
         if self.output.every_frames == 0 {
             return Err(ctx.invalid("output.every_frames", "must be >= 1, got 0"));
         }

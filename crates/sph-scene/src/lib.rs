@@ -94,6 +94,11 @@
 //! duration = 6.0                   # s, simulated time
 //! frame_dt = 0.016                 # s, one output/solver frame
 //! gravity = [0.0, -9.81, 0.0]      # m/s² (default [0, -9.81, 0])
+//! # dimensions = 2                 # 3 (default) or 2: the scene's section at z = 0, plane
+//! #                                #   strain (kind = "elastoplastic" only): blocks fill
+//! #                                #   their layer at z = 0, the tank and the pour are open
+//! #                                #   along z, the pour's volume and rate are per metre of
+//! #                                #   depth; no periodic z axis, no mesh or cylinder fluid
 //!
 //! [solver]                         # one table per solver, selected by `kind` (the solver
 //!                                  # crate's settings struct: PbfSettings, PcisphSettings,
@@ -365,6 +370,7 @@ mod override_span;
 mod overrides;
 mod params;
 mod parse;
+mod planar;
 mod raw;
 mod read;
 mod render;

@@ -25,6 +25,7 @@ impl Scene {
             particle_spacing: self.particle_spacing,
             frame_dt: self.frame_dt_s,
             gravity: self.gravity,
+            dimensions: self.dimensions,
         }
     }
 
@@ -52,7 +53,7 @@ impl Scene {
                 })
             }),
             periodic: self.boundary.periodic.iter().map(|p| p.to_axis()).collect(),
-            pour: self.pour.as_ref().map(crate::PourSpec::to_pour),
+            pour: self.pour.as_ref().map(|p| self.pour_of(p)),
         }
     }
 

@@ -140,6 +140,7 @@ fn from_raw(
         duration_s: sim.duration,
         frame_dt_s: sim.frame_dt,
         gravity: sim.gravity.unwrap_or(DEFAULT_GRAVITY),
+        dimensions: sim.dimensions.unwrap_or_default(),
         tank: raw.tank.map(|t| Aabb {
             min: v3(t.min),
             max: v3(t.max),

@@ -35,6 +35,7 @@ pub(crate) struct RawSimulation {
     pub duration: f64,
     pub frame_dt: f64,
     pub gravity: Option<[f64; 3]>,
+    pub dimensions: Option<sph_solver::Dimensions>,
 }
 
 /// The tag of the `[solver]` table. Its other fields are ignored here and read by

@@ -60,6 +60,13 @@ macro_rules! solvers {
                 }
             }
 
+            /// Whether the solver runs in the plane ([`SolverSettings::PLANAR`]).
+            pub fn planar(self) -> bool {
+                match self {
+                    $( SolverKind::$Kind => <$Settings as SolverSettings>::PLANAR, )+
+                }
+            }
+
             /// The scene boundary features the solver takes
             /// ([`SolverSettings::BOUNDARY_FEATURES`]).
             pub fn boundary_features(self) -> BoundaryFeatures {

@@ -347,6 +347,13 @@ pub struct Scene {
     pub frame_dt_s: f64,
     /// Gravity (m/s²).
     pub gravity: [f64; 3],
+    /// Three dimensions, or the plane `z = 0` (`[simulation] dimensions = 2`): the scene's
+    /// section there. In the plane the fluid blocks fill the one lattice layer at `z = 0`,
+    /// the tank and the pour's box are open along `z` (their `z` extents are not read), the
+    /// pour's `volume` and `rate` are per metre of depth (m³/m, m³/s per m), each particle
+    /// stands for a slab one spacing deep, and only solvers that run in the plane take it
+    /// ([`sph_solver::SolverSettings::PLANAR`]).
+    pub dimensions: sph_solver::Dimensions,
     /// The container, if any.
     pub tank: Option<Aabb<f64>>,
     /// Fluid bodies, in file order.

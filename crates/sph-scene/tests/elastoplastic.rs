@@ -370,3 +370,123 @@ fn bad_pours_name_their_key() {
     let e = other.check().unwrap_err().to_string();
     assert!(e.contains("pour") && e.contains("elastoplastic"), "{e}");
 }
+
+/// `[simulation] dimensions = 2`: the section at `z = 0` at the scene's spacing. The block
+/// fills its one layer at `z = 0` (10 × 5 grains of the 0.2 × 0.1 m block at 0.02 m), the
+/// solver runs in the plane, the pour's box is the layer `|z| ≤ s/2` and its volume and
+/// rate, per metre of depth, are those of a slab one spacing deep; the quick spacing cuts
+/// its own section.
+#[test]
+fn a_planar_scene_is_the_section_at_z_0() {
+    let planar = |text: &str| {
+        text.replacen(
+            "[boundary]\nmodel = \"particles\"\nperiodic = [{ axis = \"z\", lo = 0.0, hi = 0.06 }]",
+            "[boundary]\nmodel = \"particles\"",
+            1,
+        )
+        .replacen(
+            "frame_dt = 0.016\n",
+            "frame_dt = 0.016\ndimensions = 2\n",
+            1,
+        )
+    };
+    let s = parse(&planar(BASE)).unwrap();
+    assert!(s.is_planar());
+    let x = s.fluid_positions::<f64>().unwrap();
+    assert_eq!(x.len(), 10 * 5);
+    assert!(x.iter().all(|p| p.z == 0.0));
+    let SolverParams::Elastoplastic(p) = s.solver_params::<f64>().unwrap() else {
+        panic!("not elastoplastic")
+    };
+    assert_eq!(p.dimensions, sph_solver::Dimensions::Two);
+    let pour_2d = POUR.replacen("volume = 0.00048", "volume = 0.0048", 1);
+    let s = parse(&planar(&format!("{BASE}{pour_2d}"))).unwrap();
+    let SolverParams::Elastoplastic(p) = s.solver_params::<f64>().unwrap() else {
+        panic!("not elastoplastic")
+    };
+    let pour = p.pour.expect("a pour");
+    assert_eq!((pour.region.min.z, pour.region.max.z), (-0.01, 0.01));
+    assert_eq!(
+        (pour.volume_m3, pour.rate_m3_s),
+        (0.0048 * 0.02, 0.00144 * 0.02)
+    );
+    // 0.0048 m³ per metre of depth is 0.0048 m² of section; a layer of the 0.04 m wide
+    // funnel is 2 grains of 0.02 × 0.02 m² (0.0008 m²): 6 layers.
+    assert_eq!((pour.grains_per_layer(0.02), s.poured_grains()), (2, 12));
+    let fine = parse(&planar(&format!("{BASE}{pour_2d}")).replacen(
+        "particle_spacing = 0.02",
+        "particle_spacing = 0.01",
+        1,
+    ))
+    .unwrap();
+    // At 0.01 m a layer is 4 grains of 0.0001 m² (0.0004 m²): 12 layers.
+    assert_eq!(fine.poured_grains(), 48);
+    assert!(fine
+        .fluid_positions::<f64>()
+        .unwrap()
+        .iter()
+        .all(|p| p.z == 0.0));
+}
+
+/// A planar scene is refused, at its key: with a solver that runs in 3D only, with a
+/// periodic z axis, with gravity across the plane, with a cylinder of fluid, and a count
+/// other than 2 or 3.
+#[test]
+fn planar_refusals_name_their_key() {
+    let with_dims = |text: &str| {
+        text.replacen(
+            "frame_dt = 0.016\n",
+            "frame_dt = 0.016\ndimensions = 2\n",
+            1,
+        )
+    };
+    let e = parse(&with_dims(BASE)).unwrap_err();
+    assert!(
+        e.contains("boundary.periodic") && e.contains("no periodic z axis"),
+        "{e}"
+    );
+    let no_z = BASE.replacen(
+        "\nperiodic = [{ axis = \"z\", lo = 0.0, hi = 0.06 }]",
+        "",
+        1,
+    );
+    let e = parse(&with_dims(&no_z).replacen(
+        "frame_dt = 0.016\n",
+        "frame_dt = 0.016\ngravity = [0.0, -9.81, 0.5]\n",
+        1,
+    ))
+    .unwrap_err();
+    assert!(e.contains("simulation.gravity"), "{e}");
+    let e = parse(&BASE.replacen(
+        "frame_dt = 0.016\n",
+        "frame_dt = 0.016\ndimensions = 4\n",
+        1,
+    ))
+    .unwrap_err();
+    assert!(e.contains("dimensions must be 2 or 3, got 4"), "{e}");
+    let pbf = r#"
+name = "w"
+[simulation]
+particle_spacing = 0.02
+duration = 0.1
+frame_dt = 0.016
+dimensions = 2
+[solver]
+kind = "pbf"
+substeps = 2
+iterations = 3
+xsph_c = 0.01
+[tank]
+min = [0.0, 0.0, 0.0]
+max = [0.6, 0.4, 0.06]
+[[fluid]]
+kind = "block"
+min = [0.2, 0.1, 0.0]
+max = [0.4, 0.2, 0.06]
+"#;
+    let e = parse(pbf).unwrap_err();
+    assert!(
+        e.contains("simulation.dimensions") && e.contains("3D only"),
+        "{e}"
+    );
+}

@@ -60,6 +60,8 @@
 pub mod boundary;
 pub mod cone_match;
 pub mod csr;
+pub mod density_lanes;
+mod dimensions;
 mod error;
 mod fluid_solver;
 pub mod frame;
@@ -80,6 +82,7 @@ pub use boundary::{
     VolumeMapOptions, VolumeMapStats,
 };
 pub use cone_match::ConeMatch;
+pub use dimensions::Dimensions;
 pub use error::{MapFileProblem, SolverError};
 pub use fluid_solver::{FluidSolver, Solids};
 pub use frame::{FrameSolver, SchemeParts, SubstepScheme};

@@ -86,6 +86,8 @@ pub struct SceneValues {
     pub frame_dt: f64,
     /// Gravity (m/s²).
     pub gravity: [f64; 3],
+    /// Two or three dimensions ([`crate::Dimensions`]).
+    pub dimensions: crate::Dimensions,
 }
 
 /// A solver's scene-facing settings (the `[solver]` table of its kind), implemented by each
@@ -104,6 +106,10 @@ pub trait SolverSettings: Sized + Clone + std::fmt::Debug + PartialEq {
     /// The scene boundary features the solver takes ([`crate::scene_boundary`]): by
     /// default solids as collision boundaries or volume maps only.
     const BOUNDARY_FEATURES: BoundaryFeatures = BoundaryFeatures::SOLIDS_ONLY;
+
+    /// Whether the solver runs in the plane ([`crate::Dimensions::Two`]); by default only
+    /// in three dimensions.
+    const PLANAR: bool = false;
 
     /// The density kernel of the solver (the kernel its volume maps are integrated with and
     /// its masses calibrated with).

@@ -59,21 +59,53 @@ pub fn non_finite<R: Real>(v: &Vec3<R>) -> Option<usize> {
     (0..3).find(|&a| !v[a].is_finite_value())
 }
 
+/// Whether an axis of `v` is not finite: [`non_finite`] without its early exit (no branch),
+/// for the passes of [`first_where`].
+#[inline]
+fn any_non_finite<R: Real>(v: &Vec3<R>) -> bool {
+    !(v.x.is_finite_value() & v.y.is_finite_value() & v.z.is_finite_value())
+}
+
 /// Checks a state on entry to a step: array lengths, finite positions and velocities
 /// ([`SolverError::InvalidState`]) and finite positive masses ([`SolverError::InvalidMass`]),
 /// naming the first offending particle.
 pub fn check_state<R: Real>(state: &ParticleSet<R>) -> Result<(), SolverError> {
-    state.validate()?;
+    let n = state.positions.len();
+    let lengths_match = [
+        state.velocities.len(),
+        state.masses.len(),
+        state.densities.len(),
+    ]
+    .iter()
+    .all(|&len| len == n);
+    let not_finite = any_non_finite::<R>;
+    // The fast pass only says whether something is wrong; `validate` names it.
+    if !lengths_match
+        || first_where(&state.positions, not_finite).is_some()
+        || first_where(&state.velocities, not_finite).is_some()
+    {
+        state.validate()?;
+    }
     check_masses(&state.masses)
+}
+
+/// The index of the first element of `items` for which `bad` holds (`None` if none does),
+/// as rayon's `position_first` but at the cost of a plain pass: `bad` is evaluated for every
+/// element of fixed chunks of [`REDUCE_CHUNK`] (without an early exit, so that the pass has
+/// no branch per element), the chunks in parallel, and only the first chunk that holds a bad
+/// element is scanned again for its index. For the checks made on every step, where nothing
+/// is found.
+pub fn first_where<T: Sync>(items: &[T], bad: impl Fn(&T) -> bool + Sync) -> Option<usize> {
+    let chunk = items
+        .par_chunks(REDUCE_CHUNK)
+        .position_first(|c| c.iter().fold(false, |any, x| any | bad(x)))?;
+    let first = chunk * REDUCE_CHUNK;
+    items[first..].iter().position(bad).map(|k| first + k)
 }
 
 /// Finite, positive masses ([`SolverError::InvalidMass`] naming the first other one).
 pub fn check_masses<R: Real>(masses: &[R]) -> Result<(), SolverError> {
-    match masses
-        .par_iter()
-        .with_min_len(MIN_LEN)
-        .position_first(|&m| !(m.is_finite_value() && m > R::zero()))
-    {
+    match first_where(masses, |&m| !(m.is_finite_value() && m > R::zero())) {
         Some(index) => Err(SolverError::InvalidMass {
             index,
             value: masses[index].as_f64(),
@@ -218,11 +250,7 @@ pub struct StepAt {
 /// A non-finite predicted position is a [`SolverError::BlowUp`] naming the first such
 /// particle.
 pub fn check_predicted<R: Real>(at: StepAt, predicted: &[Vec3<R>]) -> Result<(), SolverError> {
-    match predicted
-        .par_iter()
-        .with_min_len(MIN_LEN)
-        .position_first(|x| non_finite(x).is_some())
-    {
+    match first_where(predicted, any_non_finite) {
         Some(i) => Err(blow_up(
             at.solver,
             at.step,
@@ -246,11 +274,9 @@ pub fn check_divergence<R: Real>(
     boundary: &dyn Boundary<R>,
     h: R,
 ) -> Result<(), SolverError> {
-    if let Some(i) = (0..x.len())
-        .into_par_iter()
-        .with_min_len(MIN_LEN)
-        .position_first(|i| non_finite(&x[i]).is_some() || non_finite(&v[i]).is_some())
-    {
+    let first_x = first_where(x, any_non_finite);
+    let first_v = first_where(v, any_non_finite);
+    if let Some(i) = first_x.into_iter().chain(first_v).min() {
         return Err(blow_up(
             at.solver,
             at.step,
@@ -266,11 +292,9 @@ pub fn check_divergence<R: Real>(
         return Ok(());
     }
     let margin = -h;
-    if let Some(i) = x
-        .par_iter()
-        .with_min_len(MIN_LEN)
-        .position_first(|xi| solids.iter().any(|sd| sd.signed_distance(xi) < margin))
-    {
+    if let Some(i) = first_where(x, |xi| {
+        solids.iter().any(|sd| sd.signed_distance(xi) < margin)
+    }) {
         let (k, d) = solids
             .iter()
             .enumerate()

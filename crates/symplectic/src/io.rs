@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use arrow_array::{ArrayRef, BooleanArray, Float64Array, RecordBatch, StringArray, UInt64Array};
-use arrow_schema::{DataType, Field, Schema};
+use arrow_schema::{Field, Schema};
 use serde::Deserialize;
 
 use crate::classes::{
@@ -16,9 +16,13 @@ use crate::classes::{
 };
 use crate::kepler::{state_from_elements, ConicElements};
 use crate::{
-    outer_solar_system, Ephemeris, Frame, Integrator, ParticleIntegrator, ParticleStatus, Planets,
-    Population, RemovalRules, Scheme, SymplecticError, Variant, Vec3,
+    outer_solar_system, DistanceFrame, Ephemeris, EventRules, Frame, Integrator,
+    ParticleIntegrator, ParticleStatus, Planets, Population, RemovalRules, Scheme, SymplecticError,
+    Variant, Vec3,
 };
+
+mod events_table;
+pub use events_table::{events_table, EVENTS_TABLE};
 
 /// Days per Julian year, the unit of spans in the specification.
 pub const DAYS_PER_YEAR: f64 = 365.25;
@@ -77,6 +81,11 @@ pub struct PopulationSpec {
     /// radii, hand back beyond 3.5, tolerance 10⁻¹²).
     #[serde(default)]
     pub encounters: Option<crate::Encounters>,
+    /// What is recorded without removing ([`EventRules`]; none if the table is absent):
+    /// `perihelion_below = [2.5]`, `tisserand_crossing = true`,
+    /// `close_approach = { hill_radii = 1.0 }` (or `{ au = 0.1 }`), `max_per_particle`.
+    #[serde(default)]
+    pub events: EventRules,
 }
 
 /// The planetary system.
@@ -268,6 +277,21 @@ impl PopulationSpec {
                 "must be >= 1".into(),
             ));
         }
+        // The rules' own checks, with the file and the table named.
+        let named = |table: &str, e: SymplecticError| match e {
+            SymplecticError::InvalidParameter {
+                name,
+                value,
+                reason,
+            } => spec_error(
+                path,
+                &format!("{table}{name}"),
+                format!("{value}: {reason}"),
+            ),
+            other => other,
+        };
+        self.removal.validate().map_err(|e| named("removal.", e))?;
+        self.events.validate().map_err(|e| named("", e))?;
         self.check_limits(path)
     }
 
@@ -453,6 +477,7 @@ impl PopulationSpec {
             population.set_window_steps(w)?;
         }
         population.set_encounters(self.encounters)?;
+        population.set_events(self.events.clone())?;
         Ok(population)
     }
 }
@@ -796,7 +821,9 @@ pub use crate::guard::available_memory;
 /// `unclassified`),
 /// and `in_encounter` (whether the particle, active, is being integrated through an
 /// encounter; `false` for every removed particle) and `encounters_begun` (its switches to
-/// the encounter mode so far, [`PopulationMember::encounters_begun`](crate::PopulationMember)).
+/// the encounter mode so far, [`PopulationMember::encounters_begun`](crate::PopulationMember)),
+/// and `events_dropped` (events its full log did not keep, [`EventLog::dropped`](crate::EventLog);
+/// the events themselves are in [`events_table`]).
 pub fn population_table(population: &Population) -> Result<RecordBatch, SymplecticError> {
     let members = population.members();
     let n = members.len();
@@ -848,46 +875,81 @@ pub fn population_table(population: &Population) -> Result<RecordBatch, Symplect
         "vz_au_per_day",
         "tisserand_jupiter",
     ];
-    let mut fields = vec![
-        Field::new("id", DataType::UInt64, false),
-        Field::new("status", DataType::Utf8, false),
-    ];
-    let mut arrays: Vec<ArrayRef> = vec![
+    let mut table = Columns::default();
+    table.push(
+        "id",
         Arc::new(UInt64Array::from_iter_values(members.iter().map(|m| m.id))),
-        Arc::new(StringArray::from(status)),
-    ];
-    for (name, c) in names.iter().zip(cols) {
-        fields.push(Field::new(*name, DataType::Float64, false));
-        arrays.push(Arc::new(Float64Array::from(c)));
+    );
+    table.push("status", Arc::new(StringArray::from(status)));
+    table.floats(&names, cols);
+    table.push("region", Arc::new(StringArray::from(region)));
+    table.push("levison_class", Arc::new(StringArray::from(levison)));
+    table.push(
+        "in_encounter",
+        Arc::new(BooleanArray::from_iter(
+            // Active members only: a removed member is in no encounter (a checkpoint of an
+            // earlier version may still hold the encounter state it was removed in).
+            members
+                .iter()
+                .map(|m| Some(m.status == ParticleStatus::Active && m.encounter.is_some())),
+        )),
+    );
+    table.push(
+        "encounters_begun",
+        Arc::new(UInt64Array::from_iter_values(
+            members.iter().map(|m| u64::from(m.encounters_begun)),
+        )),
+    );
+    table.push(
+        "events_dropped",
+        Arc::new(UInt64Array::from_iter_values(
+            members
+                .iter()
+                .map(|m| m.events.as_ref().map_or(0, |log| log.dropped)),
+        )),
+    );
+    table.batch()
+}
+
+/// The columns of a table being built, in order (every column non-nullable).
+#[derive(Default)]
+pub(crate) struct Columns {
+    fields: Vec<Field>,
+    arrays: Vec<ArrayRef>,
+}
+
+impl Columns {
+    /// Appends the column `name`.
+    pub(crate) fn push(&mut self, name: &str, array: ArrayRef) {
+        self.fields
+            .push(Field::new(name, array.data_type().clone(), false));
+        self.arrays.push(array);
     }
-    fields.push(Field::new("region", DataType::Utf8, false));
-    arrays.push(Arc::new(StringArray::from(region)));
-    fields.push(Field::new("levison_class", DataType::Utf8, false));
-    arrays.push(Arc::new(StringArray::from(levison)));
-    fields.push(Field::new("in_encounter", DataType::Boolean, false));
-    arrays.push(Arc::new(BooleanArray::from_iter(
-        // Active members only: a removed member is in no encounter (a checkpoint of an
-        // earlier version may still hold the encounter state it was removed in).
-        members
-            .iter()
-            .map(|m| Some(m.status == ParticleStatus::Active && m.encounter.is_some())),
-    )));
-    fields.push(Field::new("encounters_begun", DataType::UInt64, false));
-    arrays.push(Arc::new(UInt64Array::from_iter_values(
-        members.iter().map(|m| u64::from(m.encounters_begun)),
-    )));
-    RecordBatch::try_new(Arc::new(Schema::new(fields)), arrays).map_err(|e| {
-        SymplecticError::Output {
-            path: String::new(),
-            reason: e.to_string(),
+
+    /// Appends one `f64` column per name.
+    pub(crate) fn floats(&mut self, names: &[&str], columns: Vec<Vec<f64>>) {
+        for (name, c) in names.iter().zip(columns) {
+            self.push(name, Arc::new(Float64Array::from(c)));
         }
-    })
+    }
+
+    /// The table.
+    pub(crate) fn batch(self) -> Result<RecordBatch, SymplecticError> {
+        RecordBatch::try_new(Arc::new(Schema::new(self.fields)), self.arrays).map_err(|e| {
+            SymplecticError::Output {
+                path: String::new(),
+                reason: e.to_string(),
+            }
+        })
+    }
 }
 
 /// A short label of a status (`active`, `hill_sphere_<planet>`, `collision_<planet>` with the
-/// planet's name, `perihelion`, `ejected`, `regularisation_lost`, `failed`) and the removal
-/// time (NaN if active).
+/// planet's name, `collision_sun`, `perihelion`, `ejected`, `min_distance_<frame>` and
+/// `max_distance_<frame>` with `heliocentric` or `barycentric`, `regularisation_lost`,
+/// `failed`) and the removal time (NaN if active).
 pub fn status_label(s: &ParticleStatus, planets: &Planets) -> (String, f64) {
+    // A status of a later version of the enum (non-exhaustive) would need a label here.
     match s {
         ParticleStatus::Active => ("active".into(), f64::NAN),
         ParticleStatus::HillSphereEntry { time, planet, .. } => {
@@ -898,6 +960,13 @@ pub fn status_label(s: &ParticleStatus, planets: &Planets) -> (String, f64) {
         }
         ParticleStatus::PerihelionBelowLimit { time, .. } => ("perihelion".into(), *time),
         ParticleStatus::Ejected { time, .. } => ("ejected".into(), *time),
+        ParticleStatus::SunCollision { time, .. } => ("collision_sun".into(), *time),
+        ParticleStatus::InsideMinDistance { time, frame, .. } => {
+            (format!("min_distance_{}", frame_label(*frame)), *time)
+        }
+        ParticleStatus::BeyondMaxDistance { time, frame, .. } => {
+            (format!("max_distance_{}", frame_label(*frame)), *time)
+        }
         ParticleStatus::RegularisationLost { time, .. } => ("regularisation_lost".into(), *time),
         ParticleStatus::IntegrationFailed { time, .. } => ("failed".into(), *time),
     }
@@ -919,4 +988,12 @@ pub fn write_parquet(path: &Path, batch: &RecordBatch) -> Result<(), SymplecticE
     writer.write(batch).map_err(|e| err(e.to_string()))?;
     let file = writer.into_inner().map_err(|e| err(e.to_string()))?;
     file.commit().map_err(|e| err(e.to_string()))
+}
+
+/// `heliocentric` or `barycentric`.
+fn frame_label(frame: DistanceFrame) -> &'static str {
+    match frame {
+        DistanceFrame::Heliocentric => "heliocentric",
+        DistanceFrame::Barycentric => "barycentric",
+    }
 }

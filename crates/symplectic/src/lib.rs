@@ -60,7 +60,11 @@
 //!   (rayon) through synchronisation windows against one shared, read-only ephemeris window
 //!   ([`Ephemeris::interpolate`]), extended once per window; removal per particle with its
 //!   reason, time and state ([`RemovalRules`]: Hill-sphere entry, perihelion below a limit,
-//!   ejection; regularisation lost; [`ParticleStatus`]); shards ([`Population::shard`],
+//!   unbound beyond a distance, heliocentric or barycentric `r < R` and `r > R` bound or not,
+//!   collision with the Sun; regularisation lost; [`ParticleStatus`]); events recorded
+//!   without ending a particle ([`EventRules`]: the first perihelion below a value, the first
+//!   crossing of `T_J = 3`, each close approach to a planet, kept per member in its
+//!   [`EventLog`]); shards ([`Population::shard`],
 //!   [`Population::merge`]) and versioned atomic checkpoints ([`Population::save`]). The
 //!   result is a deterministic function of the input: bit-identical on any number of
 //!   threads, across shards, after a resume, and equal bit for bit to each particle
@@ -202,7 +206,9 @@ pub use particles::{
 };
 pub use planets::Planets;
 pub use population::{
-    Population, PopulationMember, PopulationProgress, RemovalRules, DEFAULT_WINDOW_STEPS,
+    ApproachRadius, CometEvent, DistanceFrame, DistanceLimit, EventKind, EventLog, EventRules,
+    OpenApproach, Population, PopulationMember, PopulationProgress, RemovalRules,
+    DEFAULT_MAX_EVENTS_PER_PARTICLE, DEFAULT_WINDOW_STEPS, MAX_PERIHELION_THRESHOLDS,
 };
 pub use run::{
     load_checkpoint, save_checkpoint, CometRun, Limits, ParticleStatus, TrackedParticle,

@@ -57,6 +57,35 @@ pub enum ParticleStatus {
         /// The planet's radius.
         radius: f64,
     },
+    /// Collided with the Sun ([`RemovalRules::sun_collision`](crate::RemovalRules::sun_collision)):
+    /// closer to its centre than its radius at a check, or past a perihelion below it since
+    /// the previous check.
+    SunCollision {
+        /// Time when detected (the end of the step).
+        time: f64,
+        /// Distance to the Sun's centre then, or the perihelion passed below the radius.
+        distance: f64,
+    },
+    /// Came closer to the Sun or the barycentre than
+    /// [`RemovalRules::min_distance`](crate::RemovalRules::min_distance).
+    InsideMinDistance {
+        /// Time when detected (the end of the step).
+        time: f64,
+        /// The distance then (AU).
+        distance: f64,
+        /// From the Sun or the barycentre.
+        frame: crate::DistanceFrame,
+    },
+    /// Went farther from the Sun or the barycentre than
+    /// [`RemovalRules::max_distance`](crate::RemovalRules::max_distance), bound or not.
+    BeyondMaxDistance {
+        /// Time when detected (the end of the step).
+        time: f64,
+        /// The distance then (AU).
+        distance: f64,
+        /// From the Sun or the barycentre.
+        frame: crate::DistanceFrame,
+    },
     /// The step failed for another reason (non-finite state, Kepler solver); the particle is
     /// kept at its state before the step (a [`Population`](crate::Population) goes on with the
     /// others).

@@ -51,6 +51,16 @@ pub struct GiantPlanet {
 /// The astronomical unit in kilometres (IAU 2012 Resolution B2: 149 597 870.7 km).
 pub const AU_KM: f64 = 149_597_870.7;
 
+/// The nominal solar radius in km, 695 700 (IAU 2015 Resolution B3, "On recommended nominal
+/// conversion constants for selected solar and planetary properties", Prša et al., AJ 152,
+/// 41 (2016), doi:10.3847/0004-6256/152/2/41).
+pub const SUN_NOMINAL_RADIUS_KM: f64 = 695_700.0;
+
+/// The nominal solar radius in AU, [`SUN_NOMINAL_RADIUS_KM`] / [`AU_KM`] = 0.004 650 47 AU: a
+/// particle closer than this to the Sun's centre has collided with it
+/// ([`RemovalRules::sun_collision`](crate::RemovalRules::sun_collision)).
+pub const SUN_RADIUS_AU: f64 = SUN_NOMINAL_RADIUS_KM / AU_KM;
+
 /// Equatorial radii (1 bar level) of Jupiter, Saturn, Uranus and Neptune in km: 71 492,
 /// 60 268, 25 559, 24 764 (B. A. Archinal et al., "Report of the IAU Working Group on
 /// Cartographic Coordinates and Rotational Elements: 2015", *Celestial Mechanics and Dynamical

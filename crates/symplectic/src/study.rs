@@ -5,20 +5,25 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::io::{population_table, write_parquet, PopulationSpec, DAYS_PER_YEAR};
+use crate::io::{events_table, population_table, write_parquet, PopulationSpec, DAYS_PER_YEAR};
 use crate::{Population, PopulationProgress, SymplecticError};
 
 /// Name of the checkpoint in the output directory.
 pub const CHECKPOINT_FILE: &str = "checkpoint.json";
 /// Name of the final table in the output directory.
 pub const FINAL_TABLE: &str = "final.parquet";
+pub use crate::io::EVENTS_TABLE;
 /// Directory of the snapshot tables in the output directory.
 pub const SNAPSHOT_DIR: &str = "snapshots";
 
 const STUDY_FORMAT: &str = "symplectic-population-study";
 /// 2: the population's encounter settings have a hand-back radius (a version 1 checkpoint
 /// goes on handed back at its switch radius, as it was integrated).
-const STUDY_VERSION: u32 = 2;
+/// 3: the population's end rules `sun_collision`, `min_distance`, `max_distance`, its event
+/// rules and the members' event logs (read as off and empty from versions 1 and 2), and an
+/// encounter in progress holds the particle only (and its `p₄`; one of versions 1 and 2,
+/// the Sun, the planets and the particle, is converted when the member next steps).
+const STUDY_VERSION: u32 = 3;
 
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -47,11 +52,17 @@ pub struct StudySummary {
     /// Checkpoints written by this call: at their cadence and at the end (and on Ctrl-C,
     /// which ends the call with an error instead of a summary).
     pub checkpoints_written: u64,
+    /// Rows of the events table ([`EVENTS_TABLE`]).
+    pub events: u64,
+    /// Events that full logs did not keep (the population table's `events_dropped`).
+    pub events_dropped: u64,
 }
 
 /// Runs the study of `spec_path` into `out_dir`: snapshot tables
 /// `snapshots/snapshot_NNNNNN.parquet` at every `span.snapshot_every_years` from the epoch
-/// (the first at the epoch), `final.parquet` at the end, and `checkpoint.json` at every
+/// (the first at the epoch), `final.parquet` and `events.parquet` (every particle's events,
+/// [`events_table`]; no rows if the specification records none) at the end, and
+/// `checkpoint.json` at every
 /// `span.checkpoint_every_years` from the epoch (at every snapshot if it is not given), at
 /// the end, and when stopped by Ctrl-C. If `out_dir` holds a checkpoint of the same
 /// specification, the study resumes from it; the files it writes are then identical to
@@ -81,8 +92,8 @@ pub fn run_study(
         }
         if c.version == 1 {
             c.population.keep_version_1_hand_back();
-            c.version = STUDY_VERSION;
         }
+        c.version = STUDY_VERSION;
         if c.spec != spec_text {
             return Err(SymplecticError::Checkpoint {
                 path: checkpoint_path.display().to_string(),
@@ -156,11 +167,23 @@ pub fn run_study(
     state.population.advance_to(end, &mut on_sync)?;
     let final_path = out_dir.join(FINAL_TABLE);
     write_parquet(&final_path, &population_table(&state.population)?)?;
+    let events_path = out_dir.join(EVENTS_TABLE);
+    let events = events_table(&state.population)?;
+    write_parquet(&events_path, &events)?;
+    let events_dropped = state
+        .population
+        .members()
+        .iter()
+        .filter_map(|m| m.events.as_ref())
+        .map(|log| log.dropped)
+        .sum();
     Ok(StudySummary {
         progress: state.population.progress(),
         resumed,
         snapshots_written: written,
         checkpoints_written: checkpoints,
+        events: events.num_rows() as u64,
+        events_dropped,
     })
 }
 
@@ -194,7 +217,10 @@ fn is_study_temporary(name: &str) -> bool {
         .is_some_and(|k| !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit()));
     suffix.len() == 6
         && suffix.bytes().all(|b| b.is_ascii_alphanumeric())
-        && (target == CHECKPOINT_FILE || target == FINAL_TABLE || is_snapshot)
+        && (target == CHECKPOINT_FILE
+            || target == FINAL_TABLE
+            || target == EVENTS_TABLE
+            || is_snapshot)
 }
 
 /// Path of snapshot `k`.

@@ -207,6 +207,7 @@ fn removal_is_per_particle_with_reason_and_time() {
         hill_factor: Some(1.0),
         min_perihelion: Some(5.0),
         ejection_distance: Some(1000.0),
+        ..RemovalRules::default()
     };
     let mut pop = population(integ, rules, &st);
     let end = 3000.0 * DAYS_PER_YEAR;
@@ -269,6 +270,7 @@ fn centaurs(n: usize, seed: u64) -> Population {
         hill_factor: None,
         min_perihelion: Some(2.5),
         ejection_distance: Some(100.0),
+        ..RemovalRules::default()
     };
     let ids: Vec<u64> = (0..n as u64).collect();
     let mut pop = Population::new(ephemeris(), integ, rules, 0.0, 30.0, &st, &ids).unwrap();

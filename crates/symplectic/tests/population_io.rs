@@ -548,3 +548,90 @@ mod elements_of_states {
         }
     }
 }
+
+/// A study with end rules and events: the `[removal]` keys `sun_collision`, `min_distance`,
+/// `max_distance` and the `[events]` table are read, and `events.parquet` holds the events
+/// of the population the specification builds, advanced to the end (byte for byte the
+/// table written from it); a resumed study writes it again, identical.
+#[test]
+fn a_study_writes_the_events_table() {
+    use symplectic::io::{events_table, write_parquet, PopulationSpec, EVENTS_TABLE};
+    let spec_text = with(
+        SPEC,
+        "hill_factor = 1.0\nmin_perihelion = 26.0",
+        "min_perihelion = 26.0\nsun_collision = true\n\
+         min_distance = { distance = 20.0, frame = \"heliocentric\" }\n\
+         max_distance = { distance = 400.0, frame = \"barycentric\" }\n\n\
+         [events]\nperihelion_below = [50.0, 37.0]\ntisserand_crossing = true\n\
+         close_approach = { au = 2.0 }\nmax_per_particle = 10",
+    );
+    let (path, out) = study("events", &spec_text, GOOD_ROWS);
+    let summary = run_study(&path, &out, |_| {}).unwrap();
+    // Row 0 (q = 36 AU) is below both values from its first step, row 1 (q = 40 AU) below
+    // 50 AU.
+    assert!(summary.events >= 3, "{} events", summary.events);
+    let spec = PopulationSpec::from_file(&path).unwrap();
+    assert_eq!(spec.events.perihelion_below, vec![50.0, 37.0]);
+    let mut pop = spec.population(&path).unwrap();
+    pop.advance_to(120.0 * 365.25, |_| {}).unwrap();
+    let own = out.join("own-events.parquet");
+    write_parquet(&own, &events_table(&pop).unwrap()).unwrap();
+    let written = std::fs::read(out.join(EVENTS_TABLE)).unwrap();
+    assert_eq!(written, std::fs::read(&own).unwrap());
+    std::fs::remove_file(&own).unwrap();
+    let before = files(&out);
+    assert!(run_study(&path, &out, |_| {}).unwrap().resumed);
+    assert_eq!(files(&out), before);
+}
+
+/// Bad end rules and event rules in a specification are refused with the file and the key.
+#[test]
+fn bad_end_rules_and_events_name_the_key() {
+    for (name, old, new, key) in [
+        (
+            "min_distance",
+            "min_perihelion = 26.0",
+            "min_distance = { distance = -1.0 }",
+            "removal.min_distance.distance",
+        ),
+        (
+            "min_above_max",
+            "min_perihelion = 26.0",
+            "min_distance = { distance = 50.0 }\nmax_distance = { distance = 40.0 }",
+            "removal.min_distance.distance",
+        ),
+        (
+            "frame",
+            "min_perihelion = 26.0",
+            "max_distance = { distance = 50.0, frame = \"galactic\" }",
+            "removal.max_distance.frame",
+        ),
+        (
+            "perihelion_below",
+            "min_perihelion = 26.0",
+            "min_perihelion = 26.0\n[events]\nperihelion_below = [2.5, 0.0]",
+            "events.perihelion_below",
+        ),
+        (
+            "approach_unit",
+            "min_perihelion = 26.0",
+            "min_perihelion = 26.0\n[events]\nclose_approach = { parsecs = 1.0 }",
+            "events.close_approach",
+        ),
+        (
+            "approach_radius",
+            "min_perihelion = 26.0",
+            "min_perihelion = 26.0\n[events]\nclose_approach = { hill_radii = inf }",
+            "events.close_approach.hill_radii",
+        ),
+        (
+            "unknown_event",
+            "min_perihelion = 26.0",
+            "min_perihelion = 26.0\n[events]\nfirst_q = 2.5",
+            "first_q",
+        ),
+    ] {
+        let e = bad_study(&format!("events-{name}"), &with(SPEC, old, new), GOOD_ROWS);
+        assert!(e.contains(key) && e.contains("study.toml"), "{name}: {e}");
+    }
+}

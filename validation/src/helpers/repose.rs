@@ -73,6 +73,9 @@ pub struct Measured {
     pub steepest_deg: f64,
     /// The difference of the two flanks' angles (degrees).
     pub flank_difference_deg: f64,
+    /// The angle of the flank facing `−x` (the left one) and of the flank facing `+x`
+    /// (degrees; NaN for a flank the measure did not find).
+    pub flank_deg: [f64; 2],
     /// The heap's height (m).
     pub height_m: f64,
 }
@@ -249,6 +252,7 @@ pub fn measure_heap(
         angle_deg: m.angle_deg,
         steepest_deg: m.steepest_deg.unwrap_or(f64::NAN),
         flank_difference_deg: (flank(-1) - flank(1)).abs(),
+        flank_deg: [flank(-1), flank(1)],
         height_m: m.pile_height_m,
     };
     Some((m, measured))

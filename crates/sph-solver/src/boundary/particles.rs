@@ -131,6 +131,23 @@ impl<R: Real> WallLattice<R> {
         })
     }
 
+    /// The lattice cut to the single layer of nodes at `at` (m) along `axis` (0, 1 or 2):
+    /// the walls of a planar (2D) run, whose particles all lie in that plane. Errors:
+    /// an axis past 2 or a non-finite `at`.
+    pub fn in_plane(mut self, axis: usize, at: R) -> Result<Self, SolverError> {
+        if axis > 2 || !at.is_finite_value() {
+            return Err(sampling_error(
+                self.solver,
+                "plane",
+                axis as f64,
+                "a planar wall lattice needs an axis 0, 1 or 2 and a finite position (value: the axis)",
+            ));
+        }
+        self.lo[axis] = at - self.spacing * R::of_f64(0.5);
+        self.counts[axis] = 1;
+        Ok(self)
+    }
+
     /// The solids' walls as boundary particles: the nodes that lie inside a solid no deeper
     /// than the rows (the deepest solid that holds the node, from its signed distance).
     /// Each takes the solid whose surface is nearest among those holding it: its unit

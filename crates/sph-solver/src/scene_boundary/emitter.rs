@@ -14,7 +14,8 @@
 //! no grain is nearer than [`ROOM_OVER_SPACING`] spacings to any of its grains, otherwise
 //! it waits for the next frame (the pour then runs late). Each layer is shifted across
 //! gravity by [`Pour::layer_shift`] (alternate layers a quarter spacing either way along `x`,
-//! or a seeded random shift of up to half a spacing along `x` and `z`), so that a narrow pour
+//! or a seeded random shift of up to half a spacing along `x` and `z`; along `x` only for a
+//! layer one node deep along a non-periodic `z`, a planar run's), so that a narrow pour
 //! does not stack its grains in columns. Gravity must point along `−y` ([`Pour::validate`]).
 
 use sph_core::{ParticleSet, Real, Vec3};
@@ -42,6 +43,9 @@ pub struct PourEmitter {
     landed_speed: f64,
     /// The periodic axes: (axis, period).
     periodic: Vec<(usize, f64)>,
+    /// The layer is one node deep along a non-periodic `z` (a planar run's pour): its
+    /// grains stay in that plane, unshifted along `z`.
+    planar: bool,
     /// Layers placed so far.
     poured: usize,
     /// The pour (its layers' shifts).
@@ -76,6 +80,7 @@ impl PourEmitter {
                 .iter()
                 .map(|a| (a.axis, a.period().as_f64()))
                 .collect(),
+            planar: nz == 1 && !periodic.iter().any(|a| a.axis == 2),
             poured: 0,
             pour: Pour {
                 region: sph_core::Aabb { min: lo, max: hi },
@@ -178,6 +183,7 @@ impl PourEmitter {
             });
         }
         let [dx, dz] = self.pour.layer_shift(self.poured, s);
+        let dz = if self.planar { 0.0 } else { dz };
         let layer: Vec<[f64; 3]> = self
             .nodes
             .iter()

@@ -3,13 +3,18 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::events::EventLog;
 use crate::encounter::Encounter;
 use crate::particles::TestParticle;
 use crate::run::ParticleStatus;
 use crate::{SymplecticError, Vec3};
 
-/// When a particle of a [`Population`](crate::Population) is removed, checked at the end of each of its steps.
-/// A rule left out (`None`) is not applied.
+/// When a particle of a [`Population`](crate::Population) is removed, checked at the end of
+/// each of its steps (in the encounter mode, at the end of each of the encounter
+/// integrator's steps). A rule left out (`None`, `false`) is not applied; the first rule met
+/// ends the particle, in the order of the fields, and names itself in its
+/// [`ParticleStatus`]. A file written before the rules `min_distance`, `max_distance` and
+/// `sun_collision` existed reads them as off.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RemovalRules {
@@ -28,10 +33,54 @@ pub struct RemovalRules {
     /// Remove an unbound particle (barycentric osculating energy `≥ 0`) beyond this distance
     /// from the barycentre.
     pub ejection_distance: Option<f64>,
+    /// Remove a particle that has collided with the Sun: closer to its centre than
+    /// [`SUN_RADIUS_AU`](crate::solar_system::SUN_RADIUS_AU) (the IAU nominal solar
+    /// radius) at a step end, or past a heliocentric perihelion below that radius during the
+    /// step that just ended (its heliocentric two-body orbit about `G m₀` at the step end, as
+    /// Mercury's central-body collision check does: Chambers 1999, MNRAS 304, 793), so that a
+    /// grazing passage between two step ends is not missed. Status
+    /// [`ParticleStatus::SunCollision`]. Applied in the encounter mode too.
+    #[serde(default)]
+    pub sun_collision: bool,
+    /// Remove a particle closer than a distance to the Sun or the barycentre (Swift's
+    /// `rmin`), at step ends. Status [`ParticleStatus::InsideMinDistance`]. Applied in the
+    /// encounter mode too.
+    #[serde(default)]
+    pub min_distance: Option<DistanceLimit>,
+    /// Remove a particle farther than a distance from the Sun or the barycentre, bound or
+    /// not (Swift's `rmax`; [`RemovalRules::ejection_distance`] removes only unbound
+    /// particles), at step ends. Status [`ParticleStatus::BeyondMaxDistance`]. Applied in
+    /// the encounter mode too.
+    #[serde(default)]
+    pub max_distance: Option<DistanceLimit>,
+}
+
+/// Where a distance of a removal rule ([`RemovalRules::min_distance`],
+/// [`RemovalRules::max_distance`]) is measured from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DistanceFrame {
+    /// From the Sun's centre.
+    #[default]
+    Heliocentric,
+    /// From the barycentre of the Sun and the planets.
+    Barycentric,
+}
+
+/// A distance and where it is measured from (`{ distance = 0.1, frame = "heliocentric" }`
+/// in a population file; the frame defaults to heliocentric).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DistanceLimit {
+    /// The distance (AU), finite and `> 0`.
+    pub distance: f64,
+    /// Measured from the Sun or the barycentre.
+    #[serde(default)]
+    pub frame: DistanceFrame,
 }
 
 impl RemovalRules {
-    pub(super) fn validate(&self) -> Result<(), SymplecticError> {
+    pub(crate) fn validate(&self) -> Result<(), SymplecticError> {
         for (name, value) in [
             ("hill_factor", self.hill_factor),
             ("min_perihelion", self.min_perihelion),
@@ -45,6 +94,29 @@ impl RemovalRules {
                         reason: "removal rule must be finite and >= 0",
                     });
                 }
+            }
+        }
+        for (name, limit) in [
+            ("min_distance.distance", self.min_distance),
+            ("max_distance.distance", self.max_distance),
+        ] {
+            if let Some(l) = limit {
+                if !(l.distance.is_finite() && l.distance > 0.0) {
+                    return Err(SymplecticError::InvalidParameter {
+                        name,
+                        value: l.distance,
+                        reason: "removal distance must be finite and > 0 (AU)",
+                    });
+                }
+            }
+        }
+        if let (Some(near), Some(far)) = (self.min_distance, self.max_distance) {
+            if near.frame == far.frame && near.distance >= far.distance {
+                return Err(SymplecticError::InvalidParameter {
+                    name: "min_distance.distance",
+                    value: near.distance,
+                    reason: "must be below max_distance.distance in the same frame (every particle would be removed)",
+                });
             }
         }
         Ok(())
@@ -78,6 +150,11 @@ pub struct PopulationMember {
     /// before the counter existed.
     #[serde(default)]
     pub encounters_begun: u32,
+    /// The events recorded so far and what their detection needs to remember
+    /// ([`EventRules`](crate::EventRules)); `None` until the first step checked with event
+    /// rules set, and in a population saved before events existed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub events: Option<Box<EventLog>>,
 }
 
 /// Where a [`Population`](crate::Population) stands after a synchronisation.

@@ -12,12 +12,20 @@ use crate::particles::ParticleIntegrator;
 use crate::run::ParticleStatus;
 use crate::{Encounters, SymplecticError, Variant, Vec3, WorkCounters};
 
+mod ends;
+mod events;
 mod members;
 #[cfg(test)]
 mod tests;
 mod window;
 
-pub use members::{PopulationMember, PopulationProgress, RemovalRules};
+pub use events::{
+    ApproachRadius, CometEvent, EventKind, EventLog, EventRules, OpenApproach,
+    DEFAULT_MAX_EVENTS_PER_PARTICLE, MAX_PERIHELION_THRESHOLDS,
+};
+pub use members::{
+    DistanceFrame, DistanceLimit, PopulationMember, PopulationProgress, RemovalRules,
+};
 use window::{run_window, total_gm, StepPath};
 
 /// Default length of a synchronisation window, in planet steps.
@@ -122,6 +130,9 @@ pub struct Population {
     /// removal rule, and lost regularisation removes).
     #[serde(default)]
     encounters: Option<Encounters>,
+    /// What is recorded without removing (none in a population saved before events).
+    #[serde(default)]
+    events: EventRules,
     members: Vec<PopulationMember>,
     /// Synchronisation time reached.
     time: f64,
@@ -234,6 +245,7 @@ impl Population {
                     sun_position: bodies.positions[0],
                     encounter: None,
                     encounters_begun: 0,
+                    events: None,
                 })
             })
             .collect::<Result<Vec<_>, SymplecticError>>()?;
@@ -242,6 +254,7 @@ impl Population {
             integrator,
             rules,
             encounters: None,
+            events: EventRules::default(),
             members,
             time,
             window_steps: DEFAULT_WINDOW_STEPS,
@@ -312,6 +325,32 @@ impl Population {
         }
         self.encounters = encounters;
         Ok(())
+    }
+
+    /// Records `events` from now on ([`EventRules`]; the default records none). Errors name
+    /// the field of a bad value; the Tisserand crossing needs a planet named Jupiter.
+    pub fn set_events(&mut self, events: EventRules) -> Result<(), SymplecticError> {
+        events.validate()?;
+        if events.tisserand_crossing && self.jupiter_index().is_none() {
+            return Err(SymplecticError::InvalidParameter {
+                name: "events.tisserand_crossing",
+                value: 1.0,
+                reason: "needs a planet named Jupiter (Planets::with_names_and_radii)",
+            });
+        }
+        self.events = events;
+        Ok(())
+    }
+
+    /// What is recorded without removing.
+    pub fn events(&self) -> &EventRules {
+        &self.events
+    }
+
+    /// Jupiter's index among the bodies (the Sun is 0), if a planet is so named.
+    fn jupiter_index(&self) -> Option<usize> {
+        let planets = self.ephemeris.planets();
+        (1..=planets.len()).find(|&j| planets.name(j) == "Jupiter")
     }
 
     /// The close-encounter settings, if any.
@@ -448,6 +487,7 @@ impl Population {
             });
         }
         let window = f64::from(self.window_steps) * self.ephemeris.grid_step();
+        let jupiter = self.jupiter_index();
         let mut needed = f64::NEG_INFINITY;
         while let Some(oldest) = self.oldest_active_time() {
             if oldest >= t_end {
@@ -463,9 +503,10 @@ impl Population {
             let ephemeris = &self.ephemeris;
             let members = &mut self.members;
             let (integrator, rules) = (self.integrator, (self.rules, self.encounters));
+            let events = (&self.events, jupiter);
             let (extension, (steps, beyond)) = rayon::join(
                 || ephemeris.extension(ahead),
-                || run_window(ephemeris, integrator, rules, members, end, path),
+                || run_window(ephemeris, integrator, rules, events, members, end, path),
             );
             self.particle_steps += steps;
             self.ephemeris.append(extension?)?;
@@ -513,6 +554,7 @@ impl Population {
             integrator: self.integrator,
             rules: self.rules,
             encounters: self.encounters,
+            events: self.events.clone(),
             members: Vec::new(),
             time: self.time,
             window_steps: self.window_steps,
@@ -522,7 +564,7 @@ impl Population {
 
     /// Joins shards of one population advanced to the same time ([`Population::shard`]): the
     /// members in identifier order, the ephemeris covering all of them. Errors if the shards
-    /// differ in integrator, rules, planets' step or time, or share an identifier.
+    /// differ in integrator, rules, event rules, planets' step or time, or share an identifier.
     pub fn merge(shards: Vec<Self>) -> Result<Self, SymplecticError> {
         let Some(first) = shards.first() else {
             return Err(SymplecticError::InvalidParameter {
@@ -548,11 +590,12 @@ impl Population {
             let same = s.integrator == first.integrator
                 && s.rules == first.rules
                 && s.encounters == first.encounters
+                && s.events == first.events
                 && s.ephemeris.integrator() == first.ephemeris.integrator()
                 && s.ephemeris.grid_time(0).to_bits() == first.ephemeris.grid_time(0).to_bits();
             if !same {
                 return Err(differ(
-                    "differ in integrator, removal rules, encounters or planets: not shards of one population"
+                    "differ in integrator, removal rules, encounters, event rules or planets: not shards of one population"
                         .into(),
                 ));
             }
@@ -628,7 +671,9 @@ impl Population {
 
 const POPULATION_FORMAT: &str = "symplectic-population";
 /// 2: [`Encounters::hand_back_hill_factor`] and [`PopulationMember::encounters_begun`];
-/// 3: [`Encounter::state`](crate::Encounter) holds the particle only (and its `p₄`); an
+/// 3: the removal rules `sun_collision`, `min_distance`, `max_distance`, the event rules and
+/// the members' event logs (a version 1 or 2 file reads them as off and empty), and
+/// [`Encounter::state`](crate::Encounter) holds the particle only (and its `p₄`); an
 /// encounter state of an older file (the Sun, the planets and the particle) is converted
 /// when the member next steps.
 const POPULATION_VERSION: u32 = 3;

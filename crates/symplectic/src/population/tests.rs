@@ -41,7 +41,8 @@ proptest! {
     #![proptest_config(ProptestConfig { cases: 32, ..ProptestConfig::default() })]
 
     /// The lanes give the population of the scalar path bit for bit: every member's
-    /// state, status (rule, time, figures), step and work counts, on one or two threads.
+    /// state, status (rule, time, figures), step and work counts, events, on one or two
+    /// threads.
     #[test]
     fn lanes_equal_the_scalar_path(
         seed in 0u64..10_000,
@@ -54,16 +55,30 @@ proptest! {
         min_perihelion in prop::option::of(5.0f64..30.0),
         ejection in prop::option::of(60.0f64..200.0),
         encounters in any::<bool>(),
+        events in any::<bool>(),
     ) {
         let scheme = if s6 { Scheme::S6 } else { Scheme::S2 };
+        let distance = |distance, frame| Some(DistanceLimit { distance, frame });
         let rules = RemovalRules {
             hill_factor: hill,
             min_perihelion,
             ejection_distance: ejection,
+            // Every step end through the scalar checks: the events and the geometric rules.
+            sun_collision: events,
+            min_distance: distance(8.0, DistanceFrame::Heliocentric).filter(|_| events),
+            max_distance: distance(150.0, DistanceFrame::Barycentric).filter(|_| events),
         };
         let b1 = if small_b1 { 3e-8 } else { crate::PAPER_B1 };
         let mut start = population(n, seed, scheme, b1, rules);
         start.set_window_steps(window).unwrap();
+        if events {
+            start.set_events(EventRules {
+                perihelion_below: vec![20.0, 12.0],
+                tisserand_crossing: true,
+                close_approach: Some(ApproachRadius::HillRadii(5.0)),
+                ..EventRules::default()
+            }).unwrap();
+        }
         if encounters && hill.is_none() {
             start.set_encounters(Some(crate::Encounters::default())).unwrap();
         }
@@ -93,6 +108,7 @@ fn lanes_test_population_meets_every_outcome() {
         hill_factor: Some(1.0),
         min_perihelion: Some(8.0),
         ejection_distance: Some(100.0),
+        ..RemovalRules::default()
     };
     let mut p = population(200, 3, Scheme::S2, 3e-8, rules);
     p.advance_to(400.0 * 365.25, |_| {}).unwrap();

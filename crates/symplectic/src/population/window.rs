@@ -6,6 +6,8 @@ use std::collections::VecDeque;
 
 use rayon::prelude::*;
 
+use super::ends::{geometric_end, SunState};
+use super::events::{CheckPoint, EventContext, EventRules};
 use super::members::{PopulationMember, RemovalRules};
 use crate::encounter::{
     regularisation, Encounter, EncounterScratch, Encounters, ENCOUNTER_STATE_LEN,
@@ -36,6 +38,13 @@ struct WindowContext<'a> {
     rules: RemovalRules,
     /// Integration through close encounters.
     encounters: Option<Encounters>,
+    /// What is recorded without removing.
+    events: &'a EventRules,
+    /// Jupiter's index among the bodies, if any.
+    jupiter: Option<usize>,
+    /// Whether every step end is checked by the scalar code (events, or the geometric end
+    /// rules of [`geometric_end`]): the lanes then flag every lane.
+    every_step: bool,
     /// Radius of each planet, if known.
     radii: Vec<Option<f64>>,
     /// `(m_j/3m₀)^{1/3}` per planet.
@@ -114,8 +123,9 @@ struct LaneState {
     positions: Vec<V3>,
     velocities: Vec<V3>,
     kick: KickLanes,
-    /// One lane's body positions, for [`WindowContext::removal`].
+    /// One lane's body positions and velocities, for [`WindowContext::transition`].
     column: Vec<Vec3>,
+    column_velocities: Vec<Vec3>,
 }
 
 /// One window: every active member steps while its time is before `end`, reading `ephemeris`.
@@ -124,6 +134,7 @@ pub(super) fn run_window(
     ephemeris: &Ephemeris,
     integrator: ParticleIntegrator,
     (rules, encounters): (RemovalRules, Option<Encounters>),
+    (events, jupiter): (&EventRules, Option<usize>),
     members: &mut [PopulationMember],
     end: f64,
     path: StepPath,
@@ -144,6 +155,12 @@ pub(super) fn run_window(
         integrator,
         rules,
         encounters,
+        events,
+        jupiter,
+        every_step: events.any()
+            || rules.sun_collision
+            || rules.min_distance.is_some()
+            || rules.max_distance.is_some(),
         radii: (1..=planets.len()).map(|j| planets.radius(j)).collect(),
         hill_coefficients: planets
             .masses()
@@ -253,6 +270,7 @@ impl WindowContext<'_> {
             velocities: vec![zero; self.gm.len()],
             kick: KickLanes::zero(),
             column: Vec::with_capacity(self.gm.len()),
+            column_velocities: Vec::with_capacity(self.gm.len()),
         };
         let mut queue: VecDeque<usize> = (0..members.len())
             .filter(|&i| {
@@ -419,6 +437,7 @@ impl WindowContext<'_> {
                 }
             } else {
                 let p = &mut m.particle;
+                let previous_time = p.time;
                 p.position = lanes::lane(&q, l);
                 p.velocity = lanes::lane(&v, l);
                 p.time = t.0[l];
@@ -434,8 +453,13 @@ impl WindowContext<'_> {
                     lanes
                         .column
                         .extend(lanes.positions.iter().map(|x| lanes::lane(x, l)));
+                    lanes.column_velocities.clear();
+                    lanes
+                        .column_velocities
+                        .extend(lanes.velocities.iter().map(|x| lanes::lane(x, l)));
                     let f1 = lanes.kick.f1.0[l];
-                    if self.transition(m, &lanes.column, f1, &mut slot.worker) {
+                    let bodies = (&lanes.column[..], &lanes.column_velocities[..]);
+                    if self.transition(m, bodies, f1, previous_time, &mut slot.worker) {
                         let (s, b) = self.run_encounter(m, &mut slot.worker);
                         (steps, beyond) = (steps + s, beyond.max(b));
                         slot.bodies_time = f64::NAN;
@@ -522,9 +546,10 @@ impl WindowContext<'_> {
                 w.bodies_time = t;
                 m.sun_position = w.bodies.positions[0];
                 let positions = std::mem::take(&mut w.bodies.positions);
+                let velocities = std::mem::take(&mut w.bodies.velocities);
                 let f1 = w.kick.f1();
-                self.transition(m, &positions, f1, w);
-                w.bodies.positions = positions;
+                self.transition(m, (&positions, &velocities), f1, saved.time, w);
+                (w.bodies.positions, w.bodies.velocities) = (positions, velocities);
                 StepOutcome::Stepped
             }
             Err(SymplecticError::BeyondEphemeris { time, .. }) => {
@@ -568,6 +593,9 @@ impl WindowContext<'_> {
     #[inline(always)]
     fn removal_lanes(&self, q: &V3, v: &V3, positions: &[V3], f1: &V) -> Mask {
         let rules = &self.rules;
+        if self.every_step {
+            return [true; LANES];
+        }
         let mut hit = [false; LANES];
         let mut flag = |test: Mask| {
             for (h, t) in hit.iter_mut().zip(test) {
@@ -629,16 +657,19 @@ impl WindowContext<'_> {
         }
     }
 
-    /// Applies to `m`, just stepped by the map, the first rule it meets with the bodies at its
-    /// time (`positions`) and `F₁` at its end (`f1`): removal, or the switch to the encounter
-    /// mode ([`Encounters`]). Returns whether it switched.
+    /// Applies to `m`, just stepped by the map from `previous_time`, the first rule it meets
+    /// with the bodies at its time (`positions`, `velocities`) and `F₁` at its end (`f1`):
+    /// removal, or the switch to the encounter mode ([`Encounters`]), after recording its
+    /// events. Returns whether it switched.
     fn transition(
         &self,
         m: &mut PopulationMember,
-        positions: &[Vec3],
+        (positions, velocities): (&[Vec3], &[Vec3]),
         f1: f64,
+        previous_time: f64,
         w: &mut Worker,
     ) -> bool {
+        self.record_events(m, positions, velocities, true);
         if let Some(settings) = self.encounters {
             // The same operations as the lanes' flags (`removal_lanes`).
             let r = m.particle.position.norm();
@@ -652,8 +683,68 @@ impl WindowContext<'_> {
         }
         if let Some(status) = self.removal(&m.particle, positions) {
             m.status = status;
+        } else if let Some(status) =
+            self.geometric_end_at(&m.particle, previous_time, positions, velocities)
+        {
+            m.status = status;
         }
         false
+    }
+
+    /// The particle's barycentric position, with the bodies at its time.
+    fn barycentric(&self, p: &TestParticle, positions: &[Vec3]) -> Vec3 {
+        match self.integrator.variant {
+            Variant::Barycentric => p.position,
+            Variant::Mixed => p.position + positions[0],
+        }
+    }
+
+    /// Records the events of `m` at its time with the bodies then ([`EventRules`]);
+    /// `elements_apply`: whether its barycentric elements describe its orbit.
+    fn record_events(
+        &self,
+        m: &mut PopulationMember,
+        positions: &[Vec3],
+        velocities: &[Vec3],
+        elements_apply: bool,
+    ) {
+        if !self.events.any() {
+            return;
+        }
+        let ctx = EventContext {
+            rules: self.events,
+            total_gm: self.total_gm,
+            hill_coefficients: &self.hill_coefficients,
+            jupiter: self.jupiter,
+        };
+        let c = CheckPoint {
+            time: m.particle.time,
+            position: self.barycentric(&m.particle, positions),
+            velocity: m.particle.velocity,
+            body_positions: positions,
+            body_velocities: velocities,
+        };
+        m.events
+            .get_or_insert_with(Default::default)
+            .check(&ctx, &c, elements_apply);
+    }
+
+    /// The Sun-collision and distance rules ([`geometric_end`]) for `p`, its previous check
+    /// at `previous_time`.
+    fn geometric_end_at(
+        &self,
+        p: &TestParticle,
+        previous_time: f64,
+        positions: &[Vec3],
+        velocities: &[Vec3],
+    ) -> Option<ParticleStatus> {
+        let sun = SunState {
+            position: positions[0],
+            velocity: velocities[0],
+            gm: self.gm[0],
+        };
+        let q = self.barycentric(p, positions);
+        geometric_end(&self.rules, p.time, previous_time, q, p.velocity, &sun)
     }
 
     /// Switches `m` (at its time, in the map) to the encounter mode.
@@ -718,6 +809,7 @@ impl WindowContext<'_> {
                     break;
                 }
             }
+            let previous_time = e.time;
             let stepped = e.step(
                 &self.grid,
                 &settings,
@@ -744,9 +836,15 @@ impl WindowContext<'_> {
                     distance,
                     radius,
                 };
-            } else if g.nearest_ratio >= settings.hill_factor {
-                if let Some(status) = self.orbit_removal(&m.particle) {
-                    m.status = status;
+            } else {
+                let beyond_switch = g.nearest_ratio >= settings.hill_factor;
+                if self.every_step {
+                    self.check_in_encounter(m, previous_time, beyond_switch, w);
+                }
+                if m.status == ParticleStatus::Active && beyond_switch {
+                    if let Some(status) = self.orbit_removal(&m.particle) {
+                        m.status = status;
+                    }
                 }
             }
         }
@@ -779,6 +877,36 @@ impl WindowContext<'_> {
         (steps, f64::NEG_INFINITY)
     }
 
+    /// Events and geometric end rules of `m` in the encounter mode, after a step from
+    /// `previous_time`, with the planets of the ephemeris at its time.
+    fn check_in_encounter(
+        &self,
+        m: &mut PopulationMember,
+        previous_time: f64,
+        elements_apply: bool,
+        w: &mut Worker,
+    ) {
+        if w.bodies_time != m.particle.time {
+            w.bodies_time = f64::NAN;
+            if let Err(err) = self.grid.interpolate(m.particle.time, &mut w.bodies, false) {
+                m.status = ParticleStatus::IntegrationFailed {
+                    time: m.particle.time,
+                    reason: err.to_string(),
+                };
+                return;
+            }
+            w.bodies_time = m.particle.time;
+        }
+        let bodies = &w.bodies;
+        self.record_events(m, &bodies.positions, &bodies.velocities, elements_apply);
+        let p = &m.particle;
+        if let Some(status) =
+            self.geometric_end_at(p, previous_time, &bodies.positions, &bodies.velocities)
+        {
+            m.status = status;
+        }
+    }
+
     /// The planet (1-based) whose `factor` Hill radii the particle is inside, with the
     /// distance and the Hill radius.
     fn hill_entry(
@@ -787,10 +915,7 @@ impl WindowContext<'_> {
         positions: &[Vec3],
         factor: f64,
     ) -> Option<(usize, f64, f64)> {
-        let q = match self.integrator.variant {
-            Variant::Barycentric => p.position,
-            Variant::Mixed => p.position + positions[0],
-        };
+        let q = self.barycentric(p, positions);
         // Compared squared (no square root per planet and step); the distances are taken
         // only for the report.
         let sun = positions[0];
@@ -817,10 +942,7 @@ impl WindowContext<'_> {
                 });
             }
         }
-        let q = match self.integrator.variant {
-            Variant::Barycentric => p.position,
-            Variant::Mixed => p.position + positions[0],
-        };
+        let q = self.barycentric(p, positions);
         self.orbit_removal_at(p, &q)
     }
 

@@ -70,6 +70,7 @@ fn run_ours(ctx: &Context, n: usize) -> Result<(Removals, Vec<(usize, u64)>)> {
         hill_factor: Some(1.0),
         min_perihelion: None,
         ejection_distance: Some(1000.0),
+        ..RemovalRules::default()
     };
     let mut pop = Population::new(
         ephemeris,

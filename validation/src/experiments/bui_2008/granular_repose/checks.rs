@@ -111,6 +111,14 @@ pub fn check_heap(
     let (m, measured) = measure_heap(out, case, &heap, floor.y)?;
     let predicted = cone.predicted_repose_angle_deg(case.theta_deg);
     heap_metrics(out, case, predicted, &measured);
+    out.metric(
+        format!("{}/left_flank_deg", case.tag),
+        measured.flank_deg[0],
+    );
+    out.metric(
+        format!("{}/right_flank_deg", case.tag),
+        measured.flank_deg[1],
+    );
     check_toes(
         out,
         &case.tag,
