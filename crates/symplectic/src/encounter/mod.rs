@@ -30,10 +30,11 @@
 //! integrator at every substep. The particle alone is integrated, in barycentric coordinates,
 //! by the Bulirsch–Stoer method (module `bulirsch_stoer`) with a relative tolerance per step
 //! [`Encounters::tolerance`] and steps fitted to the encounter by the error control, together
-//! with its `p₄` (`dp₄/dt = −∂H/∂t`, the term the map's kicks add), so that `H + p₄`, a
-//! constant of the exact motion in both modes, is carried through the encounter and stays
-//! the diagnostic of the whole trajectory. Nothing jumps at the switch or the hand-back: the
-//! particle's state is handed over as it is and the planets are the same. The geometry of an
+//! with its `p₄` (`dp₄/dt = −∂H/∂t`, the term the map's kicks add), so that the change of
+//! `H + p₄`, a constant of the exact motion, over the encounter is its integration error,
+//! which the hand-back passes on to the map (*Hand-back*). Nothing jumps at the switch or
+//! the hand-back: the particle's position and velocity are handed over as they are and the
+//! planets are the same. The geometry of an
 //! encounter is then set by the ephemeris' accuracy (measured against the Newtonian flow of
 //! its grid states: [`Ephemeris`](crate::Ephemeris), 2.1·10⁻⁹ AU for Jupiter at the 91.3125 d
 //! planet step of the shipped populations) and by the tolerance. (Until this version the
@@ -48,8 +49,22 @@
 //! **Hand-back.** After a step of the encounter integrator, the particle returns to the map
 //! when it is outside [`Encounters::hand_back_hill_factor`] Hill radii of every planet (3.5
 //! by default, beyond the switch's 3), `F₁ ≥ ¾ (B₀ + B₁/r)` (a margin above the switch's ½),
-//! and at least one map step's time (`h/F₁` at the switch) has passed since the switch. It
-//! keeps its step `h` in the new variable `s` and the `p₄` integrated through the encounter.
+//! and at least one map step's time (`h/F₁` at the switch) has passed since the switch, and
+//! if the map's `F₀` is then at least `½ (B₀ + B₁/r)`. It keeps its step `h` in the new
+//! variable `s`. The two modes conserve different functions of the same state: the encounter
+//! integrator, the exact motion's `K = H + p₄ = F₀ − F₁`; the map, whose pieces are the
+//! flows of `ln F₀` and `−ln F₁` (the logarithmic Hamiltonian of S. Mikkola and K. Tanikawa,
+//! "Explicit symplectic algorithms for time-transformed Hamiltonians", *Celest. Mech. Dyn.
+//! Astron.* 74, 287–295 (1999), doi:10.1023/A:1008368322547), the ratio `F₀/F₁`. Carrying
+//! `K` through an encounter would turn the map's small error `F₀/F₁ − 1` into
+//! `(F₀/F₁ − 1) · F₁(switch)/F₁(hand-back)`: `F₁` holds the nearest planet's `G m/|q − Q|`,
+//! larger at the switch (3 R_H) than at the hand-back (3.5 R_H), by 2.2 % on average in the
+//! Centaur population, so that the error grew geometrically over a comet's encounters (after
+//! some 270 of them to `|K/F₁| ≈ 1`, where `F₀` reaches zero and the map fails). So the
+//! hand-back sets `p₄` such that `F₀/F₁` is the map's value at the switch plus the change of
+//! `K` over the encounter (the encounter integrator's error, which the energy diagnostic then
+//! sees): `K = F₁ (F₀/F₁|switch − 1) + ΔK`. (Where `F₀` or `F₁` was not positive at the
+//! switch, the map's ratio is taken as 1: only `ΔK` is kept.)
 //!
 //! *Hysteresis.* Both margins keep a particle from going back and forth across one
 //! boundary. A sharp switch in and out at the same radius does: a comet skimming 3 R_H
@@ -210,6 +225,18 @@ pub struct Encounter {
     pub earliest_hand_back: f64,
     /// Steps of the encounter integrator so far.
     pub steps: u64,
+    /// `H + p₄` at the switch (AU²/day²): the encounter's own error is the change of
+    /// `H + p₄` from this value at the hand-back.
+    #[serde(default)]
+    pub switch_energy: f64,
+    /// `F₀/F₁` of the map at the switch (1 if either was not positive): the quantity the
+    /// map conserves (module [`encounter`](self), *Hand-back*), continued at the hand-back.
+    #[serde(default = "unit_ratio")]
+    pub switch_ratio: f64,
+}
+
+fn unit_ratio() -> f64 {
+    1.0
 }
 
 /// Length of [`Encounter::state`]: position, velocity, `p₄`.
@@ -269,8 +296,14 @@ impl Encounter {
     /// Switches `p` (barycentric, at its time) to the encounter mode: its position, velocity
     /// and `p₄` as they are (the planets are the ephemeris' in both modes, so nothing jumps);
     /// the first step proposed is one map step's time `map_dt` (a grid step's eighth if that
-    /// is not positive).
-    pub(crate) fn begin(p: &TestParticle, grid: &GridView<'_>, map_dt: f64) -> Self {
+    /// is not positive). `switch` holds the map's `H + p₄` and `F₁` there (`None` if the
+    /// planets could not be read).
+    pub(crate) fn begin(
+        p: &TestParticle,
+        grid: &GridView<'_>,
+        map_dt: f64,
+        switch: Option<(f64, f64)>,
+    ) -> Self {
         let mut state = Vec::with_capacity(ENCOUNTER_STATE_LEN);
         state.extend(p.position.iter().copied());
         state.extend(p.velocity.iter().copied());
@@ -280,6 +313,11 @@ impl Encounter {
         } else {
             grid.step() / 8.0
         };
+        let (switch_energy, switch_ratio) = match switch {
+            Some((energy, f1)) if f1 > 0.0 && f1 + energy > 0.0 => (energy, (f1 + energy) / f1),
+            Some((energy, _)) => (energy, 1.0),
+            None => (0.0, 1.0),
+        };
         Self {
             time: p.time,
             state,
@@ -287,6 +325,8 @@ impl Encounter {
             since: p.time,
             earliest_hand_back: p.time + map_dt.max(0.0),
             steps: 0,
+            switch_energy,
+            switch_ratio,
         }
     }
 
@@ -322,6 +362,7 @@ impl Encounter {
         p.velocity = Vec3::from_column_slice(&self.state[3 * objects + k..3 * objects + k + 3]);
         p.time = self.time;
         p.p4 = -integrator.hamiltonian(&p, bodies);
+        (self.switch_energy, self.switch_ratio) = (0.0, 1.0);
         self.state.clear();
         self.state
             .extend(p.position.iter().chain(p.velocity.iter()).copied());
@@ -405,9 +446,17 @@ impl Encounter {
         g
     }
 
-    /// The particle as a map particle at its time: position, velocity and `p₄` as integrated
-    /// (not reset: `H + p₄` goes on from the map's value before the switch, so a planet that
-    /// jumped between the modes would show in it), the map step `step` kept.
+    /// The map's `H + p₄` at the hand-back, where `H` (`hamiltonian`) and `F₁` (`f1`) are
+    /// the particle's now: `F₁ (F₀/F₁ at the switch − 1)`, the map's conserved ratio
+    /// continued, plus the change of `H + p₄` over the encounter (its integration error).
+    /// `F₀ = F₁ + (H + p₄)` is then `F₁ · F₀/F₁ at the switch` plus that error.
+    pub(crate) fn hand_back_energy(&self, hamiltonian: f64, f1: f64) -> f64 {
+        f1 * (self.switch_ratio - 1.0) + (hamiltonian + self.p4() - self.switch_energy)
+    }
+
+    /// The particle as a map particle at its time: position, velocity and `p₄` as integrated,
+    /// the map step `step` kept. The population's hand-back then sets `p₄` to
+    /// [`Encounter::hand_back_energy`] `− H`.
     pub(crate) fn hand_back(&self, previous: &TestParticle) -> TestParticle {
         let (position, velocity) = self.particle();
         TestParticle {

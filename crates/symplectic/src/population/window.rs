@@ -751,16 +751,18 @@ impl WindowContext<'_> {
     fn begin_encounter(&self, m: &mut PopulationMember, w: &mut Worker) {
         let p = &m.particle;
         // One map step's time from here: `h/F₁` with the ephemeris' planets (`h/(B₀ + B₁/r)`
-        // where `F₁` is not positive).
-        let map_dt = match self.grid.interpolate(p.time, &mut w.bodies, false) {
+        // where `F₁` is not positive); the map's `H + p₄` and `F₁` at the switch.
+        let (map_dt, switch) = match self.grid.interpolate(p.time, &mut w.bodies, false) {
             Ok(()) => {
                 let (f1, part) = regularisation(&self.integrator, &p.position, &w.bodies);
-                p.step / if f1 > 0.0 { f1 } else { part }
+                let energy = self.integrator.hamiltonian(p, &w.bodies) + p.p4;
+                let dt = p.step / if f1 > 0.0 { f1 } else { part };
+                (dt, Some((energy, f1)))
             }
-            Err(_) => 0.0,
+            Err(_) => (0.0, None),
         };
         w.bodies_time = f64::NAN;
-        m.encounter = Some(Box::new(Encounter::begin(p, &self.grid, map_dt)));
+        m.encounter = Some(Box::new(Encounter::begin(p, &self.grid, map_dt, switch)));
         m.encounters_begun = m.encounters_begun.saturating_add(1);
     }
 
@@ -802,11 +804,19 @@ impl WindowContext<'_> {
                 let (q, _) = e.particle();
                 let (f1, part) = regularisation(&self.integrator, &q, &w.bodies);
                 if g.nearest_ratio >= settings.hand_back_hill_factor && f1 >= 0.75 * part {
-                    m.particle = e.hand_back(&m.particle);
-                    m.sun_position = w.bodies.positions[0];
-                    m.encounter = None;
-                    w.bodies_time = f64::NAN;
-                    break;
+                    // The map's `F₀ = F₁ + (H + p₄)` must be positive too, with the switch's
+                    // margin (`F₀ ≥ ½ (B₀ + B₁/r)`).
+                    let mut p = e.hand_back(&m.particle);
+                    let hamiltonian = self.integrator.hamiltonian(&p, &w.bodies);
+                    let energy = e.hand_back_energy(hamiltonian, f1);
+                    if f1 + energy >= 0.5 * part {
+                        p.p4 = energy - hamiltonian;
+                        m.particle = p;
+                        m.sun_position = w.bodies.positions[0];
+                        m.encounter = None;
+                        w.bodies_time = f64::NAN;
+                        break;
+                    }
                 }
             }
             let previous_time = e.time;
