@@ -230,7 +230,7 @@ pub const CENTAUR_SEED: u64 = 2027;
 pub const CENTAUR_B1: f64 = 4e-6;
 
 /// The Centaur population (the `centaur_throughput` example): the four giants of
-/// `outer_solar_system` (ecliptic J2000) integrated by S6 at `planet_step_days` (730.5 d in
+/// `outer_solar_system` (ecliptic J2000) integrated by S6 at `planet_step_days` (91.3125 d in
 /// `populations/centaurs.toml`); `n` comets with `a` 5.5–30 AU, `e` 0–0.2, `i` 0–10° and
 /// random angles (`symplectic::samples::CENTAURS`, seed `seed`), S2 in the barycentric
 /// variant with `B₀ = 0`, `B₁ =` [`CENTAUR_B1`], a first step of `step_per_au_days` × the
