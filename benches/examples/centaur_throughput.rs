@@ -4,10 +4,10 @@
 //! `cargo run --release -p benches --example centaur_throughput -- N YEARS [FIRST_STEP] [TOLERANCE] [SEED] [PLANET_STEP_DAYS]`
 //!
 //! builds `benches::centaur_population` (the four giants, S6 at `PLANET_STEP_DAYS`, default
-//! 730.5 d; `N` comets with
+//! 91.3125 d as in `populations/centaurs.toml`; `N` comets with
 //! `a` 5.5–30 AU, `e` 0–0.2, `i` 0–10°; S2 barycentric with `B₁ = 4·10⁻⁶`, a first step of
-//! `FIRST_STEP` days per AU of initial distance (default 2), or of that many days for every
-//! comet if it ends in `d` (`20d`: the population file's `initial_step_days`); encounters
+//! `FIRST_STEP` days per AU of initial distance, or of that many days for every comet if it
+//! ends in `d` (default `20d`, the population file's `initial_step_days`); encounters
 //! inside 3 Hill radii by Bulirsch–Stoer at `TOLERANCE` (default 10⁻¹²); removal below
 //! q = 2.5 AU, unbound beyond 100 AU, or at a collision with a planet or the Sun), advances it `YEARS` years on `RAYON_NUM_THREADS`
 //! threads and prints as its last line
@@ -47,7 +47,7 @@ fn run() -> Result<(), String> {
             .map_or(Ok(default), |s| s.parse().map_err(|_| usage.to_string()))
     };
     let first_step = match args.get(2) {
-        None => benches::FirstStep::PerAuDays(2.0),
+        None => benches::FirstStep::Days(20.0),
         Some(s) => match s.strip_suffix('d') {
             Some(days) => benches::FirstStep::Days(days.parse().map_err(|_| usage.to_string())?),
             None => benches::FirstStep::PerAuDays(s.parse().map_err(|_| usage.to_string())?),
@@ -55,7 +55,7 @@ fn run() -> Result<(), String> {
     };
     let tolerance = arg(3, symplectic::DEFAULT_ENCOUNTER_TOLERANCE)?;
     let seed = arg(4, benches::CENTAUR_SEED as f64)? as u64;
-    let planet_step = arg(5, 730.5)?;
+    let planet_step = arg(5, 91.3125)?;
     let (mut population, states) =
         benches::centaur_population(n, seed, first_step, tolerance, planet_step)?;
     if let Ok(path) = std::env::var("CENTAUR_THROUGHPUT_INITIAL") {
