@@ -56,9 +56,39 @@ impl BodyStates {
 /// position, so the particle's extended Hamiltonian `H + p₄` is an exact invariant of the
 /// particle's continuous dynamics and its drift measures only the particle integrator's
 /// error. The paper's recipe gives a trajectory that is discontinuous in velocity at grid
-/// points and whose `dQ/dt` of eq. 33 is not the derivative of its `Q`. The interpolation
-/// error is `≈ (ωτ)⁶/46080` of a planet's orbit radius (`ω` its mean motion): 2.5·10⁻⁶ AU for
-/// Jupiter at τ = 365 d, below the second-order map's own error.
+/// points and whose `dQ/dt` of eq. 33 is not the derivative of its `Q`.
+///
+/// **One trajectory for every reader.** This interpolant is *the* planets' trajectory of a
+/// [`Population`](crate::Population): the map reads it at its kicks and the encounter mode
+/// ([`encounter`](crate::encounter)) at every substep of its integrator, so that a switch
+/// and a hand-back change nothing the comet feels. Its accuracy is that of the planets in a
+/// close encounter; measured (`cargo run --release -p symplectic --example
+/// ephemeris_accuracy`, 2026-12-05) as the largest distance, over two orbits of Jupiter,
+/// between the interpolant and the Newtonian flow of the grid state before it (integrated by
+/// Bulirsch–Stoer at 2·10⁻¹⁵ per step), for the four giants integrated by S6 at `τ`:
+///
+/// | τ (days) | Jupiter (AU) | Saturn (AU) | Uranus, Neptune (AU) | of which S6's one step, Jupiter |
+/// | ---: | ---: | ---: | ---: | ---: |
+/// | 730.5 | 5.0·10⁻⁴ | 4.9·10⁻⁶ | 6.3·10⁻⁸ | 1.5·10⁻⁶ |
+/// | 365.25 | 8.3·10⁻⁶ | 1.0·10⁻⁷ | 4.2·10⁻⁹ | 1.4·10⁻⁸ |
+/// | 182.625 | 1.3·10⁻⁷ | 2.3·10⁻⁹ | 5.5·10⁻¹⁰ | 7.2·10⁻¹⁰ |
+/// | 121.75 | 1.2·10⁻⁸ | 4.5·10⁻¹⁰ | 1.6·10⁻¹⁰ | 1.8·10⁻¹⁰ |
+/// | 91.3125 | 2.1·10⁻⁹ | 1.8·10⁻¹⁰ | 6.9·10⁻¹¹ | 7.3·10⁻¹¹ |
+///
+/// The interpolant's error goes as `τ⁶` (`≈ (ωτ)⁶/46080` of the orbit radius for a circular
+/// orbit, `ω` the mean motion; three times that for Jupiter, whose perihelion speed sets
+/// it); the S6 map's own one-step error (the flow at the interval's end against the next
+/// grid state) as `τ⁷`, and no interpolant of a grid can be nearer the flow than that. A
+/// higher-order interpolant of the 730.5 d grid is therefore no way to 10⁻⁸ AU (S6 alone
+/// is 1.5·10⁻⁶ AU off); the planet step is: 91.3125 d (a quarter of a year, the step of the
+/// shipped Centaur population) puts Jupiter within 2.1·10⁻⁹ AU of the flow
+/// (`tests/ephemeris_accuracy.rs` holds it under 10⁻⁸ AU). Its cost: eight planet steps
+/// instead of one per 730.5 d, about 1 µs each (4·10⁶ steps, some 4 s, per simulated Myr,
+/// shared by the whole population), and nothing per particle step (one interpolation as
+/// before). Memory: a grid state is 360 bytes for five bodies; a whole Myr would be
+/// 1.4 GB at this step, but an ephemeris retains only its window
+/// ([`Ephemeris::discard_before`]; a population about three windows of
+/// [`DEFAULT_WINDOW_STEPS`](crate::DEFAULT_WINDOW_STEPS) states, 280 kB), whatever the span.
 ///
 /// The grid is a window: states older than needed are dropped with
 /// [`Ephemeris::discard_before`]; newer ones are computed on demand.
@@ -342,25 +372,6 @@ impl GridView<'_> {
     /// The grid step `τ`.
     pub(crate) fn step(&self) -> f64 {
         self.tau
-    }
-
-    /// The time of the retained grid state at or before `t` (the state the interpolation at
-    /// `t` starts from); errors as [`GridView::interpolate`] does.
-    pub(crate) fn grid_time_at_or_before(&self, t: f64) -> Result<f64, SymplecticError> {
-        if t > self.newest {
-            return Err(SymplecticError::BeyondEphemeris {
-                time: t,
-                newest: self.newest,
-            });
-        }
-        if !(t.is_finite() && t >= self.oldest) {
-            return Err(SymplecticError::InvalidParameter {
-                name: "ephemeris time",
-                value: t,
-                reason: "not finite, or precedes the retained window of planet states",
-            });
-        }
-        Ok(self.ephemeris.grid_time(self.grid_index(t)))
     }
 
     /// Index of the grid point at or before `t` (rounding corrected against the grid times).

@@ -72,8 +72,9 @@
 //! - [`encounter`]: close encounters integrated through ([`Population::set_encounters`],
 //!   [`Encounters`]): inside 3 Hill radii of a planet (MERCURY's and MERCURIUS' changeover),
 //!   or where `B₀, B₁` no longer dominate (the paper's condition 35, read as a factor 2), a
-//!   particle is integrated by Bulirsch–Stoer together with the Sun and the planets, which
-//!   are advanced from the last grid state rather than interpolated, and handed back to the
+//!   particle is integrated by Bulirsch–Stoer among the planets of the same ephemeris the
+//!   map reads (one trajectory of the planets in both modes: nothing jumps at the switch or
+//!   the hand-back, and `H + p₄` is carried through), and handed back to the
 //!   map outside 3.5 Hill radii (a hysteresis band: a comet skimming 3 Hill radii switches
 //!   once, not at every dip; [`PopulationMember::encounters_begun`] counts the switches);
 //!   ends by collision with a planet's radius

@@ -20,7 +20,9 @@ const STUDY_FORMAT: &str = "symplectic-population-study";
 /// 2: the population's encounter settings have a hand-back radius (a version 1 checkpoint
 /// goes on handed back at its switch radius, as it was integrated).
 /// 3: the population's end rules `sun_collision`, `min_distance`, `max_distance`, its event
-/// rules and the members' event logs (read as off and empty from versions 1 and 2).
+/// rules and the members' event logs (read as off and empty from versions 1 and 2), and an
+/// encounter in progress holds the particle only (and its `p₄`; one of versions 1 and 2,
+/// the Sun, the planets and the particle, is converted when the member next steps).
 const STUDY_VERSION: u32 = 3;
 
 #[derive(Serialize, Deserialize)]

@@ -317,3 +317,67 @@ fn a_version_1_checkpoint_goes_on_without_hysteresis() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A member saved in the encounter mode by a version 2 checkpoint, whose encounter state held
+/// the Sun, the planets and the particle, goes on among the ephemeris' planets from the
+/// particle's state; a state of neither layout ends the member with the reason named.
+#[test]
+fn a_version_2_encounter_state_is_converted() {
+    let dir = std::env::temp_dir().join(format!("encounter-states-v2-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("population.json");
+    // A quasi-satellite inside 1.5 Hill radii: in the encounter mode from its first step on.
+    let mut pop = population(&[quasi_satellite(1.5)], Encounters::default());
+    pop.advance_to(DAYS_PER_YEAR, |_| {}).unwrap();
+    assert!(
+        pop.members()[0].encounter.is_some(),
+        "in the encounter mode"
+    );
+    pop.save(&path).unwrap();
+    let mut straight = Population::load(&path).unwrap();
+    straight.advance_to(1.5 * DAYS_PER_YEAR, |_| {}).unwrap();
+    let mut json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    assert_eq!(json["version"], 3);
+    json["version"] = 2.into();
+    let state = &mut json["population"]["members"][0]["encounter"]["state"];
+    let particle: Vec<f64> = state
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    // Version 2's layout: the positions of the Sun, the four planets and the particle, then
+    // their velocities (the bodies' values are not read).
+    let mut old = vec![0.0; 36];
+    old[15..18].copy_from_slice(&particle[0..3]);
+    old[33..36].copy_from_slice(&particle[3..6]);
+    *state = serde_json::to_value(&old).unwrap();
+    std::fs::write(&path, serde_json::to_vec(&json).unwrap()).unwrap();
+    let mut converted = Population::load(&path).unwrap();
+    converted.advance_to(1.5 * DAYS_PER_YEAR, |_| {}).unwrap();
+    let (a, b) = (&converted.members()[0], &straight.members()[0]);
+    assert_eq!(a.status, ParticleStatus::Active);
+    // The same equations for position and velocity from the same state; only `p₄` (reset to
+    // −H, where the straight run carries its integrated value) enters the step control. 10⁻⁶
+    // AU: far above the tolerance's 10⁻¹² per step over the half year's steps, far below the
+    // astronomical units by which a body's state taken for the particle's would differ.
+    let apart = (a.particle.position - b.particle.position).norm();
+    assert!(apart < 1e-6, "{apart:e} AU from the straight run");
+    // A state of neither layout: the member ends, the state named.
+    json["population"]["members"][0]["encounter"]["state"] =
+        serde_json::to_value([1.0, 2.0, 3.0, 4.0, 5.0]).unwrap();
+    std::fs::write(&path, serde_json::to_vec(&json).unwrap()).unwrap();
+    let mut broken = Population::load(&path).unwrap();
+    broken.advance_to(1.5 * DAYS_PER_YEAR, |_| {}).unwrap();
+    match &broken.members()[0].status {
+        ParticleStatus::IntegrationFailed { reason, .. } => {
+            assert!(
+                reason.contains("encounter state") && reason.contains("5 values"),
+                "{reason}"
+            )
+        }
+        other => panic!("{other:?}"),
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

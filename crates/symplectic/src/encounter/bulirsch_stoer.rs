@@ -21,8 +21,14 @@
 //! shorter by the same rule. MERCURY's hybrid integrator (Chambers 1999) integrates its
 //! close encounters with this method.
 //!
+//! The right-hand side is the caller's function of time and state ([`Field`]): the Newtonian
+//! equations of a few bodies integrated together ([`derivative`]), or a massless particle among
+//! bodies given as functions of time (the encounter mode, planets from the ephemeris).
+//!
 //! Everything is a function of the state and the proposed step: the same input gives the same
-//! trajectory bit for bit, whoever calls it and however often it pauses between steps.
+//! trajectory bit for bit, whoever calls it and however often it pauses between steps. A step
+//! whose right-hand side fails (the ephemeris does not reach a substep's time) leaves the state
+//! as it was and returns that error, so the step can be redone later with the same result.
 
 use crate::SymplecticError;
 
@@ -58,6 +64,28 @@ pub(crate) fn derivative(gm: &[f64], y: &[f64], dy: &mut [f64], forces: &mut u64
                 }
             }
         }
+    }
+}
+
+/// A right-hand side `dy = f(t, y)`; an error stops the step and leaves the state unchanged.
+pub(crate) trait Field {
+    /// Fills `dy` with the derivative of `y` at time `t`.
+    fn derivative(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SymplecticError>;
+}
+
+/// [`derivative`] as a [`Field`]: bodies integrated together (no explicit time), counting the
+/// pair terms.
+pub(crate) struct Bodies<'a> {
+    /// `G m` of the massive bodies.
+    pub gm: &'a [f64],
+    /// Pair terms evaluated so far.
+    pub forces: u64,
+}
+
+impl Field for Bodies<'_> {
+    fn derivative(&mut self, _t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SymplecticError> {
+        derivative(self.gm, y, dy, &mut self.forces);
+        Ok(())
     }
 }
 
@@ -107,16 +135,14 @@ impl BulirschStoer {
     /// One accepted step from `(t, y)` of at most `max_step` (`f64::INFINITY`: none), trying
     /// `proposed` first; `y` and `t` advance. Errors if the step shrinks below the time's
     /// resolution or the state stops being finite.
-    #[allow(clippy::too_many_arguments)]
     pub(crate) fn step(
         &self,
-        gm: &[f64],
+        field: &mut impl Field,
         y: &mut [f64],
         t: &mut f64,
         proposed: f64,
         max_step: f64,
         scratch: &mut Scratch,
-        forces: &mut u64,
     ) -> Result<Taken, SymplecticError> {
         scratch.size(y.len());
         let mut h = proposed.min(max_step);
@@ -137,17 +163,8 @@ impl BulirschStoer {
                 evaluations += (n + 1) as u64;
                 let (previous, current) = (&mut scratch.previous, &mut scratch.current);
                 std::mem::swap(previous, current);
-                midpoint(
-                    gm,
-                    y,
-                    h,
-                    n,
-                    &mut current[0],
-                    &mut scratch.z0,
-                    &mut scratch.z1,
-                    &mut scratch.f,
-                    forces,
-                );
+                let buffers = (&mut scratch.z0, &mut scratch.z1, &mut scratch.f);
+                midpoint(field, y, *t, h, n, &mut current[0], buffers)?;
                 for k in 1..=row {
                     let ratio = (n as f64) / ((2 * (row + 1 - k)) as f64);
                     let denominator = ratio * ratio - 1.0;
@@ -193,42 +210,46 @@ impl BulirschStoer {
     }
 }
 
-/// Gragg's modified midpoint rule: `n` substeps of `H/n` from `y`, the smoothed end value in
-/// `out`.
-#[allow(clippy::too_many_arguments)]
+/// Gragg's modified midpoint rule: `n` substeps of `H/n` from `y` at `t`, the smoothed end
+/// value in `out`; `(z0, z1, f)` are buffers of the state's length.
 fn midpoint(
-    gm: &[f64],
+    field: &mut impl Field,
     y: &[f64],
+    t: f64,
     big_h: f64,
     n: usize,
     out: &mut [f64],
-    z0: &mut [f64],
-    z1: &mut [f64],
-    f: &mut [f64],
-    forces: &mut u64,
-) {
+    (z0, z1, f): (&mut Vec<f64>, &mut Vec<f64>, &mut Vec<f64>),
+) -> Result<(), SymplecticError> {
     let h = big_h / n as f64;
+    // Substep `m` at `t + m H/n` (the last one at `t + H`).
+    let at = |m: usize| t + big_h * (m as f64 / n as f64);
     z0.copy_from_slice(y);
-    derivative(gm, z0, f, forces);
+    field.derivative(at(0), z0, f)?;
     for ((z, &a), &d) in z1.iter_mut().zip(y).zip(f.iter()) {
         *z = a + h * d;
     }
-    for _ in 1..n {
-        derivative(gm, z1, f, forces);
+    for m in 1..n {
+        field.derivative(at(m), z1, f)?;
         for ((a, b), &d) in z0.iter_mut().zip(z1.iter_mut()).zip(f.iter()) {
             let next = *a + 2.0 * h * d;
             *a = *b;
             *b = next;
         }
     }
-    derivative(gm, z1, f, forces);
+    field.derivative(at(n), z1, f)?;
     for (((o, &a), &b), &d) in out.iter_mut().zip(z0.iter()).zip(z1.iter()).zip(f.iter()) {
         *o = 0.5 * (b + a + h * d);
     }
+    Ok(())
 }
 
 /// `max_i |a_i − b_i| / (tol · s_i)` with `s_i` the length of the 3-vector (one object's
-/// position or velocity) that component `i` belongs to, in the layout of [`derivative`].
+/// position or velocity) that component `i` belongs to, in the layout of [`derivative`]. A
+/// remainder shorter than 3 (the encounter mode's `p₄`, a quadrature along the trajectory
+/// the vectors control) is extrapolated with them but not controlled: its own size is no
+/// scale (it passes through zero when a close encounter turns the comet's barycentric
+/// energy round, and a relative test there would stall the step).
 fn scaled_difference(a: &[f64], b: &[f64], tolerance: f64) -> f64 {
     let mut worst = 0.0f64;
     for (va, vb) in a.chunks_exact(3).zip(b.chunks_exact(3)) {
@@ -262,12 +283,13 @@ mod tests {
         let mut y = vec![0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0];
         let period = 2.0 * std::f64::consts::PI;
         let bs = BulirschStoer { tolerance: 1e-12 };
-        let (mut t, mut h, mut scratch, mut forces) = (0.0, 0.1, Scratch::default(), 0);
+        let (mut t, mut h, mut scratch) = (0.0, 0.1, Scratch::default());
+        let mut field = Bodies { gm: &gm, forces: 0 };
         let mut steps = 0;
         while t < period {
             let remaining = period - t;
             let taken = bs
-                .step(&gm, &mut y, &mut t, h, remaining, &mut scratch, &mut forces)
+                .step(&mut field, &mut y, &mut t, h, remaining, &mut scratch)
                 .unwrap();
             if taken.step >= remaining {
                 t = period;

@@ -25,25 +25,31 @@
 //!   no longer removed as `regularisation_lost`: the encounter integrator takes over until
 //!   the condition holds again.
 //!
-//! **How.** The planets at the particle's own times are not interpolated during an
-//! encounter: the quintic Hermite interpolant's error, `≈ (ωτ)⁶/46080` of the orbit radius
-//! ([`Ephemeris`](crate::Ephemeris)), is 1.6·10⁻⁴ AU for Jupiter on the default 730.5-day
-//! grid, 0.5 % of an impact distance of 0.1 R_H (0.036 AU). As the paper does for its
-//! particle times (eqs. 33–34), the planets are advanced from the last grid state at or
-//! before the particle's time, here by the same integrator as the particle: the Sun, the
-//! planets and the particle are integrated together in barycentric coordinates (the
-//! particle massless) by the Bulirsch–Stoer method (module `bulirsch_stoer`) with a relative
-//! tolerance per step [`Encounters::tolerance`], steps fitted to the encounter by the error
-//! control. The particle keeps its own clock; nothing depends on the window or on the other
-//! particles, so the population stays bit-identical across threads, shards, checkpoints and
-//! lanes.
+//! **How.** The planets are one function of time in both modes: the ephemeris' interpolant
+//! ([`Ephemeris`](crate::Ephemeris)), read by the map at its kicks and by the encounter
+//! integrator at every substep. The particle alone is integrated, in barycentric coordinates,
+//! by the Bulirsch–Stoer method (module `bulirsch_stoer`) with a relative tolerance per step
+//! [`Encounters::tolerance`] and steps fitted to the encounter by the error control, together
+//! with its `p₄` (`dp₄/dt = −∂H/∂t`, the term the map's kicks add), so that `H + p₄`, a
+//! constant of the exact motion in both modes, is carried through the encounter and stays
+//! the diagnostic of the whole trajectory. Nothing jumps at the switch or the hand-back: the
+//! particle's state is handed over as it is and the planets are the same. The geometry of an
+//! encounter is then set by the ephemeris' accuracy (measured against the Newtonian flow of
+//! its grid states: [`Ephemeris`](crate::Ephemeris), 2.1·10⁻⁹ AU for Jupiter at the 91.3125 d
+//! planet step of the shipped populations) and by the tolerance. (Until this version the
+//! planets were integrated here from the last grid state, up to a grid step back, so that
+//! they jumped by the interpolant's error at the switch and back at the hand-back, and `p₄`
+//! was reset at the hand-back, which hid the jump.) The particle keeps its own clock;
+//! nothing depends on the window or on the other particles, so the population stays
+//! bit-identical across threads, shards, checkpoints and lanes: a step that needs the planets
+//! beyond the ephemeris' newest grid time is abandoned with the state unchanged and redone,
+//! with the same result, in the next window.
 //!
 //! **Hand-back.** After a step of the encounter integrator, the particle returns to the map
 //! when it is outside [`Encounters::hand_back_hill_factor`] Hill radii of every planet (3.5
-//! by default, beyond the switch's 3), `F₁ ≥ ¾ (B₀ + B₁/r)` with the planets from the
-//! ephemeris (a margin above the switch's ½), and at least one map step's time (`h/F₁` at
-//! the switch) has passed since the switch. It keeps its step `h` in the new variable `s`;
-//! `p₄ = −H` is set anew with the ephemeris' planets.
+//! by default, beyond the switch's 3), `F₁ ≥ ¾ (B₀ + B₁/r)` (a margin above the switch's ½),
+//! and at least one map step's time (`h/F₁` at the switch) has passed since the switch. It
+//! keeps its step `h` in the new variable `s` and the `p₄` integrated through the encounter.
 //!
 //! *Hysteresis.* Both margins keep a particle from going back and forth across one
 //! boundary. A sharp switch in and out at the same radius does: a comet skimming 3 R_H
@@ -73,10 +79,12 @@
 //! (H. F. Levison and M. J. Duncan, "The long-term dynamical behavior of short-period
 //! comets", *Icarus* 108, 18–36 (1994), doi:10.1006/icar.1994.1039), which a test particle
 //! allows: its switch changes no planet's orbit. The encounter is integrated in barycentric,
-//! not planetocentric, coordinates; the error control works on each object's position and
-//! velocity vectors, so the particle's relative error per step is bounded by the tolerance
+//! not planetocentric, coordinates; the error control works on the particle's position and
+//! velocity vectors (and `p₄`), so its relative error per step is bounded by the tolerance
 //! against its barycentric distance (about 5 AU near Jupiter: `5·10⁻¹²` AU per step at the
-//! default tolerance, against a closest approach of 0.01 AU or more).
+//! default tolerance, against a closest approach of 0.01 AU or more). MERCURY integrates the
+//! planets along with the encounter; here they are massive bodies of the ephemeris, whose
+//! states the comet does not change.
 
 pub(crate) mod bulirsch_stoer;
 
@@ -84,8 +92,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::ephemeris::{BodyStates, GridView};
 use crate::particles::{ParticleIntegrator, TestParticle};
-use crate::{SymplecticError, Vec3};
-use bulirsch_stoer::{BulirschStoer, Scratch};
+use crate::{SymplecticError, Vec3, WorkCounters};
+use bulirsch_stoer::{Bodies, BulirschStoer, Field, Scratch};
 
 /// Default switch distance, in Hill radii (MERCURY's and MERCURIUS' default).
 pub const DEFAULT_ENCOUNTER_HILL_FACTOR: f64 = 3.0;
@@ -183,15 +191,16 @@ impl Encounters {
     }
 }
 
-/// A particle in the encounter mode: the Sun, the planets and the particle integrated
-/// together from the last planet grid state before the switch.
+/// A particle in the encounter mode: its barycentric position and velocity and its `p₄`,
+/// integrated among the planets of the ephemeris (the same function of time the map reads).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Encounter {
     /// Time of `state`.
     pub time: f64,
-    /// Barycentric positions of the Sun, the planets and the particle (3 values each), then
-    /// their velocities.
+    /// The particle's barycentric position (3 values), velocity (3 values) and `p₄` (1 value,
+    /// `dp₄/dt = −∂H/∂t`: `H + p₄` is a constant of the encounter's exact motion, as of the
+    /// map's).
     pub state: Vec<f64>,
     /// The next step the integrator proposes (days).
     pub next_step: f64,
@@ -202,6 +211,9 @@ pub struct Encounter {
     /// Steps of the encounter integrator so far.
     pub steps: u64,
 }
+
+/// Length of [`Encounter::state`]: position, velocity, `p₄`.
+pub(crate) const ENCOUNTER_STATE_LEN: usize = 7;
 
 /// Where a particle in the encounter mode stands against the planets.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -214,126 +226,170 @@ pub(crate) struct Geometry {
     pub collision: Option<(usize, f64, f64)>,
 }
 
-impl Encounter {
-    /// Switches `p` (barycentric, at its time) to the encounter mode: the planets at the grid
-    /// state at or before `p.time` are advanced to `p.time` by the integrator, then joined by
-    /// the particle.
-    pub(crate) fn begin(
-        p: &TestParticle,
-        grid: &GridView<'_>,
-        settings: &Encounters,
-        map_dt: f64,
-        scratch: &mut EncounterScratch,
-    ) -> Result<Self, SymplecticError> {
-        let t_grid = grid.grid_time_at_or_before(p.time)?;
-        grid.interpolate(t_grid, &mut scratch.bodies, false)?;
-        let n1 = scratch.bodies.gm.len();
-        let planets = &mut scratch.planets;
-        planets.clear();
-        planets.extend(
-            scratch
-                .bodies
-                .positions
-                .iter()
-                .flat_map(|x| x.iter().copied()),
-        );
-        planets.extend(
-            scratch
-                .bodies
-                .velocities
-                .iter()
-                .flat_map(|x| x.iter().copied()),
-        );
-        let bs = settings.integrator();
-        let mut t = t_grid;
-        let mut h = grid.step() / 8.0;
-        let mut forces = 0;
-        while t < p.time {
-            let remaining = p.time - t;
-            let taken = bs.step(
-                &scratch.bodies.gm,
-                planets,
-                &mut t,
-                h,
-                remaining,
-                &mut scratch.bs,
-                &mut forces,
-            )?;
-            // The last step is cut to land on the particle's time; `t` is set to it exactly.
-            if taken.step >= remaining {
-                t = p.time;
+/// The encounter mode's right-hand side: a massless particle among the bodies of the
+/// ephemeris at each substep's time, with `dp₄/dt = Σ_j G m_j (q − Q_j)·V_j/|q − Q_j|³`
+/// (`−∂H/∂t` of the barycentric `H`, the term the map's kicks add to `p₄`).
+struct AmongBodies<'a, 'b> {
+    grid: &'a GridView<'b>,
+    bodies: &'a mut BodyStates,
+    /// The interpolations and pair terms counted so far.
+    work: &'a mut WorkCounters,
+}
+
+impl Field for AmongBodies<'_, '_> {
+    fn derivative(&mut self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SymplecticError> {
+        self.grid.interpolate(t, self.bodies, false)?;
+        let q = [y[0], y[1], y[2]];
+        let (mut a, mut dp4) = ([0.0; 3], 0.0);
+        for ((gm, qj), vj) in self
+            .bodies
+            .gm
+            .iter()
+            .zip(&self.bodies.positions)
+            .zip(&self.bodies.velocities)
+        {
+            let d = [q[0] - qj[0], q[1] - qj[1], q[2] - qj[2]];
+            let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            let gm_r3 = gm / (r2 * r2.sqrt());
+            for c in 0..3 {
+                a[c] -= gm_r3 * d[c];
             }
-            h = taken.next;
+            dp4 += gm_r3 * (d[0] * vj[0] + d[1] * vj[1] + d[2] * vj[2]);
         }
-        let mut state = Vec::with_capacity(6 * (n1 + 1));
-        state.extend_from_slice(&planets[..3 * n1]);
+        self.work.interpolations += 1;
+        self.work.force_evaluations += self.bodies.gm.len() as u64;
+        dy[..3].copy_from_slice(&y[3..6]);
+        dy[3..6].copy_from_slice(&a);
+        dy[6] = dp4;
+        Ok(())
+    }
+}
+
+impl Encounter {
+    /// Switches `p` (barycentric, at its time) to the encounter mode: its position, velocity
+    /// and `p₄` as they are (the planets are the ephemeris' in both modes, so nothing jumps);
+    /// the first step proposed is one map step's time `map_dt` (a grid step's eighth if that
+    /// is not positive).
+    pub(crate) fn begin(p: &TestParticle, grid: &GridView<'_>, map_dt: f64) -> Self {
+        let mut state = Vec::with_capacity(ENCOUNTER_STATE_LEN);
         state.extend(p.position.iter().copied());
-        state.extend_from_slice(&planets[3 * n1..]);
         state.extend(p.velocity.iter().copied());
-        Ok(Self {
+        state.push(p.p4);
+        let first = if map_dt.is_finite() && map_dt > 0.0 {
+            map_dt
+        } else {
+            grid.step() / 8.0
+        };
+        Self {
             time: p.time,
             state,
-            next_step: h.min(map_dt.max(f64::MIN_POSITIVE)),
+            next_step: first,
             since: p.time,
-            earliest_hand_back: p.time + map_dt,
+            earliest_hand_back: p.time + map_dt.max(0.0),
             steps: 0,
-        })
+        }
     }
 
-    /// Number of bodies (Sun and planets).
-    fn bodies(&self) -> usize {
-        self.state.len() / 6 - 1
-    }
-
-    fn position(&self, object: usize) -> Vec3 {
-        Vec3::from_column_slice(&self.state[3 * object..3 * object + 3])
-    }
-
-    fn velocity(&self, object: usize) -> Vec3 {
-        let o = 3 * (self.bodies() + 1) + 3 * object;
-        Vec3::from_column_slice(&self.state[o..o + 3])
+    /// Converts the state of a checkpoint written before version 3 (positions of the Sun, the
+    /// planets and the particle, then their velocities) to this version's (the particle and
+    /// its `p₄`): the particle's position and velocity kept, `p₄ = −H` among `bodies` (the
+    /// ephemeris' at the encounter's time), as that version's hand-back set it. A state of
+    /// this version is left alone; one of neither layout is refused by name.
+    pub(crate) fn upgrade(
+        &mut self,
+        integrator: &ParticleIntegrator,
+        previous: &TestParticle,
+        bodies: &BodyStates,
+    ) -> Result<(), SymplecticError> {
+        let len = self.state.len();
+        if len == ENCOUNTER_STATE_LEN {
+            return Ok(());
+        }
+        let objects = len / 6;
+        if len != 6 * objects || objects != bodies.gm.len() + 1 {
+            return Err(SymplecticError::InvalidState {
+                what: "encounter state",
+                reason: format!(
+                    "{len} values: expected {ENCOUNTER_STATE_LEN} (position, velocity, p4), or \
+                     {} as written before checkpoint version 3",
+                    6 * (bodies.gm.len() + 1)
+                ),
+            });
+        }
+        let k = 3 * (objects - 1);
+        let mut p = previous.clone();
+        p.position = Vec3::from_column_slice(&self.state[k..k + 3]);
+        p.velocity = Vec3::from_column_slice(&self.state[3 * objects + k..3 * objects + k + 3]);
+        p.time = self.time;
+        p.p4 = -integrator.hamiltonian(&p, bodies);
+        self.state.clear();
+        self.state
+            .extend(p.position.iter().chain(p.velocity.iter()).copied());
+        self.state.push(p.p4);
+        Ok(())
     }
 
     /// The particle's barycentric position and velocity.
     pub(crate) fn particle(&self) -> (Vec3, Vec3) {
-        let k = self.bodies();
-        (self.position(k), self.velocity(k))
+        (
+            Vec3::from_column_slice(&self.state[0..3]),
+            Vec3::from_column_slice(&self.state[3..6]),
+        )
     }
 
-    /// One step of the integrator (never cut: its length depends on the state only).
+    /// The particle's `p₄`.
+    pub(crate) fn p4(&self) -> f64 {
+        self.state[6]
+    }
+
+    /// One step of the integrator (never cut: its length depends on the state only), the
+    /// planets read from `grid`; its interpolations and pair terms are added to `work`. A
+    /// step that needs the planets beyond the grid returns
+    /// [`SymplecticError::BeyondEphemeris`] and leaves the encounter as it was.
     pub(crate) fn step(
         &mut self,
-        gm: &[f64],
+        grid: &GridView<'_>,
         settings: &Encounters,
         scratch: &mut EncounterScratch,
-        forces: &mut u64,
+        work: &mut WorkCounters,
     ) -> Result<(), SymplecticError> {
-        let taken = settings.integrator().step(
-            gm,
+        let mut field = AmongBodies {
+            grid,
+            bodies: &mut scratch.bodies,
+            work,
+        };
+        let result = settings.integrator().step(
+            &mut field,
             &mut self.state,
             &mut self.time,
             self.next_step,
             f64::INFINITY,
             &mut scratch.bs,
-            forces,
-        )?;
+        );
+        let taken = result?;
         self.next_step = taken.next;
         self.steps += 1;
         Ok(())
     }
 
-    /// The particle against the planets: the nearest in Hill radii and a collision, if any.
-    /// `hill_coefficients[j]` is `(m_j/3m₀)^{1/3}`, `radii[j]` the radius of planet `j + 1`.
-    pub(crate) fn geometry(&self, hill_coefficients: &[f64], radii: &[Option<f64>]) -> Geometry {
+    /// The particle against the planets of `bodies` (at the particle's time): the nearest in
+    /// Hill radii and a collision, if any. `hill_coefficients[j]` is `(m_j/3m₀)^{1/3}`,
+    /// `radii[j]` the radius of planet `j + 1`.
+    pub(crate) fn geometry(
+        &self,
+        bodies: &BodyStates,
+        hill_coefficients: &[f64],
+        radii: &[Option<f64>],
+    ) -> Geometry {
         let (q, _) = self.particle();
-        let sun = self.position(0);
+        let sun = bodies.positions[0];
         let mut g = Geometry {
             nearest: 1,
             nearest_ratio: f64::INFINITY,
             collision: None,
         };
         for (j, c) in hill_coefficients.iter().enumerate() {
-            let planet = self.position(j + 1);
+            let planet = bodies.positions[j + 1];
             let distance = (q - planet).norm();
             let hill = (planet - sun).norm() * c;
             if distance / hill < g.nearest_ratio {
@@ -349,26 +405,20 @@ impl Encounter {
         g
     }
 
-    /// The particle as a map particle at its time, with the ephemeris' `bodies` at that
-    /// time: `p₄ = −H`, the map step `step` kept.
-    pub(crate) fn hand_back(
-        &self,
-        integrator: &ParticleIntegrator,
-        previous: &TestParticle,
-        bodies: &BodyStates,
-    ) -> TestParticle {
+    /// The particle as a map particle at its time: position, velocity and `p₄` as integrated
+    /// (not reset: `H + p₄` goes on from the map's value before the switch, so a planet that
+    /// jumped between the modes would show in it), the map step `step` kept.
+    pub(crate) fn hand_back(&self, previous: &TestParticle) -> TestParticle {
         let (position, velocity) = self.particle();
-        let mut p = TestParticle {
+        TestParticle {
             position,
             velocity,
             time: self.time,
-            p4: 0.0,
+            p4: self.p4(),
             step: previous.step,
             steps: previous.steps,
             work: previous.work,
-        };
-        p.p4 = -integrator.hamiltonian(&p, bodies);
-        p
+        }
     }
 }
 
@@ -389,9 +439,10 @@ pub struct EncounterOutcome {
 
 /// Integrates the Sun and the planets (`bodies`: `G m` and barycentric states at
 /// `bodies.time`) and a massless particle (barycentric `position`, `velocity`) to `t_end`
-/// with the encounter integrator of a [`Population`](crate::Population) (the same steps,
-/// except the last, cut to land on `t_end`): a single encounter, for comparison with other
-/// codes.
+/// with the Bulirsch–Stoer integrator of a [`Population`](crate::Population)'s encounter
+/// mode and its tolerance (the last step cut to land on `t_end`), the bodies integrated along
+/// with the particle from exact states rather than read from an ephemeris: a single
+/// encounter, for comparison with other codes.
 pub fn integrate_through(
     bodies: &BodyStates,
     position: Vec3,
@@ -425,8 +476,12 @@ pub fn integrate_through(
     state.extend(bodies.velocities.iter().flat_map(|x| x.iter().copied()));
     state.extend(velocity.iter().copied());
     let bs = settings.integrator();
-    let (mut t, mut h, mut steps, mut forces) = (bodies.time, 1.0, 0, 0);
+    let (mut t, mut h, mut steps) = (bodies.time, 1.0, 0);
     let mut scratch = Scratch::default();
+    let mut field = Bodies {
+        gm: &bodies.gm,
+        forces: 0,
+    };
     let mut closest = vec![f64::INFINITY; n1 - 1];
     let distance = |state: &[f64], j: usize| {
         let k = 3 * n1;
@@ -437,15 +492,7 @@ pub fn integrate_through(
     };
     while t < t_end {
         let remaining = t_end - t;
-        let taken = bs.step(
-            &bodies.gm,
-            &mut state,
-            &mut t,
-            h,
-            remaining,
-            &mut scratch,
-            &mut forces,
-        )?;
+        let taken = bs.step(&mut field, &mut state, &mut t, h, remaining, &mut scratch)?;
         if taken.step >= remaining {
             t = t_end;
         }
@@ -487,5 +534,4 @@ pub(crate) fn regularisation(
 pub(crate) struct EncounterScratch {
     bs: Scratch,
     bodies: BodyStates,
-    planets: Vec<f64>,
 }

@@ -139,7 +139,7 @@ pub struct PopulationMember {
     pub sun_position: Vec3,
     /// The encounter mode's state while the particle is in it
     /// ([`Encounters`](crate::Encounters)); `particle`
-    /// then holds its position, velocity and time, not `p₄`. `None` once the particle is
+    /// then holds its position, velocity, time and `p₄`. `None` once the particle is
     /// removed, in the encounter mode or not.
     #[serde(default)]
     pub encounter: Option<Box<Encounter>>,

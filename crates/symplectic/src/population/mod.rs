@@ -670,9 +670,12 @@ impl Population {
 }
 
 const POPULATION_FORMAT: &str = "symplectic-population";
-/// 2: [`Encounters::hand_back_hill_factor`] and [`PopulationMember::encounters_begun`].
+/// 2: [`Encounters::hand_back_hill_factor`] and [`PopulationMember::encounters_begun`];
 /// 3: the removal rules `sun_collision`, `min_distance`, `max_distance`, the event rules and
-/// the members' event logs (a version 1 or 2 file reads them as off and empty).
+/// the members' event logs (a version 1 or 2 file reads them as off and empty), and
+/// [`Encounter::state`](crate::Encounter) holds the particle only (and its `p₄`); an
+/// encounter state of an older file (the Sun, the planets and the particle) is converted
+/// when the member next steps.
 const POPULATION_VERSION: u32 = 3;
 
 /// [`Envelope`] as written, borrowing the population (no copy of it).

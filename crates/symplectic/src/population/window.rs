@@ -9,7 +9,9 @@ use rayon::prelude::*;
 use super::ends::{geometric_end, SunState};
 use super::events::{CheckPoint, EventContext, EventRules};
 use super::members::{PopulationMember, RemovalRules};
-use crate::encounter::{regularisation, Encounter, EncounterScratch, Encounters};
+use crate::encounter::{
+    regularisation, Encounter, EncounterScratch, Encounters, ENCOUNTER_STATE_LEN,
+};
 use crate::ephemeris::{BodyStates, Ephemeris, GridView};
 use crate::lanes::{self, norm, norm_squared, KickLanes, Mask, LANES, V, V3};
 use crate::particles::ParticlePiece;
@@ -560,11 +562,11 @@ impl WindowContext<'_> {
                 time,
             }) => {
                 m.particle = saved;
-                if let Some(settings) = self.encounters {
+                if self.encounters.is_some() {
                     // Not removed: the encounter integrator takes over from the state before
                     // the step.
                     w.bodies_time = f64::NAN;
-                    self.begin_encounter(m, &settings, w);
+                    self.begin_encounter(m, w);
                 } else {
                     m.status = ParticleStatus::RegularisationLost {
                         time,
@@ -675,7 +677,7 @@ impl WindowContext<'_> {
             let margin_lost = below_or_nan(f1, 0.5 * part);
             let near = self.hill_entry(&m.particle, positions, settings.hill_factor);
             if margin_lost || near.is_some() {
-                self.begin_encounter(m, &settings, w);
+                self.begin_encounter(m, w);
                 return true;
             }
         }
@@ -745,9 +747,8 @@ impl WindowContext<'_> {
         geometric_end(&self.rules, p.time, previous_time, q, p.velocity, &sun)
     }
 
-    /// Switches `m` (at its time, in the map) to the encounter mode, or removes it if the
-    /// switch fails.
-    fn begin_encounter(&self, m: &mut PopulationMember, settings: &Encounters, w: &mut Worker) {
+    /// Switches `m` (at its time, in the map) to the encounter mode.
+    fn begin_encounter(&self, m: &mut PopulationMember, w: &mut Worker) {
         let p = &m.particle;
         // One map step's time from here: `h/F₁` with the ephemeris' planets (`h/(B₀ + B₁/r)`
         // where `F₁` is not positive).
@@ -759,18 +760,8 @@ impl WindowContext<'_> {
             Err(_) => 0.0,
         };
         w.bodies_time = f64::NAN;
-        match Encounter::begin(p, &self.grid, settings, map_dt, &mut w.encounter) {
-            Ok(e) => {
-                m.encounter = Some(Box::new(e));
-                m.encounters_begun = m.encounters_begun.saturating_add(1);
-            }
-            Err(e) => {
-                m.status = ParticleStatus::IntegrationFailed {
-                    time: p.time,
-                    reason: format!("encounter integrator: {e}"),
-                }
-            }
-        }
+        m.encounter = Some(Box::new(Encounter::begin(p, &self.grid, map_dt)));
+        m.encounters_begun = m.encounters_begun.saturating_add(1);
     }
 
     /// Advances `m` in the encounter mode until it is handed back to the map, removed, or
@@ -781,6 +772,8 @@ impl WindowContext<'_> {
             return (0, f64::NEG_INFINITY);
         };
         let mut steps = 0;
+        // `w.bodies` holds the planets at the encounter's time once a step is taken.
+        w.bodies_time = f64::NAN;
         while m.status == ParticleStatus::Active
             && m.particle.time < self.end
             && !crate::guard::stop_requested()
@@ -788,47 +781,54 @@ impl WindowContext<'_> {
             let Some(e) = m.encounter.as_deref_mut() else {
                 break;
             };
-            if e.steps > 0 && e.time >= e.earliest_hand_back {
-                let g = e.geometry(&self.hill_coefficients, &self.radii);
-                if g.nearest_ratio >= settings.hand_back_hill_factor {
-                    match self.grid.interpolate(e.time, &mut w.bodies, false) {
-                        Err(SymplecticError::BeyondEphemeris { time, .. }) => return (steps, time),
-                        Err(err) => {
-                            m.status = ParticleStatus::IntegrationFailed {
-                                time: e.time,
-                                reason: err.to_string(),
-                            };
-                            break;
-                        }
-                        Ok(()) => {
-                            let (q, _) = e.particle();
-                            let (f1, part) = regularisation(&self.integrator, &q, &w.bodies);
-                            if f1 >= 0.75 * part {
-                                m.particle = e.hand_back(&self.integrator, &m.particle, &w.bodies);
-                                m.sun_position = w.bodies.positions[0];
-                                m.encounter = None;
-                                w.bodies_time = f64::NAN;
-                                break;
-                            }
-                        }
-                    }
+            if e.state.len() != ENCOUNTER_STATE_LEN {
+                // A state of an older checkpoint.
+                let upgraded = self
+                    .grid
+                    .interpolate(e.time, &mut w.bodies, false)
+                    .and_then(|()| e.upgrade(&self.integrator, &m.particle, &w.bodies));
+                if let Err(err) = upgraded {
+                    return self.encounter_failed(m, err, steps);
                 }
             }
-            let mut forces = 0;
+            if e.steps > 0 && e.time >= e.earliest_hand_back {
+                if w.bodies_time != e.time {
+                    if let Err(err) = self.grid.interpolate(e.time, &mut w.bodies, false) {
+                        return self.encounter_failed(m, err, steps);
+                    }
+                    w.bodies_time = e.time;
+                }
+                let g = e.geometry(&w.bodies, &self.hill_coefficients, &self.radii);
+                let (q, _) = e.particle();
+                let (f1, part) = regularisation(&self.integrator, &q, &w.bodies);
+                if g.nearest_ratio >= settings.hand_back_hill_factor && f1 >= 0.75 * part {
+                    m.particle = e.hand_back(&m.particle);
+                    m.sun_position = w.bodies.positions[0];
+                    m.encounter = None;
+                    w.bodies_time = f64::NAN;
+                    break;
+                }
+            }
             let previous_time = e.time;
-            if let Err(err) = e.step(&self.gm, &settings, &mut w.encounter, &mut forces) {
-                m.status = ParticleStatus::IntegrationFailed {
-                    time: e.time,
-                    reason: format!("encounter integrator: {err}"),
-                };
-                break;
+            let stepped = e.step(
+                &self.grid,
+                &settings,
+                &mut w.encounter,
+                &mut m.particle.work,
+            );
+            if let Err(err) = stepped {
+                return self.encounter_failed(m, err, steps);
             }
             steps += 1;
-            m.particle.work.force_evaluations += forces;
             let (q, v) = e.particle();
-            (m.particle.position, m.particle.velocity, m.particle.time) = (q, v, e.time);
-            m.sun_position = Vec3::from_column_slice(&e.state[0..3]);
-            let g = e.geometry(&self.hill_coefficients, &self.radii);
+            (m.particle.position, m.particle.velocity) = (q, v);
+            (m.particle.time, m.particle.p4) = (e.time, e.p4());
+            if let Err(err) = self.grid.interpolate(e.time, &mut w.bodies, false) {
+                return self.encounter_failed(m, err, steps);
+            }
+            w.bodies_time = e.time;
+            m.sun_position = w.bodies.positions[0];
+            let g = e.geometry(&w.bodies, &self.hill_coefficients, &self.radii);
             if let Some((planet, distance, radius)) = g.collision {
                 m.status = ParticleStatus::Collision {
                     time: e.time,
@@ -848,11 +848,32 @@ impl WindowContext<'_> {
                 }
             }
         }
+        w.bodies_time = f64::NAN;
         // A member removed in the encounter mode (collision, perihelion, ejection, a failed
         // step) is no longer in it: its state at removal is in `particle`.
         if m.status != ParticleStatus::Active {
             m.encounter = None;
         }
+        (steps, f64::NEG_INFINITY)
+    }
+
+    /// An encounter step or a reading of the planets failed: a time beyond the ephemeris
+    /// pauses the member until the next window (returned as the time needed); anything else
+    /// removes it.
+    fn encounter_failed(
+        &self,
+        m: &mut PopulationMember,
+        err: SymplecticError,
+        steps: u64,
+    ) -> (u64, f64) {
+        if let SymplecticError::BeyondEphemeris { time, .. } = err {
+            return (steps, time);
+        }
+        m.status = ParticleStatus::IntegrationFailed {
+            time: m.particle.time,
+            reason: format!("encounter integrator: {err}"),
+        };
+        m.encounter = None;
         (steps, f64::NEG_INFINITY)
     }
 
@@ -865,13 +886,16 @@ impl WindowContext<'_> {
         elements_apply: bool,
         w: &mut Worker,
     ) {
-        w.bodies_time = f64::NAN;
-        if let Err(err) = self.grid.interpolate(m.particle.time, &mut w.bodies, false) {
-            m.status = ParticleStatus::IntegrationFailed {
-                time: m.particle.time,
-                reason: err.to_string(),
-            };
-            return;
+        if w.bodies_time != m.particle.time {
+            w.bodies_time = f64::NAN;
+            if let Err(err) = self.grid.interpolate(m.particle.time, &mut w.bodies, false) {
+                m.status = ParticleStatus::IntegrationFailed {
+                    time: m.particle.time,
+                    reason: err.to_string(),
+                };
+                return;
+            }
+            w.bodies_time = m.particle.time;
         }
         let bodies = &w.bodies;
         self.record_events(m, &bodies.positions, &bodies.velocities, elements_apply);

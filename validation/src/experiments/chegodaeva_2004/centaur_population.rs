@@ -4,8 +4,8 @@
 //!
 //! The population study `populations/centaurs.toml` (300 comets, barycentric `a` 5.5–30 AU,
 //! `e` 0–0.2, `i` 0–10°, random angles; S2 barycentric map with `B₁ = 4·10⁻⁶`, planets S6 at
-//! 730.5 d; encounters inside 3 Hill radii by Bulirsch–Stoer at 10⁻¹², handed back to the map
-//! beyond 3.5) run through [`symplectic::io::PopulationSpec`] for 200 kyr (quick) or 1 Myr
+//! 91.3125 d, whose trajectory the map and the encounter mode both read; encounters inside 3
+//! Hill radii by Bulirsch–Stoer at 10⁻¹², handed back to the map beyond 3.5) run through [`symplectic::io::PopulationSpec`] for 200 kyr (quick) or 1 Myr
 //! (`--full`). A comet ends at a
 //! collision with a planet (its equatorial radius), when its barycentric perihelion falls
 //! below 2.5 AU, or when it is unbound beyond 100 AU.
