@@ -229,19 +229,28 @@ pub const CENTAUR_SEED: u64 = 2027;
 /// outside the Sun-vicinity limit and the encounter spheres.
 pub const CENTAUR_B1: f64 = 4e-6;
 
+/// A comet's first physical step in [`centaur_population`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum FirstStep {
+    /// This many days per AU of the comet's initial distance from the barycentre.
+    PerAuDays(f64),
+    /// This many days for every comet (`integrator.initial_step_days` of a population file).
+    Days(f64),
+}
+
 /// The Centaur population (the `centaur_throughput` example): the four giants of
-/// `outer_solar_system` (ecliptic J2000) integrated by S6 at `planet_step_days` (91.3125 d in
-/// `populations/centaurs.toml`); `n` comets with `a` 5.5–30 AU, `e` 0–0.2, `i` 0–10° and
+/// `outer_solar_system` (ecliptic J2000) integrated by S6 at `planet_step_days`; `n` comets
+/// with `a` 5.5–30 AU, `e` 0–0.2, `i` 0–10° and
 /// random angles (`symplectic::samples::CENTAURS`, seed `seed`), S2 in the barycentric
-/// variant with `B₀ = 0`, `B₁ =` [`CENTAUR_B1`], a first step of `step_per_au_days` × the
-/// initial distance, integrated through close encounters (3 Hill radii, tolerance
+/// variant with `B₀ = 0`, `B₁ =` [`CENTAUR_B1`], a first step `first_step`,
+/// integrated through close encounters (3 Hill radii, tolerance
 /// `tolerance`); removal below a barycentric perihelion of 2.5 AU (the Sun's vicinity),
-/// unbound beyond 100 AU (ejected), or at a collision with a planet. Returns the population
-/// at time 0 and the comets' initial barycentric states.
+/// unbound beyond 100 AU (ejected), or at a collision with a planet or the Sun. Returns the
+/// population at time 0 and the comets' initial barycentric states.
 pub fn centaur_population(
     n: usize,
     seed: u64,
-    step_per_au_days: f64,
+    first_step: FirstStep,
     tolerance: f64,
     planet_step_days: f64,
 ) -> Result<
@@ -266,7 +275,10 @@ pub fn centaur_population(
         .map_err(|e| e.to_string())?;
     let first_steps: Vec<f64> = states
         .iter()
-        .map(|(q, _)| step_per_au_days * q.norm())
+        .map(|(q, _)| match first_step {
+            FirstStep::PerAuDays(days) => days * q.norm(),
+            FirstStep::Days(days) => days,
+        })
         .collect();
     let ids: Vec<u64> = (0..n as u64).collect();
     let ephemeris = Ephemeris::new(
@@ -282,6 +294,7 @@ pub fn centaur_population(
         hill_factor: None,
         min_perihelion: Some(2.5),
         ejection_distance: Some(100.0),
+        sun_collision: true,
         ..RemovalRules::default()
     };
     let mut population = Population::with_first_steps(

@@ -162,8 +162,8 @@
 //! ejection from energy and angular momentum: ≈ 40 flops, 1 square root): about 1000 flops
 //! and 30 square roots or divisions, all on data in L1. S6 has 3 drifts, 4 kicks and 3
 //! interpolations. Each particle is one [`PopulationMember`] of
-//! [`Population::bytes_per_particle`] bytes (200 on x86-64; 192 before the count of encounters begun, 184 before the encounter state), stepped many times per window
-//! while it sits in L1, so memory traffic is 2 × 200 bytes per particle per window, not per
+//! [`Population::bytes_per_particle`] bytes (208 on x86-64; 200 before the event log, 192 before the count of encounters begun, 184 before the encounter state), stepped many times per window
+//! while it sits in L1, so memory traffic is 2 × 208 bytes per particle per window, not per
 //! step. The ephemeris window (360 bytes per planet step for five bodies, ≈ 2 ×
 //! [`DEFAULT_WINDOW_STEPS`] steps, ≈ 180 KB) is shared read-only by all threads and stays in
 //! L2; extending it costs one planet step per grid point, once for the whole population

@@ -25,6 +25,22 @@
 //! encounters), which narrows the true scatter of the difference: the unpaired tests are
 //! conservative. Each test is two-sided at 0.27 % (`|z| < 3`, KS `p > 0.0027`); over the
 //! eight tests the chance of a false alarm is about 2 %.
+//!
+//! **Power of the q < 2.5 AU test.** For two binomial samples of `n` comets each, fractions
+//! `p` and `p′ = p (1 ± 0.25)` (a 25 % change), the test fails with probability
+//! `Φ(|p′ − p|/σ − 3) + Φ(−|p′ − p|/σ − 3)`, `σ = √((p(1 − p) + p′(1 − p′))/n)` (the unpooled
+//! standard error of the difference under the change; the smaller of the two directions is
+//! quoted). With MERCURIUS's fractions (`p` = 43/300 = 0.143 at 200 kyr, 78/300 = 0.26 at 1 Myr
+//! in `mercurius_ends.csv`; 57/1000 = 0.057 at 20 kyr and 92/1000 = 0.092 at 50 kyr in the
+//! 1,000-comet run of the same script, `mercurius_ends_1000.csv`): the quick check (n = 300, 200 kyr) catches a 25 %
+//! change with probability 0.036 and `--full` (n = 300, 1 Myr) with 0.11; n = 1,000 over 1 Myr
+//! gives 0.58 (0.49 at the 1,000-comet run's own 234/1000 = 0.234, `mercurius_ends_1000.csv`,
+//! whose 0.8 needs 1,668 comets). A power of 0.8 (0.9) needs n = 3,102 (3,863) comets over 200 kyr, 1,449
+//! (1,808) over 1 Myr, 5,210 (6,485) over 50 kyr or 8,738 (10,870) over 20 kyr; in comet-years
+//! (each counted until it ends) the shortest of these spans is the cheapest, 1.7·10⁸ at 20 kyr
+//! against 5.3·10⁷ for today's quick check (3.2×). Neither check has that power today: a
+//! change of the fraction by less than about 67 % (quick) or 44 % (`--full`) passes more often
+//! than not.
 
 use anyhow::{bail, Result};
 use symplectic::io::{status_label, PopulationSpec};
