@@ -489,25 +489,29 @@ impl<R: Real> ElastoplasticScheme<R> {
             reinitialise_density(s, &inputs);
         }
         let bp = &self.boundary_particles;
-        let gravity = self.params.common.gravity;
-        // The wall extrapolation over the step's positions and densities (both uses below).
-        let extrapolation = |images, x, rho| Extrapolation {
-            kernel: c.kernel,
-            images,
-            x,
-            rho,
-            particles: bp,
-            gravity,
-        };
         if !bp.is_empty() {
-            let e = extrapolation(&s.images, &s.x, &s.rho);
+            let e = Extrapolation {
+                kernel: c.kernel,
+                images: &s.images,
+                x: &s.x,
+                rho: &s.rho,
+                particles: bp,
+                gravity: self.params.common.gravity,
+            };
             s.boundary_lists.weigh(&e);
             extrapolate(&e, &s.boundary_lists, &mut s.stress, Some(&mut s.v), None);
         }
         pair_gradients(s, &inputs);
         stress_pass(s, &inputs);
         if !bp.is_empty() {
-            let e = extrapolation(&s.images, &s.x, &s.rho);
+            let e = Extrapolation {
+                kernel: c.kernel,
+                images: &s.images,
+                x: &s.x,
+                rho: &s.rho,
+                particles: bp,
+                gravity: self.params.common.gravity,
+            };
             let (rho0, eps) = (c.rho0, c.eps_stress);
             let art = |s_b: &Matrix3<R>| artificial_stress(s_b, rho0, eps);
             extrapolate(
