@@ -97,10 +97,7 @@ pub fn settled_block_elastoplastic<R: Real>(
     ),
     sph_solver::SolverError,
 > {
-    use elastoplastic_granular::{ElastoplasticParams, InitialStress};
-    use sph_core::{BoxSdf, Inverted};
     let s = 0.025;
-    let (p, _) = dam_break_fluid::<R>();
     let v = |x: f64, y: f64, z: f64| Vec3::new(R::of_f64(x), R::of_f64(y), R::of_f64(z));
     let lo = (-1.95, 0.05, -0.5);
     let side = 39.0 * s;
@@ -112,17 +109,7 @@ pub fn settled_block_elastoplastic<R: Real>(
         v(lo.0, lo.1, lo.2),
         v(lo.0 + side, lo.1 + 2.0 * side, lo.2 + side),
     )?;
-    let mut params = ElastoplasticParams::<R>::for_spacing(R::of_f64(s), R::of_f64(30.0));
-    params.common.dt = R::of_f64(frame_dt);
-    params.common.substeps = 1;
-    params.youngs_modulus = R::of_f64(youngs_modulus_pa);
-    params.initial_stress = InitialStress::Geostatic;
-    params.boundary_particle_region = Some(block);
-    let mass = params.common.particle_mass();
-    let rho0 = params.common.rest_density;
-    let solids: sph_solver::Solids<R> = vec![Box::new(Inverted(BoxSdf::new(container)?))];
-    let solver = elastoplastic_granular::Elastoplastic::new(params, solids)?;
-    Ok((solver, sph_core::ParticleSet::from_positions(p, mass, rho0)))
+    granular_block_in(frame_dt, youngs_modulus_pa, block, container)
 }
 
 /// The elastic–plastic granular solver (Bui et al. 2008, `elastoplastic-granular`, its
@@ -144,12 +131,31 @@ pub fn dam_break_elastoplastic<R: Real>(
     ),
     sph_solver::SolverError,
 > {
+    let (_, tank) = dam_break_fluid::<R>();
+    let region = Aabb::new(tank.min, Vec3::new(tank.max.x, R::of_f64(1.2), tank.max.z))?;
+    granular_block_in(frame_dt, youngs_modulus_pa, region, tank)
+}
+
+/// The grains of [`dam_break_fluid`] under the elastic–plastic solver's defaults for spacing
+/// 0.025 m and φ = 30° at Young's modulus `youngs_modulus_pa`, geostatic start, frames of
+/// `frame_dt` s (one substep), boundary particles over `region`, inside the inverted box
+/// `container` (the two scenes above).
+fn granular_block_in<R: Real>(
+    frame_dt: f64,
+    youngs_modulus_pa: f64,
+    region: Aabb<R>,
+    container: Aabb<R>,
+) -> Result<
+    (
+        elastoplastic_granular::Elastoplastic<R>,
+        sph_core::ParticleSet<R>,
+    ),
+    sph_solver::SolverError,
+> {
     use elastoplastic_granular::{ElastoplasticParams, InitialStress};
     use sph_core::{BoxSdf, Inverted};
-    let s = 0.025;
-    let (p, tank) = dam_break_fluid::<R>();
-    let region = Aabb::new(tank.min, Vec3::new(tank.max.x, R::of_f64(1.2), tank.max.z))?;
-    let mut params = ElastoplasticParams::<R>::for_spacing(R::of_f64(s), R::of_f64(30.0));
+    let (p, _) = dam_break_fluid::<R>();
+    let mut params = ElastoplasticParams::<R>::for_spacing(R::of_f64(0.025), R::of_f64(30.0));
     params.common.dt = R::of_f64(frame_dt);
     params.common.substeps = 1;
     params.youngs_modulus = R::of_f64(youngs_modulus_pa);
@@ -157,7 +163,7 @@ pub fn dam_break_elastoplastic<R: Real>(
     params.boundary_particle_region = Some(region);
     let mass = params.common.particle_mass();
     let rho0 = params.common.rest_density;
-    let solids: sph_solver::Solids<R> = vec![Box::new(Inverted(BoxSdf::new(tank)?))];
+    let solids: sph_solver::Solids<R> = vec![Box::new(Inverted(BoxSdf::new(container)?))];
     let solver = elastoplastic_granular::Elastoplastic::new(params, solids)?;
     Ok((solver, sph_core::ParticleSet::from_positions(p, mass, rho0)))
 }
