@@ -53,6 +53,10 @@ pub(crate) fn density_pass<R: Real>(
     // The f32 lanes where they run; drag needs the occlusion, which only the scalar loop
     // takes.
     let lanes = CubicLanes::new(&c.kernel, x.len(), nb).filter(|_| !c.drag);
+    if lanes.is_some() {
+        s.packed.fill(x, m);
+    }
+    let packed = &s.packed;
     let outputs = (
         (&mut s.density[..], &mut s.bgrad[..], &mut s.grad_sum[..]),
         (&mut s.aii[..], &mut s.occlusion[..]),
@@ -79,7 +83,7 @@ pub(crate) fn density_pass<R: Real>(
                 let (mut sum, sum_grad, sum_grad_sq) = match &lanes {
                     Some(l) => {
                         let (a, b) = (offsets[i] - base, offsets[i + 1] - base);
-                        let s = l.density_gradient(x, m, nb, i, &mut gs[a..b]);
+                        let s = l.density_gradient(packed, nb, i, &mut gs[a..b]);
                         (s.density, s.grad, s.grad_sq)
                     }
                     None => {

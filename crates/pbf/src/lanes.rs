@@ -19,7 +19,7 @@
 use neighbour_search::NeighbourLists;
 use sph_core::{Real, Vec3};
 use sph_kernels::Kernel;
-use sph_solver::pair_lanes::{coords, f32s, f32s_mut, lanes_available};
+use sph_solver::pair_lanes::{coords, f32s, f32s_mut, lanes_available, Packed};
 
 use crate::kernels::Consts;
 
@@ -113,8 +113,7 @@ fn vec3<R: Real>(v: [f32; 3]) -> Vec3<R> {
 #[allow(clippy::too_many_arguments)] // the pass's inputs, one particle
 pub(crate) fn lambda_sums<R: Real>(
     k: &LaneConsts,
-    x: &[Vec3<R>],
-    m: &[R],
+    (x, m, packed): (&[Vec3<R>], &[R], &Packed),
     nb: &NeighbourLists,
     i: usize,
     grad_factor: &mut [R],
@@ -122,14 +121,14 @@ pub(crate) fn lambda_sums<R: Real>(
 ) -> LambdaSums<R> {
     let list = nb.neighbours(i);
     assert!(grad_factor.len() == list.len() && scorr.len() == list.len());
+    assert_eq!(packed.values().len(), 4 * x.len(), "packed values of other particles");
     #[cfg(target_arch = "x86_64")]
     {
-        let (xf, mf) = (coords(x), f32s(m));
         let (gf, sc) = (f32s_mut(grad_factor), f32s_mut(scorr));
         // SAFETY: a LaneConsts exists only after avx512f was detected, for lists of
-        // x.len() particles (indices clamped below n inside); the slices have the list's
-        // length (asserted above).
-        let s = unsafe { avx512::lambda(k, xf, mf, position_of(x, i), list, gf, sc) };
+        // x.len() particles (indices clamped below n inside), packed holds 4 values per
+        // particle; the slices have the list's length (asserted above).
+        let s = unsafe { avx512::lambda(k, packed.values(), i, list, gf, sc) };
         LambdaSums {
             density: m[i] * R::of_f64(k.k_poly6 as f64) + R::of_f64(s[0] as f64),
             grad: vec3([s[1], s[2], s[3]]),
@@ -145,8 +144,7 @@ pub(crate) fn lambda_sums<R: Real>(
 #[allow(clippy::too_many_arguments)] // the pass's inputs, one particle
 pub(crate) fn delta_sum<R: Real>(
     k: &LaneConsts,
-    x: &[Vec3<R>],
-    m: &[R],
+    (m, packed): (&[R], &Packed),
     lambda: &[R],
     nb: &NeighbourLists,
     i: usize,
@@ -155,6 +153,7 @@ pub(crate) fn delta_sum<R: Real>(
 ) -> Vec3<R> {
     let list = nb.neighbours(i);
     assert!(cache.0.len() == list.len() && cache.1.len() == list.len() && lambda.len() == m.len());
+    assert_eq!(packed.values().len(), 4 * m.len(), "packed values of other particles");
     #[cfg(target_arch = "x86_64")]
     {
         let own = [lambda[i], m[i], half_unit].map(|v| v.as_f64() as f32);
@@ -162,8 +161,8 @@ pub(crate) fn delta_sum<R: Real>(
         let s = unsafe {
             avx512::delta(
                 k,
-                (coords(x), f32s(m), f32s(lambda)),
-                position_of(x, i),
+                (packed.values(), f32s(lambda)),
+                i,
                 own,
                 list,
                 (f32s(cache.0), f32s(cache.1)),
@@ -179,24 +178,18 @@ pub(crate) fn delta_sum<R: Real>(
 /// `Σ_j (v_j − v_i) (m_j/ρ0) W_ij` (eq. 17, before the factor `c`).
 pub(crate) fn density_xsph<R: Real>(
     k: &LaneConsts,
-    x: &[Vec3<R>],
+    packed: &Packed,
     v: &[Vec3<R>],
-    m: &[R],
     nb: &NeighbourLists,
     i: usize,
 ) -> (R, Vec3<R>) {
     let list = nb.neighbours(i);
-    assert_eq!(v.len(), x.len());
+    assert_eq!(4 * v.len(), packed.values().len(), "packed values of other particles");
     #[cfg(target_arch = "x86_64")]
     {
         // SAFETY: as in `lambda_sums`; `v` has one velocity per particle (asserted).
         let s = unsafe {
-            avx512::density_xsph(
-                k,
-                (coords(x), coords(v), f32s(m)),
-                (position_of(x, i), position_of(v, i)),
-                list,
-            )
+            avx512::density_xsph(k, (packed.values(), coords(v)), i, position_of(v, i), list)
         };
         (R::of_f64(s[0] as f64), vec3([s[1], s[2], s[3]]))
     }
@@ -208,55 +201,9 @@ pub(crate) fn density_xsph<R: Real>(
 mod avx512 {
     use std::arch::x86_64::*;
 
+    use sph_solver::pair_lanes::avx512::{gather, pairs};
+
     use super::LaneConsts;
-
-    /// Sixteen (or fewer) pairs of one particle: which lanes hold a pair, the neighbours'
-    /// indices (clamped to `n − 1`), the offsets `x_i − x_j` per axis and `r²`.
-    struct Pairs {
-        live: __mmask16,
-        j: __m512i,
-        d: [__m512; 3],
-        r2: __m512,
-    }
-
-    /// The pairs `list[s..s + 16]` (fewer at the end) of the particle at `xi`.
-    ///
-    /// # Safety
-    /// avx512f; `x` holds `3n` coordinates, `s < list.len()`.
-    #[target_feature(enable = "avx512f")]
-    #[inline]
-    unsafe fn pairs(x: &[f32], xi: &[__m512; 3], list: &[u32], s: usize) -> Pairs {
-        let left = list.len() - s;
-        let live: __mmask16 = if left >= 16 {
-            0xffff
-        } else {
-            (1u16 << left) - 1
-        };
-        let j = _mm512_maskz_loadu_epi32(live, list.as_ptr().add(s).cast());
-        let last = _mm512_set1_epi32((x.len() / 3).saturating_sub(1) as i32);
-        let j = _mm512_min_epu32(j, last);
-        let j3 = _mm512_mullo_epi32(j, _mm512_set1_epi32(3));
-        let zero = _mm512_setzero_ps();
-        let xp = x.as_ptr();
-        let mut d = [zero; 3];
-        for (a, da) in d.iter_mut().enumerate() {
-            let xj = _mm512_mask_i32gather_ps::<4>(zero, live, j3, xp.add(a).cast());
-            *da = _mm512_sub_ps(xi[a], xj);
-        }
-        // nalgebra's norm_squared: (dx² + dy²) + dz².
-        let r2 = _mm512_add_ps(
-            _mm512_add_ps(_mm512_mul_ps(d[0], d[0]), _mm512_mul_ps(d[1], d[1])),
-            _mm512_mul_ps(d[2], d[2]),
-        );
-        Pairs { live, j, d, r2 }
-    }
-
-    /// `values[j]` per live lane (0 elsewhere).
-    #[target_feature(enable = "avx512f")]
-    #[inline]
-    unsafe fn gather(values: &[f32], p: &Pairs) -> __m512 {
-        _mm512_mask_i32gather_ps::<4>(_mm512_setzero_ps(), p.live, p.j, values.as_ptr().cast())
-    }
 
     /// Poly6 `W(r²)`: `((k t) t) t` with `t = 1 − r²/h²`, 0 for `r² ≥ h²` or `t ≤ 0`
     /// (ordered comparisons: NaN propagates, as in `Poly6::value_r2`).
@@ -290,24 +237,22 @@ mod avx512 {
     /// `super::lambda_sums`).
     ///
     /// # Safety
-    /// avx512f; `x` holds `3n` coordinates and `m` `n` masses; `gf` and `sc` have the
+    /// avx512f; `xm` holds `4n` packed values, `i < n`; `gf` and `sc` have the
     /// list's length.
     #[target_feature(enable = "avx512f")]
     pub(super) unsafe fn lambda(
         c: &LaneConsts,
-        x: &[f32],
-        m: &[f32],
-        xi: [f32; 3],
+        xm: &[f32],
+        i: usize,
         list: &[u32],
         gf: &mut [f32],
         sc: &mut [f32],
     ) -> [f32; 5] {
-        let xi = xi.map(|v| _mm512_set1_ps(v));
         let inv_rho0 = _mm512_set1_ps(c.inv_rho0);
         let mut acc = [_mm512_setzero_ps(); 5];
         for s in (0..list.len()).step_by(16) {
-            let p = pairs(x, &xi, list, s);
-            let mj = gather(m, &p);
+            let p = pairs(xm, i, list, s);
+            let mj = p.mj;
             let w = poly6(c, p.r2);
             acc[0] = _mm512_mask_add_ps(acc[0], p.live, acc[0], _mm512_mul_ps(mj, w));
             let scorr = match c.scorr {
@@ -338,23 +283,22 @@ mod avx512 {
     /// The `Δp` pass's lane sum (see `super::delta_sum`); `own` is `[λ_i, m_i, unit/2]`.
     ///
     /// # Safety
-    /// avx512f; `x` holds `3n` coordinates, `m` and `lambda` `n` values; both cache slices
+    /// avx512f; `xm` holds `4n` packed values, `lambda` `n`, `i < n`; both cache slices
     /// have the list's length.
     #[target_feature(enable = "avx512f")]
     pub(super) unsafe fn delta(
         c: &LaneConsts,
-        (x, m, lambda): (&[f32], &[f32], &[f32]),
-        xi: [f32; 3],
+        (xm, lambda): (&[f32], &[f32]),
+        i: usize,
         own: [f32; 3],
         list: &[u32],
         (gf, sc): (&[f32], &[f32]),
     ) -> [f32; 3] {
-        let xi = xi.map(|v| _mm512_set1_ps(v));
         let [li, mi, half_unit] = own.map(|v| _mm512_set1_ps(v));
         let mut acc = [_mm512_setzero_ps(); 3];
         for s in (0..list.len()).step_by(16) {
-            let p = pairs(x, &xi, list, s);
-            let (mj, lj) = (gather(m, &p), gather(lambda, &p));
+            let p = pairs(xm, i, list, s);
+            let (mj, lj) = (p.mj, gather(lambda, &p));
             let f = _mm512_maskz_loadu_ps(p.live, gf.as_ptr().add(s));
             // λ_i m_j + λ_j m_i (+ s_corr (m_i + m_j) unit/2).
             let mut coeff = _mm512_add_ps(_mm512_mul_ps(li, mj), _mm512_mul_ps(lj, mi));
@@ -374,22 +318,22 @@ mod avx512 {
     /// `[Σ m_j W, Σ (v_j − v_i)_x (m_j/ρ0) W, … y, … z]` (see `super::density_xsph`).
     ///
     /// # Safety
-    /// avx512f; `x` and `v` hold `3n` coordinates, `m` `n` masses.
+    /// avx512f; `xm` holds `4n` packed values, `v` `3n` coordinates, `i < n`.
     #[target_feature(enable = "avx512f")]
     pub(super) unsafe fn density_xsph(
         c: &LaneConsts,
-        (x, v, m): (&[f32], &[f32], &[f32]),
-        (xi, vi): ([f32; 3], [f32; 3]),
+        (xm, v): (&[f32], &[f32]),
+        i: usize,
+        vi: [f32; 3],
         list: &[u32],
     ) -> [f32; 4] {
-        let xi = xi.map(|v| _mm512_set1_ps(v));
         let vi = vi.map(|v| _mm512_set1_ps(v));
         let inv_rho0 = _mm512_set1_ps(c.inv_rho0);
         let zero = _mm512_setzero_ps();
         let mut acc = [zero; 4];
         for s in (0..list.len()).step_by(16) {
-            let p = pairs(x, &xi, list, s);
-            let mj = gather(m, &p);
+            let p = pairs(xm, i, list, s);
+            let mj = p.mj;
             let w = poly6(c, p.r2);
             acc[0] = _mm512_mask_add_ps(acc[0], p.live, acc[0], _mm512_mul_ps(mj, w));
             // (v_j − v_i) ((m_j/ρ0) W).
@@ -412,10 +356,10 @@ mod tests {
     use proptest::prelude::*;
     use sph_core::Vec3;
     use sph_kernels::Kernel;
-use sph_solver::pair_lanes::{coords, f32s, f32s_mut, lanes_available};
     use sph_solver::step::StepNeighbours;
 
     use super::{delta_sum, density_xsph, lambda_sums, LaneConsts};
+    use sph_solver::pair_lanes::Packed;
     use crate::kernels::Consts;
     use crate::passes;
     use crate::PbfParams;
@@ -477,12 +421,14 @@ use sph_solver::pair_lanes::{coords, f32s, f32s_mut, lanes_available};
                 return Ok(());
             };
             let unit = crate::PbfParams::<f32>::default().scorr_unit().unwrap();
+            let mut packed = Packed::default();
+            packed.fill(&x, &m);
             for i in 0..x.len() {
                 let len = nb.neighbours(i).len();
                 let (mut gf, mut sc) = (vec![0f32; len], vec![0f32; len]);
                 let (mut gf_l, mut sc_l) = (vec![1f32; len], vec![1f32; len]);
                 let want = passes::lambda_sums(&c, &x, &m, nb, i, &mut gf, &mut sc);
-                let got = lambda_sums(&l, &x, &m, nb, i, &mut gf_l, &mut sc_l);
+                let got = lambda_sums(&l, (&x, &m, &packed), nb, i, &mut gf_l, &mut sc_l);
                 for k in 0..len {
                     prop_assert_eq!(gf[k].to_bits(), gf_l[k].to_bits(), "W'/r of pair {} of {}", k, i);
                     prop_assert_eq!(sc[k].to_bits(), sc_l[k].to_bits(), "s_corr of pair {} of {}", k, i);
@@ -508,7 +454,7 @@ use sph_solver::pair_lanes::{coords, f32s, f32s_mut, lanes_available};
                 let half_unit = 0.5 * unit;
                 let cache = (&gf[..], &sc[..]);
                 let want = passes::delta_sum(&c, &x, &m, &lambda, nb, i, cache, half_unit);
-                let got = delta_sum(&l, &x, &m, &lambda, nb, i, cache, half_unit);
+                let got = delta_sum(&l, (&m, &packed), &lambda, nb, i, cache, half_unit);
                 let mut abs = [0f64; 3];
                 for (k, &j) in nb.neighbours(i).iter().enumerate() {
                     let j = j as usize;
@@ -538,6 +484,8 @@ use sph_solver::pair_lanes::{coords, f32s, f32s_mut, lanes_available};
             let Some(l) = LaneConsts::new(&c, x.len(), nb) else {
                 return Ok(());
             };
+            let mut packed = Packed::default();
+            packed.fill(&x, &m);
             for i in 0..x.len() {
                 let (mut rho, mut xsph) = (0f32, Vec3::<f32>::zeros());
                 let (mut abs_rho, mut abs_xsph) = (0f64, [0f64; 3]);
@@ -553,7 +501,7 @@ use sph_solver::pair_lanes::{coords, f32s, f32s_mut, lanes_available};
                     }
                 }
                 let len = nb.neighbours(i).len();
-                let (got_rho, got_xsph) = density_xsph(&l, &x, &v, &m, nb, i);
+                let (got_rho, got_xsph) = density_xsph(&l, &packed, &v, nb, i);
                 within("density", got_rho, rho, len, abs_rho)?;
                 for a in 0..3 {
                     within("XSPH", got_xsph[a], xsph[a], len, abs_xsph[a])?;

@@ -4,6 +4,7 @@ use neighbour_search::NeighbourLists;
 use rayon::prelude::*;
 use sph_core::{Real, Vec3};
 use sph_kernels::Kernel;
+use sph_solver::pair_lanes::Packed;
 use sph_solver::step::MIN_LEN;
 use sph_solver::Boundary;
 
@@ -22,6 +23,9 @@ pub(crate) struct PairCache<R: Real> {
     grad_factor: Vec<R>,
     /// `s_corr` of the pair (eq. 13; 0 when the artificial pressure is off).
     scorr: Vec<R>,
+    /// The positions and masses of the pass, packed for the lanes (filled only when they
+    /// run).
+    pub(crate) packed: Packed,
 }
 
 impl<R: Real> PairCache<R> {
@@ -96,12 +100,15 @@ pub(crate) fn lambda_pass<R: Real>(
 ) -> f64 {
     let pairs = input.nb.pair_count();
     cache.resize(pairs);
+    if input.lanes.is_some() {
+        cache.packed.fill(input.x, input.m);
+    }
     lambda_block(
         input,
         0,
         out,
-        &mut cache.grad_factor[..pairs],
-        &mut cache.scorr[..pairs],
+        &cache.packed,
+        (&mut cache.grad_factor[..pairs], &mut cache.scorr[..pairs]),
     )
 }
 
@@ -113,8 +120,8 @@ fn lambda_block<R: Real>(
     input: PassInput<'_, R>,
     first: usize,
     out: LambdaOut<'_, R>,
-    grad_factor: &mut [R],
-    scorr: &mut [R],
+    packed: &Packed,
+    (grad_factor, scorr): (&mut [R], &mut [R]),
 ) -> f64 {
     let n = out.density.len();
     let offsets = input.nb.offsets();
@@ -133,7 +140,7 @@ fn lambda_block<R: Real>(
                     lambda: l0,
                     boundary_grad: b0,
                 };
-                lambda_block(input, first, out, g0, s0)
+                lambda_block(input, first, out, packed, (g0, s0))
             },
             || {
                 let out = LambdaOut {
@@ -141,7 +148,7 @@ fn lambda_block<R: Real>(
                     lambda: l1,
                     boundary_grad: b1,
                 };
-                lambda_block(input, first + mid, out, g1, s1)
+                lambda_block(input, first + mid, out, packed, (g1, s1))
             },
         );
         return a + b;
@@ -168,7 +175,7 @@ fn lambda_block<R: Real>(
         let xi = x[i];
         let (gf, sc) = (&mut grad_factor[a..b], &mut scorr[a..b]);
         let sums = match &lanes {
-            Some(l) => lanes::lambda_sums(l, x, m, nb, i, gf, sc),
+            Some(l) => lanes::lambda_sums(l, (x, m, packed), nb, i, gf, sc),
             None => lambda_sums(c, x, m, nb, i, gf, sc),
         };
         let mut sum_w = sums.density;
@@ -299,7 +306,9 @@ pub(crate) fn delta_pass<R: Real>(
             let (a, b) = (offsets[i], offsets[i + 1]);
             let pair_cache = (&cache.grad_factor[a..b], &cache.scorr[a..b]);
             let acc = match &lanes {
-                Some(l) => lanes::delta_sum(l, x, m, lambda, nb, i, pair_cache, half_unit),
+                Some(l) => {
+                    lanes::delta_sum(l, (m, &cache.packed), lambda, nb, i, pair_cache, half_unit)
+                }
                 None => delta_sum(c, x, m, lambda, nb, i, pair_cache, half_unit),
             };
             let mut d = acc * c.inv_rho0;

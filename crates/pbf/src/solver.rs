@@ -395,6 +395,10 @@ fn velocity_update<R: Real>(input: VelocityInput<'_, R>, s: &mut PbfScratch<R>) 
     let vort_on = p.vorticity_epsilon != R::zero();
     let xsph_on = p.xsph_c > R::zero();
     let v = &s.velocity[..];
+    if lanes.is_some() && !vort_on {
+        s.pairs.packed.fill(x, m);
+    }
+    let packed = &s.pairs.packed;
     // Densities at the final positions and eq. 15; without vorticity confinement, XSPH
     // (eq. 17) in the same pass (it needs the same Poly6 values and nothing else of this
     // pass).
@@ -413,7 +417,7 @@ fn velocity_update<R: Real>(input: VelocityInput<'_, R>, s: &mut PbfScratch<R>) 
             let mut xsph = Vec3::zeros();
             let lanes = lanes.filter(|_| !vort_on);
             if let Some(l) = &lanes {
-                let (pair_w, pair_xsph) = lanes::density_xsph(l, x, v, m, nb, i);
+                let (pair_w, pair_xsph) = lanes::density_xsph(l, packed, v, nb, i);
                 sum_w += pair_w;
                 if xsph_on {
                     xsph = pair_xsph;
