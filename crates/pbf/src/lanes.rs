@@ -121,7 +121,11 @@ pub(crate) fn lambda_sums<R: Real>(
 ) -> LambdaSums<R> {
     let list = nb.neighbours(i);
     assert!(grad_factor.len() == list.len() && scorr.len() == list.len());
-    assert_eq!(packed.values().len(), 4 * x.len(), "packed values of other particles");
+    assert_eq!(
+        packed.values().len(),
+        4 * x.len(),
+        "packed values of other particles"
+    );
     #[cfg(target_arch = "x86_64")]
     {
         let (gf, sc) = (f32s_mut(grad_factor), f32s_mut(scorr));
@@ -153,7 +157,11 @@ pub(crate) fn delta_sum<R: Real>(
 ) -> Vec3<R> {
     let list = nb.neighbours(i);
     assert!(cache.0.len() == list.len() && cache.1.len() == list.len() && lambda.len() == m.len());
-    assert_eq!(packed.values().len(), 4 * m.len(), "packed values of other particles");
+    assert_eq!(
+        packed.values().len(),
+        4 * m.len(),
+        "packed values of other particles"
+    );
     #[cfg(target_arch = "x86_64")]
     {
         let own = [lambda[i], m[i], half_unit].map(|v| v.as_f64() as f32);
@@ -184,7 +192,11 @@ pub(crate) fn density_xsph<R: Real>(
     i: usize,
 ) -> (R, Vec3<R>) {
     let list = nb.neighbours(i);
-    assert_eq!(4 * v.len(), packed.values().len(), "packed values of other particles");
+    assert_eq!(
+        4 * v.len(),
+        packed.values().len(),
+        "packed values of other particles"
+    );
     #[cfg(target_arch = "x86_64")]
     {
         // SAFETY: as in `lambda_sums`; `v` has one velocity per particle (asserted).
@@ -211,10 +223,16 @@ mod avx512 {
     #[inline]
     unsafe fn poly6(c: &LaneConsts, r2: __m512) -> __m512 {
         let zero = _mm512_setzero_ps();
-        let t = _mm512_sub_ps(_mm512_set1_ps(1.0), _mm512_mul_ps(r2, _mm512_set1_ps(c.inv_h2)));
+        let t = _mm512_sub_ps(
+            _mm512_set1_ps(1.0),
+            _mm512_mul_ps(r2, _mm512_set1_ps(c.inv_h2)),
+        );
         let outside = _mm512_cmp_ps_mask::<_CMP_GE_OQ>(r2, _mm512_set1_ps(c.h2))
             | _mm512_cmp_ps_mask::<_CMP_LE_OQ>(t, zero);
-        let w = _mm512_mul_ps(_mm512_mul_ps(_mm512_mul_ps(_mm512_set1_ps(c.k_poly6), t), t), t);
+        let w = _mm512_mul_ps(
+            _mm512_mul_ps(_mm512_mul_ps(_mm512_set1_ps(c.k_poly6), t), t),
+            t,
+        );
         _mm512_mask_blend_ps(outside, w, zero)
     }
 
@@ -225,7 +243,10 @@ mod avx512 {
     unsafe fn spiky_factor(c: &LaneConsts, r2: __m512) -> __m512 {
         let zero = _mm512_setzero_ps();
         let r = _mm512_sqrt_ps(r2);
-        let t = _mm512_sub_ps(_mm512_set1_ps(1.0), _mm512_mul_ps(r, _mm512_set1_ps(c.inv_h)));
+        let t = _mm512_sub_ps(
+            _mm512_set1_ps(1.0),
+            _mm512_mul_ps(r, _mm512_set1_ps(c.inv_h)),
+        );
         let inside = _mm512_cmp_ps_mask::<_CMP_GT_OQ>(r, zero)
             & _mm512_cmp_ps_mask::<_CMP_LT_OQ>(r, _mm512_set1_ps(c.h))
             & _mm512_cmp_ps_mask::<_CMP_GT_OQ>(t, zero);
@@ -340,8 +361,7 @@ mod avx512 {
             let weight = _mm512_mul_ps(_mm512_mul_ps(mj, inv_rho0), w);
             let j3 = _mm512_mullo_epi32(p.j, _mm512_set1_epi32(3));
             for a in 0..3 {
-                let vj =
-                    _mm512_mask_i32gather_ps::<4>(zero, p.live, j3, v.as_ptr().add(a).cast());
+                let vj = _mm512_mask_i32gather_ps::<4>(zero, p.live, j3, v.as_ptr().add(a).cast());
                 let t = _mm512_mul_ps(_mm512_sub_ps(vj, vi[a]), weight);
                 acc[1 + a] = _mm512_mask_add_ps(acc[1 + a], p.live, acc[1 + a], t);
             }
@@ -359,10 +379,10 @@ mod tests {
     use sph_solver::step::StepNeighbours;
 
     use super::{delta_sum, density_xsph, lambda_sums, LaneConsts};
-    use sph_solver::pair_lanes::Packed;
     use crate::kernels::Consts;
     use crate::passes;
     use crate::PbfParams;
+    use sph_solver::pair_lanes::Packed;
 
     /// `2 γ_n` with `γ_n = n u / (1 − n u)`, `u = 2⁻²⁴`: two summation orders of `n + 1`
     /// terms differ by at most this times `Σ|t_k|` (Higham 2002, §4.2; see the module docs).
@@ -375,7 +395,10 @@ mod tests {
     fn within(what: &str, a: f32, b: f32, n: usize, abs_sum: f64) -> Result<(), TestCaseError> {
         let bound = two_gamma(n) * abs_sum;
         let diff = (f64::from(a) - f64::from(b)).abs();
-        prop_assert!(diff <= bound, "{what}: lanes {a} scalar {b} differ by {diff} > {bound}");
+        prop_assert!(
+            diff <= bound,
+            "{what}: lanes {a} scalar {b} differ by {diff} > {bound}"
+        );
         Ok(())
     }
 

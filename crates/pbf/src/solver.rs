@@ -424,7 +424,11 @@ fn velocity_update<R: Real>(input: VelocityInput<'_, R>, s: &mut PbfScratch<R>) 
                 }
             }
             // The scalar loop runs only without the lanes.
-            let scalar_list = if lanes.is_some() { &[][..] } else { nb.neighbours(i) };
+            let scalar_list = if lanes.is_some() {
+                &[][..]
+            } else {
+                nb.neighbours(i)
+            };
             for &j in scalar_list {
                 let j = j as usize;
                 let r = xi - x[j];

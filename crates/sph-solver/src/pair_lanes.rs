@@ -176,7 +176,11 @@ impl CubicLanes {
     ) -> DensityGradientSums<R> {
         let list = nb.neighbours(i);
         assert_eq!(grad_scale.len(), list.len());
-        assert_eq!(nb.offsets().len(), packed.len() + 1, "lists of other particles");
+        assert_eq!(
+            nb.offsets().len(),
+            packed.len() + 1,
+            "lists of other particles"
+        );
         #[cfg(target_arch = "x86_64")]
         {
             // SAFETY: a CubicLanes exists only after avx512f was detected and R = f32
@@ -323,7 +327,10 @@ pub mod avx512 {
             // f: 1 + ((6q)q)(q − 1) near, ((2t)t)t far; f': (6q)((3q) − 2), ((−6)t)t.
             let f_near = _mm512_add_ps(
                 one,
-                _mm512_mul_ps(_mm512_mul_ps(_mm512_mul_ps(six, q), q), _mm512_sub_ps(q, one)),
+                _mm512_mul_ps(
+                    _mm512_mul_ps(_mm512_mul_ps(six, q), q),
+                    _mm512_sub_ps(q, one),
+                ),
             );
             let f_far = _mm512_mul_ps(_mm512_mul_ps(_mm512_mul_ps(two, t), t), t);
             let df_near = _mm512_mul_ps(
@@ -331,9 +338,15 @@ pub mod avx512 {
                 _mm512_sub_ps(_mm512_mul_ps(three, q), two),
             );
             let df_far = _mm512_mul_ps(_mm512_mul_ps(_mm512_set1_ps(-6.0), t), t);
-            let w = _mm512_mul_ps(_mm512_set1_ps(c.k), _mm512_mask_blend_ps(near, f_far, f_near));
+            let w = _mm512_mul_ps(
+                _mm512_set1_ps(c.k),
+                _mm512_mask_blend_ps(near, f_far, f_near),
+            );
             let w = _mm512_mask_blend_ps(outside, w, zero);
-            let dw = _mm512_mul_ps(_mm512_set1_ps(c.k_h), _mm512_mask_blend_ps(near, df_far, df_near));
+            let dw = _mm512_mul_ps(
+                _mm512_set1_ps(c.k_h),
+                _mm512_mask_blend_ps(near, df_far, df_near),
+            );
             let dw = _mm512_mask_blend_ps(outside, dw, zero);
             // W'(r)/r for r > 0, else 0.
             let f = _mm512_maskz_div_ps(_mm512_cmp_ps_mask::<_CMP_GT_OQ>(r, zero), dw, r);
@@ -370,7 +383,10 @@ mod tests {
         let nu = n as f64 * f64::from(f32::EPSILON) / 2.0;
         let bound = 2.0 * nu / (1.0 - nu) * abs_sum;
         let diff = (f64::from(a) - f64::from(b)).abs();
-        prop_assert!(diff <= bound, "{what}: lanes {a} scalar {b} differ by {diff} > {bound}");
+        prop_assert!(
+            diff <= bound,
+            "{what}: lanes {a} scalar {b} differ by {diff} > {bound}"
+        );
         Ok(())
     }
 
