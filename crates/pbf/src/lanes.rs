@@ -328,9 +328,9 @@ mod avx512 {
                 let t = _mm512_mul_ps(_mm512_mul_ps(scorr, _mm512_add_ps(mi, mj)), half_unit);
                 coeff = _mm512_add_ps(coeff, t);
             }
-            for a in 0..3 {
-                let g = _mm512_mul_ps(_mm512_mul_ps(p.d[a], f), coeff);
-                acc[a] = _mm512_mask_add_ps(acc[a], p.live, acc[a], g);
+            for (sum, d) in acc.iter_mut().zip(p.d) {
+                let g = _mm512_mul_ps(_mm512_mul_ps(d, f), coeff);
+                *sum = _mm512_mask_add_ps(*sum, p.live, *sum, g);
             }
         }
         acc.map(|a| _mm512_reduce_add_ps(a))
@@ -371,6 +371,7 @@ mod avx512 {
 }
 
 #[cfg(test)]
+#[allow(clippy::needless_range_loop)] // an axis indexes a vector and its bound in step
 mod tests {
     use neighbour_search::Method;
     use proptest::prelude::*;

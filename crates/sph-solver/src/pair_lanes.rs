@@ -368,6 +368,7 @@ pub mod avx512 {
 }
 
 #[cfg(test)]
+#[allow(clippy::needless_range_loop)] // an axis indexes a vector and its bound in step
 mod tests {
     use neighbour_search::Method;
     use proptest::prelude::*;
