@@ -406,7 +406,10 @@ mod tests {
     /// A cloud of particles at spacing 0.025 m (PBF's default `h` = 0.05 m): `n` random
     /// positions in a cube of side `0.025 n^(1/3)` (so about 30 neighbours each, as in the
     /// dam break, with coincident and near-`h` pairs possible), masses, `λ` and velocities.
-    fn cloud() -> impl Strategy<Value = (Vec<Vec3<f32>>, Vec<f32>, Vec<f32>, Vec<Vec3<f32>>)> {
+    /// Positions, masses, `λ` and velocities of a cloud.
+    type Cloud = (Vec<Vec3<f32>>, Vec<f32>, Vec<f32>, Vec<Vec3<f32>>);
+
+    fn cloud() -> impl Strategy<Value = Cloud> {
         (20usize..400).prop_flat_map(|n| {
             let side = 0.025 * (n as f32).cbrt();
             let p = (0.0..side, 0.0..side, 0.0..side).prop_map(|(a, b, c)| Vec3::new(a, b, c));
