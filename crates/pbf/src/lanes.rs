@@ -403,12 +403,12 @@ mod tests {
         Ok(())
     }
 
-    /// A cloud of particles at spacing 0.025 m (PBF's default `h` = 0.05 m): `n` random
-    /// positions in a cube of side `0.025 n^(1/3)` (so about 30 neighbours each, as in the
-    /// dam break, with coincident and near-`h` pairs possible), masses, `λ` and velocities.
     /// Positions, masses, `λ` and velocities of a cloud.
     type Cloud = (Vec<Vec3<f32>>, Vec<f32>, Vec<f32>, Vec<Vec3<f32>>);
 
+    /// A cloud of particles at spacing 0.025 m (PBF's default `h` = 0.05 m): `n` random
+    /// positions in a cube of side `0.025 n^(1/3)` (so about 30 neighbours each, as in the
+    /// dam break, with coincident and near-`h` pairs possible), masses, `λ` and velocities.
     fn cloud() -> impl Strategy<Value = Cloud> {
         (20usize..400).prop_flat_map(|n| {
             let side = 0.025 * (n as f32).cbrt();
