@@ -7,6 +7,7 @@ use rayon::prelude::*;
 use sph_core::{Real, Vec3};
 use sph_kernels::Kernel;
 use sph_solver::csr::par_csr_blocks;
+use sph_solver::pair_lanes::CubicLanes;
 use sph_solver::step::{par_update_sum, MIN_LEN};
 use sph_solver::Boundary;
 
@@ -49,6 +50,13 @@ pub(crate) fn density_pass<R: Real>(
     let indices = nb.indices();
     s.grad_scale.resize(indices.len(), R::zero());
     let dt2 = c.dt * c.dt;
+    // The f32 lanes where they run; drag needs the occlusion, which only the scalar loop
+    // takes.
+    let lanes = CubicLanes::new(&c.kernel, x.len(), nb).filter(|_| !c.drag);
+    if lanes.is_some() {
+        s.packed.fill(x, m);
+    }
+    let packed = &s.packed;
     let outputs = (
         (&mut s.density[..], &mut s.bgrad[..], &mut s.grad_sum[..]),
         (&mut s.aii[..], &mut s.occlusion[..]),
@@ -72,29 +80,39 @@ pub(crate) fn density_pass<R: Real>(
                     Vec3::zeros()
                 };
                 let mut max_cos = c.cos_cone;
-                let mut sum = mi * c.w0;
-                let mut sum_grad = Vec3::zeros();
-                let mut sum_grad_sq = R::zero();
-                for k in offsets[i]..offsets[i + 1] {
-                    let j = indices[k] as usize;
-                    let d = xi - x[j];
-                    let r = d.norm();
-                    sum += m[j] * c.kernel.value(r);
-                    let f = if r > R::zero() {
-                        c.kernel.derivative(r) / r
-                    } else {
-                        R::zero()
-                    };
-                    gs[k - base] = f;
-                    let gw = d * f;
-                    sum_grad += gw * m[j];
-                    sum_grad_sq += m[j] * gw.norm_squared();
-                    if c.drag && r > R::zero() {
-                        // cos φ of x_j − x_i against the upstream direction (the distance
-                        // is the density's).
-                        max_cos = max_cos.max(upstream.dot(&(-d)) / r);
+                let (mut sum, sum_grad, sum_grad_sq) = match &lanes {
+                    Some(l) => {
+                        let (a, b) = (offsets[i] - base, offsets[i + 1] - base);
+                        let s = l.density_gradient(packed, nb, i, &mut gs[a..b]);
+                        (s.density, s.grad, s.grad_sq)
                     }
-                }
+                    None => {
+                        let mut sum = mi * c.w0;
+                        let mut sum_grad = Vec3::zeros();
+                        let mut sum_grad_sq = R::zero();
+                        for k in offsets[i]..offsets[i + 1] {
+                            let j = indices[k] as usize;
+                            let d = xi - x[j];
+                            let r = d.norm();
+                            sum += m[j] * c.kernel.value(r);
+                            let f = if r > R::zero() {
+                                c.kernel.derivative(r) / r
+                            } else {
+                                R::zero()
+                            };
+                            gs[k - base] = f;
+                            let gw = d * f;
+                            sum_grad += gw * m[j];
+                            sum_grad_sq += m[j] * gw.norm_squared();
+                            if c.drag && r > R::zero() {
+                                // cos φ of x_j − x_i against the upstream direction (the
+                                // distance is the density's).
+                                max_cos = max_cos.max(upstream.dot(&(-d)) / r);
+                            }
+                        }
+                        (sum, sum_grad, sum_grad_sq)
+                    }
+                };
                 *occ_out = occlusion_of_cosine(max_cos, c.cos_cone);
                 if let Some(b) = volume {
                     let smp = b.sample(&xi);

@@ -55,6 +55,8 @@ pub(crate) struct Scratch<R: Real> {
     /// Partial sums of the density error per chunk of [`REDUCE_CHUNK`] particles.
     pub error_partials: Vec<f64>,
     pub perm_scalar: Vec<R>,
+    /// The step's positions and masses packed for the lanes (filled only when they run).
+    pub packed: sph_solver::pair_lanes::Packed,
 }
 
 impl<R: Real> Scratch<R> {

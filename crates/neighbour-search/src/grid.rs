@@ -151,6 +151,7 @@ fn query_runs<R: Real>(
             buf.report(&guard);
         });
     stats.query_s = watch.lap();
+    crate::scan::equalise_capacities(&mut tasks[..]);
     stats.candidate_tests = tasks[..task_count].iter().map(|t| t.0.tests).sum();
     guard.verdict(tasks[..task_count].iter().map(|t| &t.0))?;
     assemble_by(out, n, &mut tasks[..task_count], |t| &t.0, |t| &mut t.0)?;

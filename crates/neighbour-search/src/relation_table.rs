@@ -235,6 +235,7 @@ fn build_and_query<K: Key, R: Real>(
             buf.report(&guard);
         });
     work.stats.query_s = watch.lap();
+    crate::scan::equalise_capacities(&mut work.tasks[..]);
     work.stats.candidate_tests = work.tasks[..task_count].iter().map(|t| t.0.tests).sum();
     let tasks = &mut work.tasks[..task_count];
     guard.verdict(tasks.iter().map(|t| &t.0))?;

@@ -50,6 +50,27 @@ impl<R: Real> Gathered<R> {
         self.ids.clear();
     }
 
+    /// Candidates (padding included) the buffers hold without reallocating.
+    pub fn capacity(&self) -> usize {
+        self.ids
+            .capacity()
+            .min(self.xs.capacity())
+            .min(self.ys.capacity())
+            .min(self.zs.capacity())
+    }
+
+    /// Grows the buffers to hold `capacity` candidates (padding included) without
+    /// reallocating; no allocation when they already do.
+    pub fn reserve_total(&mut self, capacity: usize) {
+        // `reserve_exact`: `reserve` would round up (amortised doubling), and the tasks
+        // would then outgrow one another at every search.
+        let more = capacity.saturating_sub(self.len());
+        self.xs.reserve_exact(more);
+        self.ys.reserve_exact(more);
+        self.zs.reserve_exact(more);
+        self.ids.reserve_exact(more);
+    }
+
     /// Number of candidates gathered.
     pub fn len(&self) -> usize {
         self.ids.len()
@@ -494,6 +515,19 @@ mod avx512 {
             }
         }
         found
+    }
+}
+
+/// Grows every task's gathering buffers to the largest capacity any of them reached, so
+/// that a later search, whose tasks take other cells as the particles move, reallocates only
+/// for a block larger than any gathered so far (without this a warm step still allocates in
+/// a task that had only small blocks before).
+pub(crate) fn equalise_capacities<R: Real, T>(tasks: &mut [(T, Gathered<R>)]) {
+    let most = tasks.iter().map(|t| t.1.capacity()).max().unwrap_or(0);
+    for (_, g) in tasks.iter_mut() {
+        if g.capacity() < most {
+            g.reserve_total(most);
+        }
     }
 }
 

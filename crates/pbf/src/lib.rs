@@ -188,6 +188,7 @@
 //! the neighbours being L2 hits after the cell reorder.
 
 mod kernels;
+mod lanes;
 mod params;
 mod passes;
 mod scorr;

@@ -4,10 +4,12 @@ use neighbour_search::NeighbourLists;
 use rayon::prelude::*;
 use sph_core::{Real, Vec3};
 use sph_kernels::Kernel;
+use sph_solver::pair_lanes::Packed;
 use sph_solver::step::MIN_LEN;
 use sph_solver::Boundary;
 
 use crate::kernels::Consts;
+use crate::lanes::{self, LambdaSums, LaneConsts};
 
 /// Per-pair values of one Jacobi iteration, in the CSR order of the neighbour lists:
 /// computed by [`lambda_pass`] and reused by [`delta_pass`], which sees the same positions,
@@ -21,6 +23,9 @@ pub(crate) struct PairCache<R: Real> {
     grad_factor: Vec<R>,
     /// `s_corr` of the pair (eq. 13; 0 when the artificial pressure is off).
     scorr: Vec<R>,
+    /// The positions and masses of the pass, packed for the lanes (filled only when they
+    /// run).
+    pub(crate) packed: Packed,
 }
 
 impl<R: Real> PairCache<R> {
@@ -53,6 +58,8 @@ pub(crate) struct PassInput<'a, R: Real> {
     /// The boundary when it takes part in the density (volume maps), `None` otherwise, with
     /// the particles it can reach during this step's iterations (see [`near_boundary`]).
     pub volume: Option<(&'a dyn Boundary<R>, &'a [bool])>,
+    /// The `f32` lane kernels' constants when they run ([`LaneConsts::new`]).
+    pub lanes: Option<LaneConsts>,
 }
 
 /// Which particles a volume boundary can reach during one step's Jacobi iterations: those
@@ -93,12 +100,15 @@ pub(crate) fn lambda_pass<R: Real>(
 ) -> f64 {
     let pairs = input.nb.pair_count();
     cache.resize(pairs);
+    if input.lanes.is_some() {
+        cache.packed.fill(input.x, input.m);
+    }
     lambda_block(
         input,
         0,
         out,
-        &mut cache.grad_factor[..pairs],
-        &mut cache.scorr[..pairs],
+        &cache.packed,
+        (&mut cache.grad_factor[..pairs], &mut cache.scorr[..pairs]),
     )
 }
 
@@ -110,8 +120,8 @@ fn lambda_block<R: Real>(
     input: PassInput<'_, R>,
     first: usize,
     out: LambdaOut<'_, R>,
-    grad_factor: &mut [R],
-    scorr: &mut [R],
+    packed: &Packed,
+    (grad_factor, scorr): (&mut [R], &mut [R]),
 ) -> f64 {
     let n = out.density.len();
     let offsets = input.nb.offsets();
@@ -130,7 +140,7 @@ fn lambda_block<R: Real>(
                     lambda: l0,
                     boundary_grad: b0,
                 };
-                lambda_block(input, first, out, g0, s0)
+                lambda_block(input, first, out, packed, (g0, s0))
             },
             || {
                 let out = LambdaOut {
@@ -138,7 +148,7 @@ fn lambda_block<R: Real>(
                     lambda: l1,
                     boundary_grad: b1,
                 };
-                lambda_block(input, first + mid, out, g1, s1)
+                lambda_block(input, first + mid, out, packed, (g1, s1))
             },
         );
         return a + b;
@@ -149,6 +159,7 @@ fn lambda_block<R: Real>(
         m,
         nb,
         volume,
+        lanes,
     } = input;
     let base = offsets[first];
     let mut compression = R::zero();
@@ -162,32 +173,14 @@ fn lambda_block<R: Real>(
         let i = first + k;
         let (a, b) = (offsets[i] - base, offsets[i + 1] - base);
         let xi = x[i];
-        let mut sum_w = m[i] * c.w0;
-        let mut grad_i = Vec3::zeros();
-        let mut sum_g2 = R::zero();
-        for ((&j, gf), sc) in nb
-            .neighbours(i)
-            .iter()
-            .zip(&mut grad_factor[a..b])
-            .zip(&mut scorr[a..b])
-        {
-            let j = j as usize;
-            let r = xi - x[j];
-            let r2 = r.norm_squared();
-            let w = c.poly6.value_r2(r2);
-            sum_w += m[j] * w;
-            *sc = if c.scorr_on {
-                c.scorr.from_kernel_value(w)
-            } else {
-                R::zero()
-            };
-            let f = spiky_factor(c, r2);
-            *gf = f;
-            // ∇_{p_j} C_i = −(m_j/ρ0) ∇W(p_i − p_j); ∇_{p_i} C_i = Σ_j (m_j/ρ0) ∇W.
-            let g = (r * f) * (m[j] * c.inv_rho0);
-            grad_i += g;
-            sum_g2 += g.norm_squared();
-        }
+        let (gf, sc) = (&mut grad_factor[a..b], &mut scorr[a..b]);
+        let sums = match &lanes {
+            Some(l) => lanes::lambda_sums(l, (x, m, packed), nb, i, gf, sc),
+            None => lambda_sums(c, x, m, nb, i, gf, sc),
+        };
+        let mut sum_w = sums.density;
+        let mut grad_i = sums.grad;
+        let sum_g2 = sums.grad_sq;
         if let Some((bd, near)) = volume {
             if near[i] {
                 // ρ_B = ρ0 Ψ; ∇_{p_i} (ρ0 Ψ / ρ0) = ∇Ψ.
@@ -211,6 +204,75 @@ fn lambda_block<R: Real>(
     compression.as_f64()
 }
 
+/// The sums of particle `i`'s pairs in the `λ` pass (eqs. 2 and 8, with the density's self
+/// term `m_i W(0)` first, without the boundary), writing its pairs' Spiky factors and `s_corr` (its CSR range of the
+/// cache): the scalar loop, in list order.
+pub(crate) fn lambda_sums<R: Real>(
+    c: &Consts<R>,
+    x: &[Vec3<R>],
+    m: &[R],
+    nb: &NeighbourLists,
+    i: usize,
+    grad_factor: &mut [R],
+    scorr: &mut [R],
+) -> LambdaSums<R> {
+    let xi = x[i];
+    let mut sums = LambdaSums {
+        density: m[i] * c.w0,
+        grad: Vec3::zeros(),
+        grad_sq: R::zero(),
+    };
+    for ((&j, gf), sc) in nb.neighbours(i).iter().zip(grad_factor).zip(scorr) {
+        let j = j as usize;
+        let r = xi - x[j];
+        let r2 = r.norm_squared();
+        let w = c.poly6.value_r2(r2);
+        sums.density += m[j] * w;
+        *sc = if c.scorr_on {
+            c.scorr.from_kernel_value(w)
+        } else {
+            R::zero()
+        };
+        let f = spiky_factor(c, r2);
+        *gf = f;
+        // ∇_{p_j} C_i = −(m_j/ρ0) ∇W(p_i − p_j); ∇_{p_i} C_i = Σ_j (m_j/ρ0) ∇W.
+        let g = (r * f) * (m[j] * c.inv_rho0);
+        sums.grad += g;
+        sums.grad_sq += g.norm_squared();
+    }
+    sums
+}
+
+/// The `Δp` pass's pair sum of particle `i`,
+/// `Σ_j (λ_i m_j + λ_j m_i + s_corr (m_i + m_j) unit/2) ∇W_ij` (before `1/ρ0`), from the
+/// pair cache (`W'(r)/r`, `s_corr`) of its CSR range: the scalar loop, in list order.
+#[allow(clippy::too_many_arguments)] // the pass's inputs, one particle
+pub(crate) fn delta_sum<R: Real>(
+    c: &Consts<R>,
+    x: &[Vec3<R>],
+    m: &[R],
+    lambda: &[R],
+    nb: &NeighbourLists,
+    i: usize,
+    (grad_factor, scorr): (&[R], &[R]),
+    half_unit: R,
+) -> Vec3<R> {
+    let (xi, li, mi) = (x[i], lambda[i], m[i]);
+    let mut acc = Vec3::zeros();
+    for ((&j, &f), &sc) in nb.neighbours(i).iter().zip(grad_factor).zip(scorr) {
+        let j = j as usize;
+        let r = xi - x[j];
+        let mj = m[j];
+        // λ_i ∇_{p_i} C_i + λ_j ∇_{p_i} C_j, with ∇_{p_i} C_j = (m_i/ρ0) ∇W(p_i − p_j).
+        let mut coeff = li * mj + lambda[j] * mi;
+        if c.scorr_on {
+            coeff += sc * (mi + mj) * half_unit;
+        }
+        acc += (r * f) * coeff;
+    }
+    acc
+}
+
 /// Eqs. 13 and 14, then the boundary's contact response: `delta_p` receives `Δp_i` (with
 /// the boundary term `λ_i ∇Ψ_i` of a volume boundary), `next` the corrected position
 /// `x_i + Δp_i` after [`Boundary::project`]. Reads the pair cache written by
@@ -230,6 +292,7 @@ pub(crate) fn delta_pass<R: Real>(
         m,
         nb,
         volume,
+        lanes,
     } = input;
     let half_unit = R::of_f64(0.5) * c.scorr_unit;
     let offsets = nb.offsets();
@@ -240,30 +303,19 @@ pub(crate) fn delta_pass<R: Real>(
         .enumerate()
         .with_min_len(MIN_LEN)
         .for_each(|(i, (dp, xn))| {
-            let (xi, li, mi) = (x[i], lambda[i], m[i]);
             let (a, b) = (offsets[i], offsets[i + 1]);
-            let mut acc = Vec3::zeros();
-            for ((&j, &f), &sc) in nb
-                .neighbours(i)
-                .iter()
-                .zip(&cache.grad_factor[a..b])
-                .zip(&cache.scorr[a..b])
-            {
-                let j = j as usize;
-                let r = xi - x[j];
-                let mj = m[j];
-                // λ_i ∇_{p_i} C_i + λ_j ∇_{p_i} C_j, with ∇_{p_i} C_j = (m_i/ρ0) ∇W(p_i − p_j).
-                let mut coeff = li * mj + lambda[j] * mi;
-                if c.scorr_on {
-                    coeff += sc * (mi + mj) * half_unit;
+            let pair_cache = (&cache.grad_factor[a..b], &cache.scorr[a..b]);
+            let acc = match &lanes {
+                Some(l) => {
+                    lanes::delta_sum(l, (m, &cache.packed), lambda, nb, i, pair_cache, half_unit)
                 }
-                acc += (r * f) * coeff;
-            }
+                None => delta_sum(c, x, m, lambda, nb, i, pair_cache, half_unit),
+            };
             let mut d = acc * c.inv_rho0;
             if with_volume {
-                d += boundary_grad[i] * li;
+                d += boundary_grad[i] * lambda[i];
             }
             *dp = d;
-            *xn = boundary.project(xi + d);
+            *xn = boundary.project(x[i] + d);
         });
 }

@@ -48,6 +48,16 @@ impl<R: Real> ArtificialPressure<R> {
     pub fn inverse_w_delta_q(&self) -> R {
         self.inv_w_dq
     }
+
+    /// The strength `k` of eq. 13.
+    pub(crate) fn strength(&self) -> R {
+        self.k
+    }
+
+    /// The exponent `n` of eq. 13.
+    pub(crate) fn exponent(&self) -> u32 {
+        self.n
+    }
 }
 
 /// `x^n` by repeated squaring, inlined (a runtime `powi` compiles to a library call, which in

@@ -14,6 +14,7 @@ use sph_solver::step::{
 use sph_solver::{Boundary, FrameSolver, SchemeParts, SolverError, StepStats, SubstepScheme};
 
 use crate::kernels::{Consts, PBF_KERNEL};
+use crate::lanes::{self, LaneConsts};
 use crate::params::PbfParams;
 use crate::passes::{delta_pass, lambda_pass, near_boundary, LambdaOut, PassInput};
 use crate::scratch::PbfScratch;
@@ -198,12 +199,14 @@ impl<R: Real> PbfScheme<R> {
             );
         }
         let volume = volume.map(|b| (b, &s.near_boundary[..]));
+        let nb = self.parts.neighbours.lists();
         let input = PassInput {
             c: &self.c,
             x: &s.predicted,
             m: masses,
-            nb: self.parts.neighbours.lists(),
+            nb,
             volume,
+            lanes: LaneConsts::new(&self.c, n, nb),
         };
         let out = LambdaOut {
             density: &mut s.density,
@@ -279,6 +282,7 @@ impl<R: Real> PbfScheme<R> {
             near_boundary(b, &s.predicted, h, &mut s.near_boundary);
         }
         let reach = volume.map(|b| (b, &s.near_boundary[..]));
+        let lanes = LaneConsts::new(&c, state.len(), nb);
         let inv_n = 1.0 / (state.len().max(1) as f64);
         let mut done = 0;
         loop {
@@ -288,6 +292,7 @@ impl<R: Real> PbfScheme<R> {
                 m,
                 nb,
                 volume: reach,
+                lanes,
             };
             let out = LambdaOut {
                 density: &mut s.density,
@@ -337,6 +342,7 @@ impl<R: Real> PbfScheme<R> {
                 m,
                 nb,
                 volume,
+                lanes,
             },
             s,
         );
@@ -362,6 +368,7 @@ struct VelocityInput<'a, R: Real> {
     m: &'a [R],
     nb: &'a NeighbourLists,
     volume: Option<&'a dyn Boundary<R>>,
+    lanes: Option<LaneConsts>,
 }
 
 /// Algorithm 1 lines 20–22: `v = (x* − x)/Δt`, the densities at the final positions (for
@@ -375,6 +382,7 @@ fn velocity_update<R: Real>(input: VelocityInput<'_, R>, s: &mut PbfScratch<R>) 
         m,
         nb,
         volume,
+        lanes,
     } = input;
     let dt = p.substep_dt();
     let inv_dt = R::one() / dt;
@@ -387,6 +395,10 @@ fn velocity_update<R: Real>(input: VelocityInput<'_, R>, s: &mut PbfScratch<R>) 
     let vort_on = p.vorticity_epsilon != R::zero();
     let xsph_on = p.xsph_c > R::zero();
     let v = &s.velocity[..];
+    if lanes.is_some() && !vort_on {
+        s.pairs.packed.fill(x, m);
+    }
+    let packed = &s.pairs.packed;
     // Densities at the final positions and eq. 15; without vorticity confinement, XSPH
     // (eq. 17) in the same pass (it needs the same Poly6 values and nothing else of this
     // pass).
@@ -403,7 +415,21 @@ fn velocity_update<R: Real>(input: VelocityInput<'_, R>, s: &mut PbfScratch<R>) 
             let mut sum_w = m[i] * c.w0;
             let mut omega = Vec3::zeros();
             let mut xsph = Vec3::zeros();
-            for &j in nb.neighbours(i) {
+            let lanes = lanes.filter(|_| !vort_on);
+            if let Some(l) = &lanes {
+                let (pair_w, pair_xsph) = lanes::density_xsph(l, packed, v, nb, i);
+                sum_w += pair_w;
+                if xsph_on {
+                    xsph = pair_xsph;
+                }
+            }
+            // The scalar loop runs only without the lanes.
+            let scalar_list = if lanes.is_some() {
+                &[][..]
+            } else {
+                nb.neighbours(i)
+            };
+            for &j in scalar_list {
                 let j = j as usize;
                 let r = xi - x[j];
                 let wij = c.poly6.value_r2(r.norm_squared());

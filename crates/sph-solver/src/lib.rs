@@ -66,6 +66,7 @@ mod error;
 mod fluid_solver;
 pub mod frame;
 pub mod initial;
+pub mod pair_lanes;
 mod parameters;
 mod params;
 pub mod scene_boundary;
