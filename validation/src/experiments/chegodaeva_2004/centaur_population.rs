@@ -33,8 +33,8 @@
 //! standard error of the difference under the change; the smaller of the two directions is
 //! quoted). With MERCURIUS's fractions in `mercurius_ends_1000.csv` (57/1000 at 20 kyr,
 //! 92/1000 at 50 kyr, 234/1000 at 1 Myr): 0.8 needs n = 8,738 comets over 20 kyr, 5,210 over
-//! 50 kyr, 1,668 over 1 Myr; the 1,000 comets have power POWER_UNPAIRED_QUICK over 50 kyr and
-//! POWER_UNPAIRED_FULL over 1 Myr.
+//! 50 kyr, 1,668 over 1 Myr; the 1,000 comets have power 0.095 over 50 kyr and 0.49
+//! over 1 Myr.
 //!
 //! **The paired test.** Both codes start the same comet from the same state, so early on a
 //! comet that one code sends below 2.5 AU the other tends to send too: the outcomes are
@@ -44,7 +44,49 @@
 //! comets only, not of all. A change that adds (removes) `Δ = 0.25 p n` comets at random
 //! moves `b − c` by `Δ` and `b + c` by at most `Δ`, so the check fails with probability at
 //! least `Φ(Δ/√(b + c + Δ) − 3)` (metric "power of the McNemar check", computed from each
-//! run's own `b + c`). PAIRED_TABLE
+//! run's own `b + c`), and the change caught with 80 % probability solves
+//! `Δ/√(b + c + Δ) = 3 + Φ⁻¹(0.8)` (metric "change … the McNemar check catches with 80 %
+//! probability").
+//!
+//! **The correlation, measured** (the `--full` run of 2026-12-05 below, each code's ends
+//! censored at the span; `φ` the correlation of the two codes' outcomes comet by comet;
+//! powers against a 25 % change; the comets a paired check at that span would need for 0.8,
+//! from that span's `p` and `(b + c)/n`, and their cost in comet-years, each comet counted
+//! until it ends, and in our wall time at the `--full` run's 1.1·10⁶ comet-years per second
+//! on 2 threads):
+//!
+//! | span | ours | MERCURIUS | both | b | c | φ | paired power | unpaired | comets for 0.8 | comet-years | ours (s) |
+//! | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |
+//! | 5 kyr | 29 | 28 | 8 | 21 | 20 | 0.26 | 0.023 | 0.018 | 14,457 | 7.1·10⁷ | 65 |
+//! | 10 kyr | 39 | 40 | 10 | 29 | 30 | 0.22 | 0.036 | 0.027 | 10,183 | 9.9·10⁷ | 90 |
+//! | 20 kyr | 58 | 57 | 20 | 38 | 37 | 0.31 | 0.068 | 0.045 | 6,486 | 1.3·10⁸ | 113 |
+//! | **50 kyr** | 94 | 92 | 40 | 54 | 52 | 0.37 | **0.165** | 0.095 | 3,599 | 1.7·10⁸ | 153 |
+//! | 100 kyr | 117 | 122 | 56 | 61 | 66 | 0.40 | 0.284 | 0.155 | 2,499 | 2.3·10⁸ | 207 |
+//! | 200 kyr | 145 | 147 | 71 | 74 | 76 | 0.40 | 0.378 | 0.216 | 2,041 | 3.6·10⁸ | 326 |
+//! | **1 Myr** | 239 | 234 | 118 | 121 | 116 | 0.34 | **0.657** | 0.491 | 1,274 | 9.8·10⁸ | 893 |
+//!
+//! The outcomes are correlated (`φ` 0.2–0.4), not enough to make 1,000 comets decisive: the
+//! paired test needs a third to a half of the unpaired test's comets. **No design within the
+//! quick budget that the existing references allow reaches a 25 % change.** The quick mode
+//! (about a minute: 1,000 comets over 50 kyr, 4.7·10⁷ comet-years, the most the 1,000-comet
+//! reference allows in that time) catches with 80 % probability a change of about 52 % (power
+//! 0.165 against 25 %; the 300 comets over 200 kyr before caught 67 %); `--full` (1 Myr)
+//! catches about 29 % (power 0.66 against 25 %; 0.8 would need 1,274 comets). A shorter span
+//! with more comets is cheaper per unit of power: 0.8 against 25 % at 5 kyr needs about
+//! 14,500 comets, 7.1·10⁷ comet-years, about 65 s here, but a MERCURIUS reference of those
+//! comets over 5 kyr that does not exist yet (and these figures come from 28 and 41 events,
+//! uncertain by some 20 %); it would also judge only the earliest q < 2.5 AU ends, those of
+//! comets that start on Jupiter-crossing orbits.
+//!
+//! **`--full`, measured** (2026-12-05, 18:36–18:48 UTC, `validation run --full --only
+//! centaur-population`, 2 rayon threads, under the build lock on the shared 2-core machine:
+//! 700.9 s of wall time, 1,349 s of CPU; 230,332 switches to the encounter integrator, 230
+//! per comet): passes 10/10. Surviving at 250, 500, 750 kyr and 1 Myr: 820/821, 752/770,
+//! 713/729, 685/696 (ours/MERCURIUS; z = −0.06, −0.94, −0.80, −0.53); ended by q < 2.5 AU
+//! 239/234 (z = 0.26), ejected 73/62 (0.98), collided with a planet 3/8 (−1.51: ours 3 with
+//! Jupiter; MERCURIUS 4 with Jupiter, 2 with Neptune, 1 with Saturn and with Uranus);
+//! McNemar `b` = 121, `c` = 116, z = 0.32; KS of the lifetimes D = 0.052, p = 0.79; no other
+//! end.
 use anyhow::{bail, Result};
 
 use super::centaur_sample::{censor, run_ours, Ends};
@@ -120,6 +162,18 @@ fn normal_cdf(x: f64) -> f64 {
 /// (the far tail, below 10⁻³, left out).
 fn mcnemar_power(discordant: usize, shift: f64) -> f64 {
     normal_cdf(shift / (discordant as f64 + shift).sqrt() - Z_MAX)
+}
+
+/// `Φ⁻¹(0.8)`, the standard normal quantile of 80 % (Abramowitz & Stegun, Table 26.5).
+const Z_POWER_80: f64 = 0.841_621;
+
+/// The relative change of a count `reference` that McNemar's check catches with 80 %
+/// probability ([`mcnemar_power`] = 0.8): the shift `Δ` solving `Δ/√(d + Δ) = Z_MAX + z₀.₈`,
+/// `Δ = (k² + √(k⁴ + 4k²d))/2` with `k = Z_MAX + z₀.₈`, over `reference`.
+fn mcnemar_change_at_80(discordant: usize, reference: usize) -> f64 {
+    let k2 = (Z_MAX + Z_POWER_80).powi(2);
+    let shift = (k2 + (k2 * k2 + 4.0 * k2 * discordant as f64).sqrt()) / 2.0;
+    shift / reference as f64
 }
 
 /// A named end rule: which labels it counts.
@@ -245,7 +299,8 @@ impl Experiment for CentaurPopulation {
     fn run(&self, ctx: &mut Context) -> Result<Outcome> {
         let span = ctx.mode.pick(QUICK_SPAN_YEARS, FULL_SPAN_YEARS);
         let checkpoints = ctx.mode.pick(None, Some(FULL_CHECKPOINT_YEARS));
-        let (ours, encounters_begun) = run_ours(ctx, span, checkpoints)?;
+        let run = run_ours(ctx, span, checkpoints)?;
+        let (ours, encounters_begun) = (run.ends, run.encounters_begun);
         let reference = reference(ctx, span)?;
         if ours.len() != reference.len() {
             bail!(
@@ -303,10 +358,14 @@ impl Experiment for CentaurPopulation {
         out.metric("q < 2.5 AU: comets only ours ended so (b)", b as f64);
         out.metric("q < 2.5 AU: comets only MERCURIUS ended so (c)", c as f64);
         // A 25 % change of the fraction MERCURIUS finds, at this run's discordance.
-        let shift = 0.25 * count(&reference, |l| l == "perihelion").0 as f64;
+        let theirs = count(&reference, |l| l == "perihelion").0;
         out.metric(
             "power of the McNemar check against a 25 % change of the q < 2.5 AU fraction",
-            mcnemar_power(b + c, shift),
+            mcnemar_power(b + c, 0.25 * theirs as f64),
+        );
+        out.metric(
+            "change of the q < 2.5 AU fraction the McNemar check catches with 80 % probability",
+            mcnemar_change_at_80(b + c, theirs),
         );
         out.check(Check::less_than(
             "|z| McNemar, ended by q < 2.5 AU, paired by comet",
@@ -375,6 +434,9 @@ impl Experiment for CentaurPopulation {
             encounters_begun as f64,
         );
         out.metric("span (years)", span);
+        if let Some(t) = run.resumed_from_years {
+            out.metric("resumed from a checkpoint at (years)", t);
+        }
         write_csv_rows(
             &ctx.path("ours_ends.csv"),
             &["id", "end", "end_time_years"],
@@ -420,6 +482,16 @@ mod tests {
         assert_eq!((b, c), (2, 1));
         assert!((z - 1.0 / 3f64.sqrt()).abs() < 1e-15);
         assert_eq!(mcnemar_z(&ours, &ours).0, 0.0);
+    }
+
+    #[test]
+    fn the_change_caught_at_80_percent_has_that_power() {
+        // The inverse of mcnemar_power: at the shift it returns, the power is 0.8 (to the
+        // 1e-6 of the quantile's six digits and the fit of normal_cdf).
+        for (d, m) in [(106, 92), (237, 234), (0, 10)] {
+            let x = mcnemar_change_at_80(d, m);
+            assert!((mcnemar_power(d, x * m as f64) - 0.8).abs() < 1e-5, "{d} {m}");
+        }
     }
 
     #[test]

@@ -29,8 +29,7 @@ const CHECKPOINT_FILE: &str = "population_checkpoint.json";
 struct RunCheckpoint {
     /// The population file's text.
     spec: String,
-    /// The initial-state file's text length and the number of comets (a cheap identity of
-    /// the reference file, which is versioned with the code).
+    /// The number of comets (the initial states are versioned with the code).
     comets: usize,
     /// The run's span (years).
     span_years: f64,
@@ -89,42 +88,52 @@ fn build_stamp() -> u64 {
         .map_or(0, |d| d.as_secs())
 }
 
-/// Runs the comets of [`INITIAL_STATES`] with `populations/centaurs.toml`'s settings for
-/// `span_years`, each comet's end censored at the span, and the switches to the encounter
-/// integrator of all comets. With `checkpoint_every_years`, the population is written to
-/// the output directory at that cadence (atomically) and a run of the same build,
-/// specification and span resumes from it; the checkpoint is removed once the run ends.
-pub(crate) fn run_ours(
-    ctx: &Context,
-    span_years: f64,
-    checkpoint_every_years: Option<f64>,
-) -> Result<(Ends, u64)> {
+/// What [`run_ours`] returns.
+pub(crate) struct OursRun {
+    /// Each comet's end, in id order, censored at the span.
+    pub ends: Ends,
+    /// Switches to the encounter integrator of all comets
+    /// (`PopulationProgress::encounters_begun`).
+    pub encounters_begun: u64,
+    /// The checkpoint's time the run resumed from (years), if it did.
+    pub resumed_from_years: Option<f64>,
+}
+
+/// `populations/centaurs.toml`'s text, and its population built from [`INITIAL_STATES`].
+fn fresh(ctx: &Context) -> Result<(String, Population)> {
     let spec_path = workspace_root().join("populations/centaurs.toml");
     let spec_text = std::fs::read_to_string(&spec_path)
         .with_context(|| format!("reading {}", spec_path.display()))?;
     let mut spec = PopulationSpec::parse(&spec_text, &spec_path)?;
     spec.particles.kind = ParticleKind::BarycentricState;
     let rows = initial_rows(ctx)?;
+    let population = spec.population_from_rows(&rows, Path::new(INITIAL_STATES))?;
+    Ok((spec_text, population))
+}
+
+/// Runs the comets of [`INITIAL_STATES`] with `populations/centaurs.toml`'s settings for
+/// `span_years`. With `checkpoint_every_years`, the population is written to the output
+/// directory at every multiple of that cadence (atomically) and a run of the same build,
+/// specification, comets and span resumes from it; the checkpoint is removed once the run
+/// ends.
+pub(crate) fn run_ours(
+    ctx: &Context,
+    span_years: f64,
+    checkpoint_every_years: Option<f64>,
+) -> Result<OursRun> {
+    let (spec_text, mut population) = fresh(ctx)?;
+    let comets = population.members().len();
     let checkpoint = ctx.path(CHECKPOINT_FILE);
     let build = build_stamp();
-    let fresh = |rows: &[ParticleRow]| -> Result<Population> {
-        Ok(spec.population_from_rows(rows, Path::new(INITIAL_STATES))?)
-    };
-    let mut population = match checkpoint_every_years {
-        Some(_) if checkpoint.exists() => {
-            let c: RunCheckpoint = load_checkpoint(&checkpoint)?;
-            let same = c.spec == spec_text
-                && c.comets == rows.len()
-                && c.span_years == span_years
-                && c.build == build;
-            if same {
-                c.population
-            } else {
-                fresh(&rows)?
-            }
+    let mut resumed_from_years = None;
+    if checkpoint_every_years.is_some() && checkpoint.exists() {
+        let c: RunCheckpoint = load_checkpoint(&checkpoint)?;
+        if c.spec == spec_text && c.comets == comets && c.span_years == span_years && c.build == build
+        {
+            resumed_from_years = Some(c.population.time() / DAYS_PER_YEAR);
+            population = c.population;
         }
-        _ => fresh(&rows)?,
-    };
+    }
     ctx.progress.set_length(span_years as u64);
     let end = span_years * DAYS_PER_YEAR;
     let every = checkpoint_every_years.map_or(end, |y| y * DAYS_PER_YEAR);
@@ -142,7 +151,7 @@ pub(crate) fn run_ours(
         if checkpoint_every_years.is_some() {
             let c = RunCheckpoint {
                 spec: spec_text.clone(),
-                comets: rows.len(),
+                comets,
                 span_years,
                 build,
                 population,
@@ -164,7 +173,11 @@ pub(crate) fn run_ours(
             censor(label, t / DAYS_PER_YEAR, span_years)
         })
         .collect();
-    Ok((ends, population.progress().encounters_begun))
+    Ok(OursRun {
+        ends,
+        encounters_begun: population.progress().encounters_begun,
+        resumed_from_years,
+    })
 }
 
 /// An end after `span` years counts as active (both codes are compared over the same span).
@@ -173,5 +186,45 @@ pub(crate) fn censor(label: String, years: f64, span: f64) -> (String, f64) {
         ("active".into(), f64::INFINITY)
     } else {
         (label, years)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{reference_data_dir, Mode};
+    use indicatif::ProgressBar;
+
+    /// A run killed after its checkpoint at 1 kyr and started again ends as the
+    /// uninterrupted run, bit for bit; a checkpoint of another span is not resumed.
+    #[test]
+    fn a_killed_run_resumes_bit_for_bit() {
+        let dir = std::env::temp_dir().join(format!("centaur-sample-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let ctx = Context::new(Mode::Full, dir.clone(), reference_data_dir(), ProgressBar::hidden());
+        let span = 2_000.0;
+        let whole = run_ours(&ctx, span, None).unwrap();
+        assert!(whole.ends.iter().any(|(l, _)| l != "active"), "no comet ended: nothing to compare");
+        // What the killed run left: its checkpoint at 1 kyr, written as run_ours writes it.
+        let (spec, mut population) = fresh(&ctx).unwrap();
+        population.advance_to(1_000.0 * DAYS_PER_YEAR, |_| {}).unwrap();
+        let killed = |span_years: f64, population: Population| RunCheckpoint {
+            spec: spec.clone(),
+            comets: population.members().len(),
+            span_years,
+            build: build_stamp(),
+            population,
+        };
+        save_checkpoint(&ctx.path(CHECKPOINT_FILE), &killed(span, population.clone())).unwrap();
+        let resumed = run_ours(&ctx, span, Some(1_000.0)).unwrap();
+        assert_eq!(resumed.resumed_from_years, Some(1_000.0));
+        assert_eq!(resumed.ends, whole.ends);
+        assert_eq!(resumed.encounters_begun, whole.encounters_begun);
+        assert!(!ctx.path(CHECKPOINT_FILE).exists(), "the finished run's checkpoint stays");
+        save_checkpoint(&ctx.path(CHECKPOINT_FILE), &killed(3_000.0, population)).unwrap();
+        let other = run_ours(&ctx, span, Some(1_000.0)).unwrap();
+        assert_eq!(other.resumed_from_years, None);
+        assert_eq!(other.ends, whole.ends);
+        std::fs::remove_dir_all(&dir).ok();
     }
 }
