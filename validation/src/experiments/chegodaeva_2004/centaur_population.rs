@@ -193,7 +193,10 @@ fn reference(ctx: &Context, span_years: f64) -> Result<Ends> {
                 _ => table.number(i, "end_time_days")? / DAYS_PER_YEAR,
             };
             if table.number(i, "id")? != i as f64 {
-                bail!("{REFERENCE_ENDS}: row {} is not comet {i} (rows in id order expected)", i + 2);
+                bail!(
+                    "{REFERENCE_ENDS}: row {} is not comet {i} (rows in id order expected)",
+                    i + 2
+                );
             }
             Ok(censor(label, t, span_years))
         })
@@ -490,7 +493,10 @@ mod tests {
         // 1e-6 of the quantile's six digits and the fit of normal_cdf).
         for (d, m) in [(106, 92), (237, 234), (0, 10)] {
             let x = mcnemar_change_at_80(d, m);
-            assert!((mcnemar_power(d, x * m as f64) - 0.8).abs() < 1e-5, "{d} {m}");
+            assert!(
+                (mcnemar_power(d, x * m as f64) - 0.8).abs() < 1e-5,
+                "{d} {m}"
+            );
         }
     }
 

@@ -128,7 +128,10 @@ pub(crate) fn run_ours(
     let mut resumed_from_years = None;
     if checkpoint_every_years.is_some() && checkpoint.exists() {
         let c: RunCheckpoint = load_checkpoint(&checkpoint)?;
-        if c.spec == spec_text && c.comets == comets && c.span_years == span_years && c.build == build
+        if c.spec == spec_text
+            && c.comets == comets
+            && c.span_years == span_years
+            && c.build == build
         {
             resumed_from_years = Some(c.population.time() / DAYS_PER_YEAR);
             population = c.population;
@@ -201,13 +204,23 @@ mod tests {
     fn a_killed_run_resumes_bit_for_bit() {
         let dir = std::env::temp_dir().join(format!("centaur-sample-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
-        let ctx = Context::new(Mode::Full, dir.clone(), reference_data_dir(), ProgressBar::hidden());
+        let ctx = Context::new(
+            Mode::Full,
+            dir.clone(),
+            reference_data_dir(),
+            ProgressBar::hidden(),
+        );
         let span = 2_000.0;
         let whole = run_ours(&ctx, span, None).unwrap();
-        assert!(whole.ends.iter().any(|(l, _)| l != "active"), "no comet ended: nothing to compare");
+        assert!(
+            whole.ends.iter().any(|(l, _)| l != "active"),
+            "no comet ended: nothing to compare"
+        );
         // What the killed run left: its checkpoint at 1 kyr, written as run_ours writes it.
         let (spec, mut population) = fresh(&ctx).unwrap();
-        population.advance_to(1_000.0 * DAYS_PER_YEAR, |_| {}).unwrap();
+        population
+            .advance_to(1_000.0 * DAYS_PER_YEAR, |_| {})
+            .unwrap();
         let killed = |span_years: f64, population: Population| RunCheckpoint {
             spec: spec.clone(),
             comets: population.members().len(),
@@ -215,12 +228,19 @@ mod tests {
             build: build_stamp(),
             population,
         };
-        save_checkpoint(&ctx.path(CHECKPOINT_FILE), &killed(span, population.clone())).unwrap();
+        save_checkpoint(
+            &ctx.path(CHECKPOINT_FILE),
+            &killed(span, population.clone()),
+        )
+        .unwrap();
         let resumed = run_ours(&ctx, span, Some(1_000.0)).unwrap();
         assert_eq!(resumed.resumed_from_years, Some(1_000.0));
         assert_eq!(resumed.ends, whole.ends);
         assert_eq!(resumed.encounters_begun, whole.encounters_begun);
-        assert!(!ctx.path(CHECKPOINT_FILE).exists(), "the finished run's checkpoint stays");
+        assert!(
+            !ctx.path(CHECKPOINT_FILE).exists(),
+            "the finished run's checkpoint stays"
+        );
         save_checkpoint(&ctx.path(CHECKPOINT_FILE), &killed(3_000.0, population)).unwrap();
         let other = run_ours(&ctx, span, Some(1_000.0)).unwrap();
         assert_eq!(other.resumed_from_years, None);
