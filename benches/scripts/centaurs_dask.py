@@ -49,7 +49,7 @@ def ends(population: partisim.Population, years: float):
     """(id, end label, end time in years or inf) per comet, as the experiment writes them."""
     table = population.table()
     out = []
-    for i, status, t in zip(table["id"], table["status"], table["time_days"]):
+    for i, status, t in zip(table["id"], table["status"], table["removal_time_days"]):
         t_years = t / YEAR_DAYS
         if status == "active" or t_years > years:
             out.append((int(i), "active", math.inf))
