@@ -4,7 +4,9 @@
   the :class:`~partisim.PopulationSpec` settings and its shard's particles only, builds the
   planets itself from the same initial state, advances and returns its shard; the shards are
   merged in identifier order. A particle's trajectory depends only on its own initial state
-  and the planet grid, so the result is bit-identical to one process.
+  and the planet grid, so the result is bit-identical to one process. With a checkpoint
+  directory each shard is saved at a cadence of simulated time, and a shard whose worker
+  died, or a whole run killed and started again, goes on from its checkpoint, bit for bit.
 - :func:`run_scene_sweep`: a study of scene variants (a base scene file and a table of
   overrides: a friction-angle sweep, a resolution study, a parameter scan), one task per
   run, each run checkpointed into a shared directory and resumed from its latest
@@ -44,15 +46,64 @@ import numpy as np
 from .comets import Population, PopulationSpec
 
 
-def _run_shard(spec: PopulationSpec, to_years: float) -> Population:
-    return spec.build().advance(to_years)
+def _shard_key(spec: PopulationSpec, to_years: float, every_years: Optional[float]) -> str:
+    """A digest of everything that defines a shard's run (its settings, particles,
+    identifiers, end time and checkpoint cadence), naming its checkpoint: a checkpoint of
+    another run is never resumed."""
+    h = hashlib.sha256()
+    h.update(spec.settings_json().encode())
+    h.update(spec.kind.encode())
+    h.update(np.ascontiguousarray(spec.particles).tobytes())
+    if spec.ids is not None:
+        h.update(np.ascontiguousarray(spec.ids).tobytes())
+    h.update(json.dumps([float(to_years), every_years]).encode())
+    return h.hexdigest()[:16]
+
+
+def _next_stop(time_years: float, every_years: Optional[float], to_years: float) -> float:
+    """The next checkpoint time after ``time_years``: the next multiple of ``every_years``
+    from the epoch (so that a resumed shard stops where the uninterrupted one did), or
+    ``to_years``."""
+    if every_years is None:
+        return to_years
+    # A stop lands on its multiple exactly; the margin keeps it from being taken again.
+    k = int(np.floor(time_years / every_years + 1e-9)) + 1
+    return min(k * every_years, to_years)
+
+
+def _run_shard(
+    spec: PopulationSpec,
+    to_years: float,
+    checkpoint: Optional[str] = None,
+    every_years: Optional[float] = None,
+) -> Population:
+    """One shard (the Dask task): from its checkpoint if there is one, else from its
+    specification; with ``checkpoint``, the shard is saved there (atomically, by
+    :meth:`Population.save`) at every multiple of ``every_years`` and at the end."""
+    ckpt = Path(checkpoint) if checkpoint is not None else None
+    if ckpt is not None and ckpt.exists():
+        population = Population.load(str(ckpt))
+    else:
+        population = spec.build()
+    while population.time_years < to_years:
+        population.advance(_next_stop(population.time_years, every_years, to_years),
+                           progress=False)
+        if ckpt is not None:
+            population.save(str(ckpt))
+    return population
 
 
 def run_population_dask(
-    client: Any, population_spec: PopulationSpec, to_years: float, shards: int = 2
+    client: Any,
+    population_spec: PopulationSpec,
+    to_years: float,
+    shards: int = 2,
+    checkpoint_dir: Optional[Union[str, os.PathLike]] = None,
+    checkpoint_every_years: Optional[float] = None,
+    retries: int = 0,
 ) -> Population:
     """Advances a population to ``to_years`` (years after the planets' epoch) as
-    ``shards`` Dask tasks on ``client`` and merges them.
+    ``shards`` Dask tasks on ``client`` and merges them; resumable with ``checkpoint_dir``.
 
     Parameters
     ----------
@@ -64,12 +115,30 @@ def run_population_dask(
         End time (years after the planets' epoch).
     shards : int
         Number of tasks (>= 1); the particles are split into contiguous blocks of nearly
-        equal size.
+        equal size. More shards than workers balance the load (a shard of comets that end
+        early finishes early) and checkpoint the population by chunks of comets.
+    checkpoint_dir : path, optional
+        A directory shared by the workers (created if missing). Each shard saves its
+        population there (``shardNNNN-<digest>.population``, written atomically: a temporary
+        file renamed over the last) at every multiple of ``checkpoint_every_years`` and at
+        its end; a shard started again (its worker died, or the whole call was killed and
+        made again with the same arguments) goes on from its checkpoint, and a finished one
+        is loaded without running. The digest names the shard's settings, particles,
+        identifiers, ``to_years`` and cadence, so a checkpoint of another run is never
+        resumed. The files are kept after the call (remove the directory to start afresh).
+        ``None``: no checkpoints; a shard whose worker dies starts again from the epoch.
+    checkpoint_every_years : float, optional
+        Years between a shard's checkpoints (> 0); ``None``: only at its end.
+    retries : int
+        Dask retries of a task that raised (a worker's death is rescheduled by Dask in any
+        case, up to its ``distributed.scheduler.allowed-failures``).
 
     Returns
     -------
     Population
-        The merged population, equal bit for bit to ``population_spec.build().advance(to_years)``.
+        The merged population, equal bit for bit to ``population_spec.build().advance(to_years)``,
+        interrupted and resumed or not (a particle's trajectory depends only on its own
+        initial state and the planets' grid, and a stop changes no step).
     """
     n = len(population_spec.particles)
     # Any integer as numpy has them (np.int64, ...), not a float or a bool.
@@ -79,13 +148,33 @@ def run_population_dask(
         count = None
     if count is None or count < 1:
         raise ValueError(f"shards = {shards!r}: must be an integer >= 1")
+    if checkpoint_every_years is not None:
+        every = checkpoint_every_years
+        if isinstance(every, (bool, np.bool_)) or not isinstance(every, (int, float, np.number)) \
+                or not np.isfinite(every) or every <= 0:
+            raise ValueError(
+                f"checkpoint_every_years = {every!r}: must be None or a finite number > 0"
+            )
+        checkpoint_every_years = float(every)
+    if isinstance(retries, (bool, np.bool_)) or not isinstance(retries, (int, np.integer)) or retries < 0:
+        raise ValueError(f"retries = {retries!r}: must be an integer >= 0")
+    to_years = float(to_years)
+    if not np.isfinite(to_years):
+        raise ValueError(f"to_years = {to_years}: must be finite")
+    ckpt_dir = None
+    if checkpoint_dir is not None:
+        ckpt_dir = Path(checkpoint_dir).resolve()
+        ckpt_dir.mkdir(parents=True, exist_ok=True)
     shards = min(count, max(n, 1))
     ids = population_spec.ids
     if ids is None:
         ids = np.arange(n, dtype=np.uint64)
     bounds = np.linspace(0, n, shards + 1).round().astype(int)
+    # A token per call in each task's key, so that a second call over the same checkpoints
+    # reads them again instead of getting results Dask still holds.
+    call = uuid.uuid4().hex[:8]
     futures: List[Any] = []
-    for a, b in zip(bounds[:-1], bounds[1:]):
+    for i, (a, b) in enumerate(zip(bounds[:-1], bounds[1:])):
         part = PopulationSpec(
             **{
                 **population_spec.__dict__,
@@ -93,7 +182,20 @@ def run_population_dask(
                 "ids": np.ascontiguousarray(ids[a:b]),
             }
         )
-        futures.append(client.submit(_run_shard, part, float(to_years), pure=False))
+        digest = _shard_key(part, to_years, checkpoint_every_years)
+        ckpt = None if ckpt_dir is None else str(ckpt_dir / f"shard{i:04d}-{digest}.population")
+        futures.append(
+            client.submit(
+                _run_shard,
+                part,
+                to_years,
+                ckpt,
+                checkpoint_every_years,
+                key=f"partisim-population-shard-{i:04d}-{digest}-{call}",
+                retries=int(retries),
+                pure=False,
+            )
+        )
     return Population.merge(client.gather(futures))
 
 

@@ -2,55 +2,113 @@
 //! planets, against the same initial conditions and end rules integrated by REBOUND's
 //! MERCURIUS.
 //!
-//! The population study `populations/centaurs.toml` (300 comets, barycentric `a` 5.5–30 AU,
-//! `e` 0–0.2, `i` 0–10°, random angles; S2 barycentric map with `B₁ = 4·10⁻⁶`, planets S6 at
-//! 91.3125 d, whose trajectory the map and the encounter mode both read; encounters inside 3
-//! Hill radii by Bulirsch–Stoer at 10⁻¹², handed back to the map beyond 3.5) run through [`symplectic::io::PopulationSpec`] for 200 kyr (quick) or 1 Myr
-//! (`--full`). A comet ends at a
-//! collision with a planet (its equatorial radius), when its barycentric perihelion falls
-//! below 2.5 AU, or when it is unbound beyond 100 AU.
+//! 1,000 Centaurs (`reference-data/centaur-population/initial_1000.csv`: the first 1,000
+//! draws of `symplectic::samples::CENTAURS`, seed 2027, barycentric `a` 5.5–30 AU, `e`
+//! 0–0.2, `i` 0–10°, random angles, as barycentric states at the planets' epoch) run with
+//! the settings of `populations/centaurs.toml` (S2 barycentric map with `B₁ = 4·10⁻⁶`,
+//! planets S6 at 91.3125 d, whose trajectory the map and the encounter mode both read;
+//! encounters inside 3 Hill radii by Bulirsch–Stoer at 10⁻¹², handed back to the map beyond
+//! 3.5) for 50 kyr (quick) or 1 Myr (`--full`, checkpointed every 100 kyr into the output
+//! directory and resumed from there by a run of the same build: `centaur_sample`). A comet
+//! ends at a collision with a planet (its equatorial radius), when its barycentric perihelion
+//! falls below 2.5 AU, or when it is unbound beyond 100 AU.
 //!
-//! Reference: `reference-data/centaur-population/mercurius_ends.csv`, REBOUND 5.2.0 MERCURIUS
-//! (H. Rein, D. M. Hernandez, D. Tamayo et al., "Hybrid symplectic integrators for planetary
-//! dynamics", *MNRAS* 485, 5490–5497 (2019), doi:10.1093/mnras/stz769; `r_crit_hill = 3`,
-//! `dt = 0.1 yr`) on the same 300 initial states with the same end rules over 1 Myr (script
-//! and provenance beside it); quick mode compares both codes censored at its span.
+//! Reference: `reference-data/centaur-population/mercurius_ends_1000.csv`, REBOUND 5.2.2
+//! MERCURIUS (H. Rein, D. M. Hernandez, D. Tamayo et al., "Hybrid symplectic integrators for
+//! planetary dynamics", *MNRAS* 485, 5490–5497 (2019), doi:10.1093/mnras/stz769;
+//! `r_crit_hill = 3`, `dt = 0.1 yr`) on the same 1,000 initial states with the same end rules
+//! over 1 Myr (script and provenance beside it); both codes are censored at the span.
 //!
-//! Single trajectories diverge within a few encounters, so the codes are compared as two
-//! samples of the same distribution: the surviving fraction at a quarter, half, three
-//! quarters and the whole span, and the fractions ended by each rule, by a two-proportion
-//! z-test (pooled binomial standard error of the difference), and the end times of the comets
-//! that ended (their dynamical lifetimes) by the two-sample Kolmogorov–Smirnov test.
-//! Sharing initial conditions correlates the samples only early (before the first
-//! encounters), which narrows the true scatter of the difference: the unpaired tests are
-//! conservative. Each test is two-sided at 0.27 % (`|z| < 3`, KS `p > 0.0027`); over the
-//! eight tests the chance of a false alarm is about 2 %.
+//! **Unpaired tests.** Single trajectories diverge within a few encounters, so the codes are
+//! first compared as two samples of the same distribution: the surviving fraction at a
+//! quarter, half, three quarters and the whole span, and the fractions ended by each rule, by
+//! a two-proportion z-test (pooled binomial standard error of the difference), and the end
+//! times of the comets that ended (their dynamical lifetimes) by the two-sample
+//! Kolmogorov–Smirnov test. Each test is two-sided at 0.27 % (`|z| < 3`, KS `p > 0.0027`);
+//! over the nine tests the chance of a false alarm is about 2.4 %.
 //!
-//! **Power of the q < 2.5 AU test.** For two binomial samples of `n` comets each, fractions
-//! `p` and `p′ = p (1 ± 0.25)` (a 25 % change), the test fails with probability
+//! **Power of the unpaired q < 2.5 AU test.** For two binomial samples of `n` comets each,
+//! fractions `p` and `p′ = p (1 ± 0.25)` (a 25 % change), the test fails with probability
 //! `Φ(|p′ − p|/σ − 3) + Φ(−|p′ − p|/σ − 3)`, `σ = √((p(1 − p) + p′(1 − p′))/n)` (the unpooled
 //! standard error of the difference under the change; the smaller of the two directions is
-//! quoted). With MERCURIUS's fractions (`p` = 43/300 = 0.143 at 200 kyr, 78/300 = 0.26 at 1 Myr
-//! in `mercurius_ends.csv`; 57/1000 = 0.057 at 20 kyr and 92/1000 = 0.092 at 50 kyr in the
-//! 1,000-comet run of the same script, `mercurius_ends_1000.csv`): the quick check (n = 300, 200 kyr) catches a 25 %
-//! change with probability 0.036 and `--full` (n = 300, 1 Myr) with 0.11; n = 1,000 over 1 Myr
-//! gives 0.58 (0.49 at the 1,000-comet run's own 234/1000 = 0.234, `mercurius_ends_1000.csv`,
-//! whose 0.8 needs 1,668 comets). A power of 0.8 (0.9) needs n = 3,102 (3,863) comets over 200 kyr, 1,449
-//! (1,808) over 1 Myr, 5,210 (6,485) over 50 kyr or 8,738 (10,870) over 20 kyr; in comet-years
-//! (each counted until it ends) the shortest of these spans is the cheapest, 1.7·10⁸ at 20 kyr
-//! against 5.3·10⁷ for today's quick check (3.2×). Neither check has that power today: a
-//! change of the fraction by less than about 67 % (quick) or 44 % (`--full`) passes more often
-//! than not.
-
+//! quoted). With MERCURIUS's fractions in `mercurius_ends_1000.csv` (57/1000 at 20 kyr,
+//! 92/1000 at 50 kyr, 234/1000 at 1 Myr): 0.8 needs n = 8,738 comets over 20 kyr, 5,210 over
+//! 50 kyr, 1,668 over 1 Myr; the 1,000 comets have power 0.095 over 50 kyr and 0.49
+//! over 1 Myr.
+//!
+//! **The paired test.** Both codes start the same comet from the same state, so early on a
+//! comet that one code sends below 2.5 AU the other tends to send too: the outcomes are
+//! correlated comet by comet, and McNemar's test on the discordant comets (`b`: only ours
+//! ended by q < 2.5 AU within the span, `c`: only MERCURIUS; `z = (b − c)/√(b + c)`,
+//! two-sided 0.27 %) sees a change of the fraction against the scatter of the discordant
+//! comets only, not of all. A change that adds (removes) `Δ = 0.25 p n` comets at random
+//! moves `b − c` by `Δ` and `b + c` by at most `Δ`, so the check fails with probability at
+//! least `Φ(Δ/√(b + c + Δ) − 3)` (metric "power of the McNemar check", computed from each
+//! run's own `b + c`), and the change caught with 80 % probability solves
+//! `Δ/√(b + c + Δ) = 3 + Φ⁻¹(0.8)` (metric "change … the McNemar check catches with 80 %
+//! probability").
+//!
+//! **The correlation, measured** (the `--full` run of 2026-12-05 below, each code's ends
+//! censored at the span; `φ` the correlation of the two codes' outcomes comet by comet;
+//! powers against a 25 % change; the comets a paired check at that span would need for 0.8,
+//! from that span's `p` and `(b + c)/n`, and their cost in comet-years, each comet counted
+//! until it ends, and in our wall time at the `--full` run's 1.1·10⁶ comet-years per second
+//! on 2 threads):
+//!
+//! | span | ours | MERCURIUS | both | b | c | φ | paired power | unpaired | comets for 0.8 | comet-years | ours (s) |
+//! | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |
+//! | 5 kyr | 29 | 28 | 8 | 21 | 20 | 0.26 | 0.023 | 0.018 | 14,457 | 7.1·10⁷ | 65 |
+//! | 10 kyr | 39 | 40 | 10 | 29 | 30 | 0.22 | 0.036 | 0.027 | 10,183 | 9.9·10⁷ | 90 |
+//! | 20 kyr | 58 | 57 | 20 | 38 | 37 | 0.31 | 0.068 | 0.045 | 6,486 | 1.3·10⁸ | 113 |
+//! | **50 kyr** | 94 | 92 | 40 | 54 | 52 | 0.37 | **0.165** | 0.095 | 3,599 | 1.7·10⁸ | 153 |
+//! | 100 kyr | 117 | 122 | 56 | 61 | 66 | 0.40 | 0.284 | 0.155 | 2,499 | 2.3·10⁸ | 207 |
+//! | 200 kyr | 145 | 147 | 71 | 74 | 76 | 0.40 | 0.378 | 0.216 | 2,041 | 3.6·10⁸ | 326 |
+//! | **1 Myr** | 239 | 234 | 118 | 121 | 116 | 0.34 | **0.657** | 0.491 | 1,274 | 9.8·10⁸ | 893 |
+//!
+//! The outcomes are correlated (`φ` 0.2–0.4), not enough to make 1,000 comets decisive: the
+//! paired test needs a third to a half of the unpaired test's comets. **No design within the
+//! quick budget that the existing references allow reaches a 25 % change.** The quick mode
+//! (about a minute: 1,000 comets over 50 kyr, 4.7·10⁷ comet-years, the most the 1,000-comet
+//! reference allows in that time) catches with 80 % probability a change of about 52 % (power
+//! 0.165 against 25 %; the 300 comets over 200 kyr before caught 67 %); `--full` (1 Myr)
+//! catches about 29 % (power 0.66 against 25 %; 0.8 would need 1,274 comets). A shorter span
+//! with more comets is cheaper per unit of power: 0.8 against 25 % at 5 kyr needs about
+//! 14,500 comets, 7.1·10⁷ comet-years, about 65 s here, but a MERCURIUS reference of those
+//! comets over 5 kyr that does not exist yet (and these figures come from 28 and 41 events,
+//! uncertain by some 20 %); it would also judge only the earliest q < 2.5 AU ends, those of
+//! comets that start on Jupiter-crossing orbits.
+//!
+//! **`--full`, measured** (2026-12-05, 18:36–18:48 UTC, `validation run --full --only
+//! centaur-population`, 2 rayon threads, under the build lock on the shared 2-core machine:
+//! 700.9 s of wall time, 1,349 s of CPU; 230,332 switches to the encounter integrator, 230
+//! per comet): passes 10/10. Surviving at 250, 500, 750 kyr and 1 Myr: 820/821, 752/770,
+//! 713/729, 685/696 (ours/MERCURIUS; z = −0.06, −0.94, −0.80, −0.53); ended by q < 2.5 AU
+//! 239/234 (z = 0.26), ejected 73/62 (0.98), collided with a planet 3/8 (−1.51: ours 3 with
+//! Jupiter; MERCURIUS 4 with Jupiter, 2 with Neptune, 1 with Saturn and with Uranus);
+//! McNemar `b` = 121, `c` = 116, z = 0.32; KS of the lifetimes D = 0.052, p = 0.79; no other
+//! end.
+//!
+//! **Quick, measured** (2026-12-05, 19:11 UTC, the same build and machine, 2 threads): 47.3 s
+//! (the 300 comets over 200 kyr before: 61 s), passes 10/10. Surviving at 12.5, 25, 37.5 and
+//! 50 kyr: 955/955, 931/931, 915/913, 899/901 (z = 0, 0, 0.16, −0.15); q < 2.5 AU 94/92
+//! (0.15), ejected 6/2 (1.42), collided 1/5 (−1.64); McNemar `b` = 54, `c` = 52, z = 0.19
+//! (the `--full` run's ends censored at 50 kyr give the same counts); KS D = 0.068, p = 0.97;
+//! 29,159 switches. Power of the McNemar check against a 25 % change 0.165; it catches 52 %
+//! with 80 % probability.
+//!
+//! On Dask: `benches/scripts/centaurs_dask.py` runs the same 1,000 comets with
+//! `partisim.dask.run_population_dask` (chunks of comets, each checkpointed atomically and
+//! resumed); on 2 workers over 50 kyr it took 53.0 s and its ends equal this experiment's, all
+//! 1,000, bit for bit (`docs/performance.md`).
 use anyhow::{bail, Result};
-use symplectic::io::{status_label, PopulationSpec};
 
+use super::centaur_sample::{censor, run_ours, Ends};
 use super::comet_population::z_two_proportions;
 use crate::helpers::solar_system::DAYS_PER_YEAR;
 use crate::helpers::{
     load_reference_csv, plot_xy, write_csv_rows, Legend, Marker, PlotSpec, Series, SeriesStyle,
 };
-use crate::{workspace_root, Check, Context, Experiment, Outcome};
+use crate::{Check, Context, Experiment, Outcome};
 
 /// The experiment.
 pub struct CentaurPopulation;
@@ -59,49 +117,85 @@ pub struct CentaurPopulation;
 const Z_MAX: f64 = 3.0;
 /// Smallest p-value of the Kolmogorov–Smirnov test (the same two-sided 0.27 %).
 const P_MIN: f64 = 0.0027;
+/// MERCURIUS's ends of the comets of [`super::centaur_sample::INITIAL_STATES`] over 1 Myr.
+const REFERENCE_ENDS: &str = "centaur-population/mercurius_ends_1000.csv";
+/// The quick mode's span (years; module docs: the paired test's power against its cost).
+const QUICK_SPAN_YEARS: f64 = 50_000.0;
+/// The full mode's span (years).
+const FULL_SPAN_YEARS: f64 = 1_000_000.0;
+/// The full mode's checkpoint cadence (years of simulated time).
+const FULL_CHECKPOINT_YEARS: f64 = 100_000.0;
 
-/// How a comet ended: the label (`active`, `perihelion`, `ejected`, `collision_<planet>`,
-/// anything else from our code) and the time in years (∞ if active at the span's end).
-type Ends = Vec<(String, f64)>;
+/// McNemar's statistic for paired binary outcomes, `z = (b − c)/√(b + c)` with `b` the
+/// comets where only `ours` holds, `c` those where only `theirs` does (Q. McNemar, "Note on
+/// the sampling error of the difference between correlated proportions or percentages",
+/// *Psychometrika* 12, 153–157 (1947)); 0 without discordant pairs. Also `(b, c)`.
+fn mcnemar_z(ours: &[bool], theirs: &[bool]) -> (f64, usize, usize) {
+    let b = ours.iter().zip(theirs).filter(|(o, t)| **o && !**t).count();
+    let c = ours.iter().zip(theirs).filter(|(o, t)| !**o && **t).count();
+    let z = if b + c == 0 {
+        0.0
+    } else {
+        (b as f64 - c as f64) / ((b + c) as f64).sqrt()
+    };
+    (z, b, c)
+}
+
+/// The standard normal distribution function `Φ(x) = erfc(−x/√2)/2`, with `erfc` by the
+/// Chebyshev fit of W. H. Press et al., *Numerical Recipes*, 3rd ed., Cambridge 2007, §6.2
+/// (`erfccheb`'s predecessor `erfcc`: fractional error below 1.2·10⁻⁷ everywhere).
+fn normal_cdf(x: f64) -> f64 {
+    let z = x.abs() / std::f64::consts::SQRT_2;
+    let t = 1.0 / (1.0 + 0.5 * z);
+    let poly = [
+        -1.265_512_23,
+        1.000_023_68,
+        0.374_091_96,
+        0.096_784_18,
+        -0.186_288_06,
+        0.278_868_07,
+        -1.135_203_98,
+        1.488_515_87,
+        -0.822_152_23,
+        0.170_872_77,
+    ];
+    let series = poly.iter().rev().fold(0.0, |acc, c| acc * t + c);
+    let erfc = t * (-z * z + series).exp();
+    if x >= 0.0 {
+        1.0 - 0.5 * erfc
+    } else {
+        0.5 * erfc
+    }
+}
+
+/// The probability that McNemar's check (`|z| < Z_MAX`) fails when our code ends
+/// `shift` more (or fewer) comets by q < 2.5 AU than it does, the added or lost comets
+/// drawn at random among the others: `b − c` moves by `shift`, `b + c` to at most
+/// `discordant + shift`, so the power is at least `Φ(shift/√(discordant + shift) − Z_MAX)`
+/// (the far tail, below 10⁻³, left out).
+fn mcnemar_power(discordant: usize, shift: f64) -> f64 {
+    normal_cdf(shift / (discordant as f64 + shift).sqrt() - Z_MAX)
+}
+
+/// `Φ⁻¹(0.8)`, the standard normal quantile of 80 % (Abramowitz & Stegun, Table 26.5).
+const Z_POWER_80: f64 = 0.841_621;
+
+/// The relative change of a count `reference` that McNemar's check catches with 80 %
+/// probability ([`mcnemar_power`] = 0.8): the shift `Δ` solving `Δ/√(d + Δ) = Z_MAX + z₀.₈`,
+/// `Δ = (k² + √(k⁴ + 4k²d))/2` with `k = Z_MAX + z₀.₈`, over `reference`.
+fn mcnemar_change_at_80(discordant: usize, reference: usize) -> f64 {
+    let k2 = (Z_MAX + Z_POWER_80).powi(2);
+    let shift = (k2 + (k2 * k2 + 4.0 * k2 * discordant as f64).sqrt()) / 2.0;
+    shift / reference as f64
+}
 
 /// A named end rule: which labels it counts.
 type Rule = (&'static str, fn(&str) -> bool);
 
-/// Our ends, and the switches to the encounter integrator of all comets
-/// (`PopulationProgress::encounters_begun`).
-fn run_ours(ctx: &Context, span_years: f64) -> Result<(Ends, u64)> {
-    let path = workspace_root().join("populations/centaurs.toml");
-    let spec = PopulationSpec::from_file(&path)?;
-    let mut population = spec.population(&path)?;
-    ctx.progress.set_length(span_years as u64);
-    let progress = population.advance_to(span_years * DAYS_PER_YEAR, |p| {
-        ctx.progress.set_position((p.time / DAYS_PER_YEAR) as u64)
-    })?;
-    let planets = population.ephemeris().planets().clone();
-    let ends = population
-        .members()
-        .iter()
-        .map(|m| {
-            let (label, t) = status_label(&m.status, &planets);
-            censor(label, t / DAYS_PER_YEAR, span_years)
-        })
-        .collect();
-    Ok((ends, progress.encounters_begun))
-}
-
-/// An end after `span` years counts as active (both codes are compared over the same span).
-fn censor(label: String, years: f64, span: f64) -> (String, f64) {
-    if label == "active" || years > span {
-        ("active".into(), f64::INFINITY)
-    } else {
-        (label, years)
-    }
-}
-
 fn reference(ctx: &Context, span_years: f64) -> Result<Ends> {
     let table = load_reference_csv(
         ctx,
-        "centaur-population/mercurius_ends.csv",
+        REFERENCE_ENDS,
         &["id", "end", "end_time_days", "planet"],
     )?;
     (0..table.len())
@@ -111,6 +205,12 @@ fn reference(ctx: &Context, span_years: f64) -> Result<Ends> {
                 "active" => f64::INFINITY,
                 _ => table.number(i, "end_time_days")? / DAYS_PER_YEAR,
             };
+            if table.number(i, "id")? != i as f64 {
+                bail!(
+                    "{REFERENCE_ENDS}: row {} is not comet {i} (rows in id order expected)",
+                    i + 2
+                );
+            }
             Ok(censor(label, t, span_years))
         })
         .collect()
@@ -213,8 +313,10 @@ impl Experiment for CentaurPopulation {
     }
 
     fn run(&self, ctx: &mut Context) -> Result<Outcome> {
-        let span = ctx.mode.pick(200_000.0, 1_000_000.0);
-        let (ours, encounters_begun) = run_ours(ctx, span)?;
+        let span = ctx.mode.pick(QUICK_SPAN_YEARS, FULL_SPAN_YEARS);
+        let checkpoints = ctx.mode.pick(None, Some(FULL_CHECKPOINT_YEARS));
+        let run = run_ours(ctx, span, checkpoints)?;
+        let (ours, encounters_begun) = (run.ends, run.encounters_begun);
         let reference = reference(ctx, span)?;
         if ours.len() != reference.len() {
             bail!(
@@ -266,6 +368,27 @@ impl Experiment for CentaurPopulation {
                 count(&reference, which),
             );
         }
+        // The same comets from the same states: paired, comet by comet (module docs).
+        let flags = |e: &Ends| -> Vec<bool> { e.iter().map(|(l, _)| l == "perihelion").collect() };
+        let (z, b, c) = mcnemar_z(&flags(&ours), &flags(&reference));
+        out.metric("q < 2.5 AU: comets only ours ended so (b)", b as f64);
+        out.metric("q < 2.5 AU: comets only MERCURIUS ended so (c)", c as f64);
+        // A 25 % change of the fraction MERCURIUS finds, at this run's discordance.
+        let theirs = count(&reference, |l| l == "perihelion").0;
+        out.metric(
+            "power of the McNemar check against a 25 % change of the q < 2.5 AU fraction",
+            mcnemar_power(b + c, 0.25 * theirs as f64),
+        );
+        out.metric(
+            "change of the q < 2.5 AU fraction the McNemar check catches with 80 % probability",
+            mcnemar_change_at_80(b + c, theirs),
+        );
+        out.check(Check::less_than(
+            "|z| McNemar, ended by q < 2.5 AU, paired by comet",
+            z.abs(),
+            Z_MAX,
+            "McNemar's test on the discordant comets against REBOUND MERCURIUS from the same initial states, two-sided 0.27 % (module docs: its power)",
+        ));
         write_csv_rows(
             &ctx.path("fractions.csv"),
             &["statistic", "ours", "mercurius", "comets", "z"],
@@ -327,6 +450,9 @@ impl Experiment for CentaurPopulation {
             encounters_begun as f64,
         );
         out.metric("span (years)", span);
+        if let Some(t) = run.resumed_from_years {
+            out.metric("resumed from a checkpoint at (years)", t);
+        }
         write_csv_rows(
             &ctx.path("ours_ends.csv"),
             &["id", "end", "end_time_years"],
@@ -352,6 +478,39 @@ mod tests {
         let ne_sqrt = (n as f64 / 2.0).sqrt();
         assert!((ks_p_value(1.358 / ne_sqrt, n, n) - 0.050).abs() < 1e-3);
         assert!((ks_p_value(1.628 / ne_sqrt, n, n) - 0.010).abs() < 3e-4);
+    }
+
+    #[test]
+    fn normal_cdf_matches_the_table() {
+        // Φ(1.959964) = 0.975, Φ(−3) = 0.0013499, Φ(0) = 0.5 (Abramowitz & Stegun, Table
+        // 26.1); the fit's fractional error of 1.2e-7 (Numerical Recipes) sets the tolerance.
+        assert!((normal_cdf(1.959_964) - 0.975).abs() < 1e-6);
+        assert!((normal_cdf(-3.0) - 0.001_349_9).abs() < 1e-7);
+        assert!((normal_cdf(0.0) - 0.5).abs() < 1e-7);
+    }
+
+    #[test]
+    fn mcnemar_counts_only_the_discordant_pairs() {
+        // By hand: pairs (T,T), (T,F), (T,F), (F,T), (F,F): b = 2, c = 1, z = 1/√3.
+        let ours = [true, true, true, false, false];
+        let theirs = [true, false, false, true, false];
+        let (z, b, c) = mcnemar_z(&ours, &theirs);
+        assert_eq!((b, c), (2, 1));
+        assert!((z - 1.0 / 3f64.sqrt()).abs() < 1e-15);
+        assert_eq!(mcnemar_z(&ours, &ours).0, 0.0);
+    }
+
+    #[test]
+    fn the_change_caught_at_80_percent_has_that_power() {
+        // The inverse of mcnemar_power: at the shift it returns, the power is 0.8 (to the
+        // 1e-6 of the quantile's six digits and the fit of normal_cdf).
+        for (d, m) in [(106, 92), (237, 234), (0, 10)] {
+            let x = mcnemar_change_at_80(d, m);
+            assert!(
+                (mcnemar_power(d, x * m as f64) - 0.8).abs() < 1e-5,
+                "{d} {m}"
+            );
+        }
     }
 
     #[test]

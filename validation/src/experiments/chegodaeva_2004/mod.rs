@@ -3,6 +3,7 @@
 //! populations of comets on their own clocks, and comets through close encounters.
 
 pub mod centaur_population;
+mod centaur_sample;
 pub mod comet_encounters;
 pub mod comet_population;
 pub mod symplectic_100myr;
