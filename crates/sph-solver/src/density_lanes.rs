@@ -135,7 +135,16 @@ mod tests {
             let cubic = CubicSpline::new(h).unwrap();
             let mut out = vec![0.0f32; x.len()];
             let mut packed = Packed::default();
-            densities_at(&cubic, 1000.0, &x, &m, nb.lists(), None, &mut packed, &mut out);
+            densities_at(
+                &cubic,
+                1000.0,
+                &x,
+                &m,
+                nb.lists(),
+                None,
+                &mut packed,
+                &mut out,
+            );
             for (i, rho) in out.iter().enumerate() {
                 let want = density_at(&cubic, 1000.0, &x, &m, nb.lists(), None, i);
                 let list = nb.lists().neighbours(i);
@@ -156,7 +165,16 @@ mod tests {
                 );
             }
             let poly6 = Poly6::new(h).unwrap();
-            densities_at(&poly6, 1000.0, &x, &m, nb.lists(), None, &mut packed, &mut out);
+            densities_at(
+                &poly6,
+                1000.0,
+                &x,
+                &m,
+                nb.lists(),
+                None,
+                &mut packed,
+                &mut out,
+            );
             for (i, rho) in out.iter().enumerate() {
                 let want = density_at(&poly6, 1000.0, &x, &m, nb.lists(), None, i);
                 assert_eq!(rho.to_bits(), want.to_bits(), "Poly6, particle {i}");
