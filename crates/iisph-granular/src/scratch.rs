@@ -137,3 +137,61 @@ impl<R: Real> Scratch<R> {
         self.error_partials.resize(n.div_ceil(REDUCE_CHUNK), 0.0);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use sph_core::{Sdf, Vec3};
+    use sph_solver::boundary::BoundarySample;
+    use sph_solver::Boundary;
+
+    use super::SampleCache;
+
+    /// A boundary whose sample encodes where it was taken (`Ψ = x + 2y + 4z`).
+    struct Ramp;
+
+    impl Boundary<f32> for Ramp {
+        fn name(&self) -> &'static str {
+            "ramp"
+        }
+        fn solids(&self) -> &[Box<dyn Sdf<f32>>] {
+            &[]
+        }
+        fn has_volume(&self) -> bool {
+            true
+        }
+        fn volume_kernel(&self) -> Option<(sph_kernels::KernelKind, f32)> {
+            None
+        }
+        fn sample(&self, x: &Vec3<f32>) -> BoundarySample<f32> {
+            BoundarySample {
+                volume: x.x + 2.0 * x.y + 4.0 * x.z,
+                volume_gradient: Vec3::new(1.0, 2.0, 4.0),
+            }
+        }
+        fn project(&self, x: Vec3<f32>) -> Vec3<f32> {
+            x
+        }
+        fn contact_distance(&self) -> f32 {
+            0.0
+        }
+    }
+
+    /// An entry counts only at the very bits sampled: the same position gives the query's
+    /// sample, a moved particle, `−0` for `+0`, another index or a cleared cache give none.
+    #[test]
+    fn samples_are_reused_only_at_the_sampled_bits() {
+        let x = vec![Vec3::new(0.0f32, 1.0, 2.0), Vec3::new(0.5, 0.25, 0.0)];
+        let mut cache = SampleCache::default();
+        cache.fill(&x, &Ramp);
+        for (i, p) in x.iter().enumerate() {
+            assert_eq!(cache.get(i, p), Some(Ramp.sample(p)));
+        }
+        assert_eq!(cache.get(1, &Vec3::new(0.5, 0.25, -0.0)), None);
+        let moved = Vec3::new(0.5, 0.25f32.next_up(), 0.0);
+        assert_eq!(cache.get(1, &moved), None);
+        assert_eq!(cache.get(0, &x[1]), None);
+        assert_eq!(cache.get(2, &x[1]), None);
+        cache.clear();
+        assert_eq!(cache.get(0, &x[0]), None);
+    }
+}
