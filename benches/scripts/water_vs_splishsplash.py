@@ -119,7 +119,8 @@ def peer(method, steps, threads, out_dir):
     env = dict(os.environ, OMP_NUM_THREADS=str(threads), LD_PRELOAD=GL_DISPATCH)
     cmd = [sys.executable, __file__, "--peer", method, "--steps", str(steps), "--out", out_dir]
     out = subprocess.run(cmd, env=env, capture_output=True, text=True, check=True).stdout
-    return json.loads(out.strip().splitlines()[-1])
+    # The peer prints its timers after the JSON line.
+    return json.loads(next(line for line in out.splitlines() if line.startswith("{")))
 
 
 def ours(method, steps, threads, examples):
