@@ -13,6 +13,10 @@
 //! SPlisHSPlasH's `boundaryHandlingMethod` 2; the map's build time is printed and not
 //! counted in the time per step.
 //!
+//! `particles=N` stacks the block into a taller column of `N` particles (the lattice
+//! continued upwards, lowest layers first, the top layer partial): the real-time figure at
+//! `particles=100000` (a column about 1 × 1.67 × 1 m in the same tank).
+//!
 //! `unilateral` (PBF) switches to SPlisHSPlasH's form of the constraint: `max(C_i, 0)`,
 //! `ε = 10⁻⁶ m⁻²`, no artificial pressure and its particle mass `0.8 ρ0 (2r)³`, instead of
 //! the paper's defaults.
@@ -21,8 +25,9 @@
 //! SimStep"), the mean iteration count, the phase breakdown and the density error at the
 //! end. SPlisHSPlasH is run on
 //! the same scene with its PBF solver (`simulationMethod` 2, iterating to 0.1 % mean density
-//! error, 2–100 iterations, boundary particles of Akinci et al. 2012) by a script kept
-//! outside the repository (`pip install pysplishsplash==2.19.0` in a throwaway venv); its
+//! error, 2–100 iterations, boundary particles of Akinci et al. 2012, or volume maps) by
+//! `benches/scripts/water_vs_splishsplash.py` (`pip install pysplishsplash==2.19.0` in a
+//! throwaway venv); its
 //! mean iteration count is what to pass as ITERATIONS for an iteration-matched comparison,
 //! and `tol=0.001` gives the accuracy-matched one (same stopping rule and tolerance; the
 //! density it measures differs in that SPlisHSPlasH's includes its boundary particles).
@@ -36,6 +41,24 @@ use pcisph::{Pcisph, PcisphParams};
 use sph_core::{BoxSdf, Inverted};
 use sph_kernels::KernelKind;
 use sph_solver::boundary::{VolumeMapBoundary, VolumeMapOptions};
+
+/// The first `n` particles, lowest first, of the block `p` (39 layers at spacing 0.025 m)
+/// repeated upwards every 39 layers, so that the lattice continues without a seam.
+fn taller_column(p: Vec<sph_core::Vec3<f32>>, n: usize) -> Vec<sph_core::Vec3<f32>> {
+    let layers_height = 39.0 * 0.025;
+    let mut column = p.clone();
+    for copy in 1..n.div_ceil(p.len()) {
+        let shift = sph_core::Vec3::new(0.0, copy as f32 * layers_height, 0.0);
+        column.extend(p.iter().map(|x| x + shift));
+    }
+    column.sort_by(|a, b| {
+        (a.y.total_cmp(&b.y))
+            .then(a.x.total_cmp(&b.x))
+            .then(a.z.total_cmp(&b.z))
+    });
+    column.truncate(n);
+    column
+}
 
 /// The walls: SDF collision at the particle radius, or volume maps of Poly6 at `h`.
 fn walls(
@@ -72,7 +95,10 @@ fn main() {
         None => iter_arg.parse().unwrap_or(5),
     };
     let which = args.get(2).map_or("pbf", String::as_str);
-    let (p, tank) = benches::dam_break_fluid::<f32>();
+    let (mut p, tank) = benches::dam_break_fluid::<f32>();
+    if let Some(n) = args.iter().find_map(|a| a.strip_prefix("particles=")) {
+        p = taller_column(p, n.parse().expect("particles=N: a count"));
+    }
     let unilateral = args.iter().any(|a| a == "unilateral");
     let volume_map = args.iter().any(|a| a == "volume-map");
     // SPlisHSPlasH's particle volume is 0.8 (2r)³ (`FluidModel`), so its lattice starts

@@ -56,7 +56,7 @@ pub(crate) fn density_pass<R: Real>(
     if lanes.is_some() {
         s.packed.fill(x, m);
     }
-    let packed = &s.packed;
+    let (packed, cached) = (&s.packed, &s.end_samples);
     let outputs = (
         (&mut s.density[..], &mut s.bgrad[..], &mut s.grad_sum[..]),
         (&mut s.aii[..], &mut s.occlusion[..]),
@@ -115,7 +115,7 @@ pub(crate) fn density_pass<R: Real>(
                 };
                 *occ_out = occlusion_of_cosine(max_cos, c.cos_cone);
                 if let Some(b) = volume {
-                    let smp = b.sample(&xi);
+                    let smp = cached.get(i, &xi).unwrap_or_else(|| b.sample(&xi));
                     sum += c.rho0 * smp.volume;
                     *bg = smp.volume_gradient;
                 } else {

@@ -1,7 +1,10 @@
 //! The per-particle working arrays of the solver.
 
+use rayon::prelude::*;
 use sph_core::{Real, Vec3};
-use sph_solver::step::REDUCE_CHUNK;
+use sph_solver::boundary::BoundarySample;
+use sph_solver::step::{MIN_LEN, REDUCE_CHUNK};
+use sph_solver::Boundary;
 
 use crate::granular::Sym3;
 
@@ -57,6 +60,55 @@ pub(crate) struct Scratch<R: Real> {
     pub perm_scalar: Vec<R>,
     /// The step's positions and masses packed for the lanes (filled only when they run).
     pub packed: sph_solver::pair_lanes::Packed,
+    /// The volume boundary's samples at the end-of-step positions, for the next step's
+    /// density pass.
+    pub end_samples: SampleCache<R>,
+}
+
+/// A volume boundary's samples `Ψ`, `∇Ψ` at the positions of the end of a step, which the
+/// next step's density pass reuses instead of querying the boundary again at the same
+/// positions (one query per particle and step instead of two). An entry counts only where
+/// the particle's position is bit for bit the one sampled, so a reorder, an edit of the
+/// state between steps or a change of the particle count falls back to a fresh query; the
+/// boundary of a solver is fixed, so a reused sample is the one a query would return.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct SampleCache<R: Real> {
+    /// The positions sampled.
+    positions: Vec<Vec3<R>>,
+    /// The boundary's sample at each.
+    samples: Vec<BoundarySample<R>>,
+}
+
+impl<R: Real> SampleCache<R> {
+    /// Samples `boundary` at every position of `x`, in parallel, replacing the entries.
+    pub(crate) fn fill(&mut self, x: &[Vec3<R>], boundary: &dyn Boundary<R>) {
+        self.positions.clear();
+        self.positions.extend_from_slice(x);
+        self.samples.resize(x.len(), BoundarySample::default());
+        self.samples
+            .par_iter_mut()
+            .zip(x.par_iter())
+            .with_min_len(MIN_LEN)
+            .for_each(|(s, p)| *s = boundary.sample(p));
+    }
+
+    /// The sample of particle `i` if it was taken at `x` exactly (the same bits).
+    #[inline]
+    pub(crate) fn get(&self, i: usize, x: &Vec3<R>) -> Option<BoundarySample<R>> {
+        let at = self.positions.get(i)?;
+        let same = (0..3).all(|a| at[a].as_f64().to_bits() == x[a].as_f64().to_bits());
+        same.then(|| self.samples[i])
+    }
+
+    /// The samples, one per position of the last [`SampleCache::fill`].
+    pub(crate) fn samples(&self) -> &[BoundarySample<R>] {
+        &self.samples
+    }
+
+    /// Forgets every entry (keeps the storage).
+    pub(crate) fn clear(&mut self) {
+        self.positions.clear();
+    }
 }
 
 impl<R: Real> Scratch<R> {
@@ -83,5 +135,63 @@ impl<R: Real> Scratch<R> {
         self.v_new.resize(n, z);
         self.density_new.resize(n, R::zero());
         self.error_partials.resize(n.div_ceil(REDUCE_CHUNK), 0.0);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use sph_core::{Sdf, Vec3};
+    use sph_solver::boundary::BoundarySample;
+    use sph_solver::Boundary;
+
+    use super::SampleCache;
+
+    /// A boundary whose sample encodes where it was taken (`Ψ = x + 2y + 4z`).
+    struct Ramp;
+
+    impl Boundary<f32> for Ramp {
+        fn name(&self) -> &'static str {
+            "ramp"
+        }
+        fn solids(&self) -> &[Box<dyn Sdf<f32>>] {
+            &[]
+        }
+        fn has_volume(&self) -> bool {
+            true
+        }
+        fn volume_kernel(&self) -> Option<(sph_kernels::KernelKind, f32)> {
+            None
+        }
+        fn sample(&self, x: &Vec3<f32>) -> BoundarySample<f32> {
+            BoundarySample {
+                volume: x.x + 2.0 * x.y + 4.0 * x.z,
+                volume_gradient: Vec3::new(1.0, 2.0, 4.0),
+            }
+        }
+        fn project(&self, x: Vec3<f32>) -> Vec3<f32> {
+            x
+        }
+        fn contact_distance(&self) -> f32 {
+            0.0
+        }
+    }
+
+    /// An entry counts only at the very bits sampled: the same position gives the query's
+    /// sample, a moved particle, `−0` for `+0`, another index or a cleared cache give none.
+    #[test]
+    fn samples_are_reused_only_at_the_sampled_bits() {
+        let x = vec![Vec3::new(0.0f32, 1.0, 2.0), Vec3::new(0.5, 0.25, 0.0)];
+        let mut cache = SampleCache::default();
+        cache.fill(&x, &Ramp);
+        for (i, p) in x.iter().enumerate() {
+            assert_eq!(cache.get(i, p), Some(Ramp.sample(p)));
+        }
+        assert_eq!(cache.get(1, &Vec3::new(0.5, 0.25, -0.0)), None);
+        let moved = Vec3::new(0.5, 0.25f32.next_up(), 0.0);
+        assert_eq!(cache.get(1, &moved), None);
+        assert_eq!(cache.get(0, &x[1]), None);
+        assert_eq!(cache.get(2, &x[1]), None);
+        cache.clear();
+        assert_eq!(cache.get(0, &x[0]), None);
     }
 }

@@ -472,9 +472,22 @@ impl<R: Real> IisphScheme<R> {
                 &s.x_new,
                 m,
                 nb,
-                volume,
+                None,
+                &mut s.packed,
                 &mut s.density_new,
             );
+            // The boundary's term, sampled once: the next step's density pass reuses the
+            // samples at these positions.
+            match volume {
+                Some(b) => {
+                    s.end_samples.fill(&s.x_new, b);
+                    let samples = s.end_samples.samples();
+                    for (rho, smp) in s.density_new.iter_mut().zip(samples) {
+                        *rho += c.rho0 * smp.volume;
+                    }
+                }
+                None => s.end_samples.clear(),
+            }
         }
         check_divergence(at, &s.x_new, &s.v_new, &*self.parts.boundary, h)?;
         state.positions.copy_from_slice(&s.x_new);

@@ -203,6 +203,31 @@ impl CubicLanes {
     }
 }
 
+impl CubicLanes {
+    /// Particle `i`'s density `m_i W(0) + Σ_j m_j W_ij` alone (no boundary term), the
+    /// pairs' terms as [`CubicLanes::density_gradient`] computes them.
+    ///
+    /// # Panics
+    /// When the lists are not of the packed particles.
+    pub fn density<R: Real>(&self, packed: &Packed, nb: &NeighbourLists, i: usize) -> R {
+        let list = nb.neighbours(i);
+        assert_eq!(
+            nb.offsets().len(),
+            packed.len() + 1,
+            "lists of other particles"
+        );
+        #[cfg(target_arch = "x86_64")]
+        {
+            // SAFETY: as in `density_gradient` (no per-pair output here).
+            let s = unsafe { avx512::density(self, packed.values(), i, list) };
+            let r = |v: f32| R::of_f64(v as f64);
+            r(packed.values()[4 * i + 3]) * r(self.k) + r(s)
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        unreachable!("no lane constants off x86_64")
+    }
+}
+
 /// The loads the solvers' lane kernels share: sixteen pairs of one particle from the packed
 /// positions and masses, and gathers of other per-particle fields.
 #[cfg(target_arch = "x86_64")]
@@ -292,6 +317,72 @@ pub mod avx512 {
         _mm512_mask_i32gather_ps::<4>(_mm512_setzero_ps(), p.live, p.j, values.as_ptr().cast())
     }
 
+    /// The cubic spline's `W(r)` and `W'(r)` per lane, each pair's operations in the
+    /// scalar kernel's order (`q = r · (1/h)`, `t = 1 − q`; the two pieces selected by
+    /// masks; 0 for `r ≥ h` or `t ≤ 0`, ordered comparisons so that NaN propagates as in
+    /// the scalar code).
+    ///
+    /// # Safety
+    /// avx512f.
+    #[target_feature(enable = "avx512f")]
+    #[inline]
+    unsafe fn cubic(c: &CubicLanes, r: __m512) -> (__m512, __m512) {
+        let zero = _mm512_setzero_ps();
+        let (one, half, two, three, six) = (
+            _mm512_set1_ps(1.0),
+            _mm512_set1_ps(0.5),
+            _mm512_set1_ps(2.0),
+            _mm512_set1_ps(3.0),
+            _mm512_set1_ps(6.0),
+        );
+        let q = _mm512_mul_ps(r, _mm512_set1_ps(c.inv_h));
+        let t = _mm512_sub_ps(one, q);
+        let outside = _mm512_cmp_ps_mask::<_CMP_GE_OQ>(r, _mm512_set1_ps(c.h))
+            | _mm512_cmp_ps_mask::<_CMP_LE_OQ>(t, zero);
+        let near = _mm512_cmp_ps_mask::<_CMP_LE_OQ>(q, half);
+        // f: 1 + ((6q)q)(q − 1) near, ((2t)t)t far; f': (6q)((3q) − 2), ((−6)t)t.
+        let f_near = _mm512_add_ps(
+            one,
+            _mm512_mul_ps(
+                _mm512_mul_ps(_mm512_mul_ps(six, q), q),
+                _mm512_sub_ps(q, one),
+            ),
+        );
+        let f_far = _mm512_mul_ps(_mm512_mul_ps(_mm512_mul_ps(two, t), t), t);
+        let df_near = _mm512_mul_ps(
+            _mm512_mul_ps(six, q),
+            _mm512_sub_ps(_mm512_mul_ps(three, q), two),
+        );
+        let df_far = _mm512_mul_ps(_mm512_mul_ps(_mm512_set1_ps(-6.0), t), t);
+        let w = _mm512_mul_ps(
+            _mm512_set1_ps(c.k),
+            _mm512_mask_blend_ps(near, f_far, f_near),
+        );
+        let dw = _mm512_mul_ps(
+            _mm512_set1_ps(c.k_h),
+            _mm512_mask_blend_ps(near, df_far, df_near),
+        );
+        (
+            _mm512_mask_blend_ps(outside, w, zero),
+            _mm512_mask_blend_ps(outside, dw, zero),
+        )
+    }
+
+    /// The lane sum `Σ m_j W_ij` of particle `i`.
+    ///
+    /// # Safety
+    /// avx512f; `xm` holds `4n` packed values, `i < n`.
+    #[target_feature(enable = "avx512f")]
+    pub(super) unsafe fn density(c: &CubicLanes, xm: &[f32], i: usize, list: &[u32]) -> f32 {
+        let mut acc = _mm512_setzero_ps();
+        for s in (0..list.len()).step_by(16) {
+            let p = pairs(xm, i, list, s);
+            let (w, _) = cubic(c, _mm512_sqrt_ps(p.r2));
+            acc = _mm512_mask_add_ps(acc, p.live, acc, _mm512_mul_ps(p.mj, w));
+        }
+        _mm512_reduce_add_ps(acc)
+    }
+
     /// The lane sums `[Σ m_j W, Σ m_j ∇W_x, … y, … z, Σ m_j |∇W|²]` of particle `i`.
     ///
     /// # Safety
@@ -305,49 +396,13 @@ pub mod avx512 {
         gs: &mut [f32],
     ) -> [f32; 5] {
         let zero = _mm512_setzero_ps();
-        let (one, half, two, three, six) = (
-            _mm512_set1_ps(1.0),
-            _mm512_set1_ps(0.5),
-            _mm512_set1_ps(2.0),
-            _mm512_set1_ps(3.0),
-            _mm512_set1_ps(6.0),
-        );
         let mut acc = [zero; 5];
         for s in (0..list.len()).step_by(16) {
             let p = pairs(xm, i, list, s);
             let (live, d, mj) = (p.live, p.d, p.mj);
             // r = √((dx² + dy²) + dz²), nalgebra's norm.
             let r = _mm512_sqrt_ps(p.r2);
-            let q = _mm512_mul_ps(r, _mm512_set1_ps(c.inv_h));
-            let t = _mm512_sub_ps(one, q);
-            // W and W' are 0 for r ≥ h or t ≤ 0 (ordered: NaN propagates, as in q_t).
-            let outside = _mm512_cmp_ps_mask::<_CMP_GE_OQ>(r, _mm512_set1_ps(c.h))
-                | _mm512_cmp_ps_mask::<_CMP_LE_OQ>(t, zero);
-            let near = _mm512_cmp_ps_mask::<_CMP_LE_OQ>(q, half);
-            // f: 1 + ((6q)q)(q − 1) near, ((2t)t)t far; f': (6q)((3q) − 2), ((−6)t)t.
-            let f_near = _mm512_add_ps(
-                one,
-                _mm512_mul_ps(
-                    _mm512_mul_ps(_mm512_mul_ps(six, q), q),
-                    _mm512_sub_ps(q, one),
-                ),
-            );
-            let f_far = _mm512_mul_ps(_mm512_mul_ps(_mm512_mul_ps(two, t), t), t);
-            let df_near = _mm512_mul_ps(
-                _mm512_mul_ps(six, q),
-                _mm512_sub_ps(_mm512_mul_ps(three, q), two),
-            );
-            let df_far = _mm512_mul_ps(_mm512_mul_ps(_mm512_set1_ps(-6.0), t), t);
-            let w = _mm512_mul_ps(
-                _mm512_set1_ps(c.k),
-                _mm512_mask_blend_ps(near, f_far, f_near),
-            );
-            let w = _mm512_mask_blend_ps(outside, w, zero);
-            let dw = _mm512_mul_ps(
-                _mm512_set1_ps(c.k_h),
-                _mm512_mask_blend_ps(near, df_far, df_near),
-            );
-            let dw = _mm512_mask_blend_ps(outside, dw, zero);
+            let (w, dw) = cubic(c, r);
             // W'(r)/r for r > 0, else 0.
             let f = _mm512_maskz_div_ps(_mm512_cmp_ps_mask::<_CMP_GT_OQ>(r, zero), dw, r);
             _mm512_mask_storeu_ps(gs.as_mut_ptr().add(s), live, f);
@@ -394,9 +449,10 @@ mod tests {
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(48))]
 
-        /// The cubic spline's lane kernel against the scalar loop written here from
+        /// The cubic spline's lane kernels against the scalar loop written here from
         /// `CubicSpline::value` and `derivative` in list order (IISPH's density loop): each
-        /// pair's `W'(r)/r` bit for bit, the sums within `2 γ_n Σ|t_k|`. Random clouds at
+        /// pair's `W'(r)/r` bit for bit, the sums (and the density alone) within
+        /// `2 γ_n Σ|t_k|`. Random clouds at
         /// spacing 1 with `h = 2` (about 30 neighbours, coincident pairs possible).
         /// Skipped (nothing to compare) without AVX-512.
         #[test]
@@ -447,6 +503,8 @@ mod tests {
                     abs[4] += f64::from(g2);
                 }
                 within("density", got.density, rho, list.len(), abs[0])?;
+                let alone: f32 = lanes.density(&packed, nb, i);
+                within("density alone", alone, rho, list.len(), abs[0])?;
                 for a in 0..3 {
                     within("gradient", got.grad[a], grad[a], list.len(), abs[1 + a])?;
                 }
