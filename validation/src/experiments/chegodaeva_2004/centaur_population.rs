@@ -125,10 +125,20 @@
 //! with 80 % probability. Its ends equal those of the 20,000-comet, 10 kyr run above censored
 //! at 5 kyr and cut to 16,000 comets (0 of 16,000 differ).
 //!
-//! On Dask: `benches/scripts/centaurs_dask.py` runs the `--full` comets with
+//! **On Dask**: `benches/scripts/centaurs_dask.py` runs the `--full` comets with
 //! `partisim.dask.run_population_dask` (chunks of comets, each checkpointed atomically and
-//! resumed); on 2 workers over 50 kyr it took 53.0 s and its ends equal the in-process run's,
-//! all 1,000, bit for bit (`docs/performance.md`).
+//! resumed). Over 50 kyr on 2 workers it took 53.0 s and its ends equal the in-process run's,
+//! all 1,000, bit for bit. **Over 1 Myr on 2 workers** (2026-12-05, `LocalCluster`, one
+//! thread each, 8 chunks of 125 comets, a checkpoint every 100 kyr; `python
+//! benches/scripts/centaurs_dask.py CKPT ENDS.csv 1e6 2 8 1e5`, under the build lock on the
+//! shared 2-core machine): started 22:09:43 UTC, killed (SIGKILL to the whole process group)
+//! at 22:15:36 after 353 s with two chunks done and two part-way, started again with the same
+//! arguments at 22:21:22 and finished at 22:28:32 (430.5 s, 795 s of CPU): **783 s of wall
+//! time in all** (the in-process `--full` run: 700.9 s). The resumed run ends 685 active, 239
+//! by q < 2.5 AU, 73 ejected, 3 collided with Jupiter; surviving at 250, 500, 750 kyr 820,
+//! 752, 713; McNemar `b` = 121, `c` = 116; KS D = 0.052: every count of the in-process
+//! `--full` run above (the integrator's code unchanged since). Its ends were not compared
+//! with an uninterrupted run's row by row (no time for one).
 use anyhow::{bail, Result};
 
 use super::centaur_sample::{censor, run_ours, Ends, Sample};
