@@ -137,8 +137,9 @@
 //! time in all** (the in-process `--full` run: 700.9 s). The resumed run ends 685 active, 239
 //! by q < 2.5 AU, 73 ejected, 3 collided with Jupiter; surviving at 250, 500, 750 kyr 820,
 //! 752, 713; McNemar `b` = 121, `c` = 116; KS D = 0.052: every count of the in-process
-//! `--full` run above (the integrator's code unchanged since). Its ends were not compared
-//! with an uninterrupted run's row by row (no time for one).
+//! `--full` run above, and row by row, bit for bit (label and end time, 0 of 1,000 differ),
+//! those of this experiment's `--full` run of this build uninterrupted (2026-12-05,
+//! 22:33:43–22:45:24 UTC, 2 threads, 700.8 s, 10/10, the same counts again).
 use anyhow::{bail, Result};
 
 use super::centaur_sample::{censor, run_ours, Ends, Sample};
