@@ -50,7 +50,7 @@ def ends(population: partisim.Population, years: float):
     table = population.table()
     out = []
     for i, status, t in zip(table["id"], table["status"], table["removal_time_days"]):
-        t_years = t / YEAR_DAYS
+        t_years = float(t) / YEAR_DAYS
         if status == "active" or t_years > years:
             out.append((int(i), "active", math.inf))
         else:

@@ -17,7 +17,10 @@ End rules, as symplectic's `RemovalRules` and encounter ends state them:
   G (M_sun + sum m_j) below 2.5 AU (`perihelion`), or unbound (v^2 r >= 2 G M) beyond 100 AU
   (`ejected`). The end time is the time of the check.
 
-Usage: python mercurius_population.py initial.csv out.csv N YEARS [DT_YEARS] [CHECK_YEARS]
+Usage: python mercurius_population.py initial.csv out.csv N YEARS [DT_YEARS] [CHECK_YEARS] [FIRST]
+
+FIRST (default 0): integrate the N comets from the FIRST-th on (0-based, in file order), so that
+a large sample can be split into processes run side by side.
 
 `benches/scripts/centaurs_vs_mercurius.py` imports `read_initial`, `simulation` and `advance`
 to run MERCURIUS under these end rules.
@@ -41,14 +44,15 @@ EJECTION_DISTANCE_AU = 100.0
 HILL_FACTOR = 3.0
 
 
-def read_initial(src, n):
-    """The bodies' and the first `n` comets' rows of initial.csv: (id, [gm, x, y, z, vx, vy, vz])."""
+def read_initial(src, n, first=0):
+    """The bodies' rows and `n` comets' rows of initial.csv from the `first`-th comet on:
+    (id, [gm, x, y, z, vx, vy, vz])."""
     bodies, comets = [], []
     with open(src) as f:
         for row in csv.DictReader(f):
             values = [float(row[k]) for k in ("gm", "x", "y", "z", "vx", "vy", "vz")]
             (bodies if row["kind"] == "body" else comets).append((int(row["id"]), values))
-    return bodies, comets[:n]
+    return bodies, comets[first:first + n]
 
 
 def simulation(bodies, comets, dt_years):
@@ -140,8 +144,8 @@ def write_ends(dst, comets, ends):
             w.writerow([cid, end, "" if t_e is None else repr(t_e), planet or ""])
 
 
-def main(src, dst, n, years, dt_years=0.1, check_years=1.0):
-    bodies, comets = read_initial(src, n)
+def main(src, dst, n, years, dt_years=0.1, check_years=1.0, first=0):
+    bodies, comets = read_initial(src, n, first)
     sim, ends = simulation(bodies, comets, dt_years)
     n_active = len(bodies)
     start = time.time()
@@ -161,7 +165,7 @@ def main(src, dst, n, years, dt_years=0.1, check_years=1.0):
     if left != {cid for cid, v in ends.items() if v[0] == "active"}:
         sys.exit("the comets left in the simulation are not those recorded as active")
     write_ends(dst, comets, ends)
-    print(f"rebound {rebound.__version__} mercurius n={len(comets)} years={years} "
+    print(f"rebound {rebound.__version__} mercurius n={len(comets)} first={first} years={years} "
           f"dt_years={dt_years} check_years={check_years} seconds={seconds:.1f} "
           f"active={sum(1 for v in ends.values() if v[0] == 'active')}", file=sys.stderr)
 
@@ -170,4 +174,5 @@ if __name__ == "__main__":
     a = sys.argv[1:]
     if len(a) < 4:
         sys.exit(__doc__)
-    main(a[0], a[1], int(a[2]), float(a[3]), *(float(x) for x in a[4:6]))
+    main(a[0], a[1], int(a[2]), float(a[3]), *(float(x) for x in a[4:6]),
+         *(int(x) for x in a[6:7]))

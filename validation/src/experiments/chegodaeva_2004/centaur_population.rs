@@ -2,22 +2,26 @@
 //! planets, against the same initial conditions and end rules integrated by REBOUND's
 //! MERCURIUS.
 //!
-//! 1,000 Centaurs (`reference-data/centaur-population/initial_1000.csv`: the first 1,000
-//! draws of `symplectic::samples::CENTAURS`, seed 2027, barycentric `a` 5.5–30 AU, `e`
-//! 0–0.2, `i` 0–10°, random angles, as barycentric states at the planets' epoch) run with
+//! Centaurs drawn by `symplectic::samples::CENTAURS` (seed 2027: barycentric `a` 5.5–30 AU,
+//! `e` 0–0.2, `i` 0–10°, random angles, as barycentric states at the planets' epoch) run with
 //! the settings of `populations/centaurs.toml` (S2 barycentric map with `B₁ = 4·10⁻⁶`,
 //! planets S6 at 91.3125 d, whose trajectory the map and the encounter mode both read;
 //! encounters inside 3 Hill radii by Bulirsch–Stoer at 10⁻¹², handed back to the map beyond
-//! 3.5) for 50 kyr (quick) or 1 Myr (`--full`, checkpointed every 100 kyr into the output
-//! directory and resumed from there by a run of the same build: `centaur_sample`). A comet
+//! 3.5). Quick: the first 16,000 draws (`reference-data/centaur-population/initial_20000.csv`)
+//! over 5 kyr, the design below that catches a 25 % change of the q < 2.5 AU fraction.
+//! `--full`: the first 1,000 draws (`initial_1000.csv`, the same states as the first 1,000
+//! rows of `initial_20000.csv`) over 1 Myr, checkpointed every 100 kyr into the output
+//! directory and resumed from there by a run of the same build (`centaur_sample`). A comet
 //! ends at a collision with a planet (its equatorial radius), when its barycentric perihelion
 //! falls below 2.5 AU, or when it is unbound beyond 100 AU.
 //!
-//! Reference: `reference-data/centaur-population/mercurius_ends_1000.csv`, REBOUND 5.2.2
-//! MERCURIUS (H. Rein, D. M. Hernandez, D. Tamayo et al., "Hybrid symplectic integrators for
-//! planetary dynamics", *MNRAS* 485, 5490–5497 (2019), doi:10.1093/mnras/stz769;
-//! `r_crit_hill = 3`, `dt = 0.1 yr`) on the same 1,000 initial states with the same end rules
-//! over 1 Myr (script and provenance beside it); both codes are censored at the span.
+//! References (`reference-data/centaur-population/`, script and provenance in `SOURCE.md`):
+//! REBOUND 5.2.2 MERCURIUS (H. Rein, D. M. Hernandez, D. Tamayo et al., "Hybrid symplectic
+//! integrators for planetary dynamics", *MNRAS* 485, 5490–5497 (2019),
+//! doi:10.1093/mnras/stz769; `r_crit_hill = 3`, `dt = 0.1 yr`) on the same initial states with
+//! the same end rules: `mercurius_ends_20000.csv` (20,000 comets over 10 kyr; quick reads the
+//! first 16,000) and `mercurius_ends_1000.csv` (1,000 comets over 1 Myr; `--full`). Both
+//! codes are censored at the span.
 //!
 //! **Unpaired tests.** Single trajectories diverge within a few encounters, so the codes are
 //! first compared as two samples of the same distribution: the surviving fraction at a
@@ -44,9 +48,11 @@
 //! comets only, not of all. A change that adds (removes) `Δ = 0.25 p n` comets at random
 //! moves `b − c` by `Δ` and `b + c` by at most `Δ`, so the check fails with probability at
 //! least `Φ(Δ/√(b + c + Δ) − 3)` (metric "power of the McNemar check", computed from each
-//! run's own `b + c`), and the change caught with 80 % probability solves
-//! `Δ/√(b + c + Δ) = 3 + Φ⁻¹(0.8)` (metric "change … the McNemar check catches with 80 %
-//! probability").
+//! run's own `b + c` and MERCURIUS's count; the unit test
+//! `a_25_percent_change_fails_the_mcnemar_check_as_often_as_its_power_says` draws 2,000
+//! changed populations of that model, ±25 %, and finds them failing at least that often), and
+//! the change caught with 80 % probability solves `Δ/√(b + c + Δ) = 3 + Φ⁻¹(0.8)` (metric
+//! "change … the McNemar check catches with 80 % probability").
 //!
 //! **The correlation, measured** (the `--full` run of 2026-12-05 below, each code's ends
 //! censored at the span; `φ` the correlation of the two codes' outcomes comet by comet;
@@ -60,23 +66,43 @@
 //! | 5 kyr | 29 | 28 | 8 | 21 | 20 | 0.26 | 0.023 | 0.018 | 14,457 | 7.1·10⁷ | 65 |
 //! | 10 kyr | 39 | 40 | 10 | 29 | 30 | 0.22 | 0.036 | 0.027 | 10,183 | 9.9·10⁷ | 90 |
 //! | 20 kyr | 58 | 57 | 20 | 38 | 37 | 0.31 | 0.068 | 0.045 | 6,486 | 1.3·10⁸ | 113 |
-//! | **50 kyr** | 94 | 92 | 40 | 54 | 52 | 0.37 | **0.165** | 0.095 | 3,599 | 1.7·10⁸ | 153 |
+//! | 50 kyr | 94 | 92 | 40 | 54 | 52 | 0.37 | 0.165 | 0.095 | 3,599 | 1.7·10⁸ | 153 |
 //! | 100 kyr | 117 | 122 | 56 | 61 | 66 | 0.40 | 0.284 | 0.155 | 2,499 | 2.3·10⁸ | 207 |
 //! | 200 kyr | 145 | 147 | 71 | 74 | 76 | 0.40 | 0.378 | 0.216 | 2,041 | 3.6·10⁸ | 326 |
 //! | **1 Myr** | 239 | 234 | 118 | 121 | 116 | 0.34 | **0.657** | 0.491 | 1,274 | 9.8·10⁸ | 893 |
 //!
 //! The outcomes are correlated (`φ` 0.2–0.4), not enough to make 1,000 comets decisive: the
-//! paired test needs a third to a half of the unpaired test's comets. **No design within the
-//! quick budget that the existing references allow reaches a 25 % change.** The quick mode
-//! (about a minute: 1,000 comets over 50 kyr, 4.7·10⁷ comet-years, the most the 1,000-comet
-//! reference allows in that time) catches with 80 % probability a change of about 52 % (power
-//! 0.165 against 25 %; the 300 comets over 200 kyr before caught 67 %); `--full` (1 Myr)
-//! catches about 29 % (power 0.66 against 25 %; 0.8 would need 1,274 comets). A shorter span
-//! with more comets is cheaper per unit of power: 0.8 against 25 % at 5 kyr needs about
-//! 14,500 comets, 7.1·10⁷ comet-years, about 65 s here, but a MERCURIUS reference of those
-//! comets over 5 kyr that does not exist yet (and these figures come from 28 and 41 events,
-//! uncertain by some 20 %); it would also judge only the earliest q < 2.5 AU ends, those of
-//! comets that start on Jupiter-crossing orbits.
+//! paired test needs a third to a half of the unpaired test's comets, and the shortest spans
+//! are the cheapest per unit of power (7.1·10⁷ comet-years at 5 kyr against 9.8·10⁸ at 1 Myr).
+//! `--full` (1 Myr, 1,000 comets) catches about 29 % with 80 % probability (power 0.66
+//! against 25 %).
+//!
+//! **The quick design, measured.** The 1,000-comet estimates at short spans rest on 28 to 59
+//! events, so the design was chosen on a larger sample: MERCURIUS on 20,000 comets over 10 kyr
+//! (`mercurius_ends_20000.csv`) and this experiment on the same 20,000 over 10 kyr
+//! (2026-12-05, 21:43–21:46 UTC, 2 threads, 211.7 s, 1.95·10⁸ comet-years, 9.2·10⁵ per second;
+//! its ends censored at each span and cut to the first `n` comets; MERCURIUS's fraction at 5
+//! kyr 512/20,000 = 2.56 %, at 10 kyr 4.06 %):
+//!
+//! | comets | span | MERCURIUS | ours | b | c | φ | paired power | unpaired | comet-years |
+//! | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |
+//! | 20,000 | 2.5 kyr | 317 | 310 | 193 | 200 | 0.36 | 0.741 | 0.498 | 5.0·10⁷ |
+//! | 14,000 | 5 kyr | 348 | 341 | 219 | 226 | 0.34 | 0.780 | 0.561 | 6.9·10⁷ |
+//! | 15,000 | 5 kyr | 376 | 369 | 235 | 242 | 0.34 | 0.825 | 0.610 | 7.4·10⁷ |
+//! | **16,000** | **5 kyr** | 403 | 403 | 258 | 258 | 0.34 | **0.855** | 0.654 | 7.9·10⁷ |
+//! | 18,000 | 5 kyr | 450 | 444 | 284 | 290 | 0.34 | 0.902 | 0.721 | 8.9·10⁷ |
+//! | 14,000 | 6 kyr | 390 | 391 | 252 | 251 | 0.34 | 0.836 | 0.635 | 8.3·10⁷ |
+//! | 12,000 | 7.5 kyr | 397 | 403 | 259 | 253 | 0.34 | 0.845 | 0.650 | 8.8·10⁷ |
+//! | 10,000 | 10 kyr | 401 | 395 | 247 | 253 | 0.35 | 0.863 | 0.661 | 9.8·10⁷ |
+//! | 20,000 | 10 kyr | 812 | 790 | 504 | 526 | 0.33 | 0.997 | 0.969 | 2.0·10⁸ |
+//!
+//! The quick mode runs the cheapest row above 0.8 with some margin: **16,000 comets over 5
+//! kyr, power 0.855 against a 25 % change** (the paired check; 0.654 for the unpaired one),
+//! and checks that its own power, from its own `b + c`, stays at least 0.8 (a run whose
+//! discordance grows so far that a 25 % change could pass fails that check). The 1,000 × 50
+//! kyr survival and lifetime tests of the quick mode before are now those of `--full` (1 Myr,
+//! the same tests); quick runs every test on its own 16,000 comets. It judges the earliest
+//! q < 2.5 AU ends, those of comets that start on or near Jupiter-crossing orbits.
 //!
 //! **`--full`, measured** (2026-12-05, 18:36–18:48 UTC, `validation run --full --only
 //! centaur-population`, 2 rayon threads, under the build lock on the shared 2-core machine:
@@ -88,27 +114,41 @@
 //! McNemar `b` = 121, `c` = 116, z = 0.32; KS of the lifetimes D = 0.052, p = 0.79; no other
 //! end.
 //!
-//! **Quick, measured** (2026-12-05, 19:11 UTC, the same build and machine, 2 threads): 47.3 s
-//! (the 300 comets over 200 kyr before: 61 s), passes 10/10. Surviving at 12.5, 25, 37.5 and
-//! 50 kyr: 955/955, 931/931, 915/913, 899/901 (z = 0, 0, 0.16, −0.15); q < 2.5 AU 94/92
-//! (0.15), ejected 6/2 (1.42), collided 1/5 (−1.64); McNemar `b` = 54, `c` = 52, z = 0.19
-//! (the `--full` run's ends censored at 50 kyr give the same counts); KS D = 0.068, p = 0.97;
-//! 29,159 switches. Power of the McNemar check against a 25 % change 0.165; it catches 52 %
-//! with 80 % probability.
+//! **Quick, measured** (2026-12-05, 21:48 UTC, `validation run --only centaur-population`, 2
+//! rayon threads, under the build lock on the shared 2-core machine): **82.5 s** of wall time
+//! (161 s of CPU; the 1,000 comets over 50 kyr before: 47.3 s), passes 11/11. Surviving at
+//! 1.25, 2.5, 3.75 and 5 kyr: 15,827/15,833, 15,733/15,739, 15,645/15,648, 15,580/15,579
+//! (ours/MERCURIUS; z = −0.33, −0.26, −0.11, 0.03); q < 2.5 AU 403/403 (0), ejected 0/0,
+//! collided 17/18 (−0.17: ours 12 with Jupiter, 3 with Saturn, 2 with Uranus; MERCURIUS 11,
+//! 5, 2); McNemar `b` = 258, `c` = 258, z = 0; KS D = 0.031, p = 0.99; 67,512 switches.
+//! Power of the McNemar check against a 25 % change 0.855 (checked ≥ 0.8); it catches 23.6 %
+//! with 80 % probability. Its ends equal those of the 20,000-comet, 10 kyr run above censored
+//! at 5 kyr and cut to 16,000 comets (0 of 16,000 differ).
 //!
-//! On Dask: `benches/scripts/centaurs_dask.py` runs the same 1,000 comets with
+//! **On Dask**: `benches/scripts/centaurs_dask.py` runs the `--full` comets with
 //! `partisim.dask.run_population_dask` (chunks of comets, each checkpointed atomically and
-//! resumed); on 2 workers over 50 kyr it took 53.0 s and its ends equal this experiment's, all
-//! 1,000, bit for bit (`docs/performance.md`).
+//! resumed). Over 50 kyr on 2 workers it took 53.0 s and its ends equal the in-process run's,
+//! all 1,000, bit for bit. **Over 1 Myr on 2 workers** (2026-12-05, `LocalCluster`, one
+//! thread each, 8 chunks of 125 comets, a checkpoint every 100 kyr; `python
+//! benches/scripts/centaurs_dask.py CKPT ENDS.csv 1e6 2 8 1e5`, under the build lock on the
+//! shared 2-core machine): started 22:09:43 UTC, killed (SIGKILL to the whole process group)
+//! at 22:15:36 after 353 s with two chunks done and two part-way, started again with the same
+//! arguments at 22:21:22 and finished at 22:28:32 (430.5 s, 795 s of CPU): **783 s of wall
+//! time in all** (the in-process `--full` run: 700.9 s). The resumed run ends 685 active, 239
+//! by q < 2.5 AU, 73 ejected, 3 collided with Jupiter; surviving at 250, 500, 750 kyr 820,
+//! 752, 713; McNemar `b` = 121, `c` = 116; KS D = 0.052: every count of the in-process
+//! `--full` run above, and row by row, bit for bit (label and end time, 0 of 1,000 differ),
+//! those of this experiment's `--full` run of this build uninterrupted (2026-12-05,
+//! 22:33:43–22:45:24 UTC, 2 threads, 700.8 s, 10/10, the same counts again).
 use anyhow::{bail, Result};
 
-use super::centaur_sample::{censor, run_ours, Ends};
+use super::centaur_sample::{censor, run_ours, Ends, Sample};
 use super::comet_population::z_two_proportions;
 use crate::helpers::solar_system::DAYS_PER_YEAR;
 use crate::helpers::{
     load_reference_csv, plot_xy, write_csv_rows, Legend, Marker, PlotSpec, Series, SeriesStyle,
 };
-use crate::{Check, Context, Experiment, Outcome};
+use crate::{Check, Context, Experiment, Mode, Outcome};
 
 /// The experiment.
 pub struct CentaurPopulation;
@@ -117,10 +157,28 @@ pub struct CentaurPopulation;
 const Z_MAX: f64 = 3.0;
 /// Smallest p-value of the Kolmogorov–Smirnov test (the same two-sided 0.27 %).
 const P_MIN: f64 = 0.0027;
-/// MERCURIUS's ends of the comets of [`super::centaur_sample::INITIAL_STATES`] over 1 Myr.
-const REFERENCE_ENDS: &str = "centaur-population/mercurius_ends_1000.csv";
-/// The quick mode's span (years; module docs: the paired test's power against its cost).
-const QUICK_SPAN_YEARS: f64 = 50_000.0;
+/// The quick mode's comets (module docs: the paired test's power against its cost).
+const QUICK: Sample = Sample {
+    initial: "centaur-population/initial_20000.csv",
+    comets: QUICK_COMETS,
+};
+/// How many comets the quick mode runs (module docs).
+const QUICK_COMETS: usize = 16_000;
+/// MERCURIUS's ends of the comets of `QUICK.initial` over 10 kyr.
+const QUICK_REFERENCE: &str = "centaur-population/mercurius_ends_20000.csv";
+/// The quick mode's span (years; module docs).
+const QUICK_SPAN_YEARS: f64 = 5_000.0;
+/// The smallest power against a 25 % change of the q < 2.5 AU fraction the quick design
+/// must have (module docs): the conventional 0.8 (J. Cohen, *Statistical Power Analysis for
+/// the Behavioral Sciences*, 2nd ed., Erlbaum 1988, §2.4).
+const QUICK_MIN_POWER: f64 = 0.8;
+/// The full mode's comets.
+const FULL: Sample = Sample {
+    initial: "centaur-population/initial_1000.csv",
+    comets: 1_000,
+};
+/// MERCURIUS's ends of the comets of `FULL.initial` over 1 Myr.
+const FULL_REFERENCE: &str = "centaur-population/mercurius_ends_1000.csv";
 /// The full mode's span (years).
 const FULL_SPAN_YEARS: f64 = 1_000_000.0;
 /// The full mode's checkpoint cadence (years of simulated time).
@@ -192,13 +250,13 @@ fn mcnemar_change_at_80(discordant: usize, reference: usize) -> f64 {
 /// A named end rule: which labels it counts.
 type Rule = (&'static str, fn(&str) -> bool);
 
-fn reference(ctx: &Context, span_years: f64) -> Result<Ends> {
-    let table = load_reference_csv(
-        ctx,
-        REFERENCE_ENDS,
-        &["id", "end", "end_time_days", "planet"],
-    )?;
-    (0..table.len())
+/// The first `comets` rows of MERCURIUS's ends in `file`, censored at `span_years`.
+fn reference(ctx: &Context, file: &str, comets: usize, span_years: f64) -> Result<Ends> {
+    let table = load_reference_csv(ctx, file, &["id", "end", "end_time_days", "planet"])?;
+    if table.len() < comets {
+        bail!("{file}: {} comets, {comets} expected", table.len());
+    }
+    (0..comets)
         .map(|i| {
             let label = table.text(i, "end")?.to_string();
             let t = match label.as_str() {
@@ -207,7 +265,7 @@ fn reference(ctx: &Context, span_years: f64) -> Result<Ends> {
             };
             if table.number(i, "id")? != i as f64 {
                 bail!(
-                    "{REFERENCE_ENDS}: row {} is not comet {i} (rows in id order expected)",
+                    "{file}: row {} is not comet {i} (rows in id order expected)",
                     i + 2
                 );
             }
@@ -314,10 +372,12 @@ impl Experiment for CentaurPopulation {
 
     fn run(&self, ctx: &mut Context) -> Result<Outcome> {
         let span = ctx.mode.pick(QUICK_SPAN_YEARS, FULL_SPAN_YEARS);
+        let sample = ctx.mode.pick(QUICK, FULL);
+        let reference_file = ctx.mode.pick(QUICK_REFERENCE, FULL_REFERENCE);
         let checkpoints = ctx.mode.pick(None, Some(FULL_CHECKPOINT_YEARS));
-        let run = run_ours(ctx, span, checkpoints)?;
+        let run = run_ours(ctx, sample, span, checkpoints)?;
         let (ours, encounters_begun) = (run.ends, run.encounters_begun);
-        let reference = reference(ctx, span)?;
+        let reference = reference(ctx, reference_file, sample.comets, span)?;
         if ours.len() != reference.len() {
             bail!(
                 "{} comets here, {} in the reference: not the same population",
@@ -375,10 +435,19 @@ impl Experiment for CentaurPopulation {
         out.metric("q < 2.5 AU: comets only MERCURIUS ended so (c)", c as f64);
         // A 25 % change of the fraction MERCURIUS finds, at this run's discordance.
         let theirs = count(&reference, |l| l == "perihelion").0;
+        let power = mcnemar_power(b + c, 0.25 * theirs as f64);
         out.metric(
             "power of the McNemar check against a 25 % change of the q < 2.5 AU fraction",
-            mcnemar_power(b + c, 0.25 * theirs as f64),
+            power,
         );
+        if ctx.mode == Mode::Quick {
+            out.check(Check::greater_than(
+                "power of the McNemar check against a 25 % change of the q < 2.5 AU fraction",
+                power,
+                QUICK_MIN_POWER,
+                "the quick design's target: a 25 % change fails with at least 80 % probability (Cohen 1988; module docs)",
+            ));
+        }
         out.metric(
             "change of the q < 2.5 AU fraction the McNemar check catches with 80 % probability",
             mcnemar_change_at_80(b + c, theirs),
@@ -469,6 +538,11 @@ impl Experiment for CentaurPopulation {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use symplectic::samples::SplitMix64;
+
+    /// The quick run's (comets, MERCURIUS's q < 2.5 AU ends, discordant comets `b + c`), from
+    /// its metrics (module docs, "Quick, measured").
+    const QUICK_RUN_COUNTS: (usize, usize, usize) = (16_000, 403, 516);
 
     #[test]
     fn ks_p_value_matches_the_kolmogorov_table() {
@@ -510,6 +584,78 @@ mod tests {
                 (mcnemar_power(d, x * m as f64) - 0.8).abs() < 1e-5,
                 "{d} {m}"
             );
+        }
+    }
+
+    /// Uniform in `0..k` (`k ≥ 1`).
+    fn below(rng: &mut SplitMix64, k: usize) -> usize {
+        ((rng.uniform() * k as f64) as usize).min(k - 1)
+    }
+
+    /// `v` in a uniformly random order (Fisher–Yates).
+    fn shuffled(rng: &mut SplitMix64, mut v: Vec<usize>) -> Vec<usize> {
+        for i in (1..v.len()).rev() {
+            v.swap(i, below(rng, i + 1));
+        }
+        v
+    }
+
+    /// Paired outcomes drawn from the model of [`mcnemar_power`]: `n` comets, the reference
+    /// ending the first `m` by q < 2.5 AU; without a change, `d` comets discordant, each
+    /// ours-only or reference-only with probability 1/2; then ours gains (`grow`) or loses
+    /// `shift` comets so ended, drawn at random among its others (its own). Returns the flags
+    /// (ours, reference).
+    fn changed_pairs(
+        rng: &mut SplitMix64,
+        (n, m, d): (usize, usize, usize),
+        shift: usize,
+        grow: bool,
+    ) -> (Vec<bool>, Vec<bool>) {
+        let reference: Vec<bool> = (0..n).map(|i| i < m).collect();
+        let mut ours = reference.clone();
+        let pos = shuffled(rng, (0..m).collect());
+        let neg = shuffled(rng, (m..n).collect());
+        let only_ours = (0..d).filter(|_| below(rng, 2) == 0).count();
+        neg[..only_ours].iter().for_each(|&i| ours[i] = true);
+        pos[..d - only_ours].iter().for_each(|&i| ours[i] = false);
+        let candidates = shuffled(rng, (0..n).filter(|&i| ours[i] != grow).collect());
+        candidates[..shift].iter().for_each(|&i| ours[i] = grow);
+        (ours, reference)
+    }
+
+    #[test]
+    fn a_25_percent_change_fails_the_mcnemar_check_as_often_as_its_power_says() {
+        // The quick run's counts (module docs: comets, MERCURIUS's q < 2.5 AU ends, b + c) and
+        // the 1 Myr run's. The fraction of 2,000 draws whose McNemar |z| reaches Z_MAX is at
+        // least the power mcnemar_power states (a lower bound) less three binomial standard
+        // errors of that fraction (the draws' own scatter), in both directions; at the quick
+        // run's counts it is at least QUICK_MIN_POWER.
+        let draws = 2_000;
+        let mut rng = SplitMix64::new(2027);
+        for (counts, quick) in [(QUICK_RUN_COUNTS, true), ((1_000, 234, 237), false)] {
+            let shift = (0.25 * counts.1 as f64).round() as usize;
+            let power = mcnemar_power(counts.2, shift as f64);
+            for grow in [true, false] {
+                let failed = (0..draws)
+                    .filter(|_| {
+                        let (ours, reference) = changed_pairs(&mut rng, counts, shift, grow);
+                        mcnemar_z(&ours, &reference).0.abs() >= Z_MAX
+                    })
+                    .count() as f64
+                    / draws as f64;
+                let se = (power * (1.0 - power) / draws as f64).sqrt();
+                eprintln!("{counts:?} grow {grow}: fails {failed}, power at least {power:.4}");
+                assert!(
+                    failed >= power - 3.0 * se,
+                    "{counts:?} grow {grow}: fails {failed}, power {power}"
+                );
+                if quick {
+                    assert!(
+                        failed >= QUICK_MIN_POWER,
+                        "{counts:?} grow {grow}: {failed}"
+                    );
+                }
+            }
         }
     }
 

@@ -1,8 +1,8 @@
-//! The 1,000 Centaurs of `centaur-population`, run from the initial states that MERCURIUS ran
-//! (`reference-data/centaur-population/initial_1000.csv`), with the settings of
-//! `populations/centaurs.toml`, and resumable: a checkpoint in the experiment's output
-//! directory at a fixed cadence of simulated time, written atomically, from which a killed
-//! run goes on bit for bit.
+//! The Centaurs of `centaur-population`, run from the initial states that MERCURIUS ran (the
+//! first comets of `reference-data/centaur-population/initial_1000.csv` or
+//! `initial_20000.csv`), with the settings of `populations/centaurs.toml`, and resumable: a
+//! checkpoint in the experiment's output directory at a fixed cadence of simulated time,
+//! written atomically, from which a killed run goes on bit for bit.
 
 use std::path::Path;
 
@@ -15,9 +15,16 @@ use crate::helpers::load_reference_csv;
 use crate::helpers::solar_system::DAYS_PER_YEAR;
 use crate::{workspace_root, Context};
 
-/// The comets' initial barycentric states (the Sun and the giants' rows beside them), the
-/// same file MERCURIUS's ends were computed from.
-pub(crate) const INITIAL_STATES: &str = "centaur-population/initial_1000.csv";
+/// Comets' initial barycentric states (the Sun and the giants' rows beside them) in a file of
+/// the reference data, the same file MERCURIUS's ends were computed from: its first
+/// `comets` comets.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Sample {
+    /// The file, relative to the reference-data directory.
+    pub initial: &'static str,
+    /// How many comets, from the first.
+    pub comets: usize,
+}
 
 /// Name of the run's checkpoint in the experiment's output directory.
 const CHECKPOINT_FILE: &str = "population_checkpoint.json";
@@ -29,7 +36,9 @@ const CHECKPOINT_FILE: &str = "population_checkpoint.json";
 struct RunCheckpoint {
     /// The population file's text.
     spec: String,
-    /// The number of comets (the initial states are versioned with the code).
+    /// The initial states' file and the number of comets (the states are versioned with the
+    /// code).
+    initial: String,
     comets: usize,
     /// The run's span (years).
     span_years: f64,
@@ -44,15 +53,18 @@ struct RunCheckpoint {
 /// anything else from our code) and the time in years (∞ if active at the span's end).
 pub(crate) type Ends = Vec<(String, f64)>;
 
-/// The comets' initial states as particle rows (barycentric states, AU and AU/day).
-fn initial_rows(ctx: &Context) -> Result<Vec<ParticleRow>> {
+/// The sample's comets' initial states as particle rows (barycentric states, AU and AU/day).
+fn initial_rows(ctx: &Context, sample: Sample) -> Result<Vec<ParticleRow>> {
     let table = load_reference_csv(
         ctx,
-        INITIAL_STATES,
+        sample.initial,
         &["kind", "id", "gm", "x", "y", "z", "vx", "vy", "vz"],
     )?;
     let mut rows = Vec::new();
     for i in 0..table.len() {
+        if rows.len() == sample.comets {
+            break;
+        }
         if table.text(i, "kind")? != "particle" {
             continue;
         }
@@ -63,7 +75,8 @@ fn initial_rows(ctx: &Context) -> Result<Vec<ParticleRow>> {
         let id = table.number(i, "id")?;
         if id != rows.len() as f64 {
             bail!(
-                "{INITIAL_STATES}: line {}: comet id {id}, expected {} (comets in id order from 0)",
+                "{}: line {}: comet id {id}, expected {} (comets in id order from 0)",
+                sample.initial,
                 i + 2,
                 rows.len()
             );
@@ -73,6 +86,14 @@ fn initial_rows(ctx: &Context) -> Result<Vec<ParticleRow>> {
             id: id as u64,
             values,
         });
+    }
+    if rows.len() < sample.comets {
+        bail!(
+            "{}: {} comets, {} expected",
+            sample.initial,
+            rows.len(),
+            sample.comets
+        );
     }
     Ok(rows)
 }
@@ -99,29 +120,29 @@ pub(crate) struct OursRun {
     pub resumed_from_years: Option<f64>,
 }
 
-/// `populations/centaurs.toml`'s text, and its population built from [`INITIAL_STATES`].
-fn fresh(ctx: &Context) -> Result<(String, Population)> {
+/// `populations/centaurs.toml`'s text, and its population built from the sample.
+fn fresh(ctx: &Context, sample: Sample) -> Result<(String, Population)> {
     let spec_path = workspace_root().join("populations/centaurs.toml");
     let spec_text = std::fs::read_to_string(&spec_path)
         .with_context(|| format!("reading {}", spec_path.display()))?;
     let mut spec = PopulationSpec::parse(&spec_text, &spec_path)?;
     spec.particles.kind = ParticleKind::BarycentricState;
-    let rows = initial_rows(ctx)?;
-    let population = spec.population_from_rows(&rows, Path::new(INITIAL_STATES))?;
+    let rows = initial_rows(ctx, sample)?;
+    let population = spec.population_from_rows(&rows, Path::new(sample.initial))?;
     Ok((spec_text, population))
 }
 
-/// Runs the comets of [`INITIAL_STATES`] with `populations/centaurs.toml`'s settings for
-/// `span_years`. With `checkpoint_every_years`, the population is written to the output
-/// directory at every multiple of that cadence (atomically) and a run of the same build,
-/// specification, comets and span resumes from it; the checkpoint is removed once the run
-/// ends.
+/// Runs the sample's comets with `populations/centaurs.toml`'s settings for `span_years`.
+/// With `checkpoint_every_years`, the population is written to the output directory at every
+/// multiple of that cadence (atomically) and a run of the same build, specification, comets
+/// and span resumes from it; the checkpoint is removed once the run ends.
 pub(crate) fn run_ours(
     ctx: &Context,
+    sample: Sample,
     span_years: f64,
     checkpoint_every_years: Option<f64>,
 ) -> Result<OursRun> {
-    let (spec_text, mut population) = fresh(ctx)?;
+    let (spec_text, mut population) = fresh(ctx, sample)?;
     let comets = population.members().len();
     let checkpoint = ctx.path(CHECKPOINT_FILE);
     let build = build_stamp();
@@ -129,6 +150,7 @@ pub(crate) fn run_ours(
     if checkpoint_every_years.is_some() && checkpoint.exists() {
         let c: RunCheckpoint = load_checkpoint(&checkpoint)?;
         if c.spec == spec_text
+            && c.initial == sample.initial
             && c.comets == comets
             && c.span_years == span_years
             && c.build == build
@@ -154,6 +176,7 @@ pub(crate) fn run_ours(
         if checkpoint_every_years.is_some() {
             let c = RunCheckpoint {
                 spec: spec_text.clone(),
+                initial: sample.initial.to_string(),
                 comets,
                 span_years,
                 build,
@@ -211,18 +234,23 @@ mod tests {
             ProgressBar::hidden(),
         );
         let span = 2_000.0;
-        let whole = run_ours(&ctx, span, None).unwrap();
+        let sample = Sample {
+            initial: "centaur-population/initial_1000.csv",
+            comets: 1_000,
+        };
+        let whole = run_ours(&ctx, sample, span, None).unwrap();
         assert!(
             whole.ends.iter().any(|(l, _)| l != "active"),
             "no comet ended: nothing to compare"
         );
         // What the killed run left: its checkpoint at 1 kyr, written as run_ours writes it.
-        let (spec, mut population) = fresh(&ctx).unwrap();
+        let (spec, mut population) = fresh(&ctx, sample).unwrap();
         population
             .advance_to(1_000.0 * DAYS_PER_YEAR, |_| {})
             .unwrap();
         let killed = |span_years: f64, population: Population| RunCheckpoint {
             spec: spec.clone(),
+            initial: sample.initial.to_string(),
             comets: population.members().len(),
             span_years,
             build: build_stamp(),
@@ -233,7 +261,7 @@ mod tests {
             &killed(span, population.clone()),
         )
         .unwrap();
-        let resumed = run_ours(&ctx, span, Some(1_000.0)).unwrap();
+        let resumed = run_ours(&ctx, sample, span, Some(1_000.0)).unwrap();
         assert_eq!(resumed.resumed_from_years, Some(1_000.0));
         assert_eq!(resumed.ends, whole.ends);
         assert_eq!(resumed.encounters_begun, whole.encounters_begun);
@@ -242,7 +270,7 @@ mod tests {
             "the finished run's checkpoint stays"
         );
         save_checkpoint(&ctx.path(CHECKPOINT_FILE), &killed(3_000.0, population)).unwrap();
-        let other = run_ours(&ctx, span, Some(1_000.0)).unwrap();
+        let other = run_ours(&ctx, sample, span, Some(1_000.0)).unwrap();
         assert_eq!(other.resumed_from_years, None);
         assert_eq!(other.ends, whole.ends);
         std::fs::remove_dir_all(&dir).ok();
