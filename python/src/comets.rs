@@ -288,7 +288,10 @@ impl Population {
 
     /// The snapshot table (the columns of `cargo xtask comets`' Parquet snapshots) as a
     /// dict of numpy arrays (`status`, `region` and `levison_class` lists of str,
-    /// `in_encounter` booleans, `encounters_begun` integers).
+    /// `in_encounter` booleans; `encounters_begun`, `planet_encounters`,
+    /// `planet_encounter_switches` and `max_switches_per_encounter` integers: the switches to
+    /// the encounter mode, the close encounters with the planets, the switches in them and the
+    /// most in one, `symplectic::EncounterTally`).
     fn table<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let batch = population_table(&self.inner).map_err(rust_err)?;
         batch_dict(py, &batch)

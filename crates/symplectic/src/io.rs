@@ -822,7 +822,9 @@ pub use crate::guard::available_memory;
 /// and `in_encounter` (whether the particle, active, is being integrated through an
 /// encounter; `false` for every removed particle) and `encounters_begun` (its switches to
 /// the encounter mode so far, [`PopulationMember::encounters_begun`](crate::PopulationMember)),
-/// and `events_dropped` (events its full log did not keep, [`EventLog::dropped`](crate::EventLog);
+/// `planet_encounters`, `planet_encounter_switches` and `max_switches_per_encounter` (its
+/// close encounters with the planets, the switches in them and the most in one:
+/// [`EncounterTally`](crate::EncounterTally)), and `events_dropped` (events its full log did not keep, [`EventLog::dropped`](crate::EventLog);
 /// the events themselves are in [`events_table`]).
 pub fn population_table(population: &Population) -> Result<RecordBatch, SymplecticError> {
     let members = population.members();
@@ -900,6 +902,14 @@ pub fn population_table(population: &Population) -> Result<RecordBatch, Symplect
             members.iter().map(|m| u64::from(m.encounters_begun)),
         )),
     );
+    let tally = |f: fn(&crate::EncounterTally) -> u32| {
+        Arc::new(UInt64Array::from_iter_values(
+            members.iter().map(|m| u64::from(f(&m.tally))),
+        ))
+    };
+    table.push("planet_encounters", tally(|t| t.encounters));
+    table.push("planet_encounter_switches", tally(|t| t.switches));
+    table.push("max_switches_per_encounter", tally(|t| t.max_switches));
     table.push(
         "events_dropped",
         Arc::new(UInt64Array::from_iter_values(

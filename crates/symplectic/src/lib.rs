@@ -76,11 +76,15 @@
 //!   map reads (one trajectory of the planets in both modes: nothing jumps at the switch or
 //!   the hand-back, and `H + p₄` is carried through), and handed back to the
 //!   map outside 3.5 Hill radii (a hysteresis band: a comet skimming 3 Hill radii switches
-//!   once, not at every dip; [`PopulationMember::encounters_begun`] counts the switches);
-//!   ends by collision with a planet's radius
+//!   once, not at every dip; [`PopulationMember::encounters_begun`] counts the switches,
+//!   [`Population::switches_per_encounter`] the switches per close encounter with a planet,
+//!   [`EncounterTally`]); ends by collision with a planet's radius
 //!   ([`ParticleStatus::Collision`]), and never for lost regularisation. Checked against
 //!   REBOUND's IAS15 on single encounters with Jupiter and Neptune down to 0.02 Hill radii
-//!   (within 5·10⁻¹² AU) and against a fine fixed-step RK4 (property test); as a population,
+//!   and, comet by comet, along the population's own path (the map, the switch, the
+//!   encounter, the hand-back: eleven comets passing the four giants at 0.05 to 2.9 Hill
+//!   radii, `tests/population_path.rs`), each within a fixed bound from IAS15's own
+//!   convergence, and against a fine fixed-step RK4 (property test); as a population,
 //!   300 Centaurs over 1 Myr against REBOUND's MERCURIUS with the same initial conditions and
 //!   end rules (survival, lifetimes, fractions ejected, collided and reaching q < 2.5 AU;
 //!   the validation experiment `centaur-population`);
@@ -162,8 +166,8 @@
 //! ejection from energy and angular momentum: ≈ 40 flops, 1 square root): about 1000 flops
 //! and 30 square roots or divisions, all on data in L1. S6 has 3 drifts, 4 kicks and 3
 //! interpolations. Each particle is one [`PopulationMember`] of
-//! [`Population::bytes_per_particle`] bytes (208 on x86-64; 200 before the event log, 192 before the count of encounters begun, 184 before the encounter state), stepped many times per window
-//! while it sits in L1, so memory traffic is 2 × 208 bytes per particle per window, not per
+//! [`Population::bytes_per_particle`] bytes (232 on x86-64; 208 before the encounter tally, 200 before the event log, 192 before the count of encounters begun, 184 before the encounter state), stepped many times per window
+//! while it sits in L1, so memory traffic is 2 × 232 bytes per particle per window, not per
 //! step. The ephemeris window (360 bytes per planet step for five bodies, ≈ 2 ×
 //! [`DEFAULT_WINDOW_STEPS`] steps, ≈ 180 KB) is shared read-only by all threads and stays in
 //! L2; extending it costs one planet step per grid point, once for the whole population
@@ -206,9 +210,10 @@ pub use particles::{
 };
 pub use planets::Planets;
 pub use population::{
-    ApproachRadius, CometEvent, DistanceFrame, DistanceLimit, EventKind, EventLog, EventRules,
-    OpenApproach, Population, PopulationMember, PopulationProgress, RemovalRules,
-    DEFAULT_MAX_EVENTS_PER_PARTICLE, DEFAULT_WINDOW_STEPS, MAX_PERIHELION_THRESHOLDS,
+    ApproachRadius, CometEvent, DistanceFrame, DistanceLimit, EncounterTally, EventKind, EventLog,
+    EventRules, OpenApproach, OpenEncounter, Population, PopulationMember, PopulationProgress,
+    RemovalRules, SwitchesPerEncounter, DEFAULT_MAX_EVENTS_PER_PARTICLE, DEFAULT_WINDOW_STEPS,
+    ENCOUNTER_SEPARATION_FACTOR, MAX_PERIHELION_THRESHOLDS,
 };
 pub use run::{
     load_checkpoint, save_checkpoint, CometRun, Limits, ParticleStatus, TrackedParticle,

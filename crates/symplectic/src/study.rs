@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::io::{events_table, population_table, write_parquet, PopulationSpec, DAYS_PER_YEAR};
-use crate::{Population, PopulationProgress, SymplecticError};
+use crate::{Population, PopulationProgress, SwitchesPerEncounter, SymplecticError};
 
 /// Name of the checkpoint in the output directory.
 pub const CHECKPOINT_FILE: &str = "checkpoint.json";
@@ -56,6 +56,9 @@ pub struct StudySummary {
     pub events: u64,
     /// Events that full logs did not keep (the population table's `events_dropped`).
     pub events_dropped: u64,
+    /// Switches to the encounter mode per close encounter with a planet
+    /// ([`Population::switches_per_encounter`]).
+    pub switches_per_encounter: SwitchesPerEncounter,
 }
 
 /// Runs the study of `spec_path` into `out_dir`: snapshot tables
@@ -184,6 +187,7 @@ pub fn run_study(
         checkpoints_written: checkpoints,
         events: events.num_rows() as u64,
         events_dropped,
+        switches_per_encounter: state.population.switches_per_encounter(),
     })
 }
 

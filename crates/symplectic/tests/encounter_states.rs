@@ -191,18 +191,40 @@ fn a_comet_skimming_the_switch_radius_switches_once_with_hysteresis() {
     let begun = |p: &Population| p.members()[0].encounters_begun;
     assert_eq!(begun(&with), 1, "with hysteresis");
     assert_eq!(with.progress().encounters_begun, 1);
+    // One close encounter with Jupiter (the comet stays within twice the switch radius
+    // between the dips), of one switch.
+    let per = with.switches_per_encounter();
+    assert_eq!(
+        (per.encounters, per.switches, per.max),
+        (1, 1, 1),
+        "{per:?}"
+    );
 
     let sharp = Encounters {
         hand_back_hill_factor: Encounters::default().hill_factor,
         ..Encounters::default()
     };
     let mut without = population(&[comet], sharp);
-    hill_ratios(&mut without, years);
+    let ratios = hill_ratios(&mut without, years);
     assert!(
         begun(&without) > 1,
         "{} switches without hysteresis",
         begun(&without)
     );
+    // Still one encounter, now of several switches.
+    let per = without.switches_per_encounter();
+    assert_eq!(per.encounters, 1, "{per:?}");
+    assert_eq!(per.max, begun(&without), "{per:?}");
+    assert_eq!(per.mean(), f64::from(begun(&without)), "{per:?}");
+    // The encounter is over once the comet is beyond twice the switch radius at a map
+    // step's end (each ratio is at one), under way while it has not been.
+    let open = without.members()[0].tally.open.map(|o| o.planet);
+    let last = ratios[ratios.len() - 1];
+    if last >= 2.0 * 3.0 {
+        assert_eq!(open, None, "at {last} R_H: {ratios:.2?}");
+    } else if ratios.iter().all(|&r| r < 2.0 * 3.0) {
+        assert_eq!(open, Some(1), "{ratios:.2?}");
+    }
     #[cfg(feature = "io")]
     {
         let table = symplectic::io::population_table(&without).unwrap();
@@ -213,6 +235,19 @@ fn a_comet_skimming_the_switch_radius_switches_once_with_hysteresis() {
             .downcast_ref::<arrow_array::UInt64Array>()
             .unwrap();
         assert_eq!(column.value(0), u64::from(begun(&without)));
+        for (name, value) in [
+            ("planet_encounters", 1),
+            ("planet_encounter_switches", begun(&without)),
+            ("max_switches_per_encounter", begun(&without)),
+        ] {
+            let column = table
+                .column_by_name(name)
+                .unwrap()
+                .as_any()
+                .downcast_ref::<arrow_array::UInt64Array>()
+                .unwrap();
+            assert_eq!(column.value(0), u64::from(value), "{name}");
+        }
     }
 }
 

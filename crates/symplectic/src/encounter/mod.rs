@@ -81,7 +81,12 @@
 //! tidal acceleration `3Ω²r` is `(R_H/r)³`: 3.7 % at 3 R_H, 2.3 % at 3.5 R_H, so the map is
 //! handed no particle it would not have kept. `hand_back_hill_factor = hill_factor` gives
 //! the switch without hysteresis. [`PopulationMember::encounters_begun`](crate::PopulationMember)
-//! counts the switches of each particle.
+//! counts the switches of each particle, [`EncounterTally`](crate::EncounterTally) its close
+//! encounters with the planets (from a switch inside the switch radius until it is beyond
+//! twice that radius) and the switches in each, and
+//! [`Population::switches_per_encounter`](crate::Population::switches_per_encounter) their
+//! mean and largest number over a population (the population table's
+//! `planet_encounters`, `planet_encounter_switches` and `max_switches_per_encounter`).
 //!
 //! **Ends** during an encounter (checked after each step of the encounter integrator): a
 //! collision (closer to a planet's centre than its radius,

@@ -150,11 +150,126 @@ pub struct PopulationMember {
     /// before the counter existed.
     #[serde(default)]
     pub encounters_begun: u32,
+    /// Its close encounters with the planets and the switches in each
+    /// ([`EncounterTally`]). Zero in a population saved before the tally existed.
+    #[serde(default)]
+    pub tally: EncounterTally,
     /// The events recorded so far and what their detection needs to remember
     /// ([`EventRules`](crate::EventRules)); `None` until the first step checked with event
     /// rules set, and in a population saved before events existed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub events: Option<Box<EventLog>>,
+}
+
+/// How many separation radii ([`EncounterTally`]) per switch radius
+/// ([`Encounters::hill_factor`](crate::Encounters::hill_factor)): twice it, 6 Hill radii by
+/// default, where the planet's pull against the Sun's tidal acceleration, `(R_H/d)³`, is
+/// 0.5 %, an eighth of its value at the switch radius.
+pub const ENCOUNTER_SEPARATION_FACTOR: f64 = 2.0;
+
+/// A particle's close encounters with the planets, and the switches to the encounter mode
+/// in each.
+///
+/// **An encounter** is one close approach to one planet, as a planetary dynamicist counts
+/// it: it begins at a switch to the encounter mode inside the switch radius of the planet
+/// ([`Encounters::hill_factor`](crate::Encounters::hill_factor) Hill radii) and lasts until
+/// the particle, back in the map, is at a map step's end beyond the separation radius:
+/// [`ENCOUNTER_SEPARATION_FACTOR`] times the switch radius, or the hand-back radius if that
+/// is larger (6 Hill radii with the defaults), or until it switches inside the switch radius
+/// of another planet. A switch to the same planet before that belongs to the same encounter:
+/// a comet skimming the switch radius (a slow, trailing or quasi-satellite passage, whose
+/// distance in Hill radii swings by ±10 % over Jupiter's orbit) makes one encounter however
+/// often it switches. With the hand-back radius beyond the switch's (hysteresis) an encounter
+/// takes one switch unless the particle goes out beyond the hand-back radius and comes back
+/// without passing the separation radius; without hysteresis it takes one per dip. Switches
+/// where the map's regularisation was lost away from every planet (the Sun's vicinity) are
+/// no planetary encounter and are counted only in
+/// [`PopulationMember::encounters_begun`].
+///
+/// A particle with an encounter under way is followed by the scalar checks at every map step
+/// (the lanes flag it, [`crate::Population`]); its trajectory is unchanged.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub struct EncounterTally {
+    /// Encounters begun.
+    pub encounters: u32,
+    /// Switches in those encounters.
+    pub switches: u32,
+    /// Most switches in one of them (under way or ended).
+    pub max_switches: u32,
+    /// The encounter under way, if any: the planet (1-based) and its switches so far.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub open: Option<OpenEncounter>,
+}
+
+/// An encounter under way ([`EncounterTally::open`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct OpenEncounter {
+    /// The planet (1-based).
+    pub planet: u32,
+    /// Its switches so far.
+    pub switches: u32,
+}
+
+impl EncounterTally {
+    /// A switch to the encounter mode inside the switch radius of `planet` (1-based).
+    pub(crate) fn switch(&mut self, planet: u32) {
+        let open = match &mut self.open {
+            Some(o) if o.planet == planet => {
+                o.switches = o.switches.saturating_add(1);
+                *o
+            }
+            _ => {
+                self.encounters = self.encounters.saturating_add(1);
+                *self.open.insert(OpenEncounter {
+                    planet,
+                    switches: 1,
+                })
+            }
+        };
+        self.switches = self.switches.saturating_add(1);
+        self.max_switches = self.max_switches.max(open.switches);
+    }
+}
+
+/// Switches to the encounter mode per close encounter with a planet, over a population
+/// ([`Population::switches_per_encounter`](crate::Population::switches_per_encounter);
+/// [`EncounterTally`] defines an encounter).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SwitchesPerEncounter {
+    /// Encounters, all particles.
+    pub encounters: u64,
+    /// Switches in them.
+    pub switches: u64,
+    /// Most switches in one encounter.
+    pub max: u32,
+}
+
+impl SwitchesPerEncounter {
+    /// The mean number of switches per encounter (`NaN` without an encounter).
+    pub fn mean(&self) -> f64 {
+        if self.encounters == 0 {
+            f64::NAN
+        } else {
+            self.switches as f64 / self.encounters as f64
+        }
+    }
+
+    /// Adds a particle's tally.
+    pub(crate) fn add(mut self, t: &EncounterTally) -> Self {
+        self.encounters += u64::from(t.encounters);
+        self.switches += u64::from(t.switches);
+        self.max = self.max.max(t.max_switches);
+        self
+    }
+
+    /// Joins two partial sums.
+    pub(crate) fn join(self, other: Self) -> Self {
+        Self {
+            encounters: self.encounters + other.encounters,
+            switches: self.switches + other.switches,
+            max: self.max.max(other.max),
+        }
+    }
 }
 
 /// Where a [`Population`](crate::Population) stands after a synchronisation.

@@ -24,7 +24,8 @@ pub use events::{
     DEFAULT_MAX_EVENTS_PER_PARTICLE, MAX_PERIHELION_THRESHOLDS,
 };
 pub use members::{
-    DistanceFrame, DistanceLimit, PopulationMember, PopulationProgress, RemovalRules,
+    DistanceFrame, DistanceLimit, EncounterTally, OpenEncounter, PopulationMember,
+    PopulationProgress, RemovalRules, SwitchesPerEncounter, ENCOUNTER_SEPARATION_FACTOR,
 };
 use window::{run_window, total_gm, StepPath};
 
@@ -245,6 +246,7 @@ impl Population {
                     sun_position: bodies.positions[0],
                     encounter: None,
                     encounters_begun: 0,
+                    tally: EncounterTally::default(),
                     events: None,
                 })
             })
@@ -408,6 +410,17 @@ impl Population {
             removed: self.members.len() - active,
             encounters_begun,
         }
+    }
+
+    /// Switches to the encounter mode per close encounter with a planet, over every
+    /// particle, active or removed ([`EncounterTally`] defines an encounter): the count of
+    /// encounters and of their switches, the mean and the most in one.
+    pub fn switches_per_encounter(&self) -> SwitchesPerEncounter {
+        self.members
+            .par_iter()
+            .with_min_len(4096)
+            .fold(SwitchesPerEncounter::default, |s, m| s.add(&m.tally))
+            .reduce(SwitchesPerEncounter::default, SwitchesPerEncounter::join)
     }
 
     /// Work of the planets, the ephemeris and every particle (a particle of a population

@@ -8,7 +8,7 @@ use rayon::prelude::*;
 
 use super::ends::{geometric_end, SunState};
 use super::events::{CheckPoint, EventContext, EventRules};
-use super::members::{PopulationMember, RemovalRules};
+use super::members::{PopulationMember, RemovalRules, ENCOUNTER_SEPARATION_FACTOR};
 use crate::encounter::{
     regularisation, Encounter, EncounterScratch, Encounters, ENCOUNTER_STATE_LEN,
 };
@@ -409,7 +409,12 @@ impl WindowContext<'_> {
         }
         self.fetch_lanes(lanes, &t, live, &mut redo);
         let finite: [Mask; 7] = [q[0], q[1], q[2], v[0], v[1], v[2], p4].map(lanes::finite);
-        let removal = self.removal_lanes(&q, &v, &lanes.positions, &lanes.kick.f1);
+        let mut removal = self.removal_lanes(&q, &v, &lanes.positions, &lanes.kick.f1);
+        // A member with an encounter under way goes through the scalar checks, which follow
+        // it out to the separation radius (`EncounterTally`); its step is the lane's.
+        for (flag, slot) in removal.iter_mut().zip(&lanes.slots) {
+            *flag |= slot.member.is_some_and(|i| members[i].tally.open.is_some());
+        }
         let (mut steps, mut beyond) = (0, f64::NEG_INFINITY);
         let forces = kicks * self.gm.len() as u64;
         for (l, slot) in lanes.slots.iter_mut().enumerate() {
@@ -670,6 +675,7 @@ impl WindowContext<'_> {
         w: &mut Worker,
     ) -> bool {
         self.record_events(m, positions, velocities, true);
+        self.end_encounter_beyond_separation(m, positions);
         if let Some(settings) = self.encounters {
             // The same operations as the lanes' flags (`removal_lanes`).
             let r = m.particle.position.norm();
@@ -689,6 +695,28 @@ impl WindowContext<'_> {
             m.status = status;
         }
         false
+    }
+
+    /// Ends the encounter under way of `m` ([`EncounterTally`](crate::EncounterTally)) if it is beyond the
+    /// separation radius of its planet, with the bodies at its time.
+    fn end_encounter_beyond_separation(&self, m: &mut PopulationMember, positions: &[Vec3]) {
+        let (Some(open), Some(settings)) = (m.tally.open, self.encounters) else {
+            return;
+        };
+        let factor = (ENCOUNTER_SEPARATION_FACTOR * settings.hill_factor)
+            .max(settings.hand_back_hill_factor);
+        let q = self.barycentric(&m.particle, positions);
+        let j = open.planet as usize;
+        let (Some(c), Some(planet)) = (
+            self.hill_coefficients.get(j.wrapping_sub(1)),
+            positions.get(j),
+        ) else {
+            return;
+        };
+        let hill2 = (planet - positions[0]).norm_squared() * (c * c);
+        if (q - planet).norm_squared() >= factor * factor * hill2 {
+            m.tally.open = None;
+        }
     }
 
     /// The particle's barycentric position, with the bodies at its time.
@@ -761,9 +789,20 @@ impl WindowContext<'_> {
             }
             Err(_) => (0.0, None),
         };
+        // The planet whose switch radius it is inside, if any (not where the regularisation
+        // was lost away from the planets).
+        let planet = match (switch, self.encounters) {
+            (Some(_), Some(settings)) => self
+                .hill_entry(p, &w.bodies.positions, settings.hill_factor)
+                .map(|(j, _, _)| j),
+            _ => None,
+        };
         w.bodies_time = f64::NAN;
         m.encounter = Some(Box::new(Encounter::begin(p, &self.grid, map_dt, switch)));
         m.encounters_begun = m.encounters_begun.saturating_add(1);
+        if let Some(j) = planet.and_then(|j| u32::try_from(j).ok()) {
+            m.tally.switch(j);
+        }
     }
 
     /// Advances `m` in the encounter mode until it is handed back to the map, removed, or

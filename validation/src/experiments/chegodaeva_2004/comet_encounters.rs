@@ -7,10 +7,12 @@
 //! Eight cases (`reference-data/comet-encounters/`): closest approaches of 0.02, 0.05, 0.3 and
 //! 1 Hill radius of each planet, from the Sun and four giants of `outer_solar_system` at the
 //! epoch. The particle's position and velocity after the pass must agree with IAS15's at
-//! ε = 10⁻¹¹ within 10 × the two codes' own error estimates (each code against itself at a
-//! tighter setting: IAS15 at ε = 10⁻⁹ against 10⁻¹¹, ours at the tolerance against a
-//! hundredth of it) plus 10⁻¹³ of the particle's distance and speed (round-off of barycentric
-//! coordinates near 5–30 AU amplified through the pass). The crate's test
+//! ε = 10⁻¹¹ within a fixed bound per case, taken from the reference and the tolerance, never
+//! from our own error estimate: 10 × IAS15's convergence (its run at its default ε = 10⁻⁹
+//! against 10⁻¹¹: the error of the default run, an order of magnitude of it) plus the
+//! precision the tolerance asks of the state, `tol` of the position's (velocity's) length per
+//! component, `√3 tol` in length (below IAS15's convergence, as for the velocities at
+//! Neptune, no code can be held to more). The crate's test
 //! `single_encounters_agree_with_ias15` checks the same cases; here they are reported. The
 //! same in quick and full mode (a second of work).
 
@@ -109,10 +111,7 @@ impl Experiment for CometEncounters {
     fn run(&self, ctx: &mut Context) -> Result<Outcome> {
         let reference = ias15(ctx)?;
         let settings = Encounters::default();
-        let tight = Encounters {
-            tolerance: settings.tolerance / 100.0,
-            ..settings
-        };
+        let tolerance = 3f64.sqrt() * settings.tolerance;
         let planet_names = ["Sun", "Jupiter", "Saturn", "Uranus", "Neptune"];
         let mut out = Outcome::new();
         let mut rows = Vec::new();
@@ -126,13 +125,8 @@ impl Experiment for CometEncounters {
             let (loose, exact) = (find(1e-9)?, find(1e-11)?);
             let (q0, v0) = c.state;
             let ours = integrate_through(&c.bodies, q0, v0, c.t_end, &settings)?;
-            let ours_tight = integrate_through(&c.bodies, q0, v0, c.t_end, &tight)?;
-            let tol_q = 10.0
-                * ((loose.3 - exact.3).norm() + (ours.position - ours_tight.position).norm())
-                + 1e-13 * exact.3.norm();
-            let tol_v = 10.0
-                * ((loose.4 - exact.4).norm() + (ours.velocity - ours_tight.velocity).norm())
-                + 1e-13 * exact.4.norm();
+            let tol_q = 10.0 * (loose.3 - exact.3).norm() + tolerance * exact.3.norm();
+            let tol_v = 10.0 * (loose.4 - exact.4).norm() + tolerance * exact.4.norm();
             let dq = (ours.position - exact.3).norm();
             let dv = (ours.velocity - exact.4).norm();
             let sun = c.bodies.positions[0];
@@ -143,7 +137,8 @@ impl Experiment for CometEncounters {
                 "case {k}, {} at {closest:.3} R_H",
                 planet_names.get(c.planet).copied().unwrap_or("?")
             );
-            let origin = "10 × (IAS15 ε 1e-9 vs 1e-11 + ours tol vs tol/100) + 1e-13 of the scale (module docs)";
+            let origin =
+                "10 × IAS15 (ε 1e-9 vs 1e-11) + √3 tol of the state's length (module docs)";
             out.check(Check::at_most(
                 format!("{name}: position difference (AU)"),
                 dq,
