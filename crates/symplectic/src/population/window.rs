@@ -8,7 +8,7 @@ use rayon::prelude::*;
 
 use super::ends::{geometric_end, SunState};
 use super::events::{CheckPoint, EventContext, EventRules};
-use super::members::{PopulationMember, RemovalRules, ENCOUNTER_SEPARATION_FACTOR};
+use super::members::{DistanceFrame, PopulationMember, RemovalRules, ENCOUNTER_SEPARATION_FACTOR};
 use crate::encounter::{
     regularisation, Encounter, EncounterScratch, Encounters, ENCOUNTER_STATE_LEN,
 };
@@ -17,6 +17,7 @@ use crate::lanes::{self, norm, norm_squared, KickLanes, Mask, LANES, V, V3};
 use crate::particles::ParticlePiece;
 use crate::particles::{KickTerms, ParticleIntegrator, TestParticle};
 use crate::run::ParticleStatus;
+use crate::solar_system::SUN_RADIUS_AU;
 use crate::{SymplecticError, Variant, Vec3};
 
 /// Per-thread scratch of [`Population::advance_to`](crate::Population::advance_to).
@@ -43,8 +44,12 @@ struct WindowContext<'a> {
     /// Jupiter's index among the bodies, if any.
     jupiter: Option<usize>,
     /// Whether every step end is checked by the scalar code (events, or the geometric end
-    /// rules of [`geometric_end`]): the lanes then flag every lane.
+    /// rules of [`geometric_end`]), in the encounter mode as in the map.
     every_step: bool,
+    /// Whether the lanes flag every lane for the scalar checks (events, which the lanes do not
+    /// evaluate); the geometric end rules are flagged by a wider test in the lanes instead
+    /// ([`WindowContext::removal_lanes`]).
+    flag_every_lane: bool,
     /// Radius of each planet, if known.
     radii: Vec<Option<f64>>,
     /// `(m_j/3m₀)^{1/3}` per planet.
@@ -161,6 +166,7 @@ pub(super) fn run_window(
             || rules.sun_collision
             || rules.min_distance.is_some()
             || rules.max_distance.is_some(),
+        flag_every_lane: events.any(),
         radii: (1..=planets.len()).map(|j| planets.radius(j)).collect(),
         hill_coefficients: planets
             .masses()
@@ -196,6 +202,77 @@ pub(super) fn run_window(
 fn below_or_nan(x: f64, y: f64) -> bool {
     matches!(x.partial_cmp(&y), None | Some(std::cmp::Ordering::Less))
 }
+
+/// The lanes that may meet one of [`geometric_end`]'s rules at barycentric `(q, v)` with the
+/// Sun at `(sun, sun_velocity)` and `G m_sun = sun_gm`: a wider test than the rules' own
+/// (the lanes' flag only sends a lane to the scalar check, which decides; a lane flagged for
+/// nothing goes on unchanged, so the result is the scalar path's bit for bit), without a
+/// division, a square root or an angle:
+///
+/// - the Sun: within [`SUN_RADIUS_FLAG_FACTOR`] solar radii, or a heliocentric osculating
+///   pericentre below that many (passed or not: `perihelion_passed_within` also asks that it
+///   was passed within the step), from `q < L ⟺ h² − Lμ < Lμe` squared as in
+///   [`WindowContext::orbit_removal_at`];
+/// - `min_distance` / `max_distance`: the squared distance against the squared limit widened
+///   by [`DISTANCE_FLAG_MARGIN`].
+///
+/// The widenings cover the rounding of the two formulas (relative 10⁻¹⁵ here), by far.
+#[inline(always)]
+fn geometric_end_lanes(
+    rules: &RemovalRules,
+    q: &V3,
+    v: &V3,
+    sun: &V3,
+    sun_velocity: &V3,
+    sun_gm: f64,
+) -> Mask {
+    let sub = |a: &V3, b: &V3| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    let helio = sub(q, sun);
+    let mut hit = [false; LANES];
+    if rules.sun_collision {
+        let v_helio = sub(v, sun_velocity);
+        let limit = SUN_RADIUS_FLAG_FACTOR * SUN_RADIUS_AU;
+        let mu = sun_gm;
+        let r2 = norm_squared(&helio);
+        let r = norm(&helio);
+        let h = [
+            helio[1] * v_helio[2] - helio[2] * v_helio[1],
+            helio[2] * v_helio[0] - helio[0] * v_helio[2],
+            helio[0] * v_helio[1] - helio[1] * v_helio[0],
+        ];
+        let h2 = norm_squared(&h);
+        let v2r = norm_squared(&v_helio) * r;
+        let r_mu2_e2 = (r * mu * mu + (v2r - 2.0 * mu) * h2).max(0.0);
+        let (u, w) = (h2 - limit * mu, limit * mu);
+        let (left, right) = (u * u * (r * mu * mu), w * w * r_mu2_e2);
+        for (l, flag) in hit.iter_mut().enumerate() {
+            *flag |= r2.0[l] < limit * limit || u.0[l] < 0.0 || left.0[l] < right.0[l];
+        }
+    }
+    let distance2 = |frame: DistanceFrame| match frame {
+        DistanceFrame::Heliocentric => norm_squared(&helio),
+        DistanceFrame::Barycentric => norm_squared(q),
+    };
+    if let Some(limit) = &rules.min_distance {
+        let (d2, bound) = (distance2(limit.frame), limit.distance * limit.distance);
+        for (l, flag) in hit.iter_mut().enumerate() {
+            *flag |= d2.0[l] < bound * (1.0 + DISTANCE_FLAG_MARGIN);
+        }
+    }
+    if let Some(limit) = &rules.max_distance {
+        let (d2, bound) = (distance2(limit.frame), limit.distance * limit.distance);
+        for (l, flag) in hit.iter_mut().enumerate() {
+            *flag |= d2.0[l] > bound * (1.0 - DISTANCE_FLAG_MARGIN);
+        }
+    }
+    hit
+}
+
+/// How many solar radii the lanes' Sun test flags ([`geometric_end_lanes`]).
+const SUN_RADIUS_FLAG_FACTOR: f64 = 2.0;
+/// The relative widening of the squared distance limits in the lanes' test
+/// ([`geometric_end_lanes`]).
+const DISTANCE_FLAG_MARGIN: f64 = 1e-9;
 
 /// Adds two `(steps, beyond)` pairs.
 fn sum_steps(a: (u64, f64), b: (u64, f64)) -> (u64, f64) {
@@ -409,7 +486,12 @@ impl WindowContext<'_> {
         }
         self.fetch_lanes(lanes, &t, live, &mut redo);
         let finite: [Mask; 7] = [q[0], q[1], q[2], v[0], v[1], v[2], p4].map(lanes::finite);
-        let mut removal = self.removal_lanes(&q, &v, &lanes.positions, &lanes.kick.f1);
+        let mut removal = self.removal_lanes(
+            &q,
+            &v,
+            (&lanes.positions, &lanes.velocities),
+            &lanes.kick.f1,
+        );
         // A member with an encounter under way goes through the scalar checks, which follow
         // it out to the separation radius (`EncounterTally`); its step is the lane's.
         for (flag, slot) in removal.iter_mut().zip(&lanes.slots) {
@@ -596,9 +678,15 @@ impl WindowContext<'_> {
     /// `v` among the bodies at `positions`: the same tests with the same operations, so that
     /// only the lanes it flags need the scalar form (which names the rule).
     #[inline(always)]
-    fn removal_lanes(&self, q: &V3, v: &V3, positions: &[V3], f1: &V) -> Mask {
+    fn removal_lanes(
+        &self,
+        q: &V3,
+        v: &V3,
+        (positions, velocities): (&[V3], &[V3]),
+        f1: &V,
+    ) -> Mask {
         let rules = &self.rules;
-        if self.every_step {
+        if self.flag_every_lane {
             return [true; LANES];
         }
         let mut hit = [false; LANES];
@@ -624,6 +712,14 @@ impl WindowContext<'_> {
                 flag(std::array::from_fn(|l| distance2.0[l] < limit.0[l]));
             }
         }
+        flag(geometric_end_lanes(
+            rules,
+            q,
+            v,
+            &positions[0],
+            &velocities[0],
+            self.gm[0],
+        ));
         if rules.min_perihelion.is_none() && rules.ejection_distance.is_none() {
             return hit;
         }
