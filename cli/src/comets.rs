@@ -82,12 +82,15 @@ pub fn run(args: &CometsArgs) -> Result<()> {
     bar.finish();
     let p = summary.progress;
     println!(
-        "{}: {} particles active, {} removed; {} particle steps; {} switches to the encounter integrator; {}{} snapshots written to {}, final table {}, {} events to {}{}",
+        "{}: {} particles active, {} removed; {} particle steps; {} switches to the encounter integrator ({} close encounters with a planet, {:.2} switches per encounter, at most {}); {}{} snapshots written to {}, final table {}, {} events to {}{}",
         args.population.display(),
         p.active,
         p.removed,
         p.particle_steps,
         p.encounters_begun,
+        summary.switches_per_encounter.encounters,
+        summary.switches_per_encounter.mean(),
+        summary.switches_per_encounter.max,
         if summary.resumed { "resumed; " } else { "" },
         summary.snapshots_written,
         out.join(SNAPSHOT_DIR).display(),

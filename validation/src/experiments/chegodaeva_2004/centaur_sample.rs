@@ -116,6 +116,8 @@ pub(crate) struct OursRun {
     /// Switches to the encounter integrator of all comets
     /// (`PopulationProgress::encounters_begun`).
     pub encounters_begun: u64,
+    /// Switches per close encounter with a planet (`Population::switches_per_encounter`).
+    pub switches_per_encounter: symplectic::SwitchesPerEncounter,
     /// The checkpoint's time the run resumed from (years), if it did.
     pub resumed_from_years: Option<f64>,
 }
@@ -202,6 +204,7 @@ pub(crate) fn run_ours(
     Ok(OursRun {
         ends,
         encounters_begun: population.progress().encounters_begun,
+        switches_per_encounter: population.switches_per_encounter(),
         resumed_from_years,
     })
 }
