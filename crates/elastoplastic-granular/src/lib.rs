@@ -102,6 +102,7 @@
 pub mod boundary_particles;
 pub mod initial;
 mod kernels;
+mod lanes;
 mod name;
 mod params;
 mod passes;

@@ -8,10 +8,13 @@ use sph_core::{Real, Vec3};
 use sph_kernels::Kernel;
 use sph_solver::boundary::Boundary;
 use sph_solver::csr::par_csr_blocks;
+use sph_solver::pair_lanes::f32s;
+use sph_solver::scene_boundary::PeriodicImages;
 use sph_solver::step::MIN_LEN;
 use sph_solver::NeighbourLists;
 
 use crate::kernels::Consts;
+use crate::lanes::{flat, GrainLanes, MomentumArrays, StressArrays, StressSums};
 use crate::params::WallModel;
 use crate::scratch::Scratch;
 use crate::stress::artificial_stress;
@@ -72,8 +75,34 @@ pub(crate) fn reinitialise_density<R: Real, K: Kernel<R>>(
         });
 }
 
+/// The lane constants where the pair loops run in lanes ([`GrainLanes::new`]): the lists'
+/// particles are the positions `s.x` (no periodic images).
+fn grain_lanes<R: Real, K: Kernel<R>>(
+    s: &Scratch<R>,
+    inp: &StepInputs<'_, R, K>,
+) -> Option<GrainLanes> {
+    let listed = inp.nb.offsets().len().checked_sub(1)?;
+    if listed != s.x.len() {
+        return None;
+    }
+    GrainLanes::new(&inp.c, inp.nb, listed, !s.images.src.is_empty())
+}
+
+/// The kernel gradient `∇_i W_ij` at the offset `x_ij = x_i − x_j`: zero beyond the
+/// support (a listed pair in the lists' skin).
+#[inline]
+pub(crate) fn pair_gradient<R: Real, K: Kernel<R>>(c: &Consts<R, K>, xij: &Vec3<R>) -> Vec3<R> {
+    if xij.norm_squared() > c.support2_above {
+        Vec3::zeros()
+    } else {
+        c.kernel.gradient(xij)
+    }
+}
+
 /// The kernel gradient `∇_i W_ij` of every grain's listed pair, in the lists' CSR order
-/// (zero beyond the support): computed once per explicit step and read by both passes.
+/// (zero beyond the support): computed once per explicit step and read by both passes. In
+/// lanes where they run ([`crate::lanes`]; bit for bit the scalar gradients), after packing
+/// the positions and masses they and the momentum pass read.
 pub(crate) fn pair_gradients<R: Real, K: Kernel<R>>(
     s: &mut Scratch<R>,
     inp: &StepInputs<'_, R, K>,
@@ -82,7 +111,16 @@ pub(crate) fn pair_gradients<R: Real, K: Kernel<R>>(
     let offsets = &inp.nb.offsets()[..=n];
     let pairs = offsets[n];
     s.pair_grad.resize(pairs, Vec3::zeros());
-    let (x, images, h2, kernel) = (&s.x[..], &s.images, inp.c.support2_above, inp.c.kernel);
+    let lanes = grain_lanes(s, inp);
+    if lanes.is_some() {
+        let all = s.x.len();
+        s.mass_all.clear();
+        s.mass_all.extend_from_slice(inp.masses);
+        s.mass_all.resize(all, inp.boundary_mass);
+        s.packed.fill(&s.x, &s.mass_all);
+    }
+    let (x, images) = (&s.x[..], &s.images);
+    let xm = s.packed.values();
     let mut grains = vec![(); n];
     par_csr_blocks(
         offsets,
@@ -91,21 +129,68 @@ pub(crate) fn pair_gradients<R: Real, K: Kernel<R>>(
         &|first, grains: &mut [()], out: &mut [Vec3<R>]| {
             let base = offsets[first];
             for i in first..first + grains.len() {
-                let xi = x[i];
                 let at = offsets[i] - base;
-                for (k, &j) in inp.nb.neighbours(i).iter().enumerate() {
+                let out = &mut out[at..offsets[i + 1] - base];
+                if let Some(l) = &lanes {
+                    l.gradients(xm, inp.nb, i, out);
+                    continue;
+                }
+                let xi = x[i];
+                for (o, &j) in out.iter_mut().zip(inp.nb.neighbours(i)) {
                     let (_, xj) = images.resolve(j as usize, x);
-                    let xij = xi - xj;
-                    out[at + k] = if xij.norm_squared() > h2 {
-                        Vec3::zeros()
-                    } else {
-                        kernel.gradient(&xij)
-                    };
+                    *o = pair_gradient(&inp.c, &(xi - xj));
                 }
             }
             0.0
         },
     );
+}
+
+/// The arrays the stress pass's pair sums read.
+pub(crate) struct StressFields<'a, R: Real> {
+    pub nb: &'a NeighbourLists,
+    pub images: &'a PeriodicImages<R>,
+    /// Positions, velocities and `m/ρ` of the particles (grains, then boundary particles).
+    pub x: &'a [Vec3<R>],
+    pub v: &'a [Vec3<R>],
+    pub volume: &'a [R],
+    /// The grains' masses; the boundary particles' is `boundary_mass`.
+    pub masses: &'a [R],
+    pub boundary_mass: R,
+}
+
+/// Grain `i`'s velocity gradient `L_i = Σ_j V_j (v_j − v_i) ⊗ ∇W_ij`, its continuity rate
+/// `−Σ_j m_j (v_j − v_i)·∇W_ij` (no wall share) and whether a grain other than `i` lies
+/// inside its support, from its stored pair gradients `grad_i`, left to right.
+#[inline(always)]
+pub(crate) fn stress_sums<R: Real>(
+    f: &StressFields<'_, R>,
+    i: usize,
+    grad_i: &[Vec3<R>],
+) -> StressSums<R> {
+    let n = f.masses.len();
+    let vi = f.v[i];
+    let mut grad_v = Matrix3::zeros();
+    let mut drho = R::zero();
+    let mut in_contact = false;
+    for (&j, &gw) in f.nb.neighbours(i).iter().zip(grad_i) {
+        // Beyond the support (the lists' skin) the gradient is zero, whose terms would add
+        // zeros.
+        if gw == Vec3::zeros() {
+            continue;
+        }
+        let (j, _) = f.images.resolve(j as usize, f.x);
+        in_contact |= j < n && j != i;
+        let dv = f.v[j] - vi;
+        grad_v += dv * gw.transpose() * f.volume[j];
+        let m = f.masses.get(j).copied().unwrap_or(f.boundary_mass);
+        drho -= m * dv.dot(&gw);
+    }
+    StressSums {
+        grad_v,
+        drho,
+        in_contact,
+    }
 }
 
 /// Pass 1: the wall gradients at `x`, the velocity gradient `L_i` and the continuity rate
@@ -123,8 +208,23 @@ pub(crate) fn stress_pass<R: Real, K: Kernel<R>>(s: &mut Scratch<R>, inp: &StepI
         .zip(inp.masses.par_iter().zip(s.rho[..n].par_iter()))
         .with_min_len(MIN_LEN)
         .for_each(|(vol, (&m, &r))| *vol = m / r);
-    let (x, v, rho, volume) = (&s.x[..], &s.v[..], &s.rho[..], &s.volume[..]);
-    let (stress, plastic, images) = (&s.stress[..], &s.plastic_strain[..], &s.images);
+    let lanes = grain_lanes(s, inp);
+    let fields = StressFields {
+        nb: inp.nb,
+        images: &s.images,
+        x: &s.x,
+        v: &s.v,
+        volume: &s.volume,
+        masses: inp.masses,
+        boundary_mass: inp.boundary_mass,
+    };
+    let lane_arrays = lanes.map(|_| StressArrays {
+        v: flat::<_, R>(&s.v, 3),
+        volume: f32s(&s.volume),
+        mass: f32s(&s.mass_all),
+    });
+    let (x, v, rho) = (&s.x[..], &s.v[..], &s.rho[..]);
+    let (stress, plastic) = (&s.stress[..], &s.plastic_strain[..]);
     let (grad, offsets) = (&s.pair_grad[..], inp.nb.offsets());
     s.stress_new[..n]
         .par_iter_mut()
@@ -139,22 +239,15 @@ pub(crate) fn stress_pass<R: Real, K: Kernel<R>>(s: &mut Scratch<R>, inp: &StepI
         .for_each(
             |(i, ((((((sig, r), kappa), art), grads), sig_rho2), art_on))| {
                 let (xi, vi) = (x[i], v[i]);
-                let mut grad_v = Matrix3::zeros();
-                let mut drho = R::zero();
-                let mut in_contact = false;
                 let grad_i = &grad[offsets[i]..offsets[i + 1]];
-                for (&j, &gw) in inp.nb.neighbours(i).iter().zip(grad_i) {
-                    // Beyond the support (the lists' skin) the gradient is zero, whose terms
-                    // would add zeros.
-                    if gw == Vec3::zeros() {
-                        continue;
-                    }
-                    let (j, _) = images.resolve(j as usize, x);
-                    in_contact |= j < n && j != i;
-                    let dv = v[j] - vi;
-                    grad_v += dv * gw.transpose() * volume[j];
-                    drho -= inp.mass(j) * dv.dot(&gw);
-                }
+                let StressSums {
+                    mut grad_v,
+                    mut drho,
+                    in_contact,
+                } = match (&lanes, &lane_arrays) {
+                    (Some(l), Some(a)) => l.stress_sums(a, inp.nb, n, i, flat::<_, R>(grad_i, 3)),
+                    _ => stress_sums(&fields, i, grad_i),
+                };
                 if slots > 0 {
                     inp.walls.sample(inp.boundary, &xi, grads);
                     for (g, &model) in grads.iter().zip(inp.models) {
@@ -182,20 +275,104 @@ pub(crate) fn stress_pass<R: Real, K: Kernel<R>>(s: &mut Scratch<R>, inp: &StepI
         );
 }
 
+/// The arrays the momentum pass's pair terms read.
+pub(crate) struct MomentumFields<'a, R: Real> {
+    pub images: &'a PeriodicImages<R>,
+    /// Positions, velocities and the new densities of the particles (grains, then boundary
+    /// particles).
+    pub x: &'a [Vec3<R>],
+    pub v: &'a [Vec3<R>],
+    pub rho: &'a [R],
+    /// `σ/ρ²` of the new stresses and densities, the artificial stresses `R` and whether each
+    /// is non-zero.
+    pub sig_rho2: &'a [Matrix3<R>],
+    pub art: &'a [Matrix3<R>],
+    pub art_on: &'a [bool],
+    /// The grains' masses; the boundary particles' is `boundary_mass`.
+    pub masses: &'a [R],
+    pub boundary_mass: R,
+}
+
+/// The pair stress `σ_i/ρ_i² + σ_j/ρ_j² − Π_ij I + f_ij^n (R_i + R_j)` (Pa m⁶/kg²) of grain
+/// `i`'s listed neighbour `j` (an index of the lists) and the neighbour's mass `m_j`:
+/// Monaghan's artificial viscosity on approaching pairs, Gray, Monaghan & Swift's artificial
+/// stress where either side has one.
+#[inline(always)]
+pub(crate) fn pair_stress<R: Real, K: Kernel<R>>(
+    c: &Consts<R, K>,
+    f: &MomentumFields<'_, R>,
+    i: usize,
+    j: usize,
+) -> (Matrix3<R>, R) {
+    let (xi, vi, ri) = (f.x[i], f.v[i], f.rho[i]);
+    let (j, xj) = f.images.resolve(j, f.x);
+    let xij = xi - xj;
+    let rj = f.rho[j];
+    let mut t = f.sig_rho2[i] + f.sig_rho2[j];
+    // Monaghan's artificial viscosity, for approaching pairs (`Π_ij > 0`: only the diagonal
+    // changes).
+    let vij = vi - f.v[j];
+    let vx = vij.dot(&xij);
+    if vx < R::zero() {
+        let phi = c.h * vx / (xij.norm_squared() + c.eta2);
+        let pi = (-c.alpha * c.c0 * phi + c.beta * phi * phi) / ((ri + rj) * R::of_f64(0.5));
+        for k in 0..3 {
+            t[(k, k)] -= pi;
+        }
+    }
+    // Gray, Monaghan & Swift's artificial stress.
+    if f.art_on[i] || f.art_on[j] {
+        let w = (c.kernel.value(xij.norm()) * c.inv_w_spacing).powf(c.exponent);
+        t += (f.art[i] + f.art[j]) * w;
+    }
+    (t, f.masses.get(j).copied().unwrap_or(f.boundary_mass))
+}
+
+/// The momentum pass's term `m_j T_ij ∇W_ij` of grain `i`'s listed neighbour `j` with the
+/// pair gradient `gw` and the pair stress `T_ij` ([`pair_stress`]).
+#[inline(always)]
+pub(crate) fn pair_term<R: Real, K: Kernel<R>>(
+    c: &Consts<R, K>,
+    f: &MomentumFields<'_, R>,
+    i: usize,
+    j: usize,
+    gw: &Vec3<R>,
+) -> Vec3<R> {
+    let (t, m) = pair_stress(c, f, i, j);
+    t * gw * m
+}
+
 /// Pass 2: the acceleration from the new stresses (with the artificial viscosity and
 /// stress and the walls' share), the velocity and position after `Δt` (symplectic Euler),
 /// the position projected out of the solids and the velocity corrected by that projection.
+/// The pair terms ([`pair_term`]) in lanes where they run, for a grain without artificial
+/// stress ([`crate::lanes`]).
 pub(crate) fn momentum_pass<R: Real, K: Kernel<R>>(s: &mut Scratch<R>, inp: &StepInputs<'_, R, K>) {
     let c = inp.c;
     let slots = inp.models.len();
     let n = inp.masses.len();
-    let (x, v) = (&s.x[..], &s.v[..]);
-    let (sig, rho, art, grads) = (&s.stress_new[..], &s.rho_new[..], &s.art[..], &s.wall_grad);
-    let (sig_rho2, art_on) = (&s.stress_over_rho2[..], &s.art_on[..]);
-    let images = &s.images;
+    let lanes = grain_lanes(s, inp);
+    let f = MomentumFields {
+        images: &s.images,
+        x: &s.x,
+        v: &s.v,
+        rho: &s.rho_new,
+        sig_rho2: &s.stress_over_rho2,
+        art: &s.art,
+        art_on: &s.art_on,
+        masses: inp.masses,
+        boundary_mass: inp.boundary_mass,
+    };
+    let lane_arrays = lanes.map(|_| MomentumArrays {
+        xm: s.packed.values(),
+        v: flat::<_, R>(&s.v, 3),
+        rho: f32s(&s.rho_new),
+        sig_rho2: flat::<_, R>(&s.stress_over_rho2, 9),
+        art_on: &s.art_on,
+    });
+    let (sig, grads) = (&s.stress_new[..], &s.wall_grad);
     let (grad, offsets) = (&s.pair_grad[..], inp.nb.offsets());
     let two = R::of_f64(2.0);
-    let half = R::of_f64(0.5);
     let inv_dt = R::one() / inp.dt;
     s.v_new[..n]
         .par_iter_mut()
@@ -203,37 +380,27 @@ pub(crate) fn momentum_pass<R: Real, K: Kernel<R>>(s: &mut Scratch<R>, inp: &Ste
         .enumerate()
         .with_min_len(MIN_LEN)
         .for_each(|(i, (vn, xn))| {
-            let (xi, vi, ri) = (x[i], v[i], rho[i]);
-            let si = sig_rho2[i];
-            let art_i = art[i];
-            let art_i_on = art_on[i];
+            let (xi, vi, ri) = (f.x[i], f.v[i], f.rho[i]);
             let mut a = inp.gravity;
+            let list = inp.nb.neighbours(i);
             let grad_i = &grad[offsets[i]..offsets[i + 1]];
-            for (&j, &gw) in inp.nb.neighbours(i).iter().zip(grad_i) {
-                if gw == Vec3::zeros() {
-                    continue;
+            match (&lanes, &lane_arrays) {
+                (Some(l), Some(arrays)) if !f.art_on[i] => {
+                    let mut rest = Vec3::zeros();
+                    let mut scalar = |k: usize| {
+                        rest += pair_term(&c, &f, i, list[k] as usize, &grad_i[k]);
+                    };
+                    let lanes_sum: Vec3<R> =
+                        l.acceleration(arrays, inp.nb, i, flat::<_, R>(grad_i, 3), &mut scalar);
+                    a += lanes_sum + rest;
                 }
-                let (j, xj) = images.resolve(j as usize, x);
-                let xij = xi - xj;
-                let rj = rho[j];
-                let mut t = si + sig_rho2[j];
-                // Monaghan's artificial viscosity, for approaching pairs (`Π_ij > 0`: only
-                // the diagonal changes).
-                let vij = vi - v[j];
-                let vx = vij.dot(&xij);
-                if vx < R::zero() {
-                    let phi = c.h * vx / (xij.norm_squared() + c.eta2);
-                    let pi = (-c.alpha * c.c0 * phi + c.beta * phi * phi) / ((ri + rj) * half);
-                    for k in 0..3 {
-                        t[(k, k)] -= pi;
+                _ => {
+                    for (&j, gw) in list.iter().zip(grad_i) {
+                        if *gw != Vec3::zeros() {
+                            a += pair_term(&c, &f, i, j as usize, gw);
+                        }
                     }
                 }
-                // Gray, Monaghan & Swift's artificial stress.
-                if art_i_on || art_on[j] {
-                    let f = (c.kernel.value(xij.norm()) * c.inv_w_spacing).powf(c.exponent);
-                    t += (art_i + art[j]) * f;
-                }
-                a += t * gw * inp.mass(j);
             }
             if slots > 0 {
                 let gi = &grads[i * slots..(i + 1) * slots];

@@ -6,6 +6,7 @@ use sph_core::{Real, Vec3};
 
 use sph_solver::boundary::wall_extrapolation::BoundaryLists;
 use sph_solver::boundary::BoundaryParticle;
+use sph_solver::pair_lanes::Packed;
 use sph_solver::scene_boundary::PeriodicImages;
 
 /// Per-particle arrays (structure of arrays).
@@ -34,6 +35,10 @@ pub(crate) struct Scratch<R: Real> {
     /// The kernel gradient of each grain's listed pair (CSR order of the neighbour lists),
     /// once per explicit step for both passes.
     pub pair_grad: Vec<Vec3<R>>,
+    /// The masses of the grains followed by the boundary particles', and the positions and
+    /// masses packed for the lanes ([`crate::lanes`]; filled only where they run).
+    pub mass_all: Vec<R>,
+    pub packed: Packed,
     /// The boundary particles' grain neighbours and Shepard weights.
     pub boundary_lists: BoundaryLists<R>,
     pub x_new: Vec<Vec3<R>>,
