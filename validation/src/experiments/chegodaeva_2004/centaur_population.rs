@@ -530,7 +530,10 @@ impl Experiment for CentaurPopulation {
             "ours: close encounters with a planet (inside 3 Hill radii)",
             per_encounter.encounters as f64,
         );
-        out.metric("ours: switches per close encounter, mean", per_encounter.mean());
+        out.metric(
+            "ours: switches per close encounter, mean",
+            per_encounter.mean(),
+        );
         out.metric(
             "ours: switches per close encounter, most",
             f64::from(per_encounter.max),
