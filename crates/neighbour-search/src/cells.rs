@@ -1,5 +1,8 @@
 //! Cell coordinates, validation and packed cell keys shared by the grid methods.
 
+// Unsafe: the call of a function compiled for AVX-512, behind the run-time detection of the features; see the SAFETY comment.
+#![allow(unsafe_code)]
+
 use rayon::prelude::*;
 use sph_core::{Real, Vec3};
 
@@ -86,7 +89,7 @@ pub(crate) fn compute_cells<R: Real>(
     if positions.is_empty() {
         return Ok(None);
     }
-    type Acc = (bool, [i32; 3], [i32; 3]);
+    type Acc = CellsAcc;
     let id = || -> Acc { (true, [i32::MAX; 3], [i32::MIN; 3]) };
     let merge = |(g0, mut lo, mut hi): Acc, (g1, l, h): Acc| -> Acc {
         for a in 0..3 {
@@ -98,22 +101,7 @@ pub(crate) fn compute_cells<R: Real>(
     let (ok, lo, hi) = out
         .par_chunks_mut(CELLS_CHUNK)
         .zip(positions.par_chunks(CELLS_CHUNK))
-        .map(|(cells, pts)| {
-            let (mut good, mut lo, mut hi) = id();
-            for (c, p) in cells.iter_mut().zip(pts) {
-                for a in 0..3 {
-                    let q = p[a].as_f64() / cell;
-                    // False for NaN and ±∞ too.
-                    let valid = q.abs() <= CELL_LIMIT;
-                    let v = floor_i32(if valid { q } else { 0.0 });
-                    good &= valid;
-                    c[a] = v;
-                    lo[a] = lo[a].min(v);
-                    hi[a] = hi[a].max(v);
-                }
-            }
-            (good, lo, hi)
-        })
+        .map(|(cells, pts)| cells_chunk(cells, pts, cell))
         .reduce(id, merge);
     if ok {
         return Ok(Some((lo, hi)));
@@ -141,6 +129,54 @@ pub(crate) fn compute_cells<R: Real>(
         }
     }
     unreachable!("a cell failed but no particle was found at fault")
+}
+
+/// One task of [`compute_cells`]: the cells of `pts` into `cells`, whether all were valid,
+/// and their componentwise min and max. On x86-64 with AVX-512F and DQ (detected at run
+/// time) the same loop is compiled for them, which vectorises its `f64` divisions and
+/// conversions; the operations, and so the cells, are the same.
+fn cells_chunk<R: Real>(cells: &mut [[i32; 3]], pts: &[Vec3<R>], cell: f64) -> CellsAcc {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx512f")
+        && std::arch::is_x86_feature_detected!("avx512dq")
+    {
+        // SAFETY: the features were detected.
+        return unsafe { cells_chunk_avx512(cells, pts, cell) };
+    }
+    cells_chunk_body(cells, pts, cell)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512dq")]
+unsafe fn cells_chunk_avx512<R: Real>(
+    cells: &mut [[i32; 3]],
+    pts: &[Vec3<R>],
+    cell: f64,
+) -> CellsAcc {
+    cells_chunk_body(cells, pts, cell)
+}
+
+/// Whether every cell was valid, and the componentwise min and max of the cells.
+type CellsAcc = (bool, [i32; 3], [i32; 3]);
+
+/// The loop of [`cells_chunk`], branch-free (an invalid coordinate is replaced by 0 and
+/// flagged) so that it vectorises.
+#[inline(always)]
+fn cells_chunk_body<R: Real>(cells: &mut [[i32; 3]], pts: &[Vec3<R>], cell: f64) -> CellsAcc {
+    let (mut good, mut lo, mut hi) = (true, [i32::MAX; 3], [i32::MIN; 3]);
+    for (c, p) in cells.iter_mut().zip(pts) {
+        for a in 0..3 {
+            let q = p[a].as_f64() / cell;
+            // False for NaN and ±∞ too.
+            let valid = q.abs() <= CELL_LIMIT;
+            let v = floor_i32(if valid { q } else { 0.0 });
+            good &= valid;
+            c[a] = v;
+            lo[a] = lo[a].min(v);
+            hi[a] = hi[a].max(v);
+        }
+    }
+    (good, lo, hi)
 }
 
 /// Particles per task of [`compute_cells`].
@@ -238,6 +274,56 @@ impl KeyPacker {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The cells of the run-time selected loop (AVX-512 where available) are those of the
+    /// baseline-compiled loop, bit for bit, including negative, huge and non-finite
+    /// coordinates, in both precisions.
+    #[test]
+    fn selected_cells_loop_equals_baseline() {
+        fn check<R: Real>() {
+            let mut seed = 0x9e3779b97f4a7c15u64;
+            let mut next = || {
+                seed ^= seed << 13;
+                seed ^= seed >> 7;
+                seed ^= seed << 17;
+                seed
+            };
+            let special = [
+                f64::NAN,
+                f64::INFINITY,
+                -f64::INFINITY,
+                3e9,
+                -3e9,
+                -0.0,
+                0.05,
+            ];
+            let pts: Vec<Vec3<R>> = (0..1000)
+                .map(|k| {
+                    let v = |r: u64| {
+                        if k % 97 == 0 && r.is_multiple_of(3) {
+                            special[(r % special.len() as u64) as usize]
+                        } else {
+                            (r % 2_000_001) as f64 * 1e-3 - 1000.0
+                        }
+                    };
+                    Vec3::new(
+                        R::of_f64(v(next())),
+                        R::of_f64(v(next())),
+                        R::of_f64(v(next())),
+                    )
+                })
+                .collect();
+            for cell in [0.05 * (1.0 + CELL_MARGIN), 1e-3, 7.3] {
+                let (mut a, mut b) = (vec![[0; 3]; pts.len()], vec![[0; 3]; pts.len()]);
+                let fast = cells_chunk(&mut a, &pts, cell);
+                let base = cells_chunk_body(&mut b, &pts, cell);
+                assert_eq!(a, b);
+                assert_eq!(fast, base);
+            }
+        }
+        check::<f32>();
+        check::<f64>();
+    }
 
     #[test]
     fn packing_preserves_lexicographic_order() {

@@ -13,7 +13,7 @@ use crate::{NeighbourLists, SearchError, SearchLimits};
 
 /// Pairs a task finds between two reports to the shared [`PairGuard`] (one atomic
 /// addition per this many pairs: negligible next to the distance tests).
-const REPORT_EVERY: usize = 1 << 14;
+pub(crate) const REPORT_EVERY: usize = 1 << 14;
 
 /// The [`SearchLimits`] of one search, shared by its parallel tasks: the pairs found so far
 /// against `max_pairs`, the caller's interrupt flag, and a stop flag that the first task
@@ -132,17 +132,47 @@ impl TaskOutput {
                 self.pending += found as usize;
                 self.pending < REPORT_EVERY || self.report(guard)
             }
-            Err(e) => {
-                let want = self.neighbours.capacity().max(before) * 2;
-                self.failed = Some(SearchError::out_of_memory::<u32>(
-                    "neighbour indices",
-                    want,
-                    e,
-                ));
-                guard.halt();
-                false
-            }
+            Err(e) => self.fail(before, e, guard),
         }
+    }
+
+    /// Scans a run of particles with `scan` (which appends their lists to the task's buffer
+    /// and `(particle, count)` to its particles, and returns the pairs found); `false`
+    /// when the task must stop, as [`TaskOutput::record`].
+    #[inline]
+    pub fn record_run(
+        &mut self,
+        guard: &PairGuard<'_>,
+        scan: impl FnOnce(
+            &mut Vec<u32>,
+            &mut Vec<(u32, u32)>,
+        ) -> Result<usize, std::collections::TryReserveError>,
+    ) -> bool {
+        let before = self.neighbours.len();
+        match scan(&mut self.neighbours, &mut self.particles) {
+            Ok(found) => {
+                self.pending += found;
+                self.pending < REPORT_EVERY || self.report(guard)
+            }
+            Err(e) => self.fail(before, e, guard),
+        }
+    }
+
+    /// Records a failed allocation of the neighbour indices and stops every task.
+    fn fail(
+        &mut self,
+        before: usize,
+        e: std::collections::TryReserveError,
+        guard: &PairGuard<'_>,
+    ) -> bool {
+        let want = self.neighbours.capacity().max(before) * 2;
+        self.failed = Some(SearchError::out_of_memory::<u32>(
+            "neighbour indices",
+            want,
+            e,
+        ));
+        guard.halt();
+        false
     }
 
     /// Reports the pending pairs to `guard` (at the end of a task, so that its count is

@@ -5,7 +5,7 @@ use rustc_hash::FxHashMap;
 use sph_core::{Real, Vec3};
 
 use crate::cells::{cell_size, compute_cells, Key, KeyPacker};
-use crate::csr::{assemble_by, items_per_task, PairGuard, TaskOutput};
+use crate::csr::{assemble_by, items_per_task, PairGuard, TaskOutput, REPORT_EVERY};
 use crate::radix::{sort_pairs, RadixScratch};
 use crate::runs::run_starts;
 use crate::scan::Gathered;
@@ -95,7 +95,9 @@ impl<R: Real, K: Key> SortedParticles<R, K> {
 /// with the sorted index of the run's first particle). The candidates of a cell's 27
 /// neighbour cells are first gathered into one contiguous block: measured on the dam-break
 /// anchor scene, this beats scanning the nine ranges in place (their ragged ends cost
-/// more than the copy, which is shared by the ~8 particles of a cell). Keeps to the
+/// more than the copy, which is shared by the ~8 particles of a cell). The cell's particles
+/// are then scanned in one call of the kernel (one output reservation per cell, not per
+/// particle), with the lists of a particle-by-particle scan. Keeps to the
 /// [`crate::SearchLimits`] of `out`.
 #[allow(clippy::too_many_arguments)]
 fn query_runs<R: Real>(
@@ -141,9 +143,16 @@ fn query_runs<R: Real>(
                 }
                 let len = g.finish();
                 buf.tests += (len * (end - start)) as u64;
-                for (e, k) in (start..end).enumerate() {
-                    let scan = |nb: &mut Vec<u32>| g.neighbours_of(len, own + e, r2, nb);
-                    if !buf.record(order[k], &guard, scan) {
+                // In pieces whose lists can hold at most about `REPORT_EVERY` pairs, so
+                // that a dense cell neither reserves nor finds much past the pair limit.
+                let piece = (REPORT_EVERY / len.max(1)).max(1);
+                for first in (start..end).step_by(piece) {
+                    let ids = &order[first..(first + piece).min(end)];
+                    let at = own + first - start;
+                    let scan = |nb: &mut Vec<u32>, ps: &mut Vec<(u32, u32)>| {
+                        g.neighbours_of_run(len, at, ids, r2, nb, ps)
+                    };
+                    if !buf.record_run(&guard, scan) {
                         break 'runs;
                     }
                 }

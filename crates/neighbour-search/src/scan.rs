@@ -115,6 +115,50 @@ impl<R: Real> Gathered<R> {
         scan_ranges(p, block, &[(0, len as u32)], e, r2, out)
     }
 
+    /// Scans the `count` particles `own..own + count` of the block (a cell's own particles,
+    /// contiguous in it) each against all `len` candidates, skipping itself, as
+    /// [`Gathered::neighbours_of`] would one after another: appends their lists to `out`
+    /// in that order and `(ids[e], length)` to `particles`; returns the pairs found. One
+    /// reservation and one kernel dispatch per run instead of per particle; the lists are
+    /// the same, entry for entry. On a failed allocation nothing is appended.
+    #[allow(clippy::too_many_arguments)]
+    pub fn neighbours_of_run(
+        &self,
+        len: usize,
+        own: usize,
+        ids: &[u32],
+        r2: R,
+        out: &mut Vec<u32>,
+        particles: &mut Vec<(u32, u32)>,
+    ) -> Result<usize, TryReserveError> {
+        let count = ids.len();
+        assert!(own + count <= len && len + LANES <= self.ids.len());
+        // Each list has at most `len` entries, and a kernel writes at most LANES entries
+        // past the running count.
+        out.try_reserve(count * len + LANES)?;
+        particles.try_reserve(count)?;
+        let block = Block {
+            xs: &self.xs,
+            ys: &self.ys,
+            zs: &self.zs,
+            ids: &self.ids,
+        };
+        let first = particles.len();
+        particles.extend(ids.iter().map(|&id| (id, 0)));
+        let before = out.len();
+        // SAFETY: `out` has room for `count * len + LANES` more entries: the lists before
+        // a particle's hold at most `len` entries each, its own at most `len`, and a kernel
+        // writes at most LANES entries past its running count. Reads stay below
+        // `len + LANES <= self.ids.len()` (asserted above). Every counted entry is
+        // initialised by the kernel.
+        unsafe {
+            let dst = out.as_mut_ptr().add(before);
+            let found = scan_run(block, len, own, r2, &mut particles[first..], dst);
+            out.set_len(before + found);
+            Ok(found)
+        }
+    }
+
     /// Appends the padding the scan needs; returns the number of real candidates.
     pub fn finish(&mut self) -> usize {
         let len = self.len();
@@ -255,6 +299,59 @@ unsafe fn scan<R: Real>(
         }
     }
     unsafe { scan_portable(p, b, ranges, skip, r2, out) }
+}
+
+/// Scans particles `own..own + lens.len()` of `b` each against candidates `0..len`,
+/// skipping itself, writing the lists one after another from `out` and each length to
+/// `lens[e].1`; returns the total. The kernel is chosen once for the run, and the loop over
+/// the particles runs inside it.
+///
+/// # Safety
+/// As [`scan`], for each particle: `out` has room for `lens.len() * len + LANES` entries
+/// and the block is padded after `len`.
+#[inline]
+unsafe fn scan_run<R: Real>(
+    b: Block<'_, R>,
+    len: usize,
+    own: usize,
+    r2: R,
+    lens: &mut [(u32, u32)],
+    out: *mut u32,
+) -> usize {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            if let (Some(xs), Some(ys), Some(zs)) = (same::<R, f32>(b.xs), same(b.ys), same(b.zs)) {
+                let blk = Block {
+                    xs,
+                    ys,
+                    zs,
+                    ids: b.ids,
+                };
+                let r2 = r2.as_f64() as f32; // exact: the value is f32
+                return unsafe { avx512::run_f32(blk, len, own, r2, lens, out) };
+            }
+            if let (Some(xs), Some(ys), Some(zs)) = (same::<R, f64>(b.xs), same(b.ys), same(b.zs)) {
+                let blk = Block {
+                    xs,
+                    ys,
+                    zs,
+                    ids: b.ids,
+                };
+                return unsafe { avx512::run_f64(blk, len, own, r2.as_f64(), lens, out) };
+            }
+        }
+    }
+    let mut found = 0;
+    for (e, l) in lens.iter_mut().enumerate() {
+        let i = own + e;
+        let p = [b.xs[i], b.ys[i], b.zs[i]];
+        // SAFETY: see the function's contract.
+        let n = unsafe { scan(p, b, &[(0, len as u32)], i, r2, out.add(found)) };
+        l.1 = n as u32;
+        found += n;
+    }
+    found
 }
 
 /// The portable kernel: branch-free compaction, one candidate at a time.
@@ -440,6 +537,7 @@ mod avx512 {
         mask.count_ones() as usize
     }
 
+    #[inline]
     #[target_feature(enable = "avx512f,popcnt")]
     pub(super) unsafe fn scan_f32(
         q: [f32; 4],
@@ -477,6 +575,53 @@ mod avx512 {
         found
     }
 
+    /// [`super::scan_run`] in `f32` lanes.
+    #[target_feature(enable = "avx512f,popcnt")]
+    pub(super) unsafe fn run_f32(
+        b: Block<'_, f32>,
+        len: usize,
+        own: usize,
+        r2: f32,
+        lens: &mut [(u32, u32)],
+        out: *mut u32,
+    ) -> usize {
+        let mut found = 0;
+        let ranges = [(0, len as u32)];
+        for (e, l) in lens.iter_mut().enumerate() {
+            let i = own + e;
+            let q = [b.xs[i], b.ys[i], b.zs[i], r2];
+            // SAFETY: the caller's contract of `scan_run`.
+            let n = unsafe { scan_f32(q, b, &ranges, i, out.add(found)) };
+            l.1 = n as u32;
+            found += n;
+        }
+        found
+    }
+
+    /// [`super::scan_run`] in `f64` lanes.
+    #[target_feature(enable = "avx512f,popcnt")]
+    pub(super) unsafe fn run_f64(
+        b: Block<'_, f64>,
+        len: usize,
+        own: usize,
+        r2: f64,
+        lens: &mut [(u32, u32)],
+        out: *mut u32,
+    ) -> usize {
+        let mut found = 0;
+        let ranges = [(0, len as u32)];
+        for (e, l) in lens.iter_mut().enumerate() {
+            let i = own + e;
+            let q = [b.xs[i], b.ys[i], b.zs[i], r2];
+            // SAFETY: the caller's contract of `scan_run`.
+            let n = unsafe { scan_f64(q, b, &ranges, i, out.add(found)) };
+            l.1 = n as u32;
+            found += n;
+        }
+        found
+    }
+
+    #[inline]
     #[target_feature(enable = "avx512f,popcnt")]
     pub(super) unsafe fn scan_f64(
         q: [f64; 4],
@@ -610,6 +755,66 @@ mod tests {
             assert_eq!(avx2_out, slow, "AVX2 kernel differs from the portable one");
         }
         (fast, slow)
+    }
+
+    /// A run scanned at once against its particles scanned one at a time (the selected
+    /// kernel) and the portable kernel, in precision `R`.
+    fn run_matches<R: Real>(pts: &[[f64; 3]], own: usize, count: usize, r: f64) {
+        let mut g = Gathered::<R>::default();
+        for (i, p) in pts.iter().enumerate() {
+            g.push(
+                R::of_f64(p[0]),
+                R::of_f64(p[1]),
+                R::of_f64(p[2]),
+                100 + i as u32,
+            );
+        }
+        let len = g.finish();
+        let r2 = R::of_f64(r) * R::of_f64(r);
+        let ids: Vec<u32> = (0..count as u32).map(|e| 1000 + e).collect();
+        let (mut run, mut run_lens) = (vec![7u32], vec![(1u32, 2u32)]);
+        let found = g
+            .neighbours_of_run(len, own, &ids, r2, &mut run, &mut run_lens)
+            .unwrap();
+        let (mut one, mut one_lens) = (vec![7u32], vec![(1u32, 2u32)]);
+        let mut slow = vec![7u32];
+        for (e, &id) in ids.iter().enumerate() {
+            let n = g.neighbours_of(len, own + e, r2, &mut one).unwrap();
+            one_lens.push((id, n));
+            let b = Block {
+                xs: &g.xs,
+                ys: &g.ys,
+                zs: &g.zs,
+                ids: &g.ids,
+            };
+            let p = [g.xs[own + e], g.ys[own + e], g.zs[own + e]];
+            let mut buf = vec![0u32; len + LANES];
+            let k =
+                unsafe { scan_portable(p, b, &[(0, len as u32)], own + e, r2, buf.as_mut_ptr()) };
+            slow.extend_from_slice(&buf[..k]);
+        }
+        assert_eq!(found, run.len() - 1);
+        assert_eq!(run, one, "run kernel differs from the per-particle one");
+        assert_eq!(run_lens, one_lens);
+        assert_eq!(run, slow, "run kernel differs from the portable one");
+    }
+
+    proptest! {
+        /// A cell's particles scanned in one run give the lists, entry for entry and in
+        /// order, of the per-particle scan and of the portable kernel, in both precisions.
+        #[test]
+        fn run_and_per_particle_agree(
+            pts in proptest::collection::vec([-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64], 1..70),
+            own_at in 0.0..1.0f64,
+            count_at in 0.0..1.0f64,
+            r in 0.01..1.5f64,
+        ) {
+            let n = pts.len();
+            let own = ((own_at * n as f64) as usize).min(n - 1);
+            let count = ((count_at * (n - own) as f64) as usize).max(1);
+            run_matches::<f32>(&pts, own, count, r);
+            run_matches::<f64>(&pts, own, count, r);
+        }
     }
 
     proptest! {
