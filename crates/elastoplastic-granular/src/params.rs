@@ -65,11 +65,12 @@ pub const DEFAULT_ARTIFICIAL_STRESS_EXPONENT: f64 = 2.55;
 /// come to rest up to `C_p` = 1.16, the largest value tried (docs/performance.md, "The
 /// Courant number from a stability measurement"). The column's deposit drifts with the step
 /// (its front 0.8 spacing further at twice the earlier default's step, 1.6 at three times,
-/// 1.9 at four); the default is the largest value tried at which the front stays within a
-/// spacing of the earlier default's, 2.5 times below the largest stable value tried, for the scenes not measured (other Poisson ratios, walls,
-/// spacings). Bui et al. (2008) take `C` = 0.1–0.2 with `√(E/ρ0)`, i.e. `C_p`
-/// = 0.12–0.23 at ν = 0.3 (`c_p = 1.160 √(E/ρ0)` there); this crate's earlier default was
-/// `C` = 0.2 with `√(E/ρ0)` (`C_p` = 0.232).
+/// 1.9 at four; the earlier default itself 1.1 spacings from half its step); the default is
+/// the largest value tried at which the front stays within a spacing of the earlier
+/// default's, 2.5 times below the largest stable value tried, for the scenes not measured
+/// (other Poisson ratios, walls, spacings). Bui et al. (2008) take `C` = 0.1–0.2 with
+/// `√(E/ρ0)`, i.e. `C_p` = 0.12–0.23 at ν = 0.3 (`c_p = 1.160 √(E/ρ0)` there); this crate's
+/// earlier default was `C` = 0.2 with `√(E/ρ0)` (`C_p` = 0.232).
 pub const DEFAULT_CFL_NUMBER: f64 = 0.46;
 /// The cone's match of the defaults: Bui et al. (2008)'s plane strain of an associated
 /// material.
