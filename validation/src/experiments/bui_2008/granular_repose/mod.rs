@@ -82,7 +82,7 @@ use crate::helpers::repose::{
     HeapRun, Measured, ReposeFigures,
 };
 use crate::helpers::Marker;
-use crate::{Context, Experiment, Mode, Outcome};
+use crate::{Check, Context, Experiment, Mode, Outcome};
 
 /// The experiment.
 pub struct GranularRepose;
@@ -152,6 +152,7 @@ fn judge(ctx: &mut Context, runs: &[(Plan, HeapRun)]) -> Result<Outcome> {
             }
         }
     }
+    check_pours_at_rest(&mut out, runs);
     let cases = group(&measured);
     check_cases(&mut out, ctx.mode, &cases);
     let means: Vec<(ConeMatch, f64, Measured)> = cases
@@ -180,4 +181,29 @@ fn judge(ctx: &mut Context, runs: &[(Plan, HeapRun)]) -> Result<Outcome> {
     };
     plot_repose(ctx, &figures, &pours, &profiles)?;
     Ok(out)
+}
+
+/// Each case with an angle (θ > 0) has at least one pour at rest: the ensemble it is judged
+/// by is its pours at rest, and a case with none would have no angle check at all.
+fn check_pours_at_rest(out: &mut Outcome, runs: &[(Plan, HeapRun)]) {
+    let mut cases: Vec<(&str, usize, usize)> = Vec::new();
+    for (p, case) in runs.iter().filter(|(p, _)| p.theta_deg > 0.0) {
+        let at_rest = usize::from(case.run.rest_from_s.is_some() && case.run.blow_up.is_none());
+        let name = case_of(&p.tag);
+        match cases.iter_mut().find(|(c, _, _)| *c == name) {
+            Some((_, pours, rested)) => {
+                *pours += 1;
+                *rested += at_rest;
+            }
+            None => cases.push((name, 1, at_rest)),
+        }
+    }
+    for (name, pours, rested) in cases {
+        out.check(Check::greater_than(
+            format!("{name}/pours at rest before the cap, of {pours}"),
+            rested as f64,
+            0.0,
+            "definition of the case's ensemble: its pours at rest (a heap still moving has no angle of repose yet); with none the case's angle is not judged",
+        ));
+    }
 }
