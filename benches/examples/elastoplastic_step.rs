@@ -15,15 +15,15 @@
 //! poured heaps' modulus, at which a metre of grains strains elastically by
 //! ρ0 g H / E ≈ 0.03, far below tan φ = 0.58); with `settled`, the block held at rest in a
 //! box that fits it (`benches::settled_block_elastoplastic`, Bui's 5.84 MPa unless `E=`).
-//! Frames of 2 ms (each one substep of `n` explicit steps, `Δt ≤ C h/c`), 1 warm-up frame,
-//! then `FRAMES` timed frames (default 10). A frame starts with a reordering (every tenth)
-//! and a neighbour search; its explicit steps share the lists while no grain moves more
-//! than half the skin. Prints the wall time per explicit step over whole frames (searches
-//! included), the phases per step, per particle (grains; the boundary particles are extra
-//! work), the ratio to the water step per particle, the ratio per particle and **simulated
-//! second** (what users wait for: the water takes one 2 ms step per 2 ms, the grains `n`
-//! explicit steps), and a checksum of the grains' end positions (equal checksums mean
-//! bitwise equal runs).
+//! Frames of 2 ms (each one substep of `n` explicit steps, `Δt ≤ C h/c_p`, `c_p` the P-wave
+//! speed), 1 warm-up frame, then `FRAMES` timed frames (default 10). A frame starts with a
+//! reordering (every tenth) and a neighbour search; its explicit steps share the lists
+//! while no grain moves more than half the skin. Prints the wall time per explicit step
+//! over whole frames (searches included), the phases per step, per particle (grains; the
+//! boundary particles are extra work), the ratio to the water step per particle, the ratio
+//! per particle and **simulated second** (what users wait for: the water takes one 2 ms
+//! step per 2 ms, the grains `n` explicit steps), and a checksum of the grains' end
+//! positions (equal checksums mean bitwise equal runs).
 use std::time::Instant;
 
 use iisph_granular::{FluidSolver, Iisph, IisphParams, ParticleSet, Real};

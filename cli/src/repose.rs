@@ -1,6 +1,8 @@
 //! `particles repose DIR`: the angle of repose of the last (or a given) frame of a scene
-//! run, measured with [`granular_measure::angle_of_repose`], and whether the heap is at rest
-//! by [`granular_measure::rest`]'s criterion judged over the run's frames up to it (the last
+//! run, measured with [`granular_measure::angle_of_repose`] (`--shape funnel`: a conical heap
+//! on the scene's circular base, per azimuthal sector,
+//! [`granular_measure::cone_angle_by_sector`]), and whether the heap is at rest by
+//! [`granular_measure::rest`]'s criterion judged over the run's frames up to it (the last
 //! second of them and the speeds' hold under way), with by how much it misses; any granular
 //! scene's output can be measured, not only the experiment's.
 
@@ -8,7 +10,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use granular_measure::{
-    angle_of_repose, flank_layer_stress, FlankLayers, PileShape, ReposeMeasurement, ReposeOptions,
+    angle_of_repose, cone_angle_by_sector, flank_layer_stress, ConeBase, ConeOptions, FlankLayers,
+    PileShape, ReposeMeasurement, ReposeOptions,
 };
 use sph_core::Vec3;
 use sph_sim::observe::RestCriterion;
@@ -24,6 +27,11 @@ pub enum Shape {
     Planar,
     /// An axisymmetric pile around the particles' centroid.
     Conical,
+    /// A conical heap on a circular base, the scene's first solid cylinder (the funnel
+    /// method's fixed base): the generatrix per azimuthal sector, its mean and spread
+    /// (`granular_measure::cone_angle_by_sector`). As a rest shape (`run --until-rest`):
+    /// a conical pile around the centroid.
+    Funnel,
 }
 
 impl Shape {
@@ -31,7 +39,7 @@ impl Shape {
     pub fn pile(self) -> PileShape {
         match self {
             Shape::Planar => PileShape::Planar,
-            Shape::Conical => PileShape::Conical { axis_xz: None },
+            Shape::Conical | Shape::Funnel => PileShape::Conical { axis_xz: None },
         }
     }
 }
@@ -44,7 +52,8 @@ pub struct ReposeArgs {
     /// The frame to measure [default: the last `frame_*.vtk` in DIR].
     #[arg(long, value_name = "FILE")]
     frame: Option<PathBuf>,
-    /// Planar heap (profile along x) or conical pile.
+    /// Planar heap (profile along x), conical pile, or a conical heap on the scene's
+    /// circular base measured per azimuthal sector.
     #[arg(long, value_enum, default_value = "planar")]
     shape: Shape,
     /// The scene file [default: the one recorded by `run` in DIR].
@@ -82,9 +91,51 @@ pub fn run(a: &ReposeArgs) -> Result<()> {
     let s = scene.particle_spacing;
     let floor = scene.tank.map_or(0.0, |t| t.min.y);
     let shape = a.shape.pile();
+    if a.shape == Shape::Funnel {
+        anyhow::ensure!(
+            !a.layers,
+            "--layers measures a planar heap's flanks (give --shape planar)"
+        );
+        print_funnel(&scene, positions, &file)?;
+    } else {
+        print_pile(a, &frame, &file, floor, s)?;
+    }
+    // The frames of DIR up to the measured one.
+    let upto = frames.iter().position(|(_, p)| same_file(p, &file));
+    match upto {
+        Some(i) => {
+            print_rest(&scene, shape, &frames[..=i])?;
+            let verdict = a.dir.join(sph_sim::rest_log::REST_VERDICT_FILE);
+            if i + 1 == frames.len() && verdict.is_file() {
+                let text = std::fs::read_to_string(&verdict)
+                    .with_context(|| format!("reading {}", verdict.display()))?;
+                let summary = text
+                    .lines()
+                    .find_map(|l| l.trim().strip_prefix("\"summary\": "))
+                    .map(|l| l.trim_end_matches(',').trim_matches('"').to_string())
+                    .unwrap_or_else(|| "unreadable".into());
+                println!(
+                    "the run's own verdict (run --until-rest, judged every frame, {}): {summary}",
+                    verdict.display()
+                );
+            }
+        }
+        None => println!(
+            "rest: not judged ({} is not one of {}'s frames)",
+            file.display(),
+            a.dir.display()
+        ),
+    }
+    Ok(())
+}
+
+/// The planar or conical measure of the frame: the angle, the flanks and the resolution,
+/// and with `--layers` the flanks' layers.
+fn print_pile(a: &ReposeArgs, frame: &FrameRead, file: &Path, floor: f64, s: f64) -> Result<()> {
+    let positions = &frame.positions;
     let opts = match a.shape {
         Shape::Planar => ReposeOptions::planar(floor, s),
-        Shape::Conical => ReposeOptions::conical(floor, s),
+        _ => ReposeOptions::conical(floor, s),
     }
     .with_spacing(s);
     let m = angle_of_repose(positions, &opts)
@@ -112,33 +163,61 @@ pub fn run(a: &ReposeArgs) -> Result<()> {
             a.shape == Shape::Planar,
             "--layers measures a planar heap's flanks (give --shape planar)"
         );
-        print_layers(&frame, &file, s, floor, &m)?;
+        print_layers(frame, file, s, floor, &m)?;
     }
-    // The frames of DIR up to the measured one.
-    let upto = frames.iter().position(|(_, p)| same_file(p, &file));
-    match upto {
-        Some(i) => {
-            print_rest(&scene, shape, &frames[..=i])?;
-            let verdict = a.dir.join(sph_sim::rest_log::REST_VERDICT_FILE);
-            if i + 1 == frames.len() && verdict.is_file() {
-                let text = std::fs::read_to_string(&verdict)
-                    .with_context(|| format!("reading {}", verdict.display()))?;
-                let summary = text
-                    .lines()
-                    .find_map(|l| l.trim().strip_prefix("\"summary\": "))
-                    .map(|l| l.trim_end_matches(',').trim_matches('"').to_string())
-                    .unwrap_or_else(|| "unreadable".into());
-                println!(
-                    "the run's own verdict (run --until-rest, judged every frame, {}): {summary}",
-                    verdict.display()
-                );
-            }
-        }
-        None => println!(
-            "rest: not judged ({} is not one of {}'s frames)",
-            file.display(),
-            a.dir.display()
-        ),
+    Ok(())
+}
+
+/// Azimuthal sectors of `--shape funnel`.
+const FUNNEL_SECTORS: usize = 12;
+
+/// `--shape funnel`: the heap on the scene's first solid cylinder, per azimuthal sector.
+fn print_funnel(scene: &Scene, positions: &[Vec3<f32>], file: &Path) -> Result<()> {
+    let base = scene
+        .solids
+        .iter()
+        .find_map(|s| match *s {
+            sph_scene::SolidSpec::Cylinder {
+                base_center: c,
+                radius,
+                height,
+            } => Some(ConeBase {
+                centre_xz: [c[0], c[2]],
+                radius_m: radius,
+                top_y: c[1] + height,
+            }),
+            _ => None,
+        })
+        .with_context(|| {
+            format!(
+                "--shape funnel: {} has no solid cylinder (the heap's base)",
+                scene.source.display()
+            )
+        })?;
+    let opts = ConeOptions::new(base, FUNNEL_SECTORS, scene.particle_spacing);
+    let m = cone_angle_by_sector(positions, &opts)
+        .with_context(|| format!("measuring {}", file.display()))?;
+    println!(
+        "{}: angle of repose {:.2}° (mean over {} of {FUNNEL_SECTORS} sectors; std {:.2}°, {:.2}–{:.2}°), height {:.4} m on the base of radius {} m, {} of {} particles on it",
+        file.display(),
+        m.mean_deg,
+        m.fitted,
+        m.std_deg,
+        m.min_deg,
+        m.max_deg,
+        m.height_m,
+        base.radius_m,
+        m.grains_on_base,
+        positions.len()
+    );
+    for s in &m.sectors {
+        let angle = s
+            .angle_deg
+            .map_or_else(|| "not fitted".into(), |a| format!("{a:.2}°"));
+        println!(
+            "  sector {:.0}–{:.0}°: {angle} ({} surface points over {:.4} m)",
+            s.azimuth_deg[0], s.azimuth_deg[1], s.points, s.run_m
+        );
     }
     Ok(())
 }

@@ -52,8 +52,10 @@
 //!
 //! One explicit step (symplectic Euler): `L`, `ρ̇` and the stress update from `(x, v, σ, ρ)`,
 //! then the acceleration from the new `σ`, `ρ`; `v ← v + Δt a`, `x ← x + Δt v`, projected out
-//! of the solids. `Δt = (dt/substeps)/n` with the smallest `n` such that `Δt ≤ C h / c`,
-//! `c = √(E/ρ0)`, `h` the smoothing length (half the support radius). The steps are
+//! of the solids. `Δt = (dt/substeps)/n` with the smallest `n` such that `Δt ≤ C h / c_p`,
+//! `c_p = √((K + 4G/3)/ρ0)` the P-wave speed (the fastest elastic wave; `1.160 √(E/ρ0)` at
+//! ν = 0.3), `h` the smoothing length (half the support radius), `C` measured on the shipped
+//! scenes ([`DEFAULT_CFL_NUMBER`]). The steps are
 //! sub-cycled inside each substep of the frame shell; the neighbour lists are built with
 //! radius `support + skin` and kept while no particle has moved more than `skin/2` (and no
 //! grain and moving wall together more than `skin`).
@@ -97,7 +99,8 @@
 //!   `Σ √(2 Δe^p:Δe^p)` over the flow rule's and the return's deviatoric plastic strain.
 //! - Material defaults follow SPHinXsys's transcription of Bui's aluminium-bar test
 //!   (`E` = 5.84 MPa, `ν` = 0.3, `ρ0` = 2040 kg/m³), not checked against the paper here; the
-//!   speed of sound is `√(E/ρ0)` as in Bui (SPHinXsys uses `√(K/ρ0)`).
+//!   speed of sound is `√(E/ρ0)` as in Bui (SPHinXsys uses `√(K/ρ0)`), but the explicit
+//!   step's Courant bound takes the P-wave speed `√((K + 4G/3)/ρ0)`, the fastest wave.
 
 pub mod boundary_particles;
 pub mod initial;

@@ -54,9 +54,24 @@ pub const DEFAULT_VISCOSITY_BETA: f64 = 0.0;
 pub const DEFAULT_ARTIFICIAL_STRESS_EPSILON: f64 = 0.5;
 /// Artificial stress exponent `n` of the defaults (Gray, Monaghan & Swift 2001, §5).
 pub const DEFAULT_ARTIFICIAL_STRESS_EXPONENT: f64 = 2.55;
-/// CFL number `C` of `Δt = C h / c` of the defaults (Bui et al. 2008 take 0.1–0.2; the upper
-/// end).
-pub const DEFAULT_CFL_NUMBER: f64 = 0.2;
+/// CFL number `C` of the defaults, in `Δt ≤ C h / c_p` with `c_p = √((K + 4G/3)/ρ0)` the
+/// P-wave speed ([`ElastoplasticParams::p_wave_speed`]), the fastest elastic wave and so the
+/// one a Courant condition must hold (Courant, Friedrichs & Lewy 1928).
+///
+/// Measured, not taken: with the defaults (ν = 0.3, the cubic B-spline, `h = 1.2 s`,
+/// symplectic Euler, `α_Π` = 0.1) the quick Bui column (`scenes/granular_column_bui.toml`,
+/// `E` = 5.84 MPa, 600 grains) and the quick 30° poured heap
+/// (`scenes/granular_repose_poured_30.toml`, `E` = 0.584 MPa, 1,200 grains) are stable and
+/// come to rest up to `C_p` = 1.16, the largest value tried (docs/performance.md, "The
+/// Courant number from a stability measurement"). The column's deposit drifts with the step
+/// (its front 0.8 spacing further at twice the earlier default's step, 1.6 at three times,
+/// 1.9 at four; the earlier default itself 1.1 spacings from half its step); the default is
+/// the largest value tried at which the front stays within a spacing of the earlier
+/// default's, 2.5 times below the largest stable value tried, for the scenes not measured
+/// (other Poisson ratios, walls, spacings). Bui et al. (2008) take `C` = 0.1–0.2 with
+/// `√(E/ρ0)`, i.e. `C_p` = 0.12–0.23 at ν = 0.3 (`c_p = 1.160 √(E/ρ0)` there); this crate's
+/// earlier default was `C` = 0.2 with `√(E/ρ0)` (`C_p` = 0.232).
+pub const DEFAULT_CFL_NUMBER: f64 = 0.46;
 /// The cone's match of the defaults: Bui et al. (2008)'s plane strain of an associated
 /// material.
 pub const DEFAULT_CONE_MATCH: ConeMatch = ConeMatch::PlaneStrainAssociated;
@@ -108,7 +123,7 @@ pub enum InitialStress {
 /// | `viscosity_alpha`, `viscosity_beta` | 0.1, 0 | [`DEFAULT_VISCOSITY_ALPHA`] |
 /// | `viscosity_speed_m_s` | `None` (the speed of sound) | Monaghan 1992 |
 /// | `artificial_stress_epsilon`, `_exponent` | 0.5, 2.55 | Gray et al. 2001 |
-/// | `cfl_number` | 0.2 | [`DEFAULT_CFL_NUMBER`] |
+/// | `cfl_number` | 0.46 (with the P-wave speed) | [`DEFAULT_CFL_NUMBER`] |
 /// | `skin` | `0.3 s` | [`DEFAULT_SKIN_OVER_SPACING`] |
 /// | `density_reinit_interval_s` | 0 (off; [`DENSITY_REINIT_INTERVAL_S`] to turn it on) | Bui et al. 2008 |
 /// | `default_wall`, `wall_models` | no-slip, none | |
@@ -148,8 +163,8 @@ pub struct ElastoplasticParams<R: Real> {
     pub artificial_stress_epsilon: R,
     /// Gray et al. (2001)'s artificial stress exponent `n`.
     pub artificial_stress_exponent: R,
-    /// CFL number `C` of the explicit step `Δt = C h / c`, `h` the smoothing length (half
-    /// the support radius) and `c = √(E/ρ0)`.
+    /// CFL number `C` of the explicit step `Δt ≤ C h / c_p`, `h` the smoothing length (half
+    /// the support radius) and `c_p` the P-wave speed ([`Self::p_wave_speed`]).
     pub cfl_number: R,
     /// Neighbour-list skin (m): lists are built with radius `support + skin` and kept while
     /// no particle has moved more than `skin / 2` since.
@@ -271,9 +286,19 @@ impl<R: Real> ElastoplasticParams<R> {
             .unwrap_or(self.default_wall)
     }
 
-    /// The speed of sound `c = √(E/ρ0)` (m/s) of the time step and the viscosity.
+    /// The speed of sound `c = √(E/ρ0)` (m/s) of the viscosity and the blow-up bound.
     pub fn sound_speed(&self) -> R {
         (self.youngs_modulus / self.common.rest_density).sqrt()
+    }
+
+    /// The P-wave (longitudinal) speed `c_p = √((K + 4G/3)/ρ0) = √(E (1 − ν) / ((1 + ν)
+    /// (1 − 2ν) ρ0))` (m/s) of the explicit step (Landau & Lifshitz, *Theory of Elasticity*,
+    /// §22): the fastest elastic wave, `1.160 √(E/ρ0)` at ν = 0.3.
+    pub fn p_wave_speed(&self) -> R {
+        let nu = self.poisson_ratio;
+        let one = R::one();
+        let stiffening = (one - nu) / ((one + nu) * (one - nu - nu));
+        (self.youngs_modulus * stiffening / self.common.rest_density).sqrt()
     }
 
     /// The velocity scale of the artificial viscosity's linear term (m/s):
@@ -288,10 +313,10 @@ impl<R: Real> ElastoplasticParams<R> {
         self.common.support_radius * R::of_f64(0.5)
     }
 
-    /// The explicit steps of one substep and their length (s): `n = ⌈(dt/substeps) / (C h/c)⌉`
-    /// steps of `(dt/substeps)/n`.
+    /// The explicit steps of one substep and their length (s): `n = ⌈(dt/substeps) / (C h/c_p)⌉`
+    /// steps of `(dt/substeps)/n`, `c_p` the P-wave speed ([`Self::p_wave_speed`]).
     pub fn explicit_steps(&self) -> (usize, R) {
-        let limit = self.cfl_number * self.smoothing_length() / self.sound_speed();
+        let limit = self.cfl_number * self.smoothing_length() / self.p_wave_speed();
         let sub = self.common.substep_dt();
         let n = (sub / limit).as_f64().ceil().max(1.0);
         let n = if n.is_finite() && n < usize::MAX as f64 {

@@ -787,11 +787,11 @@ impl<R: Real> SubstepScheme<R> for ElastoplasticScheme<R> {
 }
 
 /// A blow-up when a particle moves faster than the sound speed `c = √(E/ρ0)`: the explicit
-/// step `Δt ≤ C h / c` keeps the elastic waves within the Courant condition only while the
-/// particles themselves are slower than `c` (else `|v| Δt > C h` as well), so a faster particle
-/// means the scheme has left its stability bound. Needs no closed domain (an open or
-/// periodic set-up has no solid to find a runaway particle in). Errors: the first such
-/// particle, with its speed and `c`.
+/// step `Δt ≤ C h / c_p` (`c_p ≥ c` the P-wave speed) keeps the elastic waves within the
+/// Courant condition only while the particles themselves are slower than the waves, so a
+/// faster particle means the scheme has left its stability bound. Needs no closed domain
+/// (an open or periodic set-up has no solid to find a runaway particle in). Errors: the first
+/// such particle, with its speed and `c`.
 fn check_sound_barrier<R: Real>(at: StepAt, v: &[Vec3<R>], c: R) -> Result<(), SolverError> {
     let c2 = c * c;
     match v.iter().position(|u| u.norm_squared() > c2) {

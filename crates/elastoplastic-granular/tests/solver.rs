@@ -318,3 +318,34 @@ fn a_prepared_solver_shows_the_initial_stress_at_frame_0_and_steps_as_an_unprepa
         FluidSolver::particle_fields(&prepared)
     );
 }
+
+#[test]
+fn the_explicit_step_holds_the_courant_bound_of_the_p_wave() {
+    // The P-wave speed from the material's own moduli (stress.rs, `DruckerPrager::matched`),
+    // an independent path to `√((K + 4G/3)/ρ0)` (Landau & Lifshitz, Theory of Elasticity,
+    // §22); at ν = 0.3 it is `√(0.7/(1.3 × 0.4)) = 1.1602` times `√(E/ρ0)`.
+    for (e, nu) in [(5.84e6, 0.3), (5.84e5, 0.3), (1e7, 0.0), (1e7, 0.49)] {
+        let mut p = ElastoplasticParams::<f64>::for_spacing(S, 30.0);
+        p.youngs_modulus = e;
+        p.poisson_ratio = nu;
+        let m = p.material();
+        let c_p = ((m.bulk_modulus + 4.0 / 3.0 * m.shear_modulus) / p.common.rest_density).sqrt();
+        // Rounding of the two formulas: a few ulps of the square root's argument.
+        assert!(
+            (p.p_wave_speed() - c_p).abs() <= 1e-12 * c_p,
+            "E {e}, ν {nu}"
+        );
+        let (n, dt) = p.explicit_steps();
+        let limit = p.cfl_number * p.smoothing_length() / c_p;
+        let sub = p.common.substep_dt();
+        // The step is within the bound, and one step fewer would break it (n is the least).
+        assert!(dt <= limit * (1.0 + 1e-12), "E {e}, ν {nu}: {dt} > {limit}");
+        assert!(
+            n == 1 || sub / (n - 1) as f64 > limit,
+            "E {e}, ν {nu}: n = {n} not the least"
+        );
+    }
+    let p = ElastoplasticParams::<f64>::for_spacing(S, 30.0);
+    let ratio = p.p_wave_speed() / p.sound_speed();
+    assert!((ratio - (0.7f64 / 0.52).sqrt()).abs() < 1e-12, "{ratio}");
+}

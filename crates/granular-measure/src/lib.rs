@@ -4,7 +4,8 @@
 //!
 //! Measurements of granular heaps and deposits on particle output, usable on any scene's
 //! positions (a VTK frame read back, a simulation state, an experiment's run): the **angle of
-//! repose** of a settled pile ([`repose`]) and the **runout** of a collapsed column, planar
+//! repose** of a settled pile ([`repose`]), that of a conical heap on a circular base per
+//! azimuthal sector ([`cone`]: the funnel method's fixed base), and the **runout** of a collapsed column, planar
 //! ([`runout()`]) or axisymmetric ([`radial_runout`]) ([`mod@runout`]), and whether a heap is
 //! **at rest** ([`rest`]: robust speeds and the angle's drift over time, with the margins),
 //! and the **stress of a heap's flanks** in the slope's axes ([`flank`], from a solver that
@@ -25,12 +26,14 @@
 //! "Collapses of two-dimensional granular columns", *Physical Review E* 72, 041301 (2005),
 //! doi:10.1103/PhysRevE.72.041301.
 
+pub mod cone;
 mod error;
 pub mod flank;
 pub mod repose;
 pub mod rest;
 pub mod runout;
 
+pub use cone::{cone_angle_by_sector, ConeBase, ConeMeasurement, ConeOptions, SectorFit};
 pub use error::MeasureError;
 pub use flank::{flank_layer_stress, FlankLayers, LayerStress};
 pub use repose::{

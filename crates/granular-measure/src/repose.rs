@@ -305,7 +305,7 @@ fn horizontal_coordinate<R: Real>(
 }
 
 /// Least-squares line `y = a + b d` through `(d, y)`; returns `(b, rms residual, run)`.
-fn fit_line(points: &[(f64, f64)]) -> (f64, f64, f64) {
+pub(crate) fn fit_line(points: &[(f64, f64)]) -> (f64, f64, f64) {
     let n = points.len() as f64;
     let d_mean = points.iter().map(|p| p.0).sum::<f64>() / n;
     let y_mean = points.iter().map(|p| p.1).sum::<f64>() / n;

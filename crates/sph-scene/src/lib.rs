@@ -188,7 +188,7 @@
 //! #                                # the damping grow with E)
 //! # artificial_stress_epsilon = 0.5 # Gray et al.'s ε, in [0, 1]
 //! # artificial_stress_exponent = 2.55 # Gray et al.'s n, in [1, 10]
-//! # cfl_number = 0.2               # C, in (0, 1]
+//! # cfl_number = 0.46              # C of Δt ≤ C h/c_p (c_p: P-wave speed), in (0, 1]
 //! # skin = 0.003                   # m, neighbour-list skin, in [0, support radius]
 //! #                                # (default 0.3 particle_spacing)
 //! # initial_stress = "none"        # "none" | "geostatic" (σ_v = −ρ0 g depth along gravity,

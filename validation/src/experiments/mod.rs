@@ -28,6 +28,7 @@ pub fn registry() -> Vec<Box<dyn Experiment>> {
         Box::new(macklin_muller_2013::dam_break_front::DamBreakFront),
         Box::new(macklin_muller_2013::pbf_performance::PbfPerformance),
         Box::new(bui_2008::granular_repose::GranularRepose),
+        Box::new(bui_2008::granular_funnel_heap::GranularFunnelHeap),
         Box::new(neder_2024::granular_repose_thesis::GranularReposeThesis),
         Box::new(neder_2024::granular_column_collapse::GranularColumnCollapse),
         Box::new(

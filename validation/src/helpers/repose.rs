@@ -103,37 +103,45 @@ pub trait Ground: Copy {
 
 /// Builds every planned case's scene with `scene_for` (refusing a bad one before any run),
 /// then runs each until at rest by `rest` (or to its cap), its diagnostic line measured on
-/// the ground `G` of its scene.
-pub fn run_plans<V, G: Ground>(
+/// the ground `G` of its scene. The runs go in parallel on rayon's pool (a heap of a few
+/// thousand grains keeps one core busy but not two: its own parallel loops gain little) and
+/// come back in plan order; each run is the same bits as when run alone (the solver's loops
+/// split their work in fixed chunks, whatever the threads).
+pub fn run_plans<V: Send, G: Ground>(
     ctx: &mut Context,
     plans: Vec<Plan<V>>,
     scene_for: impl Fn(&Plan<V>, Mode) -> Result<Scene>,
-    rest: impl Fn(&Scene, f64) -> RestCriterion,
+    rest: impl Fn(&Scene, f64) -> RestCriterion + Sync,
 ) -> Result<Vec<(Plan<V>, HeapRun)>> {
+    use rayon::prelude::*;
     let scenes = plans
         .iter()
         .map(|p| scene_for(p, ctx.mode))
         .collect::<Result<Vec<_>>>()?;
     ctx.progress
         .set_length(scenes.iter().map(|s| s.frame_count() as u64).sum());
-    let mut runs = Vec::new();
-    for (p, scene) in plans.into_iter().zip(scenes) {
-        let criterion = rest(&scene, p.theta_deg);
-        let ground = G::of(&scene).ok();
-        let heap = |pos: &[_]| ground.map_or_else(Vec::new, |g| g.heap(pos));
-        let level_y = ground.map(G::level_y);
-        let run = run_heap(
-            ctx,
-            p.tag.clone(),
-            p.theta_deg,
-            scene,
-            criterion,
-            level_y,
-            heap,
-        )?;
-        runs.push((p, run));
-    }
-    Ok(runs)
+    let ctx: &Context = ctx;
+    plans
+        .into_par_iter()
+        .zip(scenes)
+        .with_max_len(1)
+        .map(|(p, scene)| {
+            let criterion = rest(&scene, p.theta_deg);
+            let ground = G::of(&scene).ok();
+            let heap = |pos: &[_]| ground.map_or_else(Vec::new, |g| g.heap(pos));
+            let level_y = ground.map(G::level_y);
+            let run = run_heap(
+                ctx,
+                p.tag.clone(),
+                p.theta_deg,
+                scene,
+                criterion,
+                level_y,
+                heap,
+            )?;
+            Ok((p, run))
+        })
+        .collect()
 }
 
 /// Runs `scene` until at rest by `rest` (or to its cap) and prints the run's diagnostic line

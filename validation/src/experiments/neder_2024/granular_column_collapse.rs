@@ -31,7 +31,7 @@
 //! repose heaps), a geostatic start, no-slip walls of boundary particles (a base at least as
 //! rough as the grains: the deposit slides on a layer of grains, its basal friction the
 //! internal one), periodic across the slab (plane strain without side walls). Quick mode
-//! runs the `a` = 0.5 column only (its cost: explicit steps of `0.2 h/c`; about 12 s), full
+//! runs the `a` = 0.5 column only (its cost: explicit steps of `0.46 h/c_p`, `c_p` the P-wave speed), full
 //! mode all five. Measured once in quick mode at `a` = 2 (10 mm): the normalised runout is
 //! 4.55 with no-slip walls and 4.20 with Coulomb walls `μ_w = tan θ`, above the band's
 //! 3.92 (docs/elastoplastic-granular.md).

@@ -1,6 +1,6 @@
-//! The checks of `granular-repose`'s poured heaps: every layer poured, at rest, the toes clear
-//! of the period's ends, the angle against the prediction; θ = 0 spread and flat; the angles'
-//! order; the spacing and modulus checks.
+//! The checks of each of `granular-repose`'s pours: every layer poured, at rest, the toes
+//! clear of the period's ends, its measure; θ = 0 spread and flat. The angles are judged on
+//! the ensembles ([`super::ensemble`]).
 
 use anyhow::Result;
 use elastoplastic_granular::ConeMatch;
@@ -8,21 +8,13 @@ use granular_measure::SurfacePoint;
 use sph_core::Vec3;
 use sph_scene::Scene;
 
-use super::plan::{COARSE_TAG, PLAIN_30_TAG, STIFF_TAG};
 use crate::helpers::repose::{
     check_completed, check_flatness, check_rest, heap_metrics, measure_heap, pool_relief,
     rest_settings, Ground, HeapRun, Measured,
 };
 use crate::scene_runs::RestCriterion;
-use crate::{Check, Mode, Outcome};
+use crate::{Check, Outcome};
 
-/// Band in full mode (degrees): at 10 mm the measure's resolution halves and the flanks'
-/// spread falls (0.1° at rest at 10 mm, `docs/elastoplastic-granular.md`).
-pub const TOLERANCE_FULL_DEG: f64 = 1.5;
-/// The spacing and modulus checks (degrees): a result converged in the spacing and
-/// independent of the stiffness moves by less than one degree (the criterion of
-/// `docs/elastoplastic-granular.md`).
-pub const SPACING_MODULUS_DEG: f64 = 1.0;
 /// The highest grain within two spacings of the period's ends, as a fraction of the heap's
 /// height. The band fit starts at 20 % of the height: a foot higher than that at the period's
 /// ends is a heap that met its periodic image, not a lone heap.
@@ -98,14 +90,14 @@ pub fn check_run(out: &mut Outcome, case: &HeapRun) -> Result<Option<Floor>> {
     Ok(Some(Floor::of(&case.scene)?))
 }
 
-/// The heap's checks with the band `tolerance_deg`: the toes clear of the period's ends and
-/// the angle against the prediction of `cone`; returns its measurement.
-pub fn check_heap(
+/// One pour's measure and metrics (the prediction of `cone`, both flanks) and the check that
+/// its toes are clear of the period's ends; the angle is judged on the case's ensemble
+/// ([`super::ensemble`]). Returns its measurement.
+pub fn measure_pour(
     out: &mut Outcome,
     case: &HeapRun,
     cone: ConeMatch,
     floor: Floor,
-    tolerance_deg: f64,
 ) -> Option<Measured> {
     let heap = floor.heap(&case.run.final_positions);
     let (m, measured) = measure_heap(out, case, &heap, floor.y)?;
@@ -126,19 +118,6 @@ pub fn check_heap(
         floor,
         case.scene.particle_spacing,
     );
-    out.check(Check::within(
-        format!(
-            "{}/angle of repose (deg) against atan(3 alpha_phi) = {predicted:.1}",
-            case.tag
-        ),
-        measured.angle_deg,
-        predicted - tolerance_deg,
-        predicted + tolerance_deg,
-        format!(
-            "physics: a flank formed by flowing at zero dilatancy comes to rest at tan(beta) = 3 alpha_phi ({} match; docs/elastoplastic-granular.md); band ±{tolerance_deg}° = the measure's resolution on lattice heaps (<= 0.8° at 20 mm, granular-measure/tests/measure.rs) + the flank-to-flank spread",
-            cone.name()
-        ),
-    ));
     Some(measured)
 }
 
@@ -204,37 +183,4 @@ fn check_spread(
         3.0 * s,
         "physics: without friction there is no yield stress, the poured material spreads over the whole floor like a liquid; on a covered floor the highest grains of neighbouring bins (one spacing wide) are less than two spacings apart, three allows one bin the profile drops as a pit",
     ));
-}
-
-/// The pairs: the modulus check (both modes: the stiff heap against the coarse one, quick
-/// mode's own 30° heap in quick mode) and the spacing check (full mode); the largest flank
-/// difference.
-pub fn check_pairs(out: &mut Outcome, by_tag: &[(String, Measured)], mode: Mode) {
-    let find = |tag: &str| by_tag.iter().find(|(t, _)| t == tag).map(|(_, m)| *m);
-    let plain = find(PLAIN_30_TAG);
-    let coarse = match mode {
-        Mode::Quick => plain,
-        Mode::Full => find(COARSE_TAG),
-    };
-    if let (Mode::Full, Some(fine), Some(coarse)) = (mode, plain, coarse) {
-        out.check(Check::less_than(
-            "simple-shear/theta=30/spacing: |angle at 10 mm - angle at 20 mm| (deg)",
-            (fine.angle_deg - coarse.angle_deg).abs(),
-            SPACING_MODULUS_DEG,
-            "convergence criterion of docs/elastoplastic-granular.md: a result converged in the spacing moves by less than 1° when the spacing halves",
-        ));
-    }
-    if let (Some(stiff), Some(coarse)) = (find(STIFF_TAG), coarse) {
-        out.check(Check::less_than(
-            "simple-shear/theta=30/modulus: |angle at 10 E - angle at E| (deg), viscosity speed held",
-            (stiff.angle_deg - coarse.angle_deg).abs(),
-            SPACING_MODULUS_DEG,
-            "criterion of docs/elastoplastic-granular.md: a heap of a rigid-enough material does not depend on its stiffness (1°); the viscosity's velocity scale held at the sound speed of E",
-        ));
-    }
-    let flanks = by_tag
-        .iter()
-        .map(|(_, m)| m.flank_difference_deg)
-        .fold(0.0, f64::max);
-    out.metric("largest_flank_difference_deg", flanks);
 }

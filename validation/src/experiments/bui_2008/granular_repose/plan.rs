@@ -34,42 +34,78 @@ pub enum Variant {
     },
 }
 
-/// One planned run.
-pub type Plan = repose::Plan<Variant>;
+/// Pours of each case in quick mode: as many as the experiment's time allows: two (a quick
+/// pour costs about 40 s of one core, the 40° and stiff heaps two to four times that; with
+/// two pours per case the experiment takes about as long as its single pours did before the
+/// explicit step was bounded by the P-wave speed; `docs/elastoplastic-granular.md`).
+pub const POURS_QUICK: u64 = 2;
+/// Pours of each case in full mode: eight, the ensemble's size the standards ask of a
+/// result that scatters.
+pub const POURS_FULL: u64 = 8;
 
-/// The runs of `mode`: the sweep under both matches, θ = 0 and the stiff heap (both modes);
-/// full mode adds the coarse heap of the spacing check.
+/// One pour of a case: how the case departs from its shipped scene and the pour's seed
+/// (`[pour] seed`; pours of different seeds are the case's ensemble).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Poured {
+    /// How the case departs from its shipped scene.
+    pub variant: Variant,
+    /// The pour's seed (`None`: the shipped scene's pour, for θ = 0's single run).
+    pub seed: Option<u64>,
+}
+
+/// One planned run.
+pub type Plan = repose::Plan<Poured>;
+
+/// The case of a run's tag: the tag without its `/pour=K` suffix.
+pub fn case_of(tag: &str) -> &str {
+    tag.rsplit_once("/pour=").map_or(tag, |(case, _)| case)
+}
+
+/// The runs of `mode`: the sweep under both matches and the stiff heap (both modes), full
+/// mode's coarse heap of the spacing check, each an ensemble of [`POURS_QUICK`] or
+/// [`POURS_FULL`] pours of seeds 1, 2, …, tagged `<case>/pour=<seed>`; θ = 0 one pour (a
+/// flatness check, no angle).
 pub fn plan(mode: Mode) -> Vec<Plan> {
-    let case = |tag: String, theta_deg: f64, cone: ConeMatch, variant: Variant| Plan {
-        tag,
-        theta_deg,
-        cone,
-        variant,
+    let pours = mode.pick(POURS_QUICK, POURS_FULL);
+    let ensemble = |case: String, theta_deg: f64, cone: ConeMatch, variant: Variant| {
+        (1..=pours).map(move |seed| Plan {
+            tag: format!("{case}/pour={seed}"),
+            theta_deg,
+            cone,
+            variant: Poured {
+                variant,
+                seed: Some(seed),
+            },
+        })
     };
     let mut p = Vec::new();
     for cone in MATCHES {
-        p.extend(THETAS.map(|t| {
-            case(
-                format!("{}/theta={t:.0}", cone.name()),
-                t,
-                cone,
-                Variant::Plain,
-            )
-        }));
+        for t in THETAS {
+            let case = format!("{}/theta={t:.0}", cone.name());
+            p.extend(ensemble(case, t, cone, Variant::Plain));
+        }
     }
     let ss = ConeMatch::SimpleShear;
-    p.push(case("theta=0".into(), 0.0, ss, Variant::Plain));
+    p.push(Plan {
+        tag: "theta=0".into(),
+        theta_deg: 0.0,
+        cone: ss,
+        variant: Poured {
+            variant: Variant::Plain,
+            seed: None,
+        },
+    });
     let stiff = Variant::Coarse {
         modulus_factor: STIFF_FACTOR,
     };
-    p.push(case(STIFF_TAG.into(), 30.0, ss, stiff));
+    p.extend(ensemble(STIFF_TAG.into(), 30.0, ss, stiff));
     if mode == Mode::Full {
-        // Quick mode's own 30° heap is the coarse heap (the viscosity's velocity scale
+        // Quick mode's own 30° heaps are the coarse heaps (the viscosity's velocity scale
         // defaults to the sound speed of `E`).
         let coarse = Variant::Coarse {
             modulus_factor: 1.0,
         };
-        p.push(case(COARSE_TAG.into(), 30.0, ss, coarse));
+        p.extend(ensemble(COARSE_TAG.into(), 30.0, ss, coarse));
     }
     p
 }
@@ -83,7 +119,7 @@ pub fn scene_for(p: &Plan, mode: Mode) -> Result<Scene> {
     } else {
         LIQUID_SCENE_THETA
     };
-    let mode = match p.variant {
+    let mode = match p.variant.variant {
         Variant::Coarse { .. } => Mode::Quick,
         Variant::Plain => mode,
     };
@@ -104,7 +140,10 @@ pub fn scene_for(p: &Plan, mode: Mode) -> Result<Scene> {
         // the run up (the crate's `angle_sweep` test holds the control).
         e.density_reinit_interval_s = Some(elastoplastic_granular::DENSITY_REINIT_INTERVAL_S);
     }
-    if let Variant::Coarse { modulus_factor } = p.variant {
+    if let (Some(seed), Some(pour)) = (p.variant.seed, scene.pour.as_mut()) {
+        pour.seed = Some(seed);
+    }
+    if let Variant::Coarse { modulus_factor } = p.variant.variant {
         let SolverParams::Elastoplastic(params) = scene.solver_params::<f64>()? else {
             anyhow::bail!("{}: not elastoplastic", scene.source.display());
         };
