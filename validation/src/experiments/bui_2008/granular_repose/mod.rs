@@ -49,7 +49,7 @@
 //! avalanches that build a heap branch on small differences, and single pours at 20 mm
 //! scatter by about ±1.3° (`docs/elastoplastic-granular.md`), as much as a band. θ = 0 is one
 //! pour (it is judged flat, not by an angle). The pours run in parallel
-//! ([`run_plans`](crate::helpers::repose::run_plans)).
+//! ([`run_plans`]).
 //!
 //! **Checks**, per pour ([`checks`]): no solver error; every layer poured; at rest before the
 //! cap; the toes clear of the period's ends (a lone heap, not one that met its periodic
