@@ -163,10 +163,23 @@ mod tests {
     use super::*;
 
     /// Quick mode runs the two sweeps, θ = 0 and the stiff heap (CI's budget); full mode adds
-    /// the coarse heap.
+    /// the coarse heap; each case but θ = 0 is an ensemble of pours of seeds 1..n.
     #[test]
     fn the_plans_of_both_modes() {
-        let tags = |m| plan(m).into_iter().map(|p| p.tag).collect::<Vec<_>>();
+        let cases = |m| {
+            let mut c: Vec<(String, usize, Vec<Option<u64>>)> = Vec::new();
+            for p in plan(m) {
+                let case = case_of(&p.tag).to_string();
+                match c.iter_mut().find(|(k, _, _)| *k == case) {
+                    Some((_, n, seeds)) => {
+                        *n += 1;
+                        seeds.push(p.variant.seed);
+                    }
+                    None => c.push((case, 1, vec![p.variant.seed])),
+                }
+            }
+            c
+        };
         let quick = [
             "simple-shear/theta=20",
             "simple-shear/theta=30",
@@ -177,10 +190,36 @@ mod tests {
             "theta=0",
             STIFF_TAG,
         ];
-        assert_eq!(tags(Mode::Quick), quick);
         let mut full = quick.to_vec();
         full.push(COARSE_TAG);
-        assert_eq!(tags(Mode::Full), full);
+        for (mode, names, pours) in [
+            (Mode::Quick, quick.to_vec(), POURS_QUICK),
+            (Mode::Full, full, POURS_FULL),
+        ] {
+            let got = cases(mode);
+            let got_names: Vec<&str> = got.iter().map(|(c, _, _)| c.as_str()).collect();
+            assert_eq!(got_names, names);
+            for (case, n, seeds) in &got {
+                if case == "theta=0" {
+                    assert_eq!((*n, seeds.as_slice()), (1, &[None][..]));
+                } else {
+                    let expected: Vec<Option<u64>> = (1..=pours).map(Some).collect();
+                    assert_eq!(seeds, &expected, "{case}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_pours_seed_reaches_its_scene() {
+        for p in plan(Mode::Quick) {
+            let scene = scene_for(&p, Mode::Quick).unwrap();
+            let seed = scene.pour.as_ref().and_then(|pour| pour.seed);
+            match p.variant.seed {
+                Some(s) => assert_eq!(seed, Some(s), "{}", p.tag),
+                None => assert_eq!(seed, None, "{}", p.tag),
+            }
+        }
     }
 
     #[test]
