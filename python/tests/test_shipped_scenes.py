@@ -32,8 +32,9 @@ def test_shipped_scene_runs(path, cache):
         assert stress.shape == (n0, 6)
         # The geostatic start (if any) is there before the first frame: compressive or zero.
         assert np.all(stress[:, 1] <= 0.0)
-    # A poured scene's first layer is due after 0.167 s (frame 11) at the quick spacing.
-    frames = 12 if "poured" in path.stem else 2
+    # A poured scene's (a `[pour]` table's) first layer is due after 0.167 s (frame 11) at
+    # the quick spacing.
+    frames = 12 if "[pour]" in path.read_text() else 2
     out = sim.run(frames, progress=False)
     assert out["ending"] == "completed", out
     n = len(sim.positions)
