@@ -173,27 +173,17 @@ const FUNNEL_SECTORS: usize = 12;
 
 /// `--shape funnel`: the heap on the scene's first solid cylinder, per azimuthal sector.
 fn print_funnel(scene: &Scene, positions: &[Vec3<f32>], file: &Path) -> Result<()> {
-    let base = scene
+    let (centre, radius_m) = scene
         .solids
         .iter()
-        .find_map(|s| match *s {
-            sph_scene::SolidSpec::Cylinder {
-                base_center: c,
-                radius,
-                height,
-            } => Some(ConeBase {
-                centre_xz: [c[0], c[2]],
-                radius_m: radius,
-                top_y: c[1] + height,
-            }),
-            _ => None,
-        })
+        .find_map(sph_scene::SolidSpec::cylinder_top)
         .with_context(|| {
             format!(
                 "--shape funnel: {} has no solid cylinder (the heap's base)",
                 scene.source.display()
             )
         })?;
+    let base = ConeBase::on_disc(centre, radius_m);
     let opts = ConeOptions::new(base, FUNNEL_SECTORS, scene.particle_spacing);
     let m = cone_angle_by_sector(positions, &opts)
         .with_context(|| format!("measuring {}", file.display()))?;

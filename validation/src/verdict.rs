@@ -24,6 +24,9 @@ pub enum Status {
     Fail,
     /// Returned an error or panicked.
     Error,
+    /// Ran without error and produced no check: the experiment runs no case in this mode
+    /// (a full-mode-only study run in quick mode). Not a pass: nothing was judged.
+    NoChecks,
 }
 
 impl Status {
@@ -34,6 +37,7 @@ impl Status {
             Status::Deviation => "deviation",
             Status::Fail => "fail",
             Status::Error => "error",
+            Status::NoChecks => "no-checks",
         }
     }
 
@@ -44,6 +48,7 @@ impl Status {
             Status::Deviation => "deviation",
             Status::Fail => "FAIL",
             Status::Error => "ERROR",
+            Status::NoChecks => "no checks",
         }
     }
 
@@ -111,6 +116,8 @@ pub fn judge(
 pub fn status_of(error: bool, checks: &[CheckRecord]) -> Status {
     if error {
         Status::Error
+    } else if checks.is_empty() {
+        Status::NoChecks
     } else if checks.iter().any(|c| c.verdict.fails_run()) {
         Status::Fail
     } else if checks.iter().any(|c| c.verdict == CheckVerdict::Deviation) {
@@ -127,7 +134,7 @@ pub struct Verdict {
     pub id: String,
     /// What it reproduces.
     pub source: String,
-    /// pass / deviation / fail / error.
+    /// pass / deviation / fail / error / no-checks.
     pub status: Status,
     /// Wall-clock time of `run`, seconds.
     pub wall_s: f64,
@@ -191,5 +198,8 @@ evidence = "test"
         let errored = judge("documented", Mode::Quick, vec![], &deviations, false);
         assert!(errored.is_empty());
         assert_eq!(status_of(true, &errored), Status::Error);
+        // A run without error and without checks judged nothing: not a pass.
+        assert_eq!(status_of(false, &[]), Status::NoChecks);
+        assert!(!Status::NoChecks.fails_run());
     }
 }

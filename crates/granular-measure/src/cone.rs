@@ -31,7 +31,7 @@
 //! `cos² α · 1.5 δ / D` radians for surface points between 0 and `δ` below the true surface
 //! over a radial run `D`.
 
-use crate::repose::{fit_line, surface_profile, PileShape};
+use crate::repose::{check_fit_options, fit_line, surface_profile, PileShape};
 use crate::{check_finite, MeasureError};
 use sph_core::{Real, Vec3};
 
@@ -49,6 +49,18 @@ pub struct ConeBase {
     pub radius_m: f64,
     /// The height of the disc's top (m): the heap's floor.
     pub top_y: f64,
+}
+
+impl ConeBase {
+    /// The base on a horizontal disc of centre `centre` (m, `[x, y, z]`, `y` the disc's
+    /// height) and radius `radius_m` (m).
+    pub fn on_disc(centre: [f64; 3], radius_m: f64) -> Self {
+        ConeBase {
+            centre_xz: [centre[0], centre[2]],
+            radius_m,
+            top_y: centre[1],
+        }
+    }
 }
 
 /// Options of [`cone_angle_by_sector`] (see the module documentation for the method).
@@ -111,24 +123,7 @@ impl ConeOptions {
                 "must be in [3, 360] (fewer cannot show a spread over azimuth)",
             );
         }
-        if !(self.bin_width_m.is_finite() && self.bin_width_m > 0.0) {
-            return bad("bin_width_m", self.bin_width_m, "must be finite and > 0");
-        }
-        let [lo, hi] = self.fit_band;
-        if !(lo.is_finite() && (0.0..1.0).contains(&lo)) {
-            return bad("fit_band[0]", lo, "must be in [0, 1)");
-        }
-        if !(hi.is_finite() && hi > lo && hi <= 1.0) {
-            return bad("fit_band[1]", hi, "must be in (fit_band[0], 1]");
-        }
-        if self.min_fit_points < 3 {
-            return bad(
-                "min_fit_points",
-                self.min_fit_points as f64,
-                "must be >= 3 (a line through 2 points has no residual)",
-            );
-        }
-        Ok(())
+        check_fit_options(CONE, self.bin_width_m, self.fit_band, self.min_fit_points)
     }
 }
 

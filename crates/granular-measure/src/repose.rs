@@ -81,6 +81,43 @@ pub struct ReposeOptions {
     pub steepest_run_m: Option<f64>,
 }
 
+/// The profile and fit options a slope measure shares (`what` names the measure in errors):
+/// the bin width finite and > 0, the fit band within `[0, 1]` and increasing, at least three
+/// points to a fit.
+pub(crate) fn check_fit_options(
+    what: &'static str,
+    bin_width_m: f64,
+    fit_band: [f64; 2],
+    min_fit_points: usize,
+) -> Result<(), MeasureError> {
+    let bad = |option, value, reason| {
+        Err(MeasureError::InvalidOption {
+            what,
+            option,
+            value,
+            reason,
+        })
+    };
+    if !(bin_width_m.is_finite() && bin_width_m > 0.0) {
+        return bad("bin_width_m", bin_width_m, "must be finite and > 0");
+    }
+    let [lo, hi] = fit_band;
+    if !(lo.is_finite() && (0.0..1.0).contains(&lo)) {
+        return bad("fit_band[0]", lo, "must be in [0, 1)");
+    }
+    if !(hi.is_finite() && hi > lo && hi <= 1.0) {
+        return bad("fit_band[1]", hi, "must be in (fit_band[0], 1]");
+    }
+    if min_fit_points < 3 {
+        return bad(
+            "min_fit_points",
+            min_fit_points as f64,
+            "must be >= 3 (a line through 2 points has no residual)",
+        );
+    }
+    Ok(())
+}
+
 impl ReposeOptions {
     /// A conical pile on the floor `floor_y` with its axis at the particles' centroid, bins
     /// of `bin_width_m`, the 20 %–80 % band and at least 4 points per flank.
@@ -129,23 +166,7 @@ impl ReposeOptions {
         if !self.floor_y.is_finite() {
             return bad("floor_y", self.floor_y, "must be finite");
         }
-        if !(self.bin_width_m.is_finite() && self.bin_width_m > 0.0) {
-            return bad("bin_width_m", self.bin_width_m, "must be finite and > 0");
-        }
-        let [lo, hi] = self.fit_band;
-        if !(lo.is_finite() && (0.0..1.0).contains(&lo)) {
-            return bad("fit_band[0]", lo, "must be in [0, 1)");
-        }
-        if !(hi.is_finite() && hi > lo && hi <= 1.0) {
-            return bad("fit_band[1]", hi, "must be in (fit_band[0], 1]");
-        }
-        if self.min_fit_points < 3 {
-            return bad(
-                "min_fit_points",
-                self.min_fit_points as f64,
-                "must be >= 3 (a line through 2 points has no residual)",
-            );
-        }
+        check_fit_options(REPOSE, self.bin_width_m, self.fit_band, self.min_fit_points)?;
         if let PileShape::Conical {
             axis_xz: Some([x, z]),
         } = self.shape

@@ -236,6 +236,21 @@ pub enum SolidSpec {
     },
 }
 
+impl SolidSpec {
+    /// A solid cylinder's top disc: its centre (m) and radius (m); `None` for other solids.
+    /// A heap poured on a cylinder (a pedestal) stands on this disc.
+    pub fn cylinder_top(&self) -> Option<([f64; 3], f64)> {
+        match *self {
+            SolidSpec::Cylinder {
+                base_center: c,
+                radius,
+                height,
+            } => Some(([c[0], c[1] + height, c[2]], radius)),
+            _ => None,
+        }
+    }
+}
+
 /// A solid's motion (`[[solid]] motion = { velocity = [0.0, -0.05, 0.0], duration = 12.0 }`):
 /// it moves at `velocity` from the run's start for `duration` seconds, then stands still.
 /// Only a box moves, and only as a wall of boundary particles (`[boundary] model =

@@ -159,18 +159,8 @@ pub fn base_of(scene: &Scene) -> Result<ConeBase> {
     scene
         .solids
         .iter()
-        .find_map(|s| match *s {
-            SolidSpec::Cylinder {
-                base_center: c,
-                radius,
-                height,
-            } => Some(ConeBase {
-                centre_xz: [c[0], c[2]],
-                radius_m: radius,
-                top_y: c[1] + height,
-            }),
-            _ => None,
-        })
+        .find_map(SolidSpec::cylinder_top)
+        .map(|(centre, radius_m)| ConeBase::on_disc(centre, radius_m))
         .with_context(|| {
             format!(
                 "{}: a funnel heap stands on a solid cylinder (the base)",
