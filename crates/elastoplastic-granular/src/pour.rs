@@ -10,5 +10,5 @@
 //! (`docs/elastoplastic-granular.md`, "Walls, moving walls, periodic axes and the pour").
 
 pub use sph_solver::scene_boundary::{
-    PeriodicAxis, Pour, PourEmitter, MAX_POURED_GRAINS, ROOM_OVER_SPACING,
+    PeriodicAxis, Pour, PourEmitter, FALL_OVER_LANDING_TIME, MAX_POURED_GRAINS, ROOM_OVER_SPACING,
 };

@@ -52,7 +52,8 @@ const REORDER: usize = 5;
 /// boundary particles has moved, also `boundary_motion`: each boundary particle's position
 /// and wall velocity (6 values per boundary particle, m and m/s). With a pour
 /// ([`crate::Pour`]), the frame shell adds `pour`
-/// ([`sph_solver::frame::POUR_STATE_ARRAY`]): the layers placed so far (one value).
+/// ([`sph_solver::frame::POUR_STATE_ARRAY`]): the layers placed so far and when the last
+/// was.
 pub const ELASTOPLASTIC_STATE_ARRAYS: &[&str] =
     &["stress", "plastic_strain", "boundary_motion", "pour"];
 

@@ -91,23 +91,42 @@ fn seeded_pours_are_an_ensemble() {
     assert_eq!(state.positions, a.positions);
 }
 
-/// The layers fall due at the rate (30 a second: one by 33 ms) and land on the floor: after
-/// 0.5 s all twelve are in (six grains each, 72 grains), above the floor, and the run has
-/// poured them no earlier than they were due.
+/// The layers fall due at the rate (30 a second: one by 33 ms), but each waits until the
+/// one before it has fallen `FALL_OVER_LANDING_TIME √(s/g)` = 49.7 ms (a layer released at
+/// rest is slower than the landed speed `√(g s)` before `√(s/g)`), so with frames of 16 ms
+/// they come in every fourth frame: none earlier than due, none within 49.7 ms of the one
+/// before it, all twelve in by 0.77 s (six grains each, 72 grains), above the floor.
 #[test]
-fn a_pour_adds_its_layers_on_schedule() {
+fn a_pour_adds_its_layers_on_schedule_paced_by_the_falls() {
     let (mut solver, mut state) = small_pour(12.0, 1.0);
     assert_eq!(solver.poured_layers(), Some((0, 12)));
     assert_eq!(state.len(), 0);
-    let mut frame_start_s = 0.0f64;
-    for _ in 0..32 {
+    let min_interval_s = elastoplastic_granular::FALL_OVER_LANDING_TIME * (S / 9.81).sqrt();
+    let mut last_layer_s: Option<f64> = None;
+    let mut before = 0;
+    for frame in 0..48 {
+        let frame_start_s = frame as f64 * 0.016;
         solver.step(&mut state).unwrap();
         let (done, _) = solver.poured_layers().unwrap();
         // Due at the frame's start: floor(30 t).
         let due = (30.0 * frame_start_s + 1e-9).floor() as usize;
         assert!(done <= due.min(12), "{done} layers by {frame_start_s} s");
+        assert!(
+            done <= before + 1,
+            "two layers in the frame at {frame_start_s} s"
+        );
+        if done > before {
+            if let Some(t) = last_layer_s {
+                assert!(
+                    frame_start_s - t >= min_interval_s,
+                    "a layer at {frame_start_s} s, {} s after the last",
+                    frame_start_s - t
+                );
+            }
+            last_layer_s = Some(frame_start_s);
+        }
+        before = done;
         assert_eq!(state.len(), 6 * done);
-        frame_start_s += 0.016;
     }
     assert_eq!(solver.poured_layers(), Some((12, 12)));
     assert_eq!(state.len(), 72);

@@ -182,8 +182,8 @@ pub struct FrameSolver<R: Real, S: SubstepScheme<R>> {
     emitter: Option<PourEmitter>,
 }
 
-/// The name of the array that carries a pour's progress in a [`SolverState`] (the layers
-/// placed so far, one value).
+/// The name of the array that carries a pour's progress in a [`SolverState`]: the layers
+/// placed so far, then the time the last was placed (s; absent before the first layer).
 pub const POUR_STATE_ARRAY: &str = "pour";
 
 impl<R: Real, S: SubstepScheme<R>> fmt::Debug for FrameSolver<R, S> {
@@ -405,7 +405,9 @@ impl<R: Real, S: SubstepScheme<R>> FrameSolver<R, S> {
         let mut arrays = Vec::new();
         self.scheme.save_arrays(&mut arrays);
         if let Some(p) = &self.emitter {
-            arrays.push((POUR_STATE_ARRAY.into(), vec![R::of_f64(p.poured() as f64)]));
+            let mut values = vec![R::of_f64(p.poured() as f64)];
+            values.extend(p.last_layer_s().map(R::of_f64));
+            arrays.push((POUR_STATE_ARRAY.into(), values));
         }
         SolverState::new(self.scheme.name(), self.frames, arrays)
     }
@@ -449,22 +451,29 @@ impl<R: Real, S: SubstepScheme<R>> FrameSolver<R, S> {
                 (Cow::Owned(rest), Cow::Owned(pour))
             }
         };
+        // The pour's values: the layers placed, then when the last was (absent before the
+        // first layer, and in checkpoints older than that value).
         let poured = match &self.emitter {
             Some(p) => {
+                let len = pour.first().map_or(1, |a| a.1.len().clamp(1, 2));
                 let spec = [ArraySpec {
                     name: POUR_STATE_ARRAY,
-                    len: 1,
+                    len,
                 }];
                 Some(match match_arrays(name, &pour, &spec)?[0] {
-                    Some(v) => p.check_poured(name, v[0].as_f64(), particles)?,
-                    None => 0,
+                    Some(v) => (
+                        p.check_poured(name, v[0].as_f64(), particles)?,
+                        v.get(1).map(|t| t.as_f64()),
+                    ),
+                    None => (0, None),
                 })
             }
             None => None,
         };
         self.scheme.restore_arrays(&arrays, particles)?;
-        if let (Some(p), Some(k)) = (&mut self.emitter, poured) {
+        if let (Some(p), Some((k, last))) = (&mut self.emitter, poured) {
             p.set_poured(k);
+            p.set_last_layer_s(last);
         }
         self.frames = state.frames;
         Ok(())

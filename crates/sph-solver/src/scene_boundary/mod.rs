@@ -18,7 +18,7 @@ mod walls;
 
 use sph_core::{Aabb, Real};
 
-pub use emitter::{PourEmitter, ROOM_OVER_SPACING};
+pub use emitter::{PourEmitter, FALL_OVER_LANDING_TIME, ROOM_OVER_SPACING};
 pub use feature::BoundaryFeature;
 pub use periodic::{image_offsets, Axis, PeriodicAxis, PeriodicImages, PeriodicSetting};
 pub use pour::{Pour, MAX_POURED_GRAINS};
