@@ -56,6 +56,22 @@ pub(crate) fn directory(s: &str) -> Result<PathBuf, String> {
     Ok(p)
 }
 
+/// The error and its causes, `outer: inner`, each cause left out when the message before
+/// it already says it (library errors that print their source in their own message).
+fn error_chain(e: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in e.chain() {
+        let message = cause.to_string();
+        if !text.contains(&message) {
+            if !text.is_empty() {
+                text.push_str(": ");
+            }
+            text.push_str(&message);
+        }
+    }
+    text
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
@@ -67,8 +83,40 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", error_chain(&e));
             ExitCode::from(1)
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::error_chain;
+
+    #[test]
+    fn a_cause_the_message_already_says_is_printed_once() {
+        /// An error that prints its source in its own message, and names it as its source.
+        #[derive(Debug)]
+        struct Outer {
+            source: std::io::Error,
+        }
+        impl std::fmt::Display for Outer {
+            fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                write!(f, "frame 3: {}", self.source)
+            }
+        }
+        impl std::error::Error for Outer {
+            fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+                Some(&self.source)
+            }
+        }
+        let inner = std::io::Error::other("blow-up at particle 4");
+        let e = anyhow::Error::new(Outer { source: inner }).context("scene.toml");
+        assert_eq!(
+            error_chain(&e),
+            "scene.toml: frame 3: blow-up at particle 4"
+        );
+        let plain = anyhow::anyhow!("no such file").context("reading a.toml");
+        assert_eq!(error_chain(&plain), "reading a.toml: no such file");
     }
 }
