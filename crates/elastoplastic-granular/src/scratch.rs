@@ -54,9 +54,13 @@ pub(crate) struct Scratch<R: Real> {
     /// Wall gradients `∇Ψ_k`, `slots` per particle.
     pub wall_grad: Vec<Vec3<R>>,
     /// Images of the particles near periodic ends, and the particles followed by them (the
-    /// array the neighbour lists index).
+    /// array the neighbour lists index; with images, refreshed each step by the pairs'
+    /// pass).
     pub images: PeriodicImages<R>,
     pub x_ext: Vec<Vec3<R>>,
+    /// The particle whose values each of the lists' particles carries (itself, or an
+    /// image's particle), from the last neighbour search.
+    pub owner: Vec<u32>,
     /// Permutation scratch.
     pub permute_m: Vec<Matrix3<R>>,
     pub permute_r: Vec<R>,
