@@ -544,7 +544,8 @@ mod tests {
     use super::{flat, GrainLanes, MomentumArrays, StressArrays};
     use crate::kernels::Consts;
     use crate::passes::{
-        pair_gradient, pair_stress, pair_term, stress_sums, MomentumFields, StressFields,
+        pair_gradient, pair_stress, pair_term, stress_sums, support_pairs, MomentumFields, Pair,
+        StressFields,
     };
     use crate::ElastoplasticParams;
 
@@ -645,24 +646,24 @@ mod tests {
                     }
                 }
             }
-            let images = PeriodicImages::default();
+            let mut owner = Vec::new();
+            PeriodicImages::<f32>::default().owners(count, &mut owner);
             let v: Vec<Vec3<f32>> = (0..count).map(|_| d.vec(-2.0, 2.0)).collect();
             let rho: Vec<f32> = (0..count).map(|_| d.next(1700.0, 2300.0)).collect();
             let volume: Vec<f32> = mass_all.iter().zip(&rho).map(|(m, r)| m / r).collect();
             // The stress pass's sums.
             let fields = StressFields {
-                nb,
-                images: &images,
-                x: &x,
                 v: &v,
                 volume: &volume,
                 masses: &mass_all[..grains],
                 boundary_mass,
             };
             let arrays = StressArrays { v: flat::<_, f32>(&v, 3), volume: &volume, mass: &mass_all };
+            let mut pairs = vec![Pair::default(); nb.offsets()[grains]];
             for i in 0..grains {
                 let grad_i = &grads[nb.offsets()[i]..nb.offsets()[i + 1]];
-                let want = stress_sums(&fields, i, grad_i);
+                let count = support_pairs(&c, &x, &owner, i, nb.neighbours(i), &mut pairs);
+                let want = stress_sums(&fields, i, &pairs[..count]);
                 let got = lanes.stress_sums::<f32>(&arrays, nb, grains, i, flat::<_, f32>(grad_i, 3));
                 prop_assert_eq!(got.in_contact, want.in_contact, "contact of {}", i);
                 let terms = grad_i.len();
@@ -694,8 +695,6 @@ mod tests {
                 .map(|&on| if on { d.matrix(1e3) / (2000.0 * 2000.0) } else { Matrix3::zeros() })
                 .collect();
             let f = MomentumFields {
-                images: &images,
-                x: &x,
                 v: &v,
                 rho: &rho,
                 sig_rho2: &sig_rho2,
@@ -716,18 +715,21 @@ mod tests {
                 let grad_i = &grads[nb.offsets()[i]..nb.offsets()[i + 1]];
                 let mut want = Vec3::zeros();
                 let mut abs = [0f64; 3];
-                for (&j, g) in list.iter().zip(grad_i) {
-                    if *g != Vec3::zeros() {
-                        want += pair_term(&c, &f, i, j as usize, g);
-                        let (t, m) = pair_stress(&c, &f, i, j as usize);
-                        for (r, e) in abs.iter_mut().enumerate() {
-                            *e += f64::from(m)
-                                * (0..3).map(|l| f64::from((t[(r, l)] * g[l]).abs())).sum::<f64>();
-                        }
+                let count = support_pairs(&c, &x, &owner, i, list, &mut pairs);
+                for p in &pairs[..count] {
+                    want += pair_term(&c, &f, i, p);
+                    let (t, m) = pair_stress(&c, &f, i, p);
+                    for (r, e) in abs.iter_mut().enumerate() {
+                        *e += f64::from(m)
+                            * (0..3).map(|l| f64::from((t[(r, l)] * p.grad[l]).abs())).sum::<f64>();
                     }
                 }
+                let listed = |k: usize| {
+                    let j = list[k];
+                    Pair { j, xij: x[i] - x[j as usize], grad: grad_i[k] }
+                };
                 let mut rest = Vec3::zeros();
-                let mut scalar = |k: usize| rest += pair_term(&c, &f, i, list[k] as usize, &grad_i[k]);
+                let mut scalar = |k: usize| rest += pair_term(&c, &f, i, &listed(k));
                 let lanes_sum: Vec3<f32> =
                     lanes.acceleration(&arrays, nb, i, flat::<_, f32>(grad_i, 3), &mut scalar);
                 let got = lanes_sum + rest;

@@ -9,7 +9,6 @@ use sph_kernels::Kernel;
 use sph_solver::boundary::Boundary;
 use sph_solver::csr::par_csr_blocks;
 use sph_solver::pair_lanes::f32s;
-use sph_solver::scene_boundary::PeriodicImages;
 use sph_solver::step::MIN_LEN;
 use sph_solver::NeighbourLists;
 
@@ -99,10 +98,71 @@ pub(crate) fn pair_gradient<R: Real, K: Kernel<R>>(c: &Consts<R, K>, xij: &Vec3<
     }
 }
 
-/// The kernel gradient `∇_i W_ij` of every grain's listed pair, in the lists' CSR order
-/// (zero beyond the support): computed once per explicit step and read by both passes. In
-/// lanes where they run ([`crate::lanes`]; bit for bit the scalar gradients), after packing
-/// the positions and masses they and the momentum pass read.
+/// One of a grain's pairs inside the kernel's support, as the scalar passes read it: the
+/// particle `j` whose values the neighbour carries (a periodic image resolved to its
+/// particle), the offset `x_ij = x_i − x_j` (m) and the kernel gradient `∇_i W_ij` (1/m⁴),
+/// non-zero.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Pair<R: Real> {
+    pub j: u32,
+    pub xij: Vec3<R>,
+    pub grad: Vec3<R>,
+}
+
+impl<R: Real> Default for Pair<R> {
+    fn default() -> Self {
+        Self {
+            j: 0,
+            xij: Vec3::zeros(),
+            grad: Vec3::zeros(),
+        }
+    }
+}
+
+/// Grain `i`'s listed neighbours `list` whose kernel gradient is non-zero, in list order,
+/// into `out` (at least `list.len()` long); returns how many. `listed` holds the positions
+/// of the lists' particles (a periodic image's included) and `owner` the particle whose
+/// values each carries (itself, or an image's particle). The listed pairs beyond the support
+/// (the lists' skin, about 30 % of them at the default skin) and coincident ones add zero
+/// terms to both passes' sums, which therefore skip them. Without branches on the data but
+/// in the kernel's spline: first the pairs within `support2_above`, then those of a non-zero
+/// gradient ([`pair_gradient`]).
+#[inline]
+pub(crate) fn support_pairs<R: Real, K: Kernel<R>>(
+    c: &Consts<R, K>,
+    listed: &[Vec3<R>],
+    owner: &[u32],
+    i: usize,
+    list: &[u32],
+    out: &mut [Pair<R>],
+) -> usize {
+    let xi = listed[i];
+    let mut near = 0;
+    for &j in list {
+        let xij = xi - listed[j as usize];
+        out[near] = Pair {
+            j: owner[j as usize],
+            xij,
+            grad: Vec3::zeros(),
+        };
+        near += usize::from(xij.norm_squared() <= c.support2_above);
+    }
+    let mut kept = 0;
+    for k in 0..near {
+        let p = out[k];
+        let grad = pair_gradient(c, &p.xij);
+        out[kept] = Pair { grad, ..p };
+        kept += usize::from(grad != Vec3::zeros());
+    }
+    kept
+}
+
+/// The pairs of every grain, computed once per explicit step and read by both passes. In
+/// lanes where they run ([`crate::lanes`]): the kernel gradient of every listed pair in the
+/// lists' CSR order (`s.pair_grad`, zero beyond the support; bit for bit the scalar
+/// gradients), after packing the positions and masses they and the momentum pass read.
+/// Otherwise grain `i`'s pairs inside the support ([`support_pairs`]) at the start of its
+/// CSR range of `s.pairs`, `s.pair_count[i]` of them.
 pub(crate) fn pair_gradients<R: Real, K: Kernel<R>>(
     s: &mut Scratch<R>,
     inp: &StepInputs<'_, R, K>,
@@ -110,16 +170,39 @@ pub(crate) fn pair_gradients<R: Real, K: Kernel<R>>(
     let n = inp.masses.len();
     let offsets = &inp.nb.offsets()[..=n];
     let pairs = offsets[n];
+    let Some(lanes) = grain_lanes(s, inp) else {
+        s.pairs.resize(pairs, Pair::default());
+        s.pair_count.resize(n, 0);
+        let listed = if s.images.src.is_empty() {
+            &s.x[..]
+        } else {
+            s.images.refresh(&s.x, &mut s.x_ext);
+            &s.x_ext[..]
+        };
+        let owner = &s.owner[..];
+        par_csr_blocks(
+            offsets,
+            &mut s.pair_count[..n],
+            &mut s.pairs[..pairs],
+            &|first, counts: &mut [u32], out: &mut [Pair<R>]| {
+                let base = offsets[first];
+                for (k, count) in counts.iter_mut().enumerate() {
+                    let i = first + k;
+                    let out = &mut out[offsets[i] - base..offsets[i + 1] - base];
+                    let list = inp.nb.neighbours(i);
+                    *count = support_pairs(&inp.c, listed, owner, i, list, out) as u32;
+                }
+                0.0
+            },
+        );
+        return;
+    };
     s.pair_grad.resize(pairs, Vec3::zeros());
-    let lanes = grain_lanes(s, inp);
-    if lanes.is_some() {
-        let all = s.x.len();
-        s.mass_all.clear();
-        s.mass_all.extend_from_slice(inp.masses);
-        s.mass_all.resize(all, inp.boundary_mass);
-        s.packed.fill(&s.x, &s.mass_all);
-    }
-    let (x, images) = (&s.x[..], &s.images);
+    let all = s.x.len();
+    s.mass_all.clear();
+    s.mass_all.extend_from_slice(inp.masses);
+    s.mass_all.resize(all, inp.boundary_mass);
+    s.packed.fill(&s.x, &s.mass_all);
     let xm = s.packed.values();
     let mut grains = vec![(); n];
     par_csr_blocks(
@@ -129,29 +212,29 @@ pub(crate) fn pair_gradients<R: Real, K: Kernel<R>>(
         &|first, grains: &mut [()], out: &mut [Vec3<R>]| {
             let base = offsets[first];
             for i in first..first + grains.len() {
-                let at = offsets[i] - base;
-                let out = &mut out[at..offsets[i + 1] - base];
-                if let Some(l) = &lanes {
-                    l.gradients(xm, inp.nb, i, out);
-                    continue;
-                }
-                let xi = x[i];
-                for (o, &j) in out.iter_mut().zip(inp.nb.neighbours(i)) {
-                    let (_, xj) = images.resolve(j as usize, x);
-                    *o = pair_gradient(&inp.c, &(xi - xj));
-                }
+                let out = &mut out[offsets[i] - base..offsets[i + 1] - base];
+                lanes.gradients(xm, inp.nb, i, out);
             }
             0.0
         },
     );
 }
 
+/// Grain `i`'s pairs for the scalar passes: its first `s.pair_count[i]` entries of `pairs`
+/// ([`pair_gradients`]).
+#[inline]
+fn grain_pairs<'a, R: Real>(
+    pairs: &'a [Pair<R>],
+    counts: &[u32],
+    offsets: &[usize],
+    i: usize,
+) -> &'a [Pair<R>] {
+    &pairs[offsets[i]..offsets[i] + counts[i] as usize]
+}
+
 /// The arrays the stress pass's pair sums read.
 pub(crate) struct StressFields<'a, R: Real> {
-    pub nb: &'a NeighbourLists,
-    pub images: &'a PeriodicImages<R>,
-    /// Positions, velocities and `m/ρ` of the particles (grains, then boundary particles).
-    pub x: &'a [Vec3<R>],
+    /// Velocities and `m/ρ` of the particles (grains, then boundary particles).
     pub v: &'a [Vec3<R>],
     pub volume: &'a [R],
     /// The grains' masses; the boundary particles' is `boundary_mass`.
@@ -161,25 +244,20 @@ pub(crate) struct StressFields<'a, R: Real> {
 
 /// Grain `i`'s velocity gradient `L_i = Σ_j V_j (v_j − v_i) ⊗ ∇W_ij`, its continuity rate
 /// `−Σ_j m_j (v_j − v_i)·∇W_ij` (no wall share) and whether a grain other than `i` lies
-/// inside its support, from its stored pair gradients `grad_i`, left to right.
+/// inside its support, from its pairs inside the support ([`support_pairs`]), left to right.
 #[inline(always)]
 pub(crate) fn stress_sums<R: Real>(
     f: &StressFields<'_, R>,
     i: usize,
-    grad_i: &[Vec3<R>],
+    pairs: &[Pair<R>],
 ) -> StressSums<R> {
     let n = f.masses.len();
     let vi = f.v[i];
     let mut grad_v = Matrix3::zeros();
     let mut drho = R::zero();
     let mut in_contact = false;
-    for (&j, &gw) in f.nb.neighbours(i).iter().zip(grad_i) {
-        // Beyond the support (the lists' skin) the gradient is zero, whose terms would add
-        // zeros.
-        if gw == Vec3::zeros() {
-            continue;
-        }
-        let (j, _) = f.images.resolve(j as usize, f.x);
+    for p in pairs {
+        let (j, gw) = (p.j as usize, p.grad);
         in_contact |= j < n && j != i;
         let dv = f.v[j] - vi;
         grad_v += dv * gw.transpose() * f.volume[j];
@@ -210,9 +288,6 @@ pub(crate) fn stress_pass<R: Real, K: Kernel<R>>(s: &mut Scratch<R>, inp: &StepI
         .for_each(|(vol, (&m, &r))| *vol = m / r);
     let lanes = grain_lanes(s, inp);
     let fields = StressFields {
-        nb: inp.nb,
-        images: &s.images,
-        x: &s.x,
         v: &s.v,
         volume: &s.volume,
         masses: inp.masses,
@@ -226,6 +301,7 @@ pub(crate) fn stress_pass<R: Real, K: Kernel<R>>(s: &mut Scratch<R>, inp: &StepI
     let (x, v, rho) = (&s.x[..], &s.v[..], &s.rho[..]);
     let (stress, plastic) = (&s.stress[..], &s.plastic_strain[..]);
     let (grad, offsets) = (&s.pair_grad[..], inp.nb.offsets());
+    let (pairs, counts) = (&s.pairs[..], &s.pair_count[..]);
     s.stress_new[..n]
         .par_iter_mut()
         .zip(s.rho_new[..n].par_iter_mut())
@@ -239,14 +315,16 @@ pub(crate) fn stress_pass<R: Real, K: Kernel<R>>(s: &mut Scratch<R>, inp: &StepI
         .for_each(
             |(i, ((((((sig, r), kappa), art), grads), sig_rho2), art_on))| {
                 let (xi, vi) = (x[i], v[i]);
-                let grad_i = &grad[offsets[i]..offsets[i + 1]];
                 let StressSums {
                     mut grad_v,
                     mut drho,
                     in_contact,
                 } = match (&lanes, &lane_arrays) {
-                    (Some(l), Some(a)) => l.stress_sums(a, inp.nb, n, i, flat::<_, R>(grad_i, 3)),
-                    _ => stress_sums(&fields, i, grad_i),
+                    (Some(l), Some(a)) => {
+                        let grad_i = &grad[offsets[i]..offsets[i + 1]];
+                        l.stress_sums(a, inp.nb, n, i, flat::<_, R>(grad_i, 3))
+                    }
+                    _ => stress_sums(&fields, i, grain_pairs(pairs, counts, offsets, i)),
                 };
                 if slots > 0 {
                     inp.walls.sample(inp.boundary, &xi, grads);
@@ -277,10 +355,7 @@ pub(crate) fn stress_pass<R: Real, K: Kernel<R>>(s: &mut Scratch<R>, inp: &StepI
 
 /// The arrays the momentum pass's pair terms read.
 pub(crate) struct MomentumFields<'a, R: Real> {
-    pub images: &'a PeriodicImages<R>,
-    /// Positions, velocities and the new densities of the particles (grains, then boundary
-    /// particles).
-    pub x: &'a [Vec3<R>],
+    /// Velocities and the new densities of the particles (grains, then boundary particles).
     pub v: &'a [Vec3<R>],
     pub rho: &'a [R],
     /// `σ/ρ²` of the new stresses and densities, the artificial stresses `R` and whether each
@@ -294,7 +369,7 @@ pub(crate) struct MomentumFields<'a, R: Real> {
 }
 
 /// The pair stress `σ_i/ρ_i² + σ_j/ρ_j² − Π_ij I + f_ij^n (R_i + R_j)` (Pa m⁶/kg²) of grain
-/// `i`'s listed neighbour `j` (an index of the lists) and the neighbour's mass `m_j`:
+/// `i`'s pair `p` ([`support_pairs`]) and the neighbour's mass `m_j`:
 /// Monaghan's artificial viscosity on approaching pairs, Gray, Monaghan & Swift's artificial
 /// stress where either side has one.
 #[inline(always)]
@@ -302,11 +377,10 @@ pub(crate) fn pair_stress<R: Real, K: Kernel<R>>(
     c: &Consts<R, K>,
     f: &MomentumFields<'_, R>,
     i: usize,
-    j: usize,
+    p: &Pair<R>,
 ) -> (Matrix3<R>, R) {
-    let (xi, vi, ri) = (f.x[i], f.v[i], f.rho[i]);
-    let (j, xj) = f.images.resolve(j, f.x);
-    let xij = xi - xj;
+    let (vi, ri) = (f.v[i], f.rho[i]);
+    let (j, xij) = (p.j as usize, p.xij);
     let rj = f.rho[j];
     let mut t = f.sig_rho2[i] + f.sig_rho2[j];
     // Monaghan's artificial viscosity, for approaching pairs (`Π_ij > 0`: only the diagonal
@@ -328,18 +402,17 @@ pub(crate) fn pair_stress<R: Real, K: Kernel<R>>(
     (t, f.masses.get(j).copied().unwrap_or(f.boundary_mass))
 }
 
-/// The momentum pass's term `m_j T_ij ∇W_ij` of grain `i`'s listed neighbour `j` with the
-/// pair gradient `gw` and the pair stress `T_ij` ([`pair_stress`]).
+/// The momentum pass's term `m_j T_ij ∇W_ij` of grain `i`'s pair `p` with the pair stress
+/// `T_ij` ([`pair_stress`]).
 #[inline(always)]
 pub(crate) fn pair_term<R: Real, K: Kernel<R>>(
     c: &Consts<R, K>,
     f: &MomentumFields<'_, R>,
     i: usize,
-    j: usize,
-    gw: &Vec3<R>,
+    p: &Pair<R>,
 ) -> Vec3<R> {
-    let (t, m) = pair_stress(c, f, i, j);
-    t * gw * m
+    let (t, m) = pair_stress(c, f, i, p);
+    t * p.grad * m
 }
 
 /// Pass 2: the acceleration from the new stresses (with the artificial viscosity and
@@ -353,8 +426,6 @@ pub(crate) fn momentum_pass<R: Real, K: Kernel<R>>(s: &mut Scratch<R>, inp: &Ste
     let n = inp.masses.len();
     let lanes = grain_lanes(s, inp);
     let f = MomentumFields {
-        images: &s.images,
-        x: &s.x,
         v: &s.v,
         rho: &s.rho_new,
         sig_rho2: &s.stress_over_rho2,
@@ -372,6 +443,7 @@ pub(crate) fn momentum_pass<R: Real, K: Kernel<R>>(s: &mut Scratch<R>, inp: &Ste
     });
     let (sig, grads) = (&s.stress_new[..], &s.wall_grad);
     let (grad, offsets) = (&s.pair_grad[..], inp.nb.offsets());
+    let (pairs, counts, x) = (&s.pairs[..], &s.pair_count[..], &s.x[..]);
     let two = R::of_f64(2.0);
     let inv_dt = R::one() / inp.dt;
     s.v_new[..n]
@@ -380,25 +452,37 @@ pub(crate) fn momentum_pass<R: Real, K: Kernel<R>>(s: &mut Scratch<R>, inp: &Ste
         .enumerate()
         .with_min_len(MIN_LEN)
         .for_each(|(i, (vn, xn))| {
-            let (xi, vi, ri) = (f.x[i], f.v[i], f.rho[i]);
+            let (xi, vi, ri) = (x[i], f.v[i], f.rho[i]);
             let mut a = inp.gravity;
-            let list = inp.nb.neighbours(i);
-            let grad_i = &grad[offsets[i]..offsets[i + 1]];
             match (&lanes, &lane_arrays) {
-                (Some(l), Some(arrays)) if !f.art_on[i] => {
-                    let mut rest = Vec3::zeros();
-                    let mut scalar = |k: usize| {
-                        rest += pair_term(&c, &f, i, list[k] as usize, &grad_i[k]);
+                (Some(l), Some(arrays)) => {
+                    let list = inp.nb.neighbours(i);
+                    let grad_i = &grad[offsets[i]..offsets[i + 1]];
+                    let listed = |k: usize| {
+                        let j = list[k];
+                        Pair {
+                            j,
+                            xij: xi - x[j as usize],
+                            grad: grad_i[k],
+                        }
                     };
-                    let lanes_sum: Vec3<R> =
-                        l.acceleration(arrays, inp.nb, i, flat::<_, R>(grad_i, 3), &mut scalar);
-                    a += lanes_sum + rest;
+                    if f.art_on[i] {
+                        for p in (0..list.len()).map(listed) {
+                            if p.grad != Vec3::zeros() {
+                                a += pair_term(&c, &f, i, &p);
+                            }
+                        }
+                    } else {
+                        let mut rest = Vec3::zeros();
+                        let mut scalar = |k: usize| rest += pair_term(&c, &f, i, &listed(k));
+                        let lanes_sum: Vec3<R> =
+                            l.acceleration(arrays, inp.nb, i, flat::<_, R>(grad_i, 3), &mut scalar);
+                        a += lanes_sum + rest;
+                    }
                 }
                 _ => {
-                    for (&j, gw) in list.iter().zip(grad_i) {
-                        if *gw != Vec3::zeros() {
-                            a += pair_term(&c, &f, i, j as usize, gw);
-                        }
+                    for p in grain_pairs(pairs, counts, offsets, i) {
+                        a += pair_term(&c, &f, i, p);
                     }
                 }
             }
@@ -442,4 +526,82 @@ pub(crate) fn max_displacement<R: Real>(s: &Scratch<R>, n: usize) -> R {
         .with_min_len(MIN_LEN)
         .map(|(a, b)| (a - b).norm())
         .reduce(R::zero, |a, b| if b > a { b } else { a })
+}
+
+#[cfg(test)]
+mod tests {
+    use proptest::prelude::*;
+    use sph_kernels::CubicSpline;
+    use sph_solver::scene_boundary::{PeriodicAxis, PeriodicImages};
+    use sph_solver::step::StepNeighbours;
+    use sph_solver::Method;
+
+    use super::*;
+    use crate::ElastoplasticParams;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(32))]
+
+        /// The pairs the scalar passes read ([`support_pairs`], from the images' refreshed
+        /// positions and their owners) against each listed pair resolved through
+        /// [`PeriodicImages::resolve`] and its [`pair_gradient`], those of a zero gradient
+        /// dropped: the same pairs in the same order, bit for bit (the same arithmetic), on
+        /// a random cloud in a slab periodic along `x` and `z` (three grains deep, as the
+        /// poured heaps), searched once and then moved by up to half the skin, as between
+        /// two searches.
+        #[test]
+        fn the_support_pairs_are_the_resolved_listed_pairs(
+            count in 20usize..200,
+            seed in any::<u64>(),
+        ) {
+            let s = 0.02f64;
+            let p = ElastoplasticParams::<f64>::for_spacing(s, 30.0);
+            let h = p.common.support_radius;
+            let c = Consts::new(&p, CubicSpline::new(h).unwrap()).unwrap();
+            let axes = [
+                PeriodicAxis { axis: 0, lo: 0.0, hi: 0.2 },
+                PeriodicAxis { axis: 2, lo: 0.0, hi: 0.06 },
+            ];
+            let mut state = seed | 1;
+            let mut draw = |scale: f64| {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                scale * ((state >> 11) as f64 / (1u64 << 53) as f64)
+            };
+            let mut x: Vec<Vec3<f64>> = (0..count)
+                .map(|_| Vec3::new(draw(0.2), draw(0.1), draw(0.06)))
+                .collect();
+            let mut images = PeriodicImages::default();
+            let mut ext = Vec::new();
+            images.rebuild(&mut x, &axes, h + p.skin, &mut ext);
+            let mut search = StepNeighbours::new(Method::CellStartGrid);
+            search.find(&ext, h + p.skin).unwrap();
+            let nb = search.lists();
+            let mut owner = Vec::new();
+            images.owners(count, &mut owner);
+            for q in &mut x {
+                *q += Vec3::new(draw(p.skin), draw(p.skin), draw(p.skin)) * 0.5 / 3f64.sqrt();
+            }
+            images.refresh(&x, &mut ext);
+            let mut out = vec![Pair::default(); nb.offsets()[count]];
+            let mut checked = 0;
+            for i in 0..count {
+                let list = nb.neighbours(i);
+                let got = support_pairs(&c, &ext, &owner, i, list, &mut out);
+                let want: Vec<Pair<f64>> = list
+                    .iter()
+                    .map(|&j| {
+                        let (j, xj) = images.resolve(j as usize, &x);
+                        let xij = x[i] - xj;
+                        Pair { j: j as u32, xij, grad: pair_gradient(&c, &xij) }
+                    })
+                    .filter(|q| q.grad != Vec3::zeros())
+                    .collect();
+                prop_assert_eq!(&out[..got], &want[..], "pairs of grain {}", i);
+                checked += got;
+            }
+            prop_assert!(checked > 0);
+        }
+    }
 }

@@ -9,6 +9,8 @@ use sph_solver::boundary::BoundaryParticle;
 use sph_solver::pair_lanes::Packed;
 use sph_solver::scene_boundary::PeriodicImages;
 
+use crate::passes::Pair;
+
 /// Per-particle arrays (structure of arrays).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Scratch<R: Real> {
@@ -33,8 +35,12 @@ pub(crate) struct Scratch<R: Real> {
     /// `m_j/ρ_j` of the step's densities (the velocity gradient's volume).
     pub volume: Vec<R>,
     /// The kernel gradient of each grain's listed pair (CSR order of the neighbour lists),
-    /// once per explicit step for both passes.
+    /// once per explicit step for both passes, where the lanes run.
     pub pair_grad: Vec<Vec3<R>>,
+    /// Elsewhere each grain's pairs inside the support, at the start of its CSR range, and
+    /// how many ([`crate::passes::pair_gradients`]).
+    pub pairs: Vec<Pair<R>>,
+    pub pair_count: Vec<u32>,
     /// The masses of the grains followed by the boundary particles', and the positions and
     /// masses packed for the lanes ([`crate::lanes`]; filled only where they run).
     pub mass_all: Vec<R>,
@@ -48,9 +54,13 @@ pub(crate) struct Scratch<R: Real> {
     /// Wall gradients `∇Ψ_k`, `slots` per particle.
     pub wall_grad: Vec<Vec3<R>>,
     /// Images of the particles near periodic ends, and the particles followed by them (the
-    /// array the neighbour lists index).
+    /// array the neighbour lists index; with images, refreshed each step by the pairs'
+    /// pass).
     pub images: PeriodicImages<R>,
     pub x_ext: Vec<Vec3<R>>,
+    /// The particle whose values each of the lists' particles carries (itself, or an
+    /// image's particle), from the last neighbour search.
+    pub owner: Vec<u32>,
     /// Permutation scratch.
     pub permute_m: Vec<Matrix3<R>>,
     pub permute_r: Vec<R>,

@@ -585,6 +585,7 @@ impl<R: Real> ElastoplasticScheme<R> {
                 stats.phases.add(CREATE_HASH_GRID, search.build_s());
                 stats.phases.add(DETECT_NEIGHBOURS, search.detect_s());
                 s.anchor.copy_from_slice(&s.x);
+                s.images.owners(s.x.len(), &mut s.owner);
                 s.boundary_lists.rebuild(
                     self.parts.neighbours.lists(),
                     &s.images,

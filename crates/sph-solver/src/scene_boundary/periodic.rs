@@ -54,6 +54,28 @@ impl<R: Real> PeriodicImages<R> {
         }
     }
 
+    /// Writes the particles `x` followed by their images into `extended` (as
+    /// [`PeriodicImages::rebuild`] does, without wrapping or finding the images again): the
+    /// images' positions after the particles have moved.
+    pub fn refresh(&self, x: &[Vec3<R>], extended: &mut Vec<Vec3<R>>) {
+        extended.clear();
+        extended.extend_from_slice(x);
+        extended.extend(
+            self.src
+                .iter()
+                .zip(&self.shift)
+                .map(|(&k, shift)| x[k as usize] + shift),
+        );
+    }
+
+    /// The particle each entry of the particles `0..n` followed by the images stands for
+    /// (`owner[j]` is [`PeriodicImages::resolve`]'s index), into `owner`.
+    pub fn owners(&self, n: usize, owner: &mut Vec<u32>) {
+        owner.clear();
+        owner.extend(0..n as u32);
+        owner.extend_from_slice(&self.src);
+    }
+
     /// Wraps `x` into the periods of `axes`, then rebuilds the images of every particle
     /// within `reach` of an end (corners included) and writes the particles followed by
     /// their images into `extended`.
