@@ -257,10 +257,16 @@ pub mod avx512 {
     /// 128-bit lane `l` of register `r`, then a 4 × 4 transpose within each 128-bit lane,
     /// which leaves neighbour `e` in element `e` of the `x`, `y`, `z` and `m` registers.
     ///
+    /// Always inlined, so that the sixteen pairs stay in registers: as an out-of-line call
+    /// (what `#[inline]` gave: `perf` showed a call per sixteen pairs from every lane
+    /// kernel) the result went through memory and the caller's accumulators, all in
+    /// caller-saved vector registers, were spilled around it. `#[inline(always)]` excludes
+    /// `#[target_feature]`; the intrinsics inside are compiled with the caller's AVX-512.
+    ///
     /// # Safety
-    /// avx512f; `xm` holds `4n` values, `i < n`, `s < list.len()`.
-    #[target_feature(enable = "avx512f")]
-    #[inline]
+    /// avx512f (the caller must be compiled with it); `xm` holds `4n` values, `i < n`,
+    /// `s < list.len()`.
+    #[inline(always)]
     pub unsafe fn pairs(xm: &[f32], i: usize, list: &[u32], s: usize) -> Pairs {
         let left = list.len() - s;
         let live: __mmask16 = if left >= 16 {
@@ -272,20 +278,20 @@ pub mod avx512 {
         let j = _mm512_maskz_loadu_epi32(live, list.as_ptr().add(s).cast());
         let j = _mm512_min_epu32(j, _mm512_set1_epi32(last as i32));
         let p = xm.as_ptr();
-        let load = |k: usize| {
-            let jk = if k < left {
+        // The neighbour of entry k (particle i itself past the list's end).
+        let at = |k: usize| {
+            if k < left {
                 (*list.get_unchecked(s + k) as usize).min(last)
             } else {
                 i
-            };
-            _mm_loadu_ps(p.add(4 * jk))
+            }
         };
         let mut z = [_mm512_setzero_ps(); 4];
         for (r, zr) in z.iter_mut().enumerate() {
-            let v = _mm512_castps128_ps512(load(r));
-            let v = _mm512_insertf32x4::<1>(v, load(4 + r));
-            let v = _mm512_insertf32x4::<2>(v, load(8 + r));
-            *zr = _mm512_insertf32x4::<3>(v, load(12 + r));
+            let v = _mm512_castps128_ps512(_mm_loadu_ps(p.add(4 * at(r))));
+            let v = _mm512_insertf32x4::<1>(v, _mm_loadu_ps(p.add(4 * at(4 + r))));
+            let v = _mm512_insertf32x4::<2>(v, _mm_loadu_ps(p.add(4 * at(8 + r))));
+            *zr = _mm512_insertf32x4::<3>(v, _mm_loadu_ps(p.add(4 * at(12 + r))));
         }
         let t0 = _mm512_unpacklo_ps(z[0], z[1]);
         let t1 = _mm512_unpackhi_ps(z[0], z[1]);
