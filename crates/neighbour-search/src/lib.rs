@@ -65,13 +65,17 @@
 //! about 12 instructions each: ~85 instructions), gathers its cell's ~216 candidates shared
 //! by ~8 particles (~110 element copies) and moves about 220 bytes through memory (cells,
 //! keys, cell-ordered positions, 91 bytes of neighbour indices, offsets). At the measured
-//! single-thread copy bandwidth of 11 GB/s (`cargo run --release -p benches --example
-//! bandwidth`) the memory part is ≈ 0.02 µs, and the instruction count at 2–3 per cycle is
-//! ≈ 0.03–0.04 µs: a bound of about 0.04 µs/particle (the measured figure is about 2.5×
-//! that). The rest is per-cell and per-particle overhead (locating the nine column
-//! ranges, padding, reserving output). The relation table's cost is its 27 entries per
-//! particle: 27 × 12 bytes written and radix-sorted in two passes (≈ 250 MB of traffic for
-//! this scene, ≈ 25 ms at 11 GB/s even before the sort's scattered writes), which is why it
+//! single-thread copy bandwidth of 23 GB/s (`cargo run --release -p benches --example
+//! bandwidth`) the memory part is ≈ 0.01 µs, and the instruction count at 2–3 per cycle is
+//! ≈ 0.03–0.04 µs: a bound of about 0.04 µs/particle. The particles of a cell are scanned
+//! by one call of the kernel with one output reservation per cell (in pieces of at most
+//! 2¹⁴ pairs), so no per-particle dispatch or reservation remains; what stands above the
+//! bound is the gathering of the 27 cells' candidates (nine column ranges copied and padded
+//! per cell, about a third of the search's samples under `perf`, against about half for
+//! the distance tests) and the candidate count of cells of edge `h` (about 7 tests per
+//! neighbour found on the dam break's fluid block). The relation table's cost is its 27
+//! entries per particle: 27 × 12 bytes written and radix-sorted in two passes (≈ 250 MB of
+//! traffic for this scene, ≈ 11 ms at 23 GB/s even before the sort's scattered writes), which is why it
 //! is 5–10× slower than the cell-start grid on a CPU; see the `neighbour-search` experiment
 //! of `cargo xtask validate` for the comparison with Im & Chan's claim.
 

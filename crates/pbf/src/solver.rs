@@ -373,7 +373,10 @@ struct VelocityInput<'a, R: Real> {
 
 /// Algorithm 1 lines 20–22: `v = (x* − x)/Δt`, the densities at the final positions (for
 /// the statistics and the state), vorticity (eq. 15) and confinement (eq. 16), XSPH
-/// (eq. 17); the new velocities go to `s.velocity_new`.
+/// (eq. 17); the new velocities go to `s.velocity_new`. A volume boundary's `ρ0 Ψ` is
+/// sampled only for the particles the Jacobi iterations sampled (`s.near_boundary`, from
+/// [`near_boundary`] at this step's predicted positions): the others have `Ψ = 0` by the
+/// argument of [`near_boundary`], and adding `ρ0 · 0` changes no density.
 fn velocity_update<R: Real>(input: VelocityInput<'_, R>, s: &mut PbfScratch<R>) {
     let VelocityInput {
         c,
@@ -395,6 +398,7 @@ fn velocity_update<R: Real>(input: VelocityInput<'_, R>, s: &mut PbfScratch<R>) 
     let vort_on = p.vorticity_epsilon != R::zero();
     let xsph_on = p.xsph_c > R::zero();
     let v = &s.velocity[..];
+    let near = &s.near_boundary[..];
     if lanes.is_some() && !vort_on {
         s.pairs.packed.fill(x, m);
     }
@@ -441,7 +445,7 @@ fn velocity_update<R: Real>(input: VelocityInput<'_, R>, s: &mut PbfScratch<R>) 
                     xsph += (v[j] - vi) * (m[j] * c.inv_rho0 * wij);
                 }
             }
-            if let Some(bd) = volume {
+            if let Some(bd) = volume.filter(|_| near[i]) {
                 sum_w += c.rho0 * bd.sample(&xi).volume;
             }
             *rho = sum_w;

@@ -257,10 +257,16 @@ pub mod avx512 {
     /// 128-bit lane `l` of register `r`, then a 4 × 4 transpose within each 128-bit lane,
     /// which leaves neighbour `e` in element `e` of the `x`, `y`, `z` and `m` registers.
     ///
+    /// Always inlined, so that the sixteen pairs stay in registers: as an out-of-line call
+    /// (what `#[inline]` gave: `perf` showed a call per sixteen pairs from every lane
+    /// kernel) the result went through memory and the caller's accumulators, all in
+    /// caller-saved vector registers, were spilled around it. `#[inline(always)]` excludes
+    /// `#[target_feature]`; the intrinsics inside are compiled with the caller's AVX-512.
+    ///
     /// # Safety
-    /// avx512f; `xm` holds `4n` values, `i < n`, `s < list.len()`.
-    #[target_feature(enable = "avx512f")]
-    #[inline]
+    /// avx512f (the caller must be compiled with it); `xm` holds `4n` values, `i < n`,
+    /// `s < list.len()`.
+    #[inline(always)]
     pub unsafe fn pairs(xm: &[f32], i: usize, list: &[u32], s: usize) -> Pairs {
         let left = list.len() - s;
         let live: __mmask16 = if left >= 16 {
@@ -272,20 +278,20 @@ pub mod avx512 {
         let j = _mm512_maskz_loadu_epi32(live, list.as_ptr().add(s).cast());
         let j = _mm512_min_epu32(j, _mm512_set1_epi32(last as i32));
         let p = xm.as_ptr();
-        let load = |k: usize| {
-            let jk = if k < left {
+        // The neighbour of entry k (particle i itself past the list's end).
+        let at = |k: usize| {
+            if k < left {
                 (*list.get_unchecked(s + k) as usize).min(last)
             } else {
                 i
-            };
-            _mm_loadu_ps(p.add(4 * jk))
+            }
         };
         let mut z = [_mm512_setzero_ps(); 4];
         for (r, zr) in z.iter_mut().enumerate() {
-            let v = _mm512_castps128_ps512(load(r));
-            let v = _mm512_insertf32x4::<1>(v, load(4 + r));
-            let v = _mm512_insertf32x4::<2>(v, load(8 + r));
-            *zr = _mm512_insertf32x4::<3>(v, load(12 + r));
+            let v = _mm512_castps128_ps512(_mm_loadu_ps(p.add(4 * at(r))));
+            let v = _mm512_insertf32x4::<1>(v, _mm_loadu_ps(p.add(4 * at(4 + r))));
+            let v = _mm512_insertf32x4::<2>(v, _mm_loadu_ps(p.add(4 * at(8 + r))));
+            *zr = _mm512_insertf32x4::<3>(v, _mm_loadu_ps(p.add(4 * at(12 + r))));
         }
         let t0 = _mm512_unpacklo_ps(z[0], z[1]);
         let t1 = _mm512_unpackhi_ps(z[0], z[1]);
@@ -298,7 +304,14 @@ pub mod avx512 {
         ];
         let mj = _mm512_shuffle_ps::<0xEE>(t1, t3);
         let own = xm.as_ptr().add(4 * i);
-        let d = [0, 1, 2].map(|a| _mm512_sub_ps(_mm512_set1_ps(*own.add(a)), xj[a]));
+        // No closure calls an intrinsic here: a closure of this function (which has no
+        // `#[target_feature]`) is compiled without AVX-512 when it is not inlined, and its
+        // intrinsics become calls (measured: IISPH's step took 1.9× as long).
+        let d = [
+            _mm512_sub_ps(_mm512_set1_ps(*own), xj[0]),
+            _mm512_sub_ps(_mm512_set1_ps(*own.add(1)), xj[1]),
+            _mm512_sub_ps(_mm512_set1_ps(*own.add(2)), xj[2]),
+        ];
         // nalgebra's norm_squared: (dx² + dy²) + dz².
         let r2 = _mm512_add_ps(
             _mm512_add_ps(_mm512_mul_ps(d[0], d[0]), _mm512_mul_ps(d[1], d[1])),
