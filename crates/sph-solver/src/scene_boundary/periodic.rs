@@ -102,8 +102,6 @@ impl<R: Real> PeriodicImages<R> {
         }
         self.src.clear();
         self.shift.clear();
-        extended.clear();
-        extended.extend_from_slice(x);
         // Every combination of {−1, 0, +1} periods along the axes but all zeros.
         let combos = 3usize.pow(axes.len() as u32);
         for (i, p) in x.iter().enumerate() {
@@ -125,10 +123,10 @@ impl<R: Real> PeriodicImages<R> {
                 if keep {
                     self.src.push(i as u32);
                     self.shift.push(shift);
-                    extended.push(p + shift);
                 }
             }
         }
+        self.refresh(x, extended);
     }
 }
 
