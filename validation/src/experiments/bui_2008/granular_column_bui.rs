@@ -68,13 +68,17 @@ use crate::helpers::{
 use crate::scene_runs::{
     run_scene_until_rest_keeping, shipped_scene, solver_error_check, RestCriterion, SceneRun,
 };
-use crate::{Check, Context, Experiment, Outcome};
+use crate::{Check, Context, Experiment, Mode, Outcome};
 
 /// The experiment.
 pub struct GranularColumnBui;
 
-/// The shipped scene.
-const SCENE: &str = "granular_column_bui";
+/// The shipped scene the checks run: the column in the plane (`[simulation] dimensions = 2`,
+/// plane strain), as Bui et al. compute it.
+const SCENE: &str = "granular_column_bui_planar";
+/// The same column as a periodic slab in 3D (`scenes/granular_column_bui.toml`), run beside
+/// the plane in full mode as a cross-check of the planar path (reported, not checked).
+const SLAB_SCENE: &str = "granular_column_bui";
 /// Depth of the periodic slab, in spacings (plane strain without side walls; the support,
 /// 2.4 spacings, sees its periodic images).
 const SLAB_SPACINGS: f64 = 3.0;
@@ -121,21 +125,26 @@ struct Column {
     height: f64,
 }
 
-/// The shipped scene in `ctx`'s mode with the slab [`SLAB_SPACINGS`] deep, its column and
-/// its friction angle and cone match.
-fn column_scene(ctx: &Context) -> Result<(Scene, Column, f64, ConeMatch)> {
-    let mut scene = shipped_scene(SCENE, ctx.mode)?;
+/// The shipped scene `name` in `ctx`'s mode (a 3D scene with its slab [`SLAB_SPACINGS`]
+/// deep), its column and its friction angle and cone match.
+fn column_scene(ctx: &Context, name: &str) -> Result<(Scene, Column, f64, ConeMatch)> {
+    let mut scene = shipped_scene(name, ctx.mode)?;
+    let planar = scene.is_planar();
     let depth = SLAB_SPACINGS * scene.particle_spacing;
     let Some(tank) = scene.tank.as_mut() else {
-        bail!("{SCENE}: the scene needs a tank (its floor and back wall)");
+        bail!("{name}: the scene needs a tank (its floor and back wall)");
     };
-    tank.max.z = tank.min.z + depth;
+    if !planar {
+        tank.max.z = tank.min.z + depth;
+    }
     let (z_lo, z_hi) = (tank.min.z, tank.max.z);
     let Some(FluidSpec::Block { min, max, .. }) = scene.fluids.first_mut() else {
-        bail!("{SCENE}: the scene's first fluid must be the column (a block)");
+        bail!("{name}: the scene's first fluid must be the column (a block)");
     };
-    min[2] = z_lo;
-    max[2] = z_hi;
+    if !planar {
+        min[2] = z_lo;
+        max[2] = z_hi;
+    }
     let column = Column {
         back_x: min[0],
         floor_y: min[1],
@@ -144,7 +153,7 @@ fn column_scene(ctx: &Context) -> Result<(Scene, Column, f64, ConeMatch)> {
     };
     let SolverSpec::Elastoplastic(e) = &mut scene.solver else {
         bail!(
-            "{SCENE}: the experiment needs kind = \"elastoplastic\", not \"{}\"",
+            "{name}: the experiment needs kind = \"elastoplastic\", not \"{}\"",
             scene.solver.kind_name()
         );
     };
@@ -212,7 +221,7 @@ impl Experiment for GranularColumnBui {
         &["elastoplastic-granular", "granular-measure"]
     }
     fn scenes(&self) -> &'static [&'static str] {
-        &[SCENE]
+        &[SCENE, SLAB_SCENE]
     }
     fn source(&self) -> &'static str {
         "Bui, Fukagawa, Sako & Ohno (2008) Int. J. Numer. Anal. Meth. Geomech. 32:1537-1570, section 6: collapse of a column of aluminium bars, against Rankine's active wedge (failure line at 45 deg + phi/2 through the toe)"
@@ -221,177 +230,270 @@ impl Experiment for GranularColumnBui {
     fn run(&self, ctx: &mut Context) -> Result<Outcome> {
         let peer = load_reference_csv(ctx, SPHINXSYS_FILE, &["quantity", "value"])?;
         let peer_kept = peer.number(peer.find(&[("quantity", "fraction_kept")])?, "value")?;
-        let (scene, column, phi, cone) = column_scene(ctx)?;
-        let s = scene.particle_spacing;
-        ctx.progress.set_length(scene.frame_count() as u64);
-        let t0 = std::time::Instant::now();
-        let slip_frames: Vec<usize> = SLIP_TIMES_S
-            .iter()
-            .map(|t| (t / scene.frame_dt_s).round() as usize)
-            .collect();
-        let run = run_scene_until_rest_keeping(
-            ctx,
-            &scene,
-            &slip_frames,
-            &["plastic_strain"],
-            RestCriterion::default(),
-        )?;
-        let wall_s = t0.elapsed().as_secs_f64();
-
         let mut out = Outcome::new();
-        out.metric("particles", run.particles as f64);
-        out.metric("wall_s", wall_s);
-        out.metric("spacing_m", s);
-        if let Some(e) = &run.blow_up {
-            out.check(solver_error_check("column", e));
+        let Some(m) = measure_column(ctx, SCENE, "", &mut out)? else {
             return Ok(out);
-        }
-        check_rest(&mut out, &scene, &run);
-
-        let initial = scene.fluid_particles::<f64>()?.positions;
-        let mut last = vec![Vec3::new(f64::NAN, f64::NAN, f64::NAN); initial.len()];
-        for (&id, &p) in run.final_ids.iter().zip(&run.final_positions) {
-            last[id as usize] = p;
-        }
-        let moved: Vec<bool> = initial
-            .iter()
-            .zip(&last)
-            .map(|(a, b)| (b.x - a.x).hypot(b.y - a.y) > s)
-            .collect();
-
-        // the back of the column
-        let back_top = |ps: &[Vec3<f64>]| {
-            initial
-                .iter()
-                .zip(ps)
-                .filter(|(a, _)| a.x - column.back_x < BACK_SPACINGS * s)
-                .map(|(_, p)| p.y)
-                .fold(f64::NEG_INFINITY, f64::max)
         };
-        let back_drop = back_top(&initial) - back_top(&last);
-        out.metric("back_height_drop_m", back_drop);
-        out.check(Check::at_most(
-            format!("back of the column ({BACK_SPACINGS} spacings from the wall): height lost (m)"),
-            back_drop.abs(),
-            s,
-            "physics: Rankine's active wedge fails in front of the line through the toe; the material behind it, held by the wall, does not move (one spacing: the grain size)",
-        ));
-
-        // the first slip surface against Rankine's line; the final moved zone beside it
-        let rankine = 45.0 + 0.5 * phi;
-        let tol = failure_line_tolerance_deg(rankine, s, column.height);
-        out.metric("rankine_deg", rankine);
-        out.metric("failure_line_tolerance_deg", tol);
-        let (_, final_zone) = failure_line(&initial, &moved, column, s);
-        out.metric("final_moved_zone_deg", final_zone);
-        out.metric(
-            "moved_fraction",
-            moved.iter().filter(|&&m| m).count() as f64 / moved.len() as f64,
-        );
-        let mut slip = None;
-        for (&t, &frame) in SLIP_TIMES_S.iter().zip(&slip_frames) {
-            let at = run.snapshots.iter().find(|(f, _)| *f == frame);
-            let strain = run
-                .snapshot_fields
-                .iter()
-                .find(|(f, name, k, _)| *f == frame && name == "plastic_strain" && *k == 1);
-            let (Some((_, at)), Some((_, _, _, strain))) = (at, strain) else {
-                out.note(format!("no snapshot at t = {t} s (the run ended before)"));
-                continue;
-            };
-            let moved_early: Vec<bool> = initial
-                .iter()
-                .zip(at)
-                .map(|(a, b)| (b.x - a.x).hypot(b.y - a.y) > SLIP_THRESHOLD_SPACINGS * s)
-                .collect();
-            let (_, beta_moved) = failure_line(&initial, &moved_early, column, s);
-            out.metric(format!("moved_zone_{:.0}ms_deg", 1e3 * t), beta_moved);
-            let failed: Vec<bool> = strain.iter().map(|&e| e > SLIP_PLASTIC_STRAIN).collect();
-            let (rows, beta) = failure_line(&initial, &failed, column, s);
-            out.metric(format!("slip_surface_{:.0}ms_deg", 1e3 * t), beta);
-            if t == SLIP_CHECK_S {
-                slip = Some((rows, beta));
-            }
-        }
-        let Some((rows, beta)) = slip else {
-            bail!("no snapshot at the slip surface's time {SLIP_CHECK_S} s");
-        };
-        out.check(Check::within(
-            format!("first slip surface at {SLIP_CHECK_S} s through the toe (deg) against Rankine's 45 + phi/2 = {rankine:.2}"),
-            beta,
-            rankine - tol,
-            rankine + tol,
-            format!(
-                "Rankine's active wedge (plane strain, c = 0: the slip lines at 45 deg + phi/2 from the horizontal, the minor principal stress horizontal); band 1.5 sin^2(beta) s/H0 = {tol:.2} deg: each row's boundary located to one spacing"
-            ),
-        ));
-
-        // the deposit: slope, runout, energy
-        let deposit = angle_of_repose(
-            &run.final_positions,
-            &ReposeOptions::planar(column.floor_y, s).with_spacing(s),
-        );
-        let deposit_deg = deposit.as_ref().map_or(f64::NAN, |m| m.angle_deg);
-        out.metric("deposit_slope_deg", deposit_deg);
-        out.metric("repose_angle_deg", cone.predicted_repose_angle_deg(phi));
-        out.metric("max_stable_slope_deg", cone.max_stable_slope_deg(phi));
-        if let Err(e) = &deposit {
-            out.note(format!("deposit slope not measured: {e}"));
-        }
-        let runout_m = runout(
-            &run.final_positions,
-            &RunoutOptions::connected(column.back_x, s),
-        )?;
-        out.metric("runout_m", runout_m);
-        let far_wall = scene.tank.map_or(f64::NAN, |t| t.max.x);
-        out.check(Check::greater_than(
-            "deposit's front clear of the far wall (m)",
-            far_wall - (column.back_x + runout_m),
-            2.0 * s,
-            "validity: a front at the far wall was stopped by it",
-        ));
-        out.metric(
-            "normalised_runout",
-            normalised_runout(runout_m, column.length)?,
-        );
-        let height_sum = |ps: &[Vec3<f64>]| ps.iter().map(|p| p.y - column.floor_y).sum::<f64>();
-        let kept = height_sum(&run.final_positions) / height_sum(&initial);
-        out.metric("potential_energy_kept", kept);
-        out.metric("sphinxsys_potential_energy_kept", peer_kept);
-        out.check(Check::within(
-            "fraction of the initial potential energy kept at rest",
-            kept,
-            peer_kept - ENERGY_BAND,
-            peer_kept + ENERGY_BAND,
-            format!(
-                "peer cross-check, not an experiment: SPHinXsys test_2d_column_collapse ({peer_kept:.3}, phi = 21.9 deg); band +-{ENERGY_BAND} this project's, set before the run"
-            ),
-        ));
-
+        check_column(&mut out, &m, peer_kept);
         write_csv_rows(
             &ctx.path("failure_line.csv"),
             &["y_m", "boundary_x_m"],
-            rows.iter()
+            m.slip_rows
+                .iter()
                 .map(|(y, x)| vec![format!("{y:.5}"), format!("{x:.5}")]),
         )?;
         ctx.add_file(
             "failure_line.csv",
             "per initial row: the boundary between the grains that stayed (behind) and those whose plastic strain exceeded 0.01 at 0.1 s (the first slip surface)",
         );
-        plot_deposit(ctx, &run, column, &rows, beta, rankine)?;
+        plot_deposit(ctx, &m)?;
+        if ctx.mode == Mode::Full {
+            // The 3D slab beside the plane: the planar path's cross-check (reported).
+            if let Some(slab) = measure_column(ctx, SLAB_SCENE, "slab/", &mut out)? {
+                out.metric(
+                    "slab/slip_surface_minus_plane_deg",
+                    slab.slip_deg - m.slip_deg,
+                );
+            }
+        }
         out.note(format!(
-            "phi = {phi} deg, cone {}, spacing {s} m, slab {SLAB_SPACINGS} spacings periodic in z; first slip surface: the edge of the grains whose plastic strain exceeds {SLIP_PLASTIC_STRAIN} at {SLIP_CHECK_S} s; final moved zone: by more than one spacing at rest; the deposit's slope, profile and runout are not checked (Bui et al.'s measured figures are not in our library); rest by granular_measure::rest (default figures, all grains)",
-            cone.name()
+            "phi = {} deg, cone {}, spacing {} m, in the plane (dimensions = 2, plane strain){}; first slip surface: the edge of the grains whose plastic strain exceeds {SLIP_PLASTIC_STRAIN} at {SLIP_CHECK_S} s; final moved zone: by more than one spacing at rest; the deposit's slope, profile and runout are not checked (Bui et al.'s measured figures are not in our library); rest by granular_measure::rest (default figures, all grains)",
+            m.phi,
+            m.cone.name(),
+            m.spacing,
+            if ctx.mode == Mode::Full {
+                format!("; the same column as a 3D slab {SLAB_SPACINGS} spacings deep, periodic in z, reported as slab/*")
+            } else {
+                String::new()
+            }
         ));
         Ok(out)
     }
 }
 
+/// One column's run and its measures.
+struct ColumnMeasures {
+    scene: Scene,
+    column: Column,
+    phi: f64,
+    cone: ConeMatch,
+    spacing: f64,
+    run: SceneRun,
+    /// The back's height lost (m).
+    back_drop: f64,
+    /// The first slip surface at [`SLIP_CHECK_S`]: per initial row `(y, x_b)`, and `β` (deg).
+    slip_rows: Vec<(f64, f64)>,
+    slip_deg: f64,
+    runout_m: f64,
+    kept: f64,
+}
+
+/// Runs shipped scene `name` to rest and records its measures as metrics named
+/// `{prefix}…`; `None` if it blew up (the error is then a check).
+fn measure_column(
+    ctx: &mut Context,
+    name: &str,
+    prefix: &str,
+    out: &mut Outcome,
+) -> Result<Option<ColumnMeasures>> {
+    let (scene, column, phi, cone) = column_scene(ctx, name)?;
+    let s = scene.particle_spacing;
+    ctx.progress.set_length(scene.frame_count() as u64);
+    let t0 = std::time::Instant::now();
+    let slip_frames: Vec<usize> = SLIP_TIMES_S
+        .iter()
+        .map(|t| (t / scene.frame_dt_s).round() as usize)
+        .collect();
+    let run = run_scene_until_rest_keeping(
+        ctx,
+        &scene,
+        &slip_frames,
+        &["plastic_strain"],
+        RestCriterion::default(),
+    )?;
+    put(out, prefix, "particles", run.particles as f64);
+    put(out, prefix, "wall_s", t0.elapsed().as_secs_f64());
+    put(out, prefix, "spacing_m", s);
+    if let Some(e) = &run.blow_up {
+        out.check(solver_error_check(&format!("{prefix}column"), e));
+        return Ok(None);
+    }
+    put(
+        out,
+        prefix,
+        "end_time_s",
+        run.frames.last().map_or(f64::NAN, |f| f.time_s),
+    );
+    put(
+        out,
+        prefix,
+        "rest_from_s",
+        run.rest_from_s.unwrap_or(f64::NAN),
+    );
+
+    let initial = scene.fluid_particles::<f64>()?.positions;
+    let mut last = vec![Vec3::new(f64::NAN, f64::NAN, f64::NAN); initial.len()];
+    for (&id, &p) in run.final_ids.iter().zip(&run.final_positions) {
+        last[id as usize] = p;
+    }
+    let moved: Vec<bool> = initial
+        .iter()
+        .zip(&last)
+        .map(|(a, b)| (b.x - a.x).hypot(b.y - a.y) > s)
+        .collect();
+    let back_top = |ps: &[Vec3<f64>]| {
+        initial
+            .iter()
+            .zip(ps)
+            .filter(|(a, _)| a.x - column.back_x < BACK_SPACINGS * s)
+            .map(|(_, p)| p.y)
+            .fold(f64::NEG_INFINITY, f64::max)
+    };
+    let back_drop = back_top(&initial) - back_top(&last);
+    put(out, prefix, "back_height_drop_m", back_drop);
+    let (_, final_zone) = failure_line(&initial, &moved, column, s);
+    put(out, prefix, "final_moved_zone_deg", final_zone);
+    put(
+        out,
+        prefix,
+        "moved_fraction",
+        moved.iter().filter(|&&m| m).count() as f64 / moved.len() as f64,
+    );
+    let mut slip = None;
+    for (&t, &frame) in SLIP_TIMES_S.iter().zip(&slip_frames) {
+        let at = run.snapshots.iter().find(|(f, _)| *f == frame);
+        let strain = run
+            .snapshot_fields
+            .iter()
+            .find(|(f, name, k, _)| *f == frame && name == "plastic_strain" && *k == 1);
+        let (Some((_, at)), Some((_, _, _, strain))) = (at, strain) else {
+            out.note(format!(
+                "{prefix}no snapshot at t = {t} s (the run ended before)"
+            ));
+            continue;
+        };
+        let moved_early: Vec<bool> = initial
+            .iter()
+            .zip(at)
+            .map(|(a, b)| (b.x - a.x).hypot(b.y - a.y) > SLIP_THRESHOLD_SPACINGS * s)
+            .collect();
+        let (_, beta_moved) = failure_line(&initial, &moved_early, column, s);
+        put(
+            out,
+            prefix,
+            &format!("moved_zone_{:.0}ms_deg", 1e3 * t),
+            beta_moved,
+        );
+        let failed: Vec<bool> = strain.iter().map(|&e| e > SLIP_PLASTIC_STRAIN).collect();
+        let (rows, beta) = failure_line(&initial, &failed, column, s);
+        put(
+            out,
+            prefix,
+            &format!("slip_surface_{:.0}ms_deg", 1e3 * t),
+            beta,
+        );
+        if t == SLIP_CHECK_S {
+            slip = Some((rows, beta));
+        }
+    }
+    let Some((slip_rows, slip_deg)) = slip else {
+        bail!("{name}: no snapshot at the slip surface's time {SLIP_CHECK_S} s");
+    };
+
+    let deposit = angle_of_repose(
+        &run.final_positions,
+        &ReposeOptions::planar(column.floor_y, s).with_spacing(s),
+    );
+    put(
+        out,
+        prefix,
+        "deposit_slope_deg",
+        deposit.as_ref().map_or(f64::NAN, |m| m.angle_deg),
+    );
+    if let Err(e) = &deposit {
+        out.note(format!("{prefix}deposit slope not measured: {e}"));
+    }
+    let runout_m = runout(
+        &run.final_positions,
+        &RunoutOptions::connected(column.back_x, s),
+    )?;
+    let height_sum = |ps: &[Vec3<f64>]| ps.iter().map(|p| p.y - column.floor_y).sum::<f64>();
+    let kept = height_sum(&run.final_positions) / height_sum(&initial);
+    put(out, prefix, "runout_m", runout_m);
+    put(
+        out,
+        prefix,
+        "normalised_runout",
+        normalised_runout(runout_m, column.length)?,
+    );
+    put(out, prefix, "potential_energy_kept", kept);
+    Ok(Some(ColumnMeasures {
+        scene,
+        column,
+        phi,
+        cone,
+        spacing: s,
+        run,
+        back_drop,
+        slip_rows,
+        slip_deg,
+        runout_m,
+        kept,
+    }))
+}
+
+/// Records metric `{prefix}{name}`.
+fn put(out: &mut Outcome, prefix: &str, name: &str, value: f64) {
+    out.metric(format!("{prefix}{name}"), value);
+}
+
+/// The checks on the column `m`: rest, the back, the first slip surface against Rankine's
+/// line, the front clear of the far wall, the energy kept against SPHinXsys's `peer_kept`.
+fn check_column(out: &mut Outcome, m: &ColumnMeasures, peer_kept: f64) {
+    let (s, column) = (m.spacing, m.column);
+    check_rest(out, &m.scene, &m.run);
+    out.check(Check::at_most(
+        format!("back of the column ({BACK_SPACINGS} spacings from the wall): height lost (m)"),
+        m.back_drop.abs(),
+        s,
+        "physics: Rankine's active wedge fails in front of the line through the toe; the material behind it, held by the wall, does not move (one spacing: the grain size)",
+    ));
+    let rankine = 45.0 + 0.5 * m.phi;
+    let tol = failure_line_tolerance_deg(rankine, s, column.height);
+    out.metric("rankine_deg", rankine);
+    out.metric("failure_line_tolerance_deg", tol);
+    out.check(Check::within(
+        format!("first slip surface at {SLIP_CHECK_S} s through the toe (deg) against Rankine's 45 + phi/2 = {rankine:.2}"),
+        m.slip_deg,
+        rankine - tol,
+        rankine + tol,
+        format!(
+            "Rankine's active wedge (plane strain, c = 0: the slip lines at 45 deg + phi/2 from the horizontal, the minor principal stress horizontal); band 1.5 sin^2(beta) s/H0 = {tol:.2} deg: each row's boundary located to one spacing"
+        ),
+    ));
+    out.metric("repose_angle_deg", m.cone.predicted_repose_angle_deg(m.phi));
+    out.metric("max_stable_slope_deg", m.cone.max_stable_slope_deg(m.phi));
+    let far_wall = m.scene.tank.map_or(f64::NAN, |t| t.max.x);
+    out.check(Check::greater_than(
+        "deposit's front clear of the far wall (m)",
+        far_wall - (column.back_x + m.runout_m),
+        2.0 * s,
+        "validity: a front at the far wall was stopped by it",
+    ));
+    out.metric("sphinxsys_potential_energy_kept", peer_kept);
+    out.check(Check::within(
+        "fraction of the initial potential energy kept at rest",
+        m.kept,
+        peer_kept - ENERGY_BAND,
+        peer_kept + ENERGY_BAND,
+        format!(
+            "peer cross-check, not an experiment: SPHinXsys test_2d_column_collapse ({peer_kept:.3}, phi = 21.9 deg); band +-{ENERGY_BAND} this project's, set before the run"
+        ),
+    ));
+}
+
 /// The rest check and the verdict's margins.
 fn check_rest(out: &mut Outcome, scene: &Scene, run: &SceneRun) {
-    let end_t = run.frames.last().map_or(f64::NAN, |f| f.time_s);
-    out.metric("end_time_s", end_t);
-    out.metric("rest_from_s", run.rest_from_s.unwrap_or(f64::NAN));
     let verdict = run.rest_verdict;
     for (name, _, m) in verdict.map_or_else(Vec::new, |v| v.margins()) {
         out.metric(format!("rest/{name}_at_end"), m.value);
@@ -413,14 +515,9 @@ fn check_rest(out: &mut Outcome, scene: &Scene, run: &SceneRun) {
 
 /// `deposit.png`: the deposit's grains, the initial column, the boundary of each row and
 /// the fitted failure line, and Rankine's line, all through the toe.
-fn plot_deposit(
-    ctx: &mut Context,
-    run: &SceneRun,
-    column: Column,
-    rows: &[(f64, f64)],
-    beta_deg: f64,
-    rankine_deg: f64,
-) -> Result<()> {
+fn plot_deposit(ctx: &mut Context, m: &ColumnMeasures) -> Result<()> {
+    let (run, column, rows, beta_deg) = (&m.run, m.column, &m.slip_rows, m.slip_deg);
+    let rankine_deg = 45.0 + 0.5 * m.phi;
     let toe = (column.back_x + column.length, column.floor_y);
     let line = |deg: f64| {
         let run_x = column.height / deg.to_radians().tan();
