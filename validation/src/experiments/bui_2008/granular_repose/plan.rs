@@ -26,8 +26,9 @@ pub const PLAIN_30_TAG: &str = "simple-shear/theta=30";
 pub enum Variant {
     /// The scene as shipped for the mode.
     Plain,
-    /// At the quick spacing, with `viscosity_speed_m_s` the speed of sound of the scene's
-    /// modulus and the modulus times `factor` (1: the spacing check's coarse heap).
+    /// At the quick spacing, with the scene's viscosity velocity scale held
+    /// (`viscosity_speed_m_s`, the scene's or else the speed of sound of its modulus) and the
+    /// modulus times `factor` (1: the spacing check's coarse heap).
     Coarse {
         /// The factor on Young's modulus.
         modulus_factor: f64,
@@ -147,10 +148,10 @@ pub fn scene_for(p: &Plan, mode: Mode) -> Result<Scene> {
         let SolverParams::Elastoplastic(params) = scene.solver_params::<f64>()? else {
             anyhow::bail!("{}: not elastoplastic", scene.source.display());
         };
-        let sound_speed = params.sound_speed();
+        let viscosity_speed = params.viscosity_speed();
         let modulus = params.youngs_modulus;
         if let SolverSpec::Elastoplastic(e) = &mut scene.solver {
-            e.viscosity_speed_m_s = Some(sound_speed);
+            e.viscosity_speed_m_s = Some(viscosity_speed);
             e.youngs_modulus = Some(modulus_factor * modulus);
         }
     }
