@@ -176,7 +176,7 @@ pub(crate) fn delta_sum<R: Real>(
                 (f32s(cache.0), f32s(cache.1)),
             )
         };
-        vec3(s)
+        vec3([s[0], s[1], s[2]])
     }
     #[cfg(not(target_arch = "x86_64"))]
     unreachable!("no lane constants off x86_64")
@@ -213,7 +213,7 @@ pub(crate) fn density_xsph<R: Real>(
 mod avx512 {
     use std::arch::x86_64::*;
 
-    use sph_solver::pair_lanes::avx512::{gather, pairs};
+    use sph_solver::pair_lanes::avx512::{gather, pairs, sums};
 
     use super::LaneConsts;
 
@@ -268,7 +268,7 @@ mod avx512 {
         list: &[u32],
         gf: &mut [f32],
         sc: &mut [f32],
-    ) -> [f32; 5] {
+    ) -> [f32; 8] {
         let inv_rho0 = _mm512_set1_ps(c.inv_rho0);
         let mut acc = [_mm512_setzero_ps(); 5];
         for s in (0..list.len()).step_by(16) {
@@ -298,7 +298,7 @@ mod avx512 {
             );
             acc[4] = _mm512_mask_add_ps(acc[4], p.live, acc[4], g2);
         }
-        acc.map(|a| _mm512_reduce_add_ps(a))
+        sums(acc)
     }
 
     /// The `Δp` pass's lane sum (see `super::delta_sum`); `own` is `[λ_i, m_i, unit/2]`.
@@ -314,7 +314,7 @@ mod avx512 {
         own: [f32; 3],
         list: &[u32],
         (gf, sc): (&[f32], &[f32]),
-    ) -> [f32; 3] {
+    ) -> [f32; 8] {
         let [li, mi, half_unit] = own.map(|v| _mm512_set1_ps(v));
         let mut acc = [_mm512_setzero_ps(); 3];
         for s in (0..list.len()).step_by(16) {
@@ -333,7 +333,7 @@ mod avx512 {
                 *sum = _mm512_mask_add_ps(*sum, p.live, *sum, g);
             }
         }
-        acc.map(|a| _mm512_reduce_add_ps(a))
+        sums(acc)
     }
 
     /// `[Σ m_j W, Σ (v_j − v_i)_x (m_j/ρ0) W, … y, … z]` (see `super::density_xsph`).
@@ -347,7 +347,7 @@ mod avx512 {
         i: usize,
         vi: [f32; 3],
         list: &[u32],
-    ) -> [f32; 4] {
+    ) -> [f32; 8] {
         let vi = vi.map(|v| _mm512_set1_ps(v));
         let inv_rho0 = _mm512_set1_ps(c.inv_rho0);
         let zero = _mm512_setzero_ps();
@@ -366,7 +366,7 @@ mod avx512 {
                 acc[1 + a] = _mm512_mask_add_ps(acc[1 + a], p.live, acc[1 + a], t);
             }
         }
-        acc.map(|a| _mm512_reduce_add_ps(a))
+        sums(acc)
     }
 }
 
