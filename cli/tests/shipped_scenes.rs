@@ -38,11 +38,9 @@ fn text(o: &Output) -> String {
 
 /// Frames to run: a few, but enough for a poured scene's first layer (one layer of the
 /// quick funnel, 0.1 × 0.06 × 0.02 m at 0.00072 m³/s, is due after 0.167 s: frame 11; the
-/// funnel heap's, 0.1 × 0.1 × 0.025 m at 0.0012 m³/s, after 0.208 s: placed in frame 15).
+/// funnel heap's, 0.1 × 0.1 × 0.025 m at 0.004 m³/s, after 0.0625 s: frame 4).
 fn frames_of(stem: &str) -> usize {
-    if stem.contains("funnel") {
-        16
-    } else if stem.contains("poured") {
+    if stem.contains("poured") || stem.contains("funnel") {
         12
     } else {
         2
