@@ -34,7 +34,8 @@
 //! over azimuth (2026-12-06, `docs/elastoplastic-granular.md`, "The funnel heap"): a quick
 //! 30° case alone would pass or fail by the resolution, not by the model. At 12.5 mm the 30°
 //! heap stood at 26.94° with the funnel's feed at 0.4 m/s per area, and at 28.72° with the
-//! slab heaps' 0.12 m/s (one pour each); the hoop strain of the cone's outward flow lowers
+//! slab heaps' 0.12 m/s, the 40° one at 37.45° and 32.89° (one pour each: the feed is not
+//! the cause); the hoop strain of the cone's outward flow lowers
 //! the prediction by 0.3–1° (`docs/notebooks/elastoplastic-granular.md`, "A conical flank
 //! under radial outflow"), which the band does not absorb: a miss is reported as it is.
 //! The issue asks for 2·10⁴ grains in quick mode and 10⁵ in full; those sizes wait for the
