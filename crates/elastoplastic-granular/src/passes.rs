@@ -504,15 +504,20 @@ pub(crate) fn momentum_pass<R: Real, K: Kernel<R>>(s: &mut Scratch<R>, inp: &Ste
 
 /// `σ_b/ρ_b²` and whether the artificial stress is non-zero, for the boundary particles
 /// `n..` (after their stress and artificial stress are extrapolated), as the stress pass
-/// writes them for the grains.
+/// writes them for the grains; only for those a grain's sum reads
+/// (`BoundaryLists::is_read`).
 pub(crate) fn boundary_pair_terms<R: Real>(s: &mut Scratch<R>, n: usize) {
     let (sig, rho, art) = (&s.stress_new[n..], &s.rho_new[n..], &s.art[n..]);
+    let lists = &s.boundary_lists;
     s.stress_over_rho2[n..]
         .par_iter_mut()
         .zip(s.art_on[n..].par_iter_mut())
         .enumerate()
         .with_min_len(MIN_LEN)
         .for_each(|(k, (sr, on))| {
+            if !lists.is_read(k) {
+                return;
+            }
             *sr = sig[k] / (rho[k] * rho[k]);
             *on = art[k] != Matrix3::zeros();
         });

@@ -16,9 +16,14 @@
 //! 3. **Profile per sector.** In each sector, the free-surface profile along the radial
 //!    distance `r` ([`crate::surface_profile`] on the sector's grains: the highest grain per
 //!    radial bin, buried bins dropped).
-//! 4. **Fit per sector.** The profile points whose height above the base lies in
-//!    `[f_lo H, f_hi H]` ([`ConeOptions::fit_band`], default 20 %–80 %: the rounded top and
-//!    the rim left out) are fitted by least squares `y = a + b r`; the sector's angle is
+//! 4. **Fit per sector.** The profile points from the sector's crest (its highest point)
+//!    outward whose height above the base lies in `[f_lo H, f_hi H]`
+//!    ([`ConeOptions::fit_band`], default 20 %–80 %: the rounded top and the rim left out)
+//!    are fitted by least squares `y = a + b r`. Points nearer the axis than the crest are
+//!    not on the flank: a sector's innermost radial bins cover a small area (a 30° sector's
+//!    first bin of one spacing holds about a quarter of a lattice column), and their highest
+//!    grain may be a buried one, which in the band would pull the fit shallow (one such
+//!    point took a 12.5 mm heap's sector to 9.72°, 26.28° without it). The sector's angle is
 //!    `atan(−b)`. A sector with fewer than [`ConeOptions::min_fit_points`] points in the band
 //!    is listed as not fitted.
 //! 5. **Over azimuth.** The mean of the fitted sectors' angles, their sample standard
@@ -272,8 +277,17 @@ fn fit_sector(
         axis_xz: Some(options.base.centre_xz),
     };
     fit.profile = surface_profile(grains, shape, options.bin_width_m)?;
-    let pts: Vec<(f64, f64)> = fit
-        .profile
+    // The generatrix runs from the sector's crest outward: a profile point nearer the axis
+    // than the crest is not on the flank (the innermost bins of a sector are small, and
+    // their highest grain may be a buried one).
+    let crest = fit.profile.iter().enumerate().fold(0, |best, (i, p)| {
+        if p.y_m > fit.profile[best].y_m {
+            i
+        } else {
+            best
+        }
+    });
+    let pts: Vec<(f64, f64)> = fit.profile[crest..]
         .iter()
         .filter(|p| p.y_m >= band[0] && p.y_m <= band[1])
         .map(|p| (p.d_m, p.y_m))

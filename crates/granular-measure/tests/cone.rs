@@ -140,6 +140,35 @@ fn a_lattice_cone_stands_within_the_resolution_bound() {
     }
 }
 
+/// A sector whose innermost bin holds only a buried grain (its surface grains near the axis
+/// gone, one grain left at mid-height): the points nearer the axis than the sector's crest
+/// are not on the flank, and the sector still measures its generatrix. With that grain in
+/// the fit, the sector measured 24.76° (the fit before the crest rule).
+#[test]
+fn a_buried_grain_inside_the_crest_is_not_on_the_flank() {
+    let alpha = 30.0;
+    let [cx, cz] = BASE.centre_xz;
+    let mut p: Vec<Vec3<f64>> = exact_cone(|_| alpha)
+        .into_iter()
+        .filter(|g| {
+            let (dx, dz) = (g.x - cx, g.z - cz);
+            let phi = dz.atan2(dx).to_degrees().rem_euclid(360.0);
+            !(phi < 30.0 && dx.hypot(dz) < 0.1)
+        })
+        .collect();
+    let h = alpha.to_radians().tan();
+    let phi = 15f64.to_radians();
+    p.push(Vec3::new(
+        cx + 0.02 * phi.cos(),
+        BASE.top_y + 0.5 * h,
+        cz + 0.02 * phi.sin(),
+    ));
+    let m = cone_angle_by_sector(&p, &ConeOptions::new(BASE, 12, 0.02)).unwrap();
+    let a = m.sectors[0].angle_deg.unwrap();
+    assert!((a - alpha).abs() < 1e-9, "sector 0: {a} against {alpha}");
+    assert!((m.mean_deg - alpha).abs() < 1e-9, "{}", m.mean_deg);
+}
+
 /// Grains that fell over the rim (below the base's top, outside its radius) are not the
 /// heap's: the measurement is the same with them.
 #[test]

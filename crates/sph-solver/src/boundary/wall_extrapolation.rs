@@ -48,7 +48,9 @@
 //! isotropic case `σ = −p I`, for which the rule is Adami et al.'s own. The
 //! isotropic gravity term carries the hydrostatic gradient of the normal stress across the
 //! wall (the part the wall must supply for a resting layer to carry its weight). A boundary
-//! particle without particle neighbours carries no stress and no velocity.
+//! particle without particle neighbours carries no stress and no velocity; one that no
+//! particle lists and that lists no particle (most of a wall's particles, away from the
+//! material) is read by no sum and is skipped: its values are left as they were.
 
 use nalgebra::Matrix3;
 use rayon::prelude::*;
@@ -102,9 +104,13 @@ pub struct Extrapolation<'a, R: Real, K: Kernel<R>> {
 /// order: the extrapolation's sums add in the same order as over the whole lists, whose
 /// other entries are boundary particles), rebuilt at each neighbour search, and their
 /// Shepard weights `W_bf` and gravity terms `ρ_f (g·r_bf) W_bf`, computed once per step for
-/// both extrapolations of the step.
+/// both extrapolations of the step; and which boundary particles any particle's sum reads.
 #[derive(Debug, Clone, Default)]
 pub struct BoundaryLists<R: Real> {
+    /// Whether boundary particle `k` lists a particle or a particle lists it (or an image
+    /// of it): the boundary particles whose values a sum reads, the only ones
+    /// [`extrapolate`] writes.
+    read: Vec<bool>,
     /// CSR offsets: boundary particle `k`'s entries are `start[k]..start[k + 1]`.
     start: Vec<usize>,
     /// The lists' entry (a particle or an image of one).
@@ -119,7 +125,8 @@ pub struct BoundaryLists<R: Real> {
 
 impl<R: Real> BoundaryLists<R> {
     /// Keeps, for each of the `count` boundary particles `n..n + count` of `nb`, the entries
-    /// that resolve to a particle (`< n`). Grows its arrays to the pair count (reusing them).
+    /// that resolve to a particle (`< n`), and marks the boundary particles a particle's
+    /// list holds. Grows its arrays to the pair count (reusing them).
     pub fn rebuild(
         &mut self,
         nb: &NeighbourLists,
@@ -144,9 +151,25 @@ impl<R: Real> BoundaryLists<R> {
             }
             self.start.push(self.entry.len());
         }
+        self.read.clear();
+        self.read.extend(self.start.windows(2).map(|w| w[1] > w[0]));
+        for i in 0..n {
+            for &j in nb.neighbours(i) {
+                let (f, _) = images.resolve(j as usize, x);
+                if f >= n {
+                    self.read[f - n] = true;
+                }
+            }
+        }
         let len = self.entry.len();
         self.weight.resize(len, R::zero());
         self.weighted_gravity.resize(len, R::zero());
+    }
+
+    /// Whether boundary particle `k` (`0..`) is read by a particle's sum or reads one (as of
+    /// the last [`BoundaryLists::rebuild`]): [`extrapolate`] writes only those.
+    pub fn is_read(&self, k: usize) -> bool {
+        self.read.get(k).copied().unwrap_or(false)
     }
 
     /// The weights and gravity terms at the positions `e.x` (boundary particles from `n =
@@ -178,7 +201,8 @@ pub type Derived<'a, R> = (
 /// Writes the boundary particles' stress into `stress[n..]` from the particles' `stress[..n]`
 /// (module docs), a tensor derived from it into `derived.0[n..]` if given (`derived.1` of
 /// the stress), and their velocity into `v[n..]` if given (from `v[..n]`), with the weights
-/// of the last [`BoundaryLists::weigh`].
+/// of the last [`BoundaryLists::weigh`]; only for the boundary particles a sum reads
+/// ([`BoundaryLists::is_read`]), the others left as they were.
 pub fn extrapolate<R: Real, K: Kernel<R>>(
     e: &Extrapolation<'_, R, K>,
     lists: &BoundaryLists<R>,
@@ -202,6 +226,9 @@ pub fn extrapolate<R: Real, K: Kernel<R>>(
     let two = R::of_f64(2.0);
     let work =
         |k: usize, sig: &mut Matrix3<R>, vel: Option<&mut Vec3<R>>, a: Option<&mut Matrix3<R>>| {
+            if !lists.is_read(k) {
+                return;
+            }
             let mut sum_s = Matrix3::zeros();
             let mut sum_g = R::zero();
             let mut sum_v = Vec3::zeros();
