@@ -312,6 +312,7 @@
 mod friction;
 pub mod granular;
 mod kernels;
+mod lanes;
 mod params;
 mod passes;
 mod scratch;

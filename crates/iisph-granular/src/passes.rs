@@ -7,12 +7,13 @@ use rayon::prelude::*;
 use sph_core::{Real, Vec3};
 use sph_kernels::Kernel;
 use sph_solver::csr::par_csr_blocks;
-use sph_solver::pair_lanes::CubicLanes;
+use sph_solver::pair_lanes::{CubicLanes, Packed};
 use sph_solver::step::{par_update_sum, MIN_LEN};
 use sph_solver::Boundary;
 
 use crate::granular::{drag_force, occlusion_of_cosine};
 use crate::kernels::Consts;
+use crate::lanes::PressureLanes;
 use crate::params::IisphParams;
 use crate::scratch::Scratch;
 
@@ -22,10 +23,123 @@ pub(crate) fn grad<R: Real>(xi: &Vec3<R>, xj: &Vec3<R>, f: R) -> Vec3<R> {
     (xi - xj) * f
 }
 
+/// The packed arrays of the pressure passes' lanes ([`PressureLanes`]) and the gradient
+/// sums they need.
+#[derive(Clone, Copy)]
+pub(crate) struct Packs<'a, R: Real> {
+    /// `[x, y, z, m]` of the step (filled by [`density_pass`]).
+    pub xm: &'a Packed,
+    /// `[x, y, z, m π]` of the current pressure iterate.
+    pub xp: &'a Packed,
+    /// `G_i = Σ_j m_j ∇W_ij` (the density pass's, without the boundary's term).
+    pub mass_grad: &'a [Vec3<R>],
+}
+
+/// What the pressure passes read of a step: the positions, masses and lists, the per-pair
+/// `W'(r)/r` of [`density_pass`], and the pressure lanes with their packed arrays where
+/// they run (the scalar loops otherwise).
+#[derive(Clone, Copy)]
+pub(crate) struct Step<'a, R: Real> {
+    pub x: &'a [Vec3<R>],
+    pub m: &'a [R],
+    pub nb: &'a NeighbourLists,
+    pub gs: &'a [R],
+    pub lanes: Option<(PressureLanes, Packs<'a, R>)>,
+}
+
+impl<'a, R: Real> Step<'a, R> {
+    /// The step's inputs, with the lanes where they run on `packs` (filled for these
+    /// positions, or empty).
+    pub(crate) fn new(
+        x: &'a [Vec3<R>],
+        m: &'a [R],
+        nb: &'a NeighbourLists,
+        gs: &'a [R],
+        packs: Packs<'a, R>,
+    ) -> Self {
+        let lanes = PressureLanes::new::<R>(x.len(), nb, &[packs.xm, packs.xp])
+            .filter(|_| packs.mass_grad.len() == x.len())
+            .map(|l| (l, packs));
+        Self {
+            x,
+            m,
+            nb,
+            gs,
+            lanes,
+        }
+    }
+
+    /// Particle `i`'s slice of the per-pair `W'(r)/r`.
+    #[inline]
+    fn gs_of(&self, i: usize) -> &'a [R] {
+        let o = self.nb.offsets();
+        &self.gs[o[i]..o[i + 1]]
+    }
+
+    /// [`pressure_accel`] of particle `i`.
+    #[inline]
+    pub(crate) fn pressure_accel(
+        &self,
+        c: &Consts<R>,
+        pi: &[R],
+        bgrad: &[Vec3<R>],
+        i: usize,
+    ) -> Vec3<R> {
+        match self.lanes {
+            Some((l, p)) => {
+                let own = (pi[i], p.mass_grad[i]);
+                l.pressure_sum(p.xp, self.nb, self.gs_of(i), own, i) - bgrad[i] * (c.rho0 * pi[i])
+            }
+            None => {
+                let (o, k) = (self.nb.offsets(), self.nb.indices());
+                pressure_accel(c, self.x, self.m, o, k, self.gs, pi, bgrad, i)
+            }
+        }
+    }
+
+    /// [`a_times_p`] of particle `i`.
+    #[inline]
+    pub(crate) fn a_times_p(&self, c: &Consts<R>, a: &[Vec3<R>], bgrad: &[Vec3<R>], i: usize) -> R {
+        match self.lanes {
+            Some((l, p)) => {
+                let sum =
+                    l.a_dot(p.xm, self.nb, self.gs_of(i), a, i) + c.rho0 * a[i].dot(&bgrad[i]);
+                c.dt * c.dt * sum
+            }
+            None => {
+                let (o, k) = (self.nb.offsets(), self.nb.indices());
+                a_times_p(c, self.x, self.m, o, k, self.gs, a, bgrad, i)
+            }
+        }
+    }
+}
+
+/// Packs `m_i π_i` of the current `π = p/ρ²` with the positions for the pressure lanes
+/// (`[x, y, z, m π]`), where they run: the positions too when `positions` (they are new),
+/// else only `m π`.
+pub(crate) fn pack_pressure<R: Real>(
+    x: &[Vec3<R>],
+    m: &[R],
+    nb: &NeighbourLists,
+    s: &mut Scratch<R>,
+    positions: bool,
+) {
+    if !PressureLanes::available::<R>(x.len(), nb) {
+        s.packed_pressure.clear();
+        return;
+    }
+    let pi = &s.p_over_rho2[..];
+    if !positions && s.packed_pressure.len() == x.len() {
+        s.packed_pressure.set_fourth(|i| m[i] * pi[i]);
+    } else {
+        s.packed_pressure.fill_with(x, |i| m[i] * pi[i]);
+    }
+}
+
 /// A block's outputs of [`density_pass`]: `(ρ, ∇Ψ, G)` and `(a_ii, occlusion)`.
 type DensityOutputs<'a, R> = (
     (&'a mut [R], &'a mut [Vec3<R>], &'a mut [Vec3<R>]),
-    (&'a mut [R], &'a mut [R]),
+    (&'a mut [R], &'a mut [R], &'a mut [Vec3<R>]),
 );
 
 /// Eq. 3 + eq. 29: `ρ_i`, `∇Ψ_i`, `W'(r)/r` of every pair, and the diagonal `a_ii` of
@@ -50,28 +164,33 @@ pub(crate) fn density_pass<R: Real>(
     let indices = nb.indices();
     s.grad_scale.resize(indices.len(), R::zero());
     let dt2 = c.dt * c.dt;
-    // The f32 lanes where they run; drag needs the occlusion, which only the scalar loop
-    // takes.
-    let lanes = CubicLanes::new(&c.kernel, x.len(), nb).filter(|_| !c.drag);
+    // The f32 lanes where they run (the packed positions also for the pressure passes'
+    // lanes, `Step::lanes`); drag needs the occlusion, which only the scalar loop takes.
+    let lanes = CubicLanes::new(&c.kernel, x.len(), nb);
     if lanes.is_some() {
         s.packed.fill(x, m);
+    } else {
+        s.packed.clear();
     }
+    let lanes = lanes.filter(|_| !c.drag);
     let (packed, cached) = (&s.packed, &s.end_samples);
     let outputs = (
         (&mut s.density[..], &mut s.bgrad[..], &mut s.grad_sum[..]),
-        (&mut s.aii[..], &mut s.occlusion[..]),
+        (&mut s.aii[..], &mut s.occlusion[..], &mut s.mass_grad[..]),
     );
     par_csr_blocks(
         offsets,
         outputs,
         &mut s.grad_scale[..],
-        &|first, ((rho_b, bg_b, gsum_b), (aii_b, occ_b)): DensityOutputs<'_, R>, gs: &mut [R]| {
+        &|first,
+          ((rho_b, bg_b, gsum_b), (aii_b, occ_b, mg_b)): DensityOutputs<'_, R>,
+          gs: &mut [R]| {
             let base = offsets[first];
             let block = rho_b
                 .iter_mut()
                 .zip(bg_b.iter_mut().zip(gsum_b.iter_mut()))
-                .zip(aii_b.iter_mut().zip(occ_b.iter_mut()));
-            for (l, ((rho, (bg, gsum)), (aii, occ_out))) in block.enumerate() {
+                .zip(aii_b.iter_mut().zip(occ_b.iter_mut()).zip(mg_b.iter_mut()));
+            for (l, ((rho, (bg, gsum)), ((aii, occ_out), mass_grad))) in block.enumerate() {
                 let i = first + l;
                 let (xi, mi) = (x[i], m[i]);
                 let upstream = if c.drag {
@@ -122,6 +241,7 @@ pub(crate) fn density_pass<R: Real>(
                     *bg = Vec3::zeros();
                 }
                 *rho = sum;
+                *mass_grad = sum_grad;
                 let gi = sum_grad + *bg * c.rho0;
                 *gsum = gi;
                 *aii = -dt2 / (sum * sum) * (gi.norm_squared() + mi * sum_grad_sq);
@@ -209,6 +329,13 @@ pub(crate) fn predicted_density_pass<R: Real>(
     nb: &NeighbourLists,
     s: &mut Scratch<R>,
 ) {
+    pack_pressure(x, m, nb, s, true);
+    if s.packed_pressure.len() == x.len() {
+        let va = &s.v_adv[..];
+        s.packed_velocity.fill_with(va, |i| m[i]);
+    } else {
+        s.packed_velocity.clear();
+    }
     let offsets = nb.offsets();
     let indices = nb.indices();
     let (rho, gs, bgrad, va, pi) = (
@@ -218,6 +345,14 @@ pub(crate) fn predicted_density_pass<R: Real>(
         &s.v_adv[..],
         &s.p_over_rho2[..],
     );
+    let packs = Packs {
+        xm: &s.packed,
+        xp: &s.packed_pressure,
+        mass_grad: &s.mass_grad,
+    };
+    let step = Step::new(x, m, nb, gs, packs);
+    let vm = &s.packed_velocity;
+    let lanes = step.lanes.filter(|_| vm.len() == x.len());
     s.source
         .par_iter_mut()
         .zip(s.accel.par_iter_mut())
@@ -225,14 +360,23 @@ pub(crate) fn predicted_density_pass<R: Real>(
         .with_min_len(MIN_LEN)
         .for_each(|(i, (src, acc))| {
             let (xi, vai, p_i) = (x[i], va[i], pi[i]);
-            let mut div = R::zero();
-            let mut a = Vec3::zeros();
-            for k in offsets[i]..offsets[i + 1] {
-                let j = indices[k] as usize;
-                let gw = grad(&xi, &x[j], gs[k]);
-                div += m[j] * (vai - va[j]).dot(&gw);
-                a -= gw * (m[j] * (p_i + pi[j]));
-            }
+            let (mut div, a) = match lanes {
+                Some((l, p)) => {
+                    let own = (p_i, p.mass_grad[i]);
+                    l.divergence_pressure_sum((p.xp, vm), nb, step.gs_of(i), own, i)
+                }
+                None => {
+                    let mut div = R::zero();
+                    let mut a = Vec3::zeros();
+                    for k in offsets[i]..offsets[i + 1] {
+                        let j = indices[k] as usize;
+                        let gw = grad(&xi, &x[j], gs[k]);
+                        div += m[j] * (vai - va[j]).dot(&gw);
+                        a -= gw * (m[j] * (p_i + pi[j]));
+                    }
+                    (div, a)
+                }
+            };
             div += c.rho0 * vai.dot(&bgrad[i]);
             let rho_adv = rho[i] + c.dt * div;
             *src = c.rho0 - rho_adv;
@@ -307,29 +451,31 @@ pub(crate) fn pressure_solve<R: Real>(
     if n == 0 {
         return (0, 0.0, true);
     }
-    let offsets = nb.offsets();
-    let indices = nb.indices();
     let omega = p.relaxation;
     let eta = p.density_error_tolerance.as_f64();
     let inv_rho0 = 1.0 / c.rho0.as_f64();
     let mut error = 0.0;
+    pack_pressure(x, m, nb, s, false);
     for l in 0..p.max_iterations {
         // Pressure accelerations of the iterate p^l (for l = 0 computed by
         // `predicted_density_pass`).
+        let packs = Packs {
+            xm: &s.packed,
+            xp: &s.packed_pressure,
+            mass_grad: &s.mass_grad,
+        };
+        let step = Step::new(x, m, nb, &s.grad_scale, packs);
         if l > 0 {
-            let (gs, pi, bgrad) = (&s.grad_scale[..], &s.p_over_rho2[..], &s.bgrad[..]);
+            let (pi, bgrad) = (&s.p_over_rho2[..], &s.bgrad[..]);
             s.accel
                 .par_iter_mut()
                 .enumerate()
                 .with_min_len(MIN_LEN)
-                .for_each(|(i, a)| {
-                    *a = pressure_accel(c, x, m, offsets, indices, gs, pi, bgrad, i);
-                });
+                .for_each(|(i, a)| *a = step.pressure_accel(c, pi, bgrad, i));
         }
         // A p^l, the density error of p^l, and the update p^{l+1}.
         {
-            let (gs, acc, bgrad, src, aii, rho) = (
-                &s.grad_scale[..],
+            let (acc, bgrad, src, aii, rho) = (
                 &s.accel[..],
                 &s.bgrad[..],
                 &s.source[..],
@@ -337,7 +483,7 @@ pub(crate) fn pressure_solve<R: Real>(
                 &s.density[..],
             );
             let update = |i: usize, pr: &mut R, pi: &mut R| -> f64 {
-                let ap = a_times_p(c, x, m, offsets, indices, gs, acc, bgrad, i);
+                let ap = step.a_times_p(c, acc, bgrad, i);
                 let a = aii[i];
                 let next = if a < R::zero() {
                     let q = *pr + omega * (src[i] - ap) / a;
@@ -362,6 +508,7 @@ pub(crate) fn pressure_solve<R: Real>(
             );
             error = total / n as f64 * inv_rho0;
         }
+        pack_pressure(x, m, nb, s, false);
         if l + 1 >= p.min_iterations && error <= eta {
             return (l + 1, error, true);
         }
@@ -381,10 +528,13 @@ pub(crate) fn forces_pass<R: Real>(
     boundary: &dyn Boundary<R>,
     s: &mut Scratch<R>,
 ) {
-    let offsets = nb.offsets();
-    let indices = nb.indices();
-    let (gs, pi, bgrad, va, vt) = (
-        &s.grad_scale[..],
+    let packs = Packs {
+        xm: &s.packed,
+        xp: &s.packed_pressure,
+        mass_grad: &s.mass_grad,
+    };
+    let step = Step::new(x, m, nb, &s.grad_scale, packs);
+    let (pi, bgrad, va, vt) = (
         &s.p_over_rho2[..],
         &s.bgrad[..],
         &s.v_adv[..],
@@ -400,7 +550,7 @@ pub(crate) fn forces_pass<R: Real>(
             let v_new = if c.granular {
                 vt[i]
             } else {
-                va[i] + pressure_accel(c, x, m, offsets, indices, gs, pi, bgrad, i) * c.dt
+                va[i] + step.pressure_accel(c, pi, bgrad, i) * c.dt
             };
             let y = x[i] + v_new * c.dt;
             let projected = boundary.project(y);

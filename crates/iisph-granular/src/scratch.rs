@@ -60,6 +60,13 @@ pub(crate) struct Scratch<R: Real> {
     pub perm_scalar: Vec<R>,
     /// The step's positions and masses packed for the lanes (filled only when they run).
     pub packed: sph_solver::pair_lanes::Packed,
+    /// `[x, y, z, m π]` of the current pressure iterate for the pressure lanes (filled only
+    /// when they run).
+    pub packed_pressure: sph_solver::pair_lanes::Packed,
+    /// `[v^adv, m]` for the pressure lanes (filled only when they run).
+    pub packed_velocity: sph_solver::pair_lanes::Packed,
+    /// `G_i = Σ_j m_j ∇W_ij` of the density pass (without the boundary's term).
+    pub mass_grad: Vec<Vec3<R>>,
     /// The volume boundary's samples at the end-of-step positions, for the next step's
     /// density pass.
     pub end_samples: SampleCache<R>,
@@ -117,6 +124,7 @@ impl<R: Real> Scratch<R> {
         self.density.resize(n, R::zero());
         self.bgrad.resize(n, z);
         self.grad_sum.resize(n, z);
+        self.mass_grad.resize(n, z);
         self.occlusion.resize(n, R::zero());
         self.v_adv.resize(n, z);
         self.source.resize(n, R::zero());

@@ -56,14 +56,16 @@ pub fn coords<R: Real>(v: &[Vec3<R>]) -> &[f32] {
 }
 
 /// Whether the `f32` lanes can run on `n` particles with these lists: `R` is `f32`, the
-/// processor has AVX-512 (detected at run time), and the lists are of `n` particles with
+/// processor has AVX-512 F and VL (detected at run time; VL for [`avx512::vectors`]'s
+/// masked 128-bit loads), and the lists are of `n` particles with
 /// pair and coordinate indices that fit the gathers' 32-bit offsets.
 pub fn lanes_available<R: Real>(n: usize, nb: &NeighbourLists) -> bool {
     if TypeId::of::<R>() != TypeId::of::<f32>() {
         return false;
     }
     #[cfg(target_arch = "x86_64")]
-    let detected = std::arch::is_x86_feature_detected!("avx512f");
+    let detected = std::arch::is_x86_feature_detected!("avx512f")
+        && std::arch::is_x86_feature_detected!("avx512vl");
     #[cfg(not(target_arch = "x86_64"))]
     let detected = false;
     detected
@@ -98,6 +100,46 @@ impl Packed {
                     p.copy_from_slice(&[xf[3 * i], xf[3 * i + 1], xf[3 * i + 2], mf[i]]);
                 }
             });
+    }
+
+    /// Packs `x` with a fourth value `w(i)` per particle (`[x, y, z, w]`), in parallel: a
+    /// lane kernel then loads a neighbour's position and that value as [`Packed::fill`]'s
+    /// position and mass.
+    ///
+    /// # Panics
+    /// When `R` is not `f32`.
+    pub fn fill_with<R: Real>(&mut self, x: &[Vec3<R>], w: impl Fn(usize) -> R + Sync) {
+        self.xyzm.resize(4 * x.len(), 0.0);
+        let xf = coords(x);
+        self.xyzm
+            .par_chunks_mut(4 * 1024)
+            .enumerate()
+            .for_each(|(b, chunk)| {
+                for (l, p) in chunk.chunks_exact_mut(4).enumerate() {
+                    let i = 1024 * b + l;
+                    let wi = w(i).as_f64() as f32;
+                    p.copy_from_slice(&[xf[3 * i], xf[3 * i + 1], xf[3 * i + 2], wi]);
+                }
+            });
+    }
+
+    /// Sets the fourth value of every particle to `w(i)`, in parallel, keeping the first
+    /// three.
+    pub fn set_fourth<R: Real>(&mut self, w: impl Fn(usize) -> R + Sync) {
+        self.xyzm
+            .par_chunks_mut(4 * 1024)
+            .enumerate()
+            .for_each(|(b, chunk)| {
+                for (l, p) in chunk.chunks_exact_mut(4).enumerate() {
+                    p[3] = w(1024 * b + l).as_f64() as f32;
+                }
+            });
+    }
+
+    /// Forgets the packed values (keeps the storage): a reader that checks
+    /// [`Packed::len`] against its particles then sees none.
+    pub fn clear(&mut self) {
+        self.xyzm.clear();
     }
 
     /// The packed values, four per particle.
@@ -277,6 +319,38 @@ pub mod avx512 {
         let last = (xm.len() / 4).saturating_sub(1);
         let j = _mm512_maskz_loadu_epi32(live, list.as_ptr().add(s).cast());
         let j = _mm512_min_epu32(j, _mm512_set1_epi32(last as i32));
+        let [x0, x1, x2, mj] = packed(xm, i, list, s);
+        let xj = [x0, x1, x2];
+        let own = xm.as_ptr().add(4 * i);
+        // No closure calls an intrinsic here: a closure of this function (which has no
+        // `#[target_feature]`) is compiled without AVX-512 when it is not inlined, and its
+        // intrinsics become calls (measured: IISPH's step took 1.9× as long).
+        let d = [
+            _mm512_sub_ps(_mm512_set1_ps(*own), xj[0]),
+            _mm512_sub_ps(_mm512_set1_ps(*own.add(1)), xj[1]),
+            _mm512_sub_ps(_mm512_set1_ps(*own.add(2)), xj[2]),
+        ];
+        // nalgebra's norm_squared: (dx² + dy²) + dz².
+        let r2 = _mm512_add_ps(
+            _mm512_add_ps(_mm512_mul_ps(d[0], d[0]), _mm512_mul_ps(d[1], d[1])),
+            _mm512_mul_ps(d[2], d[2]),
+        );
+        Pairs { live, j, d, r2, mj }
+    }
+
+    /// The neighbours' packed 4-vectors (`[x, y, z, m]` of [`super::Packed`]) of the pairs
+    /// `list[s..s + 16]` of particle `i` (its own past the list's end): sixteen 128-bit
+    /// loads into four registers, neighbour `4l + r` in 128-bit lane `l` of register `r`,
+    /// then [`transpose`], which leaves neighbour `e` in element `e` of each of the four
+    /// registers (one per component). Always inlined, as [`pairs`].
+    ///
+    /// # Safety
+    /// avx512f (the caller must be compiled with it); `xm` holds `4n` values, `i < n`,
+    /// `s < list.len()`.
+    #[inline(always)]
+    pub unsafe fn packed(xm: &[f32], i: usize, list: &[u32], s: usize) -> [__m512; 4] {
+        let left = list.len() - s;
+        let last = (xm.len() / 4).saturating_sub(1);
         let p = xm.as_ptr();
         // The neighbour of entry k (particle i itself past the list's end).
         let at = |k: usize| {
@@ -293,31 +367,60 @@ pub mod avx512 {
             let v = _mm512_insertf32x4::<2>(v, _mm_loadu_ps(p.add(4 * at(8 + r))));
             *zr = _mm512_insertf32x4::<3>(v, _mm_loadu_ps(p.add(4 * at(12 + r))));
         }
+        transpose(z)
+    }
+
+    /// Sixteen 4-vectors, vector `4l + r` in 128-bit lane `l` of `z[r]`, transposed within
+    /// each 128-bit lane: element `e` of the result's `c`-th register is component `c` of
+    /// vector `e`.
+    ///
+    /// # Safety
+    /// avx512f (the caller must be compiled with it).
+    #[inline(always)]
+    pub unsafe fn transpose(z: [__m512; 4]) -> [__m512; 4] {
         let t0 = _mm512_unpacklo_ps(z[0], z[1]);
         let t1 = _mm512_unpackhi_ps(z[0], z[1]);
         let t2 = _mm512_unpacklo_ps(z[2], z[3]);
         let t3 = _mm512_unpackhi_ps(z[2], z[3]);
-        let xj = [
+        [
             _mm512_shuffle_ps::<0x44>(t0, t2),
             _mm512_shuffle_ps::<0xEE>(t0, t2),
             _mm512_shuffle_ps::<0x44>(t1, t3),
-        ];
-        let mj = _mm512_shuffle_ps::<0xEE>(t1, t3);
-        let own = xm.as_ptr().add(4 * i);
-        // No closure calls an intrinsic here: a closure of this function (which has no
-        // `#[target_feature]`) is compiled without AVX-512 when it is not inlined, and its
-        // intrinsics become calls (measured: IISPH's step took 1.9× as long).
-        let d = [
-            _mm512_sub_ps(_mm512_set1_ps(*own), xj[0]),
-            _mm512_sub_ps(_mm512_set1_ps(*own.add(1)), xj[1]),
-            _mm512_sub_ps(_mm512_set1_ps(*own.add(2)), xj[2]),
-        ];
-        // nalgebra's norm_squared: (dx² + dy²) + dz².
-        let r2 = _mm512_add_ps(
-            _mm512_add_ps(_mm512_mul_ps(d[0], d[0]), _mm512_mul_ps(d[1], d[1])),
-            _mm512_mul_ps(d[2], d[2]),
-        );
-        Pairs { live, j, d, r2, mj }
+            _mm512_shuffle_ps::<0xEE>(t1, t3),
+        ]
+    }
+
+    /// The neighbours' 3-vectors `v_j` of the pairs `list[s..s + 16]` of particle `i` (its
+    /// own vector past the list's end), from `v` stored as `3n` coordinates (nalgebra's
+    /// `Vector3<f32>` array, [`super::coords`]): per axis, element `e` is neighbour `e`'s
+    /// component. Sixteen masked 128-bit loads of three elements (no read past the array's
+    /// end: a masked-out element is not accessed) and the transpose of [`pairs`], instead of
+    /// three gathers (slow on this AMD EPYC). Always inlined, as [`pairs`].
+    ///
+    /// # Safety
+    /// avx512f and avx512vl (the caller must be compiled with both); `v` holds `3n` values,
+    /// `i < n`, `s < list.len()`.
+    #[inline(always)]
+    pub unsafe fn vectors(v: &[f32], i: usize, list: &[u32], s: usize) -> [__m512; 3] {
+        let left = list.len() - s;
+        let last = (v.len() / 3).saturating_sub(1);
+        let at = |k: usize| {
+            if k < left {
+                (*list.get_unchecked(s + k) as usize).min(last)
+            } else {
+                i
+            }
+        };
+        let p = v.as_ptr();
+        let mut z = [_mm512_setzero_ps(); 4];
+        for (r, zr) in z.iter_mut().enumerate() {
+            let v = _mm512_castps128_ps512(_mm_maskz_loadu_ps(0b0111, p.add(3 * at(r))));
+            let v = _mm512_insertf32x4::<1>(v, _mm_maskz_loadu_ps(0b0111, p.add(3 * at(4 + r))));
+            let v = _mm512_insertf32x4::<2>(v, _mm_maskz_loadu_ps(0b0111, p.add(3 * at(8 + r))));
+            *zr = _mm512_insertf32x4::<3>(v, _mm_maskz_loadu_ps(0b0111, p.add(3 * at(12 + r))));
+        }
+        let [a, b, c, _] = transpose(z);
+        [a, b, c]
     }
 
     /// `_mm512_reduce_add_ps` of each of up to eight accumulators (0 past `N`), returned
@@ -565,6 +668,7 @@ mod tests {
         assert_eq!(
             CubicLanes::new(&CubicSpline::new(2.0f32).unwrap(), 2, nb.lists()).is_some(),
             std::arch::is_x86_feature_detected!("avx512f")
+                && std::arch::is_x86_feature_detected!("avx512vl")
         );
         let x64: Vec<Vec3<f64>> = x.iter().map(|p| p.cast()).collect();
         let mut nb64 = StepNeighbours::new(Method::CellStartGrid);
