@@ -28,7 +28,7 @@
 
 use neighbour_search::NeighbourLists;
 use sph_core::{Real, Vec3};
-use sph_solver::pair_lanes::{coords, f32s, lanes_available, Packed};
+use sph_solver::pair_lanes::{f32s, lanes_available, Packed};
 
 /// The pressure passes' lanes; exists only where they can run ([`PressureLanes::new`]).
 #[derive(Debug, Clone, Copy)]
@@ -83,21 +83,21 @@ impl PressureLanes {
         unreachable!("no pressure lanes off x86_64")
     }
 
-    /// `Σ_j m_j (a_i − a_j)·∇W_ij` of particle `i` (the pair sum of `(A p)_i`).
+    /// `Σ_j m_j (a_i − a_j)·∇W_ij` of particle `i` (the pair sum of `(A p)_i`), from `xp`
+    /// (its positions) and `am`, the packed `[a, m]`.
     pub(crate) fn a_dot<R: Real>(
         &self,
-        packed: &Packed,
+        (xp, am): (&Packed, &Packed),
         nb: &NeighbourLists,
         gs: &[R],
-        a: &[Vec3<R>],
         i: usize,
     ) -> R {
         let list = nb.neighbours(i);
-        assert!(gs.len() == list.len() && a.len() == packed.len());
+        assert!(gs.len() == list.len() && am.len() == xp.len());
         #[cfg(target_arch = "x86_64")]
         {
-            // SAFETY: as in `pressure_sum`; `a` has one vector per particle (asserted).
-            let s = unsafe { avx512::a_dot(packed.values(), f32s(gs), coords(a), i, list) };
+            // SAFETY: as in `pressure_sum`; `am` is packed for the same particles (asserted).
+            let s = unsafe { avx512::a_dot((xp.values(), am.values()), f32s(gs), i, list) };
             R::of_f64(s as f64)
         }
         #[cfg(not(target_arch = "x86_64"))]
@@ -135,7 +135,7 @@ impl PressureLanes {
 mod avx512 {
     use std::arch::x86_64::*;
 
-    use sph_solver::pair_lanes::avx512::{packed, pairs, sums, vectors, Pairs};
+    use sph_solver::pair_lanes::avx512::{packed, pairs, sums, Pairs};
 
     /// `∇W_ij = (x_i − x_j) gs` per axis, as `passes::grad`.
     #[inline(always)]
@@ -157,10 +157,10 @@ mod avx512 {
         ]
     }
 
-    /// The 3-vector `v[3i..3i + 3]` broadcast per axis.
+    /// The first three packed values of particle `i`, `v[4i..4i + 3]`, broadcast.
     #[inline(always)]
     unsafe fn splat(v: &[f32], i: usize) -> [__m512; 3] {
-        let p = v.as_ptr().add(3 * i);
+        let p = v.as_ptr().add(4 * i);
         [
             _mm512_set1_ps(*p),
             _mm512_set1_ps(*p.add(1)),
@@ -204,14 +204,19 @@ mod avx512 {
     /// avx512f and avx512vl; `xm` holds `4n` packed values, `a` `3n` coordinates, `i < n`;
     /// `gs` has the list's length.
     #[target_feature(enable = "avx512f,avx512vl")]
-    pub(super) unsafe fn a_dot(xm: &[f32], gs: &[f32], a: &[f32], i: usize, list: &[u32]) -> f32 {
-        let ai = splat(a, i);
+    pub(super) unsafe fn a_dot(
+        (xp, am): (&[f32], &[f32]),
+        gs: &[f32],
+        i: usize,
+        list: &[u32],
+    ) -> f32 {
+        let ai = splat(am, i);
         let mut acc = _mm512_setzero_ps();
         for s in (0..list.len()).step_by(16) {
-            let p = pairs(xm, i, list, s);
+            let p = pairs(xp, i, list, s);
             let f = _mm512_maskz_loadu_ps(p.live, gs.as_ptr().add(s));
-            let aj = vectors(a, i, list, s);
-            let t = _mm512_mul_ps(p.mj, dot(sub(ai, aj), grad(&p, f)));
+            let [a0, a1, a2, mj] = packed(am, i, list, s);
+            let t = _mm512_mul_ps(mj, dot(sub(ai, [a0, a1, a2]), grad(&p, f)));
             acc = _mm512_mask_add_ps(acc, p.live, acc, t);
         }
         _mm512_reduce_add_ps(acc)
@@ -230,12 +235,7 @@ mod avx512 {
         i: usize,
         list: &[u32],
     ) -> [f32; 8] {
-        let own = vm.as_ptr().add(4 * i);
-        let vi = [
-            _mm512_set1_ps(*own),
-            _mm512_set1_ps(*own.add(1)),
-            _mm512_set1_ps(*own.add(2)),
-        ];
+        let vi = splat(vm, i);
         let mut acc = [_mm512_setzero_ps(); 4];
         for s in (0..list.len()).step_by(16) {
             let p = pairs(xp, i, list, s);
@@ -336,7 +336,9 @@ mod tests {
             xp.fill_with(&x, |i| m[i] * pi[i]);
             let mut vm = Packed::default();
             vm.fill_with(&v, |i| m[i]);
-            let Some(l) = PressureLanes::new::<f32>(n, nb, &[&xm, &xp, &vm]) else {
+            let mut am = Packed::default();
+            am.fill_with(&a, |i| m[i]);
+            let Some(l) = PressureLanes::new::<f32>(n, nb, &[&xm, &xp, &vm, &am]) else {
                 return Ok(());
             };
             for i in 0..n {
@@ -371,7 +373,7 @@ mod tests {
                 for c in 0..3 {
                     within("pressure sum", got[c], p[c], len, abs_p[c])?;
                 }
-                let got = l.a_dot(&xm, nb, &gs, &a, i);
+                let got = l.a_dot((&xp, &am), nb, &gs, i);
                 within("A p sum", got, ad, len, abs_ad)?;
                 let (got_div, got_p) = l.divergence_pressure_sum((&xp, &vm), nb, &gs, (pi[i], g), i);
                 within("divergence", got_div, div, len, abs_div)?;

@@ -27,8 +27,6 @@ pub(crate) fn grad<R: Real>(xi: &Vec3<R>, xj: &Vec3<R>, f: R) -> Vec3<R> {
 /// sums they need.
 #[derive(Clone, Copy)]
 pub(crate) struct Packs<'a, R: Real> {
-    /// `[x, y, z, m]` of the step (filled by [`density_pass`]).
-    pub xm: &'a Packed,
     /// `[x, y, z, m π]` of the current pressure iterate.
     pub xp: &'a Packed,
     /// `G_i = Σ_j m_j ∇W_ij` (the density pass's, without the boundary's term).
@@ -57,7 +55,7 @@ impl<'a, R: Real> Step<'a, R> {
         gs: &'a [R],
         packs: Packs<'a, R>,
     ) -> Self {
-        let lanes = PressureLanes::new::<R>(x.len(), nb, &[packs.xm, packs.xp])
+        let lanes = PressureLanes::new::<R>(x.len(), nb, &[packs.xp])
             .filter(|_| packs.mass_grad.len() == x.len())
             .map(|l| (l, packs));
         Self {
@@ -97,13 +95,20 @@ impl<'a, R: Real> Step<'a, R> {
         }
     }
 
-    /// [`a_times_p`] of particle `i`.
+    /// [`a_times_p`] of particle `i`; `am` holds the packed `[a, m]` where the lanes run
+    /// ([`pack_accel`]).
     #[inline]
-    pub(crate) fn a_times_p(&self, c: &Consts<R>, a: &[Vec3<R>], bgrad: &[Vec3<R>], i: usize) -> R {
+    pub(crate) fn a_times_p(
+        &self,
+        c: &Consts<R>,
+        (a, am): (&[Vec3<R>], &Packed),
+        bgrad: &[Vec3<R>],
+        i: usize,
+    ) -> R {
         match self.lanes {
             Some((l, p)) => {
                 let sum =
-                    l.a_dot(p.xm, self.nb, self.gs_of(i), a, i) + c.rho0 * a[i].dot(&bgrad[i]);
+                    l.a_dot((p.xp, am), self.nb, self.gs_of(i), i) + c.rho0 * a[i].dot(&bgrad[i]);
                 c.dt * c.dt * sum
             }
             None => {
@@ -111,6 +116,16 @@ impl<'a, R: Real> Step<'a, R> {
                 a_times_p(c, self.x, self.m, o, k, self.gs, a, bgrad, i)
             }
         }
+    }
+}
+
+/// Packs the pressure accelerations with the masses for the lanes (`[a, m]`), where they
+/// run.
+pub(crate) fn pack_accel<R: Real>(m: &[R], nb: &NeighbourLists, a: &[Vec3<R>], am: &mut Packed) {
+    if PressureLanes::available::<R>(m.len(), nb) {
+        am.fill_with(a, |i| m[i]);
+    } else {
+        am.clear();
     }
 }
 
@@ -346,7 +361,6 @@ pub(crate) fn predicted_density_pass<R: Real>(
         &s.p_over_rho2[..],
     );
     let packs = Packs {
-        xm: &s.packed,
         xp: &s.packed_pressure,
         mass_grad: &s.mass_grad,
     };
@@ -460,7 +474,6 @@ pub(crate) fn pressure_solve<R: Real>(
         // Pressure accelerations of the iterate p^l (for l = 0 computed by
         // `predicted_density_pass`).
         let packs = Packs {
-            xm: &s.packed,
             xp: &s.packed_pressure,
             mass_grad: &s.mass_grad,
         };
@@ -473,17 +486,19 @@ pub(crate) fn pressure_solve<R: Real>(
                 .with_min_len(MIN_LEN)
                 .for_each(|(i, a)| *a = step.pressure_accel(c, pi, bgrad, i));
         }
+        pack_accel(m, nb, &s.accel, &mut s.packed_accel);
         // A p^l, the density error of p^l, and the update p^{l+1}.
         {
-            let (acc, bgrad, src, aii, rho) = (
+            let (acc, am, bgrad, src, aii, rho) = (
                 &s.accel[..],
+                &s.packed_accel,
                 &s.bgrad[..],
                 &s.source[..],
                 &s.aii[..],
                 &s.density[..],
             );
             let update = |i: usize, pr: &mut R, pi: &mut R| -> f64 {
-                let ap = step.a_times_p(c, acc, bgrad, i);
+                let ap = step.a_times_p(c, (acc, am), bgrad, i);
                 let a = aii[i];
                 let next = if a < R::zero() {
                     let q = *pr + omega * (src[i] - ap) / a;
@@ -529,7 +544,6 @@ pub(crate) fn forces_pass<R: Real>(
     s: &mut Scratch<R>,
 ) {
     let packs = Packs {
-        xm: &s.packed,
         xp: &s.packed_pressure,
         mass_grad: &s.mass_grad,
     };

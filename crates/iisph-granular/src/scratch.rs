@@ -63,6 +63,9 @@ pub(crate) struct Scratch<R: Real> {
     /// `[x, y, z, m π]` of the current pressure iterate for the pressure lanes (filled only
     /// when they run).
     pub packed_pressure: sph_solver::pair_lanes::Packed,
+    /// `[a, m]` of the current pressure accelerations for the pressure lanes (filled only
+    /// when they run).
+    pub packed_accel: sph_solver::pair_lanes::Packed,
     /// `[v^adv, m]` for the pressure lanes (filled only when they run).
     pub packed_velocity: sph_solver::pair_lanes::Packed,
     /// `G_i = Σ_j m_j ∇W_ij` of the density pass (without the boundary's term).
