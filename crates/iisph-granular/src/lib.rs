@@ -308,6 +308,18 @@
 //! (`a^f_i = −(s_i/ρ_i²) G_i − Σ_j (m_j s_j/ρ_j²) ∇W_ij`, one symmetric product per pair).
 //! Every parallel loop writes one particle's values and reduces in fixed chunks, so results
 //! are bitwise identical for any number of threads.
+//!
+//! In `f32` on a processor with AVX-512 (F and VL, detected at run time), the density pass
+//! (`sph_solver::pair_lanes`) and the pressure passes (the predicted density with the warm
+//! start's accelerations, both halves of each Jacobi iteration, the forces) take sixteen
+//! pairs of one particle per instruction, every neighbour value loaded from arrays packed
+//! four `f32` per particle (`[x, y, z, m]`, `[x, y, z, m p/ρ²]`, `[a^p, m]`, `[v^adv, m]`,
+//! refilled where their values change, one pass over the particles each) and transposed,
+//! never gathered; the pressure sum is taken as `(p_i/ρ_i²) Σ_j m_j ∇W_ij + Σ_j (m_j p_j/ρ_j²)
+//! ∇W_ij`, the first sum from the density pass. The sums differ from the scalar loops' by
+//! their order only (and the pressure sum by that split), within the bound the lanes' tests
+//! check; `f64` and processors without AVX-512 take the scalar loops. The granular model's
+//! friction passes stay scalar.
 
 mod friction;
 pub mod granular;

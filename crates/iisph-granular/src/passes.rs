@@ -96,7 +96,7 @@ impl<'a, R: Real> Step<'a, R> {
     }
 
     /// [`a_times_p`] of particle `i`; `am` holds the packed `[a, m]` where the lanes run
-    /// ([`pack_accel`]).
+    /// ([`pack_vectors`]).
     #[inline]
     pub(crate) fn a_times_p(
         &self,
@@ -119,9 +119,9 @@ impl<'a, R: Real> Step<'a, R> {
     }
 }
 
-/// Packs the pressure accelerations with the masses for the lanes (`[a, m]`), where they
-/// run.
-pub(crate) fn pack_accel<R: Real>(m: &[R], nb: &NeighbourLists, a: &[Vec3<R>], am: &mut Packed) {
+/// Packs 3-vectors `a` (`v^adv` for the predicted density, the pressure accelerations for
+/// `A p`) with the masses for the lanes (`[a, m]`), where they run.
+pub(crate) fn pack_vectors<R: Real>(m: &[R], nb: &NeighbourLists, a: &[Vec3<R>], am: &mut Packed) {
     if PressureLanes::available::<R>(m.len(), nb) {
         am.fill_with(a, |i| m[i]);
     } else {
@@ -129,25 +129,15 @@ pub(crate) fn pack_accel<R: Real>(m: &[R], nb: &NeighbourLists, a: &[Vec3<R>], a
     }
 }
 
-/// Packs `m_i π_i` of the current `π = p/ρ²` with the positions for the pressure lanes
-/// (`[x, y, z, m π]`), where they run: the positions too when `positions` (they are new),
-/// else only `m π`.
-pub(crate) fn pack_pressure<R: Real>(
-    x: &[Vec3<R>],
-    m: &[R],
-    nb: &NeighbourLists,
-    s: &mut Scratch<R>,
-    positions: bool,
-) {
-    if !PressureLanes::available::<R>(x.len(), nb) {
-        s.packed_pressure.clear();
-        return;
-    }
-    let pi = &s.p_over_rho2[..];
-    if !positions && s.packed_pressure.len() == x.len() {
-        s.packed_pressure.set_fourth(|i| m[i] * pi[i]);
+/// Packs `m_i π_i` of the current `π = p/ρ²` for the pressure lanes, in place of the masses
+/// of the step's `[x, y, z, m]` (filled by [`density_pass`], which the pressure passes no
+/// longer read): `[x, y, z, m π]`, where the lanes run.
+pub(crate) fn pack_pressure<R: Real>(m: &[R], nb: &NeighbourLists, s: &mut Scratch<R>) {
+    if PressureLanes::available::<R>(m.len(), nb) && s.packed.len() == m.len() {
+        let pi = &s.p_over_rho2[..];
+        s.packed.set_fourth(|i| m[i] * pi[i]);
     } else {
-        s.packed_pressure.fill_with(x, |i| m[i] * pi[i]);
+        s.packed.clear();
     }
 }
 
@@ -344,13 +334,8 @@ pub(crate) fn predicted_density_pass<R: Real>(
     nb: &NeighbourLists,
     s: &mut Scratch<R>,
 ) {
-    pack_pressure(x, m, nb, s, true);
-    if s.packed_pressure.len() == x.len() {
-        let va = &s.v_adv[..];
-        s.packed_velocity.fill_with(va, |i| m[i]);
-    } else {
-        s.packed_velocity.clear();
-    }
+    pack_pressure(m, nb, s);
+    pack_vectors(m, nb, &s.v_adv, &mut s.packed_vectors);
     let offsets = nb.offsets();
     let indices = nb.indices();
     let (rho, gs, bgrad, va, pi) = (
@@ -361,11 +346,11 @@ pub(crate) fn predicted_density_pass<R: Real>(
         &s.p_over_rho2[..],
     );
     let packs = Packs {
-        xp: &s.packed_pressure,
+        xp: &s.packed,
         mass_grad: &s.mass_grad,
     };
     let step = Step::new(x, m, nb, gs, packs);
-    let vm = &s.packed_velocity;
+    let vm = &s.packed_vectors;
     let lanes = step.lanes.filter(|_| vm.len() == x.len());
     s.source
         .par_iter_mut()
@@ -469,12 +454,12 @@ pub(crate) fn pressure_solve<R: Real>(
     let eta = p.density_error_tolerance.as_f64();
     let inv_rho0 = 1.0 / c.rho0.as_f64();
     let mut error = 0.0;
-    pack_pressure(x, m, nb, s, false);
+    pack_pressure(m, nb, s);
     for l in 0..p.max_iterations {
         // Pressure accelerations of the iterate p^l (for l = 0 computed by
         // `predicted_density_pass`).
         let packs = Packs {
-            xp: &s.packed_pressure,
+            xp: &s.packed,
             mass_grad: &s.mass_grad,
         };
         let step = Step::new(x, m, nb, &s.grad_scale, packs);
@@ -486,12 +471,12 @@ pub(crate) fn pressure_solve<R: Real>(
                 .with_min_len(MIN_LEN)
                 .for_each(|(i, a)| *a = step.pressure_accel(c, pi, bgrad, i));
         }
-        pack_accel(m, nb, &s.accel, &mut s.packed_accel);
+        pack_vectors(m, nb, &s.accel, &mut s.packed_vectors);
         // A p^l, the density error of p^l, and the update p^{l+1}.
         {
             let (acc, am, bgrad, src, aii, rho) = (
                 &s.accel[..],
-                &s.packed_accel,
+                &s.packed_vectors,
                 &s.bgrad[..],
                 &s.source[..],
                 &s.aii[..],
@@ -523,7 +508,7 @@ pub(crate) fn pressure_solve<R: Real>(
             );
             error = total / n as f64 * inv_rho0;
         }
-        pack_pressure(x, m, nb, s, false);
+        pack_pressure(m, nb, s);
         if l + 1 >= p.min_iterations && error <= eta {
             return (l + 1, error, true);
         }
@@ -544,7 +529,7 @@ pub(crate) fn forces_pass<R: Real>(
     s: &mut Scratch<R>,
 ) {
     let packs = Packs {
-        xp: &s.packed_pressure,
+        xp: &s.packed,
         mass_grad: &s.mass_grad,
     };
     let step = Step::new(x, m, nb, &s.grad_scale, packs);

@@ -58,16 +58,12 @@ pub(crate) struct Scratch<R: Real> {
     /// Partial sums of the density error per chunk of [`REDUCE_CHUNK`] particles.
     pub error_partials: Vec<f64>,
     pub perm_scalar: Vec<R>,
-    /// The step's positions and masses packed for the lanes (filled only when they run).
+    /// The step's positions and masses packed for the lanes (filled only when they run);
+    /// during the pressure solve `[x, y, z, m p/ρ²]` (`passes::pack_pressure`).
     pub packed: sph_solver::pair_lanes::Packed,
-    /// `[x, y, z, m π]` of the current pressure iterate for the pressure lanes (filled only
-    /// when they run).
-    pub packed_pressure: sph_solver::pair_lanes::Packed,
-    /// `[a, m]` of the current pressure accelerations for the pressure lanes (filled only
-    /// when they run).
-    pub packed_accel: sph_solver::pair_lanes::Packed,
-    /// `[v^adv, m]` for the pressure lanes (filled only when they run).
-    pub packed_velocity: sph_solver::pair_lanes::Packed,
+    /// `[v^adv, m]`, then `[a, m]` of the current pressure accelerations, for the pressure
+    /// lanes (filled only when they run).
+    pub packed_vectors: sph_solver::pair_lanes::Packed,
     /// `G_i = Σ_j m_j ∇W_ij` of the density pass (without the boundary's term).
     pub mass_grad: Vec<Vec3<R>>,
     /// The volume boundary's samples at the end-of-step positions, for the next step's
