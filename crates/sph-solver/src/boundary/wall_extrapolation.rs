@@ -102,7 +102,9 @@ pub struct Extrapolation<'a, R: Real, K: Kernel<R>> {
 
 /// The particle neighbours of each boundary particle (from the neighbour lists, in their
 /// order: the extrapolation's sums add in the same order as over the whole lists, whose
-/// other entries are boundary particles), rebuilt at each neighbour search, and their
+/// other entries, if the search listed them, are boundary particles; a search with the
+/// boundary particles passive, `StepNeighbours::find_active`, lists none), rebuilt at each
+/// neighbour search, and their
 /// Shepard weights `W_bf` and gravity terms `ρ_f (g·r_bf) W_bf`, computed once per step for
 /// both extrapolations of the step; and which boundary particles any particle's sum reads.
 #[derive(Debug, Clone, Default)]
