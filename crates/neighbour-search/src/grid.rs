@@ -165,7 +165,12 @@ fn query_runs<R: Real>(
                         g.extend_below(&xs[a..b], &ys[a..b], &zs[a..b], &order[a..b], bound);
                     }
                     let len = g.len();
-                    g.extend(&xs[mid..end], &ys[mid..end], &zs[mid..end], &order[mid..end]);
+                    g.extend(
+                        &xs[mid..end],
+                        &ys[mid..end],
+                        &zs[mid..end],
+                        &order[mid..end],
+                    );
                     g.finish();
                     if !scan_cell(buf, g, &guard, len, len, &order[mid..end], r2) {
                         break 'runs;
