@@ -113,6 +113,9 @@ pub struct BoundaryLists<R: Real> {
     /// of it): the boundary particles whose values a sum reads, the only ones
     /// [`extrapolate`] writes.
     read: Vec<bool>,
+    /// Whether chunk `c` (boundary particles `c · READ_CHUNK..`, [`READ_CHUNK`]) holds a
+    /// read one: the loops over the boundary particles skip the other chunks whole.
+    chunk_read: Vec<bool>,
     /// CSR offsets: boundary particle `k`'s entries are `start[k]..start[k + 1]`.
     start: Vec<usize>,
     /// The lists' entry (a particle or an image of one).
@@ -163,6 +166,9 @@ impl<R: Real> BoundaryLists<R> {
                 }
             }
         }
+        self.chunk_read.clear();
+        self.chunk_read
+            .extend(self.read.chunks(READ_CHUNK).map(|c| c.contains(&true)));
         let len = self.entry.len();
         self.weight.resize(len, R::zero());
         self.weighted_gravity.resize(len, R::zero());
@@ -172,6 +178,13 @@ impl<R: Real> BoundaryLists<R> {
     /// the last [`BoundaryLists::rebuild`]): [`extrapolate`] writes only those.
     pub fn is_read(&self, k: usize) -> bool {
         self.read.get(k).copied().unwrap_or(false)
+    }
+
+    /// Whether chunk `c` of [`READ_CHUNK`] boundary particles (`c · READ_CHUNK..`) holds
+    /// one [`BoundaryLists::is_read`]: a loop over the boundary particles by chunks skips
+    /// the others whole (most of a wall's, away from the material).
+    pub fn is_chunk_read(&self, c: usize) -> bool {
+        self.chunk_read.get(c).copied().unwrap_or(false)
     }
 
     /// The weights and gravity terms at the positions `e.x` (boundary particles from `n =
@@ -192,6 +205,12 @@ impl<R: Real> BoundaryLists<R> {
             });
     }
 }
+
+/// Boundary particles per chunk of [`BoundaryLists::is_chunk_read`].
+pub const READ_CHUNK: usize = 64;
+
+/// Chunks of [`READ_CHUNK`] handed to one rayon task ([`MIN_LEN`] particles).
+pub const CHUNKS_PER_TASK: usize = MIN_LEN / READ_CHUNK;
 
 /// A tensor a solver derives from each boundary particle's stress (e.g. the elastic–plastic
 /// solver's artificial stress), written by [`extrapolate`] beside it.
@@ -269,23 +288,40 @@ pub fn extrapolate<R: Real, K: Kernel<R>>(
                 *a = f(&s_b);
             }
         };
+    // By chunks of READ_CHUNK, those without a read boundary particle skipped whole.
+    let (c, read) = (READ_CHUNK, |k: usize| lists.is_chunk_read(k));
     match (v_tail, art_tail) {
         (Some(vt), None) => s_tail
-            .par_iter_mut()
-            .zip(vt.par_iter_mut())
+            .par_chunks_mut(c)
+            .zip(vt.par_chunks_mut(c))
             .enumerate()
-            .with_min_len(MIN_LEN)
-            .for_each(|(k, (sig, vel))| work(k, sig, Some(vel), None)),
+            .with_min_len(CHUNKS_PER_TASK)
+            .filter(|(k, _)| read(*k))
+            .for_each(|(k, (sig, vel))| {
+                for (e, (sig, vel)) in sig.iter_mut().zip(vel).enumerate() {
+                    work(k * c + e, sig, Some(vel), None);
+                }
+            }),
         (None, Some(at)) => s_tail
-            .par_iter_mut()
-            .zip(at.par_iter_mut())
+            .par_chunks_mut(c)
+            .zip(at.par_chunks_mut(c))
             .enumerate()
-            .with_min_len(MIN_LEN)
-            .for_each(|(k, (sig, a))| work(k, sig, None, Some(a))),
+            .with_min_len(CHUNKS_PER_TASK)
+            .filter(|(k, _)| read(*k))
+            .for_each(|(k, (sig, a))| {
+                for (e, (sig, a)) in sig.iter_mut().zip(a).enumerate() {
+                    work(k * c + e, sig, None, Some(a));
+                }
+            }),
         _ => s_tail
-            .par_iter_mut()
+            .par_chunks_mut(c)
             .enumerate()
-            .with_min_len(MIN_LEN)
-            .for_each(|(k, sig)| work(k, sig, None, None)),
+            .with_min_len(CHUNKS_PER_TASK)
+            .filter(|(k, _)| read(*k))
+            .for_each(|(k, sig)| {
+                for (e, sig) in sig.iter_mut().enumerate() {
+                    work(k * c + e, sig, None, None);
+                }
+            }),
     }
 }
