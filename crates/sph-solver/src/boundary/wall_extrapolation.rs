@@ -325,3 +325,91 @@ pub fn extrapolate<R: Real, K: Kernel<R>>(
             }),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use neighbour_search::Method;
+    use sph_kernels::CubicSpline;
+
+    use super::*;
+    use crate::step::StepNeighbours;
+
+    /// A wall of 600 boundary particles along `x` (spacing 0.01 m, ten chunks) under two
+    /// clumps of particles, searched with the boundary particles passive: [`extrapolate`]
+    /// writes exactly the boundary particles [`BoundaryLists::is_read`] marks (their values
+    /// finite, the others left at the NaN they started with), a chunk is read exactly when
+    /// one of its particles is, and the read ones are those within the search radius of a
+    /// particle (counted here by distance). A chunk index off by one (planted once,
+    /// 2026-12-06) fails it.
+    #[test]
+    fn extrapolate_writes_exactly_the_read_boundary_particles() {
+        let (s, h) = (0.01f64, 0.02f64);
+        let mut x: Vec<Vec3<f64>> = Vec::new();
+        for (lo, count) in [(0.70, 12), (4.505, 30)] {
+            x.extend((0..count).map(|i| Vec3::new(lo + i as f64 * 0.007, 0.006, 0.0)));
+        }
+        let n = x.len();
+        let particles: Vec<BoundaryParticle<f64>> = (0..600)
+            .map(|k| BoundaryParticle {
+                position: Vec3::new(k as f64 * s, 0.0, 0.0),
+                normal: Vec3::new(0.0, 1.0, 0.0),
+                model: WallModel::NoSlip,
+                velocity: Vec3::zeros(),
+            })
+            .collect();
+        x.extend(particles.iter().map(|b| b.position));
+        let mut search = StepNeighbours::new(Method::CellStartGrid);
+        search.find_active(&x, n, h).unwrap();
+        assert!(search.lists().neighbours(n + 100).is_empty());
+        let images = PeriodicImages::default();
+        let mut lists = BoundaryLists::default();
+        lists.rebuild(search.lists(), &images, &x, n, particles.len());
+        let rho = vec![1000.0; n];
+        let e = Extrapolation {
+            kernel: CubicSpline::new(h).unwrap(),
+            images: &images,
+            x: &x,
+            rho: &rho,
+            particles: &particles,
+            gravity: Vec3::new(0.0, -9.81, 0.0),
+        };
+        lists.weigh(&e);
+        let mut stress: Vec<Matrix3<f64>> = (0..x.len())
+            .map(|i| Matrix3::identity() * -(i as f64))
+            .collect();
+        stress[n..].fill(Matrix3::from_element(f64::NAN));
+        let mut v = vec![Vec3::new(0.1, 0.0, 0.0); x.len()];
+        v[n..].fill(Vec3::from_element(f64::NAN));
+        extrapolate(&e, &lists, &mut stress, Some(&mut v), None);
+        // The other arm: the stress with a tensor derived from it, no velocity.
+        let mut stress2 = stress.clone();
+        stress2[n..].fill(Matrix3::from_element(f64::NAN));
+        let mut derived = vec![Matrix3::from_element(f64::NAN); x.len()];
+        let twice = |m: &Matrix3<f64>| m * 2.0;
+        extrapolate(&e, &lists, &mut stress2, None, Some((&mut derived, &twice)));
+        let mut read = 0;
+        for k in 0..particles.len() {
+            let near = x[..n]
+                .iter()
+                .any(|p| (p - particles[k].position).norm() < h);
+            assert_eq!(lists.is_read(k), near, "boundary particle {k}");
+            let written = stress[n + k].iter().all(|c| c.is_finite()) && v[n + k].x.is_finite();
+            assert_eq!(written, near, "boundary particle {k} written");
+            let derived_written = derived[n + k].iter().all(|c| c.is_finite());
+            assert_eq!(
+                derived_written, near,
+                "boundary particle {k}'s derived tensor"
+            );
+            if near {
+                assert_eq!(stress2[n + k], stress[n + k], "boundary particle {k}");
+            }
+            read += usize::from(near);
+        }
+        assert!(read > 0 && read < particles.len());
+        for c in 0..particles.len().div_ceil(READ_CHUNK) {
+            let any = (c * READ_CHUNK..((c + 1) * READ_CHUNK).min(particles.len()))
+                .any(|k| lists.is_read(k));
+            assert_eq!(lists.is_chunk_read(c), any, "chunk {c}");
+        }
+    }
+}
