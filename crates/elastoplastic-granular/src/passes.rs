@@ -6,6 +6,7 @@ use nalgebra::Matrix3;
 use rayon::prelude::*;
 use sph_core::{Real, Vec3};
 use sph_kernels::Kernel;
+use sph_solver::boundary::wall_extrapolation::{CHUNKS_PER_TASK, READ_CHUNK};
 use sph_solver::boundary::Boundary;
 use sph_solver::csr::par_csr_blocks;
 use sph_solver::pair_lanes::f32s;
@@ -510,16 +511,20 @@ pub(crate) fn boundary_pair_terms<R: Real>(s: &mut Scratch<R>, n: usize) {
     let (sig, rho, art) = (&s.stress_new[n..], &s.rho_new[n..], &s.art[n..]);
     let lists = &s.boundary_lists;
     s.stress_over_rho2[n..]
-        .par_iter_mut()
-        .zip(s.art_on[n..].par_iter_mut())
+        .par_chunks_mut(READ_CHUNK)
+        .zip(s.art_on[n..].par_chunks_mut(READ_CHUNK))
         .enumerate()
-        .with_min_len(MIN_LEN)
-        .for_each(|(k, (sr, on))| {
-            if !lists.is_read(k) {
-                return;
+        .with_min_len(CHUNKS_PER_TASK)
+        .filter(|(c, _)| lists.is_chunk_read(*c))
+        .for_each(|(c, (srs, ons))| {
+            for (e, (sr, on)) in srs.iter_mut().zip(ons).enumerate() {
+                let k = c * READ_CHUNK + e;
+                if !lists.is_read(k) {
+                    continue;
+                }
+                *sr = sig[k] / (rho[k] * rho[k]);
+                *on = art[k] != Matrix3::zeros();
             }
-            *sr = sig[k] / (rho[k] * rho[k]);
-            *on = art[k] != Matrix3::zeros();
         });
 }
 

@@ -572,10 +572,13 @@ impl<R: Real> ElastoplasticScheme<R> {
             // less than the skin: grains `2 × moved`, a grain and a wall `moved + shift`.
             if !self.lists_valid || moved > skin * half || moved + self.boundary_shift > skin {
                 let axes = &self.params.periodic;
+                // The boundary particles (after the grains) list only grains: no sum reads
+                // a boundary–boundary pair. With periodic axes the images of both kinds
+                // follow them, and every pair is listed.
                 let search = if axes.is_empty() {
                     self.parts
                         .neighbours
-                        .find_in_step(&s.x, h + skin, at, "position")?
+                        .find_active_in_step(&s.x, n, h + skin, at, "position")?
                 } else {
                     s.images.rebuild(&mut s.x, axes, h + skin, &mut s.x_ext);
                     self.parts

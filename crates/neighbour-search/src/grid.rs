@@ -99,12 +99,20 @@ impl<R: Real, K: Key> SortedParticles<R, K> {
 /// are then scanned in one call of the kernel (one output reservation per cell, not per
 /// particle), with the lists of a particle-by-particle scan. Keeps to the
 /// [`crate::SearchLimits`] of `out`.
+///
+/// Points `active..` are passive ([`NeighbourSearch::search_active`]): a cell's particles
+/// are in increasing caller index (the stable sort), so its active particles come first
+/// and are scanned as above; its passive ones are scanned once per cell against the active
+/// candidates only, gathered in the same order, so that each passive list is the full
+/// search's list with the passive entries taken out, entry for entry. `active >= n`: the
+/// full search.
 #[allow(clippy::too_many_arguments)]
 fn query_runs<R: Real>(
     runs: &[u32],
     (xs, ys, zs): (&[R], &[R], &[R]),
     order: &[u32],
     tasks: &mut Vec<(TaskOutput, Gathered<R>)>,
+    active: usize,
     r2: R,
     out: &mut NeighbourLists,
     stats: &mut SearchStats,
@@ -112,6 +120,7 @@ fn query_runs<R: Real>(
 ) -> Result<(), SearchError> {
     let mut watch = Stopwatch::start();
     let n = xs.len();
+    let bound = active.min(n) as u32;
     let run_count = runs.len() - 1;
     let per_task = items_per_task(run_count, CELLS_PER_TASK);
     let task_count = run_count.div_ceil(per_task);
@@ -131,28 +140,39 @@ fn query_runs<R: Real>(
                     break;
                 }
                 let (start, end) = (runs[r] as usize, runs[r + 1] as usize);
+                let mid = start + order[start..end].partition_point(|&i| i < bound);
                 let (ranges, count) = locate(start);
-                g.clear();
-                let mut own = 0;
-                for &(a, b) in &ranges[..count] {
-                    let (a, b) = (a as usize, b as usize);
-                    if a <= start && start < b {
-                        own = g.len() + start - a;
+                let ranges = &ranges[..count];
+                if mid > start {
+                    g.clear();
+                    let mut own = 0;
+                    for &(a, b) in ranges {
+                        let (a, b) = (a as usize, b as usize);
+                        if a <= start && start < b {
+                            own = g.len() + start - a;
+                        }
+                        g.extend(&xs[a..b], &ys[a..b], &zs[a..b], &order[a..b]);
                     }
-                    g.extend(&xs[a..b], &ys[a..b], &zs[a..b], &order[a..b]);
+                    let len = g.finish();
+                    if !scan_cell(buf, g, &guard, len, own, &order[start..mid], r2) {
+                        break 'runs;
+                    }
                 }
-                let len = g.finish();
-                buf.tests += (len * (end - start)) as u64;
-                // In pieces whose lists can hold at most about `REPORT_EVERY` pairs, so
-                // that a dense cell neither reserves nor finds much past the pair limit.
-                let piece = (REPORT_EVERY / len.max(1)).max(1);
-                for first in (start..end).step_by(piece) {
-                    let ids = &order[first..(first + piece).min(end)];
-                    let at = own + first - start;
-                    let scan = |nb: &mut Vec<u32>, ps: &mut Vec<(u32, u32)>| {
-                        g.neighbours_of_run(len, at, ids, r2, nb, ps)
-                    };
-                    if !buf.record_run(&guard, scan) {
+                if mid < end {
+                    g.clear();
+                    for &(a, b) in ranges {
+                        let (a, b) = (a as usize, b as usize);
+                        g.extend_below(&xs[a..b], &ys[a..b], &zs[a..b], &order[a..b], bound);
+                    }
+                    let len = g.len();
+                    g.extend(
+                        &xs[mid..end],
+                        &ys[mid..end],
+                        &zs[mid..end],
+                        &order[mid..end],
+                    );
+                    g.finish();
+                    if !scan_cell(buf, g, &guard, len, len, &order[mid..end], r2) {
                         break 'runs;
                     }
                 }
@@ -166,6 +186,35 @@ fn query_runs<R: Real>(
     assemble_by(out, n, &mut tasks[..task_count], |t| &t.0, |t| &mut t.0)?;
     stats.assemble_s = watch.lap();
     Ok(())
+}
+
+/// Scans the particles `ids` (at `own..` in the gathered block `g`) against its first `len`
+/// candidates into `buf`, in pieces whose lists can hold at most about `REPORT_EVERY`
+/// pairs, so that a dense cell neither reserves nor finds much past the pair limit;
+/// `false` when the search must stop.
+#[inline]
+fn scan_cell<R: Real>(
+    buf: &mut TaskOutput,
+    g: &Gathered<R>,
+    guard: &PairGuard<'_>,
+    len: usize,
+    own: usize,
+    ids: &[u32],
+    r2: R,
+) -> bool {
+    buf.tests += (len * ids.len()) as u64;
+    let piece = (REPORT_EVERY / len.max(1)).max(1);
+    for first in (0..ids.len()).step_by(piece) {
+        let part = &ids[first..(first + piece).min(ids.len())];
+        let at = own + first;
+        let scan = |nb: &mut Vec<u32>, ps: &mut Vec<(u32, u32)>| {
+            g.neighbours_of_run(len, at, part, r2, nb, ps)
+        };
+        if !buf.record_run(guard, scan) {
+            return false;
+        }
+    }
+    true
 }
 
 /// Merges the ranges of three z-consecutive cells (contiguous in sorted order) into one.
@@ -242,6 +291,16 @@ impl<R: Real> NeighbourSearch<R> for CellStartGrid<R> {
     fn search(
         &mut self,
         positions: &[Vec3<R>],
+        radius: R,
+        out: &mut NeighbourLists,
+    ) -> Result<(), SearchError> {
+        self.search_active(positions, positions.len(), radius, out)
+    }
+
+    fn search_active(
+        &mut self,
+        positions: &[Vec3<R>],
+        active: usize,
         radius: R,
         out: &mut NeighbourLists,
     ) -> Result<(), SearchError> {
@@ -324,6 +383,7 @@ impl<R: Real> NeighbourSearch<R> for CellStartGrid<R> {
             (&self.sorted.xs, &self.sorted.ys, &self.sorted.zs),
             &self.sorted.order,
             &mut self.sorted.tasks,
+            active,
             radius * radius,
             out,
             &mut self.sorted.stats,
@@ -379,6 +439,7 @@ fn hashed_search<R: Real, K: Key>(
     map: &mut FxHashMap<K, (u32, u32)>,
     packer: &KeyPacker,
     positions: &[Vec3<R>],
+    active: usize,
     r2: R,
     out: &mut NeighbourLists,
     cells_s: f64,
@@ -417,6 +478,7 @@ fn hashed_search<R: Real, K: Key>(
         (&s.xs, &s.ys, &s.zs),
         &s.order,
         &mut s.tasks,
+        active,
         r2,
         out,
         &mut s.stats,
@@ -439,6 +501,16 @@ impl<R: Real> NeighbourSearch<R> for HashedGrid<R> {
         radius: R,
         out: &mut NeighbourLists,
     ) -> Result<(), SearchError> {
+        self.search_active(positions, positions.len(), radius, out)
+    }
+
+    fn search_active(
+        &mut self,
+        positions: &[Vec3<R>],
+        active: usize,
+        radius: R,
+        out: &mut NeighbourLists,
+    ) -> Result<(), SearchError> {
         let mut watch = Stopwatch::start();
         let cell = cell_size(radius)?;
         // Both key widths share the cell computation; the narrow one holds the cells.
@@ -455,6 +527,7 @@ impl<R: Real> NeighbourSearch<R> for HashedGrid<R> {
                 &mut self.map_narrow,
                 &packer,
                 positions,
+                active,
                 r2,
                 out,
                 t,
@@ -467,6 +540,7 @@ impl<R: Real> NeighbourSearch<R> for HashedGrid<R> {
                 &mut self.map_wide,
                 &packer,
                 positions,
+                active,
                 r2,
                 out,
                 t,

@@ -117,6 +117,28 @@ pub trait NeighbourSearch<R: Real>: Send {
         out: &mut NeighbourLists,
     ) -> Result<(), SearchError>;
 
+    /// As [`NeighbourSearch::search`], with the points `0..active` active and the others
+    /// passive: an active point lists all its neighbours, a passive one only its active
+    /// neighbours (no pair of two passive points; e.g. a solver's boundary particles, which
+    /// no sum over boundary particles reads). Each passive point's list is the full search's
+    /// list with its passive entries taken out, in the same order; the active points' lists
+    /// are the full search's. `active >= positions.len()` is the full search.
+    ///
+    /// The default searches every pair and then drops the passive–passive ones; the grids
+    /// ([`CellStartGrid`], [`HashedGrid`]) scan a cell's passive points against its active
+    /// candidates only.
+    fn search_active(
+        &mut self,
+        positions: &[Vec3<R>],
+        active: usize,
+        radius: R,
+        out: &mut NeighbourLists,
+    ) -> Result<(), SearchError> {
+        self.search(positions, radius, out)?;
+        out.drop_passive_pairs(active);
+        Ok(())
+    }
+
     /// Statistics of the last successful search (zero if the method does not keep them).
     fn stats(&self) -> SearchStats {
         SearchStats::default()

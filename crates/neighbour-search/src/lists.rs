@@ -138,6 +138,28 @@ impl NeighbourLists {
             + self.indices.capacity() * std::mem::size_of::<u32>()
     }
 
+    /// Drops from the lists of the particles `active..` their entries `active..` (the
+    /// passive–passive pairs of [`crate::NeighbourSearch::search_active`]), keeping the
+    /// order of the others; in place.
+    pub(crate) fn drop_passive_pairs(&mut self, active: usize) {
+        let n = self.particle_count();
+        if active >= n {
+            return;
+        }
+        let mut kept = self.offsets[active];
+        for i in active..n {
+            let (a, b) = (self.offsets[i], self.offsets[i + 1]);
+            self.offsets[i] = kept;
+            for k in a..b {
+                let j = self.indices[k];
+                self.indices[kept] = j;
+                kept += usize::from((j as usize) < active);
+            }
+        }
+        self.offsets[n] = kept;
+        self.indices.truncate(kept);
+    }
+
     /// Empties the lists and sizes the offsets for `n` particles (all zero).
     pub(crate) fn reset(&mut self, n: usize) -> Result<(), SearchError> {
         self.offsets.clear();

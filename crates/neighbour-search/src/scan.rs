@@ -94,6 +94,17 @@ impl<R: Real> Gathered<R> {
         append(&mut self.ids, ids);
     }
 
+    /// Appends the candidates of a run whose id is below `bound` (the active points of
+    /// [`crate::NeighbourSearch::search_active`]), in their order.
+    #[inline]
+    pub fn extend_below(&mut self, xs: &[R], ys: &[R], zs: &[R], ids: &[u32], bound: u32) {
+        for (k, &id) in ids.iter().enumerate() {
+            if id < bound {
+                self.push(xs[k], ys[k], zs[k], id);
+            }
+        }
+    }
+
     /// Pads the block and scans particle `e` of it against all others: appends its
     /// neighbours' ids to `out`, returns how many (an error if `out` cannot grow). Call
     /// [`Gathered::finish`] first.
@@ -120,7 +131,9 @@ impl<R: Real> Gathered<R> {
     /// [`Gathered::neighbours_of`] would one after another: appends their lists to `out`
     /// in that order and `(ids[e], length)` to `particles`; returns the pairs found. One
     /// reservation and one kernel dispatch per run instead of per particle; the lists are
-    /// the same, entry for entry. On a failed allocation nothing is appended.
+    /// the same, entry for entry. On a failed allocation nothing is appended. The
+    /// particles may also lie after the candidates (`own >= len`: passive points scanned
+    /// against the active candidates only, none of them itself).
     #[allow(clippy::too_many_arguments)]
     pub fn neighbours_of_run(
         &self,
@@ -132,7 +145,7 @@ impl<R: Real> Gathered<R> {
         particles: &mut Vec<(u32, u32)>,
     ) -> Result<usize, TryReserveError> {
         let count = ids.len();
-        assert!(own + count <= len && len + LANES <= self.ids.len());
+        assert!(own + count + LANES <= self.ids.len() && len + LANES <= self.ids.len());
         // Each list has at most `len` entries, and a kernel writes at most LANES entries
         // past the running count.
         out.try_reserve(count * len + LANES)?;

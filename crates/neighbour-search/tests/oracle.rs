@@ -336,3 +336,127 @@ mod cell_sorted {
         }
     }
 }
+
+/// `search_active`: the points `active..` passive, listing only the active points. Every
+/// fast method against the oracle's lists with the passive–passive pairs taken out here
+/// (as sets), and against its own full search with those entries taken out (entry for
+/// entry: the order a solver's sums add in is the full search's), on unsorted and
+/// cell-sorted clouds, on one thread and several, `active` from 0 to beyond the count.
+mod active_points {
+    use super::*;
+    use neighbour_search::{CellOrder, CellSorter};
+
+    /// `lists` with the entries `j >= active` of the particles `i >= active` removed.
+    fn without_passive_pairs(lists: &NeighbourLists, active: usize) -> Vec<Vec<u32>> {
+        lists
+            .iter()
+            .map(|(i, l)| {
+                l.iter()
+                    .copied()
+                    .filter(|&j| i < active || (j as usize) < active)
+                    .collect()
+            })
+            .collect()
+    }
+
+    fn check<R: Real>(points: &[Vec3<R>], h: R, active: usize) -> Result<(), TestCaseError> {
+        let mut full = NeighbourLists::new();
+        let oracle = match BruteForce::new().search(points, h, &mut full) {
+            Ok(()) => without_passive_pairs(&full, active),
+            Err(_) => return Ok(()), // input errors: `check_all` covers them
+        };
+        let expected: Vec<Vec<u32>> = oracle
+            .into_iter()
+            .map(|mut l| {
+                l.sort_unstable();
+                l
+            })
+            .collect();
+        for m in Method::FAST {
+            let mut s = m.build::<R>();
+            let mut whole = NeighbourLists::new();
+            match s.search(points, h, &mut whole) {
+                Ok(()) => {}
+                Err(SearchError::DomainTooLarge { .. }) => continue,
+                Err(e) => prop_assert!(false, "{}: {e}", m.name()),
+            }
+            for round in 0..2 {
+                let mut out = NeighbourLists::new();
+                s.search_active(points, active, h, &mut out)
+                    .map_err(|e| TestCaseError::fail(format!("{}: {e}", m.name())))?;
+                prop_assert_eq!(out.particle_count(), points.len());
+                prop_assert_eq!(out.offsets()[points.len()], out.indices().len());
+                let got: Vec<Vec<u32>> = out.iter().map(|(_, l)| l.to_vec()).collect();
+                prop_assert_eq!(
+                    &got,
+                    &without_passive_pairs(&whole, active),
+                    "{} round {}: not the full search's lists without the passive pairs",
+                    m.name(),
+                    round
+                );
+                prop_assert_eq!(
+                    &out.to_sorted_sets(),
+                    &expected,
+                    "{} round {}: not the oracle's sets",
+                    m.name(),
+                    round
+                );
+            }
+        }
+        Ok(())
+    }
+
+    fn cell_sorted(pts: Vec<Vec3<f64>>, h: f64) -> Vec<Vec3<f64>> {
+        let perm = CellSorter::new()
+            .permutation(&pts, h, CellOrder::Lexicographic)
+            .unwrap()
+            .to_vec();
+        perm.iter().map(|&i| pts[i as usize]).collect()
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+        #[test]
+        fn passive_points_list_only_active_ones(
+            case in (cloud(600, 1.0), 0.05..0.6f64),
+            active_frac in 0.0..1.2f64,
+            sorted in any::<bool>(),
+            threads in 1usize..4,
+        ) {
+            let (pts, h) = case;
+            let active = (active_frac * pts.len() as f64) as usize;
+            let pts: Vec<Vec3<f64>> = to_r(&pts);
+            let pts = if sorted { cell_sorted(pts, h) } else { pts };
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| check::<f64>(&pts, h, active))?;
+            let p32: Vec<Vec3<f32>> = pts.iter().map(|p| p.map(|x| x as f32)).collect();
+            pool.install(|| check::<f32>(&p32, h as f32, active))?;
+        }
+
+        /// A wall of passive points on a lattice (ties at exactly `h`) under a cloud of
+        /// active ones, as a solver's boundary rows under its particles.
+        #[test]
+        fn a_passive_lattice_under_active_points(
+            side in 1usize..12,
+            cloud_pts in cloud(200, 0.5),
+            on_cells in any::<bool>(),
+        ) {
+            let h = 0.1;
+            let step = if on_cells { h * (1.0 + CELL_MARGIN) } else { h };
+            let mut pts: Vec<Vec3<f64>> = to_r(&cloud_pts);
+            let active = pts.len();
+            for i in 0..side {
+                for k in 0..side {
+                    for j in 0..3 {
+                        pts.push(Vec3::new(
+                            i as f64 * step - 0.5,
+                            -0.5 - j as f64 * step,
+                            k as f64 * step - 0.5,
+                        ));
+                    }
+                }
+            }
+            check::<f64>(&pts, h, active)?;
+        }
+    }
+}

@@ -174,11 +174,27 @@ impl<R: Real> StepNeighbours<R> {
     /// Finds the neighbours of `positions` within `h`, falling back to a hashed grid when the
     /// cell-start grid refuses the domain.
     pub fn find(&mut self, positions: &[Vec3<R>], h: R) -> Result<SearchStats, SearchError> {
-        match self.search.search(positions, h, &mut self.lists) {
+        self.find_active(positions, positions.len(), h)
+    }
+
+    /// [`StepNeighbours::find`] with the positions `active..` passive
+    /// ([`NeighbourSearch::search_active`]): they list only the positions `..active` (a
+    /// solver's boundary particles after its particles: no boundary–boundary pair, which no
+    /// sum reads), and are listed by them. `active >= positions.len()`: every pair.
+    pub fn find_active(
+        &mut self,
+        positions: &[Vec3<R>],
+        active: usize,
+        h: R,
+    ) -> Result<SearchStats, SearchError> {
+        match self
+            .search
+            .search_active(positions, active, h, &mut self.lists)
+        {
             Ok(()) => Ok(self.search.stats()),
             Err(SearchError::DomainTooLarge { .. }) => {
                 let fb = self.fallback.get_or_insert_with(HashedGrid::new);
-                fb.search(positions, h, &mut self.lists)?;
+                fb.search_active(positions, active, h, &mut self.lists)?;
                 Ok(fb.stats())
             }
             Err(e) => Err(e),
@@ -195,7 +211,20 @@ impl<R: Real> StepNeighbours<R> {
         at: StepAt,
         what: &str,
     ) -> Result<SearchStats, SolverError> {
-        self.find(positions, h).map_err(|e| match e {
+        self.find_active_in_step(positions, positions.len(), h, at, what)
+    }
+
+    /// [`StepNeighbours::find_active`] inside a step, with the errors of
+    /// [`StepNeighbours::find_in_step`].
+    pub fn find_active_in_step(
+        &mut self,
+        positions: &[Vec3<R>],
+        active: usize,
+        h: R,
+        at: StepAt,
+        what: &str,
+    ) -> Result<SearchStats, SolverError> {
+        self.find_active(positions, active, h).map_err(|e| match e {
             SearchError::NonFinitePosition { index, .. }
             | SearchError::CellCoordinateOverflow { index, .. } => blow_up(
                 at.solver,

@@ -102,7 +102,9 @@ pub struct Extrapolation<'a, R: Real, K: Kernel<R>> {
 
 /// The particle neighbours of each boundary particle (from the neighbour lists, in their
 /// order: the extrapolation's sums add in the same order as over the whole lists, whose
-/// other entries are boundary particles), rebuilt at each neighbour search, and their
+/// other entries, if the search listed them, are boundary particles; a search with the
+/// boundary particles passive, `StepNeighbours::find_active`, lists none), rebuilt at each
+/// neighbour search, and their
 /// Shepard weights `W_bf` and gravity terms `ρ_f (g·r_bf) W_bf`, computed once per step for
 /// both extrapolations of the step; and which boundary particles any particle's sum reads.
 #[derive(Debug, Clone, Default)]
@@ -111,6 +113,9 @@ pub struct BoundaryLists<R: Real> {
     /// of it): the boundary particles whose values a sum reads, the only ones
     /// [`extrapolate`] writes.
     read: Vec<bool>,
+    /// Whether chunk `c` (boundary particles `c · READ_CHUNK..`, [`READ_CHUNK`]) holds a
+    /// read one: the loops over the boundary particles skip the other chunks whole.
+    chunk_read: Vec<bool>,
     /// CSR offsets: boundary particle `k`'s entries are `start[k]..start[k + 1]`.
     start: Vec<usize>,
     /// The lists' entry (a particle or an image of one).
@@ -161,6 +166,9 @@ impl<R: Real> BoundaryLists<R> {
                 }
             }
         }
+        self.chunk_read.clear();
+        self.chunk_read
+            .extend(self.read.chunks(READ_CHUNK).map(|c| c.contains(&true)));
         let len = self.entry.len();
         self.weight.resize(len, R::zero());
         self.weighted_gravity.resize(len, R::zero());
@@ -170,6 +178,13 @@ impl<R: Real> BoundaryLists<R> {
     /// the last [`BoundaryLists::rebuild`]): [`extrapolate`] writes only those.
     pub fn is_read(&self, k: usize) -> bool {
         self.read.get(k).copied().unwrap_or(false)
+    }
+
+    /// Whether chunk `c` of [`READ_CHUNK`] boundary particles (`c · READ_CHUNK..`) holds
+    /// one [`BoundaryLists::is_read`]: a loop over the boundary particles by chunks skips
+    /// the others whole (most of a wall's, away from the material).
+    pub fn is_chunk_read(&self, c: usize) -> bool {
+        self.chunk_read.get(c).copied().unwrap_or(false)
     }
 
     /// The weights and gravity terms at the positions `e.x` (boundary particles from `n =
@@ -190,6 +205,12 @@ impl<R: Real> BoundaryLists<R> {
             });
     }
 }
+
+/// Boundary particles per chunk of [`BoundaryLists::is_chunk_read`].
+pub const READ_CHUNK: usize = 64;
+
+/// Chunks of [`READ_CHUNK`] handed to one rayon task ([`MIN_LEN`] particles).
+pub const CHUNKS_PER_TASK: usize = MIN_LEN / READ_CHUNK;
 
 /// A tensor a solver derives from each boundary particle's stress (e.g. the elastic–plastic
 /// solver's artificial stress), written by [`extrapolate`] beside it.
@@ -267,23 +288,128 @@ pub fn extrapolate<R: Real, K: Kernel<R>>(
                 *a = f(&s_b);
             }
         };
+    // By chunks of READ_CHUNK, those without a read boundary particle skipped whole.
+    let (c, read) = (READ_CHUNK, |k: usize| lists.is_chunk_read(k));
     match (v_tail, art_tail) {
         (Some(vt), None) => s_tail
-            .par_iter_mut()
-            .zip(vt.par_iter_mut())
+            .par_chunks_mut(c)
+            .zip(vt.par_chunks_mut(c))
             .enumerate()
-            .with_min_len(MIN_LEN)
-            .for_each(|(k, (sig, vel))| work(k, sig, Some(vel), None)),
+            .with_min_len(CHUNKS_PER_TASK)
+            .filter(|(k, _)| read(*k))
+            .for_each(|(k, (sig, vel))| {
+                for (e, (sig, vel)) in sig.iter_mut().zip(vel).enumerate() {
+                    work(k * c + e, sig, Some(vel), None);
+                }
+            }),
         (None, Some(at)) => s_tail
-            .par_iter_mut()
-            .zip(at.par_iter_mut())
+            .par_chunks_mut(c)
+            .zip(at.par_chunks_mut(c))
             .enumerate()
-            .with_min_len(MIN_LEN)
-            .for_each(|(k, (sig, a))| work(k, sig, None, Some(a))),
+            .with_min_len(CHUNKS_PER_TASK)
+            .filter(|(k, _)| read(*k))
+            .for_each(|(k, (sig, a))| {
+                for (e, (sig, a)) in sig.iter_mut().zip(a).enumerate() {
+                    work(k * c + e, sig, None, Some(a));
+                }
+            }),
         _ => s_tail
-            .par_iter_mut()
+            .par_chunks_mut(c)
             .enumerate()
-            .with_min_len(MIN_LEN)
-            .for_each(|(k, sig)| work(k, sig, None, None)),
+            .with_min_len(CHUNKS_PER_TASK)
+            .filter(|(k, _)| read(*k))
+            .for_each(|(k, sig)| {
+                for (e, sig) in sig.iter_mut().enumerate() {
+                    work(k * c + e, sig, None, None);
+                }
+            }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use neighbour_search::Method;
+    use sph_kernels::CubicSpline;
+
+    use super::*;
+    use crate::step::StepNeighbours;
+
+    /// A wall of 600 boundary particles along `x` (spacing 0.01 m, ten chunks) under two
+    /// clumps of particles, searched with the boundary particles passive: [`extrapolate`]
+    /// writes exactly the boundary particles [`BoundaryLists::is_read`] marks (their values
+    /// finite, the others left at the NaN they started with), a chunk is read exactly when
+    /// one of its particles is, and the read ones are those within the search radius of a
+    /// particle (counted here by distance). A chunk index off by one (planted once,
+    /// 2026-12-06) fails it.
+    #[test]
+    fn extrapolate_writes_exactly_the_read_boundary_particles() {
+        let (s, h) = (0.01f64, 0.02f64);
+        let mut x: Vec<Vec3<f64>> = Vec::new();
+        for (lo, count) in [(0.70, 12), (4.505, 30)] {
+            x.extend((0..count).map(|i| Vec3::new(lo + i as f64 * 0.007, 0.006, 0.0)));
+        }
+        let n = x.len();
+        let particles: Vec<BoundaryParticle<f64>> = (0..600)
+            .map(|k| BoundaryParticle {
+                position: Vec3::new(k as f64 * s, 0.0, 0.0),
+                normal: Vec3::new(0.0, 1.0, 0.0),
+                model: WallModel::NoSlip,
+                velocity: Vec3::zeros(),
+            })
+            .collect();
+        x.extend(particles.iter().map(|b| b.position));
+        let mut search = StepNeighbours::new(Method::CellStartGrid);
+        search.find_active(&x, n, h).unwrap();
+        assert!(search.lists().neighbours(n + 100).is_empty());
+        let images = PeriodicImages::default();
+        let mut lists = BoundaryLists::default();
+        lists.rebuild(search.lists(), &images, &x, n, particles.len());
+        let rho = vec![1000.0; n];
+        let e = Extrapolation {
+            kernel: CubicSpline::new(h).unwrap(),
+            images: &images,
+            x: &x,
+            rho: &rho,
+            particles: &particles,
+            gravity: Vec3::new(0.0, -9.81, 0.0),
+        };
+        lists.weigh(&e);
+        let mut stress: Vec<Matrix3<f64>> = (0..x.len())
+            .map(|i| Matrix3::identity() * -(i as f64))
+            .collect();
+        stress[n..].fill(Matrix3::from_element(f64::NAN));
+        let mut v = vec![Vec3::new(0.1, 0.0, 0.0); x.len()];
+        v[n..].fill(Vec3::from_element(f64::NAN));
+        extrapolate(&e, &lists, &mut stress, Some(&mut v), None);
+        // The other arm: the stress with a tensor derived from it, no velocity.
+        let mut stress2 = stress.clone();
+        stress2[n..].fill(Matrix3::from_element(f64::NAN));
+        let mut derived = vec![Matrix3::from_element(f64::NAN); x.len()];
+        let twice = |m: &Matrix3<f64>| m * 2.0;
+        extrapolate(&e, &lists, &mut stress2, None, Some((&mut derived, &twice)));
+        let mut read = 0;
+        for k in 0..particles.len() {
+            let near = x[..n]
+                .iter()
+                .any(|p| (p - particles[k].position).norm() < h);
+            assert_eq!(lists.is_read(k), near, "boundary particle {k}");
+            let written = stress[n + k].iter().all(|c| c.is_finite()) && v[n + k].x.is_finite();
+            assert_eq!(written, near, "boundary particle {k} written");
+            let derived_written = derived[n + k].iter().all(|c| c.is_finite());
+            assert_eq!(
+                derived_written, near,
+                "boundary particle {k}'s derived tensor"
+            );
+            if near {
+                assert_eq!(stress2[n + k], stress[n + k], "boundary particle {k}");
+            }
+            read += usize::from(near);
+        }
+        assert!(read > 0 && read < particles.len());
+        for c in 0..particles.len().div_ceil(READ_CHUNK) {
+            let any = (c * READ_CHUNK..((c + 1) * READ_CHUNK).min(particles.len()))
+                .any(|k| lists.is_read(k));
+            assert_eq!(lists.is_chunk_read(c), any, "chunk {c}");
+        }
     }
 }
