@@ -754,7 +754,6 @@ mod tests {
         assert_eq!(
             GrainLanes::new(&c, nb.lists(), 2, false).is_some(),
             std::arch::is_x86_feature_detected!("avx512f")
-                && std::arch::is_x86_feature_detected!("avx512vl")
         );
         assert!(GrainLanes::new(&c, nb.lists(), 2, true).is_none());
         let p64 = ElastoplasticParams::<f64>::for_spacing(0.02, 30.0);

@@ -8,10 +8,10 @@
 //! `f32` per particle, loaded with one 128-bit load per neighbour and transposed
 //! (`sph_solver::pair_lanes::avx512::packed`), never gathered (this AMD EPYC's gathers cost
 //! more than the rest of a pair: `perf annotate` put a quarter of the pressure sum's samples
-//! on the instruction waiting for the gather of `π_j`): the step's `[x, y, z, m]`
-//! (`Packed`, filled by the density pass), `[x, y, z, m π]` of the current pressure
-//! iterate (`π = p/ρ²`), `[v^adv, m]`, and the pressure accelerations `a_j` (3-vectors, by
-//! masked loads, `avx512::vectors`); the pair's cached `W'(r)/r` read contiguously.
+//! on the instruction waiting for the gather of `π_j`): the step's positions with
+//! `m π` of the current pressure iterate (`[x, y, z, m π]`, `π = p/ρ²`, written over the
+//! masses of the density pass's `Packed`), `[v^adv, m]` and the pressure accelerations
+//! `[a, m]`; the pair's cached `W'(r)/r` read contiguously.
 //!
 //! The pressure sum is taken as `Σ_j m_j (π_i + π_j) ∇W_ij = π_i G_i + Σ_j (m π)_j ∇W_ij`
 //! with `G_i = Σ_j m_j ∇W_ij` from the density pass, so that a neighbour's `m_j π_j` comes
@@ -73,7 +73,7 @@ impl PressureLanes {
         assert_eq!(gs.len(), list.len());
         #[cfg(target_arch = "x86_64")]
         {
-            // SAFETY: a PressureLanes exists only after avx512f/vl were detected, for lists of
+            // SAFETY: a PressureLanes exists only after avx512f was detected, for lists of
             // the packed particles (indices clamped below n inside); `gs` has the list's
             // length (asserted).
             let s = unsafe { avx512::pressure_sum(xp.values(), f32s(gs), i, list) };
@@ -180,9 +180,9 @@ mod avx512 {
     /// The lane sums `[−Σ_j (m π)_j ∇W_ij]` (three axes) of particle `i`.
     ///
     /// # Safety
-    /// avx512f and avx512vl; `xp` holds `4n` packed values, `i < n`; `gs` has the list's
+    /// avx512f; `xp` holds `4n` packed values, `i < n`; `gs` has the list's
     /// length.
-    #[target_feature(enable = "avx512f,avx512vl")]
+    #[target_feature(enable = "avx512f")]
     pub(super) unsafe fn pressure_sum(xp: &[f32], gs: &[f32], i: usize, list: &[u32]) -> [f32; 8] {
         let mut acc = [_mm512_setzero_ps(); 3];
         for s in (0..list.len()).step_by(16) {
@@ -201,9 +201,9 @@ mod avx512 {
     /// The lane sum `Σ_j m_j (a_i − a_j)·∇W_ij` of particle `i`.
     ///
     /// # Safety
-    /// avx512f and avx512vl; `xm` holds `4n` packed values, `a` `3n` coordinates, `i < n`;
+    /// avx512f; `xm` holds `4n` packed values, `a` `3n` coordinates, `i < n`;
     /// `gs` has the list's length.
-    #[target_feature(enable = "avx512f,avx512vl")]
+    #[target_feature(enable = "avx512f")]
     pub(super) unsafe fn a_dot(
         (xp, am): (&[f32], &[f32]),
         gs: &[f32],
@@ -226,9 +226,9 @@ mod avx512 {
     /// particle `i`.
     ///
     /// # Safety
-    /// avx512f and avx512vl; `xp` and `vm` hold `4n` packed values, `i < n`; `gs` has the
+    /// avx512f; `xp` and `vm` hold `4n` packed values, `i < n`; `gs` has the
     /// list's length.
-    #[target_feature(enable = "avx512f,avx512vl")]
+    #[target_feature(enable = "avx512f")]
     pub(super) unsafe fn divergence_pressure_sum(
         (xp, vm): (&[f32], &[f32]),
         gs: &[f32],
@@ -384,7 +384,7 @@ mod tests {
         }
     }
 
-    /// The lanes run wherever the processor has AVX-512 F and VL (so the property test
+    /// The lanes run wherever the processor has AVX-512 (so the property test
     /// above compares something there), and never for `f64`.
     #[test]
     fn pressure_lanes_run_on_avx512_for_f32_only() {
@@ -397,7 +397,6 @@ mod tests {
         assert_eq!(
             PressureLanes::new::<f32>(2, search.lists(), &[&xm]).is_some(),
             std::arch::is_x86_feature_detected!("avx512f")
-                && std::arch::is_x86_feature_detected!("avx512vl")
         );
         assert!(PressureLanes::new::<f32>(3, search.lists(), &[&xm]).is_none());
         let x64: Vec<Vec3<f64>> = x.iter().map(|p| p.cast()).collect();

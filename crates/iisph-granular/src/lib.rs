@@ -309,7 +309,7 @@
 //! Every parallel loop writes one particle's values and reduces in fixed chunks, so results
 //! are bitwise identical for any number of threads.
 //!
-//! In `f32` on a processor with AVX-512 (F and VL, detected at run time), the density pass
+//! In `f32` on a processor with AVX-512 (detected at run time), the density pass
 //! (`sph_solver::pair_lanes`) and the pressure passes (the predicted density with the warm
 //! start's accelerations, both halves of each Jacobi iteration, the forces) take sixteen
 //! pairs of one particle per instruction, every neighbour value loaded from arrays packed

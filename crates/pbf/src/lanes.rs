@@ -213,7 +213,7 @@ pub(crate) fn density_xsph<R: Real>(
 mod avx512 {
     use std::arch::x86_64::*;
 
-    use sph_solver::pair_lanes::avx512::{gather, pairs, sums, vectors};
+    use sph_solver::pair_lanes::avx512::{gather, pairs, sums};
 
     use super::LaneConsts;
 
@@ -339,8 +339,8 @@ mod avx512 {
     /// `[Σ m_j W, Σ (v_j − v_i)_x (m_j/ρ0) W, … y, … z]` (see `super::density_xsph`).
     ///
     /// # Safety
-    /// avx512f and avx512vl; `xm` holds `4n` packed values, `v` `3n` coordinates, `i < n`.
-    #[target_feature(enable = "avx512f,avx512vl")]
+    /// avx512f; `xm` holds `4n` packed values, `v` `3n` coordinates, `i < n`.
+    #[target_feature(enable = "avx512f")]
     pub(super) unsafe fn density_xsph(
         c: &LaneConsts,
         (xm, v): (&[f32], &[f32]),
@@ -357,12 +357,12 @@ mod avx512 {
             let mj = p.mj;
             let w = poly6(c, p.r2);
             acc[0] = _mm512_mask_add_ps(acc[0], p.live, acc[0], _mm512_mul_ps(mj, w));
-            // (v_j − v_i) ((m_j/ρ0) W); v_j by sixteen masked 128-bit loads and a
-            // transpose, not three gathers (slow on this AMD EPYC).
+            // (v_j − v_i) ((m_j/ρ0) W).
             let weight = _mm512_mul_ps(_mm512_mul_ps(mj, inv_rho0), w);
-            let vj = vectors(v, i, list, s);
+            let j3 = _mm512_mullo_epi32(p.j, _mm512_set1_epi32(3));
             for a in 0..3 {
-                let t = _mm512_mul_ps(_mm512_sub_ps(vj[a], vi[a]), weight);
+                let vj = _mm512_mask_i32gather_ps::<4>(zero, p.live, j3, v.as_ptr().add(a).cast());
+                let t = _mm512_mul_ps(_mm512_sub_ps(vj, vi[a]), weight);
                 acc[1 + a] = _mm512_mask_add_ps(acc[1 + a], p.live, acc[1 + a], t);
             }
         }
@@ -549,7 +549,6 @@ mod tests {
         assert_eq!(
             LaneConsts::new(&c, 2, nb.lists()).is_some(),
             std::arch::is_x86_feature_detected!("avx512f")
-                && std::arch::is_x86_feature_detected!("avx512vl")
         );
         let c64 = Consts::new(&PbfParams::<f64>::default()).unwrap();
         let x64: Vec<Vec3<f64>> = x.iter().map(|p| p.cast()).collect();

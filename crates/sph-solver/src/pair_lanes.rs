@@ -56,16 +56,14 @@ pub fn coords<R: Real>(v: &[Vec3<R>]) -> &[f32] {
 }
 
 /// Whether the `f32` lanes can run on `n` particles with these lists: `R` is `f32`, the
-/// processor has AVX-512 F and VL (detected at run time; VL for [`avx512::vectors`]'s
-/// masked 128-bit loads), and the lists are of `n` particles with
+/// processor has AVX-512 (detected at run time), and the lists are of `n` particles with
 /// pair and coordinate indices that fit the gathers' 32-bit offsets.
 pub fn lanes_available<R: Real>(n: usize, nb: &NeighbourLists) -> bool {
     if TypeId::of::<R>() != TypeId::of::<f32>() {
         return false;
     }
     #[cfg(target_arch = "x86_64")]
-    let detected = std::arch::is_x86_feature_detected!("avx512f")
-        && std::arch::is_x86_feature_detected!("avx512vl");
+    let detected = std::arch::is_x86_feature_detected!("avx512f");
     #[cfg(not(target_arch = "x86_64"))]
     let detected = false;
     detected
@@ -390,39 +388,6 @@ pub mod avx512 {
         ]
     }
 
-    /// The neighbours' 3-vectors `v_j` of the pairs `list[s..s + 16]` of particle `i` (its
-    /// own vector past the list's end), from `v` stored as `3n` coordinates (nalgebra's
-    /// `Vector3<f32>` array, [`super::coords`]): per axis, element `e` is neighbour `e`'s
-    /// component. Sixteen masked 128-bit loads of three elements (no read past the array's
-    /// end: a masked-out element is not accessed) and the transpose of [`pairs`], instead of
-    /// three gathers (slow on this AMD EPYC). Always inlined, as [`pairs`].
-    ///
-    /// # Safety
-    /// avx512f and avx512vl (the caller must be compiled with both); `v` holds `3n` values,
-    /// `i < n`, `s < list.len()`.
-    #[inline(always)]
-    pub unsafe fn vectors(v: &[f32], i: usize, list: &[u32], s: usize) -> [__m512; 3] {
-        let left = list.len() - s;
-        let last = (v.len() / 3).saturating_sub(1);
-        let at = |k: usize| {
-            if k < left {
-                (*list.get_unchecked(s + k) as usize).min(last)
-            } else {
-                i
-            }
-        };
-        let p = v.as_ptr();
-        let mut z = [_mm512_setzero_ps(); 4];
-        for (r, zr) in z.iter_mut().enumerate() {
-            let v = _mm512_castps128_ps512(_mm_maskz_loadu_ps(0b0111, p.add(3 * at(r))));
-            let v = _mm512_insertf32x4::<1>(v, _mm_maskz_loadu_ps(0b0111, p.add(3 * at(4 + r))));
-            let v = _mm512_insertf32x4::<2>(v, _mm_maskz_loadu_ps(0b0111, p.add(3 * at(8 + r))));
-            *zr = _mm512_insertf32x4::<3>(v, _mm_maskz_loadu_ps(0b0111, p.add(3 * at(12 + r))));
-        }
-        let [a, b, c, _] = transpose(z);
-        [a, b, c]
-    }
-
     /// `_mm512_reduce_add_ps` of each of up to eight accumulators (0 past `N`), returned
     /// as one 256-bit vector's elements.
     ///
@@ -668,7 +633,6 @@ mod tests {
         assert_eq!(
             CubicLanes::new(&CubicSpline::new(2.0f32).unwrap(), 2, nb.lists()).is_some(),
             std::arch::is_x86_feature_detected!("avx512f")
-                && std::arch::is_x86_feature_detected!("avx512vl")
         );
         let x64: Vec<Vec3<f64>> = x.iter().map(|p| p.cast()).collect();
         let mut nb64 = StepNeighbours::new(Method::CellStartGrid);
