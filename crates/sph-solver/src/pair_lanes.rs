@@ -87,17 +87,7 @@ impl Packed {
     /// When `R` is not `f32` or the lengths differ.
     pub fn fill<R: Real>(&mut self, x: &[Vec3<R>], m: &[R]) {
         assert_eq!(x.len(), m.len(), "one mass per position");
-        self.xyzm.resize(4 * x.len(), 0.0);
-        let (xf, mf) = (coords(x), f32s(m));
-        self.xyzm
-            .par_chunks_mut(4 * 1024)
-            .enumerate()
-            .for_each(|(b, chunk)| {
-                for (l, p) in chunk.chunks_exact_mut(4).enumerate() {
-                    let i = 1024 * b + l;
-                    p.copy_from_slice(&[xf[3 * i], xf[3 * i + 1], xf[3 * i + 2], mf[i]]);
-                }
-            });
+        self.fill_with(x, |i| m[i]);
     }
 
     /// Packs `x` with a fourth value `w(i)` per particle (`[x, y, z, w]`), in parallel: a

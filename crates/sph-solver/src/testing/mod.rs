@@ -12,6 +12,30 @@ use sph_core::{
 
 use crate::{CommonParams, FluidSolver, Solids, SolverError};
 
+/// Whether two `f32` sums of the same `n` terms taken in different orders, `a` (the lanes')
+/// and `b` (the scalar loop's), agree within `2 γ_n Σ|t_k|` (`abs_sum`), `γ_n = n u /
+/// (1 − n u)`, `u = 2⁻²⁴`: each is within `γ_n Σ|t_k|` of the exact sum whatever its order
+/// (Higham 2002, *Accuracy and Stability of Numerical Algorithms*, §3.1 and §4.2). `Err`
+/// names `what` with the figures.
+pub fn reordered_sums_agree(
+    what: &str,
+    a: f32,
+    b: f32,
+    n: usize,
+    abs_sum: f64,
+) -> Result<(), String> {
+    let nu = n as f64 * f64::from(f32::EPSILON) / 2.0;
+    let bound = 2.0 * nu / (1.0 - nu) * abs_sum;
+    let diff = (f64::from(a) - f64::from(b)).abs();
+    if diff <= bound {
+        Ok(())
+    } else {
+        Err(format!(
+            "{what}: lanes {a} scalar {b} differ by {diff} > {bound}"
+        ))
+    }
+}
+
 /// A fluid block of `n = [nx, ny, nz]` particles at spacing `s`, at rest in the corner
 /// `(0, 0, 0)` of a tank of `tank = [tx, ty, tz]` spacings (an `Inverted<BoxSdf>`), with
 /// masses `ρ0 s³`. The particles start `s/2` from the walls, i.e. touching them.
