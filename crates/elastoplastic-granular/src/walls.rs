@@ -46,6 +46,12 @@ impl<R: Real> Boundary<R> for SharedWalls<R> {
     fn contact_distance(&self) -> R {
         self.0.contact_distance()
     }
+    fn contact_guard(&self) -> Option<sph_solver::ContactGuard<R>> {
+        self.0.contact_guard()
+    }
+    fn volume_reach(&self) -> Option<f64> {
+        self.0.volume_reach()
+    }
     fn closest(&self, x: &Vec3<R>) -> Option<ClosestPoint<R>> {
         self.0.closest(x)
     }

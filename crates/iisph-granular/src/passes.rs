@@ -540,19 +540,33 @@ pub(crate) fn forces_pass<R: Real>(
         &s.v_trial[..],
     );
     let inv_dt = R::one() / c.dt;
+    let guard = boundary.contact_guard();
+    let cache = &s.end_samples;
     s.x_new
         .par_iter_mut()
         .zip(s.v_new.par_iter_mut())
+        .zip(s.clearance.par_iter_mut())
         .enumerate()
         .with_min_len(MIN_LEN)
-        .for_each(|(i, (xn, vn))| {
+        .for_each(|(i, ((xn, vn), cl))| {
             let v_new = if c.granular {
                 vt[i]
             } else {
                 va[i] + step.pressure_accel(c, pi, bgrad, i) * c.dt
             };
             let y = x[i] + v_new * c.dt;
-            let projected = boundary.project(y);
+            let projected = match &guard {
+                // From the distance at `x_i` (the last step's, or evaluated here): the
+                // solids are evaluated at `y` only where the move may reach them.
+                Some(g) => {
+                    *cl = match cache.distance(i, &x[i]) {
+                        Some(d) => d,
+                        None => g.evaluate(boundary, &x[i]),
+                    };
+                    g.project(boundary, cl, &x[i], y)
+                }
+                None => boundary.project(y),
+            };
             let push = projected - y;
             let mut v_out = v_new + push * inv_dt;
             if c.granular {

@@ -54,6 +54,9 @@ pub(crate) struct Scratch<R: Real> {
     pub perm_vec: Vec<Vec3<R>>,
     pub x_new: Vec<Vec3<R>>,
     pub v_new: Vec<Vec3<R>>,
+    /// A lower bound on each particle's distance to the solids at `x_new`
+    /// ([`sph_solver::ContactGuard`]; written only when the boundary has a guard).
+    pub clearance: Vec<R>,
     pub density_new: Vec<R>,
     /// Partial sums of the density error per chunk of [`REDUCE_CHUNK`] particles.
     pub error_partials: Vec<f64>,
@@ -83,27 +86,65 @@ pub(crate) struct SampleCache<R: Real> {
     positions: Vec<Vec3<R>>,
     /// The boundary's sample at each.
     samples: Vec<BoundarySample<R>>,
+    /// The distance to the solids at each ([`Boundary::distance`]; filled only when the
+    /// boundary has a contact guard, else empty).
+    distances: Vec<R>,
 }
 
 impl<R: Real> SampleCache<R> {
-    /// Samples `boundary` at every position of `x`, in parallel, replacing the entries.
+    /// Samples `boundary` at every position of `x`, in parallel, replacing the entries; with
+    /// a contact guard, the distances to the solids too (the next step's contact response
+    /// starts from them), and positions beyond [`Boundary::volume_reach`] from every solid
+    /// take the zero sample without a query (the same bits).
     pub(crate) fn fill(&mut self, x: &[Vec3<R>], boundary: &dyn Boundary<R>) {
         self.positions.clear();
         self.positions.extend_from_slice(x);
         self.samples.resize(x.len(), BoundarySample::default());
-        self.samples
-            .par_iter_mut()
-            .zip(x.par_iter())
-            .with_min_len(MIN_LEN)
-            .for_each(|(s, p)| *s = boundary.sample(p));
+        if boundary.contact_guard().is_some() {
+            self.distances.resize(x.len(), R::zero());
+            self.samples
+                .par_iter_mut()
+                .zip(self.distances.par_iter_mut())
+                .zip(x.par_iter())
+                .with_min_len(MIN_LEN)
+                .for_each(|((s, d), p)| {
+                    let (distance, beyond) = boundary.distance_beyond_reach(p);
+                    *d = distance;
+                    *s = if beyond {
+                        BoundarySample::default()
+                    } else {
+                        boundary.sample(p)
+                    };
+                });
+        } else {
+            self.distances.clear();
+            self.samples
+                .par_iter_mut()
+                .zip(x.par_iter())
+                .with_min_len(MIN_LEN)
+                .for_each(|(s, p)| *s = boundary.sample(p));
+        }
+    }
+
+    /// The distance to the solids of particle `i` if it was evaluated at `x` exactly.
+    #[inline]
+    pub(crate) fn distance(&self, i: usize, x: &Vec3<R>) -> Option<R> {
+        let d = *self.distances.get(i)?;
+        self.same_position(i, x).then_some(d)
+    }
+
+    /// Whether entry `i` was taken at `x` exactly (the same bits).
+    #[inline]
+    fn same_position(&self, i: usize, x: &Vec3<R>) -> bool {
+        self.positions
+            .get(i)
+            .is_some_and(|at| (0..3).all(|a| at[a].as_f64().to_bits() == x[a].as_f64().to_bits()))
     }
 
     /// The sample of particle `i` if it was taken at `x` exactly (the same bits).
     #[inline]
     pub(crate) fn get(&self, i: usize, x: &Vec3<R>) -> Option<BoundarySample<R>> {
-        let at = self.positions.get(i)?;
-        let same = (0..3).all(|a| at[a].as_f64().to_bits() == x[a].as_f64().to_bits());
-        same.then(|| self.samples[i])
+        self.same_position(i, x).then(|| self.samples[i])
     }
 
     /// The samples, one per position of the last [`SampleCache::fill`].
@@ -140,6 +181,7 @@ impl<R: Real> Scratch<R> {
         self.v_trial.resize(ng, z);
         self.x_new.resize(n, z);
         self.v_new.resize(n, z);
+        self.clearance.resize(n, R::zero());
         self.density_new.resize(n, R::zero());
         self.error_partials.resize(n.div_ceil(REDUCE_CHUNK), 0.0);
     }

@@ -9,7 +9,7 @@ use sph_core::{apply_permutation, ParticleSet, Real, Vec3};
 use sph_kernels::KernelKind;
 use sph_solver::density_lanes::densities_at;
 use sph_solver::state::match_arrays;
-use sph_solver::step::{check_divergence, FramePhases, StepAt};
+use sph_solver::step::{check_divergence_cleared, FramePhases, StepAt};
 use sph_solver::{ArraySpec, FrameSolver, SchemeParts, SolverError, StepStats, SubstepScheme};
 
 use crate::friction;
@@ -489,7 +489,9 @@ impl<R: Real> IisphScheme<R> {
                 None => s.end_samples.clear(),
             }
         }
-        check_divergence(at, &s.x_new, &s.v_new, &*self.parts.boundary, h)?;
+        let boundary = &*self.parts.boundary;
+        let bounds = boundary.contact_guard().map(|_| &s.clearance[..]);
+        check_divergence_cleared(at, &s.x_new, &s.v_new, boundary, h, bounds)?;
         state.positions.copy_from_slice(&s.x_new);
         state.velocities.copy_from_slice(&s.v_new);
         if last {

@@ -6,7 +6,7 @@ use sph_core::{Real, Vec3};
 use sph_kernels::Kernel;
 use sph_solver::pair_lanes::Packed;
 use sph_solver::step::MIN_LEN;
-use sph_solver::Boundary;
+use sph_solver::{Boundary, ContactGuard};
 
 use crate::kernels::Consts;
 use crate::lanes::{self, LambdaSums, LaneConsts};
@@ -62,22 +62,29 @@ pub(crate) struct PassInput<'a, R: Real> {
     pub lanes: Option<LaneConsts>,
 }
 
-/// Which particles a volume boundary can reach during one step's Jacobi iterations: those
-/// closer than `1.5 h` to a solid at the predicted positions. Farther particles have
-/// `Ψ = 0` unless an iteration moves them by more than `h/2` (the iterations' corrections
-/// are a small fraction of the spacing; a move of `h/2` is a blow-up), so the solve skips
-/// their boundary samples (on SPlisHSPlasH's dam break, 85 % of the particles).
+/// Each particle's distance to the solids at the predicted positions `x` (`clearance`, the
+/// bound [`ContactGuard`] carries through the iterations), and which particles a volume
+/// boundary can reach during one step's Jacobi iterations: those closer than `1.5 h`.
+/// Farther particles have `Ψ = 0` unless an iteration moves them by more than `h/2` (the
+/// iterations' corrections are a small fraction of the spacing; a move of `h/2` is a
+/// blow-up), so the solve skips their boundary samples (on SPlisHSPlasH's dam break, 85 % of
+/// the particles).
 pub(crate) fn near_boundary<R: Real>(
     boundary: &dyn Boundary<R>,
     x: &[Vec3<R>],
     h: R,
+    clearance: &mut [R],
     near: &mut [bool],
 ) {
     let reach = h * R::of_f64(1.5);
     near.par_iter_mut()
+        .zip(clearance.par_iter_mut())
         .zip(x.par_iter())
         .with_min_len(MIN_LEN)
-        .for_each(|(n, xi)| *n = boundary.distance(xi) < reach);
+        .for_each(|((n, c), xi)| {
+            *c = boundary.distance(xi);
+            *n = *c < reach;
+        });
 }
 
 /// Per-particle outputs of [`lambda_pass`].
@@ -276,13 +283,18 @@ pub(crate) fn delta_sum<R: Real>(
 /// Eqs. 13 and 14, then the boundary's contact response: `delta_p` receives `Δp_i` (with
 /// the boundary term `λ_i ∇Ψ_i` of a volume boundary), `next` the corrected position
 /// `x_i + Δp_i` after [`Boundary::project`]. Reads the pair cache written by
-/// [`lambda_pass`] at the same positions.
+/// [`lambda_pass`] at the same positions. With a guard in `contact`, whose slice holds the
+/// particles' distance bounds at `x`, the response is called only where the bound does not
+/// prove it a no-op (the same positions; the bounds carried to `next`); without one the
+/// slice (one entry per particle) is not read.
+#[allow(clippy::too_many_arguments)] // the pass's inputs and outputs
 pub(crate) fn delta_pass<R: Real>(
     input: PassInput<'_, R>,
     lambda: &[R],
     boundary_grad: &[Vec3<R>],
     cache: &PairCache<R>,
     boundary: &dyn Boundary<R>,
+    contact: (Option<ContactGuard<R>>, &mut [R]),
     delta_p: &mut [Vec3<R>],
     next: &mut [Vec3<R>],
 ) {
@@ -297,12 +309,15 @@ pub(crate) fn delta_pass<R: Real>(
     let half_unit = R::of_f64(0.5) * c.scorr_unit;
     let offsets = nb.offsets();
     let with_volume = volume.is_some();
+    let (guard, clearance) = contact;
+    assert_eq!(clearance.len(), x.len(), "one distance bound per particle");
     delta_p
         .par_iter_mut()
         .zip(next.par_iter_mut())
+        .zip(clearance.par_iter_mut())
         .enumerate()
         .with_min_len(MIN_LEN)
-        .for_each(|(i, (dp, xn))| {
+        .for_each(|(i, ((dp, xn), cl))| {
             let (a, b) = (offsets[i], offsets[i + 1]);
             let pair_cache = (&cache.grad_factor[a..b], &cache.scorr[a..b]);
             let acc = match &lanes {
@@ -316,6 +331,9 @@ pub(crate) fn delta_pass<R: Real>(
                 d += boundary_grad[i] * lambda[i];
             }
             *dp = d;
-            *xn = boundary.project(x[i] + d);
+            *xn = match &guard {
+                Some(g) => g.project(boundary, cl, &x[i], x[i] + d),
+                None => boundary.project(x[i] + d),
+            };
         });
 }

@@ -16,6 +16,9 @@ pub struct PbfScratch<R: Real> {
     pub(crate) density: Vec<R>,
     pub(crate) boundary_grad: Vec<Vec3<R>>,
     pub(crate) near_boundary: Vec<bool>,
+    /// A lower bound on each particle's distance to the solids, carried through the Jacobi
+    /// iterations ([`sph_solver::ContactGuard`]).
+    pub(crate) clearance: Vec<R>,
     pub(crate) velocity: Vec<Vec3<R>>,
     pub(crate) velocity_new: Vec<Vec3<R>>,
     pub(crate) vorticity: Vec<Vec3<R>>,
@@ -36,6 +39,7 @@ impl<R: Real> PbfScratch<R> {
         self.density.resize(n, R::zero());
         self.boundary_grad.resize(n, z);
         self.near_boundary.resize(n, false);
+        self.clearance.resize(n, R::zero());
         self.velocity.resize(n, z);
         self.velocity_new.resize(n, z);
         self.vorticity.resize(n, z);

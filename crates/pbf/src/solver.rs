@@ -9,7 +9,7 @@ use sph_core::{validate_finite_positions, CoreError, ParticleSet, Real, Vec3};
 use sph_kernels::{Kernel, KernelKind};
 use sph_solver::boundary::check_volume_kernel;
 use sph_solver::step::{
-    check_divergence, check_masses, check_predicted, FramePhases, StepAt, MIN_LEN,
+    check_divergence_cleared, check_masses, check_predicted, FramePhases, StepAt, MIN_LEN,
 };
 use sph_solver::{Boundary, FrameSolver, SchemeParts, SolverError, StepStats, SubstepScheme};
 
@@ -195,6 +195,7 @@ impl<R: Real> PbfScheme<R> {
                 b,
                 &s.predicted,
                 self.params.common.support_radius,
+                &mut s.clearance,
                 &mut s.near_boundary,
             );
         }
@@ -220,6 +221,7 @@ impl<R: Real> PbfScheme<R> {
             &s.boundary_grad,
             &s.pairs,
             &*self.parts.boundary,
+            (None, &mut s.clearance),
             &mut s.delta_p,
             &mut s.next,
         );
@@ -278,8 +280,18 @@ impl<R: Real> PbfScheme<R> {
 
         // Lines 8–19: Jacobi iterations with the contact response.
         let t = Instant::now();
-        if let Some(b) = volume {
-            near_boundary(b, &s.predicted, h, &mut s.near_boundary);
+        // Distances at the predicted positions: the volume's reach and the contact guard's
+        // bounds (the contact response and the divergence check then evaluate the solids
+        // only for the particles near them).
+        let guard = boundary.contact_guard();
+        if volume.is_some() || guard.is_some() {
+            near_boundary(
+                boundary,
+                &s.predicted,
+                h,
+                &mut s.clearance,
+                &mut s.near_boundary,
+            );
         }
         let reach = volume.map(|b| (b, &s.near_boundary[..]));
         let lanes = LaneConsts::new(&c, state.len(), nb);
@@ -306,6 +318,7 @@ impl<R: Real> PbfScheme<R> {
                 &s.boundary_grad,
                 &s.pairs,
                 boundary,
+                (guard, &mut s.clearance),
                 &mut s.delta_p,
                 &mut s.next,
             );
@@ -349,7 +362,8 @@ impl<R: Real> PbfScheme<R> {
         let x = &s.predicted[..];
 
         // Divergence checks before anything is written to the state.
-        check_divergence(at, x, &s.velocity_new, boundary, h)?;
+        let bounds = guard.map(|_| &s.clearance[..]);
+        check_divergence_cleared(at, x, &s.velocity_new, boundary, h, bounds)?;
         state.positions.copy_from_slice(x);
         state.velocities.copy_from_slice(&s.velocity_new);
         state.densities.copy_from_slice(&s.density);

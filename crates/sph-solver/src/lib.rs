@@ -79,7 +79,7 @@ pub mod testing;
 
 pub use boundary::{
     half_space_volume, half_space_volume_derivative, Boundary, BoundarySample, ClosestPoint,
-    CollisionBoundary, Interpolation, VolumeMap, VolumeMapBoundary, VolumeMapBuild,
+    CollisionBoundary, ContactGuard, Interpolation, VolumeMap, VolumeMapBoundary, VolumeMapBuild,
     VolumeMapOptions, VolumeMapStats,
 };
 pub use cone_match::ConeMatch;

@@ -103,6 +103,16 @@ pub fn first_where<T: Sync>(items: &[T], bad: impl Fn(&T) -> bool + Sync) -> Opt
     items[first..].iter().position(bad).map(|k| first + k)
 }
 
+/// [`first_where`] over the indices `0..len`: the first `i` for which `bad(i)` holds.
+pub fn first_index_where(len: usize, bad: impl Fn(usize) -> bool + Sync) -> Option<usize> {
+    let chunks = len.div_ceil(REDUCE_CHUNK);
+    let chunk = (0..chunks).into_par_iter().position_first(|c| {
+        let end = ((c + 1) * REDUCE_CHUNK).min(len);
+        (c * REDUCE_CHUNK..end).fold(false, |any, i| any | bad(i))
+    })?;
+    (chunk * REDUCE_CHUNK..len).find(|&i| bad(i))
+}
+
 /// Finite, positive masses ([`SolverError::InvalidMass`] naming the first other one).
 pub fn check_masses<R: Real>(masses: &[R]) -> Result<(), SolverError> {
     match first_where(masses, |&m| !(m.is_finite_value() && m > R::zero())) {
@@ -303,6 +313,21 @@ pub fn check_divergence<R: Real>(
     boundary: &dyn Boundary<R>,
     h: R,
 ) -> Result<(), SolverError> {
+    check_divergence_cleared(at, x, v, boundary, h, None)
+}
+
+/// [`check_divergence`], with each particle's lower bound on its distance to the solids
+/// (`clearance`, one per position; see [`crate::boundary::ContactGuard`]): a particle whose
+/// bound is at least `−h` cannot be more than `h` inside a solid, so its distances are not
+/// evaluated. The same verdict and the same error as [`check_divergence`].
+pub fn check_divergence_cleared<R: Real>(
+    at: StepAt,
+    x: &[Vec3<R>],
+    v: &[Vec3<R>],
+    boundary: &dyn Boundary<R>,
+    h: R,
+    clearance: Option<&[R]>,
+) -> Result<(), SolverError> {
     let first_x = first_where(x, any_non_finite);
     let first_v = first_where(v, any_non_finite);
     if let Some(i) = first_x.into_iter().chain(first_v).min() {
@@ -321,9 +346,17 @@ pub fn check_divergence<R: Real>(
         return Ok(());
     }
     let margin = -h;
-    if let Some(i) = first_where(x, |xi| {
-        solids.iter().any(|sd| sd.signed_distance(xi) < margin)
-    }) {
+    let inside = |xi: &Vec3<R>| solids.iter().any(|sd| sd.signed_distance(xi) < margin);
+    let first = match clearance {
+        Some(c) => {
+            assert_eq!(c.len(), x.len(), "one distance bound per position");
+            // A NaN bound proves nothing: evaluated.
+            let cleared = |i: usize| c[i] >= margin;
+            first_index_where(x.len(), |i| !cleared(i) && inside(&x[i]))
+        }
+        None => first_where(x, inside),
+    };
+    if let Some(i) = first {
         let (k, d) = solids
             .iter()
             .enumerate()

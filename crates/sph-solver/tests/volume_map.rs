@@ -696,3 +696,52 @@ fn a_cancelled_build_stops_and_names_the_solid() {
         "the build ended before the flag was set"
     );
 }
+
+/// `Boundary::volume_reach`: wherever every solid's distance, as evaluated in `f32`, is at
+/// least the reach, `sample` is the zero sample bit for bit (a tank and a sphere inside
+/// it, one map each, on a lattice of positions through the walls' bands and the sphere's);
+/// and the distance returned is `Boundary::distance`. The oracle is `sample` itself.
+#[test]
+fn samples_beyond_the_volume_reach_are_zero() {
+    let h = 0.1f32;
+    let domain = Aabb::new(Vec3::repeat(-0.1f32), Vec3::new(1.1, 0.8, 0.6)).unwrap();
+    let tank = Aabb::new(Vec3::zeros(), Vec3::new(1.0, 0.7, 0.5)).unwrap();
+    let solids: Vec<Box<dyn Sdf<f32>>> = vec![
+        Box::new(Inverted(BoxSdf::new(tank).unwrap())),
+        Box::new(Sphere::new(Vec3::new(0.6, 0.3, 0.25), 0.12).unwrap()),
+    ];
+    let o = VolumeMapOptions::default();
+    let b = VolumeMapBoundary::new(solids, KernelKind::CubicSpline, h, domain, 0.0, o).unwrap();
+    let reach = b.volume_reach().expect("volume maps promise a reach");
+    assert!((reach - f64::from(h)).abs() <= 1e-6 * f64::from(h));
+    let (mut beyond_count, mut inside_count) = (0, 0);
+    let steps = 48;
+    for i in 0..=steps {
+        for j in 0..=steps {
+            for k in [0.02f32, 0.13, 0.25] {
+                let x = Vec3::new(
+                    -0.05 + 1.1 * i as f32 / steps as f32,
+                    -0.05 + 0.8 * j as f32 / steps as f32,
+                    k,
+                );
+                let (d, beyond) = b.distance_beyond_reach(&x);
+                assert_eq!(d.to_bits(), b.distance(&x).to_bits());
+                let s = b.sample(&x);
+                if beyond {
+                    beyond_count += 1;
+                    assert_eq!(s.volume.to_bits(), 0f32.to_bits(), "{x:?}");
+                    for a in 0..3 {
+                        assert_eq!(s.volume_gradient[a].to_bits(), 0f32.to_bits(), "{x:?}");
+                    }
+                } else if s.volume > 0.0 {
+                    inside_count += 1;
+                }
+            }
+        }
+    }
+    // Both kinds of position occur (the check is not vacuous).
+    assert!(
+        beyond_count > 500 && inside_count > 500,
+        "{beyond_count} {inside_count}"
+    );
+}

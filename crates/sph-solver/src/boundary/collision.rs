@@ -69,4 +69,11 @@ impl<R: Real> Boundary<R> for CollisionBoundary<R> {
     fn contact_distance(&self) -> R {
         self.contact_distance
     }
+    /// The walls sample nothing anywhere.
+    fn volume_reach(&self) -> Option<f64> {
+        Some(f64::NEG_INFINITY)
+    }
+    fn contact_guard(&self) -> Option<super::ContactGuard<R>> {
+        super::ContactGuard::for_solids(&self.solids, self.contact_distance)
+    }
 }

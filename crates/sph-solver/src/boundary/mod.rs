@@ -13,11 +13,13 @@
 //! lattice ([`particles`]: solids' walls, moving walls, blocks) and the extrapolation of
 //! their stress and velocity with a wall model per particle ([`wall_extrapolation`]).
 
+mod clearance;
 mod collision;
 pub mod particles;
 pub mod volume_map;
 pub mod wall_extrapolation;
 
+pub use clearance::ContactGuard;
 pub use collision::CollisionBoundary;
 pub use particles::{
     boundary_block, BoundaryParticle, WallLattice, MAX_BOUNDARY_LATTICE_NODES,
@@ -93,6 +95,36 @@ pub trait Boundary<R: Real>: Send + Sync {
     /// The nearest solid surface (`None` without solids).
     fn closest(&self, x: &Vec3<R>) -> Option<ClosestPoint<R>> {
         closest_of(self.solids(), x)
+    }
+    /// The guard that lets a solver skip [`Boundary::project`] where a particle's distance
+    /// bound proves it a no-op ([`ContactGuard`]); `Some` only when `project` is
+    /// [`project_out`] over [`Boundary::solids`] at [`Boundary::contact_distance`] and the
+    /// solids declare Lipschitz bounds. The default, `None`: every position is projected.
+    fn contact_guard(&self) -> Option<ContactGuard<R>> {
+        None
+    }
+    /// A distance (m) at or beyond which [`Boundary::sample`] is exactly zero: a position
+    /// whose signed distance to every solid, as evaluated, is at least this samples `Ψ = 0`,
+    /// `∇Ψ = 0` (the same bits as [`BoundarySample::default`]). `None` (the default): no
+    /// such promise.
+    fn volume_reach(&self) -> Option<f64> {
+        None
+    }
+    /// [`Boundary::distance`] at `x`, and whether `x` is at or beyond
+    /// [`Boundary::volume_reach`] from every solid (so that [`Boundary::sample`] is zero
+    /// there), from one evaluation of each solid's distance. A NaN distance is never beyond.
+    fn distance_beyond_reach(&self, x: &Vec3<R>) -> (R, bool) {
+        let reach = self.volume_reach();
+        let mut nearest = R::of_f64(f64::INFINITY);
+        let mut beyond = reach.is_some();
+        for s in self.solids() {
+            let d = s.signed_distance(x);
+            if d < nearest {
+                nearest = d;
+            }
+            beyond &= reach.is_some_and(|r| d.as_f64() >= r);
+        }
+        (nearest, beyond)
     }
     /// The smallest signed distance from `x` to the solids (m; `+∞` without solids).
     fn distance(&self, x: &Vec3<R>) -> R {

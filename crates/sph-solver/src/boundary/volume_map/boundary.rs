@@ -270,4 +270,17 @@ impl<R: Real> Boundary<R> for VolumeMapBoundary<R> {
     fn contact_distance(&self) -> R {
         self.contact_distance
     }
+    /// Each map samples zero where its solid's distance is at least its support radius
+    /// (`VolumeMap::sample`); the largest of them.
+    fn volume_reach(&self) -> Option<f64> {
+        Some(
+            self.maps
+                .iter()
+                .map(VolumeMap::support_radius)
+                .fold(f64::NEG_INFINITY, f64::max),
+        )
+    }
+    fn contact_guard(&self) -> Option<crate::boundary::ContactGuard<R>> {
+        crate::boundary::ContactGuard::for_solids(&self.solids, self.contact_distance)
+    }
 }
