@@ -19,7 +19,7 @@
 use neighbour_search::NeighbourLists;
 use sph_core::{Real, Vec3};
 use sph_kernels::Kernel;
-use sph_solver::pair_lanes::{coords, f32s, f32s_mut, lanes_available, Packed};
+use sph_solver::pair_lanes::{f32s, f32s_mut, lanes_available, Packed};
 
 use crate::kernels::Consts;
 
@@ -109,7 +109,9 @@ fn vec3<R: Real>(v: [f32; 3]) -> Vec3<R> {
 
 /// The `λ` pass's sums of particle `i` (see [`LambdaSums`]), writing its pairs' Spiky
 /// factors `W'(r)/r` to `grad_factor` and `s_corr` to `scorr` (the slices of its CSR range),
-/// as the scalar loop of [`crate::passes`] does.
+/// as the scalar loop of [`crate::passes`] does; without the artificial pressure (no
+/// `s_corr`) `scorr` receives the neighbours' masses `m_j` instead, which [`delta_sum`]
+/// then reads in list order rather than gathering them.
 #[allow(clippy::too_many_arguments)] // the pass's inputs, one particle
 pub(crate) fn lambda_sums<R: Real>(
     k: &LaneConsts,
@@ -144,7 +146,10 @@ pub(crate) fn lambda_sums<R: Real>(
 }
 
 /// The `Δp` pass's sum `Σ_j (λ_i m_j + λ_j m_i + s_corr (m_i + m_j) unit/2) ∇W_ij` of
-/// particle `i` (before the factor `1/ρ0`), from the pair cache of [`lambda_sums`].
+/// particle `i` (before the factor `1/ρ0`), from the pair cache of [`lambda_sums`] and the
+/// packed `[x, y, z, λ]` ([`pack_lambda`]): `λ_j` comes with the neighbour's position and,
+/// without `s_corr`, `m_j` from the pair cache, so the lanes gather nothing (with `s_corr`
+/// they gather `m_j`). The same operations in the same order as before either way.
 #[allow(clippy::too_many_arguments)] // the pass's inputs, one particle
 pub(crate) fn delta_sum<R: Real>(
     k: &LaneConsts,
@@ -165,11 +170,11 @@ pub(crate) fn delta_sum<R: Real>(
     #[cfg(target_arch = "x86_64")]
     {
         let own = [lambda[i], m[i], half_unit].map(|v| v.as_f64() as f32);
-        // SAFETY: as in `lambda_sums`; `lambda` has one value per particle (asserted).
+        // SAFETY: as in `lambda_sums`; `m` has one value per particle (asserted).
         let s = unsafe {
             avx512::delta(
                 k,
-                (packed.values(), f32s(lambda)),
+                (packed.values(), f32s(m)),
                 i,
                 own,
                 list,
@@ -182,11 +187,18 @@ pub(crate) fn delta_sum<R: Real>(
     unreachable!("no lane constants off x86_64")
 }
 
+/// Packs the velocities `[v, 0]` for [`density_xsph`].
+pub(crate) fn pack_velocities<R: Real>(packed_v: &mut Packed, v: &[Vec3<R>]) {
+    packed_v.fill_with(v, |_| R::zero());
+}
+
 /// The final density's pair sum `Σ_j m_j W_ij` of particle `i` and XSPH's
-/// `Σ_j (v_j − v_i) (m_j/ρ0) W_ij` (eq. 17, before the factor `c`).
+/// `Σ_j (v_j − v_i) (m_j/ρ0) W_ij` (eq. 17, before the factor `c`); `packed_v` holds the
+/// velocities packed as `[v, 0]` ([`pack_velocities`]), loaded as the positions are (no
+/// gather; the same values, so the same sums).
 pub(crate) fn density_xsph<R: Real>(
     k: &LaneConsts,
-    packed: &Packed,
+    (packed, packed_v): (&Packed, &Packed),
     v: &[Vec3<R>],
     nb: &NeighbourLists,
     i: usize,
@@ -197,11 +209,23 @@ pub(crate) fn density_xsph<R: Real>(
         packed.values().len(),
         "packed values of other particles"
     );
+    assert_eq!(
+        packed_v.len(),
+        v.len(),
+        "packed velocities of other particles"
+    );
     #[cfg(target_arch = "x86_64")]
     {
-        // SAFETY: as in `lambda_sums`; `v` has one velocity per particle (asserted).
+        // SAFETY: as in `lambda_sums`; both packed arrays hold 4 values per particle
+        // (asserted).
         let s = unsafe {
-            avx512::density_xsph(k, (packed.values(), coords(v)), i, position_of(v, i), list)
+            avx512::density_xsph(
+                k,
+                (packed.values(), packed_v.values()),
+                i,
+                position_of(v, i),
+                list,
+            )
         };
         (R::of_f64(s[0] as f64), vec3([s[1], s[2], s[3]]))
     }
@@ -209,11 +233,18 @@ pub(crate) fn density_xsph<R: Real>(
     unreachable!("no lane constants off x86_64")
 }
 
+/// Puts `λ` in the fourth slot of the packed `[x, y, z, m]` of the `λ` pass, for the `Δp`
+/// lanes ([`delta_sum`]); the next iteration packs the masses again.
+pub(crate) fn pack_lambda<R: Real>(packed: &mut Packed, lambda: &[R]) {
+    assert_eq!(packed.len(), lambda.len(), "one λ per packed particle");
+    packed.set_fourth(|i| lambda[i]);
+}
+
 #[cfg(target_arch = "x86_64")]
 mod avx512 {
     use std::arch::x86_64::*;
 
-    use sph_solver::pair_lanes::avx512::{gather, pairs, sums};
+    use sph_solver::pair_lanes::avx512::{gather, packed, pairs, sums};
 
     use super::LaneConsts;
 
@@ -255,7 +286,8 @@ mod avx512 {
     }
 
     /// The lane sums `[Σ m_j W, Σ g_x, Σ g_y, Σ g_z, Σ |g|²]` of the `λ` pass (see
-    /// `super::lambda_sums`).
+    /// `super::lambda_sums`); `sc` receives each pair's `s_corr`, or without the
+    /// artificial pressure the neighbour's mass `m_j`.
     ///
     /// # Safety
     /// avx512f; `xm` holds `4n` packed values, `i < n`; `gf` and `sc` have the
@@ -282,7 +314,8 @@ mod avx512 {
                     let q2 = _mm512_mul_ps(q, q);
                     _mm512_mul_ps(_mm512_set1_ps(neg_k), _mm512_mul_ps(q2, q2))
                 }
-                None => _mm512_setzero_ps(),
+                // Without the artificial pressure the slot holds m_j, for the Δp lanes.
+                None => mj,
             };
             _mm512_mask_storeu_ps(sc.as_mut_ptr().add(s), p.live, scorr);
             let f = spiky_factor(c, p.r2);
@@ -301,15 +334,16 @@ mod avx512 {
         sums(acc)
     }
 
-    /// The `Δp` pass's lane sum (see `super::delta_sum`); `own` is `[λ_i, m_i, unit/2]`.
+    /// The `Δp` pass's lane sum (see `super::delta_sum`); `xl` is the packed
+    /// `[x, y, z, λ]`, `own` is `[λ_i, m_i, unit/2]`.
     ///
     /// # Safety
-    /// avx512f; `xm` holds `4n` packed values, `lambda` `n`, `i < n`; both cache slices
-    /// have the list's length.
+    /// avx512f; `xl` holds `4n` packed values, `m` `n`, `i < n`; both cache slices have
+    /// the list's length.
     #[target_feature(enable = "avx512f")]
     pub(super) unsafe fn delta(
         c: &LaneConsts,
-        (xm, lambda): (&[f32], &[f32]),
+        (xl, m): (&[f32], &[f32]),
         i: usize,
         own: [f32; 3],
         list: &[u32],
@@ -318,8 +352,13 @@ mod avx512 {
         let [li, mi, half_unit] = own.map(|v| _mm512_set1_ps(v));
         let mut acc = [_mm512_setzero_ps(); 3];
         for s in (0..list.len()).step_by(16) {
-            let p = pairs(xm, i, list, s);
-            let (mj, lj) = (p.mj, gather(lambda, &p));
+            let p = pairs(xl, i, list, s);
+            // The packed fourth value is λ_j; m_j is in the pair cache without s_corr.
+            let lj = p.mj;
+            let mj = match c.scorr {
+                Some(_) => gather(m, &p),
+                None => _mm512_maskz_loadu_ps(p.live, sc.as_ptr().add(s)),
+            };
             let f = _mm512_maskz_loadu_ps(p.live, gf.as_ptr().add(s));
             // λ_i m_j + λ_j m_i (+ s_corr (m_i + m_j) unit/2).
             let mut coeff = _mm512_add_ps(_mm512_mul_ps(li, mj), _mm512_mul_ps(lj, mi));
@@ -339,11 +378,11 @@ mod avx512 {
     /// `[Σ m_j W, Σ (v_j − v_i)_x (m_j/ρ0) W, … y, … z]` (see `super::density_xsph`).
     ///
     /// # Safety
-    /// avx512f; `xm` holds `4n` packed values, `v` `3n` coordinates, `i < n`.
+    /// avx512f; `xm` and `vp` hold `4n` packed values each, `i < n`.
     #[target_feature(enable = "avx512f")]
     pub(super) unsafe fn density_xsph(
         c: &LaneConsts,
-        (xm, v): (&[f32], &[f32]),
+        (xm, vp): (&[f32], &[f32]),
         i: usize,
         vi: [f32; 3],
         list: &[u32],
@@ -359,10 +398,10 @@ mod avx512 {
             acc[0] = _mm512_mask_add_ps(acc[0], p.live, acc[0], _mm512_mul_ps(mj, w));
             // (v_j − v_i) ((m_j/ρ0) W).
             let weight = _mm512_mul_ps(_mm512_mul_ps(mj, inv_rho0), w);
-            let j3 = _mm512_mullo_epi32(p.j, _mm512_set1_epi32(3));
+            // The neighbours' velocities, loaded as their positions (no gather).
+            let vj = packed(vp, i, list, s);
             for a in 0..3 {
-                let vj = _mm512_mask_i32gather_ps::<4>(zero, p.live, j3, v.as_ptr().add(a).cast());
-                let t = _mm512_mul_ps(_mm512_sub_ps(vj, vi[a]), weight);
+                let t = _mm512_mul_ps(_mm512_sub_ps(vj[a], vi[a]), weight);
                 acc[1 + a] = _mm512_mask_add_ps(acc[1 + a], p.live, acc[1 + a], t);
             }
         }
@@ -379,7 +418,7 @@ mod tests {
     use sph_kernels::Kernel;
     use sph_solver::step::StepNeighbours;
 
-    use super::{delta_sum, density_xsph, lambda_sums, LaneConsts};
+    use super::{delta_sum, density_xsph, lambda_sums, pack_lambda, pack_velocities, LaneConsts};
     use crate::kernels::Consts;
     use crate::passes;
     use crate::PbfParams;
@@ -438,15 +477,19 @@ mod tests {
             let unit = crate::PbfParams::<f32>::default().scorr_unit().unwrap();
             let mut packed = Packed::default();
             packed.fill(&x, &m);
+            let mut packed_lambda = packed.clone();
+            pack_lambda(&mut packed_lambda, &lambda);
             for i in 0..x.len() {
                 let len = nb.neighbours(i).len();
                 let (mut gf, mut sc) = (vec![0f32; len], vec![0f32; len]);
                 let (mut gf_l, mut sc_l) = (vec![1f32; len], vec![1f32; len]);
                 let want = passes::lambda_sums(&c, &x, &m, nb, i, &mut gf, &mut sc);
                 let got = lambda_sums(&l, (&x, &m, &packed), nb, i, &mut gf_l, &mut sc_l);
-                for k in 0..len {
+                for (k, &j) in nb.neighbours(i).iter().enumerate() {
                     prop_assert_eq!(gf[k].to_bits(), gf_l[k].to_bits(), "W'/r of pair {} of {}", k, i);
-                    prop_assert_eq!(sc[k].to_bits(), sc_l[k].to_bits(), "s_corr of pair {} of {}", k, i);
+                    // The lanes' second slot: s_corr, or m_j without it.
+                    let slot = if c.scorr_on { sc[k] } else { m[j as usize] };
+                    prop_assert_eq!(slot.to_bits(), sc_l[k].to_bits(), "s_corr or m_j of pair {} of {}", k, i);
                 }
                 // Σ|t_k| of each sum, from the scalar terms.
                 let mut abs = [f64::from(m[i] * c.w0), 0.0, 0.0, 0.0, 0.0];
@@ -469,7 +512,7 @@ mod tests {
                 let half_unit = 0.5 * unit;
                 let cache = (&gf[..], &sc[..]);
                 let want = passes::delta_sum(&c, &x, &m, &lambda, nb, i, cache, half_unit);
-                let got = delta_sum(&l, (&m, &packed), &lambda, nb, i, cache, half_unit);
+                let got = delta_sum(&l, (&m, &packed_lambda), &lambda, nb, i, (&gf_l[..], &sc_l[..]), half_unit);
                 let mut abs = [0f64; 3];
                 for (k, &j) in nb.neighbours(i).iter().enumerate() {
                     let j = j as usize;
@@ -501,6 +544,8 @@ mod tests {
             };
             let mut packed = Packed::default();
             packed.fill(&x, &m);
+            let mut packed_v = Packed::default();
+            pack_velocities(&mut packed_v, &v);
             for i in 0..x.len() {
                 let (mut rho, mut xsph) = (0f32, Vec3::<f32>::zeros());
                 let (mut abs_rho, mut abs_xsph) = (0f64, [0f64; 3]);
@@ -516,7 +561,7 @@ mod tests {
                     }
                 }
                 let len = nb.neighbours(i).len();
-                let (got_rho, got_xsph) = density_xsph(&l, &packed, &v, nb, i);
+                let (got_rho, got_xsph) = density_xsph(&l, (&packed, &packed_v), &v, nb, i);
                 within("density", got_rho, rho, len, abs_rho)?;
                 for a in 0..3 {
                     within("XSPH", got_xsph[a], xsph[a], len, abs_xsph[a])?;

@@ -21,11 +21,15 @@ pub(crate) struct PairCache<R: Real> {
     /// Spiky gradient factor `f_ij` with `∇W(p_i − p_j) = (p_i − p_j) f_ij` (`dW/dr / r`;
     /// 0 at `r = 0` and at or beyond `h`).
     grad_factor: Vec<R>,
-    /// `s_corr` of the pair (eq. 13; 0 when the artificial pressure is off).
+    /// `s_corr` of the pair (eq. 13; 0 when the artificial pressure is off, or with the
+    /// lanes the neighbour's mass `m_j`, which the `Δp` lanes read).
     scorr: Vec<R>,
     /// The positions and masses of the pass, packed for the lanes (filled only when they
-    /// run).
+    /// run); after the `λ` pass `[x, y, z, λ]` for the `Δp` lanes.
     pub(crate) packed: Packed,
+    /// The velocities packed `[v, 0]` for the final density and XSPH lanes (filled only
+    /// when they run).
+    pub(crate) packed_v: Packed,
 }
 
 impl<R: Real> PairCache<R> {
@@ -110,13 +114,21 @@ pub(crate) fn lambda_pass<R: Real>(
     if input.lanes.is_some() {
         cache.packed.fill(input.x, input.m);
     }
-    lambda_block(
+    let compression = lambda_block(
         input,
         0,
-        out,
+        LambdaOut {
+            density: out.density,
+            lambda: &mut *out.lambda,
+            boundary_grad: out.boundary_grad,
+        },
         &cache.packed,
         (&mut cache.grad_factor[..pairs], &mut cache.scorr[..pairs]),
-    )
+    );
+    if input.lanes.is_some() {
+        lanes::pack_lambda(&mut cache.packed, out.lambda);
+    }
+    compression
 }
 
 /// [`lambda_pass`] over the particles `first..first + out.density.len()`, whose pairs are

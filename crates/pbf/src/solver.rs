@@ -415,8 +415,9 @@ fn velocity_update<R: Real>(input: VelocityInput<'_, R>, s: &mut PbfScratch<R>) 
     let near = &s.near_boundary[..];
     if lanes.is_some() && !vort_on {
         s.pairs.packed.fill(x, m);
+        lanes::pack_velocities(&mut s.pairs.packed_v, v);
     }
-    let packed = &s.pairs.packed;
+    let packed = (&s.pairs.packed, &s.pairs.packed_v);
     // Densities at the final positions and eq. 15; without vorticity confinement, XSPH
     // (eq. 17) in the same pass (it needs the same Poly6 values and nothing else of this
     // pass).
