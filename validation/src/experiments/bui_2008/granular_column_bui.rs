@@ -47,14 +47,23 @@
 //! - *Runout*: [`granular_measure::runout()`] (the connected deposit's front plus the grain's
 //!   radius, from the back wall).
 //! - *Potential energy kept*: `Σ y_final / Σ y_initial` over the grains (equal masses).
+//! - *Against the experiment* (Bui et al.'s measured final surface and failure line, as
+//!   MaterialPointSolver.jl digitised them, `reference-data/granular-column-bui/SOURCE.md`):
+//!   the runout against the surface's last point; the deposit's height (the top of the
+//!   highest grain within half a spacing) at each measured surface point, RMS of the
+//!   differences; per initial row, the boundary of the grains that moved by more than one
+//!   bar ([`BAR_DIAMETER_M`]: the experiment's line delimits the bars that did not move)
+//!   against the measured line at that height, RMS of the horizontal distances.
 //!
-//! **Checks**: the deposit's front clear of the far wall (validity); at rest by [`REST_BY_S`]; the back keeps its height within one spacing (the
-//! wall holds the material behind the failure line, which does not move); the first slip
-//! surface at Rankine's `45° + φ/2` within `1.5 sin²β s/H0` rad (see
-//! [`failure_line_tolerance_deg`]); the energy kept against SPHinXsys's 0.690 (the same
-//! material, φ = 21.9°) within [`ENERGY_BAND`]. The deposit's slope, its profile and the
-//! runout are reported, **not checked**: Bui et al.'s measured figures are not in our
-//! library (`reference-data/granular-column-bui/SOURCE.md`).
+//! **Checks**: the deposit's front clear of the far wall (validity); at rest by [`REST_BY_S`];
+//! the back keeps its height within one spacing (the wall holds the material behind the
+//! failure line, which does not move); the first slip surface at Rankine's `45° + φ/2`
+//! within `1.5 sin²β s/H0` rad (see [`failure_line_tolerance_deg`]); the runout, the final
+//! surface and the failure line against Bui et al.'s measurements, each within one spacing
+//! (the deposit is resolved to a grain) plus the digitisation's error (read at the points
+//! whose place is known); the energy kept against SPHinXsys's 0.690 (the same material,
+//! φ = 21.9°) within [`ENERGY_BAND`]. The deposit's slope and the final moved zone are
+//! reported.
 
 use anyhow::{bail, Result};
 use elastoplastic_granular::{Axis, ConeMatch};
@@ -111,6 +120,75 @@ pub const SLIP_THRESHOLD_SPACINGS: f64 = 0.25;
 pub const ENERGY_BAND: f64 = 0.05;
 /// SPHinXsys's regression figure (file in `reference-data/granular-column-bui/`).
 const SPHINXSYS_FILE: &str = "granular-column-bui/sphinxsys_column_collapse_energy.csv";
+/// The experiment's final surface, `(x, y)` from the back wall and the floor (m), as
+/// MaterialPointSolver.jl digitised it (`reference-data/granular-column-bui/SOURCE.md`).
+const MEASURED_SURFACE_FILE: &str = "granular-column-bui/bui2008_measured_surface.csv";
+/// The experiment's failure line (the edge of the bars that did not move), the same axes.
+const MEASURED_FAILURE_FILE: &str = "granular-column-bui/bui2008_measured_failure_line.csv";
+/// The bars' larger diameter (m): Bui et al.'s aluminium bars are 1 mm and 1.5 mm across
+/// (§6, as Ghaïtanellis et al. 2018, *Adv. Water Resour.* 111:156–173, Table 2, quote
+/// them). The experiment's failure line delimits the bars that did not move; the grains
+/// compared with it have moved when they travelled more than one bar (as Ghaïtanellis et al.
+/// count them), far above the column's elastic settlement (`ρ0 g H0²/(2E)` = 0.02 mm).
+pub const BAR_DIAMETER_M: f64 = 1.5e-3;
+
+/// Bui et al.'s measured deposit, in the column's frame (`x` from the back wall, `y` above
+/// the floor, m).
+#[derive(Debug, Clone)]
+struct Measured {
+    /// The final surface, `(x, y)`, `x` increasing.
+    surface: Vec<(f64, f64)>,
+    /// The failure line, `(x, y)`, `y` decreasing.
+    failure: Vec<(f64, f64)>,
+}
+
+impl Measured {
+    /// Loads both files; `x` must increase along each.
+    fn load(ctx: &Context) -> Result<Self> {
+        let read = |file: &str| -> Result<Vec<(f64, f64)>> {
+            let t = load_reference_csv(ctx, file, &["x_m", "y_m"])?;
+            let points = (0..t.len())
+                .map(|i| Ok((t.number(i, "x_m")?, t.number(i, "y_m")?)))
+                .collect::<Result<Vec<_>>>()?;
+            if points.len() < 2 || points.windows(2).any(|w| w[1].0 <= w[0].0) {
+                bail!("{file}: needs two points or more, x increasing");
+            }
+            Ok(points)
+        };
+        Ok(Self {
+            surface: read(MEASURED_SURFACE_FILE)?,
+            failure: read(MEASURED_FAILURE_FILE)?,
+        })
+    }
+
+    /// The measured runout from the back wall (m): the surface's last point, where the
+    /// deposit thins to one bar on the floor.
+    fn runout_m(&self) -> f64 {
+        self.surface.last().map_or(f64::NAN, |p| p.0)
+    }
+
+    /// The digitisation's error (m), read at the three points whose true place is known: the
+    /// surface's first point is the back wall's top, `(0, H0)` (the wall holds the material
+    /// behind the failure line, which meets the top `0.02 m` from the wall), and the failure
+    /// line's last point is on the floor, `y = 0`.
+    fn transcription_error_m(&self, height: f64) -> f64 {
+        let (x0, y0) = self.surface[0];
+        let foot = self.failure.last().map_or(f64::NAN, |p| p.1);
+        x0.abs().max((y0 - height).abs()).max(foot.abs())
+    }
+
+    /// The measured failure line's `x` at height `y` (linear between the points), `None`
+    /// outside its span of heights.
+    fn failure_x_at(&self, y: f64) -> Option<f64> {
+        self.failure.windows(2).find_map(|w| {
+            let ((xa, ya), (xb, yb)) = (w[0], w[1]);
+            let (lo, hi) = (ya.min(yb), ya.max(yb));
+            (lo..=hi)
+                .contains(&y)
+                .then(|| xa + (xb - xa) * (y - ya) / (yb - ya))
+        })
+    }
+}
 
 /// The column as the scene places it.
 #[derive(Debug, Clone, Copy)]
@@ -206,11 +284,8 @@ fn failure_line(
             (y, column.length * still[j] as f64 / count[j] as f64)
         })
         .collect();
-    let (num, den) = points.iter().fold((0.0, 0.0), |(n, d), &(y, xb)| {
-        (n + y * (column.length - xb), d + y * y)
-    });
-    let cot = num / den;
-    (points, 90.0 - cot.atan().to_degrees())
+    let beta = line_through_toe_deg(&points, column.length);
+    (points, beta)
 }
 
 impl Experiment for GranularColumnBui {
@@ -230,8 +305,9 @@ impl Experiment for GranularColumnBui {
     fn run(&self, ctx: &mut Context) -> Result<Outcome> {
         let peer = load_reference_csv(ctx, SPHINXSYS_FILE, &["quantity", "value"])?;
         let peer_kept = peer.number(peer.find(&[("quantity", "fraction_kept")])?, "value")?;
+        let measured = Measured::load(ctx)?;
         let mut out = Outcome::new();
-        let Some(m) = measure_column(ctx, SCENE, "", &mut out)? else {
+        let Some(m) = measure_column(ctx, SCENE, "", &measured, &mut out)? else {
             return Ok(out);
         };
         check_column(&mut out, &m, peer_kept);
@@ -246,10 +322,11 @@ impl Experiment for GranularColumnBui {
             "failure_line.csv",
             "per initial row: the boundary between the grains that stayed (behind) and those whose plastic strain exceeded 0.01 at 0.1 s (the first slip surface)",
         );
-        plot_deposit(ctx, &m)?;
+        write_measured_comparison(ctx, &m, &measured)?;
+        plot_deposit(ctx, &m, &measured)?;
         if ctx.mode == Mode::Full {
             // The 3D slab beside the plane: the planar path's cross-check (reported).
-            if let Some(slab) = measure_column(ctx, SLAB_SCENE, "slab/", &mut out)? {
+            if let Some(slab) = measure_column(ctx, SLAB_SCENE, "slab/", &measured, &mut out)? {
                 out.metric(
                     "slab/slip_surface_minus_plane_deg",
                     slab.slip_deg - m.slip_deg,
@@ -257,7 +334,7 @@ impl Experiment for GranularColumnBui {
             }
         }
         out.note(format!(
-            "phi = {} deg, cone {}, spacing {} m, in the plane (dimensions = 2, plane strain){}; first slip surface: the edge of the grains whose plastic strain exceeds {SLIP_PLASTIC_STRAIN} at {SLIP_CHECK_S} s; final moved zone: by more than one spacing at rest; the deposit's slope, profile and runout are not checked (Bui et al.'s measured figures are not in our library); rest by granular_measure::rest (default figures, all grains)",
+            "phi = {} deg, cone {}, spacing {} m, in the plane (dimensions = 2, plane strain){}; first slip surface: the edge of the grains whose plastic strain exceeds {SLIP_PLASTIC_STRAIN} at {SLIP_CHECK_S} s; final moved zone: by more than one spacing at rest; the runout, final surface and failure line checked against Bui et al.'s measured ones (MaterialPointSolver.jl's digitisation, reference-data/granular-column-bui/SOURCE.md); rest by granular_measure::rest (default figures, all grains)",
             m.phi,
             m.cone.name(),
             m.spacing,
@@ -286,6 +363,97 @@ struct ColumnMeasures {
     slip_deg: f64,
     runout_m: f64,
     kept: f64,
+    /// Against Bui et al.'s measured deposit.
+    fit: MeasuredFit,
+}
+
+/// The deposit against Bui et al.'s measured one.
+#[derive(Debug, Clone)]
+struct MeasuredFit {
+    /// The measured runout from the back wall (m).
+    measured_runout_m: f64,
+    /// The digitisation's error (m), [`Measured::transcription_error_m`].
+    transcription_m: f64,
+    /// RMS and largest difference (m) of the deposit's height at the measured surface's
+    /// points.
+    profile_rms_m: f64,
+    profile_max_m: f64,
+    /// The measured surface's points.
+    surface_points: usize,
+    /// Per initial row `(y, x_b)`, the boundary of the grains that moved by more than
+    /// [`BAR_DIAMETER_M`] by the end, and its line through the toe (deg).
+    bar_rows: Vec<(f64, f64)>,
+    bar_zone_deg: f64,
+    /// RMS horizontal distance (m) between those boundaries and the measured failure line,
+    /// over the rows within its span of heights, and their number.
+    failure_rms_m: f64,
+    failure_rows: usize,
+    /// The measured failure line's angle (deg), fitted through the toe as the model's rows.
+    measured_line_deg: f64,
+}
+
+/// The deposit's height above the floor at `x` (from the back wall, m): the top of the
+/// highest grain whose centre lies within half a spacing of `x` (its centre plus its radius
+/// `s/2`), 0 where there is none.
+fn deposit_height(positions: &[Vec3<f64>], column: Column, s: f64, x: f64) -> f64 {
+    positions
+        .iter()
+        .filter(|p| (p.x - column.back_x - x).abs() <= 0.5 * s)
+        .map(|p| p.y - column.floor_y + 0.5 * s)
+        .fold(0.0, f64::max)
+}
+
+/// Root mean square of `values` (NaN if empty).
+fn rms(values: &[f64]) -> f64 {
+    (values.iter().map(|v| v * v).sum::<f64>() / values.len() as f64).sqrt()
+}
+
+/// The line through the toe `(L0, 0)` fitted to boundary points `(y, x_b)` (`x_b` from the
+/// back wall) by least squares, `L0 − x_b = y cot β`; `β` in degrees.
+fn line_through_toe_deg(points: &[(f64, f64)], length: f64) -> f64 {
+    let (num, den) = points.iter().fold((0.0, 0.0), |(n, d), &(y, xb)| {
+        (n + y * (length - xb), d + y * y)
+    });
+    90.0 - (num / den).atan().to_degrees()
+}
+
+/// The deposit at rest (`last`, each grain's final position beside its `initial` one) against
+/// `measured`.
+fn compare_with_measured(
+    measured: &Measured,
+    column: Column,
+    s: f64,
+    initial: &[Vec3<f64>],
+    last: &[Vec3<f64>],
+) -> MeasuredFit {
+    let heights: Vec<f64> = measured
+        .surface
+        .iter()
+        .map(|&(x, y)| deposit_height(last, column, s, x) - y)
+        .collect();
+    let moved: Vec<bool> = initial
+        .iter()
+        .zip(last)
+        .map(|(a, b)| (b.x - a.x).hypot(b.y - a.y) > BAR_DIAMETER_M)
+        .collect();
+    let (bar_rows, bar_zone_deg) = failure_line(initial, &moved, column, s);
+    let gaps: Vec<f64> = bar_rows
+        .iter()
+        .filter_map(|&(y, xb)| measured.failure_x_at(y).map(|x| xb - x))
+        .collect();
+    let measured_line: Vec<(f64, f64)> = measured.failure.iter().map(|&(x, y)| (y, x)).collect();
+    MeasuredFit {
+        measured_runout_m: measured.runout_m(),
+        transcription_m: measured.transcription_error_m(column.height),
+        profile_rms_m: rms(&heights),
+        profile_max_m: heights.iter().fold(0.0, |m, d| m.max(d.abs())),
+        surface_points: heights.len(),
+        bar_rows,
+        bar_zone_deg,
+        failure_rms_m: rms(&gaps),
+        failure_rows: gaps.len(),
+        measured_line_deg: line_through_toe_deg(&measured_line, column.length),
+    }
 }
 
 /// Runs shipped scene `name` to rest and records its measures as metrics named
@@ -294,6 +462,7 @@ fn measure_column(
     ctx: &mut Context,
     name: &str,
     prefix: &str,
+    measured: &Measured,
     out: &mut Outcome,
 ) -> Result<Option<ColumnMeasures>> {
     let (scene, column, phi, cone) = column_scene(ctx, name)?;
@@ -427,6 +596,8 @@ fn measure_column(
         normalised_runout(runout_m, column.length)?,
     );
     put(out, prefix, "potential_energy_kept", kept);
+    let fit = compare_with_measured(measured, column, s, &initial, &last);
+    put_fit(out, prefix, runout_m, &fit);
     Ok(Some(ColumnMeasures {
         scene,
         column,
@@ -439,7 +610,25 @@ fn measure_column(
         slip_deg,
         runout_m,
         kept,
+        fit,
     }))
+}
+
+/// Records the comparison with Bui et al.'s measurements as metrics `{prefix}bui2008/…`.
+fn put_fit(out: &mut Outcome, prefix: &str, runout_m: f64, fit: &MeasuredFit) {
+    for (name, value) in [
+        ("measured_runout_m", fit.measured_runout_m),
+        ("runout_minus_measured_m", runout_m - fit.measured_runout_m),
+        ("transcription_error_m", fit.transcription_m),
+        ("profile_rms_m", fit.profile_rms_m),
+        ("profile_max_m", fit.profile_max_m),
+        ("moved_by_a_bar_zone_deg", fit.bar_zone_deg),
+        ("measured_failure_line_deg", fit.measured_line_deg),
+        ("failure_line_rms_m", fit.failure_rms_m),
+        ("failure_line_rows", fit.failure_rows as f64),
+    ] {
+        put(out, prefix, &format!("bui2008/{name}"), value);
+    }
 }
 
 /// Records metric `{prefix}{name}`.
@@ -480,6 +669,7 @@ fn check_column(out: &mut Outcome, m: &ColumnMeasures, peer_kept: f64) {
         2.0 * s,
         "validity: a front at the far wall was stopped by it",
     ));
+    check_measured(out, m);
     out.metric("sphinxsys_potential_energy_kept", peer_kept);
     out.check(Check::within(
         "fraction of the initial potential energy kept at rest",
@@ -489,6 +679,48 @@ fn check_column(out: &mut Outcome, m: &ColumnMeasures, peer_kept: f64) {
         format!(
             "peer cross-check, not an experiment: SPHinXsys test_2d_column_collapse ({peer_kept:.3}, phi = 21.9 deg); band +-{ENERGY_BAND} this project's, set before the run"
         ),
+    ));
+}
+
+/// The checks against Bui et al.'s measured deposit: the runout, the final surface and the
+/// failure line, each to one spacing (the deposit is made of grains `s` across: its front,
+/// its surface and each row's boundary are located to one grain) plus the digitisation's
+/// error.
+fn check_measured(out: &mut Outcome, m: &ColumnMeasures) {
+    let fit = &m.fit;
+    let tol = m.spacing + fit.transcription_m;
+    let origin = |what: &str| {
+        format!(
+            "experiment: Bui et al. (2008) section 6, {what} as MaterialPointSolver.jl digitised it (reference-data/granular-column-bui/SOURCE.md); tolerance one spacing ({:.4} m: the deposit is resolved to a grain) plus the digitisation's error ({:.4} m, read at the back wall's top and the failure line's foot)",
+            m.spacing, fit.transcription_m
+        )
+    };
+    out.check(Check::within(
+        format!(
+            "runout from the back wall (m) against Bui et al.'s measured {:.4}",
+            fit.measured_runout_m
+        ),
+        m.runout_m,
+        fit.measured_runout_m - tol,
+        fit.measured_runout_m + tol,
+        origin("the final surface's front"),
+    ));
+    out.check(Check::at_most(
+        "final surface: RMS height difference at the measured points (m)",
+        fit.profile_rms_m,
+        tol,
+        origin(&format!(
+            "the final surface ({} points, from the back wall to the front)",
+            fit.surface_points
+        )),
+    ));
+    out.check(Check::at_most(
+        format!(
+            "failure line: RMS horizontal distance of the rows' boundaries (grains moved by more than {BAR_DIAMETER_M} m) from the measured line (m)"
+        ),
+        fit.failure_rms_m,
+        tol,
+        origin("the failure line (the edge of the bars that did not move)"),
     ));
 }
 
@@ -513,9 +745,46 @@ fn check_rest(out: &mut Outcome, scene: &Scene, run: &SceneRun) {
     ));
 }
 
+/// `deposit_vs_measured.csv` and `failure_line_vs_measured.csv`: the deposit's height at the
+/// measured surface's points, and each row's boundary beside the measured failure line.
+fn write_measured_comparison(
+    ctx: &mut Context,
+    m: &ColumnMeasures,
+    measured: &Measured,
+) -> Result<()> {
+    write_csv_rows(
+        &ctx.path("deposit_vs_measured.csv"),
+        &["x_m", "measured_height_m", "model_height_m"],
+        measured.surface.iter().map(|&(x, y)| {
+            let h = deposit_height(&m.run.final_positions, m.column, m.spacing, x);
+            vec![format!("{x:.5}"), format!("{y:.5}"), format!("{h:.5}")]
+        }),
+    )?;
+    ctx.add_file(
+        "deposit_vs_measured.csv",
+        "at each point of Bui et al.'s measured final surface (x from the back wall): the measured height and the deposit's (the top of the highest grain within half a spacing)",
+    );
+    write_csv_rows(
+        &ctx.path("failure_line_vs_measured.csv"),
+        &["y_m", "boundary_x_m", "measured_x_m"],
+        m.fit.bar_rows.iter().map(|&(y, xb)| {
+            let x = measured
+                .failure_x_at(y)
+                .map_or(String::from("NaN"), |x| format!("{x:.5}"));
+            vec![format!("{y:.5}"), format!("{xb:.5}"), x]
+        }),
+    )?;
+    ctx.add_file(
+        "failure_line_vs_measured.csv",
+        "per initial row: the boundary of the grains that moved by more than one bar (1.5 mm) by the end, and Bui et al.'s measured failure line at that height (NaN outside its span)",
+    );
+    Ok(())
+}
+
 /// `deposit.png`: the deposit's grains, the initial column, the boundary of each row and
-/// the fitted failure line, and Rankine's line, all through the toe.
-fn plot_deposit(ctx: &mut Context, m: &ColumnMeasures) -> Result<()> {
+/// the fitted failure line, and Rankine's line, all through the toe; Bui et al.'s measured
+/// surface and failure line.
+fn plot_deposit(ctx: &mut Context, m: &ColumnMeasures, measured: &Measured) -> Result<()> {
     let (run, column, rows, beta_deg) = (&m.run, m.column, &m.slip_rows, m.slip_deg);
     let rankine_deg = 45.0 + 0.5 * m.phi;
     let toe = (column.back_x + column.length, column.floor_y);
@@ -553,12 +822,32 @@ fn plot_deposit(ctx: &mut Context, m: &ColumnMeasures) -> Result<()> {
             SeriesStyle::Dashed,
             1,
         ),
+        Series::line(
+            "Bui et al. (2008), measured surface",
+            measured
+                .surface
+                .iter()
+                .map(|&(x, y)| (x0 + x, y0 + y))
+                .collect(),
+            2,
+        ),
+        Series::styled(
+            "Bui et al. (2008), measured failure line",
+            measured
+                .failure
+                .iter()
+                .map(|&(x, y)| (x0 + x, y0 + y))
+                .collect(),
+            SeriesStyle::Dashed,
+            2,
+        ),
     ];
     let x_end = run
         .final_positions
         .iter()
         .map(|p| p.x)
-        .fold(x0 + 2.0 * l, f64::max);
+        .fold(x0 + 2.0 * l, f64::max)
+        .max(x0 + measured.runout_m());
     let spec = PlotSpec {
         legend: Legend::UpperRight,
         series,
@@ -576,4 +865,54 @@ fn plot_deposit(ctx: &mut Context, m: &ColumnMeasures) -> Result<()> {
         "the deposit at rest, the initial column, each row's boundary at 0.1 s and the first slip surface fitted through the toe, and Rankine's line",
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn column() -> Column {
+        Column {
+            back_x: 0.0,
+            floor_y: 0.0,
+            length: 0.2,
+            height: 0.1,
+        }
+    }
+
+    #[test]
+    fn the_line_through_the_toe_recovers_a_known_angle() {
+        // Boundaries on the line through (0.2, 0) at 30 deg: x_b = 0.2 - y cot 30°.
+        let cot = 30f64.to_radians().tan().recip();
+        let points: Vec<(f64, f64)> = [0.01, 0.04, 0.09]
+            .iter()
+            .map(|&y| (y, 0.2 - y * cot))
+            .collect();
+        assert!((line_through_toe_deg(&points, 0.2) - 30.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn the_measured_line_is_interpolated_between_its_points_and_not_beyond() {
+        let m = Measured {
+            surface: vec![(0.0, 0.1), (0.4, 0.0)],
+            failure: vec![(0.02, 0.1), (0.18, 0.0)],
+        };
+        assert!((m.failure_x_at(0.05).unwrap() - 0.10).abs() < 1e-12);
+        assert_eq!(m.failure_x_at(0.11), None);
+        assert!((m.runout_m() - 0.4).abs() < 1e-12);
+        // The surface's first point is read exactly, the failure line's foot on the floor.
+        assert_eq!(m.transcription_error_m(0.1), 0.0);
+    }
+
+    #[test]
+    fn the_deposit_height_is_the_top_of_the_highest_grain_within_half_a_spacing() {
+        let s = 0.01;
+        let grains = [
+            Vec3::new(0.103, 0.005, 0.0),
+            Vec3::new(0.103, 0.015, 0.0),
+            Vec3::new(0.125, 0.045, 0.0),
+        ];
+        assert!((deposit_height(&grains, column(), s, 0.10) - 0.02).abs() < 1e-12);
+        assert_eq!(deposit_height(&grains, column(), s, 0.30), 0.0);
+    }
 }
