@@ -320,6 +320,11 @@
 //! their order only (and the pressure sum by that split), within the bound the lanes' tests
 //! check; `f64` and processors without AVX-512 take the scalar loops. The granular model's
 //! friction passes stay scalar.
+//!
+//! The contact response and the divergence check evaluate the solids only for the particles
+//! a carried distance bound does not clear (`sph_solver::ContactGuard`, from the distances
+//! evaluated with the end-of-step volume samples, which are skipped beyond the map's
+//! support): the same bits.
 
 mod friction;
 pub mod granular;
