@@ -559,10 +559,9 @@ pub(crate) fn forces_pass<R: Real>(
                 // From the distance at `x_i` (the last step's, or evaluated here): the
                 // solids are evaluated at `y` only where the move may reach them.
                 Some(g) => {
-                    *cl = match cache.distance(i, &x[i]) {
-                        Some(d) => d,
-                        None => g.evaluate(boundary, &x[i]),
-                    };
+                    *cl = cache
+                        .distance(i, &x[i])
+                        .unwrap_or_else(|| boundary.distance(&x[i]));
                     g.project(boundary, cl, &x[i], y)
                 }
                 None => boundary.project(y),

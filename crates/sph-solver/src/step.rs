@@ -96,11 +96,7 @@ pub fn check_state<R: Real>(state: &ParticleSet<R>) -> Result<(), SolverError> {
 /// element is scanned again for its index. For the checks made on every step, where nothing
 /// is found.
 pub fn first_where<T: Sync>(items: &[T], bad: impl Fn(&T) -> bool + Sync) -> Option<usize> {
-    let chunk = items
-        .par_chunks(REDUCE_CHUNK)
-        .position_first(|c| c.iter().fold(false, |any, x| any | bad(x)))?;
-    let first = chunk * REDUCE_CHUNK;
-    items[first..].iter().position(bad).map(|k| first + k)
+    first_index_where(items.len(), |i| bad(&items[i]))
 }
 
 /// [`first_where`] over the indices `0..len`: the first `i` for which `bad(i)` holds.
@@ -346,17 +342,13 @@ pub fn check_divergence_cleared<R: Real>(
         return Ok(());
     }
     let margin = -h;
+    if let Some(c) = clearance {
+        assert_eq!(c.len(), x.len(), "one distance bound per position");
+    }
+    // A bound of at least −h clears a particle (a NaN bound proves nothing).
+    let cleared = |i: usize| clearance.is_some_and(|c| c[i] >= margin);
     let inside = |xi: &Vec3<R>| solids.iter().any(|sd| sd.signed_distance(xi) < margin);
-    let first = match clearance {
-        Some(c) => {
-            assert_eq!(c.len(), x.len(), "one distance bound per position");
-            // A NaN bound proves nothing: evaluated.
-            let cleared = |i: usize| c[i] >= margin;
-            first_index_where(x.len(), |i| !cleared(i) && inside(&x[i]))
-        }
-        None => first_where(x, inside),
-    };
-    if let Some(i) = first {
+    if let Some(i) = first_index_where(x.len(), |i| !cleared(i) && inside(&x[i])) {
         let (k, d) = solids
             .iter()
             .enumerate()

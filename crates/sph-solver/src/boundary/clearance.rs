@@ -58,14 +58,8 @@ impl<R: Real> ContactGuard<R> {
         })
     }
 
-    /// The distance from `x` to the nearest solid as the boundary evaluates it
-    /// ([`Boundary::distance`]): a particle's bound where it was evaluated.
-    #[inline]
-    pub fn evaluate(&self, boundary: &dyn Boundary<R>, x: &Vec3<R>) -> R {
-        boundary.distance(x)
-    }
-
-    /// The bound at `to` of a particle whose bound at `from` is `clearance`:
+    /// The bound at `to` of a particle whose bound at `from` is `clearance` (where it was
+    /// evaluated, [`Boundary::distance`]):
     /// `clearance − L |to − from| − δ` (module docs). `+∞` stays `+∞` (no solids); NaN
     /// stays NaN (and fails every test that would skip work).
     #[inline]
@@ -131,7 +125,7 @@ mod tests {
             let guard = b.contact_guard().expect("analytic solids");
             let start = Vec3::new(start.0, start.1, start.2);
             let (mut x, mut y) = (start, start);
-            let mut bound = guard.evaluate(&b, &x);
+            let mut bound = b.distance(&x);
             for (dx, dy, dz) in moves {
                 let d = Vec3::new(dx, dy, dz);
                 let next = guard.project(&b, &mut bound, &x, x + d);
