@@ -104,44 +104,106 @@ pub trait Ground: Copy {
 /// Builds every planned case's scene with `scene_for` (refusing a bad one before any run),
 /// then runs each until at rest by `rest` (or to its cap), its diagnostic line measured on
 /// the ground `G` of its scene. The runs go in parallel on rayon's pool (a heap of a few
-/// thousand grains keeps one core busy but not two: its own parallel loops gain little) and
-/// come back in plan order; each run is the same bits as when run alone (the solver's loops
-/// split their work in fixed chunks, whatever the threads).
-pub fn run_plans<V: Send, G: Ground>(
+/// thousand grains keeps one core busy but not two: its own parallel loops gain little),
+/// the longest first by [`steps_to_cap`] (each worker takes the next run when it is free, so
+/// a long run does not start last and leave the other cores idle), and come back in plan
+/// order; each run is the same bits as when run alone (the solver's loops split their work
+/// in fixed chunks, whatever the threads).
+pub fn run_plans<V: Send + Sync, G: Ground>(
     ctx: &mut Context,
     plans: Vec<Plan<V>>,
     scene_for: impl Fn(&Plan<V>, Mode) -> Result<Scene>,
     rest: impl Fn(&Scene, f64) -> RestCriterion + Sync,
 ) -> Result<Vec<(Plan<V>, HeapRun)>> {
-    use rayon::prelude::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::Mutex;
     let scenes = plans
         .iter()
         .map(|p| scene_for(p, ctx.mode))
         .collect::<Result<Vec<_>>>()?;
     ctx.progress
         .set_length(scenes.iter().map(|s| s.frame_count() as u64).sum());
+    let order = longest_first(&scenes.iter().map(steps_to_cap).collect::<Vec<_>>());
     let ctx: &Context = ctx;
+    let run_one = |p: &Plan<V>, scene: Scene| -> Result<HeapRun> {
+        let criterion = rest(&scene, p.theta_deg);
+        let ground = G::of(&scene).ok();
+        let heap = |pos: &[_]| ground.map_or_else(Vec::new, |g| g.heap(pos));
+        let level_y = ground.map(G::level_y);
+        run_heap(
+            ctx,
+            p.tag.clone(),
+            p.theta_deg,
+            scene,
+            criterion,
+            level_y,
+            heap,
+        )
+    };
+    let slots: Vec<Mutex<Slot>> = scenes
+        .into_iter()
+        .map(|scene| {
+            Mutex::new(Slot {
+                scene: Some(scene),
+                run: None,
+            })
+        })
+        .collect();
+    let next = AtomicUsize::new(0);
+    let work = || {
+        while let Some(&k) = order.get(next.fetch_add(1, Ordering::Relaxed)) {
+            let scene = lock(&slots[k]).scene.take();
+            let run = scene.map(|scene| run_one(&plans[k], scene));
+            lock(&slots[k]).run = run;
+        }
+    };
+    rayon::scope(|s| {
+        for _ in 0..rayon::current_num_threads().min(order.len()) {
+            s.spawn(|_| work());
+        }
+    });
     plans
-        .into_par_iter()
-        .zip(scenes)
-        .with_max_len(1)
-        .map(|(p, scene)| {
-            let criterion = rest(&scene, p.theta_deg);
-            let ground = G::of(&scene).ok();
-            let heap = |pos: &[_]| ground.map_or_else(Vec::new, |g| g.heap(pos));
-            let level_y = ground.map(G::level_y);
-            let run = run_heap(
-                ctx,
-                p.tag.clone(),
-                p.theta_deg,
-                scene,
-                criterion,
-                level_y,
-                heap,
-            )?;
-            Ok((p, run))
+        .into_iter()
+        .zip(slots)
+        .map(|(p, slot)| {
+            let run = slot.into_inner().unwrap_or_else(|e| e.into_inner()).run;
+            let run = run.ok_or_else(|| anyhow::anyhow!("run {} did not run", p.tag))?;
+            Ok((p, run?))
         })
         .collect()
+}
+
+/// One planned run's scene until a worker takes it, then its result.
+struct Slot {
+    scene: Option<Scene>,
+    run: Option<Result<HeapRun>>,
+}
+
+/// A slot's lock, also after a panic elsewhere (the slot's values stay whole: each is set in
+/// one assignment).
+fn lock<T>(m: &std::sync::Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// The order in which to start runs of estimated costs `cost`: the most costly first (ties in
+/// plan order), the longest-processing-time-first rule, within 4/3 of the best schedule
+/// (Graham 1969, "Bounds on multiprocessing timing anomalies", SIAM J. Appl. Math. 17,
+/// 416–429).
+fn longest_first(cost: &[f64]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..cost.len()).collect();
+    order.sort_by(|&a, &b| cost[b].total_cmp(&cost[a]));
+    order
+}
+
+/// The explicit steps `scene` takes to its cap (frames × substeps, times the explicit steps
+/// per substep of the elastic–plastic solver): the run's cost before its heap comes to rest,
+/// for the order of the runs (a stiffer or finer heap takes more steps per frame).
+pub fn steps_to_cap(scene: &Scene) -> f64 {
+    let frames = scene.frame_count() as f64 * scene.solver.substeps() as f64;
+    match scene.solver_params::<f64>() {
+        Ok(sph_scene::SolverParams::Elastoplastic(p)) => frames * p.explicit_steps().0 as f64,
+        _ => frames,
+    }
 }
 
 /// Runs `scene` until at rest by `rest` (or to its cap) and prints the run's diagnostic line
@@ -500,4 +562,16 @@ pub fn is_sweep(tag: &str) -> bool {
     !["repeat/", "wide/", "coarse/", "stiff/"]
         .iter()
         .any(|p| t.starts_with(p))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Longest first, ties in plan order.
+    #[test]
+    fn runs_start_longest_first() {
+        assert_eq!(longest_first(&[1.0, 3.0, 2.0, 3.0]), vec![1, 3, 2, 0]);
+        assert!(longest_first(&[]).is_empty());
+    }
 }

@@ -162,6 +162,23 @@ pub fn scene_for(p: &Plan, mode: Mode) -> Result<Scene> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::helpers::repose::steps_to_cap;
+
+    /// The stiff pours are the quick plan's longest by the explicit steps to the cap, so
+    /// they start first: `10 E` takes about `√10` times the steps of `E` (the step is
+    /// `C_p h / c_p`, `c_p ∝ √E`); the other cases alike.
+    #[test]
+    fn the_stiff_pours_take_the_most_steps() {
+        let plans = plan(Mode::Quick);
+        let steps = |p: &Plan| steps_to_cap(&scene_for(p, Mode::Quick).unwrap());
+        let (stiff, other): (Vec<&Plan>, Vec<&Plan>) =
+            plans.iter().partition(|p| p.tag.starts_with(STIFF_TAG));
+        let least_stiff = stiff.iter().map(|p| steps(p)).fold(f64::INFINITY, f64::min);
+        let most_other = other.iter().map(|p| steps(p)).fold(0.0, f64::max);
+        let ratio = least_stiff / most_other;
+        // √10 = 3.16, each frame's steps rounded up to a whole number (about 20 and 61).
+        assert!((2.8..3.4).contains(&ratio), "stiff / other steps {ratio}");
+    }
 
     /// Quick mode runs the two sweeps, θ = 0 and the stiff heap (CI's budget); full mode adds
     /// the coarse heap; each case but θ = 0 is an ensemble of pours of seeds 1..n.
