@@ -94,8 +94,9 @@
 //!   perihelion inside Jupiter's orbit), both in the population tables;
 //! - [`samples`]: seeded sample populations (SplitMix64) shared with the peer scripts;
 //! - with the feature `io`: `io` (the population TOML, the particle CSV with line/column
-//!   errors, Parquet tables readable by pandas and polars) and `study` (a whole study with
-//!   snapshots, final table and checkpoints, resumed byte for byte).
+//!   errors); with the feature `parquet` (which brings `io`) also its Parquet tables
+//!   readable by pandas and polars and `study` (a whole study with snapshots, final table and
+//!   checkpoints, resumed byte for byte).
 //!
 //! Every integration counts its work ([`WorkCounters`]: Kepler solves, their iterations,
 //! pairwise force evaluations, ephemeris interpolations): a cost measure that does not
@@ -191,7 +192,7 @@ mod population;
 mod run;
 pub mod samples;
 pub mod solar_system;
-#[cfg(feature = "io")]
+#[cfg(feature = "parquet")]
 pub mod study;
 mod work;
 

@@ -98,7 +98,7 @@ fn a_comet_removed_in_an_encounter_is_no_longer_in_it() {
         trails.encounter.is_some(),
         "trailing Jupiter, not in an encounter"
     );
-    #[cfg(feature = "io")]
+    #[cfg(feature = "parquet")]
     {
         let table = symplectic::io::population_table(&pop).unwrap();
         let flag = table
@@ -225,7 +225,7 @@ fn a_comet_skimming_the_switch_radius_switches_once_with_hysteresis() {
     } else if ratios.iter().all(|&r| r < 2.0 * 3.0) {
         assert_eq!(open, Some(1), "{ratios:.2?}");
     }
-    #[cfg(feature = "io")]
+    #[cfg(feature = "parquet")]
     {
         let table = symplectic::io::population_table(&without).unwrap();
         let column = table

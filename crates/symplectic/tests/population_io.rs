@@ -1,6 +1,6 @@
-//! Population files (feature `io`): bad input gets a named error with line and column and
+//! Population files (features `io` and `parquet`): bad input gets a named error with line and column and
 //! nothing is written; a study resumes bit for bit.
-#![cfg(feature = "io")]
+#![cfg(feature = "parquet")]
 
 use std::path::{Path, PathBuf};
 

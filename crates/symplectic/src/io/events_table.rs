@@ -4,7 +4,7 @@ use std::sync::Arc;
 
 use arrow_array::{BooleanArray, RecordBatch, StringArray, UInt64Array};
 
-use super::Columns;
+use super::tables::Columns;
 use crate::{EventKind, ParticleStatus, Population, SymplecticError};
 
 /// Name of the events table in a study's output directory.
