@@ -115,8 +115,7 @@ pub fn run_plans<V: Send + Sync, G: Ground>(
     scene_for: impl Fn(&Plan<V>, Mode) -> Result<Scene>,
     rest: impl Fn(&Scene, f64) -> RestCriterion + Sync,
 ) -> Result<Vec<(Plan<V>, HeapRun)>> {
-    use std::sync::atomic::{AtomicUsize, Ordering};
-    use std::sync::Mutex;
+    use rayon::iter::{ParallelBridge, ParallelIterator};
     let scenes = plans
         .iter()
         .map(|p| scene_for(p, ctx.mode))
@@ -124,65 +123,41 @@ pub fn run_plans<V: Send + Sync, G: Ground>(
     ctx.progress
         .set_length(scenes.iter().map(|s| s.frame_count() as u64).sum());
     let order = longest_first(&scenes.iter().map(steps_to_cap).collect::<Vec<_>>());
+    let mut scenes: Vec<Option<Scene>> = scenes.into_iter().map(Some).collect();
+    // The runs in the order to start them: `par_bridge` hands the next to a worker when it
+    // is free.
+    let jobs: Vec<(usize, Scene)> = order
+        .iter()
+        .filter_map(|&k| scenes[k].take().map(|scene| (k, scene)))
+        .collect();
     let ctx: &Context = ctx;
-    let run_one = |p: &Plan<V>, scene: Scene| -> Result<HeapRun> {
-        let criterion = rest(&scene, p.theta_deg);
-        let ground = G::of(&scene).ok();
-        let heap = |pos: &[_]| ground.map_or_else(Vec::new, |g| g.heap(pos));
-        let level_y = ground.map(G::level_y);
-        run_heap(
-            ctx,
-            p.tag.clone(),
-            p.theta_deg,
-            scene,
-            criterion,
-            level_y,
-            heap,
-        )
-    };
-    let slots: Vec<Mutex<Slot>> = scenes
+    let mut runs: Vec<(usize, Result<HeapRun>)> = jobs
         .into_iter()
-        .map(|scene| {
-            Mutex::new(Slot {
-                scene: Some(scene),
-                run: None,
-            })
+        .par_bridge()
+        .map(|(k, scene)| {
+            let p = &plans[k];
+            let criterion = rest(&scene, p.theta_deg);
+            let ground = G::of(&scene).ok();
+            let heap = |pos: &[_]| ground.map_or_else(Vec::new, |g| g.heap(pos));
+            let level_y = ground.map(G::level_y);
+            let run = run_heap(
+                ctx,
+                p.tag.clone(),
+                p.theta_deg,
+                scene,
+                criterion,
+                level_y,
+                heap,
+            );
+            (k, run)
         })
         .collect();
-    let next = AtomicUsize::new(0);
-    let work = || {
-        while let Some(&k) = order.get(next.fetch_add(1, Ordering::Relaxed)) {
-            let scene = lock(&slots[k]).scene.take();
-            let run = scene.map(|scene| run_one(&plans[k], scene));
-            lock(&slots[k]).run = run;
-        }
-    };
-    rayon::scope(|s| {
-        for _ in 0..rayon::current_num_threads().min(order.len()) {
-            s.spawn(|_| work());
-        }
-    });
+    runs.sort_by_key(|(k, _)| *k);
     plans
         .into_iter()
-        .zip(slots)
-        .map(|(p, slot)| {
-            let run = slot.into_inner().unwrap_or_else(|e| e.into_inner()).run;
-            let run = run.ok_or_else(|| anyhow::anyhow!("run {} did not run", p.tag))?;
-            Ok((p, run?))
-        })
+        .zip(runs)
+        .map(|(p, (_, run))| Ok((p, run?)))
         .collect()
-}
-
-/// One planned run's scene until a worker takes it, then its result.
-struct Slot {
-    scene: Option<Scene>,
-    run: Option<Result<HeapRun>>,
-}
-
-/// A slot's lock, also after a panic elsewhere (the slot's values stay whole: each is set in
-/// one assignment).
-fn lock<T>(m: &std::sync::Mutex<T>) -> std::sync::MutexGuard<'_, T> {
-    m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
 /// The order in which to start runs of estimated costs `cost`: the most costly first (ties in
