@@ -2,14 +2,17 @@
 //! (`stats.csv`: [`FrameRecord::csv_header`], [`FrameRecord::csv_row`]), the Python
 //! statistics dict (its serde form) and the experiments' rows come.
 
-use serde::{Serialize, Serializer};
+use serde::{Deserialize, Serialize, Serializer};
 use sph_core::Real;
 use sph_solver::{PhaseTimes, StepStats};
 
 use crate::sim::SceneSim;
 
 /// What one frame of a scene run did, and the state at its end.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+///
+/// Its serde form is the Python statistics dict's; read back, a record has no phase times
+/// (they are wall-clock measurements of the run that wrote it, not its results).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct FrameRecord {
     /// Frames done (this frame's number, 1 for the first).
     pub frame: usize,
@@ -46,7 +49,7 @@ pub struct FrameRecord {
     /// Whether the solver reordered the particles at the start of the frame.
     pub reordered: bool,
     /// Wall-clock seconds per phase of the solver, by name.
-    #[serde(rename = "phases_s", serialize_with = "phase_map")]
+    #[serde(rename = "phases_s", serialize_with = "phase_map", skip_deserializing)]
     pub phases: PhaseTimes,
     /// Wall-clock seconds of the frame's phases together.
     pub total_s: f64,

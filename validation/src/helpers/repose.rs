@@ -16,7 +16,7 @@ use sph_solver::ConeMatch;
 
 use super::{plot_xy, write_csv_rows, Legend, Marker, PlotSpec, Series, SeriesStyle};
 use crate::scene_runs::{
-    run_scene_until_rest, solver_error_check, RestCriterion, RestSettings, SceneRun,
+    run_scene_until_rest, solver_error_check, RestCriterion, RestSettings, RunStore, SceneRun,
 };
 use crate::{Check, Context, Mode, Outcome};
 
@@ -183,7 +183,8 @@ pub fn steps_to_cap(scene: &Scene) -> f64 {
 
 /// Runs `scene` until at rest by `rest` (or to its cap) and prints the run's diagnostic line
 /// on stderr, with the angle of `heap` (the heap's grains of the final positions) on a floor
-/// at `floor_y`.
+/// at `floor_y`. In full mode the finished run is kept in `<out>/runs/` and a run this build
+/// already finished on the same scene is taken from there ([`stored_runs`]).
 pub fn run_heap(
     ctx: &Context,
     tag: String,
@@ -193,9 +194,24 @@ pub fn run_heap(
     floor_y: Option<f64>,
     heap: impl Fn(&[Vec3<f64>]) -> Vec<Vec3<f64>>,
 ) -> Result<HeapRun> {
-    let t0 = std::time::Instant::now();
-    let run = run_scene_until_rest(ctx, &scene, rest)?;
-    let wall_s = t0.elapsed().as_secs_f64();
+    let store = stored_runs(ctx);
+    let stored = store.as_ref().and_then(|s| s.load(&tag, &scene));
+    let reused = stored.is_some();
+    let (run, wall_s) = match stored {
+        Some(kept) => {
+            ctx.progress.inc(scene.frame_count() as u64);
+            kept
+        }
+        None => {
+            let t0 = std::time::Instant::now();
+            let run = run_scene_until_rest(ctx, &scene, rest)?;
+            let wall_s = t0.elapsed().as_secs_f64();
+            if let Some(Err(e)) = store.map(|s| s.save(&tag, &scene, &run, wall_s)) {
+                eprintln!("  {tag}: the finished run is not kept: {e:#}");
+            }
+            (run, wall_s)
+        }
+    };
     // On stderr, not through the progress bar (hidden when not a terminal): a diagnostic
     // line per run.
     let angle = floor_y
@@ -205,7 +221,7 @@ pub fn run_heap(
         })
         .map_or(f64::NAN, |m| m.angle_deg);
     eprintln!(
-        "  {tag}: angle {angle:.2} deg, {} particles, {} at {:.2} s, {wall_s:.0} s wall",
+        "  {tag}: angle {angle:.2} deg, {} particles, {} at {:.2} s, {wall_s:.0} s wall{}",
         run.particles,
         if run.rest_from_s.is_some() {
             "at rest"
@@ -214,6 +230,11 @@ pub fn run_heap(
         },
         run.rest_from_s
             .unwrap_or(run.frames.last().map_or(0.0, |f| f.time_s)),
+        if reused {
+            " (the stored run of this build, reused)"
+        } else {
+            ""
+        },
     );
     Ok(HeapRun {
         tag,
@@ -222,6 +243,15 @@ pub fn run_heap(
         run,
         wall_s,
     })
+}
+
+/// Where full mode keeps its finished heap runs (`<out>/runs/`, [`RunStore`]): its ensembles
+/// take hours, and an interrupted experiment resumes with the runs it finished. Quick mode's
+/// runs take minutes and always run.
+pub fn stored_runs(ctx: &Context) -> Option<RunStore> {
+    (ctx.mode == Mode::Full)
+        .then(|| RunStore::for_this_build(ctx.path("runs")))
+        .flatten()
 }
 
 /// The first checks every run has: its size and wall time (metrics) and no solver error.
@@ -548,5 +578,54 @@ mod tests {
     fn runs_start_longest_first() {
         assert_eq!(longest_first(&[1.0, 3.0, 2.0, 3.0]), vec![1, 3, 2, 0]);
         assert!(longest_first(&[]).is_empty());
+    }
+
+    /// Full mode keeps a finished run and takes it back, bit for bit, when the same build
+    /// runs the same scene again; another scene runs.
+    #[test]
+    fn full_mode_resumes_with_the_runs_it_finished() {
+        let dir = std::env::temp_dir().join(format!("repose-store-{}", std::process::id()));
+        std::fs::remove_dir_all(&dir).ok();
+        std::fs::create_dir_all(&dir).unwrap();
+        let ctx = Context::new(
+            Mode::Full,
+            dir.clone(),
+            crate::reference_data_dir(),
+            indicatif::ProgressBar::hidden(),
+        );
+        let short = |duration_s: f64| {
+            let mut scene =
+                crate::scene_runs::shipped_scene("granular_repose_poured_30_planar", Mode::Quick)
+                    .unwrap();
+            scene.duration_s = duration_s;
+            scene
+        };
+        let run = |scene: Scene| {
+            let rest = RestCriterion::default();
+            run_heap(&ctx, "t/pour=1".into(), 30.0, scene, rest, None, |_| {
+                Vec::new()
+            })
+            .unwrap()
+        };
+        let first = run(short(0.48));
+        assert!(
+            first.run.particles > 0,
+            "the pour has placed grains to compare"
+        );
+        let kept = dir.join("runs/t_pour=1.json");
+        let written = std::fs::metadata(&kept).unwrap().modified().unwrap();
+        let again = run(short(0.48));
+        assert_eq!(again.run.final_positions, first.run.final_positions);
+        assert_eq!(again.wall_s, first.wall_s, "the kept run's wall time");
+        assert_eq!(
+            std::fs::metadata(&kept).unwrap().modified().unwrap(),
+            written
+        );
+        let longer = run(short(0.64));
+        assert!(
+            longer.run.frames.len() > first.run.frames.len(),
+            "another scene runs"
+        );
+        std::fs::remove_dir_all(&dir).ok();
     }
 }

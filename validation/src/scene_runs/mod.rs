@@ -2,12 +2,14 @@
 //! scenes and the edits of their variants ([`load`]), the simulation and frame loop of a
 //! scene ([`frames`]), the energy measures ([`energy`]), a scene run to its end or to rest
 //! that keeps a blow-up as a result ([`run_scene`], [`run_scene_until_rest`],
-//! [`solver_error_check`]) and a fluid run with a solver set ([`fluid`]).
+//! [`solver_error_check`]), a fluid run with a solver set ([`fluid`]) and finished runs kept
+//! on disk so that a long experiment resumes ([`store`]).
 
 pub mod energy;
 pub mod fluid;
 pub mod frames;
 pub mod load;
+pub mod store;
 
 use anyhow::Result;
 use sph_core::{Real, Vec3};
@@ -22,9 +24,10 @@ pub use fluid::{run_fluid, FluidRun, DIVERGED_DENSITY_RATIO};
 pub use frames::{advance_frames, run_frames, scene_sim, volume_map_cache, SceneSim};
 pub use load::{iisph_solver, set_block_and_tank, shipped_scene};
 pub use sph_sim::observe::{RestCriterion, RestSettings, RestVerdict};
+pub use store::RunStore;
 
-/// A scene run to its end (or to a blow-up).
-#[derive(Debug, Clone)]
+/// A scene run to its end (or to a blow-up); its serde form is what [`store`] keeps.
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct SceneRun {
     /// Particles simulated.
     pub particles: usize,
