@@ -193,6 +193,29 @@ mod tests {
         std::fs::remove_dir_all(&d).ok();
     }
 
+    /// Reals of 17 significant digits (what the JSON writer prints) read back bit for bit.
+    #[test]
+    fn reals_read_back_bit_for_bit() {
+        let d = dir("reals");
+        let store = RunStore::with_build(d.clone(), [7; 32]);
+        let s = scene(crate::Mode::Quick);
+        let mut r = run();
+        let x =
+            |k: u32| 0.1 + f64::from(k) * 0.012_345_678_901_234_567 + f64::from(k).sqrt() * 1e-9;
+        r.final_positions = (0..2000)
+            .map(|k| Vec3::new(x(k), x(k) * 1e-7, -x(k) * 1e5))
+            .collect();
+        store.save("t", &s, &r, 1.0).unwrap();
+        let (back, _) = store.load("t", &s).unwrap();
+        let bits = |v: &[Vec3<f64>]| -> Vec<u64> {
+            v.iter()
+                .flat_map(|p| p.iter().map(|c| c.to_bits()))
+                .collect()
+        };
+        assert_eq!(bits(&back.final_positions), bits(&r.final_positions));
+        std::fs::remove_dir_all(&d).ok();
+    }
+
     #[test]
     fn a_damaged_file_is_run_again_not_read() {
         let d = dir("damaged");
